@@ -1,0 +1,1 @@
+"""dec3d.commands"""
