@@ -1,0 +1,412 @@
+"""Binding: a raw token line + the registry -> a `CommandCall` (pure; nothing runs).
+
+Command words are resolved level by level by unique prefix; then positional values,
+keywords and an optional range clause are bound against the command's declaration.
+`range` may be omitted before the first range element (`block hide group 'x'`).
+Inline `[expr]` and `@name` values are parsed and their names checked now, and
+evaluated when the command runs.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..errors import BindError, DeckSyntaxError, NotSupportedError, SourceLocation
+from ..lang.abbrev import matches, suggest
+from ..lang.expr import check_names, parse_expression
+from ..lang.parser import ParsedDeck, RawLine
+from .legacy import legacy_hint
+from .registry import REGISTRY, Command, Node, RangeElement, Registry
+from .values import MISSING, Deferred, Param
+
+
+@dataclass(frozen=True)
+class RangeCall:
+    element: RangeElement
+    args: dict
+    negate: bool
+    location: SourceLocation
+
+
+@dataclass(frozen=True)
+class RangeClause:
+    elements: tuple[RangeCall, ...]
+    union: bool = False
+
+
+@dataclass(frozen=True)
+class CommandCall:
+    """A bound command: what to run, with which values, from where."""
+
+    command: Command
+    args: dict                      # keyword key -> value (defaults filled); Deferred until run
+    given: tuple[str, ...]          # keys given on the line, in order
+    range: RangeClause | None
+    location: SourceLocation
+    extra: dict = field(default_factory=dict)   # undeclared keywords (open_keywords commands)
+    locations: dict = field(default_factory=dict)  # key -> SourceLocation of its value
+
+    @property
+    def name(self) -> str:
+        return self.command.name
+
+    @property
+    def text(self) -> str:
+        return self.location.text
+
+
+class BindContext:
+    """What the binder knows about FISH names while reading a deck, in order."""
+
+    def __init__(self, variables=None):
+        self.session_variables = variables if variables is not None else {}
+        self.assigned: set[str] = set()
+        self.fish_functions: dict[str, Any] = {}
+        self.fish_variables: dict[str, str] = {}   # variable -> function that sets it
+
+    def define_fish(self, block) -> None:
+        self.fish_functions[block.name.lower()] = block
+        for v in block.variables:
+            self.fish_variables.setdefault(v, block.name)
+
+    def classify(self, name: str) -> str | None:
+        if name in self.fish_functions:
+            return "fish-function"
+        if name in self.assigned or name in self.session_variables:
+            return None
+        if name in self.fish_variables:
+            return "fish-variable"
+        return "undefined"
+
+
+class Binder:
+    def __init__(self, deck: ParsedDeck, context: BindContext, stack=(), registry: Registry = REGISTRY):
+        self.deck = deck
+        self.ctx = context
+        self.stack = tuple(stack)
+        self.reg = registry
+
+    # ------------------------------------------------------------ helpers
+    def where(self, tok) -> SourceLocation:
+        return self.deck.location(tok, self.stack)
+
+    def deferred(self, tok) -> Deferred:
+        if tok.type == "ATNAME":
+            name = str(tok)[1:].lower()
+            self._check_name_use([("name", name, 1)], tok, at=True)
+            return Deferred("at", ("name", name, 1), tok)
+        node = self.expression(tok)
+        return Deferred("expr", node, tok)
+
+    def expression(self, tok):
+        """Parse `[...]` and check its names; errors point into the bracket."""
+        text = str(tok)[1:-1]
+        try:
+            node = parse_expression(text)
+        except DeckSyntaxError as exc:
+            col = tok.column + getattr(exc, "column_in_expr", 1)
+            loc = self.deck.location(tok, self.stack)
+            raise DeckSyntaxError(exc.message, SourceLocation(loc.file, loc.line, col, loc.text, 1, loc.stack),
+                                  exc.hint) from None
+        problems = check_names(node, self.ctx.classify)
+        for kind, name, col in problems:
+            if node[0] == "assign" and kind == "undefined" and name == node[1]:
+                continue
+            self._raise_name_problem(kind, name, tok, tok.column + col)
+        return node
+
+    def _check_name_use(self, names, tok, at=False):
+        for _, name, _col in names:
+            kind = self.ctx.classify(name)
+            if kind:
+                self._raise_name_problem(kind, name, tok, tok.column + (1 if at else 0), at=at)
+
+    def _raise_name_problem(self, kind, name, tok, col, at=False):
+        loc = self.deck.location(tok, self.stack)
+        loc = SourceLocation(loc.file, loc.line, col, loc.text, len(name), loc.stack)
+        if kind == "fish-function":
+            raise NotSupportedError(f"FISH functions are not supported yet (call of `{name}`)", loc)
+        if kind == "fish-variable":
+            fn = self.ctx.fish_variables[name]
+            raise NotSupportedError(f"`{name}` is set by FISH function `{fn}`; FISH functions are not supported yet", loc)
+        if kind == "intrinsic":
+            raise NotSupportedError(f"FISH intrinsic `{name}` is not supported yet", loc)
+        if kind == "unknown-function":
+            raise NotSupportedError(f"`{name}` is not a FISH intrinsic dec3d knows; FISH functions are not supported yet", loc,
+                                    hint="dec3d evaluates math.*, string(), string.build(), io.out() in [ ]")
+        if at:
+            raise NotSupportedError(f"`@{name}` is neither a variable set earlier nor a known value; "
+                                    "FISH functions are not supported yet", loc)
+        raise BindError(f"undefined FISH variable `{name}`", loc, hint="assign it first, e.g. [name = 1.0]")
+
+    # ------------------------------------------------------------ commands
+    def bind(self, raw: RawLine) -> CommandCall:
+        toks = raw.tokens
+        first = toks[0]
+        if first.type != "WORD":
+            raise BindError(f"a command starts with a command word, not {str(first)!r}", self.where(first),
+                            hint="`[ ... ]` and `@name` stand alone on a line or as values")
+        node, i, path, pre = self._resolve(toks)
+        cmd = node.command
+        loc = self.where(first)
+        if cmd is None:
+            self._no_command(node, path, toks, i)
+        if cmd.accepts_anything:
+            return CommandCall(cmd, {}, (), None, loc)
+        return self._bind_args(cmd, toks, i, pre, loc)
+
+    def _resolve(self, toks):
+        node = self.reg.root
+        path: list[str] = []
+        pre: dict = {}
+        prekw: tuple[Param, ...] = ()
+        i = 0
+        while i < len(toks):
+            tok = toks[i]
+            if tok.type != "WORD" or not node.children:
+                break
+            word = str(tok).lower()
+            hits = matches(word, node.children)
+            if len(hits) == 1:
+                child = node.children[hits[0]]
+                if child.alias_of:                      # bare `call` = `program call`
+                    child = self.reg.node(child.alias_of)
+                    path = list(self.reg.aliases[hits[0]])
+                else:
+                    path.append(hits[0])
+                node = child
+                prekw = prekw + node.keywords
+                i += 1
+                continue
+            if len(hits) > 1:
+                # a command whose keywords could also take this word binds it as a keyword
+                if node.command and any(matches(word, [p.name for p in node.command.keywords])):
+                    break
+                raise BindError(f"`{tok}` is ambiguous after `{' '.join(path) or 'the start of a line'}`: "
+                                f"could be {', '.join(hits)}", self.where(tok),
+                                hint="type more letters of the word")
+            kw = matches(word, [p.name for p in prekw]) if prekw else []
+            if len(kw) == 1 and node.command is None:
+                param = next(p for p in prekw if p.name == kw[0])
+                value, i = self._take_value(param, toks, i + 1, tok)
+                pre[param.key] = value
+                continue
+            break
+        return node, i, tuple(path), pre
+
+    def _no_command(self, node: Node, path, toks, i):
+        name = " ".join(path)
+        if i < len(toks) and toks[i].type == "WORD" and (node.children or not path):
+            tok = toks[i]
+            if node.known and not node.children:
+                raise NotSupportedError(f"`{name}` is not supported yet", self.where(toks[0]))
+            cands = sorted(node.children)
+            if not path:
+                hint = legacy_hint(str(tok).lower())
+                if hint:
+                    raise LegacySyntaxError(f"`{tok}` is 3DEC 5 (legacy) syntax, not 3DEC 7+", self.where(tok), hint)
+            close = suggest(str(tok), cands)
+            where = f"`{name} {tok}`" if name else f"`{tok}`"
+            if close:
+                hint = "did you mean " + " or ".join(f"`{(name + ' ' + c).strip()}`" for c in close) + "?"
+            else:
+                hint = "expected one of: " + ", ".join(cands[:12]) + (" …" if len(cands) > 12 else "")
+            raise BindError(f"unknown command {where}", self.where(tok), hint=hint)
+        if node.known and not any(c.command for _, c in self.reg.walk(node)) or (node.known and not node.children):
+            raise NotSupportedError(f"`{name}` is not supported yet", self.where(toks[0]))
+        cands = sorted(node.children)
+        raise BindError(f"`{name}` needs a subcommand", self.where(toks[min(i, len(toks)) - 1]),
+                        hint=f"one of: {', '.join(cands)}")
+
+    def _take_value(self, param: Param, toks, i, kwtok):
+        if not param.supported:
+            raise NotSupportedError(f"keyword `{param.name}` is not supported yet", self.where(kwtok))
+        vt = param.value
+        if i < len(toks) and vt.fits(toks[i]):
+            return vt.take(toks, i, self)
+        if param.bare is not MISSING:
+            return param.bare, i
+        got = f"`{toks[i]}`" if i < len(toks) else "the end of the line"
+        raise BindError(f"`{param.name}` needs a value {vt.describe()}, got {got}",
+                        self.where(toks[i] if i < len(toks) else kwtok))
+
+    def _bind_args(self, cmd: Command, toks, i, pre, loc) -> CommandCall:
+        args: dict[str, Any] = dict(pre)
+        given: list[str] = list(pre)
+        extra: dict[str, Any] = {}
+        locs: dict[str, SourceLocation] = {}
+        names = [p.name for p in cmd.keywords]
+        by_name = {p.name: p for p in cmd.keywords}
+        pos = list(cmd.positional)
+        rng = None
+        n = len(toks)
+        while i < n:
+            tok = toks[i]
+            if pos:
+                p = pos[0]
+                if p.value.fits(tok) and not (tok.type == "WORD" and self._is_keyword_word(cmd, tok, names)):
+                    pos.pop(0)
+                    locs[p.key] = self.where(tok)
+                    args[p.key], i = p.value.take(toks, i, self)
+                    given.append(p.key)
+                    continue
+                if p.required:
+                    raise BindError(f"`{cmd.name}` needs {p.name} {p.value.describe()} here, got `{tok}`",
+                                    self.where(tok), hint=p.doc or None)
+                pos.pop(0)
+                continue
+            if tok.type != "WORD":
+                raise BindError(f"unexpected value `{tok}`", self.where(tok),
+                                hint=self._keyword_hint(cmd))
+            word = str(tok).lower()
+            hits = matches(word, names)
+            if len(hits) > 1:
+                raise BindError(f"keyword `{tok}` is ambiguous: could be {', '.join(hits)}", self.where(tok))
+            if len(hits) == 1:
+                p = by_name[hits[0]]
+                value, j = self._take_value(p, toks, i + 1, tok)
+                locs[p.key] = self.where(toks[i + 1] if j > i + 1 else tok)
+                if p.repeat:
+                    args.setdefault(p.key, []).append(value)
+                elif p.key in args and p.key in given:
+                    raise BindError(f"keyword `{p.name}` given twice", self.where(tok))
+                else:
+                    args[p.key] = value
+                given.append(p.key)
+                i = j
+                continue
+            if cmd.range and (matches(word, ["range"]) == ["range"] and len(word) >= 2 or word == "range"):
+                rng = self._bind_range(toks, i + 1, cmd)
+                break
+            if cmd.range and matches(word, self.reg.range_elements):
+                rng = self._bind_range(toks, i, cmd)
+                break
+            if cmd.open_keywords and i + 1 < n and toks[i + 1].type in ("NUMBER", "EXPR", "ATNAME", "STRING"):
+                vt = toks[i + 1]
+                if vt.type == "STRING":
+                    extra[word] = str(vt)[1:-1]
+                elif vt.type == "NUMBER":
+                    extra[word] = float(str(vt))
+                else:
+                    extra[word] = self.deferred(vt)
+                i += 2
+                continue
+            cands = names + (["range"] + sorted(self.reg.range_elements) if cmd.range else [])
+            close = suggest(word, cands)
+            raise BindError(f"unknown keyword `{tok}` for `{cmd.name}`", self.where(tok),
+                            hint=f"did you mean {' or '.join(f'`{c}`' for c in close)}?" if close
+                            else self._keyword_hint(cmd))
+        for p in pos:
+            if p.required:
+                raise BindError(f"`{cmd.name}` needs {p.name} {p.value.describe()}", self._end(toks),
+                                hint=p.doc or None)
+        for p in cmd.positional + cmd.keywords:
+            if p.key not in args:
+                if p.required:
+                    raise BindError(f"`{cmd.name}` needs keyword `{p.name}` {p.value.describe()}", self._end(toks),
+                                    hint=p.doc or None)
+                args[p.key] = [] if p.repeat else p.default
+        return CommandCall(cmd, args, tuple(given), rng, loc, extra, locs)
+
+    @staticmethod
+    def _is_keyword_word(cmd, tok, names) -> bool:
+        """A word that names a keyword is a keyword, not a positional text value."""
+        return bool(matches(str(tok), names))
+
+    def _keyword_hint(self, cmd: Command) -> str:
+        kws = [p.name for p in cmd.keywords]
+        if cmd.range:
+            kws.append("range …")
+        return f"keywords of `{cmd.name}`: {', '.join(kws)}" if kws else f"`{cmd.name}` takes no keywords"
+
+    def _end(self, toks):
+        last = toks[-1]
+        loc = self.where(last)
+        return SourceLocation(loc.file, loc.line, loc.column + len(str(last)), loc.text, 1, loc.stack)
+
+    # ------------------------------------------------------------ ranges
+    def _bind_range(self, toks, i, cmd: Command) -> RangeClause:
+        elements: list[RangeCall] = []
+        union = False
+        n = len(toks)
+        names = sorted(self.reg.range_elements)
+        while i < n:
+            tok = toks[i]
+            if tok.type != "WORD":
+                raise BindError(f"expected a range element, got `{tok}`", self.where(tok),
+                                hint=f"range elements: {', '.join(names)}")
+            word = str(tok).lower()
+            if word in ("not", "no") or matches(word, ["not"]) == ["not"] and word not in self.reg.range_elements:
+                if not elements:
+                    raise BindError("`not` must follow the range element it negates", self.where(tok))
+                last = elements[-1]
+                elements[-1] = RangeCall(last.element, last.args, not last.negate, last.location)
+                i += 1
+                continue
+            if matches(word, ["union"]) == ["union"] and len(word) >= 2:
+                union = True
+                i += 1
+                continue
+            hits = matches(word, names)
+            if len(hits) != 1:
+                close = suggest(word, names)
+                msg = (f"range element `{tok}` is ambiguous: could be {', '.join(hits)}" if hits
+                       else f"unknown range element `{tok}`")
+                raise BindError(msg, self.where(tok), hint=f"did you mean {' or '.join(close)}?" if close else
+                                f"range elements: {', '.join(names)}")
+            elem = self.reg.range_elements[hits[0]]
+            if not elem.supported:
+                raise NotSupportedError(f"range element `{elem.name}` is not supported yet", self.where(tok))
+            if elem.stores and cmd.range not in elem.stores:
+                raise BindError(f"range element `{elem.name}` does not apply to {cmd.range}s", self.where(tok))
+            args, i = self._bind_element(elem, toks, i + 1, tok)
+            elements.append(RangeCall(elem, args, False, self.where(tok)))
+        if not elements:
+            raise BindError("`range` needs at least one range element", self._end(toks),
+                            hint=f"range elements: {', '.join(names)}")
+        return RangeClause(tuple(elements), union)
+
+    def _bind_element(self, elem: RangeElement, toks, i, head):
+        args: dict[str, Any] = {}
+        pos = list(elem.positional)
+        names = [p.name for p in elem.keywords]
+        by_name = {p.name: p for p in elem.keywords}
+        n = len(toks)
+        while i < n:
+            tok = toks[i]
+            if pos:
+                p = pos[0]
+                if p.value.fits(tok) and not (tok.type == "WORD" and matches(str(tok), names)):
+                    pos.pop(0)
+                    args[p.key], i = p.value.take(toks, i, self)
+                    continue
+                if p.required:
+                    raise BindError(f"range element `{elem.name}` needs {p.name} {p.value.describe()}",
+                                    self.where(tok), hint=p.doc or None)
+                pos.pop(0)
+                continue
+            if tok.type != "WORD":
+                raise BindError(f"unexpected value `{tok}` in range element `{elem.name}`", self.where(tok))
+            hits = matches(str(tok), names)
+            if len(hits) != 1:
+                break                      # next element (or a modifier)
+            p = by_name[hits[0]]
+            value, i = self._take_value(p, toks, i + 1, tok)
+            if p.repeat:
+                args.setdefault(p.key, []).append(value)
+            else:
+                args[p.key] = value
+        for p in pos:
+            if p.required:
+                raise BindError(f"range element `{elem.name}` needs {p.name} {p.value.describe()}",
+                                self._end(toks))
+        for p in elem.positional + elem.keywords:
+            if p.key not in args:
+                if p.required:
+                    raise BindError(f"range element `{elem.name}` needs `{p.name}`", self.where(head))
+                args[p.key] = [] if p.repeat else p.default
+        return args, i
+
+
+class LegacySyntaxError(BindError):
+    """A 3DEC 4/5 command in a 3DEC 7+ deck."""

@@ -1,0 +1,52 @@
+"""`model new|title|configure|large-strain|gravity`: model-wide settings."""
+from __future__ import annotations
+
+from .registry import command
+from .values import FLAG, ONOFF, Choice, Nums, P, Text
+
+
+@command("model new", keywords=[P("force", FLAG, "accepted for 3DEC compatibility (no prompt is ever shown)")],
+         doc="Start a new model: every block, contact, setting, FISH variable and function is cleared.",
+         examples=["model new"])
+def model_new(session, call):
+    session.new_model()
+
+
+@command("model title", positional=[P("text", Text(), "the title; omitted clears it", default="")],
+         doc="Set the model title (written into save files and VTK output).",
+         examples=["model title 'Sliding wedge'", "model title"])
+def model_title(session, call):
+    session.model.settings.title = call.args["text"]
+
+
+CONFIGURE_OPTIONS = ("dynamic", "fluid", "thermal", "highorder", "feblock", "creep")
+
+
+@command("model configure", positional=[P("option", Choice(CONFIGURE_OPTIONS), "process to enable", required=True)],
+         doc="Enable an optional process or element type for the rest of the model's life.",
+         details="Options: " + ", ".join(CONFIGURE_OPTIONS) + ". Each is recorded once, in the order given; "
+                 "the engine reads them (dynamic: damping defaults for dynamic runs; highorder: 10-node "
+                 "tetrahedra; feblock: 20-node brick FE blocks).",
+         examples=["model configure dynamic", "model config dyn", "model configure highorder"])
+def model_configure(session, call):
+    opts = session.model.settings.configure
+    if call.args["option"] not in opts:
+        opts.append(call.args["option"])
+
+
+@command("model large-strain", positional=[P("mode", ONOFF, "on: update geometry as blocks move; off: small strain",
+                                              required=True)],
+         doc="Switch large-strain mode (geometry updated and new contacts detected as blocks move).",
+         examples=["model large-strain on", "model large-strain off"])
+def model_large_strain(session, call):
+    session.model.settings.large_strain = call.args["mode"]
+
+
+@command("model gravity", positional=[P("g", Nums(1, 3, counts=(1, 3)), "magnitude (acting in -z) or three components gx gy gz, m/s²",
+                                        required=True, units="m/s²")],
+         doc="Set the gravitational acceleration.",
+         details="One value is a magnitude acting along -z (z is up in 3DEC 7+); three values are the components.",
+         examples=["model gravity 0 0 -9.81", "model gravity 9.81", "model gravity (0,-9.81,0)"])
+def model_gravity(session, call):
+    g = call.args["g"]
+    session.model.settings.gravity = (0.0, 0.0, -abs(g[0])) if len(g) == 1 else tuple(float(x) for x in g)

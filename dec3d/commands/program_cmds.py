@@ -1,0 +1,76 @@
+"""`program call|return|exit|log|log-file|echo`: reading decks and logging."""
+from __future__ import annotations
+
+from .registry import command
+from .values import FLAG, ONOFF, P, Text
+
+
+@command("program call", positional=[P("file", Text(), "deck to read, relative to the calling deck", required=True)],
+         keywords=[P("suppress", FLAG, "do not echo the called file's commands"),
+                   P("line", supported=False), P("label", Text(), supported=False)],
+         doc="Read and run another deck file (`call` alone works too).",
+         details="A literal file name is read, parsed and bound together with the calling deck, before anything "
+                 "runs, so an error in a called file stops the run before any work is done; errors name the "
+                 "include stack. Without an extension, .dat, .3ddat, .fis and .dec are tried.",
+         examples=["program call 'geometry.dat'", "call \"01_Geometry.dat\""])
+def program_call(session, call):
+    # A literal name was expanded when the deck was bound (Session._bind_deck); a name given by an
+    # expression is only known now.
+    from .values import Deferred
+
+    if isinstance(call.args["file"], Deferred):  # pragma: no cover - resolved before handlers run
+        return
+    if call.location and "[" in (call.location.text or "") and "file" in call.locations:
+        loc = call.locations["file"]
+        if loc.text and loc.text[loc.column - 1: loc.column] == "[":
+            from pathlib import Path
+
+            base = Path(loc.file).parent if loc.file not in ("<input>", "<command>") else Path.cwd()
+            items = session.load_file(session._resolve_call_path(call.args["file"], base), loc.stack + (loc,))
+            session.run_items(items)
+
+
+@command("program return", doc="Stop reading the current file and return to the caller.",
+         examples=["program return", "return"])
+def program_return(session, call):
+    # the binder stops reading the file at this line; nothing is left to do
+    pass
+
+
+@command("program exit", doc="Stop running the deck (the model is kept).", examples=["program exit", "exit"])
+def program_exit(session, call):
+    from ..session import StopDeck
+
+    raise StopDeck()
+
+
+@command("program quit", doc="Stop running the deck (the model is kept).", examples=["program quit"])
+def program_quit(session, call):
+    program_exit(session, call)
+
+
+@command("program log", positional=[P("mode", ONOFF, "on: copy the echo and output to the log file", required=True)],
+         keywords=[P("append", FLAG, "add to an existing log file"), P("truncate", FLAG, "start the log file afresh (default)")],
+         doc="Switch logging of commands and output to the log file (default `dec3d.log` in the output folder).",
+         examples=["program log on", "log off"])
+def program_log(session, call):
+    if call.args["mode"]:
+        if session._log_handle is None:
+            session.open_log(None, append=call.args["append"])
+        session.log_on = True
+    else:
+        session.log_on = False
+
+
+@command("program log-file", positional=[P("file", Text(), "log file name, relative to the output folder", required=True)],
+         keywords=[P("append", FLAG, "add to an existing file"), P("truncate", FLAG, "start the file afresh (default)")],
+         doc="Name the log file; logging continues there if it is on.",
+         examples=["program log-file 'run.log'", "log-file 'init_state.txt'"])
+def program_log_file(session, call):
+    session.open_log(session.out_path(call.args["file"]), append=call.args["append"])
+
+
+@command("program echo", positional=[P("mode", ONOFF, "on: print each command before it runs", required=True)],
+         doc="Switch the echo of commands as they run.", examples=["program echo off"])
+def program_echo(session, call):
+    session.echo = call.args["mode"]

@@ -1,0 +1,104 @@
+"""Deck text -> raw lines of tokens, with positions (lark LALR, grammar in deck.lark).
+
+Nothing executes here. `parse_deck` returns a `ParsedDeck`: the source lines (for
+error carets), the token lines in order and the lifted FISH blocks.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+from lark import Lark, Token, Transformer
+from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
+
+from ..errors import DeckSyntaxError, SourceLocation
+from .prepass import FishBlock, lift_fish
+
+_GRAMMAR_DIR = Path(__file__).parent
+
+
+@dataclass(frozen=True, slots=True)
+class RawLine:
+    """One command line: its tokens (lark Tokens: type, value, line, column)."""
+
+    tokens: tuple[Token, ...]
+
+    @property
+    def line(self) -> int:
+        return self.tokens[0].line
+
+
+class _Lines(Transformer):
+    """Builds RawLine objects while parsing (inline transformer: no tree is kept)."""
+
+    def line(self, items):
+        return RawLine(tuple(items))
+
+    def start(self, items):
+        return items
+
+
+@lru_cache(maxsize=None)
+def deck_parser() -> Lark:
+    return Lark.open(
+        str(_GRAMMAR_DIR / "deck.lark"),
+        parser="lalr",
+        lexer="basic",
+        transformer=_Lines(),
+        maybe_placeholders=False,
+        cache=False,
+    )
+
+
+@dataclass
+class ParsedDeck:
+    filename: str
+    source_lines: list[str]
+    lines: list[RawLine]
+    fish: list[FishBlock]
+
+    def location(self, tok: Token, stack=()) -> SourceLocation:
+        text = self.source_lines[tok.line - 1] if 0 < tok.line <= len(self.source_lines) else ""
+        return SourceLocation(self.filename, tok.line, tok.column, text, max(1, len(str(tok))), tuple(stack))
+
+
+def normalise(text: str) -> str:
+    """CRLF/CR to LF, a final newline, tabs kept (carets expand them)."""
+    text = text.replace("\r\n", "\n").replace("\r", "\n")
+    if not text.endswith("\n"):
+        text += "\n"
+    return text
+
+
+def parse_deck(text: str, filename: str = "<input>", stack=()) -> ParsedDeck:
+    """Parse a whole deck; raise DeckSyntaxError with file:line:col on bad text."""
+    text = normalise(text)
+    source_lines = text.split("\n")
+    lifted, fish = lift_fish(text, filename)
+    try:
+        lines = deck_parser().parse(lifted)
+    except UnexpectedInput as exc:
+        raise _syntax_error(exc, filename, source_lines, stack) from None
+    return ParsedDeck(filename, source_lines, lines, fish)
+
+
+def _syntax_error(exc: UnexpectedInput, filename, source_lines, stack) -> DeckSyntaxError:
+    line, col = exc.line, exc.column
+    text = source_lines[line - 1] if 0 < line <= len(source_lines) else ""
+    ch = text[col - 1] if 0 < col <= len(text) else ""
+    if isinstance(exc, UnexpectedCharacters):
+        if ch in "'\"":
+            msg, hint = "unterminated string", f"close the string with {ch} on the same line"
+        elif ch == "[":
+            msg, hint = "unterminated inline expression", "close `[` with `]` on the same line"
+        elif ch == "]":
+            msg, hint = "`]` without a matching `[`", None
+        else:
+            msg = f"unexpected character {ch!r}"
+            hint = "delimiters are space , ( ) =; comments start with ;; continue a line with & or ..."
+    elif isinstance(exc, UnexpectedToken):
+        msg, hint = f"unexpected {exc.token.type.lower()} {str(exc.token)!r}", None
+    else:
+        msg, hint = "syntax error", None
+    return DeckSyntaxError(msg, SourceLocation(filename, line, col, text, 1, tuple(stack)), hint)
