@@ -1,2 +1,12 @@
 """dec3d: an open-source, 3DEC-style three-dimensional distinct element program."""
 __version__ = "0.1.0"
+
+
+def __getattr__(name):
+    # Session and run_deck import the language layer; loaded on first use so that
+    # `import dec3d.kernels...` stays light.
+    if name in ("Session", "run_deck"):
+        from . import session
+
+        return getattr(session, name)
+    raise AttributeError(name)

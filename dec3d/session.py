@@ -71,6 +71,7 @@ class Session:
         self.log_on = False
         self._log_handle: TextIO | None = None
         self.record: list[str] = []       # text of every command run, for save files
+        self.results: dict[str, float] = {}  # named figures commands report (verification reads them)
         self.bind_context = BindContext(self.variables)
 
     # ------------------------------------------------------------------ output
@@ -130,7 +131,7 @@ class Session:
                 node = binder.expression(first)
                 if node[0] == "assign":
                     ctx.assigned.add(node[1])
-                items.append(ExprStatement(node, deck.location(first, stack), str(first)))
+                items.append(ExprStatement(node, deck.location(first, stack), binder.source(raw)))
                 continue
             if first.type == "ATNAME" and len(toks) == 1:
                 binder.deferred(first)   # raises: FISH calls are not supported yet
@@ -259,7 +260,7 @@ def _has_deferred(call: CommandCall) -> bool:
 
 
 def _source_of(call: CommandCall) -> str:
-    return call.location.text.strip()
+    return call.text
 
 
 def run_deck(path: str | Path, out_dir: str | Path | None = None, echo: bool = False) -> Session:

@@ -8,6 +8,7 @@ evaluated when the command runs.
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -18,6 +19,10 @@ from ..lang.parser import ParsedDeck, RawLine
 from .legacy import legacy_hint
 from .registry import REGISTRY, Command, Node, RangeElement, Registry
 from .values import MISSING, Deferred, Param
+
+
+# a `;` comment that is not inside a quoted string
+_COMMENT = re.compile(r""";(?=(?:[^'"]|'[^']*'|"[^"]*")*$).*""")
 
 
 @dataclass(frozen=True)
@@ -45,6 +50,7 @@ class CommandCall:
     location: SourceLocation
     extra: dict = field(default_factory=dict)   # undeclared keywords (open_keywords commands)
     locations: dict = field(default_factory=dict)  # key -> SourceLocation of its value
+    source: str = ""
 
     @property
     def name(self) -> str:
@@ -52,14 +58,17 @@ class CommandCall:
 
     @property
     def text(self) -> str:
-        return self.location.text
+        """The command as written (continuation lines included, comments removed)."""
+        return self.source or self.location.text.strip()
 
 
 class BindContext:
     """What the binder knows about FISH names while reading a deck, in order."""
 
-    def __init__(self, variables=None):
+    def __init__(self, variables=None, lenient_names: bool = False):
         self.session_variables = variables if variables is not None else {}
+        # checking a file on its own: names it never assigns may come from a calling deck
+        self.lenient_names = lenient_names
         self.assigned: set[str] = set()
         self.fish_functions: dict[str, Any] = {}
         self.fish_variables: dict[str, str] = {}   # variable -> function that sets it
@@ -76,7 +85,7 @@ class BindContext:
             return None
         if name in self.fish_variables:
             return "fish-variable"
-        return "undefined"
+        return None if self.lenient_names else "undefined"
 
 
 class Binder:
@@ -143,6 +152,9 @@ class Binder:
     def bind(self, raw: RawLine) -> CommandCall:
         toks = raw.tokens
         first = toks[0]
+        if first.type == "ATNAME":
+            self.deferred(first)          # a FISH function: raises "not supported yet"
+            raise NotSupportedError(f"FISH function calls (`{first}(...)`) are not supported yet", self.where(first))
         if first.type != "WORD":
             raise BindError(f"a command starts with a command word, not {str(first)!r}", self.where(first),
                             hint="`[ ... ]` and `@name` stand alone on a line or as values")
@@ -152,8 +164,16 @@ class Binder:
         if cmd is None:
             self._no_command(node, path, toks, i)
         if cmd.accepts_anything:
-            return CommandCall(cmd, {}, (), None, loc)
-        return self._bind_args(cmd, toks, i, pre, loc)
+            return CommandCall(cmd, {}, (), None, loc, source=self.source(raw))
+        call = self._bind_args(cmd, toks, i, pre, loc)
+        object.__setattr__(call, "source", self.source(raw))
+        return call
+
+    def source(self, raw: RawLine) -> str:
+        """Physical lines of a command, comments stripped, joined with newlines."""
+        first, last = raw.tokens[0].line, raw.tokens[-1].line
+        lines = self.deck.source_lines[first - 1:last]
+        return "\n".join(_COMMENT.sub("", ln).rstrip() for ln in lines).strip()
 
     def _resolve(self, toks):
         node = self.reg.root
@@ -201,8 +221,13 @@ class Binder:
             if node.known and not node.children:
                 raise NotSupportedError(f"`{name}` is not supported yet", self.where(toks[0]))
             cands = sorted(node.children)
-            if not path:
-                hint = legacy_hint(str(tok).lower())
+            if len(path) <= 1:
+                # `hist time` (3DEC 5) resolves its first word to the modern `history` group
+                head = str(toks[0]).lower() if path else str(tok).lower()
+                hint = legacy_hint(head)
+                if hint and path:
+                    raise LegacySyntaxError(f"`{toks[0]} {tok}` is 3DEC 5 (legacy) syntax, not 3DEC 7+",
+                                            self.where(toks[0]), hint)
                 if hint:
                     raise LegacySyntaxError(f"`{tok}` is 3DEC 5 (legacy) syntax, not 3DEC 7+", self.where(tok), hint)
             close = suggest(str(tok), cands)

@@ -47,6 +47,9 @@ _LEGACY = {
     "bound": "block gridpoint apply ...",
     "region": "block group ... (regions became groups)",
     "pl": "plot ... (display only in dec3d)",
+    "range": "block group '<name>' range ... (3DEC 5 named ranges became groups)",
+    "list": "block list ... / model list ... / history list",
+    "history": "model history mechanical ... / block history ... / block contact history ...",
 }
 
 

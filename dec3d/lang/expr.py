@@ -192,6 +192,9 @@ def check_names(node: Node, known: Callable[[str], str | None]) -> list[tuple[st
         if tag == "name":
             if n[1] in CONSTANTS:
                 return
+            if "." in n[1] and n[1].startswith(_KNOWN_NAMESPACES):
+                problems.append(("intrinsic", n[1], n[2]))
+                return
             k = known(n[1])
             if k:
                 problems.append((k, n[1], n[2]))

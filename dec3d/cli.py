@@ -1,0 +1,91 @@
+"""The `dec3d` command line: run, repl, verify, ssdem, docs."""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from . import __version__
+
+
+def _run(args) -> int:
+    from .errors import Dec3dError
+    from .session import Session
+
+    deck = Path(args.deck)
+    out = Path(args.out) if args.out else deck.resolve().parent
+    out.mkdir(parents=True, exist_ok=True)
+    session = Session(out_dir=out, echo=not args.quiet)
+    try:
+        items = session.load_file(deck)          # parse and bind everything first
+    except Dec3dError as exc:
+        print(exc.format(), file=sys.stderr)
+        print("nothing was run: fix the deck and run it again", file=sys.stderr)
+        return 2
+    try:
+        session.run_items(items)
+    except Dec3dError as exc:
+        print(exc.format(), file=sys.stderr)
+        print("the run stopped at this command; the model holds the state before it", file=sys.stderr)
+        return 1
+    finally:
+        session.close_log()
+    return 0
+
+
+def _repl(args) -> int:
+    from .repl import run_repl
+
+    return run_repl(out_dir=args.out, history_file=args.history)
+
+
+def _verify(args) -> int:
+    from .verify import main as verify_main
+
+    return verify_main(args.names, root=args.root)
+
+
+def _docs(args) -> int:
+    from .docs import write_pages
+
+    changed = write_pages(Path(args.dir))
+    print(f"{len(changed)} page(s) written to {args.dir}")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["ssdem"]:          # the slope solver has its own argument parser
+        from .ssdem.cli import main as ssdem_main
+
+        return ssdem_main(argv[1:])
+    ap = argparse.ArgumentParser(prog="dec3d", description="3DEC-style distinct element program")
+    ap.add_argument("--version", action="version", version=f"dec3d {__version__}")
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("run", help="run a deck")
+    r.add_argument("deck")
+    r.add_argument("--out", help="folder for outputs (default: the deck's folder)")
+    r.add_argument("-q", "--quiet", action="store_true", help="do not echo commands")
+    r.set_defaults(fn=_run)
+    q = sub.add_parser("repl", help="interactive command prompt")
+    q.add_argument("--out", help="folder for outputs (default: current folder)")
+    q.add_argument("--history", help="history file (default: ~/.dec3d_history)")
+    q.set_defaults(fn=_repl)
+    v = sub.add_parser("verify", help="run the verification problems and print a pass/fail table")
+    v.add_argument("names", nargs="*", help="problem folders to run (default: all)")
+    v.add_argument("--root", default=None, help="verification folder (default: ./verification)")
+    v.set_defaults(fn=_verify)
+    sub.add_parser("ssdem", help="static Winkler-spring slope stability (dec3d ssdem -h)")
+    c = sub.add_parser("check", help="say line by line what dec3d can run in a deck (runs nothing)")
+    c.add_argument("decks", nargs="+")
+    c.add_argument("-v", "--verbose", action="store_true", help="list every line that is not runnable")
+    c.set_defaults(fn=lambda a: __import__("dec3d.check", fromlist=["main"]).main(a.decks, a.verbose))
+    d = sub.add_parser("docs", help="write the command reference pages from the registry")
+    d.add_argument("--dir", default="commands")
+    d.set_defaults(fn=_docs)
+    args = ap.parse_args(argv)
+    return args.fn(args)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    raise SystemExit(main())

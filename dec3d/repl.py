@@ -1,0 +1,129 @@
+"""`dec3d repl`: an interactive prompt on a Session (prompt_toolkit).
+
+Persistent history, completion of command words, keywords and range elements from
+the registry, `help <command>` showing the `commands/` page, continuation lines
+(`&`, `...`) and FISH blocks read until `end`. An error is printed and the session
+goes on; Ctrl-D (or `program exit`) ends it.
+"""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from prompt_toolkit import PromptSession
+from prompt_toolkit.completion import Completer, Completion
+from prompt_toolkit.history import FileHistory, InMemoryHistory
+
+from .commands import load_all
+from .commands.registry import REGISTRY
+from .errors import Dec3dError
+from .lang.abbrev import matches
+
+_CONTINUED = re.compile(r"(&|\.\.\.)\s*(;.*)?$")
+_FISH_START = re.compile(r"^\s*(fish\s+)?def(i(n(e)?)?)?\s+\w", re.I)
+_FISH_END = re.compile(r"^\s*end\s*(;.*)?$", re.I)
+
+
+class RegistryCompleter(Completer):
+    """Completes the word under the cursor from the command tree, then the command's keywords."""
+
+    def get_completions(self, document, complete_event):
+        text = document.text_before_cursor
+        words = text.split()
+        current = "" if text.endswith((" ", "\t")) or not words else words[-1]
+        done = words if current == "" else words[:-1]
+        if done[:1] == ["help"]:
+            done = done[1:]
+        for cand in sorted(self.candidates(done)):
+            if cand.startswith(current.lower()):
+                yield Completion(cand, start_position=-len(current))
+
+    @staticmethod
+    def candidates(done: list[str]) -> list[str]:
+        load_all()
+        node = REGISTRY.root
+        i = 0
+        while i < len(done):
+            hits = matches(done[i], node.children) if node.children else []
+            if len(hits) != 1:
+                break
+            node = node.children[hits[0]]
+            if node.alias_of:
+                node = REGISTRY.node(node.alias_of)
+            i += 1
+        if i == len(done) and node.children:
+            return list(node.children) + (["help"] if node is REGISTRY.root else [])
+        cmd = node.command
+        if cmd is None:
+            return []
+        names = [p.name for p in cmd.keywords]
+        for p in cmd.positional:
+            choices = getattr(p.value, "options", None)
+            if choices:
+                names += list(choices)
+        if cmd.range:
+            names += ["range"] + [n for n, e in REGISTRY.range_elements.items() if e.supported]
+        return names
+
+
+def run_repl(out_dir=None, history_file=None, input=None, output=None) -> int:
+    from .session import Session, StopDeck
+
+    session = Session(out_dir=out_dir or Path.cwd())
+    if history_file is None:
+        history = FileHistory(str(Path.home() / ".dec3d_history")) if input is None else InMemoryHistory()
+    else:
+        history = FileHistory(str(history_file))
+    prompt = PromptSession(history=history, completer=RegistryCompleter(), input=input, output=output,
+                           complete_while_typing=False)
+    session.write("dec3d interactive session: 3DEC commands, `help <command>`, Ctrl-D to leave")
+    while True:
+        try:
+            text = _read_command(prompt)
+        except EOFError:
+            break
+        except KeyboardInterrupt:
+            continue
+        if not text.strip():
+            continue
+        words = text.split()
+        if words[0].lower() == "help":
+            _help(session, words[1:])
+            continue
+        try:
+            items = session.load_text(text, "<repl>")
+            session.run_items(items)
+            if any(getattr(getattr(i, "command", None), "path", None) in (("program", "exit"), ("program", "quit"))
+                   for i in items):
+                break
+        except StopDeck:
+            break
+        except Dec3dError as exc:
+            session.write(exc.format())
+    session.close_log()
+    return 0
+
+
+def _read_command(prompt: PromptSession) -> str:
+    """One command: a line, its continuation lines, or a whole FISH block."""
+    lines = [prompt.prompt("dec3d> ")]
+    if _FISH_START.match(lines[0]):
+        while not _FISH_END.match(lines[-1]):
+            lines.append(prompt.prompt("  fish> "))
+    else:
+        while _CONTINUED.search(lines[-1]):
+            lines.append(prompt.prompt("   ...> "))
+    return "\n".join(lines)
+
+
+def _help(session, words: list[str]) -> None:
+    from .docs import page_for
+
+    if not words:
+        load_all()
+        session.write("Commands: " + ", ".join(sorted(REGISTRY.root.children)))
+        session.write("Type `help <command>` (abbreviations work), e.g. `help model gravity`.")
+        return
+    folder = Path(__file__).resolve().parent.parent / "commands"
+    page = page_for(words, folder if folder.is_dir() else None)
+    session.write(page if page is not None else f"no command `{' '.join(words)}`; type `help` for the list")

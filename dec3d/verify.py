@@ -1,0 +1,115 @@
+"""`dec3d verify`: run the verification problems and print a pass/fail table.
+
+Each folder of `verification/` holds a `problem.toml`:
+
+    title = "..."; kind = "deck" | "ssdem"; source = "..."
+    deck = "deck.dat"            # kind = "deck": quantities are FISH variables and session results
+    input = "..."; args = [...]  # kind = "ssdem"
+    [[expect]]  quantity = "..."  value = 1.0  rel_tol = 0.01 | abs_tol = ...
+    [[expect]]  quantity = "..."  below = "<other quantity>"
+    [[expect]]  quantity = "..."  value = ...  report_only = true
+
+Expectations are data; the runner knows no problem by name.
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+
+@dataclass
+class Check:
+    problem: str
+    quantity: str
+    measured: float | None
+    expected: str
+    passed: bool | None        # None: report only
+    note: str = ""
+
+
+def _deck_quantities(folder: Path, spec: dict) -> dict[str, float]:
+    import tempfile
+
+    from .session import Session
+
+    with tempfile.TemporaryDirectory() as out:
+        s = Session(out_dir=out)
+        s.call(folder / spec["deck"])
+        q = {k: float(v) for k, v in s.variables.items() if isinstance(v, (int, float)) and not isinstance(v, bool)}
+        q.update(s.results)
+        return q
+
+
+def _ssdem_quantities(folder: Path, spec: dict) -> dict[str, float]:
+    from .ssdem.verify import quantities
+
+    return quantities(folder, spec)
+
+
+KINDS: dict[str, Callable[[Path, dict], dict[str, float]]] = {
+    "deck": _deck_quantities,
+    "ssdem": _ssdem_quantities,
+}
+
+
+def default_root() -> Path:
+    here = Path.cwd() / "verification"
+    return here if here.is_dir() else Path(__file__).resolve().parent.parent / "verification"
+
+
+def problems(root: Path) -> list[Path]:
+    return sorted(p.parent for p in root.glob("*/problem.toml"))
+
+
+def check_problem(folder: Path) -> list[Check]:
+    spec = tomllib.loads((folder / "problem.toml").read_text(encoding="utf-8"))
+    kind = spec.get("kind")
+    if kind not in KINDS:
+        raise ValueError(f"{folder / 'problem.toml'}: kind must be one of {sorted(KINDS)}, got {kind!r}")
+    q = KINDS[kind](folder, spec)
+    checks = []
+    for e in spec.get("expect", []):
+        name = e["quantity"]
+        m = q.get(name)
+        if "below" in e:
+            other = q.get(e["below"])
+            ok = m is not None and other is not None and m < other
+            checks.append(Check(folder.name, name, m, f"< {e['below']} ({other:.4g})" if other is not None else
+                                f"< {e['below']} (missing)", ok))
+            continue
+        v = float(e["value"])
+        if "rel_tol" in e:
+            tol = abs(v) * float(e["rel_tol"])
+            exp = f"{v:.6g} ± {100 * float(e['rel_tol']):g} %"
+        else:
+            tol = float(e.get("abs_tol", 0.0))
+            exp = f"{v:.6g} ± {tol:g}"
+        ok = m is not None and math.isfinite(m) and abs(m - v) <= tol
+        checks.append(Check(folder.name, name, m, exp, None if e.get("report_only") else ok,
+                            e.get("note", "")))
+    return checks
+
+
+def main(names: list[str] | None = None, root: str | Path | None = None) -> int:
+    root = Path(root) if root else default_root()
+    folders = problems(root)
+    if names:
+        folders = [f for f in folders if f.name in names or any(f.name.startswith(n) for n in names)]
+    rows: list[Check] = []
+    failed = 0
+    for f in folders:
+        try:
+            rows += check_problem(f)
+        except Exception as exc:  # a crashing problem is a failed problem, reported, and the others still run
+            rows.append(Check(f.name, "(run)", None, "runs", False, f"{type(exc).__name__}: {exc}"))
+    print(f"{'problem':32s} {'quantity':22s} {'measured':>12s}  {'expected':28s} result")
+    for c in rows:
+        meas = "-" if c.measured is None else f"{c.measured:.6g}"
+        res = "report" if c.passed is None else ("PASS" if c.passed else "FAIL")
+        failed += c.passed is False
+        print(f"{c.problem:32s} {c.quantity:22s} {meas:>12s}  {c.expected:28s} {res}" + (f"  {c.note}" if c.note else ""))
+    print(f"{sum(c.passed is True for c in rows)} passed, {failed} failed")
+    return 1 if failed else 0
