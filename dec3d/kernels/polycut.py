@@ -219,6 +219,37 @@ def split_convex(vp, vsrc, fn, fsrc, fvl, normal, d, tol, u, w):
 
 
 @njit(cache=True)
+def _emit(bufs, cnt, parent, pvp, pvsrc, pfn, pfsrc, pfv):
+    """Append one piece to the output buffers (growing them); cnt = [pieces, v, f, fv]."""
+    o_parent, o_pnv, o_pnf, o_pos, o_vsrc, o_fn, o_fsrc, o_fv = bufs
+    npc, nvo, nfo, nfvo = cnt[0], cnt[1], cnt[2], cnt[3]
+    nv = pvp.shape[0]
+    nf = pfn.shape[0]
+    nfv = pfv.shape[0]
+    o_parent = _grow1(o_parent, npc + 1)
+    o_pnv = _grow1(o_pnv, npc + 1)
+    o_pnf = _grow1(o_pnf, npc + 1)
+    o_pos = _grow2(o_pos, nvo + nv)
+    o_vsrc = _grow1(o_vsrc, nvo + nv)
+    o_fn = _grow1(o_fn, nfo + nf)
+    o_fsrc = _grow1(o_fsrc, nfo + nf)
+    o_fv = _grow1(o_fv, nfvo + nfv)
+    o_parent[npc] = parent
+    o_pnv[npc] = nv
+    o_pnf[npc] = nf
+    o_pos[nvo:nvo + nv] = pvp
+    o_vsrc[nvo:nvo + nv] = pvsrc
+    o_fn[nfo:nfo + nf] = pfn
+    o_fsrc[nfo:nfo + nf] = pfsrc
+    o_fv[nfvo:nfvo + nfv] = pfv
+    cnt[0] += 1
+    cnt[1] += nv
+    cnt[2] += nf
+    cnt[3] += nfv
+    return (o_parent, o_pnv, o_pnf, o_pos, o_vsrc, o_fn, o_fsrc, o_fv)
+
+
+@njit(cache=True)
 def cut_blocks(pos, fv, f_vstart, f_nvert, b_vstart, b_vcount, b_fstart, b_fcount,
                rows, normal, offsets, tol, u, w):
     """Cut blocks ``rows`` by the planes n·x = offsets[k] (offsets sorted ascending).
@@ -232,18 +263,10 @@ def cut_blocks(pos, fv, f_vstart, f_nvert, b_vstart, b_vcount, b_fstart, b_fcoun
     out_fsrc (Σnf,) global source face row or -1 for cut faces, out_fv (Σ fn,) vertex
     indices local to the piece).
     """
-    o_parent = np.empty(16, np.int64)
-    o_pnv = np.empty(16, np.int64)
-    o_pnf = np.empty(16, np.int64)
-    o_pos = np.empty((128, 3))
-    o_vsrc = np.empty(128, np.int64)
-    o_fn = np.empty(128, np.int64)
-    o_fsrc = np.empty(128, np.int64)
-    o_fv = np.empty(512, np.int64)
-    npc = 0
-    nvo = 0
-    nfo = 0
-    nfvo = 0
+    bufs = (np.empty(16, np.int64), np.empty(16, np.int64), np.empty(16, np.int64),
+            np.empty((128, 3)), np.empty(128, np.int64), np.empty(128, np.int64),
+            np.empty(128, np.int64), np.empty(512, np.int64))
+    cnt = np.zeros(4, np.int64)
     for i in range(rows.shape[0]):
         b = rows[i]
         vs = b_vstart[b]
@@ -272,45 +295,18 @@ def cut_blocks(pos, fv, f_vstart, f_nvert, b_vstart, b_vcount, b_fstart, b_fcoun
                 fvl[q] = fv[j] - vs
                 q += 1
         nsplit = 0
-        for k in range(lo, hi + 1):
-            last = k == hi
-            if not last:
-                res = split_convex(vp, vsrc, fn, fsrc, fvl, normal, offsets[k], tol, u, w)
-                st = res[0]
-                if st == 1 or st == 2:
-                    continue
-                if st == -1:
-                    last = True
-            if last:
-                if nsplit == 0:
-                    break
-                pvp, pvsrc, pfn, pfsrc, pfv = vp, vsrc, fn, fsrc, fvl
-            else:
-                pvp, pvsrc, pfn, pfsrc, pfv = res[1], res[2], res[3], res[4], res[5]
-            # emit one piece
-            o_parent = _grow1(o_parent, npc + 1)
-            o_pnv = _grow1(o_pnv, npc + 1)
-            o_pnf = _grow1(o_pnf, npc + 1)
-            o_pos = _grow2(o_pos, nvo + pvp.shape[0])
-            o_vsrc = _grow1(o_vsrc, nvo + pvp.shape[0])
-            o_fn = _grow1(o_fn, nfo + pfn.shape[0])
-            o_fsrc = _grow1(o_fsrc, nfo + pfn.shape[0])
-            o_fv = _grow1(o_fv, nfvo + pfv.shape[0])
-            o_parent[npc] = b
-            o_pnv[npc] = pvp.shape[0]
-            o_pnf[npc] = pfn.shape[0]
-            o_pos[nvo:nvo + pvp.shape[0]] = pvp
-            o_vsrc[nvo:nvo + pvp.shape[0]] = pvsrc
-            o_fn[nfo:nfo + pfn.shape[0]] = pfn
-            o_fsrc[nfo:nfo + pfn.shape[0]] = pfsrc
-            o_fv[nfvo:nfvo + pfv.shape[0]] = pfv
-            npc += 1
-            nvo += pvp.shape[0]
-            nfo += pfn.shape[0]
-            nfvo += pfv.shape[0]
-            if last:
+        for k in range(lo, hi):
+            res = split_convex(vp, vsrc, fn, fsrc, fvl, normal, offsets[k], tol, u, w)
+            st = res[0]
+            if st == 1 or st == 2:
+                continue
+            if st == -1:
                 break
+            bufs = _emit(bufs, cnt, b, res[1], res[2], res[3], res[4], res[5])
             nsplit += 1
             vp, vsrc, fn, fsrc, fvl = res[6], res[7], res[8], res[9], res[10]
-    return (o_parent[:npc], o_pnv[:npc], o_pnf[:npc], o_pos[:nvo], o_vsrc[:nvo],
-            o_fn[:nfo], o_fsrc[:nfo], o_fv[:nfvo])
+        if nsplit > 0:
+            bufs = _emit(bufs, cnt, b, vp, vsrc, fn, fsrc, fvl)
+    npc, nvo, nfo, nfvo = cnt[0], cnt[1], cnt[2], cnt[3]
+    return (bufs[0][:npc], bufs[1][:npc], bufs[2][:npc], bufs[3][:nvo], bufs[4][:nvo],
+            bufs[5][:nfo], bufs[6][:nfo], bufs[7][:nfvo])

@@ -1,0 +1,103 @@
+"""Writing polyhedra into the model's stores, and dropping geometry no block uses.
+
+Pieces arrive as one batch of flat arrays (what the cutting kernel returns, or what
+``polys_to_batch`` makes from ``Poly`` objects):
+
+    pos (V, 3)        vertex positions, piece after piece
+    vsrc (V,)         vertex row each new vertex copies its state from, -1 for defaults
+    piece_nv (k,)     vertices per piece
+    fn (F,)           vertices per face, face after face
+    fsrc (F,)         face row each new face copies its groups from, -1 for none
+    piece_nf (k,)     faces per piece
+    fv (Σfn,)         face loops, vertex indices local to their piece
+
+Each piece gets contiguous rows in ``vertices``, ``faces`` and ``face_vertices``.
+A block whose geometry is replaced leaves its old rows behind as garbage until
+``compact_geometry`` runs. Duck-typed on the model (no import of ``dec3d.model``).
+"""
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from .mass import range_index, update_face_geometry, update_mass_properties
+from .polyhedron import Poly
+
+_KEEP_VERTEX = ("pos", "block")
+_KEEP_FACE = ("block", "vstart", "nvert", "normal", "area", "centroid")
+
+
+def polys_to_batch(polys: Sequence[Poly]):
+    """Flatten ``Poly`` objects to (pos, vsrc, piece_nv, fn, fsrc, piece_nf, fv)."""
+    pos = np.concatenate([p.vertices for p in polys]).astype(np.float64)
+    piece_nv = np.array([len(p.vertices) for p in polys], dtype=np.int64)
+    piece_nf = np.array([p.nfaces for p in polys], dtype=np.int64)
+    fn = np.concatenate([np.diff(p.face_ptr) for p in polys]).astype(np.int64)
+    fv = np.concatenate([p.face_idx for p in polys]).astype(np.int64)
+    vsrc = np.full(len(pos), -1, dtype=np.int64)
+    fsrc = np.full(len(fn), -1, dtype=np.int64)
+    return pos, vsrc, piece_nv, fn, fsrc, piece_nf, fv
+
+
+def _copy_rows(store, dst: np.ndarray, src: np.ndarray, skip: tuple[str, ...]) -> None:
+    has = src >= 0
+    if not has.any():
+        return
+    d, s = dst[has], src[has]
+    for key in store.fields:
+        if key not in skip:
+            arr = store.full(key)
+            arr[d] = arr[s]
+
+
+def write_pieces(model, block_rows, pos, vsrc, piece_nv, fn, fsrc, piece_nf, fv) -> None:
+    """Give blocks ``block_rows`` (one per piece, rows already live) the pieces' geometry,
+    then recompute their faces' geometry and their mass properties."""
+    vs, fs, fvs = model.vertices, model.faces, model.face_vertices
+    block_rows = np.asarray(block_rows, dtype=np.int64)
+    k = len(block_rows)
+    vsl = vs.append(len(pos))
+    new_v = np.arange(vsl.start, vsl.stop, dtype=np.int64)
+    vs.full("pos")[vsl] = pos
+    vs.full("block")[vsl] = np.repeat(block_rows, piece_nv)
+    _copy_rows(vs, new_v, np.asarray(vsrc, dtype=np.int64), _KEEP_VERTEX)
+
+    piece_vstart = vsl.start + np.concatenate(([0], np.cumsum(piece_nv)[:-1])).astype(np.int64)
+    fsl = fs.append(len(fn))
+    new_f = np.arange(fsl.start, fsl.stop, dtype=np.int64)
+    fvsl = fvs.append(int(np.sum(fn)))
+    piece_of_face = np.repeat(np.arange(k), piece_nf)
+    fs.full("block")[fsl] = block_rows[piece_of_face]
+    fs.full("nvert")[fsl] = fn
+    fs.full("vstart")[fsl] = fvsl.start + np.concatenate(([0], np.cumsum(fn)[:-1])).astype(np.int64)
+    _copy_rows(fs, new_f, np.asarray(fsrc, dtype=np.int64), _KEEP_FACE)
+    fvs.full("vertex")[fvsl] = np.asarray(fv, dtype=np.int64) + np.repeat(piece_vstart[piece_of_face], fn)
+
+    b = model.blocks
+    b["vert_start"][block_rows] = piece_vstart
+    b["vert_count"][block_rows] = piece_nv
+    b["face_start"][block_rows] = fsl.start + np.concatenate(([0], np.cumsum(piece_nf)[:-1])).astype(np.int64)
+    b["face_count"][block_rows] = piece_nf
+    update_face_geometry(model, new_f)
+    update_mass_properties(model, block_rows)
+
+
+def compact_geometry(model) -> None:
+    """Drop vertex, face and face-loop rows that no live block's ranges cover."""
+    b, vs, fs, fvs = model.blocks, model.vertices, model.faces, model.face_vertices
+    vkeep = np.zeros(vs.n, dtype=bool)
+    vkeep[range_index(b["vert_start"], b["vert_count"])] = True
+    fkeep = np.zeros(fs.n, dtype=bool)
+    fkeep[range_index(b["face_start"], b["face_count"])] = True
+    if vkeep.all() and fkeep.all():
+        return
+    fvkeep = np.zeros(fvs.n, dtype=bool)
+    fvkeep[range_index(fs["vstart"][fkeep], fs["nvert"][fkeep])] = True
+    vmap = vs.compact(vkeep)
+    fmap = fs.compact(fkeep)
+    fvmap = fvs.compact(fvkeep)
+    fvs["vertex"][:] = vmap[fvs["vertex"]]
+    fs["vstart"][:] = fvmap[fs["vstart"]]
+    b["vert_start"][:] = vmap[b["vert_start"]]
+    b["face_start"][:] = fmap[b["face_start"]]

@@ -1,0 +1,207 @@
+"""Convex polyhedra from user input, validated, with the reason when they are refused.
+
+``Poly`` is the small interchange form between the shape generators and the model:
+vertices (nv, 3) and CSR faces whose loops run counter-clockwise seen from outside
+(right-hand rule gives the outward normal). 3DEC asks for clockwise input; either
+winding is accepted here and each face is turned outward.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+from .errors import GeometryError
+
+
+@dataclass(frozen=True)
+class Poly:
+    """A convex polyhedron: ``vertices`` (nv, 3) m; face f is
+    ``face_idx[face_ptr[f]:face_ptr[f+1]]`` (indices into ``vertices``)."""
+
+    vertices: np.ndarray
+    face_ptr: np.ndarray
+    face_idx: np.ndarray
+
+    @property
+    def nfaces(self) -> int:
+        return len(self.face_ptr) - 1
+
+    def face(self, f: int) -> np.ndarray:
+        return self.face_idx[self.face_ptr[f]:self.face_ptr[f + 1]]
+
+    def faces(self) -> list[np.ndarray]:
+        return [self.face(f) for f in range(self.nfaces)]
+
+
+def _fmt(p) -> str:
+    return "(" + ", ".join(f"{x:.6g}" for x in p) + ")"
+
+
+def _newell(pts: np.ndarray) -> np.ndarray:
+    """Area vector (3,) of a closed polygon loop (twice the area times the unit normal / 2)."""
+    nxt = np.roll(pts, -1, axis=0)
+    return 0.5 * np.cross(pts - pts.mean(axis=0), nxt - pts.mean(axis=0)).sum(axis=0)
+
+
+def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyhedron") -> Poly:
+    """Build and check a convex polyhedron from its faces.
+
+    ``faces``: one (k, 3) array-like of corner coordinates per face, k ≥ 3, in either
+    winding. Points closer than ``tol`` are merged. Raises ``GeometryError`` naming the
+    first face (counted from 1) that is too small, not planar, open, not convex, or when
+    the volume is zero.
+    """
+    tol = float(tol)
+    verts: list[np.ndarray] = []
+    loops: list[list[int]] = []
+    for fi, face in enumerate(faces, start=1):
+        pts = np.asarray(face, dtype=np.float64)
+        if pts.ndim != 2 or pts.shape[1] != 3:
+            raise GeometryError(f"{what}: face {fi} must be a list of 3-D points")
+        if not np.all(np.isfinite(pts)):
+            raise GeometryError(f"{what}: face {fi} has a coordinate that is not a finite number")
+        loop: list[int] = []
+        for p in pts:
+            idx = -1
+            for vi, q in enumerate(verts):
+                if np.max(np.abs(q - p)) <= tol:
+                    idx = vi
+                    break
+            if idx < 0:
+                verts.append(p)
+                idx = len(verts) - 1
+            if not loop or loop[-1] != idx:
+                loop.append(idx)
+        if len(loop) > 1 and loop[0] == loop[-1]:
+            loop.pop()
+        if len(loop) < 3:
+            raise GeometryError(f"{what}: face {fi} has fewer than 3 distinct corners")
+        if len(set(loop)) != len(loop):
+            raise GeometryError(f"{what}: face {fi} passes through the same corner twice")
+        loops.append(loop)
+    if len(loops) < 4:
+        raise GeometryError(f"{what}: a closed polyhedron needs at least 4 faces, {len(loops)} given")
+    v = np.array(verts)
+
+    # planarity and area of each face
+    normals = []
+    for fi, loop in enumerate(loops, start=1):
+        pts = v[loop]
+        av = _newell(pts)
+        area = np.linalg.norm(av)
+        if area <= tol * tol:
+            raise GeometryError(f"{what}: face {fi} has zero area")
+        n = av / area
+        dist = (pts - pts.mean(axis=0)) @ n
+        j = int(np.argmax(np.abs(dist)))
+        if abs(dist[j]) > tol:
+            raise GeometryError(
+                f"{what}: face {fi} is not planar: corner {j + 1} {_fmt(pts[j])} lies "
+                f"{abs(dist[j]):.3g} m off the face's plane (tolerance {tol:g} m)")
+        normals.append(n)
+
+    # closed: every edge in exactly two faces
+    edges: dict[tuple[int, int], list[int]] = {}
+    for fi, loop in enumerate(loops):
+        for a, b in zip(loop, loop[1:] + loop[:1]):
+            edges.setdefault((min(a, b), max(a, b)), []).append(fi)
+    for (a, b), owners in edges.items():
+        if len(owners) == 1:
+            raise GeometryError(
+                f"{what}: the surface is open: edge {_fmt(v[a])}-{_fmt(v[b])} of face "
+                f"{owners[0] + 1} belongs to no other face")
+        if len(owners) > 2:
+            raise GeometryError(
+                f"{what}: edge {_fmt(v[a])}-{_fmt(v[b])} is shared by faces "
+                f"{', '.join(str(o + 1) for o in owners)}; a solid has two faces per edge")
+
+    # turn every face outward, seen from the mean of the corners
+    inside = v.mean(axis=0)
+    for fi, loop in enumerate(loops):
+        c = v[loop].mean(axis=0)
+        h = normals[fi] @ (c - inside)
+        if h < 0:
+            loop.reverse()
+            normals[fi] = -normals[fi]
+
+    # convex: no corner in front of any face's plane
+    for fi, loop in enumerate(loops, start=1):
+        n = normals[fi - 1]
+        d = (v - v[loop].mean(axis=0)) @ n
+        j = int(np.argmax(d))
+        if d[j] > tol:
+            raise GeometryError(
+                f"{what}: not convex: corner {_fmt(v[j])} lies {d[j]:.3g} m outside the "
+                f"plane of face {fi} (tolerance {tol:g} m)")
+
+    # consistent orientation: each directed edge once
+    seen: set[tuple[int, int]] = set()
+    for fi, loop in enumerate(loops, start=1):
+        for a, b in zip(loop, loop[1:] + loop[:1]):
+            if (a, b) in seen:
+                raise GeometryError(f"{what}: faces cannot be oriented consistently (face {fi})")
+            seen.add((a, b))
+
+    ptr = np.zeros(len(loops) + 1, dtype=np.int64)
+    ptr[1:] = np.cumsum([len(lp) for lp in loops])
+    idx = np.array([i for lp in loops for i in lp], dtype=np.int64)
+    poly = Poly(v, ptr, idx)
+    vol = poly_volume(poly)
+    total_area = sum(np.linalg.norm(_newell(v[lp])) for lp in loops)
+    if vol <= tol * total_area:
+        raise GeometryError(f"{what}: zero volume ({vol:.3g} m^3): the faces enclose no space")
+    return poly
+
+
+def poly_volume(poly: Poly) -> float:
+    """Volume [m³] by the divergence theorem (faces fanned from their mean)."""
+    v = poly.vertices
+    r = v.mean(axis=0)
+    vol = 0.0
+    for f in range(poly.nfaces):
+        pts = v[poly.face(f)] - r
+        m = pts.mean(axis=0)
+        nxt = np.roll(pts, -1, axis=0)
+        vol += float(np.einsum("ij,ij->", np.cross(pts - m, nxt - m), np.broadcast_to(m, pts.shape))) / 6.0
+    return vol
+
+
+# ------------------------------------------------------------------ primitives
+def brick(x1: float, x2: float, y1: float, y2: float, z1: float, z2: float,
+          tol: float = 1e-6) -> Poly:
+    """Axis-aligned box [x1, x2] × [y1, y2] × [z1, z2] (bounds in either order)."""
+    xs, ys, zs = sorted((x1, x2)), sorted((y1, y2)), sorted((z1, z2))
+    for name, (a, b) in (("x", xs), ("y", ys), ("z", zs)):
+        if b - a <= tol:
+            raise GeometryError(f"brick: zero thickness in {name} ({a:g} to {b:g})")
+    c = np.array([[xs[i], ys[j], zs[k]] for k in (0, 1) for j in (0, 1) for i in (0, 1)])
+    quads = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+    return polyhedron_from_faces([c[list(q)] for q in quads], tol, "brick")
+
+
+def tetrahedron(v1, v2, v3, v4, tol: float = 1e-6) -> Poly:
+    """Tetrahedron on four corners (any order)."""
+    p = [np.asarray(x, dtype=np.float64) for x in (v1, v2, v3, v4)]
+    tris = [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)]
+    return polyhedron_from_faces([[p[i] for i in t] for t in tris], tol, "tetrahedron")
+
+
+def prism(face1, face2, tol: float = 1e-6) -> Poly:
+    """Prism between two polygons with the same number of corners, corner i of
+    ``face1`` joined to corner i of ``face2``; the side faces must be planar."""
+    a = np.asarray(face1, dtype=np.float64).reshape(-1, 3)
+    b = np.asarray(face2, dtype=np.float64).reshape(-1, 3)
+    if len(a) != len(b):
+        raise GeometryError(f"prism: face-1 has {len(a)} corners but face-2 has {len(b)}")
+    if len(a) < 3:
+        raise GeometryError("prism: the end faces need at least 3 corners")
+    n = _newell(a)
+    if np.linalg.norm(n) > tol * tol:
+        h = np.abs((b - a.mean(axis=0)) @ (n / np.linalg.norm(n)))
+        if h.max() <= tol:
+            raise GeometryError("prism: zero volume: face-2 lies in the plane of face-1")
+    k = len(a)
+    sides = [np.array([a[i], a[(i + 1) % k], b[(i + 1) % k], b[i]]) for i in range(k)]
+    return polyhedron_from_faces([a, b, *sides], tol, "prism")
