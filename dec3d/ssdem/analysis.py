@@ -1,0 +1,89 @@
+"""One SSDEM analysis end to end: read, solve, evaluate, compare with Bishop."""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import bishop, safety, solve
+from .model import Problem
+from .readers import read
+
+
+@dataclass
+class Analysis:
+    problem: Problem
+    state: solve.State
+    safety: safety.Safety
+    bishop: dict | None = None
+    timings: dict = field(default_factory=dict)
+
+
+def analyse(path: str | Path, fmt: str = "auto", compare_bishop: bool = False,
+            progress=None, **reader_options) -> Analysis:
+    t0 = time.perf_counter()
+    prob = read(path, fmt, **reader_options)
+    t1 = time.perf_counter()
+    st = solve.run(prob, progress=progress)
+    t2 = time.perf_counter()
+    saf = safety.evaluate(prob, st)
+    out = Analysis(problem=prob, state=st, safety=saf)
+    if compare_bishop:
+        out.bishop = compare(prob, saf)
+    t3 = time.perf_counter()
+    out.timings = dict(read=t1 - t0, solve=t2 - t1, post=t3 - t2,
+                       per_step=(t2 - t1) / max(prob.settings.n_steps, 1))
+    return out
+
+
+def compare(prob: Problem, saf: safety.Safety) -> dict:
+    """Bishop's simplified method on the DEM failure surface and the minimum over circles.
+
+    The failure surface: the prescribed circle itself; otherwise (polyline or yield
+    surface) the least-squares circle through the failure-surface interface midpoints,
+    since Bishop's moment equation needs a centre.
+    """
+    slope = prob.slope
+    if slope is None:
+        return dict(available=False,
+                    reason="Appendix A files carry no ground profile or unit weight; Bishop needs the TOML input")
+    res: dict = dict(available=True)
+    surf = prob.surface
+    if surf is not None and surf.get("type") == "circle":
+        res["on_surface"] = bishop.bishop(slope, surf["centre"], surf["radius"])
+        res["on_surface"]["how"] = "the prescribed circle"
+    else:
+        pts = prob.interfaces.mid[saf.failure]
+        if len(pts) >= 3:
+            centre, r = bishop.fit_circle(pts)
+            res["on_surface"] = bishop.bishop(slope, centre, r)
+            res["on_surface"]["how"] = f"circle fitted to {len(pts)} failure-surface interface midpoints"
+        else:
+            res["on_surface"] = None
+    bottom = prob.bottom
+    if surf is not None and surf.get("search"):
+        res["search"] = dict(surf["search"])
+    else:
+        res["search"] = bishop.search(slope, bottom=bottom)
+    res["search"]["how"] = "grid of centres and radii, then Nelder-Mead"
+    return res
+
+
+def summary_numbers(an: Analysis) -> dict:
+    """The headline quantities (also what verify.quantities returns)."""
+    s = an.safety
+    q = dict(fs_dem=s.fs_global, fs_dem_mean=s.fs_mean, n_surface=float(s.n_averaged),
+             n_unstable=float(an.state.removed.sum()), n_yielded=float(np.sum(s.state == safety.YIELDED)),
+             n_cracked=float(np.sum(s.state == safety.CRACKED)),
+             converged=float(all(r.converged for r in an.state.steps)),
+             max_displacement=float(an.state.steps[-1].max_displacement) if an.state.steps else 0.0)
+    b = an.bishop
+    if b and b.get("available"):
+        if b.get("on_surface"):
+            q["fs_bishop"] = b["on_surface"]["fs"]
+            q["fs_ordinary"] = b["on_surface"]["fs_ordinary"]
+        if b.get("search") and b["search"].get("fs") is not None:
+            q["fs_bishop_min"] = b["search"]["fs"]
+    return q

@@ -1,0 +1,90 @@
+"""`dec3d ssdem INPUT [--out DIR] [--compare bishop]`: static Winkler-spring slope analysis."""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from dec3d.errors import Dec3dError
+
+#: progress bars only for runs at least this large (and only on a terminal)
+PROGRESS_MIN_BLOCKS = 2000
+
+
+def parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(
+        prog="dec3d ssdem",
+        description="Static distinct element (Winkler spring) slope stability analysis after the SSDEM thesis.")
+    ap.add_argument("input", metavar="INPUT", help="a .toml slope file, or a thesis Appendix A text file")
+    ap.add_argument("--out", metavar="DIR", help="output folder (default: <input stem>_ssdem)")
+    ap.add_argument("--compare", choices=["bishop"], help="also run Bishop's simplified method")
+    ap.add_argument("--format", choices=["auto", "toml", "appendix-a"], default="auto",
+                    help="input format (default: by suffix, .toml or else Appendix A)")
+    ap.add_argument("--units", choices=["N-m", "kN-m", "lb-ft"], default="kN-m",
+                    help="units of an Appendix A file (default kN-m, as the thesis)")
+    ap.add_argument("--tensile-strength", type=float, default=None, metavar="T",
+                    help="Appendix A only: turn the tension cut-off on at this tensile strength")
+    ap.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    return ap
+
+
+def _progress_factory(n_blocks: int, quiet: bool):
+    """A rich progress bar over load steps, for big runs on a terminal; else None."""
+    if quiet or n_blocks < PROGRESS_MIN_BLOCKS or not sys.stdout.isatty():
+        return None, None
+    from rich.progress import Progress
+    bar = Progress(transient=True)
+    task = bar.add_task("load steps", total=None)
+
+    def update(step, n_steps, iteration):
+        bar.update(task, total=n_steps, completed=step - 1,
+                   description=f"step {step}/{n_steps}, iteration {iteration}")
+    return bar, update
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parser().parse_args(argv)
+    from . import plot, report
+    from .analysis import Analysis, compare
+    from .readers import read
+    from . import safety, solve
+    import time
+
+    path = Path(args.input)
+    if not path.is_file():
+        print(f"dec3d ssdem: error: no such file: {path}", file=sys.stderr)
+        return 2
+    opts = {} if args.format == "toml" or (args.format == "auto" and path.suffix.lower() == ".toml") else \
+        dict(units=args.units, tensile_strength=args.tensile_strength)
+    try:
+        t0 = time.perf_counter()
+        prob = read(path, args.format, **opts)
+    except Dec3dError as exc:
+        print(exc.format(), file=sys.stderr)
+        return 2
+    t1 = time.perf_counter()
+    bar, update = _progress_factory(prob.blocks.n, args.quiet)
+    if bar is not None:
+        with bar:
+            st = solve.run(prob, progress=update)
+    else:
+        st = solve.run(prob)
+    t2 = time.perf_counter()
+    an = Analysis(problem=prob, state=st, safety=safety.evaluate(prob, st))
+    if args.compare == "bishop":
+        an.bishop = compare(prob, an.safety)
+    an.timings = dict(read=t1 - t0, solve=t2 - t1, post=time.perf_counter() - t2,
+                      per_step=(t2 - t1) / max(prob.settings.n_steps, 1))
+    out = Path(args.out) if args.out else Path(f"{path.stem}_ssdem")
+    files = report.write_all(an, out)
+    png = out / "figure.png"
+    plot.figure(an, png)
+    files += [png] + plot.vtk(an, out)
+    if not args.quiet:
+        sys.stdout.write(report.summary_text(an))
+        print(f"wrote {', '.join(f.name for f in files)} to {out}/")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

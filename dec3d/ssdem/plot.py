@@ -1,0 +1,87 @@
+"""Figure (matplotlib, Agg) and VTK files (meshio polygons) of an analysis."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .analysis import Analysis
+from .units import factors
+
+
+def figure(an: Analysis, path: Path) -> None:
+    """Mesh coloured by displacement, failure surface in red, unstable blocks crossed."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection, PolyCollection
+
+    p, st, s = an.problem, an.state, an.safety
+    L = factors(p.units)["length"] if p.units in ("N-m", "kN-m", "lb-ft") else 1.0
+    blk, itf = p.blocks, p.interfaces
+    polys = [blk.polygon(i) / L for i in range(blk.n)]
+    mag = np.hypot(st.u[:, 0], st.u[:, 1]) / L
+    fig, ax = plt.subplots(figsize=(11, 6), dpi=110)
+    pc = PolyCollection(polys, array=np.where(st.removed | blk.fixed, np.nan, mag), cmap="viridis",
+                        edgecolors="0.35", linewidths=0.3)
+    pc.cmap.set_bad("0.85")
+    ax.add_collection(pc)
+    fig.colorbar(pc, ax=ax, label=f"displacement magnitude ({p.units.split('-')[1] if '-' in p.units else 'm'})")
+    if st.removed.any():
+        ax.add_collection(PolyCollection([polys[i] for i in np.flatnonzero(st.removed)], facecolors="none",
+                                         edgecolors="crimson", hatch="xx", linewidths=0.6))
+        ax.plot([], [], "s", mfc="none", mec="crimson", label=f"unstable blocks ({int(st.removed.sum())})")
+    if s.failure.any():
+        segs = np.stack([itf.p0[s.failure], itf.p1[s.failure]], axis=1) / L
+        ax.add_collection(LineCollection(segs, colors="red", linewidths=2.5))
+        ax.plot([], [], "r-", lw=2.5, label="failure surface")
+    if p.profile is not None:
+        ax.plot(p.profile[:, 0] / L, p.profile[:, 1] / L, "k-", lw=1.0, label="ground surface")
+    b = an.bishop or {}
+    for key, style, name in (("on_surface", "b--", "Bishop on failure surface"), ("search", "m:", "Bishop minimum")):
+        c = b.get(key) if b.get("available") else None
+        if c and c.get("centre") is not None and np.isfinite(c.get("fs", np.nan)):
+            t = np.linspace(0, 2 * np.pi, 400)
+            xs = c["centre"][0] + c["radius"] * np.cos(t)
+            ys = c["centre"][1] + c["radius"] * np.sin(t)
+            inside = (xs >= c["x_entry"]) & (xs <= c["x_exit"]) & (ys <= c["centre"][1])
+            ax.plot(np.where(inside, xs, np.nan) / L, np.where(inside, ys, np.nan) / L, style, lw=1.5,
+                    label=f"{name}: FS {c['fs']:.3f}")
+    ax.autoscale_view()
+    ax.set_aspect("equal")
+    fs = s.fs_global
+    ax.set_title(f"{p.title}\nstatic DEM FS = {fs:.3f}" if np.isfinite(fs) else p.title)
+    ax.legend(loc="upper left", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def vtk(an: Analysis, out: Path) -> list[Path]:
+    """blocks.vtu (polygons with displacement, rotation, state) and interfaces.vtu (lines)."""
+    import meshio
+
+    p, st, s = an.problem, an.state, an.safety
+    blk, itf = p.blocks, p.interfaces
+    pts = np.column_stack([blk.verts, np.zeros(len(blk.verts))])
+    counts = np.diff(blk.offsets)
+    cells, order = [], []
+    for k in np.unique(counts):
+        ids = np.flatnonzero(counts == k)
+        conn = blk.offsets[ids][:, None] + np.arange(k)[None, :]
+        cells.append(({3: "triangle", 4: "quad"}.get(int(k), "polygon"), conn))
+        order.append(ids)
+    disp = np.column_stack([st.u[:, 0], st.u[:, 1], np.zeros(blk.n)])
+    data = {"displacement": [disp[i] for i in order], "rotation": [st.u[i, 2] for i in order],
+            "fixed": [blk.fixed[i].astype(float) for i in order],
+            "unstable_step": [st.removed_step[i].astype(float) for i in order]}
+    f1 = out / "blocks.vtu"
+    meshio.Mesh(pts, cells, cell_data=data).write(f1)
+    lp = np.column_stack([np.concatenate([itf.p0, itf.p1]), np.zeros(2 * itf.m)])
+    lines = np.column_stack([np.arange(itf.m), itf.m + np.arange(itf.m)])
+    fs = np.where(np.isfinite(s.fs), s.fs, -1.0)
+    idata = {"sigma_n": [s.sigma_n], "tau": [s.tau], "fs": [fs], "yield_pct": [s.yield_pct],
+             "state": [s.state.astype(float)], "failure_surface": [s.failure.astype(float)]}
+    f2 = out / "interfaces.vtu"
+    meshio.Mesh(lp, [("line", lines)], cell_data=idata).write(f2)
+    return [f1, f2]
