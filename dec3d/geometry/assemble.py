@@ -101,3 +101,14 @@ def compact_geometry(model) -> None:
     fs["vstart"][:] = fvmap[fs["vstart"]]
     b["vert_start"][:] = vmap[b["vert_start"]]
     b["face_start"][:] = fmap[b["face_start"]]
+
+
+def block_poly(model, row: int) -> Poly:
+    """The current geometry of one block as a ``Poly`` (vertex indices local to the block)."""
+    b, f = model.blocks, model.faces
+    vs, vc = int(b["vert_start"][row]), int(b["vert_count"][row])
+    fs, fc = int(b["face_start"][row]), int(b["face_count"][row])
+    nvert = f["nvert"][fs:fs + fc]
+    loops = model.face_vertices["vertex"][range_index(f["vstart"][fs:fs + fc], nvert)] - vs
+    ptr = np.concatenate(([0], np.cumsum(nvert))).astype(np.int64)
+    return Poly(model.vertices["pos"][vs:vs + vc].copy(), ptr, loops.astype(np.int64))

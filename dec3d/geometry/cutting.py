@@ -85,6 +85,11 @@ def cut_by_planes(model, normal, offsets, mask=None, join: bool = False) -> int:
     first[1:] = parent[1:] != parent[:-1]
     extra = ~first
     src = parent[extra]
+    # joined parents (followers, or leaders of others), before new rows copy their leader
+    lead = b["leader"]
+    has_followers = np.zeros(b.n, dtype=bool)
+    has_followers[lead[lead != np.arange(b.n)]] = True
+    joined = (lead[src] != src) | has_followers[src]
     sl = b.append(int(extra.sum()))
     new_rows = np.arange(sl.start, sl.stop, dtype=np.int64)
     for key in b.fields:
@@ -94,10 +99,6 @@ def cut_by_planes(model, normal, offsets, mask=None, join: bool = False) -> int:
     model.next_block_id += int(new_rows.size)
 
     lead = b["leader"]
-    has_followers = np.zeros(b.n, dtype=bool)
-    others = lead != np.arange(b.n)
-    has_followers[lead[others]] = True
-    joined = (lead[src] != src) | has_followers[src]
     lead[new_rows] = np.where(join | joined, lead[src], new_rows)
 
     piece_rows = np.empty(parent.size, dtype=np.int64)

@@ -117,6 +117,10 @@ def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyh
                 f"{what}: edge {_fmt(v[a])}-{_fmt(v[b])} is shared by faces "
                 f"{', '.join(str(o + 1) for o in owners)}; a solid has two faces per edge")
 
+    # all corners in one plane: nothing is enclosed, and no face can be turned outward
+    if np.abs((v - v[loops[0]].mean(axis=0)) @ normals[0]).max() <= tol:
+        raise GeometryError(f"{what}: zero volume: all corners lie in one plane")
+
     # turn every face outward, seen from the mean of the corners
     inside = v.mean(axis=0)
     for fi, loop in enumerate(loops):

@@ -137,7 +137,12 @@ def restore_state(path: str | os.PathLike) -> tuple[Model, dict]:
             if _META not in zf.namelist():
                 raise StateFileError(f"'{path}' is not a dec3d state file (no {_META})")
             meta = _check_meta(path, zf.read(_META))
-            blobs = {name: zf.read(name + ".npy") for name in sorted(meta.get("sha256", {}))}
+            members = set(zf.namelist())
+            blobs = {}
+            for name in sorted(meta.get("sha256", {})):
+                if name + ".npy" not in members:
+                    raise StateFileError(f"'{path}': array '{name}' is missing")
+                blobs[name] = zf.read(name + ".npy")
     except StateFileError:
         raise
     except (zipfile.BadZipFile, OSError, EOFError, KeyError, ValueError) as exc:

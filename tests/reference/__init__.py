@@ -1,0 +1,1 @@
+"""Slow, obviously correct twins of the numba kernels, for the kernel tests."""
