@@ -24,18 +24,35 @@ class SourceLocation:
         return f"{self.file}:{self.line}:{self.column}"
 
 
+def _resolved(location):
+    """Binding keeps token positions unresolved (see `LazyLocation`); errors resolve them."""
+    return location.resolve() if hasattr(location, "resolve") else location
+
+
+class LazyLocation:
+    """A token position turned into a SourceLocation only if an error needs it (binding is hot)."""
+
+    __slots__ = ("deck", "token", "stack")
+
+    def __init__(self, deck, token, stack=()):
+        self.deck, self.token, self.stack = deck, token, stack
+
+    def resolve(self) -> SourceLocation:
+        return self.deck.location(self.token, self.stack)
+
+
 class Dec3dError(Exception):
     """Base of every error dec3d reports to a user."""
 
     def __init__(self, message: str, location: SourceLocation | None = None, hint: str | None = None):
         super().__init__(message)
         self.message = message
-        self.location = location
+        self.location = _resolved(location)
         self.hint = hint
 
     def with_location(self, location: SourceLocation) -> "Dec3dError":
         if self.location is None:
-            self.location = location
+            self.location = _resolved(location)
         return self
 
     def format(self) -> str:

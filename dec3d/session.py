@@ -210,7 +210,7 @@ class Session:
         """Evaluate `[expr]`/`@name` values and convert them like literals; other values as bound."""
         if not _has_deferred(call):
             return call
-        params = {p.key: p for p in call.command.positional + call.command.keywords}
+        params = call.command.by_key
         args = dict(call.args)
         for key, value in args.items():
             p = params.get(key)

@@ -12,7 +12,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..errors import BindError, DeckSyntaxError, NotSupportedError, SourceLocation
+from ..errors import BindError, DeckSyntaxError, LazyLocation, NotSupportedError, SourceLocation
 from ..lang.abbrev import matches, suggest
 from ..lang.expr import check_names, parse_expression
 from ..lang.parser import ParsedDeck, RawLine
@@ -23,6 +23,11 @@ from .values import MISSING, Deferred, Param
 
 # a `;` comment that is not inside a quoted string
 _COMMENT = re.compile(r""";(?=(?:[^'"]|'[^']*'|"[^"]*")*$).*""")
+
+
+def source_text(lines, first: int, last: int) -> str:
+    """Physical lines of a command, comments stripped, joined with newlines."""
+    return "\n".join(_COMMENT.sub("", ln).rstrip() for ln in lines[first - 1:last]).strip()
 
 
 @dataclass(frozen=True)
@@ -50,7 +55,7 @@ class CommandCall:
     location: SourceLocation
     extra: dict = field(default_factory=dict)   # undeclared keywords (open_keywords commands)
     locations: dict = field(default_factory=dict)  # key -> SourceLocation of its value
-    source: str = ""
+    span: tuple = ()          # (source lines, first line, last line): the text, made on demand
 
     @property
     def name(self) -> str:
@@ -59,7 +64,9 @@ class CommandCall:
     @property
     def text(self) -> str:
         """The command as written (continuation lines included, comments removed)."""
-        return self.source or self.location.text.strip()
+        if self.span:
+            return source_text(*self.span)
+        return self.location.text.strip()
 
 
 class BindContext:
@@ -96,8 +103,8 @@ class Binder:
         self.reg = registry
 
     # ------------------------------------------------------------ helpers
-    def where(self, tok) -> SourceLocation:
-        return self.deck.location(tok, self.stack)
+    def where(self, tok) -> LazyLocation:
+        return LazyLocation(self.deck, tok, self.stack)
 
     def deferred(self, tok) -> Deferred:
         if tok.type == "ATNAME":
@@ -160,20 +167,18 @@ class Binder:
                             hint="`[ ... ]` and `@name` stand alone on a line or as values")
         node, i, path, pre = self._resolve(toks)
         cmd = node.command
-        loc = self.where(first)
+        loc = self.deck.location(first, self.stack)
         if cmd is None:
             self._no_command(node, path, toks, i)
+        span = (self.deck.source_lines, first.line, toks[-1].line)
         if cmd.accepts_anything:
-            return CommandCall(cmd, {}, (), None, loc, source=self.source(raw))
+            return CommandCall(cmd, {}, (), None, loc, span=span)
         call = self._bind_args(cmd, toks, i, pre, loc)
-        object.__setattr__(call, "source", self.source(raw))
+        object.__setattr__(call, "span", span)
         return call
 
     def source(self, raw: RawLine) -> str:
-        """Physical lines of a command, comments stripped, joined with newlines."""
-        first, last = raw.tokens[0].line, raw.tokens[-1].line
-        lines = self.deck.source_lines[first - 1:last]
-        return "\n".join(_COMMENT.sub("", ln).rstrip() for ln in lines).strip()
+        return source_text(self.deck.source_lines, raw.tokens[0].line, raw.tokens[-1].line)
 
     def _resolve(self, toks):
         node = self.reg.root
@@ -186,7 +191,7 @@ class Binder:
             if tok.type != "WORD" or not node.children:
                 break
             word = str(tok).lower()
-            hits = matches(word, node.children)
+            hits = node.match(word)
             if len(hits) == 1:
                 child = node.children[hits[0]]
                 if child.alias_of:                      # bare `call` = `program call`
@@ -260,8 +265,8 @@ class Binder:
         given: list[str] = list(pre)
         extra: dict[str, Any] = {}
         locs: dict[str, SourceLocation] = {}
-        names = [p.name for p in cmd.keywords]
-        by_name = {p.name: p for p in cmd.keywords}
+        names = cmd.keyword_names
+        by_name = cmd.by_name
         pos = list(cmd.positional)
         rng = None
         n = len(toks)
@@ -316,7 +321,7 @@ class Binder:
                     extra[word] = self.deferred(vt)
                 i += 2
                 continue
-            cands = names + (["range"] + sorted(self.reg.range_elements) if cmd.range else [])
+            cands = list(names) + (["range"] + sorted(self.reg.range_elements) if cmd.range else [])
             close = suggest(word, cands)
             raise BindError(f"unknown keyword `{tok}` for `{cmd.name}`", self.where(tok),
                             hint=f"did you mean {' or '.join(f'`{c}`' for c in close)}?" if close

@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable, Iterable, Sequence
 
+from ..lang.abbrev import matches
 from .values import Param
 
 
@@ -31,15 +32,18 @@ class Command:
     accepts_anything: bool = False     # display-only commands: every token ignored
     module: str = ""
 
+    def __post_init__(self) -> None:
+        # looked up for every bound line: computed once
+        self.keyword_names: tuple[str, ...] = tuple(p.name for p in self.keywords)
+        self.by_name: dict[str, Param] = {p.name: p for p in self.keywords}
+        self.by_key: dict[str, Param] = {p.key: p for p in self.positional + self.keywords}
+
     @property
     def name(self) -> str:
         return " ".join(self.path)
 
     def keyword(self, name: str) -> Param | None:
-        for p in self.keywords:
-            if p.name == name:
-                return p
-        return None
+        return self.by_name.get(name)
 
 
 @dataclass
@@ -52,11 +56,20 @@ class Node:
     known: bool = False                # a 3DEC command or command group dec3d knows by name
     keywords: tuple[Param, ...] = ()   # keywords allowed before the next command word (`block create group 'g' poly`)
     alias_of: tuple[str, ...] | None = None
+    cache: dict = field(default_factory=dict, repr=False)   # word -> matching child names
+
+    def match(self, word: str) -> list[str]:
+        """Children `word` may abbreviate (memoised per node: decks repeat their words)."""
+        hit = self.cache.get(word)
+        if hit is None:
+            hit = self.cache[word] = matches(word, self.children)
+        return hit
 
     def child(self, name: str) -> "Node":
         node = self.children.get(name)
         if node is None:
             node = self.children[name] = Node(name)
+            self.cache.clear()
         return node
 
 
@@ -109,6 +122,7 @@ class Registry:
         """A top-level word standing for a longer command (`call` = `program call`)."""
         node = self.root.child(word)
         node.known = True
+        self.root.cache.clear()
         node.alias_of = tuple(target.split())
         self.aliases[word] = node.alias_of
 

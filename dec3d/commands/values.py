@@ -42,7 +42,10 @@ class ValueType:
         tok = toks[i]
         if tok.type in ("EXPR", "ATNAME"):
             return binder.deferred(tok), i + 1
-        return self.convert(self.literal(tok), binder.where(tok)), i + 1
+        try:
+            return self.convert(self.literal(tok), None), i + 1
+        except BindError as exc:      # the position is only worked out when there is an error
+            raise exc.with_location(binder.where(tok)) from None
 
     def literal(self, tok):
         return str(tok)
@@ -56,10 +59,9 @@ class ValueType:
 
 def _number_literal(tok):
     s = str(tok)
-    try:
-        return int(s) if not any(c in s for c in ".eE") else float(s)
-    except ValueError:
+    if "." in s or "e" in s or "E" in s:
         return float(s)
+    return int(s)
 
 
 @dataclass(frozen=True)
@@ -120,8 +122,9 @@ class Nums(ValueType):
     def take(self, toks, i, binder):
         out = []
         start = i
+        item = self.item
         while i < len(toks) and len(out) < self.most and toks[i].type in NUMBERISH:
-            v, i = self.item.take(toks, i, binder)
+            v, i = item.take(toks, i, binder)
             out.append(v)
         if len(out) < self.least or len(out) % self.multiple_of or (self.counts and len(out) not in self.counts):
             want = str(self.least) if self.least == self.most else f"{self.least} to {self.most}"

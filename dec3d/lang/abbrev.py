@@ -12,10 +12,22 @@ from difflib import get_close_matches
 from typing import Iterable
 
 
+_CACHE: dict[tuple[str, tuple[str, ...]], list[str]] = {}
+
+
 def matches(word: str, candidates: Iterable[str]) -> list[str]:
-    """All candidates `word` may abbreviate; [exact] when one equals it."""
-    w = word.lower()
-    cands = list(candidates)
+    """All candidates `word` may abbreviate; [exact] when one equals it (memoised: decks repeat words)."""
+    cands = tuple(candidates)
+    key = (word, cands)
+    hit = _CACHE.get(key)
+    if hit is None:
+        if len(_CACHE) > 100_000:
+            _CACHE.clear()
+        hit = _CACHE[key] = _matches(word.lower(), cands)
+    return list(hit)
+
+
+def _matches(w: str, cands: tuple[str, ...]) -> list[str]:
     if w in cands:
         return [w]
     parts = w.split("-")

@@ -25,6 +25,7 @@ Node = tuple
 
 
 class _Tree(Transformer):
+    __visit_tokens__ = False
     def assign(self, c):
         return ("assign", c[0].lower(), str(c[1]), c[2], c[0].column)
 

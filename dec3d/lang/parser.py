@@ -32,6 +32,8 @@ class RawLine:
 class _Lines(Transformer):
     """Builds RawLine objects while parsing (inline transformer: no tree is kept)."""
 
+    __visit_tokens__ = False      # tokens are kept as lark made them
+
     def line(self, items):
         return RawLine(tuple(items))
 
