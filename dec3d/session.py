@@ -224,6 +224,31 @@ class Session:
         extra = {k: (self.evaluate(v) if isinstance(v, Deferred) else v) for k, v in call.extra.items()}
         return CommandCall(call.command, args, call.given, call.range, call.location, extra, call.locations)
 
+    def range_mask(self, call: CommandCall, store: str):
+        """Boolean mask over the live rows of `store` selected by the call's range clause
+        (all rows when it has none). Elements are ANDed, or ORed after `union`."""
+        import numpy as np
+
+        n = len(self.model.store(store))
+        if call.range is None:
+            return np.ones(n, dtype=bool)
+        masks = []
+        for rc in call.range.elements:
+            params = {p.key: p for p in rc.element.positional + rc.element.keywords}
+            args = {k: (self._value(params[k].value, v, rc.location) if k in params and _contains_deferred(v) else v)
+                    for k, v in rc.args.items()}
+            try:
+                m = np.asarray(rc.element.mask(self, store, args), dtype=bool)
+            except Dec3dError as exc:
+                raise exc.with_location(rc.location)
+            if m.shape != (n,):  # pragma: no cover - a bug in a range element, not user input
+                raise CommandError(f"range element `{rc.element.name}` gave {m.shape[0]} values for {n} {store}s",
+                                   rc.location)
+            masks.append(~m if rc.negate else m)
+        if call.range.union:
+            return np.logical_or.reduce(masks)
+        return np.logical_and.reduce(masks)
+
     def _value(self, vtype, value, where):
         if isinstance(value, tuple):
             raw = tuple(self.evaluate(v, where) if isinstance(v, Deferred) else v for v in value)
