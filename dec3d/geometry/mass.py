@@ -105,3 +105,30 @@ def update_face_geometry(model, face_rows) -> None:
     if rows.size:
         face_geometry(model.vertices["pos"], model.face_vertices["vertex"], f["vstart"],
                       f["nvert"], rows, f["normal"], f["area"], f["centroid"])
+
+
+def joined_properties(model):
+    """Mass properties of each rigid body made of joined blocks (leader/follower).
+
+    Returns (leaders (g,) rows, mass (g,) kg, centroid (g, 3) m, inertia (g, 3, 3) kg·m²
+    about the group's centroid), one entry per distinct leader (free blocks included, as
+    groups of one). 3DEC: "the motion calculations are only performed for the leader
+    block, whose mass, moment of inertia, and centroid position are modified to represent
+    the group of blocks" (Rigid Block Motion, after Eq. 52). Parallel-axis theorem:
+    I = Σ [I_i + m_i (|d_i|² 𝟙 − d_i d_iᵀ)], d_i = c_i − C.
+    """
+    b = model.blocks
+    leaders, group = np.unique(b["leader"], return_inverse=True)
+    m = b["mass"]
+    mass = np.bincount(group, weights=m, minlength=len(leaders))
+    first = np.zeros((len(leaders), 3))
+    np.add.at(first, group, m[:, None] * b["centroid"])
+    safe = np.where(mass > 0, mass, 1.0)
+    centroid = np.where(mass[:, None] > 0, first / safe[:, None],
+                        b["centroid"][leaders])
+    d = b["centroid"] - centroid[group]
+    shift = m[:, None, None] * ((d * d).sum(axis=1)[:, None, None] * np.eye(3)
+                                - d[:, :, None] * d[:, None, :])
+    inertia = np.zeros((len(leaders), 3, 3))
+    np.add.at(inertia, group, b["inertia"] + shift)
+    return leaders, mass, centroid, inertia

@@ -186,3 +186,21 @@ def test_non_planar_prism_side_is_refused():
     with pytest.raises(GeometryError, match="not planar"):
         prism([(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)],
               [(0, 0, 1), (1, 0, 1), (1, 1, 1.5), (0, 1, 1)])
+
+
+def test_joined_blocks_have_the_mass_properties_of_their_union():
+    from dec3d.geometry.mass import joined_properties
+    from dec3d.model.blocks import join_blocks
+
+    m = Model()
+    add_blocks(m, [brick(0, 1, 0, 1, 0, 1), brick(1, 3, 0, 1, 0, 1), brick(5, 6, 0, 1, 0, 1)],
+               density=10.0)
+    join_blocks(m, np.array([True, True, False]))
+    leaders, mass, cen, inertia = joined_properties(m)
+    whole = Model()
+    add_blocks(whole, [brick(0, 3, 0, 1, 0, 1)], density=10.0)
+    assert list(leaders) == [0, 2]
+    assert mass[0] == pytest.approx(30.0)
+    np.testing.assert_allclose(cen[0], whole.blocks["centroid"][0], atol=1e-14)
+    np.testing.assert_allclose(inertia[0], whole.blocks["inertia"][0], atol=1e-12)
+    np.testing.assert_allclose(inertia[1], m.blocks["inertia"][2], atol=1e-14)
