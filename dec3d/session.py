@@ -138,15 +138,17 @@ class Session:
                 items.append(ExprStatement(("name", str(first)[1:].lower(), 1), deck.location(first, stack), str(first)))
                 continue
             call = binder.bind(raw)
-            items.append(call)
             path = call.command.path
             if path == ("program", "call") and not isinstance(call.args["file"], Deferred):
+                # a literal name: the called file is read and bound now, in place of the call
                 target = self._resolve_call_path(call.args["file"], base_dir)
                 if any(Path(s.file) == target for s in stack) or Path(deck.filename) == target:
                     raise BindError(f"`{target.name}` calls itself (directly or through other files)", call.location)
-                items.append(Enter(target, call.location, ""))
+                items.append(Enter(target, call.location, call.text))
                 items.extend(self.load_file(target, stack + (call.location,)))
-            elif path == ("program", "return"):
+                continue
+            items.append(call)
+            if path == ("program", "return"):
                 break       # the rest of this file is not run (3DEC: return to the caller)
         while next_fish is not None:
             items.append(self._fish_item(deck, next_fish, stack))

@@ -14,20 +14,14 @@ from .values import FLAG, ONOFF, P, Text
                  "include stack. Without an extension, .dat, .3ddat, .fis and .dec are tried.",
          examples=["program call 'geometry.dat'", "call \"01_Geometry.dat\""])
 def program_call(session, call):
-    # A literal name was expanded when the deck was bound (Session._bind_deck); a name given by an
-    # expression is only known now.
-    from .values import Deferred
+    # Only a file named by an expression (`program call [name]`) reaches this handler: a literal
+    # name was read and bound together with the calling deck (Session._bind_deck).
+    from pathlib import Path
 
-    if isinstance(call.args["file"], Deferred):  # pragma: no cover - resolved before handlers run
-        return
-    if call.location and "[" in (call.location.text or "") and "file" in call.locations:
-        loc = call.locations["file"]
-        if loc.text and loc.text[loc.column - 1: loc.column] == "[":
-            from pathlib import Path
-
-            base = Path(loc.file).parent if loc.file not in ("<input>", "<command>") else Path.cwd()
-            items = session.load_file(session._resolve_call_path(call.args["file"], base), loc.stack + (loc,))
-            session.run_items(items)
+    loc = call.location
+    base = Path(loc.file).parent if loc.file not in ("<input>", "<command>", "<repl>") else Path.cwd()
+    items = session.load_file(session._resolve_call_path(call.args["file"], base), loc.stack + (loc,))
+    session.run_items(items)
 
 
 @command("program return", doc="Stop reading the current file and return to the caller.",

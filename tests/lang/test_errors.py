@@ -87,3 +87,19 @@ def test_cli_exit_codes(tmp_path):
     fails = tmp_path / "fails.dat"
     fails.write_text("model new\n[a = 1/0]\n")
     assert main(["run", str(fails), "-q"]) == 1
+
+
+def test_call_with_a_name_from_an_expression(tmp_path, session):
+    (tmp_path / "stage_2.dat").write_text("model title 'stage 2'\n")
+    deck = tmp_path / "main.dat"
+    deck.write_text("[n = 2]\nprogram call [string.build('stage_%1.dat', n)]\n")
+    session.call(deck)
+    assert session.model.settings.title == "stage 2"
+
+
+def test_program_return_ends_only_the_called_file(tmp_path, session):
+    (tmp_path / "sub.dat").write_text("model title 'sub'\nprogram return\nmodel title 'after return'\n")
+    deck = tmp_path / "main.dat"
+    deck.write_text("call 'sub.dat'\nmodel gravity 0 0 -1\n")
+    session.call(deck)
+    assert session.model.settings.title == "sub" and session.model.settings.gravity == (0.0, 0.0, -1.0)
