@@ -165,7 +165,7 @@ class Binder:
         if first.type != "WORD":
             raise BindError(f"a command starts with a command word, not {str(first)!r}", self.where(first),
                             hint="`[ ... ]` and `@name` stand alone on a line or as values")
-        node, i, path, pre = self._resolve(toks)
+        node, i, path, pre, prekw = self._resolve(toks)
         cmd = node.command
         loc = self.deck.location(first, self.stack)
         if cmd is None:
@@ -173,7 +173,7 @@ class Binder:
         span = (self.deck.source_lines, first.line, toks[-1].line)
         if cmd.accepts_anything:
             return CommandCall(cmd, {}, (), None, loc, span=span)
-        call = self._bind_args(cmd, toks, i, pre, loc)
+        call = self._bind_args(cmd, toks, i, pre, loc, prekw)
         object.__setattr__(call, "span", span)
         return call
 
@@ -217,7 +217,7 @@ class Binder:
                 pre[param.key] = value
                 continue
             break
-        return node, i, tuple(path), pre
+        return node, i, tuple(path), pre, prekw
 
     def _no_command(self, node: Node, path, toks, i):
         name = " ".join(path)
@@ -260,36 +260,31 @@ class Binder:
         raise BindError(f"`{param.name}` needs a value {vt.describe()}, got {got}",
                         self.where(toks[i] if i < len(toks) else kwtok))
 
-    def _bind_args(self, cmd: Command, toks, i, pre, loc) -> CommandCall:
-        args: dict[str, Any] = dict(pre)
-        given: list[str] = list(pre)
-        extra: dict[str, Any] = {}
-        locs: dict[str, SourceLocation] = {}
-        names = cmd.keyword_names
-        by_name = cmd.by_name
-        pos = list(cmd.positional)
-        rng = None
+    def _bind_params(self, what: str, positional, names, by_name, toks, i, args, given, locs, on_other) -> int:
+        """Bind positional values, then keywords, from toks[i:] into `args`.
+
+        A token that is neither goes to `on_other(i)`, which returns where to go on from,
+        or None to stop there (a range clause, the next range element). Returns the index
+        where binding stopped. Shared by commands and range elements.
+        """
+        pos = list(positional)
         n = len(toks)
         while i < n:
             tok = toks[i]
             if pos:
                 p = pos[0]
-                if p.value.fits(tok) and not (tok.type == "WORD" and self._is_keyword_word(cmd, tok, names)):
+                if p.value.fits(tok) and not (tok.type == "WORD" and matches(str(tok), names)):
                     pos.pop(0)
                     locs[p.key] = self.where(tok)
                     args[p.key], i = p.value.take(toks, i, self)
                     given.append(p.key)
                     continue
                 if p.required:
-                    raise BindError(f"`{cmd.name}` needs {p.name} {p.value.describe()} here, got `{tok}`",
+                    raise BindError(f"{what} needs {p.name} {p.value.describe()} here, got `{tok}`",
                                     self.where(tok), hint=p.doc or None)
                 pos.pop(0)
                 continue
-            if tok.type != "WORD":
-                raise BindError(f"unexpected value `{tok}`", self.where(tok),
-                                hint=self._keyword_hint(cmd))
-            word = str(tok).lower()
-            hits = matches(word, names)
+            hits = matches(str(tok), names) if tok.type == "WORD" else []
             if len(hits) > 1:
                 raise BindError(f"keyword `{tok}` is ambiguous: could be {', '.join(hits)}", self.where(tok))
             if len(hits) == 1:
@@ -298,19 +293,50 @@ class Binder:
                 locs[p.key] = self.where(toks[i + 1] if j > i + 1 else tok)
                 if p.repeat:
                     args.setdefault(p.key, []).append(value)
-                elif p.key in args and p.key in given:
+                elif p.key in given:
                     raise BindError(f"keyword `{p.name}` given twice", self.where(tok))
                 else:
                     args[p.key] = value
                 given.append(p.key)
                 i = j
                 continue
-            if cmd.range and (matches(word, ["range"]) == ["range"] and len(word) >= 2 or word == "range"):
+            j = on_other(i)
+            if j is None:
+                break
+            i = j
+        for p in pos:
+            if p.required:
+                raise BindError(f"{what} needs {p.name} {p.value.describe()}", self._end(toks), hint=p.doc or None)
+        return i
+
+    def _fill_defaults(self, what: str, params, args, toks) -> None:
+        for p in params:
+            if p.key not in args:
+                if p.required:
+                    raise BindError(f"{what} needs keyword `{p.name}` {p.value.describe()}", self._end(toks),
+                                    hint=p.doc or None)
+                args[p.key] = [] if p.repeat else p.default
+
+    def _bind_args(self, cmd: Command, toks, i, pre, loc, inherited=()) -> CommandCall:
+        args: dict[str, Any] = dict(pre)
+        given: list[str] = list(pre)
+        extra: dict[str, Any] = {}
+        locs: dict[str, Any] = {}
+        rng = None
+        n = len(toks)
+
+        def other(i):
+            nonlocal rng
+            tok = toks[i]
+            if tok.type != "WORD":
+                raise BindError(f"unexpected value `{tok}`", self.where(tok), hint=self._keyword_hint(cmd))
+            word = str(tok).lower()
+            if cmd.range and (word == "range" or (len(word) >= 2 and matches(word, ["range"]) == ["range"])):
                 rng = self._bind_range(toks, i + 1, cmd)
-                break
+                return None
             if cmd.range and matches(word, self.reg.range_elements):
-                rng = self._bind_range(toks, i, cmd)
-                break
+                rng = self._bind_range(toks, i, cmd)       # `range` omitted before the first element
+                return None
             if cmd.open_keywords and i + 1 < n and toks[i + 1].type in ("NUMBER", "EXPR", "ATNAME", "STRING"):
                 vt = toks[i + 1]
                 if vt.type == "STRING":
@@ -319,29 +345,23 @@ class Binder:
                     extra[word] = float(str(vt))
                 else:
                     extra[word] = self.deferred(vt)
-                i += 2
-                continue
-            cands = list(names) + (["range"] + sorted(self.reg.range_elements) if cmd.range else [])
+                return i + 2
+            cands = list(cmd.keyword_names) + (["range"] + sorted(self.reg.range_elements) if cmd.range else [])
             close = suggest(word, cands)
             raise BindError(f"unknown keyword `{tok}` for `{cmd.name}`", self.where(tok),
                             hint=f"did you mean {' or '.join(f'`{c}`' for c in close)}?" if close
                             else self._keyword_hint(cmd))
-        for p in pos:
-            if p.required:
-                raise BindError(f"`{cmd.name}` needs {p.name} {p.value.describe()}", self._end(toks),
-                                hint=p.doc or None)
-        for p in cmd.positional + cmd.keywords:
-            if p.key not in args:
-                if p.required:
-                    raise BindError(f"`{cmd.name}` needs keyword `{p.name}` {p.value.describe()}", self._end(toks),
-                                    hint=p.doc or None)
-                args[p.key] = [] if p.repeat else p.default
-        return CommandCall(cmd, args, tuple(given), rng, loc, extra, locs)
 
-    @staticmethod
-    def _is_keyword_word(cmd, tok, names) -> bool:
-        """A word that names a keyword is a keyword, not a positional text value."""
-        return bool(matches(str(tok), names))
+        what = f"`{cmd.name}`"
+        names, by_name, params = cmd.keyword_names, cmd.by_name, cmd.positional + cmd.keywords
+        extra_kw = tuple(p for p in inherited if p.name not in by_name)
+        if extra_kw:       # keywords of a command group may also follow the command word
+            names = names + tuple(p.name for p in extra_kw)
+            by_name = {**by_name, **{p.name: p for p in extra_kw}}
+            params = params + extra_kw
+        self._bind_params(what, cmd.positional, names, by_name, toks, i, args, given, locs, other)
+        self._fill_defaults(what, params, args, toks)
+        return CommandCall(cmd, args, tuple(given), rng, loc, extra, locs)
 
     def _keyword_hint(self, cmd: Command) -> str:
         kws = [p.name for p in cmd.keywords]
@@ -350,8 +370,9 @@ class Binder:
         return f"keywords of `{cmd.name}`: {', '.join(kws)}" if kws else f"`{cmd.name}` takes no keywords"
 
     def _end(self, toks):
+        """Just after the last token: where a missing value would have stood."""
         last = toks[-1]
-        loc = self.where(last)
+        loc = self.deck.location(last, self.stack)
         return SourceLocation(loc.file, loc.line, loc.column + len(str(last)), loc.text, 1, loc.stack)
 
     # ------------------------------------------------------------ ranges
@@ -398,43 +419,18 @@ class Binder:
 
     def _bind_element(self, elem: RangeElement, toks, i, head):
         args: dict[str, Any] = {}
-        pos = list(elem.positional)
-        names = [p.name for p in elem.keywords]
-        by_name = {p.name: p for p in elem.keywords}
-        n = len(toks)
-        while i < n:
+
+        def other(i):
             tok = toks[i]
-            if pos:
-                p = pos[0]
-                if p.value.fits(tok) and not (tok.type == "WORD" and matches(str(tok), names)):
-                    pos.pop(0)
-                    args[p.key], i = p.value.take(toks, i, self)
-                    continue
-                if p.required:
-                    raise BindError(f"range element `{elem.name}` needs {p.name} {p.value.describe()}",
-                                    self.where(tok), hint=p.doc or None)
-                pos.pop(0)
-                continue
             if tok.type != "WORD":
                 raise BindError(f"unexpected value `{tok}` in range element `{elem.name}`", self.where(tok))
-            hits = matches(str(tok), names)
-            if len(hits) != 1:
-                break                      # next element (or a modifier)
-            p = by_name[hits[0]]
-            value, i = self._take_value(p, toks, i + 1, tok)
-            if p.repeat:
-                args.setdefault(p.key, []).append(value)
-            else:
-                args[p.key] = value
-        for p in pos:
-            if p.required:
-                raise BindError(f"range element `{elem.name}` needs {p.name} {p.value.describe()}",
-                                self._end(toks))
-        for p in elem.positional + elem.keywords:
-            if p.key not in args:
-                if p.required:
-                    raise BindError(f"range element `{elem.name}` needs `{p.name}`", self.where(head))
-                args[p.key] = [] if p.repeat else p.default
+            return None                    # the next element, or a modifier
+
+        names = tuple(p.name for p in elem.keywords)
+        by_name = {p.name: p for p in elem.keywords}
+        what = f"range element `{elem.name}`"
+        i = self._bind_params(what, elem.positional, names, by_name, toks, i, args, [], {}, other)
+        self._fill_defaults(what, elem.positional + elem.keywords, args, toks)
         return args, i
 
 

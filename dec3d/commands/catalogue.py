@@ -9,7 +9,7 @@ take precedence over these names.
 from __future__ import annotations
 
 from .registry import REGISTRY, RangeElement
-from .values import P, Text
+from .values import Num, P, Text
 
 _GROUPS = {
     "model": "calm clean configure creep cycle deterministic domain dynamic energy factor-of-safety fluid gravity "
@@ -55,7 +55,9 @@ def install(registry=REGISTRY) -> None:
     # `block create group 'g' poly ...`: group/slot may precede the shape word
     registry.node_keywords("block create", [P("group", Text(), "group name of the new block(s)"),
                                             P("slot", Text(), "group slot"),
-                                            P("face-group", Text(), "group of the new faces")])
+                                            P("face-group", Text(), "group of the new faces"),
+                                            P("region", Num(integer=True), "3DEC 5 region number, still written by "
+                                              "some generators (`r=0`): accepted and ignored; use group")])
     registry.node_keywords("model history", [P("name", Text(), "history name")])
     registry.node_keywords("block history", [P("name", Text(), "history name")])
     registry.node_keywords("fish history", [P("name", Text(), "history name")])
