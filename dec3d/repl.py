@@ -100,6 +100,11 @@ def run_repl(out_dir=None, history_file=None, input=None, output=None) -> int:
             break
         except Dec3dError as exc:
             session.write(exc.format())
+        except Exception as exc:  # a bug in dec3d must not cost the user the session and its model
+            import traceback
+
+            session.write("internal error (please report it with the command that caused it):")
+            session.write("".join(traceback.format_exception_only(type(exc), exc)).rstrip())
     session.close_log()
     return 0
 
