@@ -1,0 +1,204 @@
+"""Common-plane (c-p) detection between two convex vertex sets (3DEC theory, Cundall 1988).
+
+Conventions (ERRATA, Eqs. 6-8): the unit normal ``n`` points from block A to block B;
+signed distances are measured from the c-p through its reference point C:
+
+    d_A = max over vertices of A of n·(V − C)      (Eq. 7, corrected)
+    d_B = min over vertices of B of n·(V − C)      (Eq. 6)
+    gap = d_B − d_A                                (> 0: apart, < 0: overlap), metres
+
+The gap does not depend on C, only on n, so the rotation search (Eq. 10) is a
+hill-climb of g(n) = min_B n·V − max_A n·V over the unit sphere: four perturbations
+n := (n ± k p)/z, (n ± k q)/z with z² = 1 + k², k from tan 5° down to tan 0.01°; the
+perturbation axes p, q are turned by 45° on alternate iterations (saddle points); the
+search stops early when the gap exceeds CTOL (no contact).
+
+Contact types (ERRATA, Table 1) from the number of vertices of A / B touching the c-p:
+1/1 vertex-vertex, 1/2 vertex-edge, 1/≥3 vertex-face, 2/2 edge-edge, 2/≥3 edge-face,
+≥3/≥3 face-face (and the symmetric cases).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+CT_NONE = 0
+CT_VV = 1
+CT_VE = 2
+CT_VF = 3
+CT_EE = 4
+CT_EF = 5
+CT_FF = 6
+CONTACT_TYPE_NAMES = ("none", "vertex-vertex", "vertex-edge", "vertex-face", "edge-edge",
+                      "edge-face", "face-face")
+
+KMAX_DEG = 5.0
+KMIN_DEG = 0.01
+ORIENT = (0.0, math.pi / 4, math.pi / 8, 3 * math.pi / 8, math.pi / 16, 5 * math.pi / 16, 3 * math.pi / 16, 7 * math.pi / 16)
+NORIENT = 8
+
+
+@njit(cache=True)
+def contact_type(na, nb):
+    """Contact type code (CT_*) from touching-vertex counts na of A and nb of B (ERRATA Table 1)."""
+    lo = min(na, nb)
+    hi = max(na, nb)
+    if lo <= 0:
+        return CT_NONE
+    if lo == 1:
+        if hi == 1:
+            return CT_VV
+        if hi == 2:
+            return CT_VE
+        return CT_VF
+    if lo == 2:
+        if hi == 2:
+            return CT_EE
+        return CT_EF
+    return CT_FF
+
+
+@njit(cache=True)
+def cp_gap(va, vb, n):
+    """g(n) = min_B n·V − max_A n·V for vertex arrays va (na, 3), vb (nb, 3) [m]."""
+    da = -1e300
+    for i in range(va.shape[0]):
+        d = n[0] * va[i, 0] + n[1] * va[i, 1] + n[2] * va[i, 2]
+        if d > da:
+            da = d
+    db = 1e300
+    for i in range(vb.shape[0]):
+        d = n[0] * vb[i, 0] + n[1] * vb[i, 1] + n[2] * vb[i, 2]
+        if d < db:
+            db = d
+    return db - da
+
+
+@njit(cache=True)
+def _basis(n, p, q):
+    """Two unit vectors p, q orthogonal to n and to each other (written in place)."""
+    ax = abs(n[0])
+    ay = abs(n[1])
+    az = abs(n[2])
+    if ax <= ay and ax <= az:
+        t0, t1, t2 = 1.0, 0.0, 0.0
+    elif ay <= az:
+        t0, t1, t2 = 0.0, 1.0, 0.0
+    else:
+        t0, t1, t2 = 0.0, 0.0, 1.0
+    p[0] = n[1] * t2 - n[2] * t1
+    p[1] = n[2] * t0 - n[0] * t2
+    p[2] = n[0] * t1 - n[1] * t0
+    s = math.sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2])
+    p[0] /= s
+    p[1] /= s
+    p[2] /= s
+    q[0] = n[1] * p[2] - n[2] * p[1]
+    q[1] = n[2] * p[0] - n[0] * p[2]
+    q[2] = n[0] * p[1] - n[1] * p[0]
+
+
+@njit(cache=True)
+def common_plane(va, vb, n0, ctol, existing, out_n, out_c):
+    """Position the c-p between convex vertex sets va (na, 3) and vb (nb, 3) [m].
+
+    n0 (3,): starting unit normal (A → B); for a new contact pass B − A centroids (Eq. 5).
+    existing: True for a contact that already has a c-p (fast path: start at k_min).
+    Writes the unit normal into out_n (3,) and the reference point (Eqs. 8-9) into out_c (3,).
+    Returns (gap [m], touching vertices of A, touching vertices of B, iterations).
+    A vertex touches when it lies within ctol of its block's nearest level on the c-p.
+    When the gap exceeds ctol the search stops early (counts are 0).
+    """
+    n = np.empty(3)
+    s = math.sqrt(n0[0] ** 2 + n0[1] ** 2 + n0[2] ** 2)
+    for i in range(3):
+        n[i] = n0[i] / s
+    p = np.empty(3)
+    q = np.empty(3)
+    t = np.empty(3)
+    best_n = np.empty(3)
+    kmax = math.tan(math.radians(KMAX_DEG))
+    kmin = math.tan(math.radians(KMIN_DEG))
+    k = kmin if existing else kmax
+    best = cp_gap(va, vb, n)
+    it = 0
+    fails = 0
+    while True:
+        it += 1
+        _basis(n, p, q)
+        # axes turned about n on successive iterations: 45° on alternate ones (as the text
+        # says), and, while a step size keeps failing, by 22.5° and 67.5° too (ridges)
+        ang = ORIENT[(it - 1) % NORIENT]
+        ca = math.cos(ang)
+        sa = math.sin(ang)
+        for i in range(3):
+            a = ca * p[i] + sa * q[i]
+            b = ca * q[i] - sa * p[i]
+            p[i] = a
+            q[i] = b
+        z = math.sqrt(1.0 + k * k)
+        improved = False
+        for j in range(4):
+            sg = 1.0 if j % 2 == 0 else -1.0
+            for i in range(3):
+                t[i] = (n[i] + sg * k * (p[i] if j < 2 else q[i])) / z
+            g = cp_gap(va, vb, t)
+            if g > best:
+                best = g
+                improved = True
+                for i in range(3):
+                    best_n[i] = t[i]
+        if improved:
+            fails = 0
+            for i in range(3):
+                n[i] = best_n[i]
+            if existing and k == kmin:
+                k = kmax        # the fast path found a better normal: do the full search
+        else:
+            fails += 1          # a step size is given up only when both axis pairs fail
+            if fails >= NORIENT:
+                fails = 0
+                if k <= kmin * 1.0000001:
+                    break
+                k = max(k * 0.5, kmin)
+        if best > ctol or it > 10000:
+            break
+    # translation: Eq. (8) for touching blocks, Eq. (9) (midway between nearest vertices) if apart
+    ia = 0
+    da = -1e300
+    for i in range(va.shape[0]):
+        d = n[0] * va[i, 0] + n[1] * va[i, 1] + n[2] * va[i, 2]
+        if d > da:
+            da = d
+            ia = i
+    ib = 0
+    db = 1e300
+    for i in range(vb.shape[0]):
+        d = n[0] * vb[i, 0] + n[1] * vb[i, 1] + n[2] * vb[i, 2]
+        if d < db:
+            db = d
+            ib = i
+    gap = db - da
+    for i in range(3):
+        out_n[i] = n[i]
+    if gap > 0.0:
+        for i in range(3):
+            out_c[i] = 0.5 * (va[ia, i] + vb[ib, i])
+    else:
+        # keep the in-plane position of out_c (the caller's reference point), move it along n
+        dc = n[0] * out_c[0] + n[1] * out_c[1] + n[2] * out_c[2]
+        for i in range(3):
+            out_c[i] += (0.5 * (da + db) - dc) * n[i]
+    if gap > ctol:
+        return gap, 0, 0, it
+    na = 0
+    for i in range(va.shape[0]):
+        if n[0] * va[i, 0] + n[1] * va[i, 1] + n[2] * va[i, 2] >= da - ctol:
+            na += 1
+    nb = 0
+    for i in range(vb.shape[0]):
+        if n[0] * vb[i, 0] + n[1] * vb[i, 1] + n[2] * vb[i, 2] <= db + ctol:
+            nb += 1
+    return gap, na, nb, it
