@@ -78,6 +78,8 @@ def save_state(model: Model, path: str | os.PathLike, records: list[str] | None 
         "settings": model.settings.to_dict(),
         "tolerance": model.tolerance,
         "next_block_id": model.next_block_id,
+        "time": model.time,
+        "step": model.step,
         "groups": model.groups.to_dict(),
         "stores": schema,
         "sha256": {name: hashlib.sha256(b).hexdigest() for name, b in blobs.items()},
@@ -163,6 +165,8 @@ def _build(path: str, meta: dict, blobs: dict[str, bytes]) -> Model:
     model.settings = Settings.from_dict(meta["settings"])
     model.tolerance = float(meta["tolerance"])
     model.next_block_id = int(meta["next_block_id"])
+    model.time = float(meta.get("time", 0.0))
+    model.step = int(meta.get("step", 0))
     model.groups = GroupTable.from_dict(meta["groups"])
     for sname, sdesc in meta["stores"].items():
         stores = model.stores

@@ -161,3 +161,33 @@ class VtkSeries:
         self.entries.append((float(time), vtu))
         write_pvd(self.pvd_path, self.entries)
         return vtu
+
+
+def request_vtk(model, stem: str, interval: int = 0) -> None:
+    """Ask for snapshots of ``model`` into the series ``stem`` (``<stem>_<nnnn>.vtu`` and
+    ``<stem>.pvd``): one now, and every ``interval`` steps afterwards when interval > 0.
+    Requests for the same stem continue its series."""
+    req = model.outputs.get("vtk")
+    if req is None or req["series"].stem != stem:
+        req = {"series": VtkSeries(stem), "interval": 0, "last_step": None}
+        model.outputs["vtk"] = req
+    req["interval"] = int(interval)
+    req["series"].write(model, model.time)
+    req["last_step"] = model.step
+
+
+def periodic_vtk(model) -> str | None:
+    """For the engine, after each batch of steps: write a snapshot if ``interval`` steps
+    have passed since the last one. Returns the file written, if any."""
+    req = model.outputs.get("vtk")
+    if not req or req["interval"] <= 0:
+        return None
+    if req["last_step"] is not None and model.step - req["last_step"] < req["interval"]:
+        return None
+    req["last_step"] = model.step
+    return req["series"].write(model, model.time)
+
+
+def stop_vtk(model) -> None:
+    """``block vtk off``: no more periodic snapshots."""
+    model.outputs.pop("vtk", None)

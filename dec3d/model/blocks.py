@@ -158,3 +158,14 @@ def summary(model: Model) -> dict:
         "extent": (pos.min(axis=0).tolist(), pos.max(axis=0).tolist()) if len(pos) else None,
     }
     return info
+
+
+def group_faces(model: Model, mask, name: str, slot: str | None = None, remove: bool = False) -> int:
+    """Put faces (boolean mask over face rows) in group ``name`` (or take them out)."""
+    mask = np.asarray(mask)
+    rows = np.flatnonzero(mask) if mask.dtype == bool else mask.astype(np.int64)
+    if remove:
+        model.groups.remove(model.faces, rows, name, slot)
+    else:
+        model.groups.assign(model.faces, rows, name, slot)
+    return int(rows.size)

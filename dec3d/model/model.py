@@ -118,6 +118,12 @@ class Model:
         #: the next block id handed out (ids are never reused)
         self.next_block_id: int = 1
         self._extra_stores: dict[str, Store] = {}
+        #: model time [s] and step count (the engine advances them; saved with the state)
+        self.time: float = 0.0
+        self.step: int = 0
+        #: periodic outputs requested by commands (e.g. "vtk": ``dec3d.io.vtk.periodic_vtk``);
+        #: plain data, not saved
+        self.outputs: dict[str, dict] = {}
 
     @property
     def stores(self) -> dict[str, Store]:

@@ -27,9 +27,10 @@ def positions(model, store_name: str) -> np.ndarray:
     """The (n, 3) point by which rows of a store are selected geometrically."""
     store = model.store(store_name)
     key = _POSITION_FIELD.get(store.name)
-    if key is None:
-        raise KeyError(f"rows of '{store_name}' have no position to select by")
-    return store[key]
+    for k in (key, "centroid", "pos"):
+        if k is not None and k in store:
+            return store[k]
+    raise KeyError(f"{store_name}s have no position to select by")
 
 
 def _vec(v) -> np.ndarray:
@@ -135,6 +136,8 @@ def mask_group(model, store_name: str, names: str | Sequence[str],
     """``group '<g>' [slot '<s>'] [or '<g2>' ...]``: in any of the groups, in ``slot`` if
     given, else in any slot."""
     store = model.store(store_name)
+    if GROUP_FIELD not in store:
+        raise KeyError(f"{store_name}s have no groups")
     if isinstance(names, str):
         names = [names]
     codes = _group_codes(model, names)
@@ -165,7 +168,7 @@ def mask_id_list(model, store_name: str, ids: Sequence[int]) -> np.ndarray:
     """``id-list <i> ...``: rows whose user id is in the list."""
     store = model.store(store_name)
     if "id" not in store:
-        raise KeyError(f"rows of '{store_name}' have no id")
+        raise KeyError(f"{store_name}s have no id")
     return np.isin(store["id"], np.asarray(list(ids), dtype=np.int64))
 
 

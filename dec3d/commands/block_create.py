@@ -1,0 +1,110 @@
+"""`block create brick|polyhedron|prism|tetrahedron|tunnel`: new convex blocks.
+
+Every form accepts `group '<g>' [slot '<s>']` (before or after the shape word) and
+`face-group '<g>'` for the new faces. The geometry is checked before anything is added:
+a refused shape leaves the model as it was.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..geometry.polyhedron import brick, polyhedron_from_faces, prism, tetrahedron
+from ..geometry.tunnel import tunnel
+from ..model.blocks import add_blocks
+from .registry import command
+from .values import ANGLE, VEC3, Nums, Num, P, Text
+
+GROUP_KW = [P("group", Text(), "group of the new blocks"),
+            P("slot", Text(), "group slot (default 'Default')"),
+            P("face-group", Text(), "group of the new blocks' faces"),
+            P("region", Num(integer=True), "3DEC 5 region number (`r=0` in old generators): accepted, ignored")]
+
+
+def _add(session, call, polys) -> None:
+    m = session.model
+    rows = add_blocks(m, polys, group=call.args["group"], slot=call.args["slot"])
+    if call.args["face_group"] is not None:
+        fs = m.blocks["face_start"][rows]
+        fc = m.blocks["face_count"][rows]
+        faces = np.concatenate([np.arange(s, s + c) for s, c in zip(fs, fc)])
+        m.groups.assign(m.faces, faces, call.args["face_group"], call.args["slot"])
+
+
+@command("block create brick",
+         positional=[P("bounds", Nums(2, 6, counts=(2, 4, 6)), "x1 x2 [y1 y2 [z1 z2]]", required=True, units="m")],
+         keywords=GROUP_KW,
+         doc="Create a block spanning x1..x2, y1..y2, z1..z2 (a pair left out repeats the one before).",
+         examples=["block create brick 0 1.292 -0.05 0 0.0 0.210 group 'S'", "block create brick 0 10",
+                   "block create group 'rock' brick 0 10 0 10 0 10"])
+def create_brick(session, call):
+    b = list(call.args["bounds"])
+    while len(b) < 6:
+        b += b[-2:]
+    _add(session, call, [brick(*b, tol=session.model.tolerance)])
+
+
+@command("block create polyhedron",
+         keywords=[P("face", Nums(9, 10**6, multiple_of=3), "the corners x,y,z of one face, in order around it",
+                     repeat=True, units="m"), *GROUP_KW],
+         doc="Create a convex block from its faces (every face given, either winding).",
+         details="Corners closer than the tolerance are merged. The faces must be planar and close the "
+                 "block; a non-planar face, an open or non-convex shape, or a zero volume is refused "
+                 "with the number of the offending face.",
+         examples=["block create polyhedron face 0,0,0 1,0,0 0,1,0 face 0,0,0 0,0,1 1,0,0 "
+                   "face 0,0,0 0,1,0 0,0,1 face 1,0,0 0,0,1 0,1,0",
+                   "block create group 'Supports' poly face 0 0 0 1 0 0 0 1 0 face 0 0 0 0 0 1 1 0 0 "
+                   "face 0 0 0 0 1 0 0 0 1 face 1 0 0 0 0 1 0 1 0"])
+def create_polyhedron(session, call):
+    faces = [np.asarray(f, dtype=np.float64).reshape(-1, 3) for f in call.args["face"]]
+    _add(session, call, [polyhedron_from_faces(faces, session.model.tolerance)])
+
+
+@command("block create prism",
+         keywords=[P("face-1", Nums(9, 10**6, multiple_of=3), "corners of one end face", required=True, units="m"),
+                   P("face-2", Nums(9, 10**6, multiple_of=3), "corners of the other end, in the same order",
+                     required=True, units="m"), *GROUP_KW],
+         doc="Create a prism between two polygons with as many corners (corner i joined to corner i).",
+         examples=["block create prism face-1 0 0 0 1 0 0 0 1 0 face-2 0 0 1 1 0 1 0 1 1 group 'p'"])
+def create_prism(session, call):
+    _add(session, call, [prism(np.reshape(call.args["face_1"], (-1, 3)), np.reshape(call.args["face_2"], (-1, 3)),
+                               session.model.tolerance)])
+
+
+@command("block create tetrahedron",
+         positional=[P("corners", Nums(12, 12), "four corners v1 v2 v3 v4", required=True, units="m")],
+         keywords=GROUP_KW,
+         doc="Create a tetrahedron on four corners.",
+         examples=["block create tetrahedron 0 0 0 1 0 0 0 1 0 0 0 1"])
+def create_tetrahedron(session, call):
+    c = np.reshape(call.args["corners"], (4, 3))
+    _add(session, call, [tetrahedron(*c, tol=session.model.tolerance)])
+
+
+@command("block create tunnel",
+         keywords=[P("dip", ANGLE, "plunge of the axis, degrees", default=0.0),
+                   P("dip-direction", ANGLE, "trend of the axis, degrees clockwise from +y", default=0.0),
+                   P("radius", Num(lo=0, lo_open=True), "radius of the opening", required=True, units="m"),
+                   P("length", Nums(2, 2), "axial start and end, from the origin", required=True, units="m"),
+                   P("origin", VEC3, "a point of the axis", default=(0.0, 0.0, 0.0), units="m"),
+                   P("blocks-axial", Num(integer=True, lo=1), "blocks along the axis", default=1),
+                   P("blocks-radial", Num(integer=True, lo=1), "rings between the opening and the boundary",
+                     default=1),
+                   P("blocks-tangential", Num(integer=True, lo=1), "blocks per 45° around the axis", default=1),
+                   P("boundary", Num(lo=0, lo_open=True), "distance from the opening to the square boundary",
+                     required=True, units="m"),
+                   P("radius-ratio", Num(lo=0, lo_open=True), "growth of the ring widths outwards", default=1.0),
+                   *GROUP_KW],
+         doc="Create the blocks of a square rock mass around a circular tunnel (opening filled).",
+         details="The axis runs along the dip vector (dip 0, dip-direction 0: along +y). The section is the "
+                 "square |u|, |v| ≤ radius + boundary; rays at equal angles (blocks-tangential per 45°) run "
+                 "from the opening's polygon to the square, cut into blocks-radial rings whose widths grow "
+                 "by radius-ratio. The opening is filled with prisms: delete them with "
+                 "`block delete range cylinder ... radius 0 <radius>`.",
+         examples=["block create tunnel dip 0 dip-direction 0 radius 1 length 0 1 blocks-axial 1 "
+                   "blocks-radial 10 blocks-tangential 5 boundary 9 radius-ratio 1.4"])
+def create_tunnel(session, call):
+    a = call.args
+    polys = tunnel(a["dip"], a["dip_direction"], a["radius"], a["length"], a["blocks_axial"],
+                   a["blocks_radial"], a["blocks_tangential"], a["boundary"], a["radius_ratio"],
+                   origin=a["origin"], tol=session.model.tolerance)
+    _add(session, call, polys)

@@ -1,0 +1,102 @@
+"""`block delete|hide|group|join|property|list`: editing and inspecting blocks."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..model.blocks import (delete_blocks, group_blocks, hide_blocks, join_blocks, joined_groups,
+                            set_density, summary)
+from .registry import command
+from .values import FLAG, ONOFF, Choice, Num, P, Text
+
+
+@command("block delete", range="block",
+         doc="Delete the blocks in range (all blocks without a range).",
+         details="Block ids are not reused. Followers of a deleted leader follow the lowest remaining block "
+                 "of their joined group.",
+         examples=["block delete range cylinder end-1 0 0 0 end-2 0 1 0 radius 0 1",
+                   "block delete range plane dip 0 dip-direction 0 below",
+                   "block delete range pos-x 0.3230 0.4038"])
+def block_delete(session, call):
+    delete_blocks(session.model, session.range_mask(call, "block"))
+
+
+@command("block hide", positional=[P("mode", ONOFF, "on hides, off shows again", default=True)], range="block",
+         doc="Hide the blocks in range (hidden blocks are not cut), or show them again with `off`.",
+         examples=["block hide range group 'brickUp' not", "block hide group \"foundation\"", "block hide off",
+                   "block hide pos-x 0 0.32", "block hide"])
+def block_hide(session, call):
+    hide_blocks(session.model, session.range_mask(call, "block"), on=call.args["mode"])
+
+
+@command("block group", positional=[P("name", Text(), "group name", required=True)],
+         keywords=[P("slot", Text(), "group slot (default 'Default')"),
+                   P("remove", FLAG, "take the blocks out of the group instead", bare=True)],
+         range="block",
+         doc="Put the blocks in range in a group (one group per slot; the old one is replaced).",
+         examples=["block group 'Masonry' range group 'S' or 'T_B' not", "block group 'top' slot 'layer'",
+                   "block group 'top' slot 'layer' remove range position-z 0 1"])
+def block_group(session, call):
+    a = call.args
+    group_blocks(session.model, session.range_mask(call, "block"), a["name"], a["slot"], remove=bool(a["remove"]))
+
+
+@command("block join", positional=[P("mode", ONOFF, "on joins, off releases", default=True)], range="block",
+         doc="Join the blocks in range into one rigid body (leader/follower), or release them with `off`.",
+         details="Joined blocks keep their convex pieces for contact detection and move as one body "
+                 "(the leader carries the group's mass, centroid and inertia). Joining merges with any "
+                 "joined group a selected block already belongs to.",
+         examples=["block join on", "block join range group 'wall'", "block join off range id 3"])
+def block_join(session, call):
+    join_blocks(session.model, session.range_mask(call, "block"), on=call.args["mode"])
+
+
+@command("block property", keywords=[P("density", Num(lo=0, lo_open=True), "mass density", required=True,
+                                       units="kg/m³")],
+         range="block",
+         doc="Set the density of the blocks in range (mass and inertia follow).",
+         examples=["block property density 2650", "block prop dens 1500 range group 'soft'"])
+def block_property(session, call):
+    set_density(session.model, session.range_mask(call, "block"), call.args["density"])
+
+
+def _groups_of(model, row) -> str:
+    names = []
+    for col, slot in enumerate(model.groups.slot_names("blocks")):
+        code = model.blocks["group"][row, col]
+        if code >= 0:
+            names.append(model.groups.name(code) if slot == "Default" else f"{model.groups.name(code)}({slot})")
+    return " ".join(names)
+
+
+@command("block list", positional=[P("what", Choice(("information",)), "summary instead of a block table")],
+         range="block",
+         doc="List the blocks in range (id, centroid, volume, density, groups), or a summary with `information`.",
+         examples=["block list", "block list information", "block list range group 'rock'"])
+def block_list(session, call):
+    m = session.model
+    mask = session.range_mask(call, "block")
+    if call.args["what"] == "information":
+        s = summary(m)
+        sel = np.flatnonzero(mask)
+        session.write(f"blocks {s['blocks']} (in range {sel.size}, hidden {s['hidden']}, "
+                      f"joined {s['joined']} in {len(joined_groups(m))} groups)")
+        session.write(f"vertices {s['vertices']}, faces {s['faces']}")
+        session.write(f"total volume {s['volume']:.6g} m^3, mass {s['mass']:.6g} kg")
+        if sel.size:
+            vol = m.blocks["volume"][sel]
+            session.write(f"volume in range: total {vol.sum():.6g}, min {vol.min():.6g}, max {vol.max():.6g} m^3")
+        if s["extent"]:
+            lo, hi = s["extent"]
+            session.write("extent x {:.6g} {:.6g}  y {:.6g} {:.6g}  z {:.6g} {:.6g} m".format(
+                lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]))
+        session.write(f"tolerance {s['tolerance']:g} m")
+        session.results.update({"blocks": float(s["blocks"]), "volume": s["volume"]})
+        return
+    b = m.blocks
+    session.write(f"{'id':>7} {'x':>11} {'y':>11} {'z':>11} {'volume':>11} {'density':>9}  groups")
+    for r in np.flatnonzero(mask):
+        c = b["centroid"][r]
+        flag = " (hidden)" if b["hidden"][r] else ""
+        session.write(f"{b['id'][r]:>7} {c[0]:>11.5g} {c[1]:>11.5g} {c[2]:>11.5g} {b['volume'][r]:>11.5g} "
+                      f"{b['density'][r]:>9.5g}  {_groups_of(m, r)}{flag}")
+
