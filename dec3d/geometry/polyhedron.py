@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from .errors import GeometryError
 
@@ -39,10 +40,31 @@ def _fmt(p) -> str:
     return "(" + ", ".join(f"{x:.6g}" for x in p) + ")"
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross product (faster than np.cross on the small arrays met here)."""
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+
+
 def _newell(pts: np.ndarray) -> np.ndarray:
-    """Area vector (3,) of a closed polygon loop (twice the area times the unit normal / 2)."""
-    nxt = np.roll(pts, -1, axis=0)
-    return 0.5 * np.cross(pts - pts.mean(axis=0), nxt - pts.mean(axis=0)).sum(axis=0)
+    """Area vector (3,) of a closed polygon loop: area times the unit normal."""
+    m = pts.mean(axis=0)
+    return 0.5 * _cross(pts - m, np.roll(pts, -1, axis=0) - m).sum(axis=0)
+
+
+def _merge_points(pts: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """Unique points (in order of first appearance) and the index of each input point's.
+
+    A point joins the earliest point within ``tol`` (max-norm) of it, or of that point."""
+    first = np.arange(len(pts))
+    pairs = cKDTree(pts).query_pairs(tol, p=np.inf, output_type="ndarray")
+    if len(pairs):
+        np.minimum.at(first, pairs[:, 1], pairs[:, 0])
+        np.minimum.at(first, pairs[:, 0], pairs[:, 1])
+        first = first[first]                         # chains: follow to the representative
+    reps, index = np.unique(first, return_inverse=True)
+    return pts[reps], index
 
 
 def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyhedron") -> Poly:
@@ -54,26 +76,25 @@ def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyh
     the volume is zero.
     """
     tol = float(tol)
-    verts: list[np.ndarray] = []
-    loops: list[list[int]] = []
+    arrays = []
     for fi, face in enumerate(faces, start=1):
         pts = np.asarray(face, dtype=np.float64)
         if pts.ndim != 2 or pts.shape[1] != 3:
             raise GeometryError(f"{what}: face {fi} must be a list of 3-D points")
         if not np.all(np.isfinite(pts)):
             raise GeometryError(f"{what}: face {fi} has a coordinate that is not a finite number")
+        arrays.append(pts)
+    if not arrays:
+        raise GeometryError(f"{what}: no faces given")
+    v, index = _merge_points(np.concatenate(arrays), tol)
+    loops: list[list[int]] = []
+    start = 0
+    for fi, pts in enumerate(arrays, start=1):
         loop: list[int] = []
-        for p in pts:
-            idx = -1
-            for vi, q in enumerate(verts):
-                if np.max(np.abs(q - p)) <= tol:
-                    idx = vi
-                    break
-            if idx < 0:
-                verts.append(p)
-                idx = len(verts) - 1
+        for idx in index[start:start + len(pts)].tolist():
             if not loop or loop[-1] != idx:
                 loop.append(idx)
+        start += len(pts)
         if len(loop) > 1 and loop[0] == loop[-1]:
             loop.pop()
         if len(loop) < 3:
@@ -83,10 +104,10 @@ def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyh
         loops.append(loop)
     if len(loops) < 4:
         raise GeometryError(f"{what}: a closed polyhedron needs at least 4 faces, {len(loops)} given")
-    v = np.array(verts)
 
     # planarity and area of each face
     normals = []
+    areas = []
     for fi, loop in enumerate(loops, start=1):
         pts = v[loop]
         av = _newell(pts)
@@ -101,6 +122,7 @@ def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyh
                 f"{what}: face {fi} is not planar: corner {j + 1} {_fmt(pts[j])} lies "
                 f"{abs(dist[j]):.3g} m off the face's plane (tolerance {tol:g} m)")
         normals.append(n)
+        areas.append(area)
 
     # closed: every edge in exactly two faces
     edges: dict[tuple[int, int], list[int]] = {}
@@ -123,22 +145,22 @@ def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyh
 
     # turn every face outward, seen from the mean of the corners
     inside = v.mean(axis=0)
-    for fi, loop in enumerate(loops):
-        c = v[loop].mean(axis=0)
-        h = normals[fi] @ (c - inside)
-        if h < 0:
-            loop.reverse()
-            normals[fi] = -normals[fi]
+    centres = np.array([v[loop].mean(axis=0) for loop in loops])
+    normals = np.array(normals)
+    flip = np.einsum("ij,ij->i", normals, centres - inside) < 0
+    normals[flip] *= -1.0
+    for fi in np.flatnonzero(flip):
+        loops[fi].reverse()
 
     # convex: no corner in front of any face's plane
-    for fi, loop in enumerate(loops, start=1):
-        n = normals[fi - 1]
-        d = (v - v[loop].mean(axis=0)) @ n
-        j = int(np.argmax(d))
-        if d[j] > tol:
-            raise GeometryError(
-                f"{what}: not convex: corner {_fmt(v[j])} lies {d[j]:.3g} m outside the "
-                f"plane of face {fi} (tolerance {tol:g} m)")
+    d = np.einsum("fvk,fk->fv", v[None, :, :] - centres[:, None, :], normals)
+    bad = np.flatnonzero(d.max(axis=1) > tol)
+    if bad.size:
+        fi = int(bad[0])
+        j = int(np.argmax(d[fi]))
+        raise GeometryError(
+            f"{what}: not convex: corner {_fmt(v[j])} lies {d[fi, j]:.3g} m outside the "
+            f"plane of face {fi + 1} (tolerance {tol:g} m)")
 
     # consistent orientation: each directed edge once
     seen: set[tuple[int, int]] = set()
@@ -153,23 +175,26 @@ def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyh
     idx = np.array([i for lp in loops for i in lp], dtype=np.int64)
     poly = Poly(v, ptr, idx)
     vol = poly_volume(poly)
-    total_area = sum(np.linalg.norm(_newell(v[lp])) for lp in loops)
-    if vol <= tol * total_area:
+    if vol <= tol * sum(areas):
         raise GeometryError(f"{what}: zero volume ({vol:.3g} m^3): the faces enclose no space")
     return poly
 
 
 def poly_volume(poly: Poly) -> float:
     """Volume [m³] by the divergence theorem (faces fanned from their mean)."""
-    v = poly.vertices
-    r = v.mean(axis=0)
-    vol = 0.0
-    for f in range(poly.nfaces):
-        pts = v[poly.face(f)] - r
-        m = pts.mean(axis=0)
-        nxt = np.roll(pts, -1, axis=0)
-        vol += float(np.einsum("ij,ij->", np.cross(pts - m, nxt - m), np.broadcast_to(m, pts.shape))) / 6.0
-    return vol
+    v = poly.vertices - poly.vertices.mean(axis=0)
+    nv = np.diff(poly.face_ptr)
+    face_of = np.repeat(np.arange(poly.nfaces), nv)
+    pts = v[poly.face_idx]
+    nxt_idx = np.arange(len(poly.face_idx)) + 1
+    ends = poly.face_ptr[1:] - 1
+    nxt_idx[ends] = poly.face_ptr[:-1]
+    nxt = v[poly.face_idx[nxt_idx]]
+    means = np.zeros((poly.nfaces, 3))
+    np.add.at(means, face_of, pts)
+    means /= nv[:, None]
+    m = means[face_of]
+    return float(np.einsum("ij,ij->", _cross(pts, nxt), m)) / 6.0
 
 
 # ------------------------------------------------------------------ primitives
