@@ -18,7 +18,7 @@ from ..lang.expr import check_names, parse_expression
 from ..lang.parser import ParsedDeck, RawLine
 from .legacy import legacy_hint
 from .registry import REGISTRY, Command, Node, RangeElement, Registry
-from .values import MISSING, Deferred, Param
+from .values import MISSING, Deferred, Flag, Param
 
 
 # a `;` comment that is not inside a quoted string
@@ -252,6 +252,8 @@ class Binder:
         if not param.supported:
             raise NotSupportedError(f"keyword `{param.name}` is not supported yet", self.where(kwtok))
         vt = param.value
+        if isinstance(vt, Flag):          # present means True; it takes no value
+            return True, i
         if i < len(toks) and vt.fits(toks[i]):
             return vt.take(toks, i, self)
         if param.bare is not MISSING:

@@ -91,3 +91,9 @@ def test_bare_call_alias_and_log(tmp_path, session):
     assert session.model.settings.title == "from sub"
     log = (tmp_path / "run.log").read_text()
     assert "hello log" in log and "not logged" not in log
+
+
+def test_flag_keywords_take_no_value(session, tmp_path):
+    session.command("model new force")
+    session.command("program log-file 'a.log' append")
+    assert (tmp_path / "a.log").exists()
