@@ -1,0 +1,82 @@
+"""`block contact jmodel|property|material-table|tolerance`: joint models and properties."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import CommandError
+from ..physics.rigid import JOINT_MODELS, engine, props_vector
+from .registry import command
+from .values import FLAG, Choice, Num, P
+
+PROPS = JOINT_MODELS["mohr"][1]
+_KW = [P(name, Num(), f"joint {name}", units="deg" if name in ("friction", "dilation", "friction-residual") else None)
+       for name in PROPS]
+
+
+def _given(call):
+    out = {name: call.args[name.replace("-", "_")] for name in PROPS if call.args[name.replace("-", "_")] is not None}
+    for k, v in call.extra.items():
+        out[k] = float(v)
+    return out
+
+
+def _check(call, model_name, props):
+    allowed = JOINT_MODELS[model_name][1]
+    bad = [k for k in props if k not in allowed]
+    if bad:
+        raise CommandError(f"joint model '{model_name}' has no property '{bad[0]}' "
+                           f"(it has: {', '.join(allowed)})", call.location)
+
+
+@command("block contact jmodel assign", positional=[P("model", Choice(tuple(JOINT_MODELS)), "joint model",
+                                                        required=True)], range="block",
+         doc="Assign a joint model to the contacts (and to contacts created later).",
+         examples=["block contact jmodel assign mohr", "block contact jmodel assign elastic"])
+def jmodel_assign(session, call):
+    e = engine(session.model)
+    e.default_model = call.args["model"]
+    code = JOINT_MODELS[e.default_model][0]
+    e.cmodel[:] = code
+    e.cname = [e.default_model] * len(e.cname)
+
+
+@command("block contact property", keywords=_KW, open_keywords=True, range="block",
+         doc="Set joint properties of the existing contacts (stiffness Pa/m, stress Pa, angles in degrees).",
+         details="Names not declared here are accepted for user joint models; a name that the assigned "
+                 "built-in model does not have is an error.",
+         examples=["block contact property stiffness-normal 1e9 stiffness-shear 1e9 friction 30",
+                   "block contact prop stiff-norm 10e6 stiff-shear 10e6 fric 20 coh 0 tension 0"])
+def contact_property(session, call):
+    e = engine(session.model)
+    props = _given(call)
+    _check(call, e.default_model, props)
+    for c in range(len(e.cuser)):
+        e.cuser[c].update(props)
+        e.cprop[c] = props_vector(e.cuser[c])
+    e.default_props.update(props)
+
+
+@command("block contact material-table default", keywords=[P("property", FLAG, "3DEC's word before the properties", bare=True), *_KW], open_keywords=True,
+         doc="Joint properties given to contacts created from now on.",
+         examples=["block contact material-table default property stiffness-normal 1e9 stiffness-shear 1e9 friction 30"])
+def material_default(session, call):
+    e = engine(session.model)
+    props = _given(call)
+    props.pop("property", None)
+    _check(call, e.default_model, props)
+    e.default_props.update(props)
+
+
+@command("block contact tolerance", positional=[P("ctol", Num(lo=0, lo_open=True), "contact tolerance CTOL",
+                                                  required=True, units="m")],
+         doc="Set CTOL: contacts are made when the gap is at most CTOL and deleted beyond it.",
+         examples=["block contact tolerance 0.01"])
+def contact_tolerance(session, call):
+    engine(session.model).ctol = float(call.args["ctol"])
+
+
+@command("block contact generate-subcontacts", range="block",
+         doc="Detect the contacts and rebuild their sub-contacts now.",
+         examples=["block contact generate-subcontacts"])
+def generate_subcontacts(session, call):
+    engine(session.model).detect()

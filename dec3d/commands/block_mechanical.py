@@ -1,0 +1,83 @@
+"""`block mechanical damping`, `block fix|free`, `block initialize`: motion settings and conditions."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..physics.rigid import engine
+from .registry import command
+from .values import FLAG, Choice, Num, P
+
+
+@command("block mechanical damping", positional=[P("mode", Choice(("local", "global", "combined", "none")),
+                                                     "damping form", required=True),
+                                                   P("alpha", Num(lo=0), "local damping coefficient", default=0.8)],
+         doc="Set the mechanical damping (default: local, α = 0.8).",
+         details="`global` and `combined` are not implemented yet and are refused; `none` switches damping off.",
+         examples=["block mechanical damping local 0.8", "block mechanical damping none"])
+def damping(session, call):
+    from ..errors import CommandError
+    mode = call.args["mode"]
+    if mode in ("global", "combined"):
+        raise CommandError(f"damping '{mode}' is not implemented yet", call.location)
+    engine(session.model).alpha_local = float(call.args["alpha"]) if mode == "local" else 0.0
+
+
+_BITS = {"velocity": 0b000111, "velocity-x": 1, "velocity-y": 2, "velocity-z": 4,
+         "rotation": 0b111000, "rotation-x": 8, "rotation-y": 16, "rotation-z": 32}
+_FIXKW = [P(k, FLAG, f"the {k} component(s)", bare=True) for k in _BITS]
+
+
+def _bits(call):
+    bits = 0
+    for k, v in _BITS.items():
+        if call.args[k.replace("-", "_")]:
+            bits |= v
+    return bits or 0b111111
+
+
+@command("block fix", keywords=_FIXKW, range="block",
+         doc="Fix velocity and/or rotation components of the blocks in range (all six when none is named).",
+         examples=["block fix", "block fix velocity-z rotation range position-z -1 0"])
+def block_fix(session, call):
+    mask = session.range_mask(call, "block")
+    b = session.model.blocks
+    engine(session.model)
+    bits = _bits(call)
+    b["fixity"][mask] |= np.uint8(bits)
+    for i in range(3):
+        if bits & (1 << i):
+            b["velocity"][mask, i] = 0.0
+        if bits & (8 << i):
+            b["spin"][mask, i] = 0.0
+
+
+@command("block free", keywords=_FIXKW, range="block",
+         doc="Free velocity and/or rotation components of the blocks in range (all six when none is named).",
+         examples=["block free", "block free rotation"])
+def block_free(session, call):
+    mask = session.range_mask(call, "block")
+    b = session.model.blocks
+    b["fixity"][mask] &= np.uint8(~_bits(call) & 0xFF)
+
+
+@command("block initialize", keywords=[P(k, Num(), f"initial {k}", units="m/s" if k.startswith("v") else "rad/s")
+                                       for k in ("velocity-x", "velocity-y", "velocity-z",
+                                                 "rvelocity-x", "rvelocity-y", "rvelocity-z")], range="block",
+         doc="Set the velocity or angular velocity of the blocks in range.",
+         examples=["block initialize velocity-z -1", "block initialize rvelocity-z 2"])
+def block_initialize(session, call):
+    mask = session.range_mask(call, "block")
+    b = session.model.blocks
+    for i, ax in enumerate("xyz"):
+        if call.args[f"velocity_{ax}"] is not None:
+            b["velocity"][mask, i] = call.args[f"velocity_{ax}"]
+        if call.args[f"rvelocity_{ax}"] is not None:
+            b["spin"][mask, i] = call.args[f"rvelocity_{ax}"]
+
+
+@command("block mechanical timestep", positional=[P("dt", Num(lo=0), "fixed time step; 0 returns to Eq. (87)",
+                                                    required=True, units="s")],
+         doc="Force the time step (0: automatic, Eq. 87 with frac 0.1).",
+         examples=["block mechanical timestep 1e-4", "block mechanical timestep 0"])
+def timestep(session, call):
+    engine(session.model).dt_user = float(call.args["dt"]) or None
