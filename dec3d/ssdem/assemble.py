@@ -55,23 +55,24 @@ def interface_forces(rel: np.ndarray, kl: np.ndarray) -> np.ndarray:
 class Assembler:
     """Sparse K for a fixed set of active DOFs, reassembled cheaply as springs change.
 
-    dof_block (n,) maps a block to its first row in the reduced system, or -1 for
-    a fixed / removed block (its DOFs are eliminated, thesis Sec. 3.2.1 H).  The
-    sparsity pattern is built once; each `matrix(kl)` only scatters new values.
+    dof (n, 3) maps each block DOF to its row in the reduced system, or -1 for a
+    fixed DOF or a removed block (eliminated rows and columns, thesis Sec. 3.2.1 H).
+    The sparsity pattern is built once; each `matrix(kl)` only scatters new values.
     """
 
-    def __init__(self, a: np.ndarray, b: np.ndarray, Ta: np.ndarray, Tb: np.ndarray, dof_block: np.ndarray):
+    def __init__(self, a: np.ndarray, b: np.ndarray, Ta: np.ndarray, Tb: np.ndarray, dof: np.ndarray):
         self.a, self.b, self.Ta, self.Tb = a, b, Ta, Tb
-        self.ndof = int(np.count_nonzero(dof_block >= 0)) * 3
-        ra, rb = dof_block[a], dof_block[b]
-        k3 = np.arange(3)
+        self.ndof = int(np.count_nonzero(dof >= 0))
+        da, db = dof[a], dof[b]
         rows, cols, sel = [], [], []
-        # the four sub-matrices in a fixed order: aa, ab, ba, bb
-        for q, (r0, c0) in enumerate(((ra, ra), (ra, rb), (rb, ra), (rb, rb))):
-            ok = (r0 >= 0) & (c0 >= 0)
-            idx = np.flatnonzero(ok)
-            rows.append((r0[idx, None, None] + k3[None, :, None] + 0 * k3[None, None, :]).ravel())
-            cols.append((c0[idx, None, None] + k3[None, None, :] + 0 * k3[None, :, None]).ravel())
+        # the four sub-matrices in a fixed order: aa, ab, ba, bb; entry (m, i, j)
+        for q, (r0, c0) in enumerate(((da, da), (da, db), (db, da), (db, db))):
+            R = np.broadcast_to(r0[:, :, None], (len(a), 3, 3))
+            C = np.broadcast_to(c0[:, None, :], (len(a), 3, 3))
+            ok = (R >= 0) & (C >= 0) & np.ones((len(a), 3, 3), bool)
+            idx = np.flatnonzero(ok.ravel())
+            rows.append(R.ravel()[idx])
+            cols.append(C.ravel()[idx])
             sel.append((q, idx))
         rows, cols = np.concatenate(rows), np.concatenate(cols)
         key = rows * max(self.ndof, 1) + cols
@@ -95,7 +96,7 @@ class Assembler:
 
     def matrix(self, kl: np.ndarray) -> sp.csr_matrix:
         C = self.blocks(kl)
-        vals = np.concatenate([C[q][idx].ravel() for q, idx in self.sel])
+        vals = np.concatenate([C[q].ravel()[idx] for q, idx in self.sel])
         data = np.bincount(self.inverse, weights=vals, minlength=self.nnz)
         return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.ndof, self.ndof))
 
@@ -103,6 +104,5 @@ class Assembler:
 def assemble_full(blocks: Blocks, itf: Interfaces, kn: np.ndarray, ks: np.ndarray) -> sp.csr_matrix:
     """The unconstrained (3n x 3n) matrix K*, every block included (for checks and tests)."""
     Ta, Tb = transfer_matrices(blocks, itf)
-    dof_block = np.arange(blocks.n) * 3
-    asm = Assembler(itf.a, itf.b, Ta, Tb, dof_block)
+    asm = Assembler(itf.a, itf.b, Ta, Tb, np.arange(3 * blocks.n).reshape(-1, 3))
     return asm.matrix(local_stiffness(kn, ks, itf.length))

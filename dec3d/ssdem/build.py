@@ -69,9 +69,10 @@ def from_slope(slope: Slope, mesh: dict, surface: dict | None, settings: Setting
         verts, offsets, fixed, base_pairs = surface_mesh(slope, surface, mesh["slices"], mesh.get("rows"))
         bottom = None
     else:
-        verts, offsets, fixed = grid_mesh(slope, mesh["size"], mesh["bottom"])
+        verts, offsets, fix = grid_mesh(slope, mesh["size"], mesh["bottom"])
+        fixed = fix.all(axis=1)
         bottom = mesh["bottom"]
-    blocks = make_blocks(verts, offsets, fixed)
+    blocks = make_blocks(verts, offsets, fixed, fix=None if surface is not None else fix)
     blocks.force = block_loads(blocks, slope)
     itf, _ = find_interfaces(blocks)
     on = np.zeros(itf.m, bool)
@@ -83,3 +84,35 @@ def from_slope(slope: Slope, mesh: dict, surface: dict | None, settings: Setting
     return Problem(title=title, blocks=blocks, interfaces=itf, settings=settings,
                    profile=slope.profile, layers=slope.layers, water=dict(ru=slope.ru, ru_mode=slope.ru_mode),
                    surface=surface, bottom=bottom, slope=slope)
+
+
+def from_polygons(polygons, fixed, *, kn, ks, c=0.0, phi=0.0, c_res=None, phi_res=None, delta_res=np.inf,
+                  tensile=0.0, cutoff=False, gamma=0.0, force=None, n_steps=1, tol=1e-6, max_iter=500,
+                  ru=0.0, ru_mode="standard", title="polygons") -> Problem:
+    """A problem from explicit polygons with one set of interface properties (SI units).
+
+    For scripts and tests: polygons is a list of (k, 2) counter-clockwise vertex arrays,
+    fixed a list of bools (or (n, 3) DOF fixity), force an optional (n, 3) array added to
+    the self-weight gamma * area.  Scalars apply to every interface.
+    """
+    verts = np.concatenate([np.asarray(p, float) for p in polygons])
+    offsets = np.concatenate([[0], np.cumsum([len(p) for p in polygons])])
+    fix = np.asarray(fixed, bool)
+    if fix.ndim == 1:
+        fix = np.repeat(fix[:, None], 3, axis=1)
+    blocks = make_blocks(verts, offsets, fix.all(axis=1), fix=fix)
+    blocks.force = self_weight(blocks, np.full(blocks.n, float(gamma)))
+    if force is not None:
+        blocks.force = blocks.force + np.asarray(force, float)
+    itf, _ = find_interfaces(blocks)
+    m = itf.m
+    full = lambda v: np.full(m, float(v))    # noqa: E731
+    itf.kn, itf.ks = full(kn), full(ks)
+    itf.c_p, itf.tan_p = full(c), full(np.tan(np.radians(phi)))
+    itf.c_r = full(c if c_res is None else c_res)
+    itf.tan_r = full(np.tan(np.radians(phi if phi_res is None else phi_res)))
+    itf.del_res, itf.tensile = full(delta_res), full(tensile)
+    itf.cutoff = np.full(m, bool(cutoff))
+    itf.u_pore, itf.on_surface = np.zeros(m), np.zeros(m, bool)
+    settings = Settings(n_steps=n_steps, tol=tol, max_iter=max_iter, ru=ru, ru_mode=ru_mode)
+    return Problem(title=title, blocks=blocks, interfaces=itf, settings=settings, fmt="polygons")

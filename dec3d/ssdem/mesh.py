@@ -6,7 +6,8 @@ Two layouts:
   columns (every profile vertex is a column edge) and rows at fixed elevations
   `size` apart; the top block of a column follows the ground.  Rows of
   neighbouring columns need not line up: interfaces are found from overlapping
-  edges.  Blocks on the base and in the outermost columns are fixed.
+  edges.  Blocks on the base are fixed; the outermost columns are rollers (u_x and
+  rotation fixed, free to settle), so the sides do not hold the soil up by shear.
 
 * surface: a prescribed slip surface (circle or polyline), as the thesis's Example 1
   used Chang's critical circle.  The mass above it is cut into slices whose bases
@@ -46,7 +47,7 @@ def column_breaks(x0: float, x1: float, size: float, must: np.ndarray) -> np.nda
 
 
 def grid_mesh(slope: Slope, size: float, bottom: float):
-    """Blocks of the whole section; returns (verts, offsets, fixed)."""
+    """Blocks of the whole section; returns (verts, offsets, fix) with fix (n, 3) DOF fixity."""
     prof = slope.profile
     xb = column_breaks(prof[0, 0], prof[-1, 0], size, prof[:, 0])
     top = slope.ground(xb)
@@ -61,12 +62,16 @@ def grid_mesh(slope: Slope, size: float, bottom: float):
         levels = bottom + size * np.arange(nlev + 1)
         for k in range(nlev):
             polys.append(np.array([[xl, levels[k]], [xr, levels[k]], [xr, levels[k + 1]], [xl, levels[k + 1]]]))
-            fixed.append(k == 0 or i == 0 or i == ncol - 1)
+            fixed.append(_fixity(k == 0, i == 0 or i == ncol - 1))
         yk = levels[-1]
         polys.append(np.array([[xl, yk], [xr, yk], [xr, tr], [xl, tl]]))
-        fixed.append(nlev == 0 or i == 0 or i == ncol - 1)
+        fixed.append(_fixity(nlev == 0, i == 0 or i == ncol - 1))
     verts, offsets = _polygons(polys)
-    return verts, offsets, np.array(fixed)
+    return verts, offsets, np.array(fixed, bool)
+
+
+def _fixity(base: bool, side: bool) -> tuple[bool, bool, bool]:
+    return (True, True, True) if base else (side, False, side)
 
 
 def surface_function(surface: dict):

@@ -22,7 +22,9 @@ class Blocks:
     verts (nv, 2), offsets (n+1,): CSR polygons, counter-clockwise
     ref (n, 2): the point whose motion (u_x, u_y, omega) are the block's DOFs
         (the centroid unless an Appendix A file gives another point)
-    area (n,), fixed (n,) bool, layer (n,) int (-1: none)
+    area (n,), fixed (n,) bool: every DOF fixed (a boundary block of the thesis)
+    fix (n, 3) bool: fixed DOFs (u_x, u_y, omega); a roller side block fixes u_x and omega
+    layer (n,) int (-1: none)
     force (n, 3): load at full loading [F_x, F_y, M about ref], N and N*m per m
     """
 
@@ -33,6 +35,7 @@ class Blocks:
     fixed: np.ndarray
     layer: np.ndarray
     force: np.ndarray
+    fix: np.ndarray = None
 
     @property
     def n(self) -> int:
@@ -127,7 +130,7 @@ class Problem:
     slope: object = None          # soil.Slope for TOML input (Bishop needs it); None otherwise
 
 
-def make_blocks(verts, offsets, fixed, force=None, ref=None, layer=None) -> Blocks:
+def make_blocks(verts, offsets, fixed, force=None, ref=None, layer=None, fix=None) -> Blocks:
     verts = np.asarray(verts, float)
     offsets = np.asarray(offsets, np.int64)
     area, cen = geometry.polygon_area_centroid(verts, offsets)
@@ -138,6 +141,7 @@ def make_blocks(verts, offsets, fixed, force=None, ref=None, layer=None) -> Bloc
         area=area, fixed=np.asarray(fixed, bool),
         layer=np.full(n, -1, np.int64) if layer is None else np.asarray(layer, np.int64),
         force=np.zeros((n, 3)) if force is None else np.asarray(force, float),
+        fix=np.repeat(np.asarray(fixed, bool)[:, None], 3, axis=1) if fix is None else np.asarray(fix, bool),
     )
 
 

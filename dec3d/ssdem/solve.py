@@ -6,11 +6,19 @@
             drop floating blocks and blocks with (near-)zero pivots, with their interfaces
             solve K u = (k/n) f  (total load: secant stiffness relates totals)
             interface stresses -> spring laws -> new k_n, k_s (never larger)
-        until max |k_s change| / k_s0 < tol and nothing new cracked or was removed
+            now and then, and at convergence: the mechanism test on the tangent matrix
+        until max |k_s change| / k_s0 < tol, nothing new cracked or was removed
 
-Unstable blocks are removed as the thesis does (Sec. 3.2.2): their DOFs and every
-interface touching them leave the system, their loads go with them, and the
-analysis continues; the step at which each left is recorded.
+Two rank tests find instability (thesis Sec. 3.2.2):
+  * the secant matrix: a floating block (no spring left to a fixed one), or a DOF
+    whose pivot is ~0 (e.g. a block on a cracked or zero-stiffness interface);
+  * the tangent matrix: springs carrying their full strength add no shear stiffness.
+    A zero pivot there is a plastic mechanism: blocks that can slide with every
+    resisting spring at its strength.  The secant matrix alone would not show it (a
+    block overloaded in shear just softens and slides further every iteration).
+Pivots are compared with the intact stiffness of the same DOF (Factor's scale).
+Unstable blocks are removed as the thesis does: their DOFs and every interface
+touching them leave the system, their loads go with them, and the analysis goes on.
 """
 from __future__ import annotations
 
@@ -22,6 +30,9 @@ from . import springs
 from .assemble import Assembler, local_stiffness, relative_motion, transfer_matrices
 from .linsolve import Factor, floating_blocks
 from .model import Problem
+
+#: secant iterations between two mechanism (tangent matrix) tests in a step
+TANGENT_EVERY = 10
 
 
 @dataclass
@@ -48,64 +59,107 @@ class State:
     removed_step: np.ndarray
     u: np.ndarray
     rel: np.ndarray
+    plastic: np.ndarray
     load: float = 0.0
     steps: list = field(default_factory=list)
     factorizations: int = 0
 
 
-def _active_interfaces(prob: Problem, st: State) -> np.ndarray:
+class _Context:
+    """What stays fixed while the set of active DOFs does not change."""
+
+    def __init__(self, prob: Problem, removed: np.ndarray, Ta, Tb):
+        blk, itf = prob.blocks, prob.interfaces
+        self.key = removed.tobytes()
+        self.live = ~blk.fix & ~removed[:, None]
+        dof = np.full((blk.n, 3), -1, np.int64)
+        dof[self.live] = np.arange(int(self.live.sum()))
+        self.owner = np.nonzero(self.live)[0]              # block of each reduced DOF
+        self.asm = Assembler(itf.a, itf.b, Ta, Tb, dof)
+        active = ~(removed[itf.a] | removed[itf.b])
+        intact = local_stiffness(itf.kn, itf.ks, itf.length) * active[:, None]
+        self.scale = self.asm.matrix(intact).diagonal() if self.asm.ndof else np.zeros(0)
+        self.factor = None
+
+
+def _active(prob: Problem, st: State) -> np.ndarray:
     itf = prob.interfaces
     return ~(st.removed[itf.a] | st.removed[itf.b])
 
 
-def _solve_with_removal(prob, st, Ta, Tb, f_total, step, cache):
+def _remove(st: State, mask: np.ndarray, step: int) -> int:
+    new = mask & ~st.removed
+    st.removed_step[new] = step
+    st.removed |= new
+    return int(new.sum())
+
+
+def _context(prob, st, Ta, Tb, cache) -> _Context:
+    if cache.get("ctx") is None or cache["ctx"].key != st.removed.tobytes():
+        cache["ctx"] = _Context(prob, st.removed, Ta, Tb)
+    return cache["ctx"]
+
+
+def _solve_with_removal(prob, st, Ta, Tb, f_total, step, cache, refactor=True) -> int:
     """Solve at the current springs, removing unstable blocks until K is regular.
 
-    Returns the number of blocks removed.  `cache` keeps the Assembler between calls
-    while the set of active DOFs does not change.
+    Returns the number of blocks removed.  With refactor=False the last factor
+    preconditions conjugate gradients instead of a new factorisation; if CG stalls,
+    K is factored afresh and its pivots tested as usual.
     """
     blk, itf, cfg = prob.blocks, prob.interfaces, prob.settings
     n_removed = 0
     while True:
-        active = _active_interfaces(prob, st)
-        free = ~blk.fixed & ~st.removed
+        active = _active(prob, st)
         carries = active & ((st.kn > 0) | (st.ks > 0))
-        floating = floating_blocks(blk.n, itf.a, itf.b, carries, blk.fixed) & free
+        floating = floating_blocks(blk.n, itf.a, itf.b, carries, blk.fix.any(axis=1))
+        floating &= ~blk.fixed & ~st.removed
         if floating.any():
-            _remove(st, floating, step)
-            n_removed += int(floating.sum())
+            n_removed += _remove(st, floating, step)
             continue
-        key = st.removed.tobytes()
-        if cache.get("key") != key:
-            dof_block = np.full(blk.n, -1, np.int64)
-            dof_block[free] = np.arange(int(free.sum())) * 3
-            cache.update(key=key, dof_block=dof_block,
-                         asm=Assembler(itf.a, itf.b, Ta, Tb, dof_block))
-        asm, dof_block = cache["asm"], cache["dof_block"]
+        ctx = _context(prob, st, Ta, Tb, cache)
         u = np.zeros((blk.n, 3))
-        if asm.ndof == 0:
+        if ctx.asm.ndof == 0:
             st.u = u
             return n_removed
-        kl = local_stiffness(st.kn, st.ks, itf.length) * active[:, None]
-        K = asm.matrix(kl)
-        fac = Factor(K, cfg.pivot_tol)
+        K = ctx.asm.matrix(local_stiffness(st.kn, st.ks, itf.length) * active[:, None])
+        if not refactor and ctx.factor is not None:
+            x = ctx.factor.pcg(K, f_total[ctx.live], st.u[ctx.live])
+            if x is not None:
+                u[ctx.live] = x
+                st.u = u
+                return n_removed
+        fac = Factor(K, cfg.pivot_tol, ctx.scale)
         st.factorizations += 1
         if len(fac.bad):
-            owner = np.flatnonzero(free)[np.unique(fac.bad // 3)]
             mask = np.zeros(blk.n, bool)
-            mask[owner] = True
-            _remove(st, mask, step)
-            n_removed += len(owner)
+            mask[ctx.owner[fac.bad]] = True
+            n_removed += _remove(st, mask, step)
             continue
-        rhs = f_total[free].ravel()
-        u[free] = fac.solve(rhs).reshape(-1, 3)
+        ctx.factor = fac
+        u[ctx.live] = fac.solve(f_total[ctx.live])
         st.u = u
         return n_removed
 
 
-def _remove(st: State, mask: np.ndarray, step: int) -> None:
-    st.removed_step[mask & ~st.removed] = step
-    st.removed |= mask
+def _mechanisms(prob, st, Ta, Tb, step, cache) -> int:
+    """Rank test of the tangent matrix; removes the blocks of plastic mechanisms."""
+    itf, cfg = prob.interfaces, prob.settings
+    active = _active(prob, st)
+    if not (st.plastic & active).any():
+        return 0
+    ctx = _context(prob, st, Ta, Tb, cache)
+    if ctx.asm.ndof == 0:
+        return 0
+    ks_t = np.where(st.plastic, 0.0, st.ks)
+    Kt = ctx.asm.matrix(local_stiffness(st.kn, ks_t, itf.length) * active[:, None])
+    fac = Factor(Kt, cfg.pivot_tol, ctx.scale)
+    st.factorizations += 1
+    if not len(fac.bad):
+        return 0
+    mask = np.zeros(prob.blocks.n, bool)
+    mask[ctx.owner[fac.bad]] = True
+    return _remove(st, mask, step)
 
 
 def stresses(prob: Problem, st: State, load: float):
@@ -126,36 +180,42 @@ def run(prob: Problem, progress=None) -> State:
     Ta, Tb = transfer_matrices(blk, itf)
     st = State(kn=itf.kn.copy(), ks=itf.ks.copy(), cracked=np.zeros(itf.m, bool),
                removed=np.zeros(blk.n, bool), removed_step=np.full(blk.n, -1, np.int64),
-               u=np.zeros((blk.n, 3)), rel=np.zeros((itf.m, 3)))
+               u=np.zeros((blk.n, 3)), rel=np.zeros((itf.m, 3)), plastic=np.zeros(itf.m, bool))
     cache: dict = {}
+    scale = np.where(itf.ks > 0, itf.ks, 1.0)
     for step in range(1, cfg.n_steps + 1):
         load = step / cfg.n_steps
         st.load = load
         f_total = load * blk.force
         converged, change, it = False, np.inf, 0
+        fresh = True                      # a new step, a crack or a removal gets a new factor
         for it in range(1, cfg.max_iter + 1):
-            removed_now = _solve_with_removal(prob, st, Ta, Tb, f_total, step, cache)
+            removed = _solve_with_removal(prob, st, Ta, Tb, f_total, step, cache, refactor=fresh)
             st.rel = relative_motion(st.u, itf.a, itf.b, Ta, Tb)
-            active = _active_interfaces(prob, st)
+            active = _active(prob, st)
             sigma_n, _, sig_eff = stresses(prob, st, load)
-            kn, ks, cracked, new_crack = springs.update(
+            kn, ks, cracked, new_crack, plastic = springs.update(
                 st.kn, st.ks, st.cracked, itf.ks, st.rel[:, 1], sigma_n, sig_eff,
                 itf.c_p, itf.tan_p, itf.c_r, itf.tan_r, itf.del_res, itf.tensile, itf.cutoff & active)
-            scale = np.where(itf.ks > 0, itf.ks, 1.0)
-            change = float(np.max(np.abs(ks - st.ks)[active] / scale[active], initial=0.0))
-            new_crack = new_crack & active
-            st.kn, st.ks, st.cracked = kn, ks, cracked
+            change = float(np.max((np.abs(ks - st.ks) / scale)[active], initial=0.0))
+            new_crack &= active
+            st.kn, st.ks, st.cracked, st.plastic = kn, ks, cracked, plastic & active
+            done = change < cfg.tol and not new_crack.any() and removed == 0
+            if done or it % TANGENT_EVERY == 0:
+                removed += _mechanisms(prob, st, Ta, Tb, step, cache)
+                done = done and removed == 0
             if progress is not None:
                 progress(step, cfg.n_steps, it)
-            if change < cfg.tol and not new_crack.any() and removed_now == 0:
+            fresh = bool(new_crack.any()) or removed > 0
+            if done:
                 converged = True
                 break
         if step == cfg.n_steps:
             # the last update changed the springs a little: re-solve so that the reported
             # displacements and stresses belong to the final springs
-            _solve_with_removal(prob, st, Ta, Tb, f_total, step, cache)
+            _solve_with_removal(prob, st, Ta, Tb, f_total, step, cache, refactor=False)
             st.rel = relative_motion(st.u, itf.a, itf.b, Ta, Tb)
-        active = _active_interfaces(prob, st)
+        active = _active(prob, st)
         yielded = active & (st.ks < itf.ks * (1 - 1e-9))
         disp = np.hypot(st.u[:, 0], st.u[:, 1])
         st.steps.append(StepRecord(step=step, load=load, iterations=it, converged=converged,

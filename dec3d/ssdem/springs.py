@@ -66,13 +66,17 @@ def update(kn, ks, cracked, ks0, delta_s, sigma_n, sig_eff, c_p, tan_p, c_r, tan
 
     Inputs (m,): current kn, ks, cracked flags, initial ks0, midpoint slip delta_s,
     total normal stress sigma_n and effective sigma'_n (compression positive), strength
-    parameters.  Returns new (kn, ks, cracked, new_crack) without modifying the inputs.
+    parameters.  Returns new (kn, ks, cracked, new_crack, plastic) without modifying the
+    inputs; `plastic` marks springs now carrying their full strength (past the peak and
+    loading), whose tangent shear stiffness is zero.
     """
     new_crack = (~cracked) & cutoff & (-sigma_n > tensile)
     cracked = cracked | new_crack
     tau_p, tau_r = strengths(sig_eff, c_p, tan_p, c_r, tan_r)
     ks_law, _ = secant_ks(delta_s, tau_p, tau_r, ks0, del_res)
     ks_new = np.minimum(ks, ks_law)                   # secant stiffness never increases
+    d_peak = np.where(ks0 > 0, tau_p / np.where(ks0 > 0, ks0, 1.0), 0.0)
+    plastic = (np.abs(delta_s) > d_peak) & (ks_law <= ks) & ~cracked
     kn_new = np.where(cracked, 0.0, kn)
     ks_new = np.where(cracked, 0.0, ks_new)
-    return kn_new, ks_new, cracked, new_crack
+    return kn_new, ks_new, cracked, new_crack, plastic
