@@ -175,6 +175,8 @@ class Binder:
             return CommandCall(cmd, {}, (), None, loc, span=span)
         call = self._bind_args(cmd, toks, i, pre, loc, prekw)
         object.__setattr__(call, "span", span)
+        if cmd.check is not None:
+            cmd.check(call)
         return call
 
     def source(self, raw: RawLine) -> str:
@@ -295,10 +297,8 @@ class Binder:
                 locs[p.key] = self.where(toks[i + 1] if j > i + 1 else tok)
                 if p.repeat:
                     args.setdefault(p.key, []).append(value)
-                elif p.key in given:
-                    raise BindError(f"keyword `{p.name}` given twice", self.where(tok))
                 else:
-                    args[p.key] = value
+                    args[p.key] = value       # given twice: the later value wins, as in 3DEC
                 given.append(p.key)
                 i = j
                 continue

@@ -5,21 +5,41 @@ import numpy as np
 
 from ..physics.rigid import engine
 from .registry import command
-from .values import FLAG, Choice, Num, P
+from .values import FLAG, Choice, Num, Nums, P
 
 
-@command("block mechanical damping", positional=[P("mode", Choice(("local", "global", "combined", "none")),
-                                                     "damping form", required=True),
-                                                   P("alpha", Num(lo=0), "local damping coefficient", default=0.8)],
+_DAMPING_NOT_YET = ("global", "combined", "rayleigh", "maxwell")
+
+
+def _check_damping(call):
+    from ..errors import NotSupportedError
+
+    if call.args["mode"] in _DAMPING_NOT_YET:
+        raise NotSupportedError(f"`block mechanical damping {call.args['mode']}` is not supported yet",
+                                call.locations.get("mode", call.location), hint="implemented: local [α], none")
+    if len(call.args["alpha"]) > 1:
+        from ..errors import BindError
+
+        raise BindError("local damping takes one coefficient", call.locations.get("alpha", call.location))
+
+
+@command("block mechanical damping",
+         positional=[P("mode", Choice(("local", "global", "combined", "none", "rayleigh", "maxwell")),
+                       "damping form", required=True),
+                     P("alpha", Nums(0, 6), "local damping coefficient α (rayleigh and maxwell take more values)",
+                       default=())],
+         check=_check_damping,
          doc="Set the mechanical damping (default: local, α = 0.8).",
-         details="`global` and `combined` are not implemented yet and are refused; `none` switches damping off.",
+         details="`none` switches damping off. `global` (adaptive), `combined`, `rayleigh` and `maxwell` are "
+                 "known and not supported yet.",
          examples=["block mechanical damping local 0.8", "block mechanical damping none"])
 def damping(session, call):
-    from ..errors import CommandError
-    mode = call.args["mode"]
-    if mode in ("global", "combined"):
-        raise CommandError(f"damping '{mode}' is not implemented yet", call.location)
-    engine(session.model).alpha_local = float(call.args["alpha"]) if mode == "local" else 0.0
+    alpha = call.args["alpha"][0] if call.args["alpha"] else 0.8
+    if not 0.0 <= alpha:
+        from ..errors import BindError
+
+        raise BindError("the damping coefficient must be ≥ 0", call.locations.get("alpha", call.location))
+    engine(session.model).alpha_local = float(alpha) if call.args["mode"] == "local" else 0.0
 
 
 _BITS = {"velocity": 0b000111, "velocity-x": 1, "velocity-y": 2, "velocity-z": 4,

@@ -31,6 +31,7 @@ class Command:
     open_keywords: bool = False        # accept keywords not declared (user joint-model properties)
     accepts_anything: bool = False     # display-only commands: every token ignored
     module: str = ""
+    check: Callable | None = None      # check(call) at bind time: value combinations, not-supported choices
 
     def __post_init__(self) -> None:
         # looked up for every bound line: computed once
@@ -155,13 +156,18 @@ REGISTRY = Registry()
 
 def command(path: str, *, positional: Sequence[Param] = (), keywords: Sequence[Param] = (),
             range: str | None = None, doc: str = "", details: str = "", examples: Sequence[str] = (),
-            open_keywords: bool = False, accepts_anything: bool = False, registry: Registry = REGISTRY):
-    """Register the decorated function as the handler of `path`."""
+            open_keywords: bool = False, accepts_anything: bool = False, check: Callable | None = None,
+            registry: Registry = REGISTRY):
+    """Register the decorated function as the handler of `path`.
+
+    `check(call)`, if given, runs when a line is bound (before anything in the deck runs):
+    for rules one keyword's type cannot say, such as a model name dec3d knows but does not
+    implement (raise NotSupportedError) or keywords that exclude each other (BindError)."""
 
     def deco(fn: Callable) -> Callable:
         registry.add(Command(tuple(path.split()), fn, tuple(positional), tuple(keywords), range,
                              doc or (fn.__doc__ or "").strip().split("\n")[0], details, tuple(examples),
-                             open_keywords, accepts_anything, fn.__module__))
+                             open_keywords, accepts_anything, fn.__module__, check))
         return fn
 
     return deco
