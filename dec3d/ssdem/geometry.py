@@ -170,7 +170,7 @@ def shared_edges(verts: np.ndarray, offsets: np.ndarray, tol: float) -> SharedEd
             out[key].append(val)
     if not out["i"]:
         z = np.zeros(0, dtype=np.int64)
-        return SharedEdges(z, z, np.zeros((0, 2)), np.zeros((0, 2)), z, z, same)
+        return SharedEdges(z, z, np.zeros((0, 2)), np.zeros((0, 2)), z, z, sorted(set(same)))
     i, j = np.concatenate(out["i"]), np.concatenate(out["j"])
     s, e = np.concatenate(out["s"]), np.concatenate(out["e"])
     # points on the line: foot of the line + parameter along it; exact vertices when the overlap is whole

@@ -110,9 +110,13 @@ def slip_extent(slope: Slope, ys, xlim) -> tuple[float, float]:
     def g(x):
         v = float(slope.ground(x) - ys(x))
         return -1.0 if np.isnan(v) else v
+    def root(a, b):
+        # the sign change between a sample outside (g <= 0) and one inside (g > 0)
+        ga = g(a)
+        return a if ga == 0 else brentq(g, a, b, xtol=1e-12 * max(1.0, abs(a)))
     i0, i1 = idx[0], idx[-1]
-    x_in = brentq(g, xs[i0 - 1], xs[i0]) if i0 > 0 and g(xs[i0 - 1]) < 0 else xs[i0]
-    x_out = brentq(g, xs[i1], xs[i1 + 1]) if i1 + 1 < len(xs) and g(xs[i1 + 1]) < 0 else xs[i1]
+    x_in = root(xs[i0 - 1], xs[i0]) if i0 > 0 else xs[i0]
+    x_out = root(xs[i1 + 1], xs[i1]) if i1 + 1 < len(xs) else xs[i1]
     return float(x_in), float(x_out)
 
 

@@ -37,6 +37,19 @@ def figure(an: Analysis, path: Path) -> None:
         ax.plot([], [], "r-", lw=2.5, label="failure surface")
     if p.profile is not None:
         ax.plot(p.profile[:, 0] / L, p.profile[:, 1] / L, "k-", lw=1.0, label="ground surface")
+    slope = p.slope
+    if slope is not None:
+        x = p.profile[:, 0]
+        for lay in slope.layers[1:]:
+            xs = np.unique(np.concatenate([x, lay.top[:, 0]]))
+            ax.plot(xs / L, slope.layer_tops(xs)[slope.layers.index(lay)] / L, color="saddlebrown", lw=0.8)
+        if slope.piezometric is not None:
+            pz = slope.piezometric
+            ax.plot(pz[:, 0] / L, np.minimum(pz[:, 1], slope.ground(pz[:, 0])) / L, "b-", lw=1.0,
+                    label="piezometric line")
+        for a, b_, q in slope.surcharges:
+            xs = np.linspace(a, b_, 9)
+            ax.plot(xs / L, slope.ground(xs) / L, color="darkorange", lw=4, alpha=0.7)
     b = an.bishop or {}
     for key, style, name in (("on_surface", "b--", "Bishop on failure surface"), ("search", "m:", "Bishop minimum")):
         c = b.get(key) if b.get("available") else None
@@ -51,7 +64,8 @@ def figure(an: Analysis, path: Path) -> None:
     ax.set_aspect("equal")
     fs = s.fs_global
     ax.set_title(f"{p.title}\nstatic DEM FS = {fs:.3f}" if np.isfinite(fs) else p.title)
-    ax.legend(loc="upper left", fontsize=8)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="upper left", fontsize=8)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)

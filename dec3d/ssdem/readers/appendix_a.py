@@ -149,6 +149,7 @@ def read_appendix_a(path: str | Path, text: str | None = None, units: str = "kN-
     bad = geometry.convexity_defect(verts, offsets, 1e-9)
     for i in np.flatnonzero(bad):
         raise tk.error("the block is not convex (vertices out of order?)", f"nodes[{i}]", at=node_at[i])
+    _check_angles(tk, nodes, angles, angle_at)
     ref = cen * fac["length"]
     notes = ["item 11 (displacement at peak) is ignored: delta_peak = tau_p / k_s per interface (ERRATA)"]
     for i in range(n):
@@ -179,7 +180,6 @@ def read_appendix_a(path: str | Path, text: str | None = None, units: str = "kN-
     sa = np.array([side_map[a][s] for a, s in zip(itf.a, itf.side_a)], int)
     sb = np.array([side_map[b][s] for b, s in zip(itf.b, itf.side_b)], int)
     itf.side_a, itf.side_b = sa, sb
-    _check_angles(tk, itf, angles, angle_at)
     kn_a, ks_a = springs[itf.a, sa, 0], springs[itf.a, sa, 1]
     kn_b, ks_b = springs[itf.b, sb, 0], springs[itf.b, sb, 1]
     # free-free: mean of the two sides' values; free-fixed: the free block's value (as the listing used)
@@ -210,14 +210,13 @@ def _inside(poly: np.ndarray, pt: np.ndarray) -> bool:
     return bool(np.all(cross >= -1e-12 * np.abs(e).max() * np.abs(w).max()))
 
 
-def _check_angles(tk: _Tokens, itf, angles: np.ndarray, angle_at: np.ndarray) -> None:
-    """Item 9 must agree with the geometry (normal angle, either sense) within ANGLE_TOL."""
-    theta = np.degrees(np.arctan2(itf.normal[:, 1], itf.normal[:, 0]))
-    for blk, side, th in ((itf.a, itf.side_a, theta), (itf.b, itf.side_b, theta + 180.0)):
-        given = angles[blk, side]
-        diff = np.abs((given - th + 90.0) % 180.0 - 90.0)     # modulo 180: n and -n are one axis
-        for k in np.flatnonzero(diff > ANGLE_TOL):
-            i, s = int(blk[k]), int(side[k])
-            raise tk.error(f"{given[k]:g} deg, but the {SIDES[s]} side's normal is at {th[k] % 360:.1f} deg",
-                           f"angles[{i}].a_{SIDES[s]}", at=int(angle_at[i]) + s,
-                           hint="the angle is between the x axis and the side's normal")
+def _check_angles(tk: _Tokens, nodes: np.ndarray, angles: np.ndarray, angle_at: np.ndarray) -> None:
+    """Item 9 must agree with every side's outward normal (either sense) within ANGLE_TOL."""
+    d = np.roll(nodes, -1, axis=1) - nodes                     # (n, 4, 2) side vectors as typed
+    theta = np.degrees(np.arctan2(-d[..., 0], d[..., 1]))       # outward normal (d_y, -d_x)
+    diff = np.abs((angles - theta + 90.0) % 180.0 - 90.0)       # modulo 180: n and -n are one axis
+    bad = (diff > ANGLE_TOL) & (np.hypot(d[..., 0], d[..., 1]) > 0)
+    for i, s in zip(*np.nonzero(bad)):
+        raise tk.error(f"{angles[i, s]:g} deg, but the {SIDES[s]} side's normal is at {theta[i, s] % 360:.1f} deg",
+                       f"angles[{i}].a_{SIDES[s]}", at=int(angle_at[i]) + int(s),
+                       hint="the angle is between the x axis and the side's normal")
