@@ -247,6 +247,10 @@ class Binder:
         if node.known and not any(c.command for _, c in self.reg.walk(node)) or (node.known and not node.children):
             raise NotSupportedError(f"`{name}` is not supported yet", self.where(toks[0]))
         cands = sorted(node.children)
+        hint = legacy_hint(str(toks[0]).lower()) if len(path) == 1 and i < len(toks) else None
+        if hint:                                 # `hist @var` (3DEC 5): a value where 3DEC 7 wants a word
+            raise LegacySyntaxError(f"`{toks[0]} {toks[i]}` is 3DEC 5 (legacy) syntax, not 3DEC 7+",
+                                    self.where(toks[0]), hint)
         raise BindError(f"`{name}` needs a subcommand", self.where(toks[min(i, len(toks)) - 1]),
                         hint=f"one of: {', '.join(cands)}")
 

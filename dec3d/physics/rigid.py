@@ -70,6 +70,8 @@ class RigidEngine:
         self.time = 0.0
         self.unbal = 0.0
         self.ratio = 1.0
+        #: callables hook(engine) run after every step (histories register here)
+        self.step_hooks: list = []
         # contacts (pair key -> row) and their arrays
         self.pairs: dict[tuple[int, int], int] = {}
         self.ca = np.zeros(0, np.int64)
@@ -272,6 +274,8 @@ class RigidEngine:
             self.unbal = fmax
             nfree = max(len(rows), 1)
             self.ratio = fmax / (fsum / nfree) if fsum > 0 else 0.0
+            for hook in self.step_hooks:
+                hook(self)
             if stop is not None and stop(self):
                 break
         return done

@@ -1,0 +1,140 @@
+"""`block history`, `model history mechanical`, `history interval`, `history export`: sampled values.
+
+Histories are sampled by the rigid engine every `history interval` steps (dec3d.physics.history);
+`history export` writes a CSV under the output folder, a PNG per history beside it, and puts
+`<name>.final|min|max|frequency` into the session's results (verification decks check them).
+"""
+from __future__ import annotations
+
+from ..errors import BindError, CommandError
+from ..io.history import write_csv, write_png
+from ..physics.history import BLOCK_QUANTITIES, MODEL_QUANTITIES, figures, histories, nearest_block_id
+from .registry import REGISTRY, command
+from .values import NUMBERISH, VEC3, Choice, Num, P, Text, ValueType, _number_literal
+
+
+class HistoryRefs(ValueType):
+    """One or more histories, each by number or by quoted name (`1 2`, `'disp' 'ub'`)."""
+
+    label = "<id|'name'>"
+    fits_types = NUMBERISH + ("STRING",)
+
+    def __init__(self, most: int = 10**6):
+        self.most = most
+
+    def take(self, toks, i, binder):
+        out = []
+        while i < len(toks) and len(out) < self.most and toks[i].type in self.fits_types:
+            tok = toks[i]
+            if tok.type in ("EXPR", "ATNAME"):
+                out.append(binder.deferred(tok))
+            else:
+                out.append(str(tok)[1:-1] if tok.type == "STRING" else _number_literal(tok))
+            i += 1
+        if not out:
+            raise BindError("expected a history number or name", binder.where(toks[min(i, len(toks) - 1)]))
+        return (tuple(out) if self.most > 1 else out[0]), i
+
+    def describe(self):
+        return self.label + (" …" if self.most > 1 else "")
+
+
+def _check_block(call):
+    if (call.args["position"] is None) == (call.args["block_id"] is None):
+        raise BindError("give either `position <x y z>` or `block-id <i>`", call.location)
+
+
+def _name(session, call):
+    name = call.args.get("name")
+    if name is not None and histories(session.model).find(name) is not None:
+        raise CommandError(f"a history named '{name}' exists already", call.location)
+    return name
+
+
+def _block_history(quantity):
+    def handler(session, call):
+        m = session.model
+        name = _name(session, call)
+        if call.args["block_id"] is not None:
+            bid = int(call.args["block_id"])
+            if not (m.blocks["id"] == bid).any():
+                raise CommandError(f"there is no block {bid}", call.locations.get("block_id", call.location))
+        else:
+            try:
+                bid = nearest_block_id(m, call.args["position"])
+            except ValueError as exc:
+                raise CommandError(str(exc), call.location)
+        histories(m).add_block(quantity, bid, name)
+
+    handler.__name__ = "block_history_" + quantity.replace("-", "_")
+    return handler
+
+
+for _q in BLOCK_QUANTITIES:
+    _what = "displacement" if _q.startswith("d") else "velocity"
+    _comp = f"{_q[-1]} component of the" if "-" in _q else "magnitude of the"
+    command(f"block history {_q}",
+            keywords=[P("position", VEC3, "the block whose centroid is nearest this point", units="m"),
+                      P("block-id", Num(integer=True, lo=1), "the block with this id"),
+                      P("gridpointid", Num(integer=True), "a gridpoint of a deformable block", supported=False),
+                      P("zone-id", Num(integer=True), "a zone of a deformable block", supported=False)],
+            check=_check_block,
+            doc=f"Record the {_comp} {_what} of one block every `history interval` steps.",
+            details="The block is the one whose centroid is nearest `position` when the command runs, or the "
+                    "block `block-id`. A leading `name '<s>'` names the history (default: its number).",
+            examples=[f"block history {_q} position 0.5 0.5 0.5", f"block history name 'h{_q[0]}' {_q} block-id 2"],
+            )(_block_history(_q))
+
+
+# other 3DEC history sources, known by name and not implemented yet
+for _other in ("dynamic", "energy", "fluid", "thermal"):
+    REGISTRY.know(f"model history {_other}")
+
+
+@command("model history mechanical",
+         positional=[P("quantity", Choice(MODEL_QUANTITIES), "what to record", required=True)],
+         doc="Record the largest unbalanced force, the unbalanced-force ratio or the total time.",
+         details="A leading `name '<s>'` names the history (default: its number).",
+         examples=["model history mechanical unbalanced-maximum", "model history name 'ub' mechanical ratio"])
+def model_history(session, call):
+    name = _name(session, call)
+    histories(session.model).add_model(call.args["quantity"], name)
+
+
+@command("history interval", positional=[P("n", Num(integer=True, lo=1), "steps between samples", required=True)],
+         doc="Sample the histories every n steps (default 10).",
+         examples=["history interval 1"])
+def history_interval(session, call):
+    histories(session.model).interval = int(call.args["n"])
+
+
+def _find(hs, key, call, slot):
+    h = hs.find(key)
+    if h is None and isinstance(key, str) and key.strip().isdigit():
+        h = hs.find(int(key))
+    if h is None:
+        raise CommandError(f"there is no history {key}", call.locations.get(slot, call.location))
+    return h
+
+
+@command("history export",
+         positional=[P("ids", HistoryRefs(), "history numbers or names", required=True)],
+         keywords=[P("vs", HistoryRefs(1), "plot and tabulate against this history instead of time"),
+                   P("file", Text(), "CSV file (under the output folder)", required=True)],
+         doc="Write the histories to a CSV file and a PNG plot per history; report their figures.",
+         details="Each history's `<name>.final`, `.min`, `.max` and `.frequency` (Hz, from the zero crossings "
+                 "of the value minus its mean) go into the session results. The plots are `<file>_<name>.png`.",
+         examples=["history export 1 file 'disp.csv'", "history export 1 2 vs 3 file 'h.csv'",
+                   "history export 'settle' file 'settle.csv'"])
+def history_export(session, call):
+    hs = histories(session.model)
+    picked = []
+    for i in call.args["ids"]:
+        picked.append(_find(hs, i, call, "ids"))
+    vs = None if call.args["vs"] is None else _find(hs, call.args["vs"], call, "vs")
+    path = session.out_path(call.args["file"])
+    write_csv(path, picked, vs)
+    for h in picked:
+        write_png(path.with_name(f"{path.stem}_{h.name}.png"), h, vs)
+        for key, v in figures(h.times, h.values).items():
+            session.results[f"{h.name}.{key}"] = v

@@ -1,0 +1,120 @@
+"""Histories: values sampled by the rigid engine's cycle every ``interval`` steps.
+
+One ``HistorySet`` hangs on the model (``histories(model)``); it registers its ``sample``
+as a step hook of the model's rigid engine (``RigidEngine.step_hooks``), so a history
+created before or after the engine exists is sampled from the next step on. Each history
+keeps the step and the total time of each sample beside the value.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+#: block quantity -> (engine field, component or None for the magnitude)
+BLOCK_QUANTITIES = {f"{q}{s}": (fld, comp)
+                    for q, fld in (("displacement", "disp"), ("velocity", "velocity"))
+                    for s, comp in (("", None), ("-x", 0), ("-y", 1), ("-z", 2))}
+MODEL_QUANTITIES = ("unbalanced-maximum", "ratio", "time-total")
+
+
+@dataclass
+class History:
+    id: int
+    name: str
+    label: str                                  # what is sampled, for the CSV header and the plot
+    value: Callable[[object], float]            # value(engine) -> float
+    steps: list[int] = field(default_factory=list)
+    times: list[float] = field(default_factory=list)
+    values: list[float] = field(default_factory=list)
+
+    def sample(self, eng) -> None:
+        self.steps.append(int(eng.step))
+        self.times.append(float(eng.time))
+        self.values.append(float(self.value(eng)))
+
+
+class HistorySet:
+    def __init__(self, model):
+        self.model = model
+        self.interval = 10
+        self.items: list[History] = []
+
+    def __call__(self, eng) -> None:
+        """Step hook: sample every history when the step count is a multiple of the interval."""
+        if self.items and eng.step % self.interval == 0:
+            for h in self.items:
+                h.sample(eng)
+
+    def add(self, label: str, value: Callable, name: str | None = None) -> History:
+        hid = (self.items[-1].id + 1) if self.items else 1
+        h = History(hid, name or str(hid), label, value)
+        self.items.append(h)
+        return h
+
+    def find(self, key) -> History | None:
+        """A history by id (number) or by name."""
+        for h in self.items:
+            if (isinstance(key, (int, float)) and not isinstance(key, bool) and h.id == int(key)) or h.name == key:
+                return h
+        return None
+
+    def add_block(self, quantity: str, block_id: int, name: str | None = None) -> History:
+        fld, comp = BLOCK_QUANTITIES[quantity]
+        model = self.model
+        cache = {"row": -1}
+
+        def value(eng) -> float:
+            b = model.blocks
+            r = cache["row"]
+            if not (0 <= r < b.n and b["id"][r] == block_id):
+                r = cache["row"] = int(np.flatnonzero(b["id"] == block_id)[0])
+            v = b[fld][r]
+            return float(np.linalg.norm(v)) if comp is None else float(v[comp])
+
+        return self.add(f"block {block_id} {quantity}", value, name)
+
+    def add_model(self, quantity: str, name: str | None = None) -> History:
+        attr = {"unbalanced-maximum": "unbal", "ratio": "ratio", "time-total": "time"}[quantity]
+        return self.add(f"mechanical {quantity}", lambda eng: float(getattr(eng, attr)), name)
+
+
+def nearest_block_id(model, position) -> int:
+    """Id of the visible block whose centroid is nearest ``position``."""
+    b = model.blocks
+    rows = np.flatnonzero(~b["hidden"])
+    if rows.size == 0:
+        raise ValueError("there are no blocks")
+    d = np.linalg.norm(b["centroid"][rows] - np.asarray(position, dtype=float), axis=1)
+    return int(b["id"][rows[int(np.argmin(d))]])
+
+
+def histories(model) -> HistorySet:
+    """The model's history set, made on first use and hooked to the model's rigid engine."""
+    from .rigid import engine
+
+    hs = getattr(model, "history_set", None)
+    if hs is None:
+        hs = HistorySet(model)
+        model.history_set = hs
+    eng = engine(model)
+    if hs not in eng.step_hooks:
+        eng.step_hooks.append(hs)
+    return hs
+
+
+def figures(times, values) -> dict[str, float]:
+    """final, min, max and frequency (Hz, from the zero crossings of value − mean; 0 if fewer than two)."""
+    v = np.asarray(values, dtype=float)
+    t = np.asarray(times, dtype=float)
+    if v.size == 0:
+        return {"final": float("nan"), "min": float("nan"), "max": float("nan"), "frequency": 0.0}
+    out = {"final": float(v[-1]), "min": float(v.min()), "max": float(v.max()), "frequency": 0.0}
+    d = v - v.mean()
+    k = np.flatnonzero((d[:-1] < 0) != (d[1:] < 0))      # a sign change between sample k and k + 1
+    if k.size >= 2:
+        tc = t[k] + (t[k + 1] - t[k]) * d[k] / (d[k] - d[k + 1])   # linear interpolation of the crossing
+        if tc[-1] > tc[0]:
+            out["frequency"] = float((k.size - 1) / (2.0 * (tc[-1] - tc[0])))
+    return out

@@ -1,0 +1,84 @@
+"""Histories: sampling interval, CSV against the engine state, PNG written, results figures."""
+import csv
+import math
+
+import numpy as np
+import pytest
+
+from dec3d.physics.history import figures, histories
+from dec3d.physics.rigid import engine
+
+DECK = """model new
+block create brick 0 1 0 1 -1 0
+block create brick 0 1 0 1 0 1
+block property density 2000
+model gravity 0 0 -10
+block contact jmodel assign elastic
+block contact material-table default property stiffness-normal 10e6 stiffness-shear 10e6
+block fix range position-z -1 0
+block mechanical damping none
+"""
+
+
+def _run(session, extra):
+    session.run_items(session.load_text(DECK + extra))
+    return engine(session.model)
+
+
+def test_sampled_every_interval_steps(session):
+    _run(session, "block history displacement-z block-id 2\nmodel history mechanical time-total\nmodel cycle 95\n")
+    hs = histories(session.model)
+    assert [h.id for h in hs.items] == [1, 2] and hs.interval == 10
+    assert hs.items[0].steps == list(range(10, 100, 10))
+    _run(session, "history interval 3\nblock history velocity block-id 2\nmodel cycle 9\n")
+    h = histories(session.model).items[-1]
+    assert h.steps == [3, 6, 9]
+
+
+def test_csv_matches_engine_state_and_png_written(session, tmp_path):
+    e = _run(session, "block history name 'uz' displacement-z position 0.4 0.6 0.7\n"
+                      "block history name 'v' velocity-z block-id 2\n"
+                      "model history name 't' mechanical time-total\nhistory interval 5\nmodel cycle 50\n"
+                      "history export 1 2 3 file 'out/h.csv'\n")
+    b = session.model.blocks
+    rows = list(csv.reader(open(tmp_path / "out" / "h.csv")))
+    assert rows[0][:2] == ["step", "time"] and rows[0][2].startswith("uz (block 2 displacement-z")
+    assert len(rows) == 1 + 10
+    last = rows[-1]
+    assert int(last[0]) == e.step == 50
+    assert float(last[1]) == e.time == float(last[4])
+    assert float(last[2]) == b["disp"][1, 2] and float(last[3]) == b["velocity"][1, 2]
+    for name in ("uz", "v", "t"):
+        png = tmp_path / "out" / f"h_{name}.png"
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert session.results["uz.final"] == b["disp"][1, 2]
+    assert session.results["t.max"] == pytest.approx(e.time)
+
+
+def test_export_vs_and_errors(session, tmp_path):
+    from dec3d.errors import Dec3dError
+
+    _run(session, "block history displacement-z block-id 2\nmodel history mechanical time-total\nmodel cycle 20\n"
+                  "history export 1 vs 2 file 'vs.csv'\n")
+    rows = list(csv.reader(open(tmp_path / "vs.csv")))
+    assert "time-total" in rows[0][2] and "displacement-z" in rows[0][3]
+    with pytest.raises(Dec3dError, match="no history 7"):
+        _run(session, "history export 7 file 'x.csv'\n")
+    with pytest.raises(Dec3dError, match="either"):
+        _run(session, "block history velocity\n")
+
+
+def test_figures_of_a_synthetic_sine():
+    t = np.arange(0, 2.0, 1e-3)
+    v = 3.0 + 0.5 * np.sin(2 * math.pi * 7.3 * t + 0.3)
+    f = figures(t, v)
+    assert f["frequency"] == pytest.approx(7.3, rel=2e-3)
+    assert f["final"] == v[-1] and f["min"] == v.min() and f["max"] == v.max()
+    assert figures([0.0, 1.0], [1.0, 1.0])["frequency"] == 0.0
+
+
+def test_undamped_block_frequency(session):
+    _run(session, "block history name 'z' displacement-z block-id 2\nhistory interval 1\nmodel cycle 400\n"
+                  "history export 1 file 'z.csv'\n")
+    f0 = math.sqrt(10e6 / 2000) / (2 * math.pi)
+    assert session.results["z.frequency"] == pytest.approx(f0, rel=0.01)
