@@ -23,8 +23,16 @@ class Analysis:
 
 def analyse(path: str | Path, fmt: str = "auto", compare_bishop: bool = False,
             progress=None, **reader_options) -> Analysis:
+    """Read `path` and run it (see `run_problem`)."""
     t0 = time.perf_counter()
     prob = read(path, fmt, **reader_options)
+    out = run_problem(prob, compare_bishop, progress)
+    out.timings["read"] = time.perf_counter() - t0 - out.timings["solve"] - out.timings["post"]
+    return out
+
+
+def run_problem(prob: Problem, compare_bishop: bool = False, progress=None) -> Analysis:
+    """Solve, evaluate the factors of safety and optionally compare with Bishop."""
     t1 = time.perf_counter()
     st = solve.run(prob, progress=progress)
     t2 = time.perf_counter()
@@ -32,8 +40,7 @@ def analyse(path: str | Path, fmt: str = "auto", compare_bishop: bool = False,
     out = Analysis(problem=prob, state=st, safety=saf)
     if compare_bishop:
         out.bishop = compare(prob, saf)
-    t3 = time.perf_counter()
-    out.timings = dict(read=t1 - t0, solve=t2 - t1, post=t3 - t2,
+    out.timings = dict(solve=t2 - t1, post=time.perf_counter() - t2,
                        per_step=(t2 - t1) / max(prob.settings.n_steps, 1))
     return out
 

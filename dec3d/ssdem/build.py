@@ -82,8 +82,7 @@ def from_slope(slope: Slope, mesh: dict, surface: dict | None, settings: Setting
     itf.on_surface = on
     assign_properties(itf, slope)
     return Problem(title=title, blocks=blocks, interfaces=itf, settings=settings,
-                   profile=slope.profile, layers=slope.layers, water=dict(ru=slope.ru, ru_mode=slope.ru_mode),
-                   surface=surface, bottom=bottom, slope=slope)
+                   profile=slope.profile, surface=surface, bottom=bottom, slope=slope)
 
 
 def from_polygons(polygons, fixed, *, kn, ks, c=0.0, phi=0.0, c_res=None, phi_res=None, delta_res=np.inf,

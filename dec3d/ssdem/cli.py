@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
+from contextlib import nullcontext
 from pathlib import Path
 
 from dec3d.errors import Dec3dError
@@ -28,10 +30,10 @@ def parser() -> argparse.ArgumentParser:
     return ap
 
 
-def _progress_factory(n_blocks: int, quiet: bool):
-    """A rich progress bar over load steps, for big runs on a terminal; else None."""
+def _progress(n_blocks: int, quiet: bool):
+    """(context, callback): a rich bar over load steps for big runs on a terminal, else nothing."""
     if quiet or n_blocks < PROGRESS_MIN_BLOCKS or not sys.stdout.isatty():
-        return None, None
+        return nullcontext(), None
     from rich.progress import Progress
     bar = Progress(transient=True)
     task = bar.add_task("load steps", total=None)
@@ -45,36 +47,26 @@ def _progress_factory(n_blocks: int, quiet: bool):
 def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
     from . import plot, report
-    from .analysis import Analysis, compare
+    from .analysis import run_problem
     from .readers import read
-    from . import safety, solve
-    import time
 
     path = Path(args.input)
     if not path.is_file():
         print(f"dec3d ssdem: error: no such file: {path}", file=sys.stderr)
         return 2
-    opts = {} if args.format == "toml" or (args.format == "auto" and path.suffix.lower() == ".toml") else \
-        dict(units=args.units, tensile_strength=args.tensile_strength)
+    toml = args.format == "toml" or (args.format == "auto" and path.suffix.lower() == ".toml")
+    opts = {} if toml else dict(units=args.units, tensile_strength=args.tensile_strength)
+    t0 = time.perf_counter()
     try:
-        t0 = time.perf_counter()
         prob = read(path, args.format, **opts)
     except Dec3dError as exc:
         print(exc.format(), file=sys.stderr)
         return 2
-    t1 = time.perf_counter()
-    bar, update = _progress_factory(prob.blocks.n, args.quiet)
-    if bar is not None:
-        with bar:
-            st = solve.run(prob, progress=update)
-    else:
-        st = solve.run(prob)
-    t2 = time.perf_counter()
-    an = Analysis(problem=prob, state=st, safety=safety.evaluate(prob, st))
-    if args.compare == "bishop":
-        an.bishop = compare(prob, an.safety)
-    an.timings = dict(read=t1 - t0, solve=t2 - t1, post=time.perf_counter() - t2,
-                      per_step=(t2 - t1) / max(prob.settings.n_steps, 1))
+    t_read = time.perf_counter() - t0
+    ctx, update = _progress(prob.blocks.n, args.quiet)
+    with ctx:
+        an = run_problem(prob, compare_bishop=args.compare == "bishop", progress=update)
+    an.timings["read"] = t_read
     out = Path(args.out) if args.out else Path(f"{path.stem}_ssdem")
     files = report.write_all(an, out)
     png = out / "figure.png"

@@ -118,16 +118,12 @@ class Problem:
     source: str = ""
     fmt: str = ""
     units: str = "SI"
-    # ground profile (k, 2) and soil description for limit equilibrium; None for Appendix A files
+    # the slope description of a TOML input (Bishop and the figure need it); None for Appendix A
+    slope: object = None          # soil.Slope
     profile: np.ndarray | None = None
-    layers: list = field(default_factory=list)
-    layer_tops: list = field(default_factory=list)
-    water: dict = field(default_factory=dict)
-    surcharges: list = field(default_factory=list)
-    surface: dict | None = None
-    bottom: float | None = None
+    surface: dict | None = None   # prescribed slip surface, if any
+    bottom: float | None = None   # base of a grid mesh
     notes: list = field(default_factory=list)
-    slope: object = None          # soil.Slope for TOML input (Bishop needs it); None otherwise
 
 
 def make_blocks(verts, offsets, fixed, force=None, ref=None, layer=None, fix=None) -> Blocks:

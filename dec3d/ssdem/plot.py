@@ -22,9 +22,9 @@ def figure(an: Analysis, path: Path) -> None:
     polys = [blk.polygon(i) / L for i in range(blk.n)]
     mag = np.hypot(st.u[:, 0], st.u[:, 1]) / L
     fig, ax = plt.subplots(figsize=(11, 6), dpi=110)
-    pc = PolyCollection(polys, array=np.where(st.removed | blk.fixed, np.nan, mag), cmap="viridis",
+    cmap = matplotlib.colormaps["viridis"].with_extremes(bad="0.85")   # fixed and removed blocks grey
+    pc = PolyCollection(polys, array=np.where(st.removed | blk.fixed, np.nan, mag), cmap=cmap,
                         edgecolors="0.35", linewidths=0.3)
-    pc.cmap.set_bad("0.85")
     ax.add_collection(pc)
     fig.colorbar(pc, ax=ax, label=f"displacement magnitude ({p.units.split('-')[1] if '-' in p.units else 'm'})")
     if st.removed.any():

@@ -81,7 +81,6 @@ def read_toml(path: str | Path, text: str | None = None, **_ignored):
         key = ("surface", "type") if surface is not None else ("mesh", "bottom")
         raise loc.error(key[0], 0, key[1], str(exc)) from None
     prob.source, prob.fmt, prob.units = str(path), "toml", top["units"]
-    prob.slope = slope
     return prob
 
 
