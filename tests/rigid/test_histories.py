@@ -8,16 +8,9 @@ import pytest
 from dec3d.physics.history import figures, histories
 from dec3d.physics.rigid import engine
 
-DECK = """model new
-block create brick 0 1 0 1 -1 0
-block create brick 0 1 0 1 0 1
-block property density 2000
-model gravity 0 0 -10
-block contact jmodel assign elastic
-block contact material-table default property stiffness-normal 10e6 stiffness-shear 10e6
-block fix range position-z -1 0
-block mechanical damping none
-"""
+from test_engine import DECK as _BLOCK_ON_SPRING
+
+DECK = _BLOCK_ON_SPRING + "block mechanical damping none\n"   # the same block, undamped
 
 
 def _run(session, extra):
