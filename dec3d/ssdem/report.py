@@ -94,6 +94,9 @@ def summary_text(an: Analysis) -> str:
         out.append("  interfaces: " + " ".join(map(str, ids[:200])) + (" ..." if len(ids) > 200 else ""))
     out.append(f"FS (static DEM, shear-force weighted average = Eq. 2.6): {_num(q['fs_dem'])}")
     out.append(f"FS (static DEM, arithmetic mean of interface FS, thesis App. C): {_num(q['fs_dem_mean'])}")
+    if s.surface_kind == "yield":
+        out.append("  (a yielded interface carries its full strength, so an average over yielded interfaces is 1 "
+                   "by construction; for the safety of a stable slope give a [surface] - a trial or the critical circle)")
     fin = s.fs[np.isfinite(s.fs)]
     if len(fin):
         out.append(f"smallest interface FS: {fin.min():.3f} (interface {int(np.flatnonzero(s.fs == fin.min())[0])})")
