@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .commands import load_all
-from .commands.binder import BindContext, Binder, LegacySyntaxError
+from .commands.binder import BindContext, Binder, CommandCall, LegacySyntaxError
 from .errors import Dec3dError, NotSupportedError
 from .lang.parser import parse_deck
 
@@ -41,18 +41,9 @@ def check_text(text: str, filename: str = "<input>") -> list[LineReport]:
             ctx.define_fish(fish[k])
             reports.append(LineReport(fish[k].line, RUNNABLE, f"fish define {fish[k].name}"))
             k += 1
-        toks = raw.tokens
         try:
-            if toks[0].type == "EXPR" and len(toks) == 1:
-                node = binder.expression(toks[0])
-                if node[0] == "assign":
-                    ctx.assigned.add(node[1])
-                what = "[inline FISH]"
-            elif toks[0].type == "ATNAME" and len(toks) == 1:
-                binder.deferred(toks[0])
-                what = str(toks[0])
-            else:
-                what = binder.bind(raw).name
+            item = binder.bind_line(raw)
+            what = item.name if isinstance(item, CommandCall) else item.source
             reports.append(LineReport(raw.line, RUNNABLE, what))
         except LegacySyntaxError as exc:
             reports.append(LineReport(raw.line, LEGACY, exc.message))

@@ -17,22 +17,13 @@ from pathlib import Path
 from typing import Any, Iterable, TextIO
 
 from .commands import load_all
-from .commands.binder import BindContext, Binder, CommandCall
+from .commands.binder import BindContext, Binder, CommandCall, ExprStatement
 from .commands.values import Deferred
 from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation
 from .lang.expr import EvalContext, evaluate
 from .lang.parser import ParsedDeck, parse_deck
 from .lang.prepass import FishBlock
 from .model.model import Model
-
-
-@dataclass(frozen=True)
-class ExprStatement:
-    """A line made only of `[ ... ]`: assignment or expression (e.g. io.out)."""
-
-    node: tuple
-    location: SourceLocation
-    source: str
 
 
 @dataclass(frozen=True)
@@ -117,7 +108,6 @@ class Session:
 
     def _bind_deck(self, deck: ParsedDeck, base_dir: Path, stack) -> list[Item]:
         binder = Binder(deck, self.bind_context, stack)
-        ctx = self.bind_context
         items: list[Item] = []
         fish = iter(deck.fish)
         next_fish = next(fish, None)
@@ -125,19 +115,10 @@ class Session:
             while next_fish is not None and next_fish.line < raw.line:
                 items.append(self._fish_item(deck, next_fish, stack))
                 next_fish = next(fish, None)
-            toks = raw.tokens
-            first = toks[0]
-            if first.type == "EXPR" and len(toks) == 1:
-                node = binder.expression(first)
-                if node[0] == "assign":
-                    ctx.assigned.add(node[1])
-                items.append(ExprStatement(node, deck.location(first, stack), binder.source(raw)))
+            call = binder.bind_line(raw)
+            if isinstance(call, ExprStatement):
+                items.append(call)
                 continue
-            if first.type == "ATNAME" and len(toks) == 1:
-                binder.deferred(first)   # raises: FISH calls are not supported yet
-                items.append(ExprStatement(("name", str(first)[1:].lower(), 1), deck.location(first, stack), str(first)))
-                continue
-            call = binder.bind(raw)
             path = call.command.path
             if path == ("program", "call") and not isinstance(call.args["file"], Deferred):
                 # a literal name: the called file is read and bound now, in place of the call

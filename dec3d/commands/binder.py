@@ -69,6 +69,15 @@ class CommandCall:
         return self.location.text.strip()
 
 
+@dataclass(frozen=True)
+class ExprStatement:
+    """A line made only of `[ ... ]` (assignment or expression, e.g. io.out) or of `@name`."""
+
+    node: tuple
+    location: SourceLocation
+    source: str
+
+
 class BindContext:
     """What the binder knows about FISH names while reading a deck, in order."""
 
@@ -156,6 +165,21 @@ class Binder:
         raise BindError(f"undefined FISH variable `{name}`", loc, hint="assign it first, e.g. [name = 1.0]")
 
     # ------------------------------------------------------------ commands
+    def bind_line(self, raw: RawLine) -> "CommandCall | ExprStatement":
+        """Any line: a `[ ... ]` statement, an `@name` call, or a command."""
+        toks = raw.tokens
+        first = toks[0]
+        if len(toks) == 1 and first.type == "EXPR":
+            node = self.expression(first)
+            if node[0] == "assign":
+                self.ctx.assigned.add(node[1])   # later lines may use the variable
+            return ExprStatement(node, self.deck.location(first, self.stack), self.source(raw))
+        if len(toks) == 1 and first.type == "ATNAME":
+            self.deferred(first)                 # a FISH function call raises "not supported yet"
+            return ExprStatement(("name", str(first)[1:].lower(), 1), self.deck.location(first, self.stack),
+                                 str(first))
+        return self.bind(raw)
+
     def bind(self, raw: RawLine) -> CommandCall:
         toks = raw.tokens
         first = toks[0]
@@ -244,7 +268,7 @@ class Binder:
             else:
                 hint = "expected one of: " + ", ".join(cands[:12]) + (" …" if len(cands) > 12 else "")
             raise BindError(f"unknown command {where}", self.where(tok), hint=hint)
-        if node.known and not any(c.command for _, c in self.reg.walk(node)) or (node.known and not node.children):
+        if node.known and not any(c.command for _, c in self.reg.walk(node)):
             raise NotSupportedError(f"`{name}` is not supported yet", self.where(toks[0]))
         cands = sorted(node.children)
         hint = legacy_hint(str(toks[0]).lower()) if len(path) == 1 and i < len(toks) else None
