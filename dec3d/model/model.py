@@ -14,7 +14,11 @@ Stores (struct-of-arrays, see ``store.py``; shapes after the leading row dimensi
     principal_moment (3,) kg·m², ascending; principal_axes (3, 3) columns are the axes
     inertia_approx () kg·m² scalar inertia for quasi-static runs (``geometry.mass``)
     velocity, spin, force, moment (3,)  m/s, rad/s, N, N·m (the engine fills them)
-    fixity ()        uint8  bits 0-2 velocity x, y, z; bits 3-5 rotation x, y, z
+    fixity ()        uint8  bits 0-2 velocity x, y, z; bits 3-5 rotation x, y, z (``block fix``)
+    disp (3,)        m      accumulated centroid displacement (``block initialize`` resets it)
+    fapp, mapp (3,)  N, N·m applied force and moment (``block apply force|moment``)
+    apply_fix ()     uint8  components held by ``block apply velocity|rvelocity`` (fixity bits);
+                     the engine moves a block with ``fixity | apply_fix``
     kind ()          int8   KIND_RIGID / KIND_DEFORMABLE / KIND_FE
     hidden ()        bool
     leader ()        int64  row of the block whose motion this one follows (itself if not joined)
@@ -63,6 +67,10 @@ def _block_fields() -> dict[str, Field]:
         "force": Field((3,), _F, 0.0),
         "moment": Field((3,), _F, 0.0),
         "fixity": Field((), np.uint8, 0),
+        "disp": Field((3,), _F, 0.0),
+        "fapp": Field((3,), _F, 0.0),
+        "mapp": Field((3,), _F, 0.0),
+        "apply_fix": Field((), np.uint8, 0),
         "kind": Field((), np.int8, KIND_RIGID),
         "hidden": Field((), np.bool_, False),
         "leader": Field((), _I, -1),

@@ -85,11 +85,6 @@ class RigidEngine:
         self.cname: list[str] = []
         self.cuser: list[dict] = []
         self._empty_sc()
-        b = model.blocks
-        from dec3d.model.store import Field
-        for key in ("disp", "fapp", "mapp"):
-            if key not in b:
-                b.add_field(key, Field((3,), np.float64, 0.0))
 
     def _empty_sc(self):
         self.sc = {"contact": np.zeros(0, np.int64), "pos": np.zeros((0, 3)), "area": np.zeros(0),
