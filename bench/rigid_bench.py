@@ -1,0 +1,144 @@
+"""Benchmark of the rigid-block cycle: an n x n x n stack of unit cubes on a fixed base.
+
+The scene of the YADE peer benchmark (/work/shared/bench/yade_cubes_bench.py, see
+bench/README.md "Peers"): n^3 unit cubes (density 2600 kg/m^3) face to face, resting on
+a fixed n x n x 1 base block, gravity -9.81 m/s^2, local damping 0.8, joint model mohr
+(kn = ks = 1e9 Pa/m, friction 34.38 deg = YADE's 0.6 rad, no cohesion, no tension) or
+elastic (`--jmodel elastic`, same stiffnesses).  5 warm-up steps (they also compile the
+numba kernels and make the first contact detection), then S timed steps.
+
+The scene is built and run only through the public command API (`dec3d.Session().command`),
+so the script keeps working while the engine behind the commands changes.  The contact and
+sub-contact counts are read, if available, from the model's rigid engine (read-only,
+guarded: "n/a" when the engine does not expose them).  Each (n, repeat) runs in a fresh
+process (peak RSS from resource.getrusage is per process); the median is printed.
+
+    python bench/rigid_bench.py [--n 10 20] [--steps 100] [--repeat 3] [--jmodel mohr|elastic]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+
+WARMUP = 5
+
+
+def deck(n: int, jmodel: str) -> str:
+    """Command lines building the scene (no cycling)."""
+    lines = ["model new", f"block create brick 0 {n} 0 {n} -1 0"]
+    for i in range(n):
+        for j in range(n):
+            for k in range(n):
+                lines.append(f"block create brick {i} {i + 1} {j} {j + 1} {k} {k + 1}")
+    props = "stiffness-normal 1e9 stiffness-shear 1e9"
+    if jmodel == "mohr":
+        props += " friction 34.38 cohesion 0 tension 0"
+    lines += [
+        "block property density 2600",
+        "block fix range position-z -1 0",
+        "model gravity 0 0 -9.81",
+        "block mechanical damping local 0.8",
+        f"block contact jmodel assign {jmodel}",
+        f"block contact material-table default property {props}",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def _counts(session) -> tuple:
+    """(contacts, sub-contacts) if the engine exposes them, else (None, None)."""
+    try:
+        e = getattr(session.model, "rigid_engine", None)
+        nc = len(e.ca)
+        nsc = len(e.sc["contact"])
+        return int(nc), int(nsc)
+    except Exception:      # the engine is being rewritten: its fields are not an API
+        return None, None
+
+
+def one(n: int, steps: int, jmodel: str) -> dict:
+    """Build, warm up and time in this process."""
+    import io
+    import resource
+    import tempfile
+
+    import dec3d
+
+    with tempfile.TemporaryDirectory() as d:
+        s = dec3d.Session(out_dir=d, stdout=io.StringIO())
+        t0 = time.perf_counter()
+        s.command(deck(n, jmodel))
+        t1 = time.perf_counter()
+        s.command(f"model cycle {WARMUP}")
+        t2 = time.perf_counter()
+        s.command(f"model cycle {steps}")
+        t3 = time.perf_counter()
+        nc, nsc = _counts(s)
+    rss_kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return dict(blocks=n ** 3, contacts=nc, subcontacts=nsc, build_s=t1 - t0, warmup_s=t2 - t1,
+                seconds=t3 - t2, peak_rss_mib=rss_kib / 1024.0)
+
+
+def machine() -> str:
+    cpu = platform.processor() or "?"
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, {platform.system()} {platform.release()}"
+
+
+def _fmt(x) -> str:
+    return "n/a" if x is None else str(x)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n", type=int, nargs="+", default=[10, 20], help="cubes per side")
+    ap.add_argument("--steps", type=int, default=100, help="timed steps S")
+    ap.add_argument("--repeat", type=int, default=3, help="runs per n (median printed)")
+    ap.add_argument("--jmodel", choices=("mohr", "elastic"), default="mohr")
+    ap.add_argument("--child", type=int, help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.child:
+        print(json.dumps(one(args.child, args.steps, args.jmodel)))
+        return 0
+    print(f"machine: {machine()}")
+    print(f"scene: n^3 unit cubes on a fixed base, jmodel {args.jmodel}, kn = ks = 1e9 Pa/m, "
+          f"{WARMUP} warm-up + {args.steps} timed steps, median of {args.repeat}")
+    print(f"{'n':>3} {'blocks':>7} {'contacts':>8} {'subcont':>8} {'build s':>8} {'warmup s':>8} "
+          f"{'seconds':>8} {'min..max':>15} {'blk-cyc/s':>10} {'subc-upd/s':>11} {'peak MiB':>9}")
+    for n in args.n:
+        runs = []
+        for _ in range(args.repeat):
+            out = subprocess.run([sys.executable, os.path.abspath(__file__), "--child", str(n),
+                                  "--steps", str(args.steps), "--jmodel", args.jmodel],
+                                 capture_output=True, text=True)
+            if out.returncode != 0:
+                sys.stderr.write(out.stderr)
+                raise SystemExit(f"n = {n}: the run failed (exit {out.returncode})")
+            runs.append(json.loads(out.stdout.strip().splitlines()[-1]))
+        sec = [r["seconds"] for r in runs]
+        t = statistics.median(sec)
+        r0 = runs[0]
+        bcs = r0["blocks"] * args.steps / t if t > 0 else float("inf")
+        scu = "n/a" if r0["subcontacts"] is None else f"{r0['subcontacts'] * args.steps / t:.3g}"
+        print(f"{n:>3} {r0['blocks']:>7} {_fmt(r0['contacts']):>8} {_fmt(r0['subcontacts']):>8} "
+              f"{statistics.median(r['build_s'] for r in runs):>8.2f} "
+              f"{statistics.median(r['warmup_s'] for r in runs):>8.2f} {t:>8.3f} "
+              f"{min(sec):>7.3f}..{max(sec):<7.3f} {bcs:>10.4g} {scu:>11} "
+              f"{statistics.median(r['peak_rss_mib'] for r in runs):>9.0f}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,20 @@
+"""bench/rigid_bench.py runs on a tiny stack and prints its figures (no timing asserted)."""
+import subprocess
+import sys
+
+from conftest import ROOT
+
+
+def test_rigid_bench_runs_and_prints_the_figures():
+    out = subprocess.run([sys.executable, str(ROOT / "bench" / "rigid_bench.py"), "--n", "2", "--steps", "5",
+                          "--repeat", "1"], capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert lines[0].startswith("machine: ")
+    head = next(ln for ln in lines if ln.split()[:2] == ["n", "blocks"])
+    for word in ("contacts", "subcont", "seconds", "blk-cyc/s", "subc-upd/s", "peak MiB"):
+        assert word in head
+    row = lines[-1].split()
+    assert row[:2] == ["2", "8"]
+    float(row[6])                      # seconds
+    assert float(row[8]) > 0           # block-cycles/s
