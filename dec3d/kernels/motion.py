@@ -1,5 +1,15 @@
-"""Rigid-block motion (3DEC theory Eqs. 44-52, ERRATA Eq. 49) and the block time step (Eq. 87).
+"""Rigid-block motion (3DEC theory Eqs. 44-52, ERRATA Eq. 49), mechanical damping (Eqs. 77-83),
+the block time step (Eq. 87) and density scaling.
 
+Sources: the 3DEC theory text (/work/shared/seeds/000_b8ba745952e0c537.txt, sections "Rigid Block
+Motion", "Mechanical Damping", "Numerical Stability", "Mass (Density) Scaling") with its ERRATA
+(D₁ = 1 − αΔt/2 in Eq. 49; frac = 0.1 in Eq. 87), and Itasca's PFC `rblock damping` command page
+(https://docs.itascacg.com/pfc700/pfc/rblock/doc/manual/commands/cmd_rblock_damping.html:
+combined damping is made of contributions from "changes in the sign of the velocity" and "changes
+in the sign of the total force", with the local damping coefficient).
+
+``rigid_motion`` (one block per row; the engine's kernel today)
+---------------------------------------------------------------
 Central differences on velocities at half steps. For each moving block (a leader row):
 
   F_u = F + F_applied + m g                       unbalanced force [N]
@@ -16,10 +26,94 @@ Central differences on velocities at half steps. For each moving block (a leader
 m_i is the inertial mass (mass-scaled or not), m the gravitational mass. Fixed velocity
 components (fixity bits 0-2) and rotation components (bits 3-5) keep their velocity.
 Forces and moments are reset to zero after the update.
+
+``rigid_motion_groups`` (joined blocks, full inertia, four damping modes)
+-------------------------------------------------------------------------
+A group (CSR ``gstart``/``gmember``; a lone block is a group of one) moves as one rigid body:
+"the motion calculations are only performed for the leader block, whose mass, moment of inertia,
+and centroid position are modified to represent the group" (3DEC theory, after Eq. 52). The
+composite properties come from ``group_properties`` (parallel-axis theorem). For a group with
+centroid C, members b with centroids c_b and arms d_b = c_b − C:
+
+  F = Σ_b (F_b + F_app,b + m_b g)
+  M = Σ_b (M_b + M_app,b + d_b × (F_b + F_app,b + m_b g))
+
+The group velocity V at C is recovered from the leader (first member): V = v_lead − ω × d_lead;
+ω is the spin shared by all members. The leader's fixity bits apply to the group.
+
+Translation: Eq. 49 with the group's inertial mass.
+Rotation, ``full_inertia`` False: Eq. 46/49 with the scalar inertia ``giscalar`` (quasi-static,
+as ``rigid_motion``; the gyroscopic term of Eq. 45 is dropped, so a torque-free body keeps ω).
+Rotation, ``full_inertia`` True (Euler's equations, Eq. 45, for dynamic runs), written as
+dL/dt = M for the world angular momentum L = J ω, J = R diag(I₁, I₂, I₃) Rᵀ, R = ``gaxes``:
+  * L lives at half steps like ω. It is not stored: at the start of a step it is rebuilt from the
+    stored ω(t−Δt/2) and the current axes R(t) by L = Pᵀ J(t) ω, where P is the half of the last
+    Cayley rotation (P² = Q(a), a = ωΔt/2, P = Q(b) with b = a / (1 + sqrt(1 + a·a))).
+  * L(t+Δt/2) = [D₁ L(t−Δt/2) + (M − M_d) Δt] D₂  (Eq. 49 form; M_d the damping moment).
+  * ω(t+Δt/2) solves the implicit mid-point relation ω = J_mid⁻¹ L with J_mid = P J(t) Pᵀ, i.e.
+    J(t) ω = Pᵀ(ω) L, by fixed-point iteration (contraction ≈ |ω|Δt; converged to round-off).
+  * axes and vertices turn by the same Cayley rotation Q(ωΔt/2).
+  The scheme is time-reversible and keeps L of a torque-free body exactly (to round-off): the L
+  rebuilt at the next step is P J(t) ω = L. The principal moments used are ``gprin`` times the
+  mass-scaling ratio gimass/gmass (1 when no scaling), so the engine passes unscaled ``gprin``.
+
+Damping (``damp_mode``), with α = ``alpha`` for modes 1 and 2:
+  0  none.
+  1  local (Eq. 79): F_d,i = α |F_u,i| sgn(ẋ_i), same with M and ω; world components.
+  2  combined (Eq. 83; 3DEC theory "Combined Damping", PFC rblock damping page):
+         F_d,i = α |F_u,i| [sgn(ẋ_i) − sgn(Ḟ_u,i)] / 2        (subtracted from F_u as in Eq. 78)
+     Eq. 83 is written for a damping force *added* to F: α|F|(sgn(Ḟ) − sgn(u̇))/2; this is the
+     same force with the sign of Eq. 78. Ḟ_u,i is taken as F_u,i(t) − F_u,i(t−Δt) from the
+     previous unbalanced force stored in ``servo`` (see below); on the first step (no history)
+     sgn(Ḟ) = 0, i.e. half the local damping. Same for the moment with ω.
+  3  adaptive global (Cundall 1982; 3DEC theory Eq. 77, "damping auto"): viscous, mass
+     proportional damping α_v (D₁, D₂ of Eq. 49) on translation and rotation, with α_v adjusted by a
+     servo so that R = Σ P / Σ |Ė_k| tends to ``servo[S_RATIO]`` (0.5). P = α_v (m_i v² + ω·L)
+     is the damping power of a group (evaluated as α_v (E_k(t−Δt/2) + E_k(t+Δt/2)), i.e. 2α_v E_k
+     at mid step) and |Ė_k| the magnitude of the change of the group's (inertial) kinetic energy
+     over the step. Eq. 77 sums the signed rates; their sum over a cycle of a freely decaying
+     system is −Σ P, so R = −1 whatever α_v: the magnitude is the reading that makes the servo
+     meaningful (for one oscillator of circular frequency w, R = π α_v / (2w), so R = 0.5 gives
+     α_v = w/π, about 16 % of critical). Every ``servo[S_WINDOW]`` steps the accumulated works
+     are compared: α_v ← α_v·f if R < ratio, α_v ← α_v/f if R > ratio (f = ``servo[S_FACTOR]``),
+     bounded to [1e-6/Δt, 1/Δt] (1/Δt keeps D₁ ≥ 1/2). A servo that starts at 0 starts at
+     0.02/Δt. The update rule (a multiplicative bang-bang servo) is this code's own: the texts
+     give only the target ratio.
+
+``servo`` layout (float64, persists across calls; ``new_servo`` makes one):
+  [0] S_ALPHA   current adaptive viscous coefficient α_v [1/s]
+  [1] S_WORK    damping work Σ P Δt accumulated over the current window [J]
+  [2] S_DEK     Σ |ΔE_k| accumulated over the current window [J]
+  [3] S_NWIN    steps in the current window
+  [4] S_RATIO   target ratio R (0.5)
+  [5] S_WINDOW  window length [steps] (10)
+  [6] S_FACTOR  servo factor f (1.1)
+  [7] S_LASTR   last measured R (diagnostic)
+  [8] S_HIST    1 when the tail holds the previous unbalanced forces of these same groups
+  [9] S_CALLS   number of calls
+  [NSERVO + 6 g : NSERVO + 6 g + 6]  previous F_u (3) and M_u (3) of group g, for combined
+      damping only (modes 0, 1, 3 need only NSERVO entries). Set S_HIST to 0 when the groups change.
+
+``out`` (4,): [0] max |F_u| over groups (fixed components left out) [N]; [1] Σ over members of
+|m g_i| + |F_i| (contact force) [N]; [2] kinetic energy with the real masses and inertia
+(½ m V² + ½ ωᵀ J ω, J from unscaled ``gprin``) [J]; [3] the viscous coefficient α_v used [1/s].
+After the step every member has vel = V + ω × (c_b − C) (new arms) and spin = ω; member centroids
+and vertices turn about C with the Cayley rotation and move by V Δt; disp accumulates each
+member's centroid displacement; forces and moments of the members are reset to zero. A group
+whose speed |V_x|+|V_y|+|V_z| reaches ``vmax`` or whose ω is not finite does not move; the first
+such group index is returned (−1 if none), the others finish the step.
+
+Density scaling (``inertial_masses``): Eq. 87 gives Δt_b = frac·2·sqrt(M/K). The inertial mass of
+a group is raised to the smallest value that is stable at the step Δt with its stiffness sum K:
+m_i = max(m, K (Δt / (2 frac))²); the scalar inertia is scaled by the same ratio m_i/m. Gravity
+keeps the real mass (3DEC theory, "Mass (Density) Scaling": inertial density is irrelevant to
+static systems "provided that gravity forces are correctly preserved").
 """
 from __future__ import annotations
 
 import math
+
+import numpy as np
 
 from numba import njit
 
@@ -124,3 +218,411 @@ def block_timestep(mass_min, k_max, frac):
     if k_max <= 0.0:
         return 0.0
     return frac * 2.0 * math.sqrt(mass_min / k_max)
+
+
+# ----------------------------------------------------------------------------------------------
+# groups of joined blocks, full inertia, damping modes
+# ----------------------------------------------------------------------------------------------
+
+S_ALPHA, S_WORK, S_DEK, S_NWIN, S_RATIO, S_WINDOW, S_FACTOR, S_LASTR, S_HIST, S_CALLS = range(10)
+#: number of global entries at the head of the servo array
+NSERVO = 10
+#: damp_mode codes
+DAMP_NONE, DAMP_LOCAL, DAMP_COMBINED, DAMP_ADAPTIVE = 0, 1, 2, 3
+
+
+def servo_size(ng):
+    """Length of a servo array good for every damping mode with ``ng`` groups."""
+    return NSERVO + 6 * int(ng)
+
+
+def new_servo(ng, ratio=0.5, window=10, factor=1.1, alpha0=0.0):
+    """A fresh servo array (layout in the module docstring) for ``ng`` groups."""
+    s = np.zeros(servo_size(ng))
+    s[S_ALPHA] = alpha0
+    s[S_RATIO] = ratio
+    s[S_WINDOW] = window
+    s[S_FACTOR] = factor
+    return s
+
+
+def group_properties(gstart, gmember, mass, centroid, inertia, inertia_approx):
+    """Composite properties of groups of joined blocks.
+
+    gstart (ng+1,) int64 CSR into gmember (int64 block rows); mass (nb,) kg; centroid (nb, 3) m;
+    inertia (nb, 3, 3) kg·m² full tensor of each block about its own centroid; inertia_approx (nb,)
+    kg·m² the scalar approximate inertia of each block (3DEC's average-distance value).
+    Returns (gmass (ng,), gcentroid (ng, 3), ginertia (ng, 3, 3) about the group centroid by the
+    parallel-axis theorem I_C = Σ [I_b + m_b (|d|² E − d dᵀ)], d = c_b − C; gprin (ng, 3)
+    principal moments ascending; gaxes (ng, 3, 3) principal axes as columns, right-handed;
+    giscalar (ng,) = Σ [I_approx,b + m_b |d|²]). A group of one keeps its block's centroid exactly.
+    """
+    gstart = np.asarray(gstart, np.int64)
+    gmember = np.asarray(gmember, np.int64)
+    mass = np.asarray(mass, np.float64)
+    centroid = np.asarray(centroid, np.float64)
+    ng = gstart.shape[0] - 1
+    cnt = np.diff(gstart)
+    gid = np.repeat(np.arange(ng), cnt)
+    m = mass[gmember]
+    c = centroid[gmember]
+    gmass = np.bincount(gid, m, minlength=ng)
+    gc = np.empty((ng, 3))
+    for k in range(3):
+        gc[:, k] = np.bincount(gid, m * c[:, k], minlength=ng) / np.where(gmass > 0, gmass, 1.0)
+    one = cnt == 1
+    gc[one] = centroid[gmember[gstart[:-1][one]]]
+    d = c - gc[gid]
+    d2 = (d * d).sum(1)
+    ib = np.asarray(inertia, np.float64)[gmember] + m[:, None, None] * (
+        d2[:, None, None] * np.eye(3) - d[:, :, None] * d[:, None, :])
+    ginertia = np.zeros((ng, 3, 3))
+    np.add.at(ginertia, gid, ib)
+    giscalar = np.bincount(gid, np.asarray(inertia_approx, np.float64)[gmember] + m * d2, minlength=ng)
+    ginertia = 0.5 * (ginertia + ginertia.transpose(0, 2, 1))
+    gprin, gaxes = np.linalg.eigh(ginertia)
+    flip = np.linalg.det(gaxes) < 0
+    gaxes[flip, :, 2] *= -1.0
+    return gmass, gc, ginertia, gprin, np.ascontiguousarray(gaxes), giscalar
+
+
+def inertial_masses(mass, iscalar, kblock, dt, frac):
+    """Density scaling (3DEC theory "Mass (Density) Scaling", Eq. 87).
+
+    mass (n,) kg real (gravitational) masses; iscalar (n,) kg·m² scalar inertias; kblock (n,) N/m
+    the stiffness sum of each group (sum over its contacts of the larger of k_n A, k_s A); dt the
+    wanted step [s]; frac the Eq. 87 factor (0.1). Returns (imass, iscalar_scaled) with
+    imass = max(mass, kblock (dt / (2 frac))²), so that frac·2·sqrt(imass / kblock) ≥ dt (equal
+    where scaled), and iscalar_scaled = iscalar · imass / mass.
+    """
+    mass = np.asarray(mass, np.float64)
+    need = np.asarray(kblock, np.float64) * (dt / (2.0 * frac)) ** 2
+    imass = np.maximum(mass, need)
+    return imass, np.asarray(iscalar, np.float64) * (imass / mass)
+
+
+@njit(cache=True)
+def _ldamp(mode, alpha, f, v, fprev, hist):
+    """Damping force of modes 1 (local, Eq. 79) and 2 (combined, Eq. 83); subtracted from f."""
+    if mode == 1:
+        return alpha * abs(f) * _sgn(v)
+    if mode == 2:
+        fd = 0.0
+        if hist:
+            fd = _sgn(f - fprev)
+        return alpha * abs(f) * (_sgn(v) - fd) * 0.5
+    return 0.0
+
+
+@njit(cache=True)
+def _cay(a0, a1, a2, r0, r1, r2):
+    """Cayley rotation of r by the Rodrigues vector a (angle 2 atan|a|)."""
+    h = 2.0 / (1.0 + a0 * a0 + a1 * a1 + a2 * a2)
+    s0 = r0 + (a1 * r2 - a2 * r1)
+    s1 = r1 + (a2 * r0 - a0 * r2)
+    s2 = r2 + (a0 * r1 - a1 * r0)
+    return (r0 + h * (a1 * s2 - a2 * s1), r1 + h * (a2 * s0 - a0 * s2), r2 + h * (a0 * s1 - a1 * s0))
+
+
+@njit(cache=True)
+def _half(a0, a1, a2):
+    """b with Q(b)² = Q(a): b = a / (1 + sqrt(1 + a·a))."""
+    q = 1.0 / (1.0 + math.sqrt(1.0 + a0 * a0 + a1 * a1 + a2 * a2))
+    return a0 * q, a1 * q, a2 * q
+
+
+@njit(cache=True)
+def _jmul(ax, p0, p1, p2, x0, x1, x2):
+    """R diag(p) Rᵀ x with R = ax (principal axes as columns)."""
+    y0 = (ax[0, 0] * x0 + ax[1, 0] * x1 + ax[2, 0] * x2) * p0
+    y1 = (ax[0, 1] * x0 + ax[1, 1] * x1 + ax[2, 1] * x2) * p1
+    y2 = (ax[0, 2] * x0 + ax[1, 2] * x1 + ax[2, 2] * x2) * p2
+    return (ax[0, 0] * y0 + ax[0, 1] * y1 + ax[0, 2] * y2,
+            ax[1, 0] * y0 + ax[1, 1] * y1 + ax[1, 2] * y2,
+            ax[2, 0] * y0 + ax[2, 1] * y1 + ax[2, 2] * y2)
+
+
+@njit(cache=True)
+def rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
+                        gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
+                        mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp,
+                        vstart, vcount, vpos, vmax, out):
+    """Advance every group of joined blocks by one step Δt [s] (see the module docstring).
+
+    gravity (3,) m/s²; damp_mode 0 none / 1 local / 2 combined / 3 adaptive global; alpha the
+    local coefficient of modes 1-2; servo float64 state (layout in the module docstring);
+    full_inertia bool. gstart (ng+1,) int64, gmember int64 block rows (first = leader);
+    gmass (ng,) kg real, gimass (ng,) kg inertial, giscalar (ng,) kg·m² scalar (scaled) inertia,
+    gprin (ng, 3) kg·m² unscaled principal moments, gaxes (ng, 3, 3) principal axes as columns and
+    gcentroid (ng, 3) m, both updated. Per block: mass (nb,) kg, fixity (nb,) uint8, force, moment,
+    fapp, mapp, vel, spin, centroid, disp (nb, 3); vstart/vcount (nb,) vertex ranges into vpos
+    (nv, 3). vmax [m/s] the speed of a blow-up. out (4,) float64 filled as documented.
+    Returns the first unstable group index or −1.
+    """
+    ng = gstart.shape[0] - 1
+    hist = False
+    if damp_mode == 2:
+        if servo.shape[0] < NSERVO + 6 * ng:
+            raise ValueError("combined damping needs a servo array of NSERVO + 6*ng entries")
+        hist = servo[S_HIST] != 0.0
+    av = 0.0
+    if damp_mode == 3:
+        av = servo[S_ALPHA]
+        if not av > 0.0:
+            av = 0.02 / dt
+        av = min(max(av, 1e-6 / dt), 1.0 / dt)
+        servo[S_ALPHA] = av
+    al = alpha if (damp_mode == 1 or damp_mode == 2) else 0.0
+    d1 = 1.0 - av * dt * 0.5
+    d2 = 1.0 / (1.0 + av * dt * 0.5)
+    fmax = 0.0
+    fsum = 0.0
+    ke = 0.0
+    work = 0.0
+    dek = 0.0
+    bad = -1
+    for g in range(ng):
+        j0 = gstart[g]
+        j1 = gstart[g + 1]
+        if j1 <= j0:
+            continue
+        lead = gmember[j0]
+        fx = fixity[lead]
+        C0 = gcentroid[g, 0]
+        C1 = gcentroid[g, 1]
+        C2 = gcentroid[g, 2]
+        F0 = 0.0
+        F1 = 0.0
+        F2 = 0.0
+        M0 = 0.0
+        M1 = 0.0
+        M2 = 0.0
+        for j in range(j0, j1):
+            b = gmember[j]
+            f0 = force[b, 0] + fapp[b, 0] + mass[b] * gravity[0]
+            f1 = force[b, 1] + fapp[b, 1] + mass[b] * gravity[1]
+            f2 = force[b, 2] + fapp[b, 2] + mass[b] * gravity[2]
+            e0 = centroid[b, 0] - C0
+            e1 = centroid[b, 1] - C1
+            e2 = centroid[b, 2] - C2
+            M0 += (moment[b, 0] + mapp[b, 0]) + (e1 * f2 - e2 * f1)
+            M1 += (moment[b, 1] + mapp[b, 1]) + (e2 * f0 - e0 * f2)
+            M2 += (moment[b, 2] + mapp[b, 2]) + (e0 * f1 - e1 * f0)
+            F0 += f0
+            F1 += f1
+            F2 += f2
+            for i in range(3):
+                fsum += abs(mass[b] * gravity[i]) + abs(force[b, i])
+        # state at t − Δt/2: ω shared, V at C from the leader
+        w0 = spin[lead, 0]
+        w1 = spin[lead, 1]
+        w2 = spin[lead, 2]
+        e0 = centroid[lead, 0] - C0
+        e1 = centroid[lead, 1] - C1
+        e2 = centroid[lead, 2] - C2
+        v0 = vel[lead, 0] - (w1 * e2 - w2 * e1)
+        v1 = vel[lead, 1] - (w2 * e0 - w0 * e2)
+        v2 = vel[lead, 2] - (w0 * e1 - w1 * e0)
+        mi = gimass[g]
+        ek0 = 0.5 * mi * (v0 * v0 + v1 * v1 + v2 * v2)
+        # translation (Eq. 49)
+        base = NSERVO + 6 * g
+        un2 = 0.0
+        nv0 = v0
+        nv1 = v1
+        nv2 = v2
+        for i in range(3):
+            fu = F0 if i == 0 else (F1 if i == 1 else F2)
+            v = v0 if i == 0 else (v1 if i == 1 else v2)
+            fp = 0.0
+            if damp_mode == 2:
+                fp = servo[base + i]
+                servo[base + i] = fu
+            if (fx >> i) & 1:
+                fu = 0.0
+            else:
+                fd = _ldamp(damp_mode, al, fu, v, fp, hist)
+                nv = (d1 * v + (fu - fd) / mi * dt) * d2
+                if i == 0:
+                    nv0 = nv
+                elif i == 1:
+                    nv1 = nv
+                else:
+                    nv2 = nv
+            un2 += fu * fu
+        un = math.sqrt(un2)
+        if un > fmax:
+            fmax = un
+        ek1 = 0.5 * mi * (nv0 * nv0 + nv1 * nv1 + nv2 * nv2)
+        # rotation
+        nw0 = w0
+        nw1 = w1
+        nw2 = w2
+        if not full_inertia:
+            isc = giscalar[g]
+            ek0 += 0.5 * isc * (w0 * w0 + w1 * w1 + w2 * w2)
+            for i in range(3):
+                mu = M0 if i == 0 else (M1 if i == 1 else M2)
+                w = w0 if i == 0 else (w1 if i == 1 else w2)
+                mp = 0.0
+                if damp_mode == 2:
+                    mp = servo[base + 3 + i]
+                    servo[base + 3 + i] = mu
+                if not (fx >> (3 + i)) & 1:
+                    md = _ldamp(damp_mode, al, mu, w, mp, hist)
+                    nw = (d1 * w + (mu - md) / isc * dt) * d2
+                    if i == 0:
+                        nw0 = nw
+                    elif i == 1:
+                        nw1 = nw
+                    else:
+                        nw2 = nw
+            ek1 += 0.5 * isc * (nw0 * nw0 + nw1 * nw1 + nw2 * nw2)
+        else:
+            rs = gimass[g] / gmass[g]
+            p0 = gprin[g, 0] * rs
+            p1 = gprin[g, 1] * rs
+            p2 = gprin[g, 2] * rs
+            ax = gaxes[g]
+            # L(t − Δt/2) = Pᵀ J(t) ω, P the half of the last rotation
+            b0, b1, b2 = _half(0.5 * dt * w0, 0.5 * dt * w1, 0.5 * dt * w2)
+            y0, y1, y2 = _jmul(ax, p0, p1, p2, w0, w1, w2)
+            L0, L1, L2 = _cay(-b0, -b1, -b2, y0, y1, y2)
+            ek0 += 0.5 * (w0 * L0 + w1 * L1 + w2 * L2)
+            for i in range(3):
+                mu = M0 if i == 0 else (M1 if i == 1 else M2)
+                w = w0 if i == 0 else (w1 if i == 1 else w2)
+                mp = 0.0
+                if damp_mode == 2:
+                    mp = servo[base + 3 + i]
+                    servo[base + 3 + i] = mu
+                if not (fx >> (3 + i)) & 1:
+                    md = _ldamp(damp_mode, al, mu, w, mp, hist)
+                    if i == 0:
+                        L0 = (d1 * L0 + (mu - md) * dt) * d2
+                    elif i == 1:
+                        L1 = (d1 * L1 + (mu - md) * dt) * d2
+                    else:
+                        L2 = (d1 * L2 + (mu - md) * dt) * d2
+            # ω(t + Δt/2): J(t) ω = Pᵀ(ω) L by fixed-point iteration
+            q0 = 1.0 / p0
+            q1 = 1.0 / p1
+            q2 = 1.0 / p2
+            nw0, nw1, nw2 = _jmul(ax, q0, q1, q2, L0, L1, L2)
+            for it in range(60):
+                b0, b1, b2 = _half(0.5 * dt * nw0, 0.5 * dt * nw1, 0.5 * dt * nw2)
+                x0, x1, x2 = _cay(-b0, -b1, -b2, L0, L1, L2)
+                u0, u1, u2 = _jmul(ax, q0, q1, q2, x0, x1, x2)
+                dw = abs(u0 - nw0) + abs(u1 - nw1) + abs(u2 - nw2)
+                nw0 = u0
+                nw1 = u1
+                nw2 = u2
+                if not dw > 1e-15 * (abs(u0) + abs(u1) + abs(u2)):
+                    break
+            if (fx >> 3) & 1:
+                nw0 = w0
+            if (fx >> 4) & 1:
+                nw1 = w1
+            if (fx >> 5) & 1:
+                nw2 = w2
+            ek1 += 0.5 * (nw0 * L0 + nw1 * L1 + nw2 * L2)
+        if damp_mode == 3:
+            work += av * dt * (ek0 + ek1)
+            dek += abs(ek1 - ek0)
+        # real kinetic energy at t + Δt/2
+        y0, y1, y2 = _jmul(gaxes[g], gprin[g, 0], gprin[g, 1], gprin[g, 2], nw0, nw1, nw2)
+        ke += 0.5 * gmass[g] * (nv0 * nv0 + nv1 * nv1 + nv2 * nv2) + 0.5 * (nw0 * y0 + nw1 * y1 + nw2 * y2)
+        sp = abs(nv0) + abs(nv1) + abs(nv2)
+        ok = sp < vmax and math.isfinite(nw0 + nw1 + nw2)
+        if not ok:
+            if bad < 0:
+                bad = g
+            for j in range(j0, j1):
+                b = gmember[j]
+                vel[b, 0] = nv0
+                vel[b, 1] = nv1
+                vel[b, 2] = nv2
+                spin[b, 0] = nw0
+                spin[b, 1] = nw1
+                spin[b, 2] = nw2
+            continue
+        dx0 = nv0 * dt
+        dx1 = nv1 * dt
+        dx2 = nv2 * dt
+        a0 = 0.5 * nw0 * dt
+        a1 = 0.5 * nw1 * dt
+        a2 = 0.5 * nw2 * dt
+        h = 2.0 / (1.0 + a0 * a0 + a1 * a1 + a2 * a2)
+        for j in range(j0, j1):
+            b = gmember[j]
+            for v in range(vstart[b], vstart[b] + vcount[b]):
+                r0 = vpos[v, 0] - C0
+                r1 = vpos[v, 1] - C1
+                r2 = vpos[v, 2] - C2
+                s0 = r0 + (a1 * r2 - a2 * r1)
+                s1 = r1 + (a2 * r0 - a0 * r2)
+                s2 = r2 + (a0 * r1 - a1 * r0)
+                vpos[v, 0] = C0 + dx0 + r0 + h * (a1 * s2 - a2 * s1)
+                vpos[v, 1] = C1 + dx1 + r1 + h * (a2 * s0 - a0 * s2)
+                vpos[v, 2] = C2 + dx2 + r2 + h * (a0 * s1 - a1 * s0)
+            r0 = centroid[b, 0] - C0
+            r1 = centroid[b, 1] - C1
+            r2 = centroid[b, 2] - C2
+            s0 = r0 + (a1 * r2 - a2 * r1)
+            s1 = r1 + (a2 * r0 - a0 * r2)
+            s2 = r2 + (a0 * r1 - a1 * r0)
+            t0 = h * (a1 * s2 - a2 * s1)
+            t1 = h * (a2 * s0 - a0 * s2)
+            t2 = h * (a0 * s1 - a1 * s0)
+            centroid[b, 0] = C0 + dx0 + r0 + t0
+            centroid[b, 1] = C1 + dx1 + r1 + t1
+            centroid[b, 2] = C2 + dx2 + r2 + t2
+            disp[b, 0] += dx0 + t0
+            disp[b, 1] += dx1 + t1
+            disp[b, 2] += dx2 + t2
+            e0 = r0 + t0
+            e1 = r1 + t1
+            e2 = r2 + t2
+            vel[b, 0] = nv0 + (nw1 * e2 - nw2 * e1)
+            vel[b, 1] = nv1 + (nw2 * e0 - nw0 * e2)
+            vel[b, 2] = nv2 + (nw0 * e1 - nw1 * e0)
+            spin[b, 0] = nw0
+            spin[b, 1] = nw1
+            spin[b, 2] = nw2
+        for k in range(3):
+            x0, x1, x2 = _cay(a0, a1, a2, gaxes[g, 0, k], gaxes[g, 1, k], gaxes[g, 2, k])
+            gaxes[g, 0, k] = x0
+            gaxes[g, 1, k] = x1
+            gaxes[g, 2, k] = x2
+        gcentroid[g, 0] = C0 + dx0
+        gcentroid[g, 1] = C1 + dx1
+        gcentroid[g, 2] = C2 + dx2
+    for j in range(gstart[0], gstart[ng]):
+        b = gmember[j]
+        for i in range(3):
+            force[b, i] = 0.0
+            moment[b, i] = 0.0
+    if damp_mode == 2:
+        servo[S_HIST] = 1.0
+    if damp_mode == 3:
+        servo[S_WORK] += work
+        servo[S_DEK] += dek
+        servo[S_NWIN] += 1.0
+        win = servo[S_WINDOW] if servo[S_WINDOW] >= 1.0 else 10.0
+        if servo[S_NWIN] >= win:
+            ratio = servo[S_RATIO] if servo[S_RATIO] > 0.0 else 0.5
+            fac = servo[S_FACTOR] if servo[S_FACTOR] > 1.0 else 1.1
+            if servo[S_DEK] > 0.0:
+                r = servo[S_WORK] / servo[S_DEK]
+                servo[S_LASTR] = r
+                a = servo[S_ALPHA] * fac if r < ratio else servo[S_ALPHA] / fac
+                servo[S_ALPHA] = min(max(a, 1e-6 / dt), 1.0 / dt)
+            servo[S_WORK] = 0.0
+            servo[S_DEK] = 0.0
+            servo[S_NWIN] = 0.0
+    servo[S_CALLS] += 1.0
+    out[0] = fmax
+    out[1] = fsum
+    out[2] = ke
+    out[3] = av
+    return bad
