@@ -4,13 +4,15 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import CommandError
-from ..physics.rigid import JOINT_MODELS, engine, props_vector
+from ..physics.jmodels import ALL_PROPS, JOINT_MODELS, MODEL_BY_CODE
+from ..physics.rigid import default_row, engine, mech
 from .registry import command
-from .values import FLAG, Num, P, Text
+from .values import FLAG, Choice, Num, P, Text
 
-PROPS = JOINT_MODELS["mohr"][1]
-_KW = [P(name, Num(), f"joint {name}", units="deg" if name in ("friction", "dilation", "friction-residual") else None)
-       for name in PROPS]
+PROPS = ALL_PROPS
+_UNITS = {p.name: p.units for m in JOINT_MODELS.values() for p in m.props.values()}
+_DOCS = {p.name: p.doc for m in JOINT_MODELS.values() for p in m.props.values()}
+_KW = [P(name, Num(), _DOCS[name], units=_UNITS[name]) for name in PROPS]
 
 
 def _given(call):
@@ -21,7 +23,7 @@ def _given(call):
 
 
 def _check(call, model_name, props):
-    allowed = JOINT_MODELS[model_name][1]
+    allowed = tuple(JOINT_MODELS[model_name].props)
     bad = [k for k in props if k not in allowed]
     if bad:
         raise CommandError(f"joint model '{model_name}' has no property '{bad[0]}' "
@@ -70,59 +72,125 @@ def _check_default(call):
 
 
 @command("block contact jmodel assign", positional=[P("model", Text(), "joint model: " + ", ".join(JOINT_MODELS),
-                                                        required=True)], range="block", check=_check_assign,
-         doc="Assign a joint model to the contacts (and to contacts created later).",
-         examples=["block contact jmodel assign mohr", "block contact jmodel assign elastic"])
+                                                        required=True)], range="contact", check=_check_assign,
+         doc="Assign a joint model to the contacts in range; without a range also to contacts created later.",
+         details="The contacts' properties go back to the material-table defaults and follow them until "
+                 "`block contact property` sets them. A contact range tests the contact's reference "
+                 "point, its own groups and the groups of its two blocks.",
+         examples=["block contact jmodel assign mohr", "block contact jmodel assign elastic range group 'base'"])
 def jmodel_assign(session, call):
     e = engine(session.model)
-    e.default_model = call.args["model"]
-    code = JOINT_MODELS[e.default_model][0]
-    e.cmodel[:] = code
-    e.cname = [e.default_model] * len(e.cname)
+    e.ensure_contacts()
+    name = _model_arg(call, "model")
+    jm = JOINT_MODELS[name]
+    sel = session.range_mask(call, "contact")
+    c = e.contacts
+    c["jmodel"][sel] = jm.code
+    c["prop"][sel] = default_row(mech(session.model), jm.code)
+    c["own_props"][sel] = 0
+    if call.range is None:
+        mech(session.model)["jmodel"] = name
 
 
-@command("block contact property", keywords=_KW, open_keywords=True, range="block",
-         doc="Set joint properties of the existing contacts (stiffness Pa/m, stress Pa, angles in degrees).",
-         details="Names not declared here are accepted for user joint models; a name that the assigned "
-                 "built-in model does not have is an error.",
+@command("block contact property", keywords=_KW, open_keywords=True, range="contact",
+         doc="Set joint properties of the contacts in range (stiffness Pa/m, stress Pa, angles in degrees).",
+         details="Without a range the values also become the defaults of contacts created later. Names not "
+                 "declared here are accepted for user joint models; a name that the assigned built-in model "
+                 "does not have is an error.",
          examples=["block contact property stiffness-normal 1e9 stiffness-shear 1e9 friction 30",
                    "block contact prop stiff-norm 10e6 stiff-shear 10e6 fric 20 coh 0 tension 0"])
 def contact_property(session, call):
     e = engine(session.model)
+    e.ensure_contacts()
+    s = mech(session.model)
     props = _given(call)
-    _check(call, e.default_model, props)
-    for c in range(len(e.cuser)):
-        e.cuser[c].update(props)
-        e.cprop[c] = props_vector(e.cuser[c])
-    e.default_props.update(props)
+    c = e.contacts
+    sel = np.flatnonzero(session.range_mask(call, "contact"))
+    codes = np.unique(c["jmodel"][sel]) if sel.size else np.array([JOINT_MODELS[s["jmodel"]].code])
+    for code in codes:
+        _check(call, MODEL_BY_CODE[int(code)].name, props)
+    for code in codes:
+        rows = sel[c["jmodel"][sel] == code]
+        if rows.size:
+            block = c["prop"][rows]
+            MODEL_BY_CODE[int(code)].apply(block, props)
+            c["prop"][rows] = block
+            c["own_props"][rows] = 1
+    if call.range is None:
+        _check(call, s["jmodel"], props)
+        s["props"].update(props)
 
 
 @command("block contact material-table default",
          keywords=[P("jmodel", Text(), "joint model of contacts created from now on"),
                    P("property", FLAG, "3DEC's word before the properties", bare=True), *_KW],
          open_keywords=True, check=_check_default,
-         doc="Joint properties given to contacts created from now on.",
+         doc="Joint properties of contacts created from now on, and of existing contacts whose properties "
+             "were never set by `block contact property`.",
          examples=["block contact material-table default property stiffness-normal 1e9 stiffness-shear 1e9 friction 30"])
 def material_default(session, call):
-    e = engine(session.model)
-    if call.args["jmodel"]:
-        e.default_model = call.args["jmodel"]
+    s = mech(session.model)
+    name = _model_arg(call, "jmodel")
     props = _given(call)
     props.pop("property", None)
-    _check(call, e.default_model, props)
-    e.default_props.update(props)
+    _check(call, name or s["jmodel"], props)
+    if name:
+        s["jmodel"] = name
+    s["props"].update(props)
 
 
 @command("block contact tolerance", positional=[P("ctol", Num(lo=0, lo_open=True), "contact tolerance CTOL",
                                                   required=True, units="m")],
          doc="Set CTOL: contacts are made when the gap is at most CTOL and deleted beyond it.",
+         details="Default: 0.005 × the mean block size (cube root of the mean volume), dec3d's choice.",
          examples=["block contact tolerance 0.01"])
 def contact_tolerance(session, call):
-    engine(session.model).ctol = float(call.args["ctol"])
+    mech(session.model)["ctol"] = float(call.args["ctol"])
 
 
 @command("block contact generate-subcontacts", range="block",
-         doc="Detect the contacts and rebuild their sub-contacts now.",
+         doc="Detect the contacts and rebuild their sub-contacts now (force history is kept).",
          examples=["block contact generate-subcontacts"])
 def generate_subcontacts(session, call):
-    engine(session.model).detect()
+    engine(session.model).detect(force_search=True)
+
+
+@command("block contact group", positional=[P("name", Text(), "group name", required=True)],
+         keywords=[P("slot", Text(), "group slot"), P("remove", FLAG, "take the contacts out of the group", bare=True)],
+         range="contact",
+         doc="Put the contacts in range into a group (contact ranges can then select it).",
+         examples=["block contact group 'Reaction' range pos-y -0.01 0.01",
+                   "block contact group 'MidCrack' slot 'components' range group-intersection 'brickDown' 'brickUp'"])
+def contact_group(session, call):
+    e = engine(session.model)
+    e.ensure_contacts()
+    a = call.args
+    rows = np.flatnonzero(session.range_mask(call, "contact"))
+    if a["remove"]:
+        session.model.groups.remove(e.contacts, rows, a["name"], a["slot"])
+    else:
+        session.model.groups.assign(e.contacts, rows, a["name"], a["slot"])
+
+
+@command("block contact reset", positional=[P("what", Choice(("displacement", "state", "force")),
+                                                 "what to reset", required=True)],
+         range="contact",
+         doc="Reset the sub-contacts of the contacts in range: `displacement` zeroes the accumulated shear "
+             "displacement and dilation (the normal displacement is kept, so forces do not jump), "
+             "`state` clears the slip and failure flags, `force` zeroes the shear forces.",
+         examples=["block contact reset displacement", "block contact reset state range group 'joint'"])
+def contact_reset(session, call):
+    e = engine(session.model)
+    e.ensure_contacts()
+    sel = session.range_mask(call, "contact")
+    ss = e.subcontacts
+    rows = sel[ss["contact"]] if ss.n else np.zeros(0, bool)
+    what = call.args["what"]
+    if what == "displacement":
+        ss["us"][rows] = 0.0
+        ss["un"][rows] -= ss["udil"][rows]
+        ss["udil"][rows] = 0.0
+    elif what == "state":
+        ss["state"][rows] = 0
+    else:
+        ss["fs"][rows] = 0.0

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..physics.rigid import engine
+from ..physics.rigid import engine, mech
 from .registry import command
 from .values import FLAG, Choice, Num, Nums, P
 
@@ -39,7 +39,10 @@ def damping(session, call):
         from ..errors import BindError
 
         raise BindError("the damping coefficient must be ≥ 0", call.locations.get("alpha", call.location))
-    engine(session.model).alpha_local = float(alpha) if call.args["mode"] == "local" else 0.0
+    s = mech(session.model)
+    s["damping"] = call.args["mode"]
+    if call.args["mode"] == "local":
+        s["alpha"] = float(alpha)
 
 
 _BITS = {"velocity": 0b000111, "velocity-x": 1, "velocity-y": 2, "velocity-z": 4,
@@ -100,4 +103,4 @@ def block_initialize(session, call):
          doc="Force the time step (0: automatic, Eq. 87 with frac 0.1).",
          examples=["block mechanical timestep 1e-4", "block mechanical timestep 0"])
 def timestep(session, call):
-    engine(session.model).dt_user = float(call.args["dt"]) or None
+    mech(session.model)["timestep"] = float(call.args["dt"]) or None

@@ -7,9 +7,9 @@ from .registry import command
 from .values import FLAG, Num, P
 
 
-def _run(session, call, n, stop=None):
+def _run(session, call, n, stop=None, max_time=None):
     try:
-        return engine(session.model).cycle(n, stop)
+        return engine(session.model).cycle(n, stop, max_time=max_time)
     except RunError as exc:
         raise CommandError(str(exc), call.location)
 
@@ -46,7 +46,7 @@ def model_solve(session, call):
         limits.append(lambda en, v=a["unbalanced_maximum"]: en.unbal <= v)
     t_end = e.time + a["time"] if a["time"] is not None else None
     if t_end is not None:
-        limits.append(lambda en: en.time >= t_end - 1e-12 * max(t_end, 1.0))
+        limits.append(lambda en: en.time >= t_end - 1e-9 * max(en.dt, 1e-300))
     if not limits:
         limits.append(lambda en: en.ratio <= 1e-5)
     both = bool(a["and"])
@@ -56,7 +56,7 @@ def model_solve(session, call):
         ok = [f(en) for f in limits]
         return all(ok) if both else any(ok)
 
-    _run(session, call, n, stop)
+    _run(session, call, n, stop, max_time=t_end if (t_end is not None and not both) else None)
 
 
 @command("model update-interval", positional=[P("n", Num(integer=True, lo=1), "steps between contact detections",

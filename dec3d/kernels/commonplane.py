@@ -125,6 +125,9 @@ def common_plane(va, vb, n0, ctol, existing, out_n, out_c):
     best = cp_gap(va, vb, n)
     it = 0
     fails = 0
+    # fast path: an existing contact's plane is confirmed by one iteration at k_min with
+    # the axes in both orientations (0° and 45°); any improvement starts the full search
+    quick = existing
     while True:
         it += 1
         _basis(n, p, q)
@@ -154,10 +157,13 @@ def common_plane(va, vb, n0, ctol, existing, out_n, out_c):
             fails = 0
             for i in range(3):
                 n[i] = best_n[i]
-            if existing and k == kmin:
+            if quick:
+                quick = False
                 k = kmax        # the fast path found a better normal: do the full search
         else:
             fails += 1          # a step size is given up only when both axis pairs fail
+            if quick and fails >= 2:
+                break
             if fails >= NORIENT:
                 fails = 0
                 if k <= kmin * 1.0000001:

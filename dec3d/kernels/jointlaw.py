@@ -18,7 +18,7 @@ Per sub-contact s of contact c (blocks A = ca[c], B = cb[c], normal n = cn[c], A
   |uˢ| exceeds the dilation-zero limit (0: no limit) (Eqs. 41-43).
 Force on B = Fⁿ n + Fˢ at x, on A the negative; moments (x − centroid) × force (ERRATA Eqs. 28-32).
 
-prop columns (P_*): kn, ks, tan φ, c, T, tan ψ, u_zero, tan φ_res, c_res, T_res.
+prop columns (P_*): kn, ks, tan φ, c, T, tan ψ, u_zero, tan φ_res (NaN: = tan φ), c_res, T_res.
 """
 from __future__ import annotations
 
@@ -53,6 +53,8 @@ def coulomb_one(kn, ks, tanf, coh, ten, tandil, zdil, tanf_r, coh_r, ten_r, mode
 
     Returns (Fn, Fs0, Fs1, Fs2, un, udil, us0, us1, us2, state).
     """
+    if tanf_r != tanf_r:                   # NaN: residual friction = peak friction
+        tanf_r = tanf
     un += dun
     us0 += dus0
     us1 += dus1

@@ -140,6 +140,15 @@ def mask_group(model, store_name: str, names: str | Sequence[str],
         raise KeyError(f"{store_name}s have no groups")
     if isinstance(names, str):
         names = [names]
+    if store.name == "contacts" and slot is None:
+        # a contact is in a group when it is, or when either of its blocks is (3DEC)
+        own = _in_groups(model, store, names, None)
+        blocks = _in_groups(model, model.blocks, names, None)
+        return own | blocks[store["a"]] | blocks[store["b"]]
+    return _in_groups(model, store, names, slot)
+
+
+def _in_groups(model, store, names, slot) -> np.ndarray:
     codes = _group_codes(model, names)
     codes = codes[codes >= 0]
     g = store[GROUP_FIELD]
@@ -154,8 +163,16 @@ def mask_group(model, store_name: str, names: str | Sequence[str],
 
 
 def mask_group_intersection(model, store_name: str, a: str, b: str) -> np.ndarray:
-    """``group-intersection '<a>' '<b>'``: rows in both groups (any slots). Contacts, when
-    they exist, select the contacts between a block of one group and a block of the other."""
+    """``group-intersection '<a>' '<b>'``: rows in both groups (any slots). Contacts select
+    the contacts between a block of one group and a block of the other, or contacts that are
+    themselves in both groups."""
+    store = model.store(store_name)
+    if store.name == "contacts":
+        own = _in_groups(model, store, [a], None) & _in_groups(model, store, [b], None)
+        ga = _in_groups(model, model.blocks, [a], None)
+        gb = _in_groups(model, model.blocks, [b], None)
+        ia, ib = store["a"], store["b"]
+        return own | (ga[ia] & gb[ib]) | (gb[ia] & ga[ib])
     return mask_group(model, store_name, a) & mask_group(model, store_name, b)
 
 

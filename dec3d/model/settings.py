@@ -20,6 +20,9 @@ class Settings:
     configure: list[str] = field(default_factory=list)
     #: `model update-interval` (steps between contact detection passes; 3DEC default 10)
     update_interval: int = 10
+    #: rigid-block engine settings (``dec3d.physics.rigid.MECH_DEFAULTS``): CTOL, damping,
+    #: time step, joint model and properties of new contacts; plain JSON values
+    mechanical: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         d = asdict(self)

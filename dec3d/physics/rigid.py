@@ -1,37 +1,93 @@
-"""Rigid-block engine: contacts, sub-contacts and the calculation cycle (3DEC theory, Fig. 13).
+"""Rigid-block engine: neighbour search, contacts, sub-contacts and the cycle (3DEC theory, Fig. 13).
 
-One ``RigidEngine`` hangs on the model (``engine(model)``). Every ``update_interval`` steps:
-neighbour pairs (axis-aligned envelopes enlarged by CTOL, sort-and-sweep on x: simple and
-exact, not yet 3DEC's cell map), common plane per pair (kernel ``commonplane``, fast path
-from the previous normal), contacts kept while gap ≤ CTOL, sub-contacts rebuilt
-(``subcontacts.make_subcontacts``) carrying the force state of the sub-contact of the same
-contact at the nearest old position (within CTOL), else the contact's mean stresses × area;
-shear forces turned to the new normal by Eq. (23). Every step: joint law and force scatter
-(kernel ``jointlaw``), then motion (kernel ``motion``) for the leader rows (joined blocks and
-full-inertia Euler equations are not done yet: every block moves on its own, scalar inertia).
-Sub-contact points move with the mean displacement of the two blocks (Eq. 11).
+State lives in the model: contacts and sub-contacts are two stores (``contacts``,
+``subcontacts``, saved and restored with the rest), the engine settings are
+``model.settings.mechanical`` (plain JSON). The ``RigidEngine`` object on the model holds
+only what can be rebuilt: the cell grid, the candidate pairs, the time step, timings.
+
+Detection (every ``model update-interval`` steps, default 10):
+  1. neighbour search by cell mapping (kernel ``cellmap``) of the block envelopes enlarged
+     by CTOL on each side (a search volume 2·CTOL larger, as the text says), redone only when
+     a vertex has moved more than CTOL/2 since the last map (the text's u_acc > CTOL, halved
+     so that two blocks moving towards each other cannot both slip past), or the blocks
+     changed; the cell space grows by 10 % when a block leaves it;
+  2. the common plane of every candidate pair (kernel ``contactmap.cp_batch``: fast path
+     from the previous plane); a pair is a contact while its gap ≤ CTOL;
+  3. sub-contacts of every contact (kernel ``subgeom``), their state carried over from the
+     previous pass (kernel ``contactmap.carry_over``).
+Cycling (kernel ``cycle.run_steps``): many steps per call, up to the next detection,
+history sample or solve check.
+
+Contacts are oriented from the block with the lower id (A) to the higher (B) and sorted
+by (id A, id B); that key finds a contact again after blocks are deleted or cut.
 """
 from __future__ import annotations
 
 import math
+import sys
+import time as _time
 
 import numpy as np
 
 from dec3d.errors import Dec3dError
-from dec3d.kernels.commonplane import common_plane, contact_type
-from dec3d.kernels.jointlaw import (MODEL_ELASTIC, MODEL_MOHR, NPROP, P_COH, P_COH_RES, P_KN, P_KS,
-                                    P_TANDIL, P_TANF, P_TANF_RES, P_TEN, P_TEN_RES, P_ZDIL,
-                                    rotate_shear, subcontact_forces)
-from dec3d.kernels.motion import block_timestep, rigid_motion
+try:
+    from dec3d.kernels.cellmap import cell_grid, cell_pairs, outside_grid
+except ImportError:  # pragma: no cover - transitional
+    from ._interim import cell_grid, cell_pairs, outside_grid
+from dec3d.kernels.contactmap import carry_over, cp_batch, envelopes, match_sorted
+from dec3d.kernels.cycle import run_steps
+from dec3d.kernels.jointlaw import NPROP, P_KN, P_KS
+from dec3d.kernels.motion import block_timestep
+from dec3d.model.groups import group_field
+from dec3d.model.store import Field, Store
 
-from .subcontacts import make_subcontacts
+from .jmodels import JOINT_MODELS, MODEL_BY_CODE
 
-#: joint models: name -> (kernel code, property names accepted)
-JOINT_MODELS = {
-    "elastic": (MODEL_ELASTIC, ("stiffness-normal", "stiffness-shear")),
-    "mohr": (MODEL_MOHR, ("stiffness-normal", "stiffness-shear", "friction", "cohesion", "tension",
-                          "dilation", "dilation-zero", "friction-residual", "cohesion-residual",
-                          "tension-residual")),
+_F = np.float64
+_I = np.int64
+
+CONTACT_FIELDS = {
+    "ida": Field((), _I, -1),            # block ids, A < B
+    "idb": Field((), _I, -1),
+    "a": Field((), _I, -1),              # block rows (refreshed at every detection)
+    "b": Field((), _I, -1),
+    "pos": Field((3,), _F, 0.0),         # c-p reference point [m]
+    "normal": Field((3,), _F, 0.0),      # unit normal A → B
+    "gap": Field((), _F, 0.0),           # [m], negative = overlap
+    "type": Field((), _I, 0),            # CT_* (kernels.commonplane)
+    "jmodel": Field((), _I, 1),          # joint model code (physics.jmodels)
+    "prop": Field((NPROP,), _F, 0.0),    # kernel property row
+    "own_props": Field((), np.uint8, 0), # 1: set by `block contact property`; 0: follows the defaults
+    "sub_start": Field((), _I, 0),       # CSR into subcontacts
+    "sub_count": Field((), _I, 0),
+    "group": group_field(),
+}
+
+SUBCONTACT_FIELDS = {
+    "contact": Field((), _I, -1),
+    "kind": Field((), _I, 0),            # 0 A-vertex/B-face, 1 B-vertex/A-face, 2 edge-edge, 3 point
+    "key0": Field((), _I, -1),
+    "key1": Field((), _I, -1),
+    "pos": Field((3,), _F, 0.0),         # on the c-p [m]
+    "area": Field((), _F, 0.0),          # [m²]
+    "fn": Field((), _F, 0.0),            # normal force, compression positive [N]
+    "fs": Field((3,), _F, 0.0),          # shear force on B [N]
+    "un": Field((), _F, 0.0),            # normal displacement (starts at the gap) [m]
+    "udil": Field((), _F, 0.0),          # dilation [m]
+    "us": Field((3,), _F, 0.0),          # accumulated shear displacement [m]
+    "state": Field((), _I, 0),           # ST_* bits (kernels.jointlaw)
+}
+
+#: engine settings (``model.settings.mechanical``) and their defaults
+MECH_DEFAULTS = {
+    "ctol": None,              # CTOL [m]; None: 0.005 × mean block size (dec3d's choice)
+    "damping": "local",        # local | combined | global | none
+    "alpha": 0.8,              # local / combined damping coefficient
+    "frac": 0.1,               # Eq. (87)
+    "timestep": None,          # fixed Δt [s] or None
+    "jmodel": "mohr",          # model of contacts created from now on
+    "props": {},               # their properties (user units)
+    "kt": 0.0,                 # K_T of Eq. (12) [m]
 }
 
 
@@ -39,247 +95,344 @@ class RunError(Dec3dError):
     """The run became unstable (NaN or runaway velocity)."""
 
 
-def props_vector(props: dict) -> np.ndarray:
-    """Property dict (degrees for angles) -> kernel row (P_* columns)."""
-    v = np.zeros(NPROP)
-    v[P_KN] = props.get("stiffness-normal", 0.0)
-    v[P_KS] = props.get("stiffness-shear", 0.0)
-    f = props.get("friction", 0.0)
-    v[P_TANF] = math.tan(math.radians(f))
-    v[P_COH] = props.get("cohesion", 0.0)
-    v[P_TEN] = props.get("tension", 0.0)
-    v[P_TANDIL] = math.tan(math.radians(props.get("dilation", 0.0)))
-    v[P_ZDIL] = props.get("dilation-zero", 0.0)
-    v[P_TANF_RES] = math.tan(math.radians(props.get("friction-residual", f)))
-    v[P_COH_RES] = props.get("cohesion-residual", 0.0)
-    v[P_TEN_RES] = props.get("tension-residual", 0.0)
-    return v
+def mech(model) -> dict:
+    """The model's engine settings, with every default filled in."""
+    m = model.settings.mechanical
+    for k, v in MECH_DEFAULTS.items():
+        if k not in m:
+            m[k] = dict(v) if isinstance(v, dict) else v
+    return m
+
+
+def contact_stores(model) -> tuple[Store, Store]:
+    """The ``contacts`` and ``subcontacts`` stores, made on first use."""
+    stores = model.stores
+    if "contacts" not in stores:
+        model.add_store(Store("contacts", CONTACT_FIELDS, capacity=64))
+    if "subcontacts" not in stores:
+        model.add_store(Store("subcontacts", SUBCONTACT_FIELDS, capacity=256))
+    return model.store("contacts"), model.store("subcontacts")
+
+
+def _subcontacts(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea):
+    """Sub-contacts of every contact (kernel ``subgeom.subcontacts_batch``, grown until it fits)."""
+    try:
+        from dec3d.kernels.subgeom import subcontacts_batch
+    except ImportError:  # pragma: no cover - transitional
+        from ._interim import subcontacts_batch
+
+    cap = max(16, 8 * len(ra))
+    while True:
+        out = (np.empty(cap, _I), np.empty(cap, _I), np.empty(cap, _I), np.empty(cap, _I),
+               np.empty((cap, 3)), np.empty(cap))
+        k = subcontacts_batch(vpos, b["vert_start"], b["vert_count"], b["face_start"], b["face_count"],
+                              f["vstart"], f["nvert"], fv["vertex"], ra, rb, cn, cc, ctol, parea, *out)
+        if k <= cap:
+            return tuple(a[:k] for a in out)
+        cap = int(k)
+
+
+def default_row(s: dict, code: int) -> np.ndarray:
+    """Property row of a contact of model ``code`` that follows the material-table defaults
+    (the default properties this model has)."""
+    jm = MODEL_BY_CODE[code]
+    return jm.row({k: v for k, v in s["props"].items() if k in jm.props})
 
 
 class RigidEngine:
     def __init__(self, model):
         self.model = model
-        self.ctol: float | None = None
-        self.default_model = "mohr"
-        self.default_props: dict[str, float] = {}
-        self.alpha_local = 0.8
-        self.alpha_visc = 0.0
-        self.frac = 0.1
-        self.dt_user: float | None = None
-        self.step = 0
-        self.time = 0.0
+        self.dt = 0.0
         self.unbal = 0.0
         self.ratio = 1.0
-        #: callables hook(engine) run after every step (histories register here)
+        #: callables hook(engine) run after every batch of steps (histories register here);
+        #: a hook with an ``interval`` attribute gets a batch boundary at every multiple of it
         self.step_hooks: list = []
-        # contacts (pair key -> row) and their arrays
-        self.pairs: dict[tuple[int, int], int] = {}
-        self.ca = np.zeros(0, np.int64)
-        self.cb = np.zeros(0, np.int64)
-        self.cn = np.zeros((0, 3))
-        self.cc = np.zeros((0, 3))
-        self.cgap = np.zeros(0)
-        self.ctype = np.zeros(0, np.int64)
-        self.cmodel = np.zeros(0, np.int64)
-        self.cprop = np.zeros((0, NPROP))
-        self.cname: list[str] = []
-        self.cuser: list[dict] = []
-        self._empty_sc()
+        self.timings = {"detect": 0.0, "search": 0.0, "subcontacts": 0.0, "cycle": 0.0, "hooks": 0.0}
+        self._grid = None
+        self._cand = None             # candidate pairs (rows A, rows B) from the last map
+        self._vpos_map = None         # vertex positions at the last map
+        self._signature = None
+        contact_stores(model)
 
-    def _empty_sc(self):
-        self.sc = {"contact": np.zeros(0, np.int64), "pos": np.zeros((0, 3)), "area": np.zeros(0),
-                   "fn": np.zeros(0), "fs": np.zeros((0, 3)), "un": np.zeros(0), "udil": np.zeros(0),
-                   "us": np.zeros((0, 3)), "state": np.zeros(0, np.int64)}
+    # ------------------------------------------------------------ model-backed state
+    @property
+    def step(self) -> int:
+        return self.model.step
+
+    @property
+    def time(self) -> float:
+        return self.model.time
+
+    @property
+    def contacts(self) -> Store:
+        return self.model.store("contacts")
+
+    @property
+    def subcontacts(self) -> Store:
+        return self.model.store("subcontacts")
+
+    def settings(self) -> dict:
+        return mech(self.model)
 
     # ------------------------------------------------------------ settings
     def tolerance(self) -> float:
-        if self.ctol is not None:
-            return self.ctol
+        ctol = self.settings()["ctol"]
+        if ctol:
+            return float(ctol)
         b = self.model.blocks
-        size = np.cbrt(b["volume"][b["volume"] > 0]).mean() if b.n else 1.0
-        return 0.005 * float(size)
+        vol = b["volume"][b["volume"] > 0]
+        size = float(np.cbrt(vol).mean()) if vol.size else 1.0
+        return 0.005 * size
 
     def point_area(self) -> float:
+        """Area given to each point sub-contact of a lower contact type (dec3d's choice:
+        1 % of the mean block face, m²)."""
         b = self.model.blocks
         return 0.01 * float(np.cbrt(b["volume"]).mean() ** 2) if b.n else 1e-4
 
     def timestep(self) -> float:
-        if self.dt_user:
-            return self.dt_user
+        s = self.settings()
+        if s["timestep"]:
+            return float(s["timestep"])
         b = self.model.blocks
-        kn = max(self.default_props.get("stiffness-normal", 0.0), self.default_props.get("stiffness-shear", 0.0))
-        if len(self.cprop):
-            kn = max(kn, float(self.cprop[:, [P_KN, P_KS]].max()))
+        jm = JOINT_MODELS[s["jmodel"]]
+        drow = jm.row(s["props"])
+        kn = max(drow[P_KN], drow[P_KS])
+        c = self.contacts
+        if c.n:
+            kn = max(kn, float(c["prop"][:, [P_KN, P_KS]].max()))
         area = float(self.model.faces["area"].max()) if self.model.faces.n else 1.0
-        mmin = float(b["mass"][b["mass"] > 0].min()) if (b["mass"] > 0).any() else 1.0
-        return block_timestep(mmin, kn * area, self.frac) or 1e-3
+        live = (b["mass"] > 0) & ~b["hidden"]
+        mmin = float(b["mass"][live].min()) if live.any() else 1.0
+        return block_timestep(mmin, kn * area, float(s["frac"])) or 1e-3
+
+    def damping(self) -> tuple[float, float]:
+        """(local α, viscous α) for the motion kernel."""
+        s = self.settings()
+        return (float(s["alpha"]), 0.0) if s["damping"] == "local" else (0.0, 0.0)
 
     # ------------------------------------------------------------ detection
-    def _block_verts(self, r):
-        b = self.model.blocks
-        s, c = b["vert_start"][r], b["vert_count"][r]
-        return self.model.vertices["pos"][s:s + c]
-
-    def candidate_pairs(self, ctol):
-        m = self.model
-        b, pos = m.blocks, m.vertices["pos"]
-        n = b.n
-        lo = np.empty((n, 3))
-        hi = np.empty((n, 3))
-        for r in range(n):
-            v = pos[b["vert_start"][r]:b["vert_start"][r] + b["vert_count"][r]]
-            lo[r], hi[r] = v.min(0) - ctol, v.max(0) + ctol
-        order = np.argsort(lo[:, 0], kind="stable")
-        out = []
-        for k, i in enumerate(order):
-            for j in order[k + 1:]:
-                if lo[j, 0] > hi[i, 0]:
-                    break
-                if (lo[i] <= hi[j]).all() and (lo[j] <= hi[i]).all():
-                    out.append((min(i, j), max(i, j)))
-        return sorted(out)
-
-    def detect(self):
-        ctol = self.tolerance()
-        b = self.model.blocks
-        cen = b["centroid"]
-        old_pairs, old = self.pairs, self._snapshot()
-        new_pairs: dict[tuple[int, int], int] = {}
-        rows = []
-        for (i, j) in self.candidate_pairs(ctol):
-            if b["hidden"][i] or b["hidden"][j]:
-                continue
-            va, vb = self._block_verts(i), self._block_verts(j)
-            prev = old_pairs.get((i, j))
-            n = np.empty(3)
-            c = old["cc"][prev].copy() if prev is not None else 0.5 * (cen[i] + cen[j])
-            n0 = old["cn"][prev] if prev is not None else cen[j] - cen[i]
-            gap, na, nb, _ = common_plane(va, vb, n0, ctol, prev is not None, n, c)
-            if gap > ctol:
-                continue
-            new_pairs[(i, j)] = len(rows)
-            rows.append((i, j, n, c, gap, contact_type(na, nb), prev))
-        self._install(rows, new_pairs, old, ctol)
-
-    def _snapshot(self):
-        return {"cn": self.cn.copy(), "cc": self.cc.copy(), "cmodel": self.cmodel.copy(),
-                "cprop": self.cprop.copy(), "cname": list(self.cname), "cuser": list(self.cuser),
-                "sc": {k: v.copy() for k, v in self.sc.items()}}
-
-    def _install(self, rows, new_pairs, old, ctol):
-        nc = len(rows)
-        self.pairs = new_pairs
-        self.ca = np.array([r[0] for r in rows], np.int64)
-        self.cb = np.array([r[1] for r in rows], np.int64)
-        self.cn = np.array([r[2] for r in rows]).reshape(nc, 3)
-        self.cc = np.array([r[3] for r in rows]).reshape(nc, 3)
-        self.cgap = np.array([r[4] for r in rows])
-        self.ctype = np.array([r[5] for r in rows], np.int64)
-        self.cmodel = np.zeros(nc, np.int64)
-        self.cprop = np.zeros((nc, NPROP))
-        self.cname, self.cuser = [], []
-        osc = old["sc"]
-        parts = {k: [] for k in self.sc}
-        pa = self.point_area()
-        for c, (i, j, n, cp, gap, ct, prev) in enumerate(rows):
-            if prev is not None:
-                self.cmodel[c], self.cprop[c] = old["cmodel"][prev], old["cprop"][prev]
-                self.cname.append(old["cname"][prev])
-                self.cuser.append(old["cuser"][prev])
-            else:
-                self.cname.append(self.default_model)
-                self.cuser.append(dict(self.default_props))
-                self.cmodel[c] = JOINT_MODELS[self.default_model][0]
-                self.cprop[c] = props_vector(self.default_props)
-            pts, areas = make_subcontacts(self._block_verts(i), self._block_verts(j), n, cp, ctol, pa)
-            k = len(pts)
-            st = {"contact": np.full(k, c, np.int64), "pos": pts, "area": areas, "fn": np.zeros(k),
-                  "fs": np.zeros((k, 3)), "un": np.full(k, gap), "udil": np.zeros(k),
-                  "us": np.zeros((k, 3)), "state": np.zeros(k, np.int64)}
-            if prev is not None:
-                sel = np.flatnonzero(osc["contact"] == prev)
-                if sel.size:
-                    fs_old = osc["fs"][sel].copy()
-                    rotate_shear(np.zeros(len(sel), np.int64), old["cn"][prev][None], n[None], fs_old)
-                    atot = osc["area"][sel].sum() or 1.0
-                    for t in range(k):
-                        d = np.linalg.norm(osc["pos"][sel] - pts[t], axis=1)
-                        o = int(np.argmin(d))
-                        if d[o] <= max(ctol, 1e-9):
-                            s = sel[o]
-                            scale = areas[t] / osc["area"][s] if osc["area"][s] > 0 else 1.0
-                            st["fs"][t] = fs_old[o] * scale
-                            for key in ("un", "udil", "us", "state"):
-                                st[key][t] = osc[key][s]
-                        else:      # smooth carry-over: mean stresses of the old contact
-                            st["fs"][t] = fs_old.sum(0) / atot * areas[t]
-                            st["un"][t] = float((osc["un"][sel] * osc["area"][sel]).sum() / atot)
-                            st["udil"][t] = float((osc["udil"][sel] * osc["area"][sel]).sum() / atot)
-                            st["state"][t] = int(np.bitwise_or.reduce(osc["state"][sel]) & 1)
-            for key in parts:
-                parts[key].append(st[key])
-        if nc:
-            self.sc = {k: np.concatenate(v) for k, v in parts.items()}
-        else:
-            self._empty_sc()
-
-    # ------------------------------------------------------------ cycling
-    def cycle(self, nsteps: int, stop=None) -> int:
-        """Run up to ``nsteps`` steps; ``stop(engine)`` checked after each step. Returns steps done."""
+    def _geometry_signature(self):
         m = self.model
         b = m.blocks
-        if b.n == 0:
+        return (b.n, m.vertices.n, m.faces.n, int(b["id"].sum()), int(b["hidden"].sum()))
+
+    def _search(self, ctol: float, force: bool) -> tuple[np.ndarray, np.ndarray]:
+        """Candidate pairs (rows, A = lower block id), remapped only when needed."""
+        m = self.model
+        b = m.blocks
+        vpos = m.vertices["pos"]
+        moved = math.inf
+        if self._vpos_map is not None and self._vpos_map.shape == vpos.shape and not force:
+            moved = float(np.abs(vpos - self._vpos_map).max()) if len(vpos) else 0.0
+        if self._cand is not None and moved <= 0.5 * ctol:
+            return self._cand
+        t0 = _time.perf_counter()
+        active = ~b["hidden"] & (b["vert_count"] > 0)
+        lo = np.empty((b.n, 3))
+        hi = np.empty((b.n, 3))
+        envelopes(vpos, b["vert_start"], b["vert_count"], active, ctol, lo, hi)
+        if self._grid is None or force or outside_grid(lo, hi, active, *self._grid):
+            self._grid = cell_grid(lo, hi, active, 0.1)
+        pairs = cell_pairs(lo, hi, active, *self._grid)
+        ida, idb = b["id"][pairs[:, 0]], b["id"][pairs[:, 1]]
+        swap = ida > idb
+        ra = np.where(swap, pairs[:, 1], pairs[:, 0]).astype(_I)
+        rb = np.where(swap, pairs[:, 0], pairs[:, 1]).astype(_I)
+        order = np.lexsort((b["id"][rb], b["id"][ra]))
+        self._cand = (np.ascontiguousarray(ra[order]), np.ascontiguousarray(rb[order]))
+        self._vpos_map = vpos.copy()
+        self.timings["search"] += _time.perf_counter() - t0
+        return self._cand
+
+    def detect(self, force_search: bool = False) -> None:
+        """Find the contacts and their sub-contacts again, keeping the force history."""
+        t0 = _time.perf_counter()
+        m = self.model
+        b, f, fv = m.blocks, m.faces, m.face_vertices
+        cs, ss = self.contacts, self.subcontacts
+        sig = self._geometry_signature()
+        changed = sig != self._signature
+        self._signature = sig
+        ctol = self.tolerance()
+        ra, rb = self._search(ctol, force_search or changed)
+        ids = b["id"]
+        prev = match_sorted(cs["ida"], cs["idb"], ids[ra], ids[rb])
+        k = len(ra)
+        nn = np.empty((k, 3))
+        cc = np.empty((k, 3))
+        gap = np.empty(k)
+        ctype = np.empty(k, _I)
+        cp_batch(ra, rb, prev, m.vertices["pos"], b["vert_start"], b["vert_count"], b["centroid"],
+                 cs["normal"], cs["pos"], ctol, nn, cc, gap, ctype)
+        keep = np.flatnonzero(ctype > 0)
+        ra, rb, prev = ra[keep], rb[keep], prev[keep]
+        nn, cc, gap, ctype = nn[keep], cc[keep], gap[keep], ctype[keep]
+        nc = len(keep)
+        # contact data carried by the pair key, or the defaults for a new contact
+        s = self.settings()
+        old = prev >= 0
+        jm = JOINT_MODELS[s["jmodel"]]
+        jcode = np.full(nc, jm.code, _I)
+        prop = np.tile(default_row(s, jm.code), (nc, 1)) if nc else np.zeros((0, NPROP))
+        group = np.full((nc, cs["group"].shape[1]), -1, np.int32)
+        own = np.zeros(nc, np.uint8)
+        jcode[old] = cs["jmodel"][prev[old]]
+        own[old] = cs["own_props"][prev[old]]
+        keep_row = old & (own == 1)
+        prop[keep_row] = cs["prop"][prev[keep_row]]
+        for code in np.unique(jcode[old & (own == 0)]):      # contacts that follow the defaults
+            sel = old & (own == 0) & (jcode == code)
+            prop[sel] = default_row(s, int(code))
+        group[old] = cs["group"][prev[old]]
+        # sub-contacts
+        t1 = _time.perf_counter()
+        sc_c, kind, key0, key1, pos, area = _subcontacts(m.vertices["pos"], b, f, fv, ra, rb, nn, cc,
+                                                         ctol, self.point_area())
+        ns = len(sc_c)
+        fs = np.empty((ns, 3))
+        un = np.empty(ns)
+        udil = np.empty(ns)
+        us = np.empty((ns, 3))
+        state = np.empty(ns, _I)
+        carry_over(prev, sc_c, kind, key0, key1, area, gap, cs["sub_start"], cs["sub_count"], ss["kind"],
+                   ss["key0"], ss["key1"], ss["area"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"],
+                   cs["normal"], nn, fs, un, udil, us, state)
+        counts = np.bincount(sc_c, minlength=nc).astype(_I) if nc else np.zeros(0, _I)
+        starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(_I) if nc else np.zeros(0, _I)
+        self.timings["subcontacts"] += _time.perf_counter() - t1
+        # install
+        cs.clear()
+        cs.append(nc)
+        for key, val in (("ida", ids[ra]), ("idb", ids[rb]), ("a", ra), ("b", rb), ("pos", cc),
+                         ("normal", nn), ("gap", gap), ("type", ctype), ("jmodel", jcode), ("prop", prop), ("own_props", own),
+                         ("sub_start", starts), ("sub_count", counts), ("group", group)):
+            cs[key][...] = val
+        ss.clear()
+        ss.append(ns)
+        fn = np.zeros(ns)
+        for key, val in (("contact", sc_c), ("kind", kind), ("key0", key0), ("key1", key1), ("pos", pos),
+                         ("area", area), ("fn", fn), ("fs", fs), ("un", un), ("udil", udil), ("us", us),
+                         ("state", state)):
+            ss[key][...] = val
+        self.timings["detect"] += _time.perf_counter() - t0
+
+    def ensure_contacts(self) -> None:
+        """Detect now if the blocks changed since the last detection (3DEC keeps contacts
+        current whenever blocks exist, so contact commands see them before any cycle)."""
+        if self._geometry_signature() != self._signature:
+            self.detect()
+
+    # ------------------------------------------------------------ cycling
+    def _rows(self):
+        b = self.model.blocks
+        return np.flatnonzero((b["leader"] == np.arange(b.n)) & ~b["hidden"]).astype(_I)
+
+    def cycle(self, nsteps: int, stop=None, max_time: float | None = None) -> int:
+        """Run up to ``nsteps`` steps; ``stop(engine)`` is checked after every batch (at most
+        ``update-interval`` steps apart); ``max_time``: stop when the model time reaches it.
+        Returns the steps done."""
+        m = self.model
+        b = m.blocks
+        if b.n == 0 or nsteps <= 0:
             return 0
-        if (b["mass"] <= 0).any():
+        live = ~b["hidden"]
+        if (b["mass"][live] <= 0).any():
             raise RunError("a block has no mass: set `block property density` before cycling")
-        g = np.asarray(m.settings.gravity, dtype=np.float64)
+        g = np.asarray(m.settings.gravity, dtype=_F)
         dt = self.timestep()
         self.dt = dt
-        rows = np.flatnonzero((b["leader"] == np.arange(b.n)) & ~b["hidden"]).astype(np.int64)
+        rows = self._rows()
+        alpha_l, alpha_v = self.damping()
         interval = max(1, int(m.settings.update_interval))
+        fixity = (b["fixity"] | b["apply_fix"]).astype(np.uint8)
+        out = np.zeros(2)
         vmax = 1e6
         done = 0
-        for _ in range(nsteps):
-            if self.step % interval == 0 or not self.pairs:
-                self.detect()
-            sc = self.sc
-            vel_before = b["velocity"].copy()
-            spin_before = b["spin"].copy()
-            subcontact_forces(dt, b["centroid"], b["velocity"], b["spin"], b["force"], b["moment"],
-                              self.ca, self.cb, self.cn, self.cmodel, self.cprop, sc["contact"], sc["pos"],
-                              sc["area"], sc["fn"], sc["fs"], sc["un"], sc["udil"], sc["us"], sc["state"])
-            cen_before = b["centroid"].copy()
-            bad, fmax, fsum = rigid_motion(dt, g, self.alpha_local, self.alpha_visc, rows, b["mass"], b["mass"],
-                                           b["inertia_approx"], b["fixity"], b["force"], b["moment"], b["fapp"],
-                                           b["mapp"], b["velocity"], b["spin"], b["centroid"], b["disp"],
-                                           b["vert_start"], b["vert_count"], m.vertices["pos"], vmax)
-            self.step += 1
-            done += 1
-            if bad >= 0 or not math.isfinite(fmax):
-                r = bad if bad >= 0 else 0
-                raise RunError(f"the run became unstable at step {self.step}: block {int(b['id'][r])} "
-                               f"reached velocity {np.abs(b['velocity'][r]).max():.3g} m/s "
-                               f"(time step {dt:.3g} s too large or stiffness too high)")
-            # sub-contact points follow the mean displacement of their two blocks (Eq. 11)
-            if len(sc["contact"]):
-                dA = self._point_disp(cen_before, sc["contact"], sc["pos"], self.ca, dt, spin_before=None)
-                dB = self._point_disp(cen_before, sc["contact"], sc["pos"], self.cb, dt, spin_before=None)
-                sc["pos"] += 0.5 * (dA + dB)
-            self.time += dt
-            self.unbal = fmax
-            nfree = max(len(rows), 1)
-            self.ratio = fmax / (fsum / nfree) if fsum > 0 else 0.0
-            for hook in self.step_hooks:
-                hook(self)
-            if stop is not None and stop(self):
-                break
+        progress = _Progress(nsteps)
+        if self._signature != self._geometry_signature():
+            self.detect()
+        try:
+            while done < nsteps:
+                if m.step % interval == 0 or self._signature != self._geometry_signature():
+                    self.detect()
+                k = min(nsteps - done, interval - m.step % interval)
+                for h in self.step_hooks:
+                    hi = int(getattr(h, "interval", 0) or 0)
+                    if hi > 0:
+                        k = min(k, hi - m.step % hi)
+                if max_time is not None:
+                    left = int(math.ceil((max_time - m.time) / dt - 1e-9))
+                    if left <= 0:
+                        break
+                    k = min(k, left)
+                cs, ss = self.contacts, self.subcontacts
+                t0 = _time.perf_counter()
+                n_ok, bad = run_steps(k, dt, g, alpha_l, alpha_v, rows, b["mass"], b["mass"], b["inertia_approx"],
+                                      fixity, b["force"], b["moment"], b["fapp"], b["mapp"], b["velocity"],
+                                      b["spin"], b["centroid"], b["disp"], b["vert_start"], b["vert_count"],
+                                      m.vertices["pos"], cs["a"], cs["b"], cs["normal"], cs["pos"],
+                                      np.arange(cs.n, dtype=_I), cs["jmodel"], cs["prop"], ss["contact"],
+                                      ss["pos"], ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"], ss["us"],
+                                      ss["state"], vmax, out)
+                self.timings["cycle"] += _time.perf_counter() - t0
+                m.step += n_ok
+                m.time += n_ok * dt
+                done += n_ok
+                if bad >= 0:
+                    raise RunError(f"the run became unstable at step {m.step}: block {int(b['id'][bad])} "
+                                   f"reached velocity {np.abs(b['velocity'][bad]).max():.3g} m/s "
+                                   f"(time step {dt:.3g} s too large or stiffness too high)")
+                self.unbal = float(out[0])
+                self.ratio = float(out[0] / (out[1] / max(len(rows), 1))) if out[1] > 0 else 0.0
+                t0 = _time.perf_counter()
+                for hook in self.step_hooks:
+                    hook(self)
+                self.timings["hooks"] += _time.perf_counter() - t0
+                progress.update(done)
+                if stop is not None and stop(self):
+                    break
+        finally:
+            progress.close()
         return done
 
-    def _point_disp(self, cen_before, scc, pos, side, dt, spin_before=None):
-        b = self.model.blocks
-        r = side[scc]
-        arm = pos - cen_before[r]
-        return b["velocity"][r] * dt + np.cross(b["spin"][r] * dt, arm)
+    def timing_report(self) -> str:
+        tot = sum(v for k, v in self.timings.items() if k in ("detect", "cycle", "hooks")) or 1e-30
+        lines = ["phase          seconds   share"]
+        for k in ("detect", "search", "subcontacts", "cycle", "hooks"):
+            v = self.timings[k]
+            lines.append(f"{k:<13}{v:9.3f}  {100 * v / tot:5.1f} %")
+        return "\n".join(lines)
+
+
+class _Progress:
+    """A rich progress bar for runs longer than about a second, on a terminal only."""
+
+    def __init__(self, total: int):
+        self.total = total
+        self.t0 = _time.perf_counter()
+        self.bar = None
+        self.task = None
+        self.enabled = sys.stdout.isatty()
+
+    def update(self, done: int) -> None:
+        if not self.enabled:
+            return
+        if self.bar is None:
+            if _time.perf_counter() - self.t0 < 1.0:
+                return
+            from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+            self.bar = Progress(TextColumn("cycling"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
+                                TimeRemainingColumn(), transient=True)
+            self.bar.start()
+            self.task = self.bar.add_task("cycle", total=self.total)
+        self.bar.update(self.task, completed=done)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.stop()
 
 
 def engine(model) -> RigidEngine:
@@ -289,3 +442,7 @@ def engine(model) -> RigidEngine:
         e = RigidEngine(model)
         model.rigid_engine = e
     return e
+
+
+def model_name(code: int) -> str:
+    return MODEL_BY_CODE[int(code)].name

@@ -25,8 +25,8 @@ def test_block_on_spring_settles_at_mg_over_k(session):
     e = _run(session, "model solve ratio 1e-7\n")
     b = session.model.blocks
     assert b["disp"][1, 2] == pytest.approx(-2.000e-3, rel=5e-3)   # R3: mg/k = 2.000 mm
-    assert e.sc["fn"].sum() == pytest.approx(20000.0, rel=1e-3)
-    assert e.ctype.tolist() == [6]
+    assert e.subcontacts["fn"].sum() == pytest.approx(20000.0, rel=1e-3)
+    assert e.contacts["type"].tolist() == [6]
 
 
 def test_blow_up_names_step_and_block(session):

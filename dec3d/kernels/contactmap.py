@@ -1,0 +1,186 @@
+"""Contact bookkeeping across detection passes (3DEC theory, "Representation of Contacts",
+"Interaction between Blocks": force history kept when contacts and sub-contacts are found again).
+
+- ``match_sorted``: rows of an old sorted key list that hold each new key (merge join).
+- ``cp_batch``: the common plane of every candidate pair, with the fast path for pairs that
+  were contacts before (kernel ``commonplane.common_plane``).
+- ``carry_over``: the state of each new sub-contact from the old sub-contacts of the same
+  contact: the sub-contact with the same identity (kind and vertex, or the two edges)
+  keeps its displacements and state and its shear force scaled by the area ratio (the
+  stress is kept); a new one gets the mean stresses of the old contact (smooth
+  reallocation, as in UDEC), or for a new contact the contact gap.
+
+Sub-contact kinds (``subgeom``): 0 vertex of A on a face of B, 1 vertex of B on a face of A,
+2 edge-edge crossing, 3 point of a lower contact type. A vertex sub-contact keeps its
+identity when its vertex moves onto another face of the opposing block (relocation).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .commonplane import common_plane, contact_type
+
+
+@njit(cache=True)
+def match_sorted(old0, old1, new0, new1):
+    """For each new key (new0[i], new1[i]) the row of the equal old key, or -1.
+
+    Both key lists sorted lexicographically and free of repeats. Returns int64 (len(new0),).
+    """
+    out = np.full(new0.shape[0], -1, np.int64)
+    j = 0
+    no = old0.shape[0]
+    for i in range(new0.shape[0]):
+        while j < no and (old0[j] < new0[i] or (old0[j] == new0[i] and old1[j] < new1[i])):
+            j += 1
+        if j < no and old0[j] == new0[i] and old1[j] == new1[i]:
+            out[i] = j
+    return out
+
+
+@njit(cache=True)
+def cp_batch(ra, rb, prev, vpos, bvstart, bvcount, centroid, old_n, old_c, ctol,
+             out_n, out_c, out_gap, out_type):
+    """Common plane of every candidate pair (rows ra[i], rb[i]; A → B).
+
+    prev (k,) int64: row of the old contact of the pair or -1 (new pairs start from the
+    line of centroids, Eq. 5; old ones from their normal and reference point, fast path).
+    vpos (nv, 3) m; bvstart/bvcount (nb,) vertex ranges; centroid (nb, 3) m;
+    old_n/old_c (nold, 3) previous normals and reference points.
+    Writes out_n/out_c (k, 3), out_gap (k,) m, out_type (k,) contact type (CT_*, 0 if apart).
+    """
+    n0 = np.empty(3)
+    nn = np.empty(3)
+    cc = np.empty(3)
+    for i in range(ra.shape[0]):
+        a = ra[i]
+        b = rb[i]
+        va = vpos[bvstart[a]:bvstart[a] + bvcount[a]]
+        vb = vpos[bvstart[b]:bvstart[b] + bvcount[b]]
+        p = prev[i]
+        if p >= 0:
+            for d in range(3):
+                n0[d] = old_n[p, d]
+                cc[d] = old_c[p, d]
+        else:
+            for d in range(3):
+                n0[d] = centroid[b, d] - centroid[a, d]
+                cc[d] = 0.5 * (centroid[a, d] + centroid[b, d])
+            if n0[0] == 0.0 and n0[1] == 0.0 and n0[2] == 0.0:
+                n0[2] = 1.0
+        gap, na, nb, _ = common_plane(va, vb, n0, ctol, p >= 0, nn, cc)
+        for d in range(3):
+            out_n[i, d] = nn[d]
+            out_c[i, d] = cc[d]
+        out_gap[i] = gap
+        out_type[i] = contact_type(na, nb) if gap <= ctol else 0
+
+
+@njit(cache=True)
+def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, cgap,
+               old_start, old_count, old_kind, old_key0, old_key1, old_area,
+               old_fs, old_un, old_udil, old_us, old_state, old_n, new_n,
+               fs, un, udil, us, state):
+    """State of the new sub-contacts from the old ones (see the module docstring).
+
+    cprev (nc,) old contact row of each new contact or -1; new_sc_* (ns,) the new
+    sub-contacts, ordered by contact; cgap (nc,) contact gap [m]; old_start/old_count
+    (nold,) CSR of the old sub-contacts per old contact; old_* the old sub-contact arrays;
+    old_n (nold, 3) / new_n (nc, 3) contact normals: old shear forces are first turned to
+    the new plane by Eq. (23). Writes fs (ns, 3) N, un, udil (ns,) m, us (ns, 3) m, state (ns,).
+    """
+    rot = np.empty(3)
+    mean_fs = np.zeros(3)
+    for s in range(new_sc_contact.shape[0]):
+        c = new_sc_contact[s]
+        p = cprev[c]
+        for d in range(3):
+            fs[s, d] = 0.0
+            us[s, d] = 0.0
+        udil[s] = 0.0
+        state[s] = 0
+        un[s] = cgap[c]
+        if p < 0:
+            continue
+        k0 = old_n[p, 1] * new_n[c, 2] - old_n[p, 2] * new_n[c, 1]
+        k1 = old_n[p, 2] * new_n[c, 0] - old_n[p, 0] * new_n[c, 2]
+        k2 = old_n[p, 0] * new_n[c, 1] - old_n[p, 1] * new_n[c, 0]
+        lo = old_start[p]
+        hi = lo + old_count[p]
+        hit = -1
+        for o in range(lo, hi):
+            if old_kind[o] != new_kind[s] or old_key0[o] != new_key0[s]:
+                continue
+            if new_kind[s] >= 2 and old_key1[o] != new_key1[s]:
+                continue
+            hit = o
+            break
+        if hit >= 0:
+            r = new_area[s] / old_area[hit] if old_area[hit] > 0.0 else 1.0
+            f0 = old_fs[hit, 0]
+            f1 = old_fs[hit, 1]
+            f2 = old_fs[hit, 2]
+            rot[0] = f0 - (f1 * k2 - f2 * k1)
+            rot[1] = f1 - (f2 * k0 - f0 * k2)
+            rot[2] = f2 - (f0 * k1 - f1 * k0)
+            for d in range(3):
+                fs[s, d] = rot[d] * r
+                us[s, d] = old_us[hit, d]
+            un[s] = old_un[hit]
+            udil[s] = old_udil[hit]
+            state[s] = old_state[hit]
+            continue
+        # no old twin: the mean stresses of the old contact, its failure state
+        atot = 0.0
+        mun = 0.0
+        mdil = 0.0
+        st = 0
+        for d in range(3):
+            mean_fs[d] = 0.0
+        for o in range(lo, hi):
+            atot += old_area[o]
+            mun += old_un[o] * old_area[o]
+            mdil += old_udil[o] * old_area[o]
+            for d in range(3):
+                mean_fs[d] += old_fs[o, d]
+            st |= old_state[o] & 1
+        if atot <= 0.0:
+            continue
+        f0 = mean_fs[0]
+        f1 = mean_fs[1]
+        f2 = mean_fs[2]
+        rot[0] = f0 - (f1 * k2 - f2 * k1)
+        rot[1] = f1 - (f2 * k0 - f0 * k2)
+        rot[2] = f2 - (f0 * k1 - f1 * k0)
+        for d in range(3):
+            fs[s, d] = rot[d] / atot * new_area[s]
+        un[s] = mun / atot
+        udil[s] = mdil / atot
+        state[s] = st
+
+
+@njit(cache=True)
+def envelopes(vpos, bvstart, bvcount, active, pad, lo, hi):
+    """Axis-aligned envelope of each active block enlarged by ``pad`` [m] on every side."""
+    for b in range(bvstart.shape[0]):
+        if not active[b]:
+            for d in range(3):
+                lo[b, d] = 0.0
+                hi[b, d] = 0.0
+            continue
+        for d in range(3):
+            lo[b, d] = math.inf
+            hi[b, d] = -math.inf
+        for v in range(bvstart[b], bvstart[b] + bvcount[b]):
+            for d in range(3):
+                x = vpos[v, d]
+                if x < lo[b, d]:
+                    lo[b, d] = x
+                if x > hi[b, d]:
+                    hi[b, d] = x
+        for d in range(3):
+            lo[b, d] -= pad
+            hi[b, d] += pad
