@@ -76,7 +76,8 @@ Damping (``damp_mode``), with α = ``alpha`` for modes 1 and 2:
      meaningful (for one oscillator of circular frequency w, R = π α_v / (2w), so R = 0.5 gives
      α_v = w/π, about 16 % of critical). Every ``servo[S_WINDOW]`` steps the accumulated works
      are compared: α_v ← α_v·f if R < ratio, α_v ← α_v/f if R > ratio (f = ``servo[S_FACTOR]``),
-     bounded to [1e-6/Δt, 1/Δt] (1/Δt keeps D₁ ≥ 1/2). A servo that starts at 0 starts at
+     bounded to [1e-4/Δt, 1/Δt] (1/Δt keeps D₁ ≥ 1/2; the floor
+     keeps the servo able to recover within ~70 windows when a settled model is loaded again). A servo that starts at 0 starts at
      0.02/Δt. The update rule (a multiplicative bang-bang servo) is this code's own: the texts
      give only the target ratio.
 
@@ -370,7 +371,7 @@ def rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
         av = servo[S_ALPHA]
         if not av > 0.0:
             av = 0.02 / dt
-        av = min(max(av, 1e-6 / dt), 1.0 / dt)
+        av = min(max(av, 1e-4 / dt), 1.0 / dt)
         servo[S_ALPHA] = av
     al = alpha if (damp_mode == 1 or damp_mode == 2) else 0.0
     d1 = 1.0 - av * dt * 0.5
@@ -616,7 +617,7 @@ def rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
                 r = servo[S_WORK] / servo[S_DEK]
                 servo[S_LASTR] = r
                 a = servo[S_ALPHA] * fac if r < ratio else servo[S_ALPHA] / fac
-                servo[S_ALPHA] = min(max(a, 1e-6 / dt), 1.0 / dt)
+                servo[S_ALPHA] = min(max(a, 1e-4 / dt), 1.0 / dt)
             servo[S_WORK] = 0.0
             servo[S_DEK] = 0.0
             servo[S_NWIN] = 0.0

@@ -98,7 +98,7 @@ def motion_groups_ref(dt, gravity, damp_mode, alpha, servo, full_inertia,
     av = 0.0
     if damp_mode == 3:
         av = servo[0] if servo[0] > 0 else 0.02 / dt
-        av = min(max(av, 1e-6 / dt), 1.0 / dt)
+        av = min(max(av, 1e-4 / dt), 1.0 / dt)
         servo[0] = av
     al = alpha if damp_mode in (1, 2) else 0.0
     D1, D2 = 1 - av * dt / 2, 1 / (1 + av * dt / 2)
@@ -210,7 +210,7 @@ def motion_groups_ref(dt, gravity, damp_mode, alpha, servo, full_inertia,
                 servo[7] = r
                 f = servo[6] if servo[6] > 1 else 1.1
                 ratio = servo[4] if servo[4] > 0 else 0.5
-                servo[0] = min(max(servo[0] * f if r < ratio else servo[0] / f, 1e-6 / dt), 1 / dt)
+                servo[0] = min(max(servo[0] * f if r < ratio else servo[0] / f, 1e-4 / dt), 1 / dt)
             servo[1] = servo[2] = servo[3] = 0.0
     servo[9] += 1
     out[:] = (fmax, fsum, ke, av)

@@ -310,6 +310,19 @@ def test_adaptive_global_damping_brings_a_spring_mass_to_rest():
     assert np.isfinite(m.servo).all()
 
 
+def test_adaptive_damping_recovers_when_a_settled_model_is_loaded_again():
+    m = Model([(np.zeros(3), (1, 1, 1), np.eye(3))], [[0]], rho=1000.0)
+    k = 1e6
+    dt = block_timestep(m.mass[0], k, 0.1)
+    for phase, load in ((0, 0.0), (1, 5e3)):
+        m.fapp[0, 0] = load
+        for n in range(4000):
+            m.force[0, 0] = -k * m.centroid[0, 0]
+            m.step(dt, np.zeros(3), 3, 0.0, False)
+        assert abs(m.centroid[0, 0] - load / k) <= 1e-6 * 5e3 / k
+        assert 0 < m.servo[S_ALPHA] <= 1.0 / dt
+
+
 @pytest.mark.parametrize("v,f,fprev", [(0.2, 50.0, 40.0), (0.2, 50.0, 60.0), (-0.2, 50.0, 60.0),
                                        (-0.2, -50.0, -40.0), (0.0, 50.0, 60.0), (0.2, -30.0, -30.0)])
 def test_combined_damping_one_step_against_eq83(v, f, fprev):
