@@ -38,6 +38,9 @@ KMAX_DEG = 5.0
 KMIN_DEG = 0.01
 ORIENT = (0.0, math.pi / 4, math.pi / 8, 3 * math.pi / 8, math.pi / 16, 5 * math.pi / 16, 3 * math.pi / 16, 7 * math.pi / 16)
 NORIENT = 8
+#: iterations of one fast-path search; a plane not settled by then (ridges of degenerate
+#: edge-edge and vertex-vertex contacts) continues from where it stopped at the next detection
+MAX_IT_EXISTING = 48
 
 
 @njit(cache=True)
@@ -101,76 +104,135 @@ def _basis(n, p, q):
 
 
 @njit(cache=True)
+def _gap3(va, vb, n0, n1, n2):
+    """cp_gap with the normal as three scalars."""
+    da = -1e300
+    for i in range(va.shape[0]):
+        d = n0 * va[i, 0] + n1 * va[i, 1] + n2 * va[i, 2]
+        if d > da:
+            da = d
+    db = 1e300
+    for i in range(vb.shape[0]):
+        d = n0 * vb[i, 0] + n1 * vb[i, 1] + n2 * vb[i, 2]
+        if d < db:
+            db = d
+    return db - da
+
+
+@njit(cache=True)
+def _perp(n0, n1, n2):
+    """A unit vector p orthogonal to n (same rule as ``_basis``) and q = n × p."""
+    ax = abs(n0)
+    ay = abs(n1)
+    az = abs(n2)
+    if ax <= ay and ax <= az:
+        t0, t1, t2 = 1.0, 0.0, 0.0
+    elif ay <= az:
+        t0, t1, t2 = 0.0, 1.0, 0.0
+    else:
+        t0, t1, t2 = 0.0, 0.0, 1.0
+    p0 = n1 * t2 - n2 * t1
+    p1 = n2 * t0 - n0 * t2
+    p2 = n0 * t1 - n1 * t0
+    s = math.sqrt(p0 * p0 + p1 * p1 + p2 * p2)
+    p0 /= s
+    p1 /= s
+    p2 /= s
+    return p0, p1, p2, n1 * p2 - n2 * p1, n2 * p0 - n0 * p2, n0 * p1 - n1 * p0
+
+
+@njit(cache=True)
 def common_plane(va, vb, n0, ctol, existing, out_n, out_c):
     """Position the c-p between convex vertex sets va (na, 3) and vb (nb, 3) [m].
 
     n0 (3,): starting unit normal (A → B); for a new contact pass B − A centroids (Eq. 5).
-    existing: True for a contact that already has a c-p (fast path: start at k_min).
+    existing: True for a contact that already has a c-p (fast path, below).
     Writes the unit normal into out_n (3,) and the reference point (Eqs. 8-9) into out_c (3,).
     Returns (gap [m], touching vertices of A, touching vertices of B, iterations).
     A vertex touches when it lies within ctol of its block's nearest level on the c-p.
     When the gap exceeds ctol the search stops early (counts are 0).
+
+    New contact: k starts at tan 5° and is halved once the four perturbations have failed
+    in every axis orientation (0°, 45°, and the 22.5° family for ridges), down to tan 0.01°.
+    Existing contact: the plane moves little between detections, so k starts at tan 0.01°;
+    one iteration in the 0° and 45° orientations confirms the plane (the text: "only one
+    rotation iteration is usually needed"); while perturbations succeed k doubles (up to
+    tan 5°), when both orientations fail it halves; at most MAX_IT_EXISTING iterations.
     """
-    n = np.empty(3)
     s = math.sqrt(n0[0] ** 2 + n0[1] ** 2 + n0[2] ** 2)
-    for i in range(3):
-        n[i] = n0[i] / s
-    p = np.empty(3)
-    q = np.empty(3)
-    t = np.empty(3)
-    best_n = np.empty(3)
+    m0 = n0[0] / s
+    m1 = n0[1] / s
+    m2 = n0[2] / s
     kmax = math.tan(math.radians(KMAX_DEG))
     kmin = math.tan(math.radians(KMIN_DEG))
     k = kmin if existing else kmax
-    best = cp_gap(va, vb, n)
+    nfail = 2 if existing else NORIENT
+    best = _gap3(va, vb, m0, m1, m2)
+    # an improvement must beat round-off: on the plateaus of edge-edge and vertex-vertex
+    # contacts (many normals give the same gap) gains of 1e-17 m would go on for ever
+    size = 0.0
+    for i in range(va.shape[0]):
+        for d in range(3):
+            size = max(size, abs(va[i, d] - va[0, d]), abs(vb[0, d] - va[0, d]))
+    eps = 1e-12 * size
     it = 0
     fails = 0
-    # fast path: an existing contact's plane is confirmed by one iteration at k_min with
-    # the axes in both orientations (0° and 45°); any improvement starts the full search
-    quick = existing
     while True:
         it += 1
-        _basis(n, p, q)
+        p0, p1, p2, q0, q1, q2 = _perp(m0, m1, m2)
         # axes turned about n on successive iterations: 45° on alternate ones (as the text
         # says), and, while a step size keeps failing, by 22.5° and 67.5° too (ridges)
-        ang = ORIENT[(it - 1) % NORIENT]
+        ang = ORIENT[(it - 1) % nfail] if existing else ORIENT[(it - 1) % NORIENT]
         ca = math.cos(ang)
         sa = math.sin(ang)
-        for i in range(3):
-            a = ca * p[i] + sa * q[i]
-            b = ca * q[i] - sa * p[i]
-            p[i] = a
-            q[i] = b
+        a0 = ca * p0 + sa * q0
+        a1 = ca * p1 + sa * q1
+        a2 = ca * p2 + sa * q2
+        b0 = ca * q0 - sa * p0
+        b1 = ca * q1 - sa * p1
+        b2 = ca * q2 - sa * p2
         z = math.sqrt(1.0 + k * k)
         improved = False
+        c0 = m0
+        c1 = m1
+        c2 = m2
         for j in range(4):
-            sg = 1.0 if j % 2 == 0 else -1.0
-            for i in range(3):
-                t[i] = (n[i] + sg * k * (p[i] if j < 2 else q[i])) / z
-            g = cp_gap(va, vb, t)
-            if g > best:
+            sg = k if j % 2 == 0 else -k
+            if j < 2:
+                t0 = (m0 + sg * a0) / z
+                t1 = (m1 + sg * a1) / z
+                t2 = (m2 + sg * a2) / z
+            else:
+                t0 = (m0 + sg * b0) / z
+                t1 = (m1 + sg * b1) / z
+                t2 = (m2 + sg * b2) / z
+            g = _gap3(va, vb, t0, t1, t2)
+            if g > best + eps:
                 best = g
                 improved = True
-                for i in range(3):
-                    best_n[i] = t[i]
+                c0 = t0
+                c1 = t1
+                c2 = t2
         if improved:
             fails = 0
-            for i in range(3):
-                n[i] = best_n[i]
-            if quick:
-                quick = False
-                k = kmax        # the fast path found a better normal: do the full search
+            m0 = c0
+            m1 = c1
+            m2 = c2
+            if existing:
+                k = min(2.0 * k, kmax)
         else:
-            fails += 1          # a step size is given up only when both axis pairs fail
-            if quick and fails >= 2:
-                break
-            if fails >= NORIENT:
+            fails += 1          # a step size is given up only when every orientation fails
+            if fails >= nfail:
                 fails = 0
                 if k <= kmin * 1.0000001:
                     break
                 k = max(k * 0.5, kmin)
-        if best > ctol or it > 10000:
+        if best > ctol or it > (MAX_IT_EXISTING if existing else 10000):
             break
+    n = np.empty(3)
+    n[0] = m0
+    n[1] = m1
+    n[2] = m2
     # translation: Eq. (8) for touching blocks, Eq. (9) (midway between nearest vertices) if apart
     ia = 0
     da = -1e300

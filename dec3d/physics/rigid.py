@@ -30,14 +30,13 @@ import time as _time
 import numpy as np
 
 from dec3d.errors import Dec3dError
-try:
-    from dec3d.kernels.cellmap import cell_grid, cell_pairs, outside_grid
-except ImportError:  # pragma: no cover - transitional
-    from ._interim import cell_grid, cell_pairs, outside_grid
+from dec3d.kernels.cellmap import cell_grid, cell_pairs, outside_grid
 from dec3d.kernels.contactmap import carry_over, cp_batch, envelopes, match_sorted
 from dec3d.kernels.cycle import run_steps
 from dec3d.kernels.jointlaw import NPROP, P_KN, P_KS
-from dec3d.kernels.motion import block_timestep
+from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST,
+                                  block_timestep, group_properties, inertial_masses, new_servo)
+from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.groups import group_field
 from dec3d.model.store import Field, Store
 
@@ -88,6 +87,9 @@ MECH_DEFAULTS = {
     "jmodel": "mohr",          # model of contacts created from now on
     "props": {},               # their properties (user units)
     "kt": 0.0,                 # K_T of Eq. (12) [m]
+    "mass_scale": "auto",      # on | off | auto (on while damping is not none: static runs)
+    "inertia": "auto",         # full | scalar | auto (full, with Euler's equations, when damping is none)
+    "servo": [],               # adaptive global damping state (kernels.motion, first NSERVO entries)
 }
 
 
@@ -116,11 +118,6 @@ def contact_stores(model) -> tuple[Store, Store]:
 
 def _subcontacts(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea):
     """Sub-contacts of every contact (kernel ``subgeom.subcontacts_batch``, grown until it fits)."""
-    try:
-        from dec3d.kernels.subgeom import subcontacts_batch
-    except ImportError:  # pragma: no cover - transitional
-        from ._interim import subcontacts_batch
-
     cap = max(16, 8 * len(ra))
     while True:
         out = (np.empty(cap, _I), np.empty(cap, _I), np.empty(cap, _I), np.empty(cap, _I),
@@ -207,10 +204,19 @@ class RigidEngine:
         mmin = float(b["mass"][live].min()) if live.any() else 1.0
         return block_timestep(mmin, kn * area, float(s["frac"])) or 1e-3
 
-    def damping(self) -> tuple[float, float]:
-        """(local α, viscous α) for the motion kernel."""
+    def damping(self) -> tuple[int, float]:
+        """(damping mode code, α) for the motion kernel."""
         s = self.settings()
-        return (float(s["alpha"]), 0.0) if s["damping"] == "local" else (0.0, 0.0)
+        code = {"none": DAMP_NONE, "local": DAMP_LOCAL, "combined": DAMP_COMBINED, "global": DAMP_ADAPTIVE}
+        return code[s["damping"]], float(s["alpha"])
+
+    def mass_scaling(self) -> bool:
+        s = self.settings()
+        return s["mass_scale"] == "on" or (s["mass_scale"] == "auto" and s["damping"] != "none")
+
+    def full_inertia(self) -> bool:
+        s = self.settings()
+        return s["inertia"] == "full" or (s["inertia"] == "auto" and s["damping"] == "none")
 
     # ------------------------------------------------------------ detection
     def _geometry_signature(self):
@@ -325,9 +331,48 @@ class RigidEngine:
             self.detect()
 
     # ------------------------------------------------------------ cycling
-    def _rows(self):
+    def _groups(self):
+        """CSR of the moving bodies: joined blocks by leader (leader first), lone blocks alone."""
         b = self.model.blocks
-        return np.flatnonzero((b["leader"] == np.arange(b.n)) & ~b["hidden"]).astype(_I)
+        rows = np.flatnonzero(~b["hidden"]).astype(_I)
+        lead = b["leader"][rows]
+        lead = np.where(lead < 0, rows, lead)
+        order = np.lexsort((rows != lead, rows, lead))
+        gmember = rows[order]
+        glead = lead[order]
+        first = np.concatenate(([True], glead[1:] != glead[:-1])) if len(rows) else np.zeros(0, bool)
+        gstart = np.concatenate((np.flatnonzero(first), [len(rows)])).astype(_I)
+        return gstart, np.ascontiguousarray(gmember)
+
+    def _stiffness_sums(self, gstart, gmember) -> np.ndarray:
+        """Per group, Σ over its sub-contacts of max(kn, ks)·area [N/m] (Eq. 87's K)."""
+        b = self.model.blocks
+        cs, ss = self.contacts, self.subcontacts
+        kb = np.zeros(b.n)
+        if ss.n:
+            c = ss["contact"]
+            k = np.maximum(cs["prop"][c, P_KN], cs["prop"][c, P_KS]) * ss["area"]
+            kb += np.bincount(cs["a"][c], k, minlength=b.n) + np.bincount(cs["b"][c], k, minlength=b.n)
+        return np.add.reduceat(kb[gmember], gstart[:-1]) if len(gmember) else np.zeros(0)
+
+    def _masses(self, gstart, gmember, gmass, giscalar, dt_fixed):
+        """(Δt, inertial masses, scaled scalar inertias) of the groups; density scaling when on."""
+        s = self.settings()
+        frac = float(s["frac"])
+        if not self.mass_scaling() or dt_fixed is None and not len(gmass):
+            dt = dt_fixed if dt_fixed is not None else self.timestep()
+            return dt, gmass.copy(), giscalar.copy()
+        kg = self._stiffness_sums(gstart, gmember)
+        if dt_fixed is not None:
+            dt = dt_fixed
+        else:
+            on = kg > 0
+            # Δt of Eq. (87) for a typical body (median mass and stiffness); lighter or stiffer
+            # bodies get a larger inertial mass, heavier ones keep theirs
+            dt = (block_timestep(float(np.median(gmass[on])), float(np.median(kg[on])), frac)
+                  if on.any() else self.timestep())
+        im, isc = inertial_masses(gmass, giscalar, kg, dt, frac)
+        return dt, im, isc
 
     def cycle(self, nsteps: int, stop=None, max_time: float | None = None) -> int:
         """Run up to ``nsteps`` steps; ``stop(engine)`` is checked after every batch (at most
@@ -340,23 +385,38 @@ class RigidEngine:
         live = ~b["hidden"]
         if (b["mass"][live] <= 0).any():
             raise RunError("a block has no mass: set `block property density` before cycling")
+        s = self.settings()
         g = np.asarray(m.settings.gravity, dtype=_F)
-        dt = self.timestep()
-        self.dt = dt
-        rows = self._rows()
-        alpha_l, alpha_v = self.damping()
-        interval = max(1, int(m.settings.update_interval))
+        mode, alpha = self.damping()
+        full = self.full_inertia()
+        gstart, gmember = self._groups()
+        ng = len(gstart) - 1
+        # orientation of each block: its principal axes are kept current (below)
+        inertia = np.einsum("bij,bj,bkj->bik", b["principal_axes"], b["principal_moment"], b["principal_axes"])
+        gmass, gcen, _, gprin, gaxes, giscalar = group_properties(gstart, gmember, b["mass"], b["centroid"],
+                                                                  inertia, b["inertia_approx"])
+        axes0 = gaxes.copy()
+        servo = new_servo(ng)
+        if mode == DAMP_ADAPTIVE and len(s["servo"]) == NSERVO:
+            servo[:NSERVO] = s["servo"]
+        servo[S_HIST] = 0.0
         fixity = (b["fixity"] | b["apply_fix"]).astype(np.uint8)
-        out = np.zeros(2)
+        dt_fixed = float(s["timestep"]) if s["timestep"] else None
+        out = np.zeros(4)
         vmax = 1e6
+        interval = max(1, int(m.settings.update_interval))
         done = 0
         progress = _Progress(nsteps)
         if self._signature != self._geometry_signature():
             self.detect()
+        dt, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt_fixed)
+        self.dt = dt
         try:
             while done < nsteps:
-                if m.step % interval == 0 or self._signature != self._geometry_signature():
+                if m.step % interval == 0:
                     self.detect()
+                    if self.mass_scaling():
+                        _, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt)
                 k = min(nsteps - done, interval - m.step % interval)
                 for h in self.step_hooks:
                     hi = int(getattr(h, "interval", 0) or 0)
@@ -369,13 +429,13 @@ class RigidEngine:
                     k = min(k, left)
                 cs, ss = self.contacts, self.subcontacts
                 t0 = _time.perf_counter()
-                n_ok, bad = run_steps(k, dt, g, alpha_l, alpha_v, rows, b["mass"], b["mass"], b["inertia_approx"],
-                                      fixity, b["force"], b["moment"], b["fapp"], b["mapp"], b["velocity"],
-                                      b["spin"], b["centroid"], b["disp"], b["vert_start"], b["vert_count"],
-                                      m.vertices["pos"], cs["a"], cs["b"], cs["normal"], cs["pos"],
-                                      np.arange(cs.n, dtype=_I), cs["jmodel"], cs["prop"], ss["contact"],
-                                      ss["pos"], ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"], ss["us"],
-                                      ss["state"], vmax, out)
+                n_ok, bad = run_steps(k, dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass, gisc,
+                                      gprin, gaxes, gcen, b["mass"], fixity, b["force"], b["moment"], b["fapp"],
+                                      b["mapp"], b["velocity"], b["spin"], b["centroid"], b["disp"],
+                                      b["vert_start"], b["vert_count"], m.vertices["pos"], cs["a"], cs["b"],
+                                      cs["normal"], cs["pos"], np.arange(cs.n, dtype=_I), cs["jmodel"], cs["prop"],
+                                      ss["contact"], ss["pos"], ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"],
+                                      ss["us"], ss["state"], vmax, out)
                 self.timings["cycle"] += _time.perf_counter() - t0
                 m.step += n_ok
                 m.time += n_ok * dt
@@ -385,7 +445,8 @@ class RigidEngine:
                                    f"reached velocity {np.abs(b['velocity'][bad]).max():.3g} m/s "
                                    f"(time step {dt:.3g} s too large or stiffness too high)")
                 self.unbal = float(out[0])
-                self.ratio = float(out[0] / (out[1] / max(len(rows), 1))) if out[1] > 0 else 0.0
+                self.ratio = float(out[0] / (out[1] / max(ng, 1))) if out[1] > 0 else 0.0
+                self.kinetic = float(out[2])
                 t0 = _time.perf_counter()
                 for hook in self.step_hooks:
                     hook(self)
@@ -395,6 +456,15 @@ class RigidEngine:
                     break
         finally:
             progress.close()
+            # keep each block's principal axes turning with its body; save the servo state
+            turn = np.einsum("gij,gkj->gik", gaxes, axes0)
+            gid = np.repeat(np.arange(ng), np.diff(gstart))
+            pa = b["principal_axes"]
+            pa[gmember] = np.einsum("bij,bjk->bik", turn[gid], pa[gmember])
+            b["inertia"][gmember] = np.einsum("bij,bj,bkj->bik", pa[gmember], b["principal_moment"][gmember],
+                                              pa[gmember])
+            if mode == DAMP_ADAPTIVE:
+                s["servo"] = [float(x) for x in servo[:NSERVO]]
         return done
 
     def timing_report(self) -> str:
