@@ -8,6 +8,15 @@ Each folder of `verification/` holds a `problem.toml`:
     [[expect]]  quantity = "..."  value = 1.0  rel_tol = 0.01 | abs_tol = ...
     [[expect]]  quantity = "..."  below = "<other quantity>"
     [[expect]]  quantity = "..."  value = ...  report_only = true
+    [[derive]]  name = "..."  kind = "slope" | "curvature" | "mean" | "max" | "min"
+                csv = "<history export file>"  history = "<name>"  [vs = "<name>"]
+                [t0 = <s>]  [t1 = <s>]       # window, seconds after the file's first sample
+    [[derive]]  name = "..."  kind = "trend" | "plunge"  of = ["<qx>", "<qy>", "<qz>"]   # degrees
+
+`derive` adds quantities worked out from exported history files (kind = "deck"): the least-squares
+slope d(history)/dt (or d(history)/d(vs) with `vs`), the curvature 2·c₂ of a least-squares quadratic
+c₀ + c₁t + c₂t² (an acceleration from a displacement), or the mean/max/min over the window; and the
+trend (clockwise from +y) and plunge (down from horizontal) of a vector of three other quantities.
 
 Expectations are data; the runner knows no problem by name.
 """
@@ -40,7 +49,49 @@ def _deck_quantities(folder: Path, spec: dict) -> dict[str, float]:
         s.call(folder / spec["deck"])
         q = {k: float(v) for k, v in s.variables.items() if isinstance(v, (int, float)) and not isinstance(v, bool)}
         q.update(s.results)
+        for d in spec.get("derive", []):
+            q[d["name"]] = derive(d, q, Path(out))
         return q
+
+
+def _column(rows: list[list[str]], name: str, path: Path):
+    import numpy as np
+
+    head = rows[0]
+    for j, h in enumerate(head[2:], start=2):
+        if h == name or h.startswith(name + " ("):
+            return np.array([float(r[j]) for r in rows[1:]])
+    raise KeyError(f"{path.name}: no history '{name}' (columns: {', '.join(head[2:])})")
+
+
+def derive(d: dict, q: dict[str, float], out: Path) -> float:
+    """One `[[derive]]` quantity (see the module docstring)."""
+    import csv
+
+    import numpy as np
+
+    kind = d["kind"]
+    if kind in ("trend", "plunge"):
+        x, y, z = (q[k] for k in d["of"])
+        if kind == "trend":
+            return math.degrees(math.atan2(x, y)) % 360.0
+        return math.degrees(math.atan2(-z, math.hypot(x, y)))
+    path = out / d["csv"]
+    rows = list(csv.reader(open(path, encoding="utf-8")))
+    t = np.array([float(r[1]) for r in rows[1:]])
+    v = _column(rows, d["history"], path)
+    rel = t - t[0]
+    sel = (rel >= float(d.get("t0", -math.inf))) & (rel <= float(d.get("t1", math.inf)))
+    if sel.sum() < (3 if kind == "curvature" else 2 if kind == "slope" else 1):
+        raise ValueError(f"derive {d['name']}: too few samples in the window")
+    x = _column(rows, d["vs"], path) if "vs" in d else t
+    if kind == "slope":
+        return float(np.polyfit(x[sel], v[sel], 1)[0])
+    if kind == "curvature":
+        return float(2.0 * np.polyfit(x[sel], v[sel], 2)[0])
+    if kind in ("mean", "max", "min"):
+        return float(getattr(np, kind)(v[sel]))
+    raise ValueError(f"derive {d['name']}: unknown kind {kind!r}")
 
 
 def _ssdem_quantities(folder: Path, spec: dict) -> dict[str, float]:

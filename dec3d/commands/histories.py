@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from ..errors import BindError, CommandError
 from ..io.history import write_csv, write_png
-from ..physics.history import BLOCK_QUANTITIES, MODEL_QUANTITIES, figures, histories, nearest_block_id
+from ..physics.history import (BLOCK_QUANTITIES, CONTACT_QUANTITIES, MODEL_QUANTITIES, RIGID_QUANTITIES, figures,
+                               histories, nearest_block_id)
 from .registry import REGISTRY, command
 from .values import NUMBERISH, VEC3, Choice, Num, P, Text, ValueType, _number_literal
 
@@ -51,7 +52,7 @@ def _name(session, call):
     return name
 
 
-def _block_history(quantity):
+def _block_history(quantity, rigid=False):
     def handler(session, call):
         m = session.model
         name = _name(session, call)
@@ -64,26 +65,75 @@ def _block_history(quantity):
                 bid = nearest_block_id(m, call.args["position"])
             except ValueError as exc:
                 raise CommandError(str(exc), call.location)
-        histories(m).add_block(quantity, bid, name)
+        if rigid:
+            histories(m).add_rigid(quantity, bid, name)
+        else:
+            histories(m).add_block(quantity, bid, name)
 
     handler.__name__ = "block_history_" + quantity.replace("-", "_")
     return handler
 
 
+_BLOCK_KW = [P("position", VEC3, "the block whose centroid is nearest this point", units="m"),
+             P("block-id", Num(integer=True, lo=1), "the block with this id"),
+             P("gridpointid", Num(integer=True), "a gridpoint of a deformable block", supported=False),
+             P("zone-id", Num(integer=True), "a zone of a deformable block", supported=False)]
+_WHAT = {"displacement": "displacement", "velocity": "velocity", "rvelocity": "angular velocity",
+         "position": "centroid position"}
+_WHICH = ("The block is the one whose centroid is nearest `position` when the command runs, or the "
+          "block `block-id`. A leading `name '<s>'` names the history (default: its number).")
+
 for _q in BLOCK_QUANTITIES:
-    _what = "displacement" if _q.startswith("d") else "velocity"
+    _what = _WHAT[_q.split("-")[0]]
     _comp = f"{_q[-1]} component of the" if "-" in _q else "magnitude of the"
-    command(f"block history {_q}",
-            keywords=[P("position", VEC3, "the block whose centroid is nearest this point", units="m"),
-                      P("block-id", Num(integer=True, lo=1), "the block with this id"),
-                      P("gridpointid", Num(integer=True), "a gridpoint of a deformable block", supported=False),
-                      P("zone-id", Num(integer=True), "a zone of a deformable block", supported=False)],
-            check=_check_block,
+    if _q.startswith("position"):
+        _comp = f"{_q[-1]} coordinate of the" if "-" in _q else "distance from the origin of the"
+    command(f"block history {_q}", keywords=_BLOCK_KW, check=_check_block,
             doc=f"Record the {_comp} {_what} of one block every `history interval` steps.",
-            details="The block is the one whose centroid is nearest `position` when the command runs, or the "
-                    "block `block-id`. A leading `name '<s>'` names the history (default: its number).",
+            details=_WHICH + ("" if _q.split("-")[0] in ("displacement", "velocity") else
+                              " (dec3d: `rvelocity` and `position` are not 3DEC history variables.)"),
             examples=[f"block history {_q} position 0.5 0.5 0.5", f"block history name 'h{_q[0]}' {_q} block-id 2"],
             )(_block_history(_q))
+
+for _q in RIGID_QUANTITIES:
+    if _q == "shape-error":
+        _doc = ("Record how far the block's vertices are from a rigid motion: the largest distance [m] between "
+                "a vertex arm (vertex − centroid) and the best-fit rotation of its arm when the history was made.")
+    else:
+        _doc = (f"Record the {_q[-1] + ' component' if '-' in _q else 'magnitude'} of the angular momentum "
+                "I(t) ω [kg·m²/s] of one block about its centroid.")
+    command(f"block history {_q}", keywords=_BLOCK_KW, check=_check_block, doc=_doc,
+            details=_WHICH + " dec3d only (not a 3DEC variable): I(t) = R I₀ Rᵀ with I₀ the inertia tensor when "
+                    "the history is made and R the best-fit (Kabsch) rotation of the vertex arms since then.",
+            examples=[f"block history {_q} position 0.5 0.5 0.5"])(_block_history(_q, rigid=True))
+
+REGISTRY.node_keywords("block contact history", [P("name", Text(), "history name")])
+
+
+def _contact_history(quantity):
+    def handler(session, call):
+        name = _name(session, call)
+        histories(session.model).add_contact(quantity, call.args["position"], name)
+
+    handler.__name__ = "contact_history_" + quantity.replace("-", "_")
+    return handler
+
+
+for _q in CONTACT_QUANTITIES:
+    _fld, _how = CONTACT_QUANTITIES[_q]
+    _doc = {"force-normal": "the normal force [N] (compression positive), summed over its sub-contacts",
+            "force-shear": "the magnitude of the shear force [N] summed over its sub-contacts",
+            "displacement-normal": "the mean normal displacement [m] of its sub-contacts (gap: positive)",
+            "displacement-shear": "the magnitude of the mean accumulated shear displacement [m] of its sub-contacts"
+            }.get(_q, f"the {_q[-1]} component of the shear force [N] on the second block, summed over its sub-contacts")
+    command(f"block contact history {_q}",
+            keywords=[P("position", VEC3, "the contact whose centre is nearest this point", units="m", required=True),
+                      P("contact-id", Num(integer=True), "a contact by id", supported=False)],
+            doc=f"Record, for one contact, {_doc}.",
+            details="The contact is the one whose centre is nearest `position` at the first sample; it is then "
+                    "followed by its two blocks (0 when they separate). A leading `name '<s>'` names the history.",
+            examples=[f"block contact history {_q} position 0.5 0.5 1", f"block contact history name 'c' {_q} position 0 0 0"],
+            )(_contact_history(_q))
 
 
 # other 3DEC history sources, known by name and not implemented yet

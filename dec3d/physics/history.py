@@ -12,10 +12,20 @@ from typing import Callable
 
 import numpy as np
 
+_XYZ = (("", None), ("-x", 0), ("-y", 1), ("-z", 2))
 #: block quantity -> (engine field, component or None for the magnitude)
 BLOCK_QUANTITIES = {f"{q}{s}": (fld, comp)
-                    for q, fld in (("displacement", "disp"), ("velocity", "velocity"))
-                    for s, comp in (("", None), ("-x", 0), ("-y", 1), ("-z", 2))}
+                    for q, fld in (("displacement", "disp"), ("velocity", "velocity"), ("rvelocity", "spin"),
+                                   ("position", "centroid"))
+                    for s, comp in _XYZ}
+#: dec3d's own block quantities (not 3DEC variables), worked out from the vertices each sample:
+#: angular momentum I(t) ω about the centroid, I(t) = R I₀ Rᵀ with R the best-fit rotation of the vertex
+#: arms since the history was made (Kabsch), and the shape error max |r − R r₀| [m] of the vertex arms
+RIGID_QUANTITIES = tuple(f"angular-momentum{s}" for s, _ in _XYZ) + ("shape-error",)
+#: contact quantity -> (sub-contact field, how it is reduced); ``block contact history``
+CONTACT_QUANTITIES = {"force-normal": ("fn", "sum"), "force-shear": ("fs", "norm"),
+                      "force-shear-x": ("fs", 0), "force-shear-y": ("fs", 1), "force-shear-z": ("fs", 2),
+                      "displacement-normal": ("un", "mean"), "displacement-shear": ("us", "norm-mean")}
 MODEL_QUANTITIES = ("unbalanced-maximum", "ratio", "time-total")
 
 
@@ -75,9 +85,82 @@ class HistorySet:
 
         return self.add(f"block {block_id} {quantity}", value, name)
 
+    def add_rigid(self, quantity: str, block_id: int, name: str | None = None) -> History:
+        """Angular momentum [kg·m²/s] or shape error [m] of one block (``RIGID_QUANTITIES``)."""
+        model = self.model
+        b = model.blocks
+        r0 = int(np.flatnonzero(b["id"] == block_id)[0])
+        s, c = int(b["vert_start"][r0]), int(b["vert_count"][r0])
+        arms0 = model.vertices["pos"][s:s + c] - b["centroid"][r0]
+        inertia0 = b["inertia"][r0].copy()
+        comp = {"": None, "-x": 0, "-y": 1, "-z": 2}.get(quantity[len("angular-momentum"):], None)
+
+        def value(eng) -> float:
+            bb = model.blocks
+            r = int(np.flatnonzero(bb["id"] == block_id)[0])
+            st = int(bb["vert_start"][r])
+            arms = model.vertices["pos"][st:st + c] - bb["centroid"][r]
+            rot = best_rotation(arms0, arms)
+            if quantity == "shape-error":
+                return float(np.linalg.norm(arms - arms0 @ rot.T, axis=1).max())
+            lm = rot @ inertia0 @ rot.T @ bb["spin"][r]
+            return float(np.linalg.norm(lm)) if comp is None else float(lm[comp])
+
+        return self.add(f"block {block_id} {quantity}", value, name)
+
+    def add_contact(self, quantity: str, position, name: str | None = None) -> History:
+        """A contact quantity summed (or averaged) over the sub-contacts of one contact: the contact whose
+        centre is nearest ``position`` at the first sample, followed by its two blocks' ids afterwards
+        (the ``contacts`` / ``subcontacts`` stores of the rigid engine)."""
+        fld, how = CONTACT_QUANTITIES[quantity]
+        model = self.model
+        pos = np.asarray(position, dtype=float)
+        pair: dict = {}
+
+        def value(eng) -> float:
+            c, sc = _contact_view(model, eng)
+            if c is None or len(c["ida"]) == 0:
+                return float("nan") if not pair else 0.0
+            if not pair:
+                k = int(np.argmin(np.linalg.norm(c["pos"] - pos, axis=1)))
+                pair["ids"] = (int(c["ida"][k]), int(c["idb"][k]))
+            ida, idb = pair["ids"]
+            hit = np.flatnonzero((c["ida"] == ida) & (c["idb"] == idb))
+            if len(hit) == 0:
+                return 0.0                     # the two blocks are no longer in contact
+            k = int(hit[0])
+            s0, n = int(c["sub_start"][k]), int(c["sub_count"][k])
+            v = sc[fld][s0:s0 + n]
+            if how == "sum":
+                return float(v.sum())
+            if how == "mean":
+                return float(v.mean()) if v.size else 0.0
+            if how == "norm":
+                return float(np.linalg.norm(v.sum(axis=0)))
+            if how == "norm-mean":
+                return float(np.linalg.norm(v.mean(axis=0))) if v.size else 0.0
+            return float(v[:, how].sum())
+
+        return self.add(f"contact near ({pos[0]:g} {pos[1]:g} {pos[2]:g}) {quantity}", value, name)
+
     def add_model(self, quantity: str, name: str | None = None) -> History:
         attr = {"unbalanced-maximum": "unbal", "ratio": "ratio", "time-total": "time"}[quantity]
         return self.add(f"mechanical {quantity}", lambda eng: float(getattr(eng, attr)), name)
+
+
+def _contact_view(model, eng):
+    """(contacts, subcontacts) stores of the rigid engine, or (None, None) before it has made them."""
+    stores = model.stores
+    if "contacts" in stores:
+        return stores["contacts"], stores["subcontacts"]
+    return None, None
+
+
+def best_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The rotation R minimising Σ |b_i − R a_i|² (Kabsch; a, b (n, 3) centred point sets)."""
+    u, _, vt = np.linalg.svd(b.T @ a)
+    d = np.sign(np.linalg.det(u @ vt)) or 1.0
+    return u @ np.diag([1.0, 1.0, d]) @ vt
 
 
 def nearest_block_id(model, position) -> int:
