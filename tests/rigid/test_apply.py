@@ -115,7 +115,6 @@ def test_applied_moment_spins_the_block(session):
     assert b["spin"][0, 2] > 0 and b["spin"][0, :2].tolist() == [0, 0]
 
 
-@pytest.mark.xfail(reason="the engine does not hold apply_fix components yet (being wired in rigid_motion)", strict=False)
 def test_applied_velocity_moves_the_block_and_is_held(session):
     # gravity on: a held component does not accelerate; remove the apply and it does
     b = _run(session, PHYS + "model gravity 0 0 -10\nblock apply velocity-x 0.1 velocity-z 0\nmodel cycle 1000\n")
@@ -125,7 +124,6 @@ def test_applied_velocity_moves_the_block_and_is_held(session):
     assert b["velocity"][0, 2] == pytest.approx(-10 * 10 * 1e-3) and b["velocity"][0, 0] == pytest.approx(0.1)
 
 
-@pytest.mark.xfail(reason="the engine does not hold apply_fix components yet (being wired in rigid_motion)", strict=False)
 def test_applied_rvelocity_is_held(session):
     b = _run(session, PHYS + "block apply rvelocity-z 0.5\nblock apply moment-z 1e6\nmodel cycle 100\n")
     assert b["spin"][0].tolist() == [0, 0, 0.5]
