@@ -8,41 +8,69 @@ from .registry import command
 from .values import FLAG, Choice, Num, Nums, P
 
 
-_DAMPING_NOT_YET = ("global", "combined", "rayleigh", "maxwell")
+_DAMPING_NOT_YET = ("rayleigh", "maxwell")
 
 
 def _check_damping(call):
-    from ..errors import NotSupportedError
+    from ..errors import BindError, NotSupportedError
 
-    if call.args["mode"] in _DAMPING_NOT_YET:
-        raise NotSupportedError(f"`block mechanical damping {call.args['mode']}` is not supported yet",
-                                call.locations.get("mode", call.location), hint="implemented: local [α], none")
+    mode = call.args["mode"]
+    where = call.locations.get("alpha", call.location)
+    if mode in _DAMPING_NOT_YET:
+        raise NotSupportedError(f"`block mechanical damping {mode}` is not supported yet",
+                                call.locations.get("mode", call.location),
+                                hint="implemented: local [α], combined [α], global [ratio], none")
     if len(call.args["alpha"]) > 1:
-        from ..errors import BindError
-
-        raise BindError("local damping takes one coefficient", call.locations.get("alpha", call.location))
+        raise BindError(f"{mode} damping takes one value", where)
+    if mode == "none" and call.args["alpha"]:
+        raise BindError("`damping none` takes no value", where)
+    if call.args["alpha"] and call.args["alpha"][0] < 0:
+        raise BindError("the damping value must be ≥ 0", where)
 
 
 @command("block mechanical damping",
          positional=[P("mode", Choice(("local", "global", "combined", "none", "rayleigh", "maxwell")),
                        "damping form", required=True),
-                     P("alpha", Nums(0, 6), "local damping coefficient α (rayleigh and maxwell take more values)",
+                     P("alpha", Nums(0, 6), "coefficient α of local and combined damping; target ratio of global",
                        default=())],
          check=_check_damping,
-         doc="Set the mechanical damping (default: local, α = 0.8).",
-         details="`none` switches damping off. `global` (adaptive), `combined`, `rayleigh` and `maxwell` are "
-                 "known and not supported yet.",
-         examples=["block mechanical damping local 0.8", "block mechanical damping none"])
+         doc="Set the mechanical damping (default: local, α = 0.8, with density scaling).",
+         details="`local [α]` (3DEC theory Eq. 79), `combined [α]` (Eq. 83: local damping on the velocity and "
+                 "on the force rate), `global [ratio]` (adaptive global viscous damping, Cundall 1982: a servo "
+                 "keeps the ratio of damping power to the rate of change of kinetic energy at 0.5 or the value "
+                 "given), `none` (dynamic runs: no damping, no density scaling, full inertia with Euler's "
+                 "equations). `rayleigh` and `maxwell` are known and not supported yet.",
+         examples=["block mechanical damping local 0.8", "block mechanical damping combined",
+                   "block mechanical damping global", "block mechanical damping none"])
 def damping(session, call):
-    alpha = call.args["alpha"][0] if call.args["alpha"] else 0.8
-    if not 0.0 <= alpha:
-        from ..errors import BindError
-
-        raise BindError("the damping coefficient must be ≥ 0", call.locations.get("alpha", call.location))
     s = mech(session.model)
-    s["damping"] = call.args["mode"]
-    if call.args["mode"] == "local":
-        s["alpha"] = float(alpha)
+    mode = call.args["mode"]
+    s["damping"] = mode
+    if mode in ("local", "combined"):
+        s["alpha"] = float(call.args["alpha"][0]) if call.args["alpha"] else 0.8
+    if mode == "global":
+        s["servo"] = []
+        s["servo_ratio"] = float(call.args["alpha"][0]) if call.args["alpha"] else 0.5
+
+
+@command("block mechanical mass-scale",
+         positional=[P("mode", Choice(("on", "off", "automatic")), "on, off, or automatic (on unless damping is none)")],
+         keywords=[P("timestep", Num(lo=0, lo_open=True), "time step the scaled masses must allow", units="s")],
+         doc="Density (mass) scaling of the rigid blocks for static runs (3DEC theory, \"Mass (Density) Scaling\").",
+         details="Each body's inertial mass is raised to the smallest value stable at the time step by Eq. (87) "
+                 "(m_i = max(m, K (Δt / 2 frac)²), K the sum of its contact stiffnesses; the inertia by the same "
+                 "ratio); gravity keeps the real mass. The step is Eq. (87) for a body of median mass and "
+                 "stiffness, or the value given. Default: automatic.",
+         examples=["block mechanical mass-scale on", "block mechanical mass-scale off",
+                   "block mechanical mass-scale on timestep 1e-4"])
+def mass_scale(session, call):
+    s = mech(session.model)
+    mode = call.args["mode"]
+    if mode is not None:
+        s["mass_scale"] = "auto" if mode == "automatic" else mode
+    if call.args["timestep"] is not None:
+        s["mass_scale"] = "on"
+        s["scale_timestep"] = float(call.args["timestep"])
 
 
 _BITS = {"velocity": 0b000111, "velocity-x": 1, "velocity-y": 2, "velocity-z": 4,

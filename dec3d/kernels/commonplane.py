@@ -142,6 +142,61 @@ def _perp(n0, n1, n2):
 
 
 @njit(cache=True)
+def _face_normal(v, n0, n1, n2, ctol, is_a):
+    """Unit normal (oriented like n) of the plane through the vertices of ``v`` that touch
+    the c-p (within ctol of the block's level nearest it), or zeros if fewer than three
+    touch or they are collinear. Three well-spread touching vertices define it."""
+    sg = 1.0 if is_a else -1.0
+    lev = -1e300
+    for i in range(v.shape[0]):
+        d = sg * (n0 * v[i, 0] + n1 * v[i, 1] + n2 * v[i, 2])
+        if d > lev:
+            lev = d
+    i0 = -1
+    for i in range(v.shape[0]):
+        if sg * (n0 * v[i, 0] + n1 * v[i, 1] + n2 * v[i, 2]) >= lev - ctol:
+            i0 = i
+            break
+    i1 = -1
+    far = 0.0
+    for i in range(v.shape[0]):
+        if sg * (n0 * v[i, 0] + n1 * v[i, 1] + n2 * v[i, 2]) >= lev - ctol:
+            d = (v[i, 0] - v[i0, 0]) ** 2 + (v[i, 1] - v[i0, 1]) ** 2 + (v[i, 2] - v[i0, 2]) ** 2
+            if d > far:
+                far = d
+                i1 = i
+    if i1 < 0:
+        return 0.0, 0.0, 0.0
+    e0 = v[i1, 0] - v[i0, 0]
+    e1 = v[i1, 1] - v[i0, 1]
+    e2 = v[i1, 2] - v[i0, 2]
+    best = 0.0
+    c0 = 0.0
+    c1 = 0.0
+    c2 = 0.0
+    for i in range(v.shape[0]):
+        if sg * (n0 * v[i, 0] + n1 * v[i, 1] + n2 * v[i, 2]) >= lev - ctol:
+            r0 = v[i, 0] - v[i0, 0]
+            r1 = v[i, 1] - v[i0, 1]
+            r2 = v[i, 2] - v[i0, 2]
+            x0 = e1 * r2 - e2 * r1
+            x1 = e2 * r0 - e0 * r2
+            x2 = e0 * r1 - e1 * r0
+            a = x0 * x0 + x1 * x1 + x2 * x2
+            if a > best:
+                best = a
+                c0 = x0
+                c1 = x1
+                c2 = x2
+    if best <= 1e-18 * far * far:
+        return 0.0, 0.0, 0.0
+    s = math.sqrt(best)
+    if c0 * n0 + c1 * n1 + c2 * n2 < 0.0:
+        s = -s
+    return c0 / s, c1 / s, c2 / s
+
+
+@njit(cache=True)
 def common_plane(va, vb, n0, ctol, existing, out_n, out_c):
     """Position the c-p between convex vertex sets va (na, 3) and vb (nb, 3) [m].
 
@@ -229,6 +284,22 @@ def common_plane(va, vb, n0, ctol, existing, out_n, out_c):
                 k = max(k * 0.5, kmin)
         if best > ctol or it > (MAX_IT_EXISTING if existing else 10000):
             break
+    if best <= ctol:
+        # face snap: the hill-climb stops within k_min (0.01°) of the best plane; when one
+        # block shows a face to the plane, that face's own normal is tried and kept if it
+        # is no worse, so face contacts get the exact plane (a 0.01° tilt across a 1 m face
+        # is a spurious 0.1 mm overlap)
+        for side in range(2):
+            f0, f1, f2 = _face_normal(va if side == 0 else vb, m0, m1, m2, ctol, side == 0)
+            if f0 == 0.0 and f1 == 0.0 and f2 == 0.0:
+                continue
+            g = _gap3(va, vb, f0, f1, f2)
+            if g >= best - eps:
+                best = g
+                m0 = f0
+                m1 = f1
+                m2 = f2
+                break
     n = np.empty(3)
     n[0] = m0
     n[1] = m1

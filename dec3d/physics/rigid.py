@@ -90,6 +90,8 @@ MECH_DEFAULTS = {
     "mass_scale": "auto",      # on | off | auto (on while damping is not none: static runs)
     "inertia": "auto",         # full | scalar | auto (full, with Euler's equations, when damping is none)
     "servo": [],               # adaptive global damping state (kernels.motion, first NSERVO entries)
+    "servo_ratio": 0.5,        # its target ratio
+    "scale_timestep": None,    # Δt wanted with density scaling [s] (None: Eq. 87, median body)
 }
 
 
@@ -359,10 +361,12 @@ class RigidEngine:
         """(Δt, inertial masses, scaled scalar inertias) of the groups; density scaling when on."""
         s = self.settings()
         frac = float(s["frac"])
-        if not self.mass_scaling() or dt_fixed is None and not len(gmass):
+        if not self.mass_scaling() or not len(gmass):
             dt = dt_fixed if dt_fixed is not None else self.timestep()
             return dt, gmass.copy(), giscalar.copy()
         kg = self._stiffness_sums(gstart, gmember)
+        if dt_fixed is None and s["scale_timestep"]:
+            dt_fixed = float(s["scale_timestep"])
         if dt_fixed is not None:
             dt = dt_fixed
         else:
@@ -396,7 +400,7 @@ class RigidEngine:
         gmass, gcen, _, gprin, gaxes, giscalar = group_properties(gstart, gmember, b["mass"], b["centroid"],
                                                                   inertia, b["inertia_approx"])
         axes0 = gaxes.copy()
-        servo = new_servo(ng)
+        servo = new_servo(ng, ratio=float(s["servo_ratio"]))
         if mode == DAMP_ADAPTIVE and len(s["servo"]) == NSERVO:
             servo[:NSERVO] = s["servo"]
         servo[S_HIST] = 0.0

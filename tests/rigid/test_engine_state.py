@@ -1,0 +1,142 @@
+"""Engine state in the model: save/restore mid-run, contact ranges, groups and resets,
+damping modes, density scaling, joined blocks."""
+import numpy as np
+import pytest
+
+from dec3d.physics.rigid import engine
+
+SPRING = """model new
+block create brick 0 1 0 1 -1 0
+block create brick 0 1 0 1 0 1
+block property density 2000
+model gravity 0 0 -10
+block contact jmodel assign elastic
+block contact material-table default property stiffness-normal 10e6 stiffness-shear 10e6
+block fix range position-z -1 0
+"""
+
+STACK3 = """model new
+block create brick 0 1 0 1 -1 0
+block create brick 0 1 0 1 0 1
+block create brick 0 1 0 1 1 2
+block property density 2000
+model gravity 0 0 -10
+block contact jmodel assign mohr
+block contact property stiffness-normal 1e8 stiffness-shear 1e8 friction 30
+block fix range position-z -1 0
+"""
+
+
+def _run(session, text):
+    session.run_items(session.load_text(text))
+    return engine(session.model)
+
+
+def _disp(session, z):
+    b = session.model.blocks
+    r = int(np.argmin(np.abs(b["centroid"][:, 2] - z)))
+    return float(b["disp"][r, 2])
+
+
+def test_save_restore_mid_run_continues_bit_identically(session, tmp_path):
+    """Contacts, sub-contact forces and engine settings travel in the save file: a run saved
+    half-way and restored ends exactly where an uninterrupted run ends."""
+    deck = STACK3 + "block mechanical damping none\nblock initialize velocity-x 0.01 range position-z 1 2\n"
+    _run(session, deck + "model cycle 300\n")
+    whole = session.model.blocks["centroid"].copy()
+    _run(session, deck + f"model cycle 150\nmodel save '{tmp_path / 'half.d3s'}'\n")
+    half_sc = engine(session.model).subcontacts["fs"].copy()
+    assert np.abs(half_sc).max() > 0
+    _run(session, f"model new\nmodel restore '{tmp_path / 'half.d3s'}'\n")
+    e = engine(session.model)
+    assert np.array_equal(e.subcontacts["fs"], half_sc)
+    assert session.model.step == 150
+    _run(session, "model cycle 150\n")
+    assert np.array_equal(session.model.blocks["centroid"], whole)
+
+
+def test_contact_property_range_selects_contacts_by_position(session):
+    """Joint 1 (z = 0) stiff, joint 2 (z = 1) soft: closures follow each joint's kn."""
+    _run(session, STACK3 + "block contact property stiffness-normal 4e8 range position-z -0.01 0.01\n"
+                           "model solve ratio 1e-8\n")
+    e = engine(session.model)
+    c = e.contacts
+    kn = c["prop"][:, 0]
+    z = c["pos"][:, 2]
+    assert kn[np.abs(z) < 0.01].tolist() == [4e8] and kn[np.abs(z - 1) < 0.01].tolist() == [1e8]
+    w = 2000 * 10.0          # weight of one cube [N]
+    # joint 1 carries 2 w at kn 4e8, joint 2 carries w at kn 1e8 (area 1 m²)
+    assert _disp(session, 0.5) == pytest.approx(-2 * w / 4e8, rel=2e-3)
+    assert _disp(session, 1.5) - _disp(session, 0.5) == pytest.approx(-w / 1e8, rel=2e-3)
+
+
+def test_contact_group_then_range_group(session):
+    _run(session, STACK3 + "block contact group 'top' range position-z 0.99 1.01\n"
+                           "block contact property friction 10 range group 'top'\n")
+    e = engine(session.model)
+    c = e.contacts
+    names = [session.model.groups.name(g) if g >= 0 else None for g in c["group"][:, 0]]
+    top = np.array([n == "top" for n in names])
+    assert top.sum() == 1 and abs(c["pos"][top][0, 2] - 1.0) < 1e-6
+    assert np.degrees(np.arctan(c["prop"][top, 2]))[0] == pytest.approx(10.0)
+    assert np.degrees(np.arctan(c["prop"][~top, 2]))[0] == pytest.approx(30.0)
+
+
+def test_group_intersection_selects_contacts_between_two_block_groups(session):
+    _run(session, STACK3 + "block group 'base' range position-z -1 0\nblock group 'mid' range position-z 0 1\n"
+                           "block contact property cohesion 5e4 range group-intersection 'base' 'mid'\n")
+    c = engine(session.model).contacts
+    coh = c["prop"][:, 3]
+    assert sorted(coh.tolist()) == [0.0, 5e4] and abs(c["pos"][coh > 0][0, 2]) < 1e-6
+
+
+def test_contact_reset_displacement_keeps_forces(session):
+    _run(session, STACK3 + "block apply force-x 5e3 range position-z 1 2\nmodel cycle 200\n")
+    ss = engine(session.model).subcontacts
+    fn = ss["fn"].copy()
+    assert np.abs(ss["us"]).max() > 0
+    _run(session, "block contact reset displacement\n")
+    assert np.abs(ss["us"]).max() == 0 and np.array_equal(ss["fn"], fn)
+
+
+def test_property_of_a_model_without_it_is_an_error(session):
+    from dec3d.errors import Dec3dError
+
+    with pytest.raises(Dec3dError, match="no property 'friction'"):
+        _run(session, SPRING + "block contact property friction 30\n")
+
+
+@pytest.mark.parametrize("damping", ["local", "combined", "global"])
+def test_every_static_damping_settles_at_mg_over_k(session, damping):
+    _run(session, SPRING + f"block mechanical damping {damping}\nmodel solve ratio 1e-6\n")
+    assert _disp(session, 0.5) == pytest.approx(-2.000e-3, rel=2e-3)
+
+
+def test_density_scaling_settles_blocks_of_very_different_mass(session):
+    """A 0.1 m cube on a 1 m cube on the base: the damped run with density scaling reaches
+    the static closures w/kn of each joint."""
+    deck = """model new
+block create brick 0 1 0 1 -1 0
+block create brick 0 1 0 1 0 1
+block create brick 0.4 0.5 0.4 0.5 1 1.1
+block property density 2000
+model gravity 0 0 -10
+block contact jmodel assign elastic
+block contact property stiffness-normal 1e8 stiffness-shear 1e8
+block fix range position-z -1 0
+model solve ratio 1e-7
+"""
+    e = _run(session, deck)
+    assert e.mass_scaling()
+    w_small, w_big = 2000 * 10 * 1e-3, 2000 * 10.0
+    assert _disp(session, 0.5) == pytest.approx(-(w_big + w_small) / 1e8, rel=3e-3)
+    assert _disp(session, 1.05) - _disp(session, 0.5) == pytest.approx(-w_small / (1e8 * 0.01), rel=3e-3)
+
+
+def test_joined_blocks_move_as_one_and_rest_on_their_base(session):
+    _run(session, STACK3 + "block join range position-z 0 2\nmodel solve ratio 1e-7\n")
+    b = session.model.blocks
+    lo, hi = _disp(session, 0.5), _disp(session, 1.5)
+    assert lo == pytest.approx(hi, abs=1e-12)                     # rigidly together
+    assert lo == pytest.approx(-2 * 2000 * 10 / 1e8, rel=3e-3)   # on the base joint only
+    assert np.abs(b["spin"]).max() < 1e-9
