@@ -9,8 +9,7 @@ numba kernels and make the first contact detection), then S timed steps.
 
 The scene is built and run only through the public command API (`dec3d.Session().command`),
 so the script keeps working while the engine behind the commands changes.  The contact and
-sub-contact counts are read, if available, from the model's rigid engine (read-only,
-guarded: "n/a" when the engine does not expose them).  Each (n, repeat) runs in a fresh
+sub-contact counts are the rows of the model's ``contacts`` and ``subcontacts`` stores.  Each (n, repeat) runs in a fresh
 process (peak RSS from resource.getrusage is per process); the median is printed.
 
     python bench/rigid_bench.py [--n 10 20] [--steps 100] [--repeat 3] [--jmodel mohr|elastic]
@@ -51,14 +50,9 @@ def deck(n: int, jmodel: str) -> str:
 
 
 def _counts(session) -> tuple:
-    """(contacts, sub-contacts) if the engine exposes them, else (None, None)."""
-    try:
-        e = getattr(session.model, "rigid_engine", None)
-        nc = len(e.ca)
-        nsc = len(e.sc["contact"])
-        return int(nc), int(nsc)
-    except Exception:      # the engine is being rewritten: its fields are not an API
-        return None, None
+    """(contacts, sub-contacts): the rows of the model's contact stores."""
+    stores = session.model.stores
+    return stores["contacts"].n, stores["subcontacts"].n
 
 
 def one(n: int, steps: int, jmodel: str) -> dict:

@@ -184,3 +184,16 @@ def envelopes(vpos, bvstart, bvcount, active, pad, lo, hi):
         for d in range(3):
             lo[b, d] -= pad
             hi[b, d] += pad
+
+
+@njit(cache=True)
+def blocks_moved(vpos, snap, bvstart, bvcount, tol, out):
+    """out[b] = True where a vertex of block b is more than ``tol`` [m] (in any coordinate)
+    from its position in ``snap`` (nv, 3)."""
+    for b in range(bvstart.shape[0]):
+        hit = False
+        for v in range(bvstart[b], bvstart[b] + bvcount[b]):
+            for d in range(3):
+                if abs(vpos[v, d] - snap[v, d]) > tol:
+                    hit = True
+        out[b] = hit

@@ -31,7 +31,7 @@ import numpy as np
 
 from dec3d.errors import Dec3dError
 from dec3d.kernels.cellmap import cell_grid, cell_pairs, outside_grid
-from dec3d.kernels.contactmap import carry_over, cp_batch, envelopes, match_sorted
+from dec3d.kernels.contactmap import blocks_moved, carry_over, cp_batch, envelopes, match_sorted
 from dec3d.kernels.cycle import run_steps
 from dec3d.kernels.jointlaw import NPROP, P_KN, P_KS
 from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST,
@@ -95,6 +95,11 @@ MECH_DEFAULTS = {
 }
 
 
+#: a block is looked at again at a detection when a vertex has moved more than QUIET × CTOL
+#: since it was last looked at (dec3d's choice; areas and planes change by ~QUIET·CTOL/size)
+QUIET = 0.1
+
+
 class RunError(Dec3dError):
     """The run became unstable (NaN or runaway velocity)."""
 
@@ -148,11 +153,12 @@ class RigidEngine:
         #: a hook with an ``interval`` attribute gets a batch boundary at every multiple of it
         self.step_hooks: list = []
         self.timings = {"detect": 0.0, "search": 0.0, "subcontacts": 0.0, "cycle": 0.0, "hooks": 0.0}
-        self._grid = None
-        self._cand = None             # candidate pairs (rows A, rows B) from the last map
-        self._vpos_map = None         # vertex positions at the last map
-        self._signature = None
+        self._cand = None             # candidate pairs (rows A, rows B) of the last cell map
         contact_stores(model)
+        v = model.vertices
+        for key in ("map_pos", "look_pos"):
+            if key not in v:
+                v.add_field(key, Field((3,), _F, 0.0))
 
     # ------------------------------------------------------------ model-backed state
     @property
@@ -221,41 +227,73 @@ class RigidEngine:
         return s["inertia"] == "full" or (s["inertia"] == "auto" and s["damping"] == "none")
 
     # ------------------------------------------------------------ detection
+    # Detection state that must survive save/restore (so a restored run continues exactly):
+    # vertex fields ``map_pos`` (positions at the last cell map) and ``look_pos`` (when the
+    # block was last looked at), settings ``grid`` (the cell space) and ``signature`` (the
+    # blocks at the last detection). The candidate pairs are rebuilt from ``map_pos``.
     def _geometry_signature(self):
         m = self.model
         b = m.blocks
-        return (b.n, m.vertices.n, m.faces.n, int(b["id"].sum()), int(b["hidden"].sum()))
+        return [b.n, m.vertices.n, m.faces.n, int(b["id"].sum()), int(b["hidden"].sum())]
 
-    def _search(self, ctol: float, force: bool) -> tuple[np.ndarray, np.ndarray]:
-        """Candidate pairs (rows, A = lower block id), remapped only when needed."""
-        m = self.model
-        b = m.blocks
-        vpos = m.vertices["pos"]
-        moved = math.inf
-        if self._vpos_map is not None and self._vpos_map.shape == vpos.shape and not force:
-            moved = float(np.abs(vpos - self._vpos_map).max()) if len(vpos) else 0.0
-        if self._cand is not None and moved <= 0.5 * ctol:
-            return self._cand
-        t0 = _time.perf_counter()
+    @property
+    def _signature(self):
+        return self.settings().get("signature")
+
+    @_signature.setter
+    def _signature(self, sig):
+        self.settings()["signature"] = sig
+
+    def _pairs(self, pos, ctol, grid):
+        """Candidate pairs of blocks whose envelopes (vertex positions ``pos``) enlarged by
+        CTOL overlap, by cell mapping; rows with A the lower block id, sorted by ids."""
+        b = self.model.blocks
         active = ~b["hidden"] & (b["vert_count"] > 0)
         lo = np.empty((b.n, 3))
         hi = np.empty((b.n, 3))
-        envelopes(vpos, b["vert_start"], b["vert_count"], active, ctol, lo, hi)
-        if self._grid is None or force or outside_grid(lo, hi, active, *self._grid):
-            self._grid = cell_grid(lo, hi, active, 0.1)
-        pairs = cell_pairs(lo, hi, active, *self._grid)
+        envelopes(pos, b["vert_start"], b["vert_count"], active, ctol, lo, hi)
+        if grid is None or outside_grid(lo, hi, active, *grid):
+            grid = cell_grid(lo, hi, active, 0.1)
+        pairs = cell_pairs(lo, hi, active, *grid)
         ida, idb = b["id"][pairs[:, 0]], b["id"][pairs[:, 1]]
         swap = ida > idb
         ra = np.where(swap, pairs[:, 1], pairs[:, 0]).astype(_I)
         rb = np.where(swap, pairs[:, 0], pairs[:, 1]).astype(_I)
         order = np.lexsort((b["id"][rb], b["id"][ra]))
-        self._cand = (np.ascontiguousarray(ra[order]), np.ascontiguousarray(rb[order]))
-        self._vpos_map = vpos.copy()
+        return (np.ascontiguousarray(ra[order]), np.ascontiguousarray(rb[order])), grid
+
+    def _search(self, ctol: float, force: bool) -> tuple[tuple[np.ndarray, np.ndarray], bool]:
+        """(candidate pairs, whether the cell space was mapped anew), remapped only when
+        a vertex has moved more than CTOL/2 since the last map, or when forced."""
+        m = self.model
+        s = self.settings()
+        v = m.vertices
+        vpos, mpos = v["pos"], v["map_pos"]
+        have = s.get("grid") is not None and len(vpos) > 0
+        if have and not force and float(np.abs(vpos - mpos).max()) <= 0.5 * ctol:
+            if self._cand is None:       # after a restore: the same pairs from the saved map
+                g = s["grid"]
+                self._cand, _ = self._pairs(mpos, ctol, (np.array(g[0]), float(g[1]), np.array(g[2], _I)))
+            return self._cand, False
+        t0 = _time.perf_counter()
+        g = s.get("grid")
+        grid = None if (g is None or force) else (np.array(g[0]), float(g[1]), np.array(g[2], _I))
+        self._cand, grid = self._pairs(vpos, ctol, grid)
+        s["grid"] = [[float(x) for x in grid[0]], float(grid[1]), [int(x) for x in grid[2]]]
+        mpos[...] = vpos
         self.timings["search"] += _time.perf_counter() - t0
-        return self._cand
+        return self._cand, True
 
     def detect(self, force_search: bool = False) -> None:
-        """Find the contacts and their sub-contacts again, keeping the force history."""
+        """Find the contacts and their sub-contacts again, keeping the force history.
+
+        Incremental: a candidate pair whose two blocks have each moved less than
+        ``QUIET`` × CTOL (largest vertex displacement) since they were last looked at keeps
+        its contact and sub-contacts as they are (their points still follow Eq. 11 every
+        step); every other pair gets a new common plane and new sub-contacts. After a
+        remap of the cell space, a change of the blocks, or with ``force_search``, every
+        pair is looked at.
+        """
         t0 = _time.perf_counter()
         m = self.model
         b, f, fv = m.blocks, m.faces, m.face_vertices
@@ -264,66 +302,119 @@ class RigidEngine:
         changed = sig != self._signature
         self._signature = sig
         ctol = self.tolerance()
-        ra, rb = self._search(ctol, force_search or changed)
+        vpos = m.vertices["pos"]
+        look = m.vertices["look_pos"]
+        (ra, rb), remapped = self._search(ctol, force_search or changed)
+        full = force_search or changed or remapped
+        if full:
+            moved = np.ones(b.n, bool)
+        else:
+            moved = np.zeros(b.n, bool)
+            blocks_moved(vpos, look, b["vert_start"], b["vert_count"], QUIET * ctol, moved)
         ids = b["id"]
         prev = match_sorted(cs["ida"], cs["idb"], ids[ra], ids[rb])
-        k = len(ra)
+        need = np.flatnonzero(moved[ra] | moved[rb])
+        k = len(need)
         nn = np.empty((k, 3))
         cc = np.empty((k, 3))
         gap = np.empty(k)
         ctype = np.empty(k, _I)
-        cp_batch(ra, rb, prev, m.vertices["pos"], b["vert_start"], b["vert_count"], b["centroid"],
+        cp_batch(ra[need], rb[need], prev[need], vpos, b["vert_start"], b["vert_count"], b["centroid"],
                  cs["normal"], cs["pos"], ctol, nn, cc, gap, ctype)
-        keep = np.flatnonzero(ctype > 0)
-        ra, rb, prev = ra[keep], rb[keep], prev[keep]
-        nn, cc, gap, ctype = nn[keep], cc[keep], gap[keep], ctype[keep]
-        nc = len(keep)
+        # the contacts: quiet old contacts as they were, looked-at pairs with gap ≤ CTOL
+        is_new = np.zeros(len(ra), bool)
+        is_new[need[ctype > 0]] = True
+        kept = (prev >= 0) & ~(moved[ra] | moved[rb])
+        rows = np.flatnonzero(kept | is_new)
+        local = np.full(len(ra), -1, _I)
+        local[need] = np.arange(k)
+        fresh = need[ctype > 0]                 # candidate indices of recomputed contacts, in order
+        nc = len(rows)
+        ra_c, rb_c, prev_c = ra[rows], rb[rows], prev[rows]
+        kept_c = kept[rows]
+        lc = local[rows]
+        p_k = prev_c[kept_c]
+        normal = np.empty((nc, 3))
+        cpos = np.empty((nc, 3))
+        cgap = np.empty(nc)
+        ctyp = np.empty(nc, _I)
+        normal[kept_c], cpos[kept_c], cgap[kept_c], ctyp[kept_c] = (cs["normal"][p_k], cs["pos"][p_k],
+                                                                   cs["gap"][p_k], cs["type"][p_k])
+        lf = lc[~kept_c]
+        normal[~kept_c], cpos[~kept_c], cgap[~kept_c], ctyp[~kept_c] = nn[lf], cc[lf], gap[lf], ctype[lf]
         # contact data carried by the pair key, or the defaults for a new contact
         s = self.settings()
-        old = prev >= 0
+        old = prev_c >= 0
         jm = JOINT_MODELS[s["jmodel"]]
         jcode = np.full(nc, jm.code, _I)
         prop = np.tile(default_row(s, jm.code), (nc, 1)) if nc else np.zeros((0, NPROP))
         group = np.full((nc, cs["group"].shape[1]), -1, np.int32)
         own = np.zeros(nc, np.uint8)
-        jcode[old] = cs["jmodel"][prev[old]]
-        own[old] = cs["own_props"][prev[old]]
+        jcode[old] = cs["jmodel"][prev_c[old]]
+        own[old] = cs["own_props"][prev_c[old]]
         keep_row = old & (own == 1)
-        prop[keep_row] = cs["prop"][prev[keep_row]]
+        prop[keep_row] = cs["prop"][prev_c[keep_row]]
         for code in np.unique(jcode[old & (own == 0)]):      # contacts that follow the defaults
             sel = old & (own == 0) & (jcode == code)
             prop[sel] = default_row(s, int(code))
-        group[old] = cs["group"][prev[old]]
-        # sub-contacts
+        group[old] = cs["group"][prev_c[old]]
+        # sub-contacts of the recomputed contacts (zero-area ones carry nothing and are dropped)
         t1 = _time.perf_counter()
-        sc_c, kind, key0, key1, pos, area = _subcontacts(m.vertices["pos"], b, f, fv, ra, rb, nn, cc,
-                                                         ctol, self.point_area())
+        f_ra, f_rb, f_prev = ra[fresh], rb[fresh], prev[fresh]
+        f_n, f_c, f_gap = nn[local[fresh]], cc[local[fresh]], gap[local[fresh]]
+        sc_c, kind, key0, key1, pos, area = _subcontacts(vpos, b, f, fv, f_ra, f_rb, f_n, f_c, ctol,
+                                                         self.point_area())
+        live = area > 0.0
+        if not live.all():
+            sc_c, kind, key0, key1, pos, area = (x[live] for x in (sc_c, kind, key0, key1, pos, area))
         ns = len(sc_c)
         fs = np.empty((ns, 3))
         un = np.empty(ns)
         udil = np.empty(ns)
         us = np.empty((ns, 3))
         state = np.empty(ns, _I)
-        carry_over(prev, sc_c, kind, key0, key1, area, gap, cs["sub_start"], cs["sub_count"], ss["kind"],
+        carry_over(f_prev, sc_c, kind, key0, key1, area, f_gap, cs["sub_start"], cs["sub_count"], ss["kind"],
                    ss["key0"], ss["key1"], ss["area"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"],
-                   cs["normal"], nn, fs, un, udil, us, state)
-        counts = np.bincount(sc_c, minlength=nc).astype(_I) if nc else np.zeros(0, _I)
-        starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(_I) if nc else np.zeros(0, _I)
+                   cs["normal"], f_n, fs, un, udil, us, state)
+        nf = len(fresh)
+        f_count = np.bincount(sc_c, minlength=nf).astype(_I) if nf else np.zeros(0, _I)
+        f_start = (np.cumsum(f_count) - f_count).astype(_I)
+        # gather: kept contacts take their old rows, recomputed ones the new rows
+        fidx = np.full(len(ra), -1, _I)
+        fidx[fresh] = np.arange(nf)
+        fi = fidx[rows]
+        counts = np.empty(nc, _I)
+        base = np.empty(nc, _I)
+        counts[kept_c], base[kept_c] = cs["sub_count"][p_k], cs["sub_start"][p_k]
+        counts[~kept_c], base[~kept_c] = f_count[fi[~kept_c]], ss.n + f_start[fi[~kept_c]]
+        starts = (np.cumsum(counts) - counts).astype(_I)
+        total = int(counts.sum())
+        src = np.repeat(base - starts, counts) + np.arange(total, dtype=_I)
+        owner = np.repeat(np.arange(nc, dtype=_I), counts)
+        pool = {"kind": (ss["kind"], kind), "key0": (ss["key0"], key0), "key1": (ss["key1"], key1),
+                "pos": (ss["pos"], pos), "area": (ss["area"], area), "fn": (ss["fn"], np.zeros(ns)),
+                "fs": (ss["fs"], fs), "un": (ss["un"], un), "udil": (ss["udil"], udil), "us": (ss["us"], us),
+                "state": (ss["state"], state)}
+        sub = {key: np.concatenate(pair)[src] for key, pair in pool.items()}
         self.timings["subcontacts"] += _time.perf_counter() - t1
         # install
         cs.clear()
         cs.append(nc)
-        for key, val in (("ida", ids[ra]), ("idb", ids[rb]), ("a", ra), ("b", rb), ("pos", cc),
-                         ("normal", nn), ("gap", gap), ("type", ctype), ("jmodel", jcode), ("prop", prop), ("own_props", own),
-                         ("sub_start", starts), ("sub_count", counts), ("group", group)):
+        for key, val in (("ida", ids[ra_c]), ("idb", ids[rb_c]), ("a", ra_c), ("b", rb_c), ("pos", cpos),
+                         ("normal", normal), ("gap", cgap), ("type", ctyp), ("jmodel", jcode), ("prop", prop),
+                         ("own_props", own), ("sub_start", starts), ("sub_count", counts), ("group", group)):
             cs[key][...] = val
         ss.clear()
-        ss.append(ns)
-        fn = np.zeros(ns)
-        for key, val in (("contact", sc_c), ("kind", kind), ("key0", key0), ("key1", key1), ("pos", pos),
-                         ("area", area), ("fn", fn), ("fs", fs), ("un", un), ("udil", udil), ("us", us),
-                         ("state", state)):
+        ss.append(total)
+        ss["contact"][...] = owner
+        for key, val in sub.items():
             ss[key][...] = val
+        # the blocks looked at are the new reference for "moved"
+        if full:
+            look[...] = vpos
+        else:
+            sel = moved[m.vertices["block"]]
+            look[sel] = vpos[sel]
         self.timings["detect"] += _time.perf_counter() - t0
 
     def ensure_contacts(self) -> None:
@@ -399,6 +490,9 @@ class RigidEngine:
         inertia = np.einsum("bij,bj,bkj->bik", b["principal_axes"], b["principal_moment"], b["principal_axes"])
         gmass, gcen, _, gprin, gaxes, giscalar = group_properties(gstart, gmember, b["mass"], b["centroid"],
                                                                   inertia, b["inertia_approx"])
+        one = np.diff(gstart) == 1          # a lone block keeps its own axes (no round-off from eigh)
+        lone = gmember[gstart[:-1][one]]
+        gprin[one], gaxes[one] = b["principal_moment"][lone], b["principal_axes"][lone]
         axes0 = gaxes.copy()
         servo = new_servo(ng, ratio=float(s["servo_ratio"]))
         if mode == DAMP_ADAPTIVE and len(s["servo"]) == NSERVO:
