@@ -83,7 +83,7 @@ def derive(d: dict, q: dict[str, float], out: Path) -> float:
     rel = t - t[0]
     sel = (rel >= float(d.get("t0", -math.inf))) & (rel <= float(d.get("t1", math.inf)))
     if sel.sum() < (3 if kind == "curvature" else 2 if kind == "slope" else 1):
-        raise ValueError(f"derive {d['name']}: too few samples in the window")
+        raise ValueError(f"derive {d.get('name', kind)}: too few samples in the window")
     x = _column(rows, d["vs"], path) if "vs" in d else t
     if kind == "slope":
         return float(np.polyfit(x[sel], v[sel], 1)[0])
@@ -91,7 +91,7 @@ def derive(d: dict, q: dict[str, float], out: Path) -> float:
         return float(2.0 * np.polyfit(x[sel], v[sel], 2)[0])
     if kind in ("mean", "max", "min"):
         return float(getattr(np, kind)(v[sel]))
-    raise ValueError(f"derive {d['name']}: unknown kind {kind!r}")
+    raise ValueError(f"derive {d.get('name', kind)}: unknown kind {kind!r}")
 
 
 def _ssdem_quantities(folder: Path, spec: dict) -> dict[str, float]:

@@ -34,3 +34,30 @@ def test_verify_table(tmp_path, capsys):
     out = capsys.readouterr().out
     assert out.count("PASS") == 2 and out.count("FAIL") == 1 and "report" in out
     assert "2 passed, 1 failed" in out
+
+
+def test_derive_from_history_files(tmp_path):
+    """`[[derive]]`: slope (against time or another history), curvature, window extrema, trend and plunge."""
+    import math
+
+    from dec3d.verify import derive
+
+    t = [0.5 + 0.1 * i for i in range(21)]
+    with open(tmp_path / "h.csv", "w") as fh:
+        fh.write("step,time,u (block 1 displacement-x),v (block 1 velocity-x),w (x)\n")
+        for i, ti in enumerate(t):
+            s = ti - t[0]
+            fh.write(f"{i},{ti!r},{1.0 + 2.0 * s + 1.5 * s * s!r},{2.0 + 3.0 * s!r},{-4.0 * s!r}\n")
+    d = {"csv": "h.csv"}
+    assert derive({**d, "kind": "slope", "history": "v"}, {}, tmp_path) == pytest.approx(3.0)
+    assert derive({**d, "kind": "curvature", "history": "u"}, {}, tmp_path) == pytest.approx(3.0)
+    assert derive({**d, "kind": "slope", "history": "w", "vs": "v"}, {}, tmp_path) == pytest.approx(-4.0 / 3.0)
+    assert derive({**d, "kind": "max", "history": "v", "t0": 0.0, "t1": 1.0}, {}, tmp_path) == pytest.approx(5.0)
+    assert derive({**d, "kind": "mean", "history": "v", "t0": 1.0}, {}, tmp_path) == pytest.approx(2.0 + 3.0 * 1.5)
+    q = {"x": math.sin(math.radians(150)), "y": math.cos(math.radians(150)), "z": -1.0}
+    assert derive({"kind": "trend", "of": ["x", "y", "z"]}, q, tmp_path) == pytest.approx(150.0)
+    assert derive({"kind": "plunge", "of": ["x", "y", "z"]}, q, tmp_path) == pytest.approx(45.0)
+    with pytest.raises(KeyError, match="no history 'nope'"):
+        derive({**d, "kind": "slope", "history": "nope"}, {}, tmp_path)
+    with pytest.raises(ValueError, match="too few"):
+        derive({**d, "kind": "slope", "history": "v", "t0": 5.0}, {}, tmp_path)

@@ -75,3 +75,52 @@ def test_undamped_block_frequency(session):
                   "history export 1 file 'z.csv'\n")
     f0 = math.sqrt(10e6 / 2000) / (2 * math.pi)
     assert session.results["z.frequency"] == pytest.approx(f0, rel=0.01)
+
+
+def test_rvelocity_position_and_contact_histories(session):
+    _run(session, "block history name 'pz' position-z block-id 2\nblock history name 'wz' rvelocity-z block-id 2\n"
+                  "block contact history name 'fn' force-normal position 0.5 0.5 0\n"
+                  "block contact history name 'un' displacement-normal position 0.5 0.5 0\n"
+                  "block contact history name 'fs' force-shear position 0.5 0.5 0\n"
+                  "block initialize rvelocity-z 0.25 range id 2\nhistory interval 1\nmodel cycle 30\n"
+                  "history export 'pz' 'wz' 'fn' 'un' 'fs' file 'c.csv'\n")
+    b = session.model.blocks
+    sc = session.model.store("subcontacts")
+    n = len(sc)
+    assert session.results["pz.final"] == b["centroid"][1, 2]
+    assert session.results["wz.final"] == b["spin"][1, 2]
+    assert session.results["fn.final"] == pytest.approx(sc["fn"][:n].sum(), rel=1e-12)
+    assert session.results["fn.max"] > 0
+    assert session.results["un.final"] == pytest.approx(sc["un"][:n].mean(), rel=1e-12)
+    assert session.results["fs.final"] == pytest.approx(np.linalg.norm(sc["fs"][:n].sum(axis=0)), rel=1e-12)
+
+
+def test_contact_history_before_any_contact_is_nan_then_follows_the_pair(session):
+    session.run_items(session.load_text(
+        "model new\nblock create brick 0 1 0 1 0 1\nblock create brick 0 1 0 1 2 3\nblock property density 1000\n"
+        "block contact history name 'f' force-normal position 0.5 0.5 1.5\nhistory interval 1\nmodel cycle 3\n"
+        "history export 'f' file 'f.csv'\n"))
+    assert math.isnan(session.results["f.final"])
+
+
+def test_angular_momentum_and_shape_error_of_a_spinning_brick(session):
+    session.run_items(session.load_text(
+        "model new\nblock create brick -0.5 0.5 -1 1 -1.5 1.5\nblock property density 1000\nmodel gravity 0 0 0\n"
+        "block mechanical damping none\nblock mechanical timestep 1e-3\nblock initialize rvelocity-x 1 rvelocity-y 1 rvelocity-z 1\n"
+        "block history name 'L' angular-momentum block-id 1\nblock history name 'Lz' angular-momentum-z block-id 1\n"
+        "block history name 's' shape-error block-id 1\nhistory interval 1\nmodel cycle 1\n"
+        "history export 'L' 'Lz' 's' file 'l.csv'\n"))
+    # L = diag(6500, 5000, 2500) (1, 1, 1) after one step: the brick has turned by 1.7 mrad
+    assert session.results["L.final"] == pytest.approx(math.sqrt(6500**2 + 5000**2 + 2500**2), rel=1e-6)
+    assert session.results["Lz.final"] == pytest.approx(2500, rel=5e-3)
+    assert session.results["s.final"] < 1e-12
+
+
+def test_best_rotation_recovers_a_rotation():
+    from dec3d.physics.history import best_rotation
+
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=(8, 3))
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    q *= np.sign(np.linalg.det(q))
+    assert np.allclose(best_rotation(a, a @ q.T), q, atol=1e-12)
