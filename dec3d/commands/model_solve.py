@@ -7,16 +7,29 @@ from .registry import command
 from .values import FLAG, Num, P
 
 
+_TIMING = P("timing", FLAG, "print how long each phase of the cycle took (dec3d)", bare=True)
+
+
 def _run(session, call, n, stop=None, max_time=None):
+    e = engine(session.model)
+    if call.args.get("timing"):
+        for k in e.timings:
+            e.timings[k] = 0.0
     try:
-        return engine(session.model).cycle(n, stop, max_time=max_time)
+        done = e.cycle(n, stop, max_time=max_time)
     except RunError as exc:
         raise CommandError(str(exc), call.location)
+    if call.args.get("timing"):
+        session.write(f"{done} steps, Δt = {e.dt:.4g} s\n{e.timing_report()}\n")
+    return done
 
 
 @command("model cycle", positional=[P("n", Num(integer=True, lo=0), "number of steps", required=True)],
+         keywords=[_TIMING],
          doc="Take n mechanical steps (contact detection every `model update-interval` steps).",
-         examples=["model cycle 1000"])
+         details="`timing` prints the time spent in each phase: detection (of which neighbour search and "
+                 "sub-contacts), the cycle kernel, and history sampling.",
+         examples=["model cycle 1000", "model cycle 1000 timing"])
 def model_cycle(session, call):
     _run(session, call, int(call.args["n"]))
 
@@ -30,7 +43,7 @@ def model_cycle(session, call):
                    P("time", Num(lo=0, lo_open=True), "stop at this total time", units="s"),
                    P("cycles", Num(integer=True, lo=1), "stop after this many steps"),
                    P("and", FLAG, "every given limit must be met", bare=True),
-                   P("or", FLAG, "any given limit is enough (default)", bare=True)],
+                   P("or", FLAG, "any given limit is enough (default)", bare=True), _TIMING],
          doc="Cycle until the limits are met (default: ratio 1e-5, at most 10^6 steps).",
          details="ratio is the largest unbalanced force over the mean of the gravity and contact forces "
                  "acting on the moving blocks.",

@@ -566,12 +566,13 @@ class RigidEngine:
         return done
 
     def timing_report(self) -> str:
-        tot = sum(v for k, v in self.timings.items() if k in ("detect", "cycle", "hooks")) or 1e-30
-        lines = ["phase          seconds   share"]
-        for k in ("detect", "search", "subcontacts", "cycle", "hooks"):
-            v = self.timings[k]
-            lines.append(f"{k:<13}{v:9.3f}  {100 * v / tot:5.1f} %")
-        return "\n".join(lines)
+        """The time spent per phase since the counters were last zeroed (seconds, share)."""
+        t = self.timings
+        tot = (t["detect"] + t["cycle"] + t["hooks"]) or 1e-30
+        rows = [("detection", t["detect"]), ("  neighbour search", t["search"]),
+                ("  sub-contacts", t["subcontacts"]), ("cycle kernel", t["cycle"]), ("histories", t["hooks"])]
+        return "\n".join([f"{'phase':<20}{'seconds':>9}{'share':>8}"] +
+                         [f"{k:<20}{v:9.3f}{100 * v / tot:7.1f}%" for k, v in rows])
 
 
 class _Progress:

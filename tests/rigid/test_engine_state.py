@@ -140,3 +140,11 @@ def test_joined_blocks_move_as_one_and_rest_on_their_base(session):
     assert lo == pytest.approx(hi, abs=1e-12)                     # rigidly together
     assert lo == pytest.approx(-2 * 2000 * 10 / 1e8, rel=3e-3)   # on the base joint only
     assert np.abs(b["spin"]).max() < 1e-9
+
+
+def test_cycle_timing_prints_the_phase_breakdown(session):
+    _run(session, SPRING + "model cycle 50 timing\n")
+    text = session.output.getvalue()
+    assert "50 steps" in text
+    for phase in ("detection", "neighbour search", "sub-contacts", "cycle kernel", "histories"):
+        assert phase in text
