@@ -37,6 +37,7 @@ from dec3d.kernels.jointlaw import NPROP, P_KN, P_KS
 from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST,
                                   block_timestep, group_properties, inertial_masses, new_servo)
 from dec3d.kernels.subgeom import subcontacts_batch
+from dec3d.io.vtk import periodic_vtk
 from dec3d.model.groups import group_field
 from dec3d.model.store import Field, Store
 
@@ -86,7 +87,6 @@ MECH_DEFAULTS = {
     "timestep": None,          # fixed Δt [s] or None
     "jmodel": "mohr",          # model of contacts created from now on
     "props": {},               # their properties (user units)
-    "kt": 0.0,                 # K_T of Eq. (12) [m]
     "mass_scale": "auto",      # on | off | auto (on while damping is not none: static runs)
     "inertia": "auto",         # full | scalar | auto (full, with Euler's equations, when damping is none)
     "servo": [],               # adaptive global damping state (kernels.motion, first NSERVO entries)
@@ -152,6 +152,7 @@ class RigidEngine:
         #: callables hook(engine) run after every batch of steps (histories register here);
         #: a hook with an ``interval`` attribute gets a batch boundary at every multiple of it
         self.step_hooks: list = []
+        #: seconds per phase; "hooks" covers histories and periodic VTK snapshots
         self.timings = {"detect": 0.0, "search": 0.0, "subcontacts": 0.0, "cycle": 0.0, "hooks": 0.0}
         self._cand = None             # candidate pairs (rows A, rows B) of the last cell map
         contact_stores(model)
@@ -520,6 +521,9 @@ class RigidEngine:
                     hi = int(getattr(h, "interval", 0) or 0)
                     if hi > 0:
                         k = min(k, hi - m.step % hi)
+                vtk = m.outputs.get("vtk")
+                if vtk and vtk["interval"] > 0:
+                    k = max(1, min(k, vtk["last_step"] + vtk["interval"] - m.step))
                 if max_time is not None:
                     left = int(math.ceil((max_time - m.time) / dt - 1e-9))
                     if left <= 0:
@@ -548,6 +552,7 @@ class RigidEngine:
                 t0 = _time.perf_counter()
                 for hook in self.step_hooks:
                     hook(self)
+                periodic_vtk(m)
                 self.timings["hooks"] += _time.perf_counter() - t0
                 progress.update(done)
                 if stop is not None and stop(self):
@@ -570,7 +575,7 @@ class RigidEngine:
         t = self.timings
         tot = (t["detect"] + t["cycle"] + t["hooks"]) or 1e-30
         rows = [("detection", t["detect"]), ("  neighbour search", t["search"]),
-                ("  sub-contacts", t["subcontacts"]), ("cycle kernel", t["cycle"]), ("histories", t["hooks"])]
+                ("  sub-contacts", t["subcontacts"]), ("cycle kernel", t["cycle"]), ("histories, VTK", t["hooks"])]
         return "\n".join([f"{'phase':<20}{'seconds':>9}{'share':>8}"] +
                          [f"{k:<20}{v:9.3f}{100 * v / tot:7.1f}%" for k, v in rows])
 

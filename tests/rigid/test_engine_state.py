@@ -148,3 +148,15 @@ def test_cycle_timing_prints_the_phase_breakdown(session):
     assert "50 steps" in text
     for phase in ("detection", "neighbour search", "sub-contacts", "cycle kernel", "histories"):
         assert phase in text
+
+
+def test_block_vtk_interval_writes_snapshots_while_cycling(session, tmp_path):
+    import pyvista as pv
+
+    _run(session, SPRING + f"block vtk filename '{tmp_path / 'snap'}' interval 20\nmodel cycle 100\n")
+    files = sorted(tmp_path.glob("snap_*.vtu"))
+    assert len(files) == 6                                      # step 0, then 20, 40, 60, 80, 100
+    pvd = (tmp_path / "snap.pvd").read_text()
+    assert pvd.count("<DataSet") == 6
+    last = pv.read(files[-1])
+    assert np.isclose(last.points[:, 2].max(), 1.0 + session.model.blocks["disp"][1, 2], atol=1e-12)
