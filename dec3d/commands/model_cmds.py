@@ -37,6 +37,9 @@ def model_configure(session, call):
 @command("model large-strain", positional=[P("mode", ONOFF, "on: update geometry as blocks move; off: small strain",
                                               required=True)],
          doc="Switch large-strain mode (geometry updated and new contacts detected as blocks move).",
+         details="Rigid blocks in dec3d always move in large strain: their vertices, contacts and sub-contacts "
+                 "are updated as they move whatever this setting says. It is kept in the model for deformable "
+                 "blocks (not implemented yet).",
          examples=["model large-strain on", "model large-strain off"])
 def model_large_strain(session, call):
     session.model.settings.large_strain = call.args["mode"]
