@@ -42,14 +42,15 @@ def match_sorted(old0, old1, new0, new1):
 
 
 @njit(cache=True)
-def cp_batch(ra, rb, prev, vpos, bvstart, bvcount, centroid, old_n, old_c, ctol,
+def cp_batch(ra, rb, prev, vpos, bvstart, bvcount, centroid, old_n, old_c, reach,
              out_n, out_c, out_gap, out_type):
     """Common plane of every candidate pair (rows ra[i], rb[i]; A → B).
 
     prev (k,) int64: row of the old contact of the pair or -1 (new pairs start from the
     line of centroids, Eq. 5; old ones from their normal and reference point, fast path).
     vpos (nv, 3) m; bvstart/bvcount (nb,) vertex ranges; centroid (nb, 3) m;
-    old_n/old_c (nold, 3) previous normals and reference points.
+    old_n/old_c (nold, 3) previous normals and reference points; reach (k,) [m]: the pair is
+    a contact when its gap is at most this (CTOL, plus the blocks' step motion when fast).
     Writes out_n/out_c (k, 3), out_gap (k,) m, out_type (k,) contact type (CT_*, 0 if apart).
     """
     n0 = np.empty(3)
@@ -71,12 +72,12 @@ def cp_batch(ra, rb, prev, vpos, bvstart, bvcount, centroid, old_n, old_c, ctol,
                 cc[d] = 0.5 * (centroid[a, d] + centroid[b, d])
             if n0[0] == 0.0 and n0[1] == 0.0 and n0[2] == 0.0:
                 n0[2] = 1.0
-        gap, na, nb, _ = common_plane(va, vb, n0, ctol, p >= 0, nn, cc)
+        gap, na, nb, _ = common_plane(va, vb, n0, reach[i], p >= 0, nn, cc)
         for d in range(3):
             out_n[i, d] = nn[d]
             out_c[i, d] = cc[d]
         out_gap[i] = gap
-        out_type[i] = contact_type(na, nb) if gap <= ctol else 0
+        out_type[i] = contact_type(na, nb) if gap <= reach[i] else 0
 
 
 @njit(cache=True)

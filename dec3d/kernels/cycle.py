@@ -50,16 +50,23 @@ def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
               mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
               ca, cb, cn, cc, cown, cmodel, cprop,
               sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
-              vmax, out):
+              vmax, out, radius, acc, trigger, motion):
     """Take up to ``nsteps`` steps of Δt = dt [s]; arrays as in ``subcontact_forces`` and
     ``rigid_motion_groups`` (cc (nc, 3) contact reference points, cown (nc,) = arange(nc)).
 
     out (4,): as ``rigid_motion_groups`` fills it, for the last step.
+    Motion bound for contact detection: each block's step motion |v| Δt + |ω| Δt r (radius
+    (nb,) m: largest centroid-to-vertex distance) is added to acc (nb,) [m]; the batch ends
+    after the step in which some acc exceeds ``trigger`` [m] (the host then detects again).
+    motion (2,): [0] the largest step motion of any block [m] (kept across calls: max),
+    [1] 1.0 if the batch ended on the trigger, 2.0 if a block moved farther than its radius
+    in one step (then returned as unstable: it can pass through other blocks unseen).
     Returns (steps done, first unstable block row or −1). An unstable step is not finished:
     the caller reports it and the arrays hold the state at that step.
     """
     done = 0
     bad = -1
+    motion[1] = 0.0
     for _ in range(nsteps):
         subcontact_forces(dt, centroid, vel, spin, force, moment, ca, cb, cn, cmodel, cprop,
                           sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state)
@@ -73,4 +80,22 @@ def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
             break
         _move_points(dt, ca, cb, cown, cc, centroid, vel, spin)
         _move_points(dt, ca, cb, sc_contact, sc_pos, centroid, vel, spin)
+        hit = False
+        for k in range(gmember.shape[0]):
+            b = gmember[k]
+            d = dt * (math.sqrt(vel[b, 0] ** 2 + vel[b, 1] ** 2 + vel[b, 2] ** 2)
+                      + radius[b] * math.sqrt(spin[b, 0] ** 2 + spin[b, 1] ** 2 + spin[b, 2] ** 2))
+            if d > motion[0]:
+                motion[0] = d
+            if d > radius[b] and bad < 0:
+                bad = b                 # farther than its own size in one step: contacts are lost
+            acc[b] += d
+            if acc[b] > trigger:
+                hit = True
+        if bad >= 0:
+            motion[1] = 2.0
+            break
+        if hit:
+            motion[1] = 1.0
+            break
     return done, bad

@@ -153,6 +153,8 @@ class RigidEngine:
         #: a hook with an ``interval`` attribute gets a batch boundary at every multiple of it
         self.step_hooks: list = []
         #: seconds per phase; "hooks" covers histories and periodic VTK snapshots
+        #: messages for the user from the last run (the command layer prints and clears them)
+        self.notices: list[str] = []
         self.timings = {"detect": 0.0, "search": 0.0, "subcontacts": 0.0, "cycle": 0.0, "hooks": 0.0}
         self._cand = None             # candidate pairs (rows A, rows B) of the last cell map
         contact_stores(model)
@@ -160,6 +162,8 @@ class RigidEngine:
         for key in ("map_pos", "look_pos"):
             if key not in v:
                 v.add_field(key, Field((3,), _F, 0.0))
+        if "map_reach" not in model.blocks:
+            model.blocks.add_field("map_reach", Field((), _F, 0.0))
 
     # ------------------------------------------------------------ model-backed state
     @property
@@ -245,14 +249,29 @@ class RigidEngine:
     def _signature(self, sig):
         self.settings()["signature"] = sig
 
+    def _step_motion(self) -> np.ndarray:
+        """Per block, how far its vertices can move in one step at the current velocities
+        (|v| Δt + |ω| Δt r, r the largest centroid-to-vertex distance) [m]; 0 before a run."""
+        m = self.model
+        b, v = m.blocks, m.vertices
+        if not self.dt or b.n == 0:
+            return np.zeros(b.n)
+        r = np.zeros(b.n)
+        if v.n:
+            np.maximum.at(r, v["block"], np.linalg.norm(v["pos"] - b["centroid"][v["block"]], axis=1))
+        return self.dt * (np.linalg.norm(b["velocity"], axis=1) + r * np.linalg.norm(b["spin"], axis=1))
+
     def _pairs(self, pos, ctol, grid):
         """Candidate pairs of blocks whose envelopes (vertex positions ``pos``) enlarged by
-        CTOL overlap, by cell mapping; rows with A the lower block id, sorted by ids."""
+        CTOL and by their step motion at the map (block field ``map_reach``) overlap, by cell
+        mapping; rows with A the lower block id, sorted by ids."""
         b = self.model.blocks
         active = ~b["hidden"] & (b["vert_count"] > 0)
         lo = np.empty((b.n, 3))
         hi = np.empty((b.n, 3))
         envelopes(pos, b["vert_start"], b["vert_count"], active, ctol, lo, hi)
+        lo -= b["map_reach"][:, None]
+        hi += b["map_reach"][:, None]
         if grid is None or outside_grid(lo, hi, active, *grid):
             grid = cell_grid(lo, hi, active, 0.1)
         pairs = cell_pairs(lo, hi, active, *grid)
@@ -279,6 +298,7 @@ class RigidEngine:
         t0 = _time.perf_counter()
         g = s.get("grid")
         grid = None if (g is None or force) else (np.array(g[0]), float(g[1]), np.array(g[2], _I))
+        m.blocks["map_reach"][...] = self._step_motion()
         self._cand, grid = self._pairs(vpos, ctol, grid)
         s["grid"] = [[float(x) for x in grid[0]], float(grid[1]), [int(x) for x in grid[2]]]
         mpos[...] = vpos
@@ -320,8 +340,12 @@ class RigidEngine:
         cc = np.empty((k, 3))
         gap = np.empty(k)
         ctype = np.empty(k, _I)
+        # a pair is a contact when its gap is at most CTOL plus what its blocks can close in
+        # one step: fast blocks get their contact (still open) before they meet
+        step = self._step_motion()
+        reach = ctol + step[ra[need]] + step[rb[need]]
         cp_batch(ra[need], rb[need], prev[need], vpos, b["vert_start"], b["vert_count"], b["centroid"],
-                 cs["normal"], cs["pos"], ctol, nn, cc, gap, ctype)
+                 cs["normal"], cs["pos"], reach, nn, cc, gap, ctype)
         # the contacts: quiet old contacts as they were, looked-at pairs with gap ≤ CTOL
         is_new = np.zeros(len(ra), bool)
         is_new[need[ctype > 0]] = True
@@ -510,10 +534,22 @@ class RigidEngine:
             self.detect()
         dt, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt_fixed)
         self.dt = dt
+        # detection also runs as soon as a block has moved CTOL/2 since the last one, so
+        # that two blocks approaching each other cannot close more than CTOL unseen
+        vpos0 = m.vertices["pos"]
+        arm = np.linalg.norm(vpos0 - b["centroid"][m.vertices["block"]], axis=1) if len(vpos0) else np.zeros(0)
+        radius = np.zeros(b.n)
+        np.maximum.at(radius, m.vertices["block"], arm)
+        acc = np.zeros(b.n)
+        motion = np.zeros(2)
+        trigger = 0.5 * self.tolerance()
+        due = False
         try:
             while done < nsteps:
-                if m.step % interval == 0:
+                if m.step % interval == 0 or due:
                     self.detect()
+                    acc[:] = 0.0
+                    due = False
                     if self.mass_scaling():
                         _, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt)
                 k = min(nsteps - done, interval - m.step % interval)
@@ -537,11 +573,17 @@ class RigidEngine:
                                       b["vert_start"], b["vert_count"], m.vertices["pos"], cs["a"], cs["b"],
                                       cs["normal"], cs["pos"], np.arange(cs.n, dtype=_I), cs["jmodel"], cs["prop"],
                                       ss["contact"], ss["pos"], ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"],
-                                      ss["us"], ss["state"], vmax, out)
+                                      ss["us"], ss["state"], vmax, out, radius, acc, trigger, motion)
                 self.timings["cycle"] += _time.perf_counter() - t0
+                due = motion[1] > 0.0
                 m.step += n_ok
                 m.time += n_ok * dt
                 done += n_ok
+                if bad >= 0 and motion[1] == 2.0:
+                    raise RunError(f"the run became unstable at step {m.step}: block {int(b['id'][bad])} moved "
+                                   f"farther than its own size in one step (speed "
+                                   f"{np.linalg.norm(b['velocity'][bad]):.3g} m/s, time step {dt:.3g} s): "
+                                   "it can pass through other blocks unseen")
                 if bad >= 0:
                     raise RunError(f"the run became unstable at step {m.step}: block {int(b['id'][bad])} "
                                    f"reached velocity {np.abs(b['velocity'][bad]).max():.3g} m/s "

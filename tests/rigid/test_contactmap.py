@@ -95,7 +95,8 @@ def test_cp_batch_equals_common_plane_pair_by_pair(session):
     k = cs.n
     nn, cc, gap, ct = np.empty((k, 3)), np.empty((k, 3)), np.empty(k), np.empty(k, np.int64)
     vp, vs, vc = m.vertices["pos"], b["vert_start"], b["vert_count"]
-    cp_batch(ra, rb, prev, vp, vs, vc, b["centroid"], cs["normal"], cs["pos"], e.tolerance(), nn, cc, gap, ct)
+    reach = np.full(k, e.tolerance())
+    cp_batch(ra, rb, prev, vp, vs, vc, b["centroid"], cs["normal"], cs["pos"], reach, nn, cc, gap, ct)
     for i in range(k):
         a, bb = ra[i], rb[i]
         if prev[i] >= 0:
@@ -147,7 +148,8 @@ def test_run_steps_equals_the_kernels_step_by_step(session):
     gcen, gax = put(s0)
     out = np.zeros(4)
     done, bad = run_steps(7, dt, g, 1, 0.8, new_servo(len(gm)), False, *common(gcen, gax), cs["a"], cs["b"],
-                          cs["normal"], cs["pos"], own, cs["jmodel"], cs["prop"], *sc(), 1e6, out)
+                          cs["normal"], cs["pos"], own, cs["jmodel"], cs["prop"], *sc(), 1e6, out,
+                          np.ones(b.n), np.zeros(b.n), 1e9, np.zeros(2))
     assert (done, bad) == (7, -1)
     fast = state()
     gcen, gax = put(s0)

@@ -30,8 +30,11 @@ def test_block_on_spring_settles_at_mg_over_k(session):
 
 
 def test_blow_up_names_step_and_block(session):
+    """The block sits between the fixed base and a fixed lid, so it cannot fly off: with a
+    time step far above Eq. (87) its oscillation grows until the run stops."""
     with pytest.raises(Dec3dError, match=r"unstable at step \d+: block 2"):
-        _run(session, "block contact jmodel assign mohr\nblock contact material-table default property stiffness-normal 1e10 tension 1e30 cohesion 1e30\n"
+        _run(session, "block create brick 0 1 0 1 1 2\nblock property density 2000\nblock fix range position-z 1 2\n"
+                      "block contact jmodel assign mohr\nblock contact material-table default property stiffness-normal 1e10 tension 1e30 cohesion 1e30\n"
                       "block mechanical damping none\nblock mechanical timestep 0.01\nmodel cycle 200\n")
     assert np.isfinite(session.model.vertices["pos"]).all()
 
