@@ -20,3 +20,19 @@ def test_language_example_results(tmp_path):
     assert s.model.settings.gravity == (0.0, 0.0, -9.81)
     assert s.model.settings.title == "Language tour" and s.model.settings.configure == ["dynamic"]
     assert s.variables["rho"] == 2650.0 and "density_of_granite" in s.fish
+
+
+def test_masonry_wall_holds_below_friction_and_slides_above(tmp_path):
+    """The top course holds a push of 0.3 x its weight (tan 35° = 0.70) and slides under 0.9 x."""
+    import numpy as np
+
+    from dec3d.session import run_deck
+
+    run_deck(ROOT / "examples" / "rigid" / "masonry_wall.dat", out_dir=tmp_path)
+    data = np.genfromtxt(tmp_path / "top.csv", delimiter=",", names=True)
+    step, ux = data[data.dtype.names[0]], data[data.dtype.names[-1]]
+    push = step[0] + 2000                                  # the second push starts here
+    held = ux[step <= push]
+    assert np.abs(held).max() < 5e-5                       # elastic only: tens of µm
+    assert ux[-1] > 2e-3 and np.all(np.diff(ux[step > push + 500]) > 0)   # sliding on
+    assert (tmp_path / "wall.pvd").read_text().count("<DataSet") >= 10
