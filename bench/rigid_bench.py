@@ -13,6 +13,7 @@ sub-contact counts are the rows of the model's ``contacts`` and ``subcontacts`` 
 process (peak RSS from resource.getrusage is per process); the median is printed.
 
     python bench/rigid_bench.py [--n 10 20] [--steps 100] [--repeat 3] [--jmodel mohr|elastic]
+                                [--full-detection]
 """
 from __future__ import annotations
 
@@ -55,13 +56,20 @@ def _counts(session) -> tuple:
     return stores["contacts"].n, stores["subcontacts"].n
 
 
-def one(n: int, steps: int, jmodel: str) -> dict:
-    """Build, warm up and time in this process."""
+def one(n: int, steps: int, jmodel: str, full: bool = False) -> dict:
+    """Build, warm up and time in this process. ``full``: every pair is looked at again at
+    every detection (the engine's incremental rule off: the worst case, a model in which
+    every block keeps moving)."""
     import io
     import resource
     import tempfile
 
     import dec3d
+
+    if full:
+        import dec3d.physics.rigid as rigid
+
+        rigid.QUIET = 0.0
 
     with tempfile.TemporaryDirectory() as d:
         s = dec3d.Session(out_dir=d, stdout=io.StringIO())
@@ -101,21 +109,25 @@ def main() -> int:
     ap.add_argument("--steps", type=int, default=100, help="timed steps S")
     ap.add_argument("--repeat", type=int, default=3, help="runs per n (median printed)")
     ap.add_argument("--jmodel", choices=("mohr", "elastic"), default="mohr")
+    ap.add_argument("--full-detection", action="store_true",
+                    help="look at every pair at every detection (no incremental skipping): the worst case")
     ap.add_argument("--child", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
-        print(json.dumps(one(args.child, args.steps, args.jmodel)))
+        print(json.dumps(one(args.child, args.steps, args.jmodel, args.full_detection)))
         return 0
     print(f"machine: {machine()}")
     print(f"scene: n^3 unit cubes on a fixed base, jmodel {args.jmodel}, kn = ks = 1e9 Pa/m, "
-          f"{WARMUP} warm-up + {args.steps} timed steps, median of {args.repeat}")
+          f"{WARMUP} warm-up + {args.steps} timed steps, median of {args.repeat}"
+          + (", full detection" if args.full_detection else ""))
     print(f"{'n':>3} {'blocks':>7} {'contacts':>8} {'subcont':>8} {'build s':>8} {'warmup s':>8} "
           f"{'seconds':>8} {'min..max':>15} {'blk-cyc/s':>10} {'subc-upd/s':>11} {'peak MiB':>9}")
     for n in args.n:
         runs = []
         for _ in range(args.repeat):
             out = subprocess.run([sys.executable, os.path.abspath(__file__), "--child", str(n),
-                                  "--steps", str(args.steps), "--jmodel", args.jmodel],
+                                  "--steps", str(args.steps), "--jmodel", args.jmodel]
+                                 + (["--full-detection"] if args.full_detection else []),
                                  capture_output=True, text=True)
             if out.returncode != 0:
                 sys.stderr.write(out.stderr)
