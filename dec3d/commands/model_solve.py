@@ -19,10 +19,6 @@ def _run(session, call, n, stop=None, max_time=None):
         done = e.cycle(n, stop, max_time=max_time)
     except RunError as exc:
         raise CommandError(str(exc), call.location)
-    finally:
-        for text in e.notices:
-            session.write(f"warning: {text}\n")
-        e.notices.clear()
     if call.args.get("timing"):
         session.write(f"{done} steps, Δt = {e.dt:.4g} s\n{e.timing_report()}\n")
     return done

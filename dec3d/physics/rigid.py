@@ -1,22 +1,28 @@
 """Rigid-block engine: neighbour search, contacts, sub-contacts and the cycle (3DEC theory, Fig. 13).
 
 State lives in the model: contacts and sub-contacts are two stores (``contacts``,
-``subcontacts``, saved and restored with the rest), the engine settings are
-``model.settings.mechanical`` (plain JSON). The ``RigidEngine`` object on the model holds
-only what can be rebuilt: the cell grid, the candidate pairs, the time step, timings.
+``subcontacts``, saved and restored with the rest), the engine settings and detection
+bookkeeping are ``model.settings.mechanical`` (plain JSON) and a few vertex/block fields.
+The ``RigidEngine`` object on the model holds only what can be rebuilt: the candidate
+pairs, the time step and timings. A restored run continues bit for bit.
 
-Detection (every ``model update-interval`` steps, default 10):
+Detection (every ``model update-interval`` steps, default 10, and as soon as a block has
+moved CTOL/2 since the last one):
   1. neighbour search by cell mapping (kernel ``cellmap``) of the block envelopes enlarged
-     by CTOL on each side (a search volume 2·CTOL larger, as the text says), redone only when
-     a vertex has moved more than CTOL/2 since the last map (the text's u_acc > CTOL, halved
-     so that two blocks moving towards each other cannot both slip past), or the blocks
-     changed; the cell space grows by 10 % when a block leaves it;
+     by CTOL on each side (a search volume 2·CTOL larger, as the text says) and by each
+     block's step motion, redone only when a vertex has moved more than CTOL/2 since the
+     last map (the text's u_acc > CTOL, halved so that two blocks moving towards each other
+     cannot both slip past), or the blocks changed; the cell space is made anew, 10 %
+     larger than the blocks, when a block leaves it;
   2. the common plane of every candidate pair (kernel ``contactmap.cp_batch``: fast path
-     from the previous plane); a pair is a contact while its gap ≤ CTOL;
+     from the previous plane, face snap); a pair is a contact while its gap is at most
+     CTOL plus the distance its two blocks can close in one step;
   3. sub-contacts of every contact (kernel ``subgeom``), their state carried over from the
-     previous pass (kernel ``contactmap.carry_over``).
+     previous pass by identity (kernel ``contactmap.carry_over``).
+  Pairs whose blocks have both moved less than QUIET·CTOL since they were last looked at
+  keep their contact and sub-contacts as they are.
 Cycling (kernel ``cycle.run_steps``): many steps per call, up to the next detection,
-history sample or solve check.
+history sample, VTK snapshot or solve check.
 
 Contacts are oriented from the block with the lower id (A) to the higher (B) and sorted
 by (id A, id B); that key finds a contact again after blocks are deleted or cut.
@@ -153,8 +159,6 @@ class RigidEngine:
         #: a hook with an ``interval`` attribute gets a batch boundary at every multiple of it
         self.step_hooks: list = []
         #: seconds per phase; "hooks" covers histories and periodic VTK snapshots
-        #: messages for the user from the last run (the command layer prints and clears them)
-        self.notices: list[str] = []
         self.timings = {"detect": 0.0, "search": 0.0, "subcontacts": 0.0, "cycle": 0.0, "hooks": 0.0}
         self._cand = None             # candidate pairs (rows A, rows B) of the last cell map
         contact_stores(model)
