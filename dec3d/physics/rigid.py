@@ -253,17 +253,21 @@ class RigidEngine:
     def _signature(self, sig):
         self.settings()["signature"] = sig
 
-    def _step_motion(self) -> np.ndarray:
-        """Per block, how far its vertices can move in one step at the current velocities
-        (|v| Δt + |ω| Δt r, r the largest centroid-to-vertex distance) [m]; 0 before a run."""
-        m = self.model
-        b, v = m.blocks, m.vertices
-        if not self.dt or b.n == 0:
-            return np.zeros(b.n)
+    def _radii(self) -> np.ndarray:
+        """Per block, the largest centroid-to-vertex distance [m]."""
+        b, v = self.model.blocks, self.model.vertices
         r = np.zeros(b.n)
         if v.n:
             np.maximum.at(r, v["block"], np.linalg.norm(v["pos"] - b["centroid"][v["block"]], axis=1))
-        return self.dt * (np.linalg.norm(b["velocity"], axis=1) + r * np.linalg.norm(b["spin"], axis=1))
+        return r
+
+    def _step_motion(self) -> np.ndarray:
+        """Per block, how far its vertices can move in one step at the current velocities
+        (|v| Δt + |ω| Δt r) [m]; 0 before a run."""
+        b = self.model.blocks
+        if not self.dt or b.n == 0:
+            return np.zeros(b.n)
+        return self.dt * (np.linalg.norm(b["velocity"], axis=1) + self._radii() * np.linalg.norm(b["spin"], axis=1))
 
     def _pairs(self, pos, ctol, grid):
         """Candidate pairs of blocks whose envelopes (vertex positions ``pos``) enlarged by
@@ -540,10 +544,7 @@ class RigidEngine:
         self.dt = dt
         # detection also runs as soon as a block has moved CTOL/2 since the last one, so
         # that two blocks approaching each other cannot close more than CTOL unseen
-        vpos0 = m.vertices["pos"]
-        arm = np.linalg.norm(vpos0 - b["centroid"][m.vertices["block"]], axis=1) if len(vpos0) else np.zeros(0)
-        radius = np.zeros(b.n)
-        np.maximum.at(radius, m.vertices["block"], arm)
+        radius = self._radii()
         acc = np.zeros(b.n)
         motion = np.zeros(2)
         trigger = 0.5 * self.tolerance()
