@@ -19,7 +19,9 @@ Face-face contacts (both sides have a touching face):
 - Every area is then scaled by S / T, S = area(P_A ∩ P_B), T = sum of the non-orphaned
   shares. With both sides complete this is the text's one-half (two spring sets in
   parallel); with one polygon inside the other the inner side carries the whole area; the
-  total is always S. Coincident vertices of A and B stay two sub-contacts.
+  total is always S. Coincident vertices of A and B stay two sub-contacts. Faces whose
+  polygons only touch along an edge or at a corner (S no more than SLIVER = 1e-6 of the
+  smaller polygon: the faces of diagonal neighbours in a settling stack) give none.
 
 Lower contact types (ERRATA Table 1; a side without a touching face is a vertex when one
 vertex touches, else an edge: its two touching vertices, or the two farthest apart in the
@@ -47,6 +49,10 @@ K_VB = 1
 K_EE = 2
 K_PT = 3
 EDGE_SHIFT = 2147483648  # 2**31
+
+
+#: overlap areas at most this fraction of the smaller touching polygon are no contact area
+SLIVER = 1e-6
 
 
 @njit(cache=True)
@@ -354,6 +360,9 @@ def _face_face(ci, n, c, p, q, ctol, vs, fvstart, fnvert, fverts, scratch, nh0, 
     nord = ints[4:6]
     ne = ints[6:8]
     nh = (nh0, nh1)
+    area = _clip_area(hull[0], nh0, hull[1], nh1, b1, b2)
+    if area <= SLIVER * min(abs(_shoelace(hull[0], nh0)), abs(_shoelace(hull[1], nh1))):
+        return k      # faces touching along an edge or at a corner (a sliver of round-off): none
     # shares a_v = area(R_v ∩ P_o): 1/3-triangle quadrilaterals of the fans
     for s in range(2):
         o = 1 - s
@@ -438,7 +447,6 @@ def _face_face(ci, n, c, p, q, ctol, vs, fvstart, fnvert, fverts, scratch, nh0, 
                 tot += share[s, v]
     for i in range(nc):
         tot += cshare[i]
-    area = _clip_area(hull[0], nh0, hull[1], nh1, b1, b2)
     scale = area / tot if tot > 0.0 else 0.0
     # emit: kind 0 (A's vertices on B), kind 1 (B's on A), kind 2 (crossings)
     for s in range(2):

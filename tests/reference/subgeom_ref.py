@@ -122,6 +122,9 @@ def subcontacts_ref(arrays, a, b, n, c, ctol, point_area):
 
 
 def _face_face(sides, hulls, ctol, lift):
+    small = min(abs(shoelace(hulls[0])), abs(shoelace(hulls[1])))
+    if overlap_area(hulls[0], hulls[1]) <= 1e-6 * small:     # faces touching along an edge or corner
+        return []
     order, edges, share, isin = [], [], [], []
     for s in range(2):
         touching, faces, xy = sides[s]
