@@ -198,3 +198,50 @@ def blocks_moved(vpos, snap, bvstart, bvcount, tol, out):
                 if abs(vpos[v, d] - snap[v, d]) > tol:
                     hit = True
         out[b] = hit
+
+
+@njit(cache=True)
+def vertex_point_areas(sc_contact, kind, key0, ctype, cn, vpos, vblock, bfstart, bfcount, fvstart,
+                       fnvert, fverts, point_area, area):
+    """Areas of the point sub-contacts of vertex-face and edge-face contacts (kind 3, key0 a
+    vertex row), in place: the text's rule (a third of the surrounding triangles on the c-p)
+    extended to a vertex whose faces are not on the plane: each face of the vertex's block
+    that contains the vertex gives its area / its vertex count, times |n_face · n| (its
+    projection onto the c-p). Never less than ``point_area``. A block standing on a corner
+    or an edge so gets springs of the size of its faces, growing smoothly to the face-face
+    areas as a face comes down onto the plane; a nominal 1 % point area let a heavy block
+    on an edge sink by a large fraction of its size.
+
+    ctype (nc,) contact types; cn (nc, 3) normals; vblock (nv,) owning block row of each
+    vertex; faces as in ``subgeom.subcontacts_batch``; area (ns,) [m²] updated.
+    """
+    for s in range(sc_contact.shape[0]):
+        c = sc_contact[s]
+        if kind[s] != 3 or not (ctype[c] == 3 or ctype[c] == 5):
+            continue
+        v = key0[s]
+        if v < 0 or v >= vblock.shape[0]:
+            continue
+        b = vblock[v]
+        tot = 0.0
+        for f in range(bfstart[b], bfstart[b] + bfcount[b]):
+            m = fnvert[f]
+            has = False
+            for j in range(fvstart[f], fvstart[f] + m):
+                if fverts[j] == v:
+                    has = True
+                    break
+            if not has:
+                continue
+            # Newell's vector: 2 × area × unit normal of the (planar) face
+            nx = 0.0
+            ny = 0.0
+            nz = 0.0
+            for j in range(m):
+                p = fverts[fvstart[f] + j]
+                q = fverts[fvstart[f] + (j + 1) % m]
+                nx += (vpos[p, 1] - vpos[q, 1]) * (vpos[p, 2] + vpos[q, 2])
+                ny += (vpos[p, 2] - vpos[q, 2]) * (vpos[p, 0] + vpos[q, 0])
+                nz += (vpos[p, 0] - vpos[q, 0]) * (vpos[p, 1] + vpos[q, 1])
+            tot += 0.5 * abs(nx * cn[c, 0] + ny * cn[c, 1] + nz * cn[c, 2]) / m
+        area[s] = max(point_area, tot)

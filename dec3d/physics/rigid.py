@@ -37,7 +37,8 @@ import numpy as np
 
 from dec3d.errors import Dec3dError
 from dec3d.kernels.cellmap import cell_grid, cell_pairs, outside_grid
-from dec3d.kernels.contactmap import blocks_moved, carry_over, cp_batch, envelopes, match_sorted
+from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, match_sorted,
+                                      vertex_point_areas)
 from dec3d.kernels.cycle import run_steps
 from dec3d.kernels.jointlaw import NPROP, P_KN, P_KS
 from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST,
@@ -397,6 +398,9 @@ class RigidEngine:
         f_n, f_c, f_gap = nn[local[fresh]], cc[local[fresh]], gap[local[fresh]]
         sc_c, kind, key0, key1, pos, area = _subcontacts(vpos, b, f, fv, f_ra, f_rb, f_n, f_c, ctol,
                                                          self.point_area())
+        vertex_point_areas(sc_c, kind, key0, ctype[local[fresh]], f_n, vpos, m.vertices["block"],
+                           b["face_start"], b["face_count"], f["vstart"], f["nvert"], fv["vertex"],
+                           self.point_area(), area)
         live = area > 0.0
         if not live.all():
             sc_c, kind, key0, key1, pos, area = (x[live] for x in (sc_c, kind, key0, key1, pos, area))

@@ -204,3 +204,35 @@ def test_face_snap_gives_the_exact_plane_under_a_small_block():
     gap, na, nb, _ = common_plane(big, small, small.mean(0) - big.mean(0), 0.005, False, n, c)
     assert gap == 0.0 and n.tolist() == [0.0, 0.0, 1.0]
     assert contact_type(na, nb) == 6
+
+
+def test_vertex_point_areas_against_projected_face_shares(session):
+    """A unit cube tilted 30° about y, standing on its edge on a base: each end of the edge
+    gets (A/4)(cos 30° + sin 30°) from its two faces at the edge (the end face is
+    perpendicular to the plane), computed here from the geometry directly."""
+    from dec3d.kernels.contactmap import vertex_point_areas
+
+    m, e = _model(session, "model new\nblock create brick -2 2 -2 2 -1 0\n"
+                           "block create brick 0 1 0 1 0 1\n")
+    b, v = m.blocks, m.vertices
+    cube = 1
+    rows = np.arange(b["vert_start"][cube], b["vert_start"][cube] + b["vert_count"][cube])
+    t = np.radians(30.0)
+    rot = np.array([[np.cos(t), 0, np.sin(t)], [0, 1, 0], [-np.sin(t), 0, np.cos(t)]])
+    v["pos"][rows] = v["pos"][rows] @ rot.T
+    v["pos"][rows, 2] -= v["pos"][rows, 2].min()
+    low = rows[np.abs(v["pos"][rows, 2]) < 1e-12]
+    assert len(low) == 2
+    sc = np.zeros(2, np.int64)
+    kind = np.full(2, 3, np.int64)
+    area = np.full(2, 1e-4)
+    vertex_point_areas(sc, kind, low.astype(np.int64), np.array([5], np.int64), np.array([[0.0, 0.0, -1.0]]),
+                       v["pos"], v["block"], b["face_start"], b["face_count"], m.faces["vstart"],
+                       m.faces["nvert"], m.face_vertices["vertex"], 1e-4, area)
+    assert np.allclose(area, 0.25 * (np.cos(t) + np.sin(t)), rtol=1e-12)
+    # a face-face sub-contact, or a vertex-vertex contact, is left alone
+    area2 = np.full(2, 0.3)
+    vertex_point_areas(sc, np.array([0, 3], np.int64), low.astype(np.int64), np.array([1], np.int64),
+                       np.array([[0.0, 0.0, -1.0]]), v["pos"], v["block"], b["face_start"], b["face_count"],
+                       m.faces["vstart"], m.faces["nvert"], m.face_vertices["vertex"], 1e-4, area2)
+    assert area2.tolist() == [0.3, 0.3]

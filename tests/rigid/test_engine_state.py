@@ -185,3 +185,36 @@ model solve time 1.6
     h = histories(session.model).find("uz")
     t, uz = np.array(h.times), np.array(h.values)
     assert uz[t < 0.4].min() < -0.7 and uz[t > 0.6].max() == pytest.approx(0.0, abs=0.02)
+
+
+def test_tall_block_topples_about_its_edge_without_sliding(session):
+    """R1 toppling case: b/h = 0.4 < tan 30°, φ = 40° > 30°: the block turns about its
+    downhill edge, which neither slides nor sinks into the base."""
+    deck = """model new
+block create brick -5 40 -5 15 -2 0
+block create brick 0 10 0 10 0 25
+block property density 2000
+block contact jmodel assign mohr
+block contact material-table default property stiffness-normal 10e6 stiffness-shear 10e6 friction 40
+block fix range position-z -2 0
+model gravity 0 0 -10
+model solve ratio 1e-6
+model gravity [10.0 * math.sin(30.0 * math.pi / 180.0)] 0 [-10.0 * math.cos(30.0 * math.pi / 180.0)]
+block mechanical damping none
+"""
+    _run(session, deck)
+    m = session.model
+    v, b = m.vertices, m.blocks
+    r = int(np.flatnonzero(b["id"] == 2)[0])
+    rows = np.arange(b["vert_start"][r], b["vert_start"][r] + b["vert_count"][r])
+    pivot = rows[(np.abs(v["pos"][rows, 0] - 10) < 0.01) & (np.abs(v["pos"][rows, 2]) < 0.1)]
+    assert len(pivot) == 2
+    top = rows[(np.abs(v["pos"][rows, 0]) < 0.01) & (v["pos"][rows, 2] > 24)]
+    p0, t0 = v["pos"][pivot].copy(), v["pos"][top].copy()
+    _run(session, "model cycle 600\n")
+    assert b["spin"][r, 1] > 0.1                                   # turning towards +x
+    edge = np.linalg.norm(v["pos"][pivot] - p0, axis=1).max()
+    assert np.linalg.norm(v["pos"][top] - t0, axis=1).min() > 10 * edge   # the edge stays put:
+    assert edge < 0.2                                              # elastic bounce of a 1e7 Pa/m joint only
+    assert v["pos"][rows, 2].min() > -0.25                         # a 1 % point area sank it 1.8 m
+    assert b["disp"][r, 2] > 0.1                                   # the centroid rises as it pivots
