@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
-from lark import Lark, Token, Transformer
+from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
 from ..errors import DeckSyntaxError, SourceLocation
@@ -35,25 +35,12 @@ class RawLine:
         return self.tokens[0].line
 
 
-class _Lines(Transformer):
-    """Builds RawLine objects while parsing (inline transformer: no tree is kept)."""
-
-    __visit_tokens__ = False      # tokens are kept as lark made them
-
-    def line(self, items):
-        return RawLine(tuple(items))
-
-    def start(self, items):
-        return items
-
-
 @lru_cache(maxsize=None)
 def deck_parser() -> Lark:
     return Lark.open(
         str(_GRAMMAR_DIR / "deck.lark"),
         parser="lalr",
         lexer="basic",
-        transformer=_Lines(),
         maybe_placeholders=False,
         cache=False,
     )
