@@ -156,6 +156,8 @@ class RigidEngine:
         self.dt = 0.0
         self.unbal = 0.0
         self.ratio = 1.0
+        #: kinetic energy of the moving bodies at the last step (real masses) [J]
+        self.kinetic = 0.0
         #: callables hook(engine) run after every batch of steps (histories register here);
         #: a hook with an ``interval`` attribute gets a batch boundary at every multiple of it
         self.step_hooks: list = []

@@ -218,3 +218,22 @@ block mechanical damping none
     assert edge < 0.2                                              # elastic bounce of a 1e7 Pa/m joint only
     assert v["pos"][rows, 2].min() > -0.25                         # a 1 % point area sank it 1.8 m
     assert b["disp"][r, 2] > 0.1                                   # the centroid rises as it pivots
+
+
+def test_kinetic_energy_history_of_a_free_fall(session, tmp_path):
+    """½ m v² of a cube falling freely, undamped: after n steps the velocity is n g Δt."""
+    deck = """model new
+block create brick 0 1 0 1 10 11
+block property density 2000
+model gravity 0 0 -10
+block mechanical damping none
+model history name 'ke' mechanical kinetic-energy
+history interval 10
+model cycle 100
+"""
+    e = _run(session, deck)
+    from dec3d.physics.history import histories
+
+    h = histories(session.model).find("ke")
+    v = 10.0 * np.array(h.steps) * e.dt
+    assert np.allclose(h.values, 0.5 * 2000.0 * v ** 2, rtol=1e-9)
