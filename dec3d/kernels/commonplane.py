@@ -80,30 +80,6 @@ def cp_gap(va, vb, n):
 
 
 @njit(cache=True)
-def _basis(n, p, q):
-    """Two unit vectors p, q orthogonal to n and to each other (written in place)."""
-    ax = abs(n[0])
-    ay = abs(n[1])
-    az = abs(n[2])
-    if ax <= ay and ax <= az:
-        t0, t1, t2 = 1.0, 0.0, 0.0
-    elif ay <= az:
-        t0, t1, t2 = 0.0, 1.0, 0.0
-    else:
-        t0, t1, t2 = 0.0, 0.0, 1.0
-    p[0] = n[1] * t2 - n[2] * t1
-    p[1] = n[2] * t0 - n[0] * t2
-    p[2] = n[0] * t1 - n[1] * t0
-    s = math.sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2])
-    p[0] /= s
-    p[1] /= s
-    p[2] /= s
-    q[0] = n[1] * p[2] - n[2] * p[1]
-    q[1] = n[2] * p[0] - n[0] * p[2]
-    q[2] = n[0] * p[1] - n[1] * p[0]
-
-
-@njit(cache=True)
 def _gap3(va, vb, n0, n1, n2):
     """cp_gap with the normal as three scalars."""
     da = -1e300
@@ -121,7 +97,8 @@ def _gap3(va, vb, n0, n1, n2):
 
 @njit(cache=True)
 def _perp(n0, n1, n2):
-    """A unit vector p orthogonal to n (same rule as ``_basis``) and q = n × p."""
+    """A unit vector p orthogonal to n (n × the coordinate axis least aligned with n, normalised)
+    and q = n × p."""
     ax = abs(n0)
     ay = abs(n1)
     az = abs(n2)

@@ -32,7 +32,7 @@ Forces and moments are reset to zero after the update.
 A group (CSR ``gstart``/``gmember``; a lone block is a group of one) moves as one rigid body:
 "the motion calculations are only performed for the leader block, whose mass, moment of inertia,
 and centroid position are modified to represent the group" (3DEC theory, after Eq. 52). The
-composite properties come from ``group_properties`` (parallel-axis theorem). For a group with
+composite properties come from ``dec3d.physics.bodies.group_properties`` (parallel-axis theorem). For a group with
 centroid C, members b with centroids c_b and arms d_b = c_b − C:
 
   F = Σ_b (F_b + F_app,b + m_b g)
@@ -81,7 +81,7 @@ Damping (``damp_mode``), with α = ``alpha`` for modes 1 and 2:
      0.02/Δt. The update rule (a multiplicative bang-bang servo) is this code's own: the texts
      give only the target ratio.
 
-``servo`` layout (float64, persists across calls; ``new_servo`` makes one):
+``servo`` layout (float64, persists across calls; ``dec3d.physics.bodies.new_servo`` makes one):
   [0] S_ALPHA   current adaptive viscous coefficient α_v [1/s]
   [1] S_WORK    damping work Σ P Δt accumulated over the current window [J]
   [2] S_DEK     Σ |ΔE_k| accumulated over the current window [J]
@@ -104,7 +104,7 @@ member's centroid displacement; forces and moments of the members are reset to z
 whose speed |V_x|+|V_y|+|V_z| reaches ``vmax`` or whose ω is not finite does not move; the first
 such group index is returned (−1 if none), the others finish the step.
 
-Density scaling (``inertial_masses``): Eq. 87 gives Δt_b = frac·2·sqrt(M/K). The inertial mass of
+Density scaling (``dec3d.physics.bodies.inertial_masses``): Eq. 87 gives Δt_b = frac·2·sqrt(M/K). The inertial mass of
 a group is raised to the smallest value that is stable at the step Δt with its stiffness sum K:
 m_i = max(m, K (Δt / (2 frac))²); the scalar inertia is scaled by the same ratio m_i/m. Gravity
 keeps the real mass (3DEC theory, "Mass (Density) Scaling": inertial density is irrelevant to
@@ -113,8 +113,6 @@ static systems "provided that gravity forces are correctly preserved").
 from __future__ import annotations
 
 import math
-
-import numpy as np
 
 from numba import njit
 
@@ -230,76 +228,6 @@ S_ALPHA, S_WORK, S_DEK, S_NWIN, S_RATIO, S_WINDOW, S_FACTOR, S_LASTR, S_HIST, S_
 NSERVO = 10
 #: damp_mode codes
 DAMP_NONE, DAMP_LOCAL, DAMP_COMBINED, DAMP_ADAPTIVE = 0, 1, 2, 3
-
-
-def servo_size(ng):
-    """Length of a servo array good for every damping mode with ``ng`` groups."""
-    return NSERVO + 6 * int(ng)
-
-
-def new_servo(ng, ratio=0.5, window=10, factor=1.1, alpha0=0.0):
-    """A fresh servo array (layout in the module docstring) for ``ng`` groups."""
-    s = np.zeros(servo_size(ng))
-    s[S_ALPHA] = alpha0
-    s[S_RATIO] = ratio
-    s[S_WINDOW] = window
-    s[S_FACTOR] = factor
-    return s
-
-
-def group_properties(gstart, gmember, mass, centroid, inertia, inertia_approx):
-    """Composite properties of groups of joined blocks.
-
-    gstart (ng+1,) int64 CSR into gmember (int64 block rows); mass (nb,) kg; centroid (nb, 3) m;
-    inertia (nb, 3, 3) kg·m² full tensor of each block about its own centroid; inertia_approx (nb,)
-    kg·m² the scalar approximate inertia of each block (3DEC's average-distance value).
-    Returns (gmass (ng,), gcentroid (ng, 3), ginertia (ng, 3, 3) about the group centroid by the
-    parallel-axis theorem I_C = Σ [I_b + m_b (|d|² E − d dᵀ)], d = c_b − C; gprin (ng, 3)
-    principal moments ascending; gaxes (ng, 3, 3) principal axes as columns, right-handed;
-    giscalar (ng,) = Σ [I_approx,b + m_b |d|²]). A group of one keeps its block's centroid exactly.
-    """
-    gstart = np.asarray(gstart, np.int64)
-    gmember = np.asarray(gmember, np.int64)
-    mass = np.asarray(mass, np.float64)
-    centroid = np.asarray(centroid, np.float64)
-    ng = gstart.shape[0] - 1
-    cnt = np.diff(gstart)
-    gid = np.repeat(np.arange(ng), cnt)
-    m = mass[gmember]
-    c = centroid[gmember]
-    gmass = np.bincount(gid, m, minlength=ng)
-    gc = np.empty((ng, 3))
-    for k in range(3):
-        gc[:, k] = np.bincount(gid, m * c[:, k], minlength=ng) / np.where(gmass > 0, gmass, 1.0)
-    one = cnt == 1
-    gc[one] = centroid[gmember[gstart[:-1][one]]]
-    d = c - gc[gid]
-    d2 = (d * d).sum(1)
-    ib = np.asarray(inertia, np.float64)[gmember] + m[:, None, None] * (
-        d2[:, None, None] * np.eye(3) - d[:, :, None] * d[:, None, :])
-    ginertia = np.zeros((ng, 3, 3))
-    np.add.at(ginertia, gid, ib)
-    giscalar = np.bincount(gid, np.asarray(inertia_approx, np.float64)[gmember] + m * d2, minlength=ng)
-    ginertia = 0.5 * (ginertia + ginertia.transpose(0, 2, 1))
-    gprin, gaxes = np.linalg.eigh(ginertia)
-    flip = np.linalg.det(gaxes) < 0
-    gaxes[flip, :, 2] *= -1.0
-    return gmass, gc, ginertia, gprin, np.ascontiguousarray(gaxes), giscalar
-
-
-def inertial_masses(mass, iscalar, kblock, dt, frac):
-    """Density scaling (3DEC theory "Mass (Density) Scaling", Eq. 87).
-
-    mass (n,) kg real (gravitational) masses; iscalar (n,) kg·m² scalar inertias; kblock (n,) N/m
-    the stiffness sum of each group (sum over its contacts of the larger of k_n A, k_s A); dt the
-    wanted step [s]; frac the Eq. 87 factor (0.1). Returns (imass, iscalar_scaled) with
-    imass = max(mass, kblock (dt / (2 frac))²), so that frac·2·sqrt(imass / kblock) ≥ dt (equal
-    where scaled), and iscalar_scaled = iscalar · imass / mass.
-    """
-    mass = np.asarray(mass, np.float64)
-    need = np.asarray(kblock, np.float64) * (dt / (2.0 * frac)) ** 2
-    imass = np.maximum(mass, need)
-    return imass, np.asarray(iscalar, np.float64) * (imass / mass)
 
 
 @njit(cache=True)

@@ -44,6 +44,8 @@ import math
 import numpy as np
 from numba import njit
 
+from .polygon2d import basis, clip_area, convex_hull, inside, shoelace
+
 K_VA = 0
 K_VB = 1
 K_EE = 2
@@ -64,135 +66,6 @@ def edge_code(a, b):
 
 
 @njit(cache=True)
-def _basis(n, p, q):
-    """Unit p, q with p × q = n: p = n × x (n × y when n is near x), q = n × p."""
-    if abs(n[0]) < 0.9:
-        t0, t1, t2 = 1.0, 0.0, 0.0
-    else:
-        t0, t1, t2 = 0.0, 1.0, 0.0
-    p[0] = n[1] * t2 - n[2] * t1
-    p[1] = n[2] * t0 - n[0] * t2
-    p[2] = n[0] * t1 - n[1] * t0
-    s = math.sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2])
-    p[0] /= s
-    p[1] /= s
-    p[2] /= s
-    q[0] = n[1] * p[2] - n[2] * p[1]
-    q[1] = n[2] * p[0] - n[0] * p[2]
-    q[2] = n[0] * p[1] - n[1] * p[0]
-
-
-@njit(cache=True)
-def _shoelace(poly, m):
-    """Signed area of the 2-D polygon poly[:m] [m²] (> 0 counter-clockwise)."""
-    s = 0.0
-    for i in range(m):
-        j = i + 1 if i + 1 < m else 0
-        s += poly[i, 0] * poly[j, 1] - poly[j, 0] * poly[i, 1]
-    return 0.5 * s
-
-
-@njit(cache=True)
-def _clip_area(subj, ns, clip, nc, b1, b2):
-    """|area| of polygon subj[:ns] ∩ convex ccw polygon clip[:nc] (Sutherland–Hodgman);
-    b1, b2: scratch (≥ ns + nc, 2)."""
-    m = ns
-    for i in range(ns):
-        b1[i, 0] = subj[i, 0]
-        b1[i, 1] = subj[i, 1]
-    src = b1
-    dst = b2
-    for e in range(nc):
-        if m == 0:
-            break
-        ax = clip[e, 0]
-        ay = clip[e, 1]
-        f = e + 1 if e + 1 < nc else 0
-        ex = clip[f, 0] - ax
-        ey = clip[f, 1] - ay
-        k = 0
-        for j in range(m):
-            i = j - 1 if j > 0 else m - 1
-            sp = ex * (src[i, 1] - ay) - ey * (src[i, 0] - ax)
-            sq = ex * (src[j, 1] - ay) - ey * (src[j, 0] - ax)
-            if sq >= 0.0:
-                if sp < 0.0:
-                    t = sp / (sp - sq)
-                    dst[k, 0] = src[i, 0] + (src[j, 0] - src[i, 0]) * t
-                    dst[k, 1] = src[i, 1] + (src[j, 1] - src[i, 1]) * t
-                    k += 1
-                dst[k, 0] = src[j, 0]
-                dst[k, 1] = src[j, 1]
-                k += 1
-            elif sp >= 0.0:
-                t = sp / (sp - sq)
-                dst[k, 0] = src[i, 0] + (src[j, 0] - src[i, 0]) * t
-                dst[k, 1] = src[i, 1] + (src[j, 1] - src[i, 1]) * t
-                k += 1
-        m = k
-        tmp = src
-        src = dst
-        dst = tmp
-    if m < 3:
-        return 0.0
-    return abs(_shoelace(src, m))
-
-
-@njit(cache=True)
-def _inside(x, y, poly, m, sign, tol):
-    """True when (x, y) lies in polygon poly[:m] (orientation sign ±1) within distance tol."""
-    for i in range(m):
-        j = i + 1 if i + 1 < m else 0
-        ex = poly[j, 0] - poly[i, 0]
-        ey = poly[j, 1] - poly[i, 1]
-        le = math.sqrt(ex * ex + ey * ey)
-        if le == 0.0:
-            continue
-        if sign * (ex * (y - poly[i, 1]) - ey * (x - poly[i, 0])) < -tol * le:
-            return False
-    return True
-
-
-@njit(cache=True)
-def _hull(xy, idx, m, order, out):
-    """Counter-clockwise convex hull (monotone chain, collinear points dropped) of the points
-    xy[idx[:m]] into out; returns its vertex count. order: scratch (≥ m,)."""
-    for i in range(m):
-        order[i] = idx[i]
-    for i in range(1, m):           # insertion sort by (x, y): m is a face's size
-        v = order[i]
-        j = i - 1
-        while j >= 0 and (xy[order[j], 0] > xy[v, 0] or
-                          (xy[order[j], 0] == xy[v, 0] and xy[order[j], 1] > xy[v, 1])):
-            order[j + 1] = order[j]
-            j -= 1
-        order[j + 1] = v
-    if m < 3:
-        for i in range(m):
-            out[i, 0] = xy[order[i], 0]
-            out[i, 1] = xy[order[i], 1]
-        if m == 2 and out[0, 0] == out[1, 0] and out[0, 1] == out[1, 1]:
-            return 1
-        return m
-    k = 0
-    for rep in range(2):
-        lo = k
-        for ii in range(m):
-            v = order[ii] if rep == 0 else order[m - 1 - ii]
-            while k >= lo + 2:
-                cr = ((out[k - 1, 0] - out[k - 2, 0]) * (xy[v, 1] - out[k - 2, 1]) -
-                      (out[k - 1, 1] - out[k - 2, 1]) * (xy[v, 0] - out[k - 2, 0]))
-                if cr > 0.0:
-                    break
-                k -= 1
-            out[k, 0] = xy[v, 0]
-            out[k, 1] = xy[v, 1]
-            k += 1
-        k -= 1                      # the last point starts the other chain
-    return k
-
-
-@njit(cache=True)
 def _face_under(x, y, s, nsf, sfaces, fvstart, fnvert, fverts, vs, sxy, loop, tol):
     """Row of the first touching face of side s whose projected loop holds (x, y), or -1."""
     for t in range(nsf[s]):
@@ -202,8 +75,8 @@ def _face_under(x, y, s, nsf, sfaces, fvstart, fnvert, fverts, vs, sxy, loop, to
             lv = fverts[fvstart[f] + i] - vs[s]
             loop[i, 0] = sxy[s, lv, 0]
             loop[i, 1] = sxy[s, lv, 1]
-        a = _shoelace(loop, m)
-        if _inside(x, y, loop, m, 1.0 if a >= 0.0 else -1.0, tol):
+        a = shoelace(loop, m)
+        if inside(x, y, loop, m, 1.0 if a >= 0.0 else -1.0, tol):
             return f
     return -1
 
@@ -267,7 +140,7 @@ def subcontacts_one(ci, ca, cb, n, c, ctol, point_area, vpos, bvstart, bvcount, 
      b1, b2, loop, order, ints, pqv, touch) = scratch
     p = pqv[0]
     q = pqv[1]
-    _basis(n, p, q)
+    basis(n, p, q)
     nt = ints[0:2]
     nsf = ints[2:4]
     nord = ints[4:6]
@@ -338,7 +211,7 @@ def subcontacts_one(ci, ca, cb, n, c, ctol, point_area, vpos, bvstart, bvcount, 
                     edges[s, ne[s], 0] = v0
                     edges[s, ne[s], 1] = v1
                     ne[s] += 1
-        h = _hull(sxy[s], tv[s], nt[s], order, hull[s])
+        h = convex_hull(sxy[s], tv[s], nt[s], order, hull[s])
         if s == 0:
             nh0 = h
         else:
@@ -360,8 +233,8 @@ def _face_face(ci, n, c, p, q, ctol, vs, fvstart, fnvert, fverts, scratch, nh0, 
     nord = ints[4:6]
     ne = ints[6:8]
     nh = (nh0, nh1)
-    area = _clip_area(hull[0], nh0, hull[1], nh1, b1, b2)
-    if area <= SLIVER * min(abs(_shoelace(hull[0], nh0)), abs(_shoelace(hull[1], nh1))):
+    area = clip_area(hull[0], nh0, hull[1], nh1, b1, b2)
+    if area <= SLIVER * min(abs(shoelace(hull[0], nh0)), abs(shoelace(hull[1], nh1))):
         return k      # faces touching along an edge or at a corner (a sliver of round-off): none
     # shares a_v = area(R_v ∩ P_o): 1/3-triangle quadrilaterals of the fans
     for s in range(2):
@@ -389,10 +262,10 @@ def _face_face(ci, n, c, p, q, ctol, vs, fvstart, fnvert, fverts, scratch, nh0, 
                     loop[2, 1] = gy
                     loop[3, 0] = 0.5 * (sxy[s, v, 0] + sxy[s, vp, 0])
                     loop[3, 1] = 0.5 * (sxy[s, v, 1] + sxy[s, vp, 1])
-                    share[s, v] += _clip_area(loop, 4, hull[o], nh[o], b1, b2)
+                    share[s, v] += clip_area(loop, 4, hull[o], nh[o], b1, b2)
         for i in range(nord[s]):
             v = sord[s, i]
-            if _inside(sxy[s, v, 0], sxy[s, v, 1], hull[o], nh[o], 1.0, ctol):
+            if inside(sxy[s, v, 0], sxy[s, v, 1], hull[o], nh[o], 1.0, ctol):
                 sin[s, v] = 1
     # proper edge-edge crossings, A's edges outer, B's inner (loop order)
     nc = 0

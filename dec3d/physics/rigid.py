@@ -41,13 +41,13 @@ from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelo
                                       vertex_point_areas)
 from dec3d.kernels.cycle import run_steps
 from dec3d.kernels.jointlaw import NPROP, P_KN, P_KS
-from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST,
-                                  block_timestep, group_properties, inertial_masses, new_servo)
+from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST, block_timestep
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.io.vtk import periodic_vtk
 from dec3d.model.groups import group_field
 from dec3d.model.store import Field, Store
 
+from .bodies import group_properties, inertial_masses, new_servo
 from .jmodels import JOINT_MODELS, MODEL_BY_CODE
 
 _F = np.float64
@@ -528,10 +528,8 @@ class RigidEngine:
         # orientation of each block: its principal axes are kept current (below)
         inertia = np.einsum("bij,bj,bkj->bik", b["principal_axes"], b["principal_moment"], b["principal_axes"])
         gmass, gcen, _, gprin, gaxes, giscalar = group_properties(gstart, gmember, b["mass"], b["centroid"],
-                                                                  inertia, b["inertia_approx"])
-        one = np.diff(gstart) == 1          # a lone block keeps its own axes (no round-off from eigh)
-        lone = gmember[gstart[:-1][one]]
-        gprin[one], gaxes[one] = b["principal_moment"][lone], b["principal_axes"][lone]
+                                                                  inertia, b["inertia_approx"],
+                                                                  b["principal_moment"], b["principal_axes"])
         axes0 = gaxes.copy()
         servo = new_servo(ng, ratio=float(s["servo_ratio"]))
         if mode == DAMP_ADAPTIVE and len(s["servo"]) == NSERVO:

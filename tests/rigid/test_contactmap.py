@@ -115,7 +115,7 @@ def test_run_steps_equals_the_kernels_step_by_step(session):
     m, e = _model(session, STACK)
     b, cs, ss = m.blocks, e.contacts, e.subcontacts
     gstart, gmember = e._groups()
-    from dec3d.kernels.motion import group_properties, new_servo
+    from dec3d.physics.bodies import group_properties, new_servo
 
     inertia = np.einsum("bij,bj,bkj->bik", b["principal_axes"], b["principal_moment"], b["principal_axes"])
     gm, gc, _, gp, ga, gi = group_properties(gstart, gmember, b["mass"], b["centroid"], inertia, b["inertia_approx"])

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from dec3d.kernels.motion import (NSERVO, S_ALPHA, S_HIST, block_timestep, group_properties,
-                                  inertial_masses, new_servo, rigid_motion, rigid_motion_groups)
+from dec3d.kernels.motion import NSERVO, S_ALPHA, S_HIST, block_timestep, rigid_motion, rigid_motion_groups
+from dec3d.physics.bodies import group_properties, inertial_masses, new_servo
 from reference.rigid_ref import cayley_matrix, motion_groups_ref
 
 SIGNS = np.array([[i, j, k] for k in (-0.5, 0.5) for j in (-0.5, 0.5) for i in (-0.5, 0.5)])
