@@ -67,9 +67,9 @@ def one(n: int, steps: int, jmodel: str, full: bool = False) -> dict:
     import dec3d
 
     if full:
-        import dec3d.physics.rigid as rigid
+        import dec3d.physics.contacts as contacts
 
-        rigid.QUIET = 0.0
+        contacts.QUIET = 0.0
 
     with tempfile.TemporaryDirectory() as d:
         s = dec3d.Session(out_dir=d, stdout=io.StringIO())

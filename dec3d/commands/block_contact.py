@@ -5,7 +5,8 @@ import numpy as np
 
 from ..errors import CommandError
 from ..physics.jmodels import ALL_PROPS, JOINT_MODELS, MODEL_BY_CODE
-from ..physics.rigid import default_row, engine, mech
+from ..physics.contacts import default_row
+from ..physics.rigid import engine, mech
 from .registry import command
 from .values import FLAG, Choice, Num, P, Text
 
@@ -63,6 +64,13 @@ def _model_arg(call, key):
     return call.args.get(key)
 
 
+def _contacts_in_range(session, call):
+    """(engine, mask over the contacts in the call's range), the contacts detected first."""
+    e = engine(session.model)
+    e.ensure_contacts()
+    return e, session.range_mask(call, "contact")
+
+
 def _check_assign(call):
     _check_model_name(_model_arg(call, "model"), call.locations.get("model", call.location))
 
@@ -79,11 +87,9 @@ def _check_default(call):
                  "point, its own groups and the groups of its two blocks.",
          examples=["block contact jmodel assign mohr", "block contact jmodel assign elastic range group 'base'"])
 def jmodel_assign(session, call):
-    e = engine(session.model)
-    e.ensure_contacts()
+    e, sel = _contacts_in_range(session, call)
     name = _model_arg(call, "model")
     jm = JOINT_MODELS[name]
-    sel = session.range_mask(call, "contact")
     c = e.contacts
     c["jmodel"][sel] = jm.code
     c["prop"][sel] = default_row(mech(session.model), jm.code)
@@ -100,12 +106,11 @@ def jmodel_assign(session, call):
          examples=["block contact property stiffness-normal 1e9 stiffness-shear 1e9 friction 30",
                    "block contact prop stiff-norm 10e6 stiff-shear 10e6 fric 20 coh 0 tension 0"])
 def contact_property(session, call):
-    e = engine(session.model)
-    e.ensure_contacts()
+    e, mask = _contacts_in_range(session, call)
     s = mech(session.model)
     props = _given(call)
     c = e.contacts
-    sel = np.flatnonzero(session.range_mask(call, "contact"))
+    sel = np.flatnonzero(mask)
     codes = np.unique(c["jmodel"][sel]) if sel.size else np.array([JOINT_MODELS[s["jmodel"]].code])
     for code in codes:
         _check(call, MODEL_BY_CODE[int(code)].name, props)
@@ -162,10 +167,9 @@ def generate_subcontacts(session, call):
          examples=["block contact group 'Reaction' range pos-y -0.01 0.01",
                    "block contact group 'MidCrack' slot 'components' range group-intersection 'brickDown' 'brickUp'"])
 def contact_group(session, call):
-    e = engine(session.model)
-    e.ensure_contacts()
+    e, sel = _contacts_in_range(session, call)
     a = call.args
-    rows = np.flatnonzero(session.range_mask(call, "contact"))
+    rows = np.flatnonzero(sel)
     if a["remove"]:
         session.model.groups.remove(e.contacts, rows, a["name"], a["slot"])
     else:
@@ -180,9 +184,7 @@ def contact_group(session, call):
              "`state` clears the slip and failure flags, `force` zeroes the shear forces.",
          examples=["block contact reset displacement", "block contact reset state range group 'joint'"])
 def contact_reset(session, call):
-    e = engine(session.model)
-    e.ensure_contacts()
-    sel = session.range_mask(call, "contact")
+    e, sel = _contacts_in_range(session, call)
     ss = e.subcontacts
     rows = sel[ss["contact"]] if ss.n else np.zeros(0, bool)
     what = call.args["what"]

@@ -1,31 +1,13 @@
-"""Rigid-block engine: neighbour search, contacts, sub-contacts and the cycle (3DEC theory, Fig. 13).
+"""Rigid-block engine: settings and the calculation cycle (3DEC theory, Fig. 13).
 
 State lives in the model: contacts and sub-contacts are two stores (``contacts``,
-``subcontacts``, saved and restored with the rest), the engine settings and detection
-bookkeeping are ``model.settings.mechanical`` (plain JSON) and a few vertex/block fields.
-The ``RigidEngine`` object on the model holds only what can be rebuilt: the candidate
-pairs, the time step and timings. A restored run continues bit for bit.
+``subcontacts``, saved and restored with the rest; ``contacts.py``), the engine settings and
+detection bookkeeping are ``model.settings.mechanical`` (plain JSON) and a few vertex/block
+fields. The ``RigidEngine`` object on the model holds only what can be rebuilt: the
+candidate pairs, the time step and timings. A restored run continues bit for bit.
 
-Detection (every ``model update-interval`` steps, default 10, and as soon as a block has
-moved CTOL/2 since the last one):
-  1. neighbour search by cell mapping (kernel ``cellmap``) of the block envelopes enlarged
-     by CTOL on each side (a search volume 2·CTOL larger, as the text says) and by each
-     block's step motion, redone only when a vertex has moved more than CTOL/2 since the
-     last map (the text's u_acc > CTOL, halved so that two blocks moving towards each other
-     cannot both slip past), or the blocks changed; the cell space is made anew, 10 %
-     larger than the blocks, when a block leaves it;
-  2. the common plane of every candidate pair (kernel ``contactmap.cp_batch``: fast path
-     from the previous plane, face snap); a pair is a contact while its gap is at most
-     CTOL plus the distance its two blocks can close in one step;
-  3. sub-contacts of every contact (kernel ``subgeom``), their state carried over from the
-     previous pass by identity (kernel ``contactmap.carry_over``).
-  Pairs whose blocks have both moved less than QUIET·CTOL since they were last looked at
-  keep their contact and sub-contacts as they are.
-Cycling (kernel ``cycle.run_steps``): many steps per call, up to the next detection,
-history sample, VTK snapshot or solve check.
-
-Contacts are oriented from the block with the lower id (A) to the higher (B) and sorted
-by (id A, id B); that key finds a contact again after blocks are deleted or cut.
+Detection is ``contacts.ContactDetection`` (mixed in). Cycling (kernel ``cycle.run_steps``):
+many steps per call, up to the next detection, history sample, VTK snapshot or solve check.
 """
 from __future__ import annotations
 
@@ -36,56 +18,19 @@ import time as _time
 import numpy as np
 
 from dec3d.errors import Dec3dError
-from dec3d.kernels.cellmap import cell_grid, cell_pairs, outside_grid
-from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, match_sorted,
-                                      vertex_point_areas)
-from dec3d.kernels.cycle import run_steps
-from dec3d.kernels.jointlaw import NPROP, P_KN, P_KS
-from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST, block_timestep
-from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.io.vtk import periodic_vtk
-from dec3d.model.groups import group_field
-from dec3d.model.store import Field, Store
+from dec3d.kernels.cycle import run_steps
+from dec3d.kernels.jointlaw import P_KN, P_KS
+from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST, block_timestep
+from dec3d.model.store import Store
 
 from .bodies import group_properties, inertial_masses, new_servo
-from .jmodels import JOINT_MODELS, MODEL_BY_CODE
+from .contacts import ContactDetection, contact_stores
+from .jmodels import JOINT_MODELS
 
 _F = np.float64
 _I = np.int64
 
-CONTACT_FIELDS = {
-    "ida": Field((), _I, -1),            # block ids, A < B
-    "idb": Field((), _I, -1),
-    "a": Field((), _I, -1),              # block rows (refreshed at every detection)
-    "b": Field((), _I, -1),
-    "pos": Field((3,), _F, 0.0),         # c-p reference point [m]
-    "normal": Field((3,), _F, 0.0),      # unit normal A → B
-    "gap": Field((), _F, 0.0),           # [m], negative = overlap
-    "type": Field((), _I, 0),            # CT_* (kernels.commonplane)
-    "jmodel": Field((), _I, 1),          # joint model code (physics.jmodels)
-    "prop": Field((NPROP,), _F, 0.0),    # kernel property row
-    "own_props": Field((), np.uint8, 0), # 1: set by `block contact property`; 0: follows the defaults
-    "sub_start": Field((), _I, 0),       # CSR into subcontacts
-    "sub_count": Field((), _I, 0),
-    "group": group_field(),
-}
-
-SUBCONTACT_FIELDS = {
-    "contact": Field((), _I, -1),
-    "kind": Field((), _I, 0),            # 0 A-vertex/B-face, 1 B-vertex/A-face, 2 edge-edge, 3 point
-    "key0": Field((), _I, -1),
-    "key1": Field((), _I, -1),
-    "pos": Field((3,), _F, 0.0),         # on the c-p [m]
-    "area": Field((), _F, 0.0),          # [m²]
-    "fn": Field((), _F, 0.0),            # normal force, compression positive [N]
-    "fs": Field((3,), _F, 0.0),          # shear force on B [N]
-    "un": Field((), _F, 0.0),            # normal displacement (starts at the gap) [m]
-    "udil": Field((), _F, 0.0),          # dilation [m]
-    "us": Field((3,), _F, 0.0),          # accumulated shear displacement [m]
-    "state": Field((), _I, 0),           # ST_* bits (kernels.jointlaw)
-}
-
-#: engine settings (``model.settings.mechanical``) and their defaults
 MECH_DEFAULTS = {
     "ctol": None,              # CTOL [m]; None: 0.005 × mean block size (dec3d's choice)
     "damping": "local",        # local | combined | global | none
@@ -102,11 +47,6 @@ MECH_DEFAULTS = {
 }
 
 
-#: a block is looked at again at a detection when a vertex has moved more than QUIET × CTOL
-#: since it was last looked at (dec3d's choice; areas and planes change by ~QUIET·CTOL/size)
-QUIET = 0.1
-
-
 class RunError(Dec3dError):
     """The run became unstable (NaN or runaway velocity)."""
 
@@ -120,37 +60,7 @@ def mech(model) -> dict:
     return m
 
 
-def contact_stores(model) -> tuple[Store, Store]:
-    """The ``contacts`` and ``subcontacts`` stores, made on first use."""
-    stores = model.stores
-    if "contacts" not in stores:
-        model.add_store(Store("contacts", CONTACT_FIELDS, capacity=64))
-    if "subcontacts" not in stores:
-        model.add_store(Store("subcontacts", SUBCONTACT_FIELDS, capacity=256))
-    return model.store("contacts"), model.store("subcontacts")
-
-
-def _subcontacts(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea):
-    """Sub-contacts of every contact (kernel ``subgeom.subcontacts_batch``, grown until it fits)."""
-    cap = max(16, 8 * len(ra))
-    while True:
-        out = (np.empty(cap, _I), np.empty(cap, _I), np.empty(cap, _I), np.empty(cap, _I),
-               np.empty((cap, 3)), np.empty(cap))
-        k = subcontacts_batch(vpos, b["vert_start"], b["vert_count"], b["face_start"], b["face_count"],
-                              f["vstart"], f["nvert"], fv["vertex"], ra, rb, cn, cc, ctol, parea, *out)
-        if k <= cap:
-            return tuple(a[:k] for a in out)
-        cap = int(k)
-
-
-def default_row(s: dict, code: int) -> np.ndarray:
-    """Property row of a contact of model ``code`` that follows the material-table defaults
-    (the default properties this model has)."""
-    jm = MODEL_BY_CODE[code]
-    return jm.row({k: v for k, v in s["props"].items() if k in jm.props})
-
-
-class RigidEngine:
+class RigidEngine(ContactDetection):
     def __init__(self, model):
         self.model = model
         self.dt = 0.0
@@ -165,12 +75,6 @@ class RigidEngine:
         self.timings = {"detect": 0.0, "search": 0.0, "subcontacts": 0.0, "cycle": 0.0, "hooks": 0.0}
         self._cand = None             # candidate pairs (rows A, rows B) of the last cell map
         contact_stores(model)
-        v = model.vertices
-        for key in ("map_pos", "look_pos"):
-            if key not in v:
-                v.add_field(key, Field((3,), _F, 0.0))
-        if "map_reach" not in model.blocks:
-            model.blocks.add_field("map_reach", Field((), _F, 0.0))
 
     # ------------------------------------------------------------ model-backed state
     @property
@@ -237,230 +141,6 @@ class RigidEngine:
     def full_inertia(self) -> bool:
         s = self.settings()
         return s["inertia"] == "full" or (s["inertia"] == "auto" and s["damping"] == "none")
-
-    # ------------------------------------------------------------ detection
-    # Detection state that must survive save/restore (so a restored run continues exactly):
-    # vertex fields ``map_pos`` (positions at the last cell map) and ``look_pos`` (when the
-    # block was last looked at), settings ``grid`` (the cell space) and ``signature`` (the
-    # blocks at the last detection). The candidate pairs are rebuilt from ``map_pos``.
-    def _geometry_signature(self):
-        m = self.model
-        b = m.blocks
-        return [b.n, m.vertices.n, m.faces.n, int(b["id"].sum()), int(b["hidden"].sum())]
-
-    @property
-    def _signature(self):
-        return self.settings().get("signature")
-
-    @_signature.setter
-    def _signature(self, sig):
-        self.settings()["signature"] = sig
-
-    def _radii(self) -> np.ndarray:
-        """Per block, the largest centroid-to-vertex distance [m]."""
-        b, v = self.model.blocks, self.model.vertices
-        r = np.zeros(b.n)
-        if v.n:
-            np.maximum.at(r, v["block"], np.linalg.norm(v["pos"] - b["centroid"][v["block"]], axis=1))
-        return r
-
-    def _step_motion(self) -> np.ndarray:
-        """Per block, how far its vertices can move in one step at the current velocities
-        (|v| Δt + |ω| Δt r) [m]; 0 before a run."""
-        b = self.model.blocks
-        if not self.dt or b.n == 0:
-            return np.zeros(b.n)
-        return self.dt * (np.linalg.norm(b["velocity"], axis=1) + self._radii() * np.linalg.norm(b["spin"], axis=1))
-
-    def _pairs(self, pos, ctol, grid):
-        """Candidate pairs of blocks whose envelopes (vertex positions ``pos``) enlarged by
-        CTOL and by their step motion at the map (block field ``map_reach``) overlap, by cell
-        mapping; rows with A the lower block id, sorted by ids."""
-        b = self.model.blocks
-        active = ~b["hidden"] & (b["vert_count"] > 0)
-        lo = np.empty((b.n, 3))
-        hi = np.empty((b.n, 3))
-        envelopes(pos, b["vert_start"], b["vert_count"], active, ctol, lo, hi)
-        lo -= b["map_reach"][:, None]
-        hi += b["map_reach"][:, None]
-        if grid is None or outside_grid(lo, hi, active, *grid):
-            grid = cell_grid(lo, hi, active, 0.1)
-        pairs = cell_pairs(lo, hi, active, *grid)
-        ida, idb = b["id"][pairs[:, 0]], b["id"][pairs[:, 1]]
-        swap = ida > idb
-        ra = np.where(swap, pairs[:, 1], pairs[:, 0]).astype(_I)
-        rb = np.where(swap, pairs[:, 0], pairs[:, 1]).astype(_I)
-        order = np.lexsort((b["id"][rb], b["id"][ra]))
-        return (np.ascontiguousarray(ra[order]), np.ascontiguousarray(rb[order])), grid
-
-    def _search(self, ctol: float, force: bool) -> tuple[tuple[np.ndarray, np.ndarray], bool]:
-        """(candidate pairs, whether the cell space was mapped anew), remapped only when
-        a vertex has moved more than CTOL/2 since the last map, or when forced."""
-        m = self.model
-        s = self.settings()
-        v = m.vertices
-        vpos, mpos = v["pos"], v["map_pos"]
-        have = s.get("grid") is not None and len(vpos) > 0
-        if have and not force and float(np.abs(vpos - mpos).max()) <= 0.5 * ctol:
-            if self._cand is None:       # after a restore: the same pairs from the saved map
-                g = s["grid"]
-                self._cand, _ = self._pairs(mpos, ctol, (np.array(g[0]), float(g[1]), np.array(g[2], _I)))
-            return self._cand, False
-        t0 = _time.perf_counter()
-        g = s.get("grid")
-        grid = None if (g is None or force) else (np.array(g[0]), float(g[1]), np.array(g[2], _I))
-        m.blocks["map_reach"][...] = self._step_motion()
-        self._cand, grid = self._pairs(vpos, ctol, grid)
-        s["grid"] = [[float(x) for x in grid[0]], float(grid[1]), [int(x) for x in grid[2]]]
-        mpos[...] = vpos
-        self.timings["search"] += _time.perf_counter() - t0
-        return self._cand, True
-
-    def detect(self, force_search: bool = False) -> None:
-        """Find the contacts and their sub-contacts again, keeping the force history.
-
-        Incremental: a candidate pair whose two blocks have each moved less than
-        ``QUIET`` × CTOL (largest vertex displacement) since they were last looked at keeps
-        its contact and sub-contacts as they are (their points still follow Eq. 11 every
-        step); every other pair gets a new common plane and new sub-contacts. After a
-        remap of the cell space, a change of the blocks, or with ``force_search``, every
-        pair is looked at.
-        """
-        t0 = _time.perf_counter()
-        m = self.model
-        b, f, fv = m.blocks, m.faces, m.face_vertices
-        cs, ss = self.contacts, self.subcontacts
-        sig = self._geometry_signature()
-        changed = sig != self._signature
-        self._signature = sig
-        ctol = self.tolerance()
-        vpos = m.vertices["pos"]
-        look = m.vertices["look_pos"]
-        (ra, rb), remapped = self._search(ctol, force_search or changed)
-        full = force_search or changed or remapped
-        if full:
-            moved = np.ones(b.n, bool)
-        else:
-            moved = np.zeros(b.n, bool)
-            blocks_moved(vpos, look, b["vert_start"], b["vert_count"], QUIET * ctol, moved)
-        ids = b["id"]
-        prev = match_sorted(cs["ida"], cs["idb"], ids[ra], ids[rb])
-        need = np.flatnonzero(moved[ra] | moved[rb])
-        k = len(need)
-        nn = np.empty((k, 3))
-        cc = np.empty((k, 3))
-        gap = np.empty(k)
-        ctype = np.empty(k, _I)
-        # a pair is a contact when its gap is at most CTOL plus what its blocks can close in
-        # one step: fast blocks get their contact (still open) before they meet
-        step = self._step_motion()
-        reach = ctol + step[ra[need]] + step[rb[need]]
-        cp_batch(ra[need], rb[need], prev[need], vpos, b["vert_start"], b["vert_count"], b["centroid"],
-                 cs["normal"], cs["pos"], reach, nn, cc, gap, ctype)
-        # the contacts: quiet old contacts as they were, looked-at pairs with gap ≤ CTOL
-        is_new = np.zeros(len(ra), bool)
-        is_new[need[ctype > 0]] = True
-        kept = (prev >= 0) & ~(moved[ra] | moved[rb])
-        rows = np.flatnonzero(kept | is_new)
-        local = np.full(len(ra), -1, _I)
-        local[need] = np.arange(k)
-        fresh = need[ctype > 0]                 # candidate indices of recomputed contacts, in order
-        nc = len(rows)
-        ra_c, rb_c, prev_c = ra[rows], rb[rows], prev[rows]
-        kept_c = kept[rows]
-        lc = local[rows]
-        p_k = prev_c[kept_c]
-        normal = np.empty((nc, 3))
-        cpos = np.empty((nc, 3))
-        cgap = np.empty(nc)
-        ctyp = np.empty(nc, _I)
-        normal[kept_c], cpos[kept_c], cgap[kept_c], ctyp[kept_c] = (cs["normal"][p_k], cs["pos"][p_k],
-                                                                   cs["gap"][p_k], cs["type"][p_k])
-        lf = lc[~kept_c]
-        normal[~kept_c], cpos[~kept_c], cgap[~kept_c], ctyp[~kept_c] = nn[lf], cc[lf], gap[lf], ctype[lf]
-        # contact data carried by the pair key, or the defaults for a new contact
-        s = self.settings()
-        old = prev_c >= 0
-        jm = JOINT_MODELS[s["jmodel"]]
-        jcode = np.full(nc, jm.code, _I)
-        prop = np.tile(default_row(s, jm.code), (nc, 1)) if nc else np.zeros((0, NPROP))
-        group = np.full((nc, cs["group"].shape[1]), -1, np.int32)
-        own = np.zeros(nc, np.uint8)
-        jcode[old] = cs["jmodel"][prev_c[old]]
-        own[old] = cs["own_props"][prev_c[old]]
-        keep_row = old & (own == 1)
-        prop[keep_row] = cs["prop"][prev_c[keep_row]]
-        for code in np.unique(jcode[old & (own == 0)]):      # contacts that follow the defaults
-            sel = old & (own == 0) & (jcode == code)
-            prop[sel] = default_row(s, int(code))
-        group[old] = cs["group"][prev_c[old]]
-        # sub-contacts of the recomputed contacts (zero-area ones carry nothing and are dropped)
-        t1 = _time.perf_counter()
-        f_ra, f_rb, f_prev = ra[fresh], rb[fresh], prev[fresh]
-        f_n, f_c, f_gap = nn[local[fresh]], cc[local[fresh]], gap[local[fresh]]
-        sc_c, kind, key0, key1, pos, area = _subcontacts(vpos, b, f, fv, f_ra, f_rb, f_n, f_c, ctol,
-                                                         self.point_area())
-        vertex_point_areas(sc_c, kind, key0, ctype[local[fresh]], f_n, vpos, m.vertices["block"],
-                           b["face_start"], b["face_count"], f["vstart"], f["nvert"], fv["vertex"],
-                           self.point_area(), area)
-        live = area > 0.0
-        if not live.all():
-            sc_c, kind, key0, key1, pos, area = (x[live] for x in (sc_c, kind, key0, key1, pos, area))
-        ns = len(sc_c)
-        fs = np.empty((ns, 3))
-        un = np.empty(ns)
-        udil = np.empty(ns)
-        us = np.empty((ns, 3))
-        state = np.empty(ns, _I)
-        carry_over(f_prev, sc_c, kind, key0, key1, area, f_gap, cs["sub_start"], cs["sub_count"], ss["kind"],
-                   ss["key0"], ss["key1"], ss["area"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"],
-                   cs["normal"], f_n, fs, un, udil, us, state)
-        nf = len(fresh)
-        f_count = np.bincount(sc_c, minlength=nf).astype(_I) if nf else np.zeros(0, _I)
-        f_start = (np.cumsum(f_count) - f_count).astype(_I)
-        # gather: kept contacts take their old rows, recomputed ones the new rows
-        fidx = np.full(len(ra), -1, _I)
-        fidx[fresh] = np.arange(nf)
-        fi = fidx[rows]
-        counts = np.empty(nc, _I)
-        base = np.empty(nc, _I)
-        counts[kept_c], base[kept_c] = cs["sub_count"][p_k], cs["sub_start"][p_k]
-        counts[~kept_c], base[~kept_c] = f_count[fi[~kept_c]], ss.n + f_start[fi[~kept_c]]
-        starts = (np.cumsum(counts) - counts).astype(_I)
-        total = int(counts.sum())
-        src = np.repeat(base - starts, counts) + np.arange(total, dtype=_I)
-        owner = np.repeat(np.arange(nc, dtype=_I), counts)
-        pool = {"kind": (ss["kind"], kind), "key0": (ss["key0"], key0), "key1": (ss["key1"], key1),
-                "pos": (ss["pos"], pos), "area": (ss["area"], area), "fn": (ss["fn"], np.zeros(ns)),
-                "fs": (ss["fs"], fs), "un": (ss["un"], un), "udil": (ss["udil"], udil), "us": (ss["us"], us),
-                "state": (ss["state"], state)}
-        sub = {key: np.concatenate(pair)[src] for key, pair in pool.items()}
-        self.timings["subcontacts"] += _time.perf_counter() - t1
-        # install
-        cs.clear()
-        cs.append(nc)
-        for key, val in (("ida", ids[ra_c]), ("idb", ids[rb_c]), ("a", ra_c), ("b", rb_c), ("pos", cpos),
-                         ("normal", normal), ("gap", cgap), ("type", ctyp), ("jmodel", jcode), ("prop", prop),
-                         ("own_props", own), ("sub_start", starts), ("sub_count", counts), ("group", group)):
-            cs[key][...] = val
-        ss.clear()
-        ss.append(total)
-        ss["contact"][...] = owner
-        for key, val in sub.items():
-            ss[key][...] = val
-        # the blocks looked at are the new reference for "moved"
-        if full:
-            look[...] = vpos
-        else:
-            sel = moved[m.vertices["block"]]
-            look[sel] = vpos[sel]
-        self.timings["detect"] += _time.perf_counter() - t0
-
-    def ensure_contacts(self) -> None:
-        """Detect now if the blocks changed since the last detection (3DEC keeps contacts
-        current whenever blocks exist, so contact commands see them before any cycle)."""
-        if self._geometry_signature() != self._signature:
-            self.detect()
 
     # ------------------------------------------------------------ cycling
     def _groups(self):
@@ -667,7 +347,3 @@ def engine(model) -> RigidEngine:
         e = RigidEngine(model)
         model.rigid_engine = e
     return e
-
-
-def model_name(code: int) -> str:
-    return MODEL_BY_CODE[int(code)].name
