@@ -4,16 +4,9 @@ import numpy as np
 import pytest
 
 from dec3d.physics.rigid import engine
+from tests.rigid.test_engine import DECK
 
-SPRING = """model new
-block create brick 0 1 0 1 -1 0
-block create brick 0 1 0 1 0 1
-block property density 2000
-model gravity 0 0 -10
-block contact jmodel assign elastic
-block contact material-table default property stiffness-normal 10e6 stiffness-shear 10e6
-block fix range position-z -1 0
-"""
+SPRING = DECK          # the block on a joint spring of test_engine.py
 
 STACK3 = """model new
 block create brick 0 1 0 1 -1 0
