@@ -9,28 +9,39 @@ from . import __version__
 
 
 def _run(args) -> int:
-    from .errors import Dec3dError
-    from .session import Session
+    session = None
+    try:
+        from .errors import Dec3dError
+        from .session import Session
 
-    deck = Path(args.deck)
-    out = Path(args.out) if args.out else deck.resolve().parent
-    out.mkdir(parents=True, exist_ok=True)
-    session = Session(out_dir=out, echo=not args.quiet)
-    try:
-        items = session.load_file(deck)          # parse and bind everything first
-    except Dec3dError as exc:
-        print(exc.format(), file=sys.stderr)
-        print("nothing was run: fix the deck and run it again", file=sys.stderr)
-        return 2
-    try:
-        session.run_items(items)
-    except Dec3dError as exc:
-        print(exc.format(), file=sys.stderr)
-        print("the run stopped at this command; the model holds the state before it", file=sys.stderr)
-        return 1
-    finally:
-        session.close_log()
-    return 0
+        deck = Path(args.deck)
+        out = Path(args.out) if args.out else deck.resolve().parent
+        out.mkdir(parents=True, exist_ok=True)
+        session = Session(out_dir=out, echo=not args.quiet)
+        try:
+            items = session.load_file(deck)          # parse and bind everything first
+        except Dec3dError as exc:
+            print(exc.format(), file=sys.stderr)
+            print("nothing was run: fix the deck and run it again", file=sys.stderr)
+            return 2
+        try:
+            session.run_items(items)
+        except Dec3dError as exc:
+            print(exc.format(), file=sys.stderr)
+            print("the run stopped at this command; the model holds the state before it", file=sys.stderr)
+            return 1
+        finally:
+            session.close_log()
+        for w in session.warnings:
+            print(f"warning: {w}", file=sys.stderr)
+        return 0
+    except KeyboardInterrupt as exc:
+        # Ctrl-C: the engine stops at the end of a batch (CycleInterrupted carries the step)
+        step = getattr(exc, "step", None)
+        if step is None:
+            step = session.model.step if session is not None else 0
+        print(f"interrupted at step {step}", file=sys.stderr)
+        return 130
 
 
 def _repl(args) -> int:

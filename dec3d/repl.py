@@ -98,6 +98,10 @@ def run_repl(out_dir=None, history_file=None, input=None, output=None) -> int:
                 break
         except StopDeck:
             break
+        except KeyboardInterrupt as exc:   # Ctrl-C while a command ran: cycling stops at a batch end
+            step = getattr(exc, "step", None)
+            session.write(f"interrupted at step {step}; the model is consistent and can cycle again"
+                          if step is not None else "interrupted")
         except Dec3dError as exc:
             session.write(exc.format())
         except Exception as exc:  # a bug in dec3d must not cost the user the session and its model

@@ -63,6 +63,7 @@ class Session:
         self._log_handle: TextIO | None = None
         self.record: list[str] = []       # text of every command run, for save files
         self.results: dict[str, float] = {}  # named figures commands report (verification reads them)
+        self.warnings: list[str] = []     # said again at the end of `dec3d run` (e.g. an unconverged solve)
         self.bind_context = BindContext(self.variables)
 
     # ------------------------------------------------------------------ output

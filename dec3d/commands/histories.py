@@ -143,8 +143,10 @@ for _other in ("dynamic", "energy", "fluid", "thermal"):
 
 @command("model history mechanical",
          positional=[P("quantity", Choice(MODEL_QUANTITIES), "what to record", required=True)],
-         doc="Record the largest unbalanced force, the unbalanced-force ratio or the total time.",
-         details="A leading `name '<s>'` names the history (default: its number).",
+         doc="Record the largest unbalanced force, a mechanical ratio, the total time or the kinetic energy.",
+         details="A leading `name '<s>'` names the history (default: its number). `unbalanced-maximum`, `ratio`, "
+                 "`ratio-average`, `ratio-local` and `ratio-maximum` are the measures `model solve` uses, with the "
+                 "same definitions (see `model solve`).",
          examples=["model history mechanical unbalanced-maximum", "model history name 'ub' mechanical ratio"])
 def model_history(session, call):
     name = _name(session, call)

@@ -27,6 +27,7 @@ import numpy as np
 
 from dec3d.config import SAVE_FORMAT_VERSION
 from dec3d.errors import Dec3dError
+from dec3d.io.finite import require_finite
 from dec3d.model.groups import GroupTable
 from dec3d.model.model import Model
 from dec3d.model.settings import Settings
@@ -65,11 +66,13 @@ def save_state(model: Model, path: str | os.PathLike, records: list[str] | None 
     for sname, store in model.stores.items():
         fields = {}
         for key, arr in store.to_arrays().items():
+            require_finite(f"{sname}.{key}", arr)
             arrays[f"{sname}.{key}"] = arr
             spec = store.fields[key]
             fields[key] = {"dtype": arr.dtype.str, "shape": list(arr.shape[1:]),
                            "fill": np.asarray(spec.fill).item()}
         schema[sname] = {"n": store.n, "fields": fields}
+    require_finite("time", model.time)
     blobs = {name: _npy_bytes(arr) for name, arr in sorted(arrays.items())}
     meta = {
         "format": FORMAT_NAME,

@@ -19,6 +19,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from dec3d.geometry.mass import range_index
+from dec3d.io.finite import require_finite
 
 VTK_POLYHEDRON = 42
 _TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.float32): "Float32",
@@ -27,6 +28,7 @@ _TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.float32): "Float32",
 
 
 def _data_array(name: str, arr: np.ndarray, indent: str) -> str:
+    require_finite(name, arr)
     arr = np.ascontiguousarray(arr)
     if arr.dtype == np.bool_:
         arr = arr.astype(np.uint8)

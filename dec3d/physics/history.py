@@ -26,7 +26,8 @@ RIGID_QUANTITIES = tuple(f"angular-momentum{s}" for s, _ in _XYZ) + ("shape-erro
 CONTACT_QUANTITIES = {"force-normal": ("fn", "sum"), "force-shear": ("fs", "norm"),
                       "force-shear-x": ("fs", 0), "force-shear-y": ("fs", 1), "force-shear-z": ("fs", 2),
                       "displacement-normal": ("un", "mean"), "displacement-shear": ("us", "norm-mean")}
-MODEL_QUANTITIES = ("unbalanced-maximum", "ratio", "time-total", "kinetic-energy")
+MODEL_QUANTITIES = ("unbalanced-maximum", "ratio", "ratio-average", "ratio-local", "ratio-maximum", "time-total",
+                    "kinetic-energy")
 
 
 @dataclass
@@ -144,8 +145,9 @@ class HistorySet:
         return self.add(f"contact near ({pos[0]:g} {pos[1]:g} {pos[2]:g}) {quantity}", value, name)
 
     def add_model(self, quantity: str, name: str | None = None) -> History:
-        attr = {"unbalanced-maximum": "unbal", "ratio": "ratio", "time-total": "time",
-                "kinetic-energy": "kinetic"}[quantity]
+        if quantity.startswith(("ratio", "unbalanced")):   # the measures of `model solve` (RigidEngine.criteria)
+            return self.add(f"mechanical {quantity}", lambda eng: float(eng.criteria()[quantity]), name)
+        attr = {"time-total": "time", "kinetic-energy": "kinetic"}[quantity]
         return self.add(f"mechanical {quantity}", lambda eng: float(getattr(eng, attr)), name)
 
 

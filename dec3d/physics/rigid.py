@@ -11,9 +11,13 @@ many steps per call, up to the next detection, history sample, VTK snapshot or s
 """
 from __future__ import annotations
 
+import copy
 import math
+import signal
 import sys
+import threading
 import time as _time
+from contextlib import contextmanager
 
 import numpy as np
 
@@ -25,7 +29,7 @@ from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_
 from dec3d.model.store import Store
 
 from .bodies import group_properties, inertial_masses, new_servo
-from .contacts import ContactDetection, contact_stores
+from .contacts import ContactDetection, contact_stores, default_row
 from .jmodels import JOINT_MODELS
 
 _F = np.float64
@@ -48,7 +52,60 @@ MECH_DEFAULTS = {
 
 
 class RunError(Dec3dError):
-    """The run became unstable (NaN or runaway velocity)."""
+    """The run became unstable (NaN or runaway velocity). The engine has put the model back
+    to its state before the ``cycle`` call that failed."""
+
+
+class CycleInterrupted(KeyboardInterrupt):
+    """Cycling stopped at the end of a batch because the user pressed Ctrl-C (or
+    ``request_stop()`` was called). The model is consistent at ``step`` and can cycle again."""
+
+    def __init__(self, step: int):
+        super().__init__(f"interrupted at step {step}")
+        self.step = step
+
+
+class _StopFlag:
+    """Set by SIGINT while the engine cycles (or by ``request_stop``); read between batches."""
+    requested = False
+
+
+def request_stop() -> None:
+    """Ask the running ``cycle`` to stop at the end of its current batch of steps
+    (what Ctrl-C does; usable from a step hook, a FISH callback or another thread)."""
+    _StopFlag.requested = True
+
+
+@contextmanager
+def _sigint_stops_cycling():
+    """While cycling, the first Ctrl-C only sets the stop flag (the engine stops at the end of
+    the batch, the model consistent); a second one raises KeyboardInterrupt at once (the
+    engine then rolls back to the state before the command). Only in the main thread and
+    when Python's default handler is in place (an embedding program keeps its own)."""
+    if (threading.current_thread() is not threading.main_thread()
+            or signal.getsignal(signal.SIGINT) is not signal.default_int_handler):
+        yield
+        return
+
+    def handler(signum, frame):
+        if _StopFlag.requested:
+            raise KeyboardInterrupt
+        _StopFlag.requested = True
+
+    old = signal.signal(signal.SIGINT, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
+#: target wall time of one kernel call [s]: Ctrl-C and progress are seen at least this often
+CHUNK_SECONDS = 0.2
+#: a line of progress every this many seconds when the output is not a terminal
+PROGRESS_SECONDS = 10.0
+#: local/maximum ratios are scaled by this so that they mean about the same as the average
+#: (Itasca, ``zone ratio`` / ``structure ratio`` command pages, see ``RigidEngine.criteria``)
+RATIO_SCALE = 0.1
 
 
 def mech(model) -> dict:
@@ -64,8 +121,8 @@ class RigidEngine(ContactDetection):
     def __init__(self, model):
         self.model = model
         self.dt = 0.0
-        self.unbal = 0.0
-        self.ratio = 1.0
+        #: the equilibrium measures of ``criteria()`` at the last step (None: not worked out yet)
+        self._criteria: dict | None = None
         #: kinetic energy of the moving bodies at the last step (real masses) [J]
         self.kinetic = 0.0
         #: callables hook(engine) run after every batch of steps (histories register here);
@@ -188,14 +245,203 @@ class RigidEngine(ContactDetection):
         im, isc = inertial_masses(gmass, giscalar, kg, dt, frac)
         return dt, im, isc
 
-    def cycle(self, nsteps: int, stop=None, max_time: float | None = None) -> int:
-        """Run up to ``nsteps`` steps; ``stop(engine)`` is checked after every batch (at most
-        ``update-interval`` steps apart); ``max_time``: stop when the model time reaches it.
-        Returns the steps done."""
+    # ------------------------------------------------------------ equilibrium measures
+    @property
+    def unbal(self) -> float:
+        """Largest unbalanced force of a moving body at the last step [N]."""
+        return self.criteria()["unbalanced-maximum"]
+
+    @property
+    def ratio(self) -> float:
+        """The mechanical ratio at the last step (the average ratio, Itasca's default)."""
+        return self.criteria()["ratio"]
+
+    def criteria(self) -> dict[str, float]:
+        """The equilibrium measures of the moving bodies at the last step, as Itasca defines them
+        for gridpoints (FLAC3D/3DEC manual, "Reaching Equilibrium" and its "Out-of-Balance Force
+        and Ratio Calculation" section; ``zone ratio`` and ``structure ratio`` command pages,
+        docs.itascacg.com), applied to dec3d's bodies (a lone block or a group of joined blocks):
+
+        - unbalanced force of a body: |Σ F| of everything acting on it (contact forces, weight,
+          applied force), the components its fixity holds left out — what moves it;
+        - applied force magnitude of a body: Σ |F| over the same forces one by one (the weight,
+          the applied force and the force of each sub-contact): "a measure of the total forces
+          being applied";
+        - ``unbalanced-maximum``: the largest unbalanced force [N];
+        - ``ratio-average``: mean unbalanced force / mean applied force magnitude;
+        - ``ratio-local``: the largest ratio of a body's unbalanced force to its own applied
+          force magnitude, scaled by 0.1 "to make it mean approximately the same as average";
+        - ``ratio-maximum``: the largest unbalanced force / mean applied force magnitude,
+          scaled by 0.1 likewise;
+        - ``ratio``: the average ratio (the default ratio of ``model solve``).
+        Bodies whose three translations are fixed take no part (dec3d's choice); a body on
+        which no force acts has no local ratio. Moments are not counted (as for gridpoints).
+        Worked out from the sub-contact forces of the last step (``fn``, ``fs``), which the
+        cycle leaves in place, so the kernels need not return them.
+        """
+        if self._criteria is None:
+            self._criteria = self._work_out_criteria()
+        return self._criteria
+
+    def _work_out_criteria(self) -> dict[str, float]:
         m = self.model
         b = m.blocks
-        if b.n == 0 or nsteps <= 0:
+        out = {"ratio": 0.0, "ratio-average": 0.0, "ratio-local": 0.0, "ratio-maximum": 0.0,
+               "unbalanced-maximum": 0.0}
+        gstart, gmember = self._groups()
+        if b.n == 0 or len(gmember) == 0:
+            return out
+        g = np.asarray(m.settings.gravity, dtype=_F)
+        cs, ss = self.contacts, self.subcontacts
+        fc = np.zeros((b.n, 3))
+        mag = np.zeros(b.n)
+        if ss.n:
+            c = ss["contact"]
+            f = ss["fn"][:, None] * cs["normal"][c] + ss["fs"]        # on B; −f on A
+            ia, ib = cs["a"][c], cs["b"][c]
+            for k in range(3):
+                fc[:, k] = np.bincount(ib, f[:, k], minlength=b.n) - np.bincount(ia, f[:, k], minlength=b.n)
+            fm = np.linalg.norm(f, axis=1)
+            mag = np.bincount(ia, fm, minlength=b.n) + np.bincount(ib, fm, minlength=b.n)
+        weight = b["mass"][:, None] * g
+        total = fc + b["fapp"] + weight
+        applied = mag + np.linalg.norm(weight, axis=1) + np.linalg.norm(b["fapp"], axis=1)
+        first = gstart[:-1]
+        F = np.add.reduceat(total[gmember], first)
+        A = np.add.reduceat(applied[gmember], first)
+        fix = (b["fixity"] | b["apply_fix"])[gmember[first]].astype(_I)
+        held = ((fix[:, None] >> np.arange(3)) & 1) == 1
+        F = np.where(held, 0.0, F)
+        free = ~held.all(axis=1)
+        if not free.any():
+            return out
+        un = np.linalg.norm(F[free], axis=1)
+        A = A[free]
+        umax = float(un.max())
+        out["unbalanced-maximum"] = umax
+        if A.sum() > 0.0:
+            out["ratio-average"] = float(un.sum() / A.sum())
+            out["ratio-maximum"] = RATIO_SCALE * umax / float(A.mean())
+        on = A > 0.0
+        if on.any():
+            out["ratio-local"] = RATIO_SCALE * float((un[on] / A[on]).max())
+        out["ratio"] = out["ratio-average"]
+        return out
+
+    def stiffness_warning(self) -> str | None:
+        """A warning when contacts in use (with sub-contacts) have zero normal or shear
+        stiffness: blocks would sink into each other or slide freely and a solve would
+        run to its cycle limit. Looks at the contacts as they are (``cycle(warn=…)`` calls it
+        after its first detection)."""
+        if self.model.blocks.n == 0:
+            return None
+        cs = self.contacts
+        if cs.n == 0:
+            return None
+        used = cs["sub_count"] > 0
+        prop = cs["prop"].copy()
+        follow = cs["own_props"] == 0             # these take the defaults at the next detection
+        for code in np.unique(cs["jmodel"][follow]):
+            prop[follow & (cs["jmodel"] == code)] = default_row(self.settings(), int(code))
+        bad = used & ((prop[:, P_KN] <= 0.0) | (prop[:, P_KS] <= 0.0))
+        if not bad.any():
+            return None
+        k = int(np.flatnonzero(bad)[0])
+        return (f"{int(bad.sum())} of {int(used.sum())} contacts have zero normal or shear stiffness "
+                f"(the first between blocks {int(cs['ida'][k])} and {int(cs['idb'][k])}): blocks will sink "
+                "into each other or slide freely; set stiffness-normal and stiffness-shear with "
+                "`block contact property` or `block contact material-table default property`")
+
+    # ------------------------------------------------------------ cycling
+    def cycle(self, nsteps: int, stop=None, max_time: float | None = None, warn=None) -> int:
+        """Run up to ``nsteps`` steps; ``stop(engine)`` is checked after every batch (at most
+        ``update-interval`` steps apart); ``max_time``: stop when the model time reaches it;
+        ``warn(text)`` gets the ``stiffness_warning()`` once contacts are detected, before the
+        first step. Returns the steps done.
+
+        A failed call leaves the model as it was before it: what the cycle changes (block
+        motion fields, vertex positions, the contact and sub-contact stores, the engine
+        settings, time, step, history samples) is copied first and put back when anything
+        raises — a blow-up (``RunError``), a second Ctrl-C, an error in a hook. The copy costs
+        about the memory of those stores once per call. The first Ctrl-C (or
+        ``request_stop()``) stops at the end of the current batch instead (kernel calls last
+        about ``CHUNK_SECONDS``): the model is consistent there and ``CycleInterrupted``
+        (a KeyboardInterrupt) is raised after the state is stored."""
+        m = self.model
+        if m.blocks.n == 0 or nsteps <= 0:
             return 0
+        snap = self._snapshot()
+        self._spin0 = snap["blocks"]["spin"]
+        _StopFlag.requested = False
+        try:
+            # a run that blows up is reported by the engine itself (RunError), not by numpy warnings
+            with _sigint_stops_cycling(), np.errstate(over="ignore", invalid="ignore"):
+                done = self._cycle(nsteps, stop, max_time, warn)
+        except BaseException:
+            self._restore(snap)
+            _StopFlag.requested = False
+            raise
+        if _StopFlag.requested:
+            _StopFlag.requested = False
+            raise CycleInterrupted(m.step)
+        return done
+
+    def _snapshot(self) -> dict:
+        m = self.model
+        b, v = m.blocks, m.vertices
+        hs = getattr(m, "history_set", None)
+        return {"blocks": {k: b[k].copy() for k in b.fields},
+                "vertices": {k: v[k].copy() for k in ("pos", "map_pos", "look_pos") if k in v},
+                # (to_arrays gives views where it can: copy them)
+                "contacts": {k: a.copy() for k, a in self.contacts.to_arrays().items()},
+                "subcontacts": {k: a.copy() for k, a in self.subcontacts.to_arrays().items()},
+                "mech": copy.deepcopy(m.settings.mechanical), "time": m.time, "step": m.step,
+                "engine": (self.dt, self.kinetic, self._cand, self._criteria),
+                "histories": [(h, len(h.steps), len(h.times), len(h.values)) for h in (hs.items if hs else [])]}
+
+    def _restore(self, snap: dict) -> None:
+        m = self.model
+        b, v = m.blocks, m.vertices
+        for k, a in snap["blocks"].items():
+            b.full(k)[: len(a)] = a
+        for k, a in snap["vertices"].items():
+            v.full(k)[: len(a)] = a
+        self.contacts.load_arrays(snap["contacts"])
+        self.subcontacts.load_arrays(snap["subcontacts"])
+        mechanical = m.settings.mechanical
+        mechanical.clear()
+        mechanical.update(snap["mech"])
+        m.time, m.step = snap["time"], snap["step"]
+        self.dt, self.kinetic, self._cand, self._criteria = snap["engine"]
+        for h, ns, nt, nv in snap["histories"]:
+            del h.steps[ns:], h.times[nt:], h.values[nv:]
+
+    def _blowup(self, bad: int, dt: float, far: bool) -> RunError:
+        """The message of a run that became unstable at block row ``bad``: a spin blow-up
+        names the angular speed [rad/s], a translation blow-up the speed [m/s]."""
+        m = self.model
+        b = m.blocks
+        bid = int(b["id"][bad])
+        w = math.hypot(*b["spin"][bad])                  # (hypot: no overflow on the way)
+        v = math.hypot(*b["velocity"][bad])
+        spin = not math.isfinite(w) or w * dt > 1.0
+        if spin:
+            w0 = math.hypot(*self._spin0[bad]) if getattr(self, "_spin0", None) is not None else math.nan
+            if not math.isfinite(w):
+                w = w0
+            what = (f"spins at {w:.3g} rad/s ({w * dt:.3g} rad in one step of {dt:.3g} s)" if math.isfinite(w)
+                    else "has a spin that is not a finite number")
+        elif far:
+            what = f"moved farther than its own size in one step (speed {v:.3g} m/s, time step {dt:.3g} s)"
+        else:
+            what = f"reached velocity {v:.3g} m/s (time step {dt:.3g} s too large or stiffness too high)"
+        tail = ": it can pass through other blocks unseen" if far and not spin else ""
+        return RunError(f"the run became unstable at step {m.step}: block {bid} {what}{tail}; "
+                        "the model is back at its state before this command")
+
+    def _cycle(self, nsteps: int, stop, max_time, warn=None) -> int:
+        m = self.model
+        b = m.blocks
         live = ~b["hidden"]
         if (b["mass"][live] <= 0).any():
             raise RunError("a block has no mass: set `block property density` before cycling")
@@ -221,9 +467,13 @@ class RigidEngine(ContactDetection):
         vmax = 1e6
         interval = max(1, int(m.settings.update_interval))
         done = 0
-        progress = _Progress(nsteps)
+        progress = _Progress(nsteps, self)
         if self._signature != self._geometry_signature():
             self.detect()
+        if warn is not None:
+            msg = self.stiffness_warning()
+            if msg:
+                warn(msg)
         dt, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt_fixed)
         self.dt = dt
         # detection also runs as soon as a block has moved CTOL/2 since the last one, so
@@ -233,8 +483,9 @@ class RigidEngine(ContactDetection):
         motion = np.zeros(2)
         trigger = 0.5 * self.tolerance()
         due = False
+        chunk = 10                       # steps per kernel call, adapted to CHUNK_SECONDS
         try:
-            while done < nsteps:
+            while done < nsteps and not _StopFlag.requested:
                 if m.step % interval == 0 or due:
                     self.detect()
                     acc[:] = 0.0
@@ -255,30 +506,39 @@ class RigidEngine(ContactDetection):
                         break
                     k = min(k, left)
                 cs, ss = self.contacts, self.subcontacts
-                t0 = _time.perf_counter()
-                n_ok, bad = run_steps(k, dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass, gisc,
-                                      gprin, gaxes, gcen, b["mass"], fixity, b["force"], b["moment"], b["fapp"],
-                                      b["mapp"], b["velocity"], b["spin"], b["centroid"], b["disp"],
-                                      b["vert_start"], b["vert_count"], m.vertices["pos"], cs["a"], cs["b"],
-                                      cs["normal"], cs["pos"], np.arange(cs.n, dtype=_I), cs["jmodel"], cs["prop"],
-                                      ss["contact"], ss["pos"], ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"],
-                                      ss["us"], ss["state"], vmax, out, radius, acc, trigger, motion)
-                self.timings["cycle"] += _time.perf_counter() - t0
+                # the batch of k steps runs as kernel calls of about CHUNK_SECONDS each, so that
+                # Ctrl-C and progress are seen in time; the split changes no number (the kernel
+                # carries its state in the arrays; time advances once per batch as before)
+                n_ok = 0
+                bad = -1
+                while n_ok < k:
+                    kk = min(k - n_ok, chunk)
+                    t0 = _time.perf_counter()
+                    c_ok, bad = run_steps(kk, dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass, gisc,
+                                          gprin, gaxes, gcen, b["mass"], fixity, b["force"], b["moment"], b["fapp"],
+                                          b["mapp"], b["velocity"], b["spin"], b["centroid"], b["disp"],
+                                          b["vert_start"], b["vert_count"], m.vertices["pos"], cs["a"], cs["b"],
+                                          cs["normal"], cs["pos"], np.arange(cs.n, dtype=_I), cs["jmodel"],
+                                          cs["prop"], ss["contact"], ss["pos"], ss["area"], ss["fn"], ss["fs"],
+                                          ss["un"], ss["udil"], ss["us"], ss["state"], vmax, out, radius, acc,
+                                          trigger, motion)
+                    spent = _time.perf_counter() - t0
+                    self.timings["cycle"] += spent
+                    n_ok += c_ok
+                    if bad >= 0 or motion[1] > 0.0 or c_ok < kk:
+                        break
+                    if c_ok > 0:
+                        chunk = max(1, min(100000, int(c_ok * CHUNK_SECONDS / max(spent, 1e-9))))
+                    progress.update(done + n_ok)
+                    if _StopFlag.requested:
+                        break
                 due = motion[1] > 0.0
                 m.step += n_ok
                 m.time += n_ok * dt
                 done += n_ok
-                if bad >= 0 and motion[1] == 2.0:
-                    raise RunError(f"the run became unstable at step {m.step}: block {int(b['id'][bad])} moved "
-                                   f"farther than its own size in one step (speed "
-                                   f"{np.linalg.norm(b['velocity'][bad]):.3g} m/s, time step {dt:.3g} s): "
-                                   "it can pass through other blocks unseen")
+                self._criteria = None
                 if bad >= 0:
-                    raise RunError(f"the run became unstable at step {m.step}: block {int(b['id'][bad])} "
-                                   f"reached velocity {np.abs(b['velocity'][bad]).max():.3g} m/s "
-                                   f"(time step {dt:.3g} s too large or stiffness too high)")
-                self.unbal = float(out[0])
-                self.ratio = float(out[0] / (out[1] / max(ng, 1))) if out[1] > 0 else 0.0
+                    raise self._blowup(bad, dt, motion[1] == 2.0)
                 self.kinetic = float(out[2])
                 t0 = _time.perf_counter()
                 for hook in self.step_hooks:
@@ -312,20 +572,31 @@ class RigidEngine(ContactDetection):
 
 
 class _Progress:
-    """A rich progress bar for runs longer than about a second, on a terminal only."""
+    """On a terminal, a rich progress bar for runs longer than about a second; otherwise
+    (output to a file or a pipe) a line every ``PROGRESS_SECONDS`` of wall time."""
 
-    def __init__(self, total: int):
+    def __init__(self, total: int, eng=None):
         self.total = total
+        self.eng = eng
         self.t0 = _time.perf_counter()
+        self.last = self.t0
         self.bar = None
         self.task = None
         self.enabled = sys.stdout.isatty()
 
     def update(self, done: int) -> None:
+        now = _time.perf_counter()
         if not self.enabled:
+            if now - self.last >= PROGRESS_SECONDS:
+                self.last = now
+                e = self.eng
+                extra = ""
+                if e is not None:
+                    extra = f", step {e.model.step}, ratio {e.ratio:.3g}"
+                print(f"cycling: {done} of {self.total} steps{extra} ({now - self.t0:.0f} s)", flush=True)
             return
         if self.bar is None:
-            if _time.perf_counter() - self.t0 < 1.0:
+            if now - self.t0 < 1.0:
                 return
             from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
