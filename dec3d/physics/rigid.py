@@ -23,6 +23,7 @@ import numpy as np
 
 from dec3d.errors import Dec3dError
 from dec3d.io.vtk import periodic_vtk
+from dec3d.kernels.balance import body_balance
 from dec3d.kernels.cycle import run_steps
 from dec3d.kernels.jointlaw import P_KN, P_KS
 from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST, block_timestep
@@ -123,6 +124,7 @@ class RigidEngine(ContactDetection):
         self.dt = 0.0
         #: the equilibrium measures of ``criteria()`` at the last step (None: not worked out yet)
         self._criteria: dict | None = None
+        self._group_cache = None      # (gstart, gmember) while cycling
         #: kinetic energy of the moving bodies at the last step (real masses) [J]
         self.kinetic = 0.0
         #: callables hook(engine) run after every batch of steps (histories register here);
@@ -276,8 +278,9 @@ class RigidEngine(ContactDetection):
         - ``ratio``: the average ratio (the default ratio of ``model solve``).
         Bodies whose three translations are fixed take no part (dec3d's choice); a body on
         which no force acts has no local ratio. Moments are not counted (as for gridpoints).
-        Worked out from the sub-contact forces of the last step (``fn``, ``fs``), which the
-        cycle leaves in place, so the kernels need not return them.
+        Worked out (kernel ``balance.body_balance``) from the sub-contact forces of the last
+        step (``fn``, ``fs``), which the cycle leaves in place, so the cycle kernels need not
+        return them.
         """
         if self._criteria is None:
             self._criteria = self._work_out_criteria()
@@ -288,34 +291,21 @@ class RigidEngine(ContactDetection):
         b = m.blocks
         out = {"ratio": 0.0, "ratio-average": 0.0, "ratio-local": 0.0, "ratio-maximum": 0.0,
                "unbalanced-maximum": 0.0}
-        gstart, gmember = self._groups()
+        gstart, gmember = self._group_cache if self._group_cache is not None else self._groups()
         if b.n == 0 or len(gmember) == 0:
             return out
-        g = np.asarray(m.settings.gravity, dtype=_F)
+        ng = len(gstart) - 1
         cs, ss = self.contacts, self.subcontacts
-        fc = np.zeros((b.n, 3))
-        mag = np.zeros(b.n)
-        if ss.n:
-            c = ss["contact"]
-            f = ss["fn"][:, None] * cs["normal"][c] + ss["fs"]        # on B; −f on A
-            ia, ib = cs["a"][c], cs["b"][c]
-            for k in range(3):
-                fc[:, k] = np.bincount(ib, f[:, k], minlength=b.n) - np.bincount(ia, f[:, k], minlength=b.n)
-            fm = np.linalg.norm(f, axis=1)
-            mag = np.bincount(ia, fm, minlength=b.n) + np.bincount(ib, fm, minlength=b.n)
-        weight = b["mass"][:, None] * g
-        total = fc + b["fapp"] + weight
-        applied = mag + np.linalg.norm(weight, axis=1) + np.linalg.norm(b["fapp"], axis=1)
-        first = gstart[:-1]
-        F = np.add.reduceat(total[gmember], first)
-        A = np.add.reduceat(applied[gmember], first)
-        fix = (b["fixity"] | b["apply_fix"])[gmember[first]].astype(_I)
-        held = ((fix[:, None] >> np.arange(3)) & 1) == 1
-        F = np.where(held, 0.0, F)
-        free = ~held.all(axis=1)
+        held = (b["fixity"] | b["apply_fix"])[gmember[gstart[:-1]]].astype(np.uint8)
+        un = np.empty(ng)
+        A = np.empty(ng)
+        body_balance(np.asarray(m.settings.gravity, dtype=_F), gstart, gmember, b["mass"], b["fapp"], held,
+                     cs["a"], cs["b"], cs["normal"], ss["contact"], ss["fn"], ss["fs"], np.empty((b.n, 3)),
+                     np.empty(b.n), un, A)
+        free = (held & 7) != 7
         if not free.any():
             return out
-        un = np.linalg.norm(F[free], axis=1)
+        un = un[free]
         A = A[free]
         umax = float(un.max())
         out["unbalanced-maximum"] = umax
@@ -450,6 +440,7 @@ class RigidEngine(ContactDetection):
         mode, alpha = self.damping()
         full = self.full_inertia()
         gstart, gmember = self._groups()
+        self._group_cache = (gstart, gmember)
         ng = len(gstart) - 1
         # orientation of each block: its principal axes are kept current (below)
         inertia = np.einsum("bij,bj,bkj->bik", b["principal_axes"], b["principal_moment"], b["principal_axes"])
@@ -549,6 +540,7 @@ class RigidEngine(ContactDetection):
                 if stop is not None and stop(self):
                     break
         finally:
+            self._group_cache = None
             progress.close()
             # keep each block's principal axes turning with its body; save the servo state
             turn = np.einsum("gij,gkj->gik", gaxes, axes0)

@@ -79,7 +79,8 @@ def _slow_criteria(m, e):
 
 def test_criteria_match_the_definitions_on_a_moving_stack(session):
     """Mid-run (far from equilibrium), with an applied force, a block held in x only and two
-    joined blocks, so that every rule of the definitions matters."""
+    joined blocks, so that every rule of the definitions matters. ``_slow_criteria`` is also the
+    slow twin of the kernel ``kernels/balance.body_balance`` behind ``criteria()``."""
     e = _run(session, BASE + "block apply force 300 -200 50 range position-z 1 2\n"
                              "block fix velocity-x range position-z 1 2\n"
                              "block join range position-z 2 3\nmodel cycle 37\n")

@@ -221,3 +221,14 @@ def test_ctrl_c_in_dec3d_run_prints_one_line_and_exits_130(tmp_path):
     assert "Traceback" not in err
     lines = [ln for ln in err.splitlines() if "interrupt" in ln.lower()]
     assert len(lines) == 1 and re.fullmatch(r"interrupted at step \d+", lines[0]), err
+
+
+def test_progress_lines_when_the_output_is_not_a_terminal(session, monkeypatch, capsys):
+    import dec3d.physics.rigid as rigid
+
+    monkeypatch.setattr(rigid, "PROGRESS_SECONDS", 0.0)      # a line at every batch instead of every 10 s
+    _run(session, STACK.replace("model cycle 20\n", "model cycle 30\n"))
+    lines = capsys.readouterr().out.splitlines()
+    assert lines, "no progress line"
+    assert all(re.fullmatch(r"cycling: \d+ of 30 steps, step \d+, ratio [0-9.e+-]+ \(\d+ s\)", ln) for ln in lines), lines
+    assert lines[-1].startswith("cycling: 30 of 30 steps, step 30,")
