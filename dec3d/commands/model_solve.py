@@ -17,7 +17,8 @@ from .values import FLAG, Num, P
 
 _TIMING = P("timing", FLAG, "print how long each phase of the cycle took (dec3d)", bare=True)
 
-#: the steps a `model solve` takes at most when it is given neither `cycles` nor `time`
+#: the steps a `model solve` takes at most when it is given neither `cycles` nor `time` (or
+#: `time` with `and`, which cannot end a solve whose ratio is never met)
 #: (dec3d's choice: a limit so that a model that cannot settle ends with "not converged"
 #: instead of running for hours; `cycles n` raises it)
 SOLVE_CYCLE_CAP = 200_000
@@ -78,7 +79,7 @@ def _fmt_criteria(values: dict) -> str:
                    P("and", FLAG, "every given limit must be met", bare=True),
                    P("or", FLAG, "any given limit is enough (default)", bare=True), _TIMING],
          doc=f"Cycle until the limits are met (default: ratio {DEFAULT_RATIO:g}; at most {SOLVE_CYCLE_CAP} steps "
-             "unless `cycles` or `time` is given).",
+             "unless `cycles`, or `time` without `and`, is given).",
          details="The ratios are Itasca's (FLAC3D/3DEC manual, \"Reaching Equilibrium\", section \"Out-of-Balance "
                  "Force and Ratio Calculation\"; `zone ratio` command page), with each moving body (a block or a "
                  "group of joined blocks) in the place of a gridpoint. A body's unbalanced force is |ΣF| of the "
@@ -90,7 +91,8 @@ def _fmt_criteria(values: dict) -> str:
                  "magnitude (the 0.1 makes them mean about the same as the average, as Itasca scales them); "
                  "`unbalanced-maximum`: the largest unbalanced force [N]. Bodies fixed in all three directions "
                  "take no part.\n\n"
-                 f"Without `cycles` or `time` a solve stops after {SOLVE_CYCLE_CAP} steps (dec3d's cap). At the end "
+                 f"Without `cycles`, or `time` without `and`, a solve stops after {SOLVE_CYCLE_CAP} steps (dec3d's "
+                 "cap; Itasca's pages name no default cycle limit that we could find). At the end "
                  "it prints the steps taken, the model time, every criterion value and which limit stopped it; a "
                  "solve with a ratio or unbalanced-force limit that stops on its step, time or clock limit says "
                  "\"not converged\", and `dec3d run` repeats that as a warning at the end of the run (the exit "
@@ -106,7 +108,9 @@ def model_solve(session, call):
         crit = {"ratio": DEFAULT_RATIO}
     t_end = e.time + a["time"] if a["time"] is not None else None
     both = bool(a["and"])
-    capped = a["cycles"] is None and a["time"] is None
+    # the cap holds unless the solve has its own end: `cycles`, or `time` alone (with `and` a
+    # time limit does not end a solve whose ratio is never met)
+    capped = a["cycles"] is None and (a["time"] is None or both)
     n = int(a["cycles"]) if a["cycles"] is not None else SOLVE_CYCLE_CAP if capped else 2**62
     wall_end = _time.monotonic() + 60.0 * a["clock"] if a["clock"] is not None else None
     why: dict = {}
@@ -135,10 +139,10 @@ def model_solve(session, call):
     values = e.criteria()
     met = met_criteria(e)
     converged = bool(crit) and (all(met) if both else any(met))
-    if t_end is not None and e.time >= t_end - 1e-9 * max(e.dt, 1e-300):
-        limit = f"the time limit ({a['time']:g} s)"
-    elif done >= n:
+    if done >= n:
         limit = f"the step limit ({n} steps{', dec3d’s default cap' if capped else ''})"
+    elif t_end is not None and e.time >= t_end - 1e-9 * max(e.dt, 1e-300):
+        limit = f"the time limit ({a['time']:g} s)"
     elif why.get("clock"):
         limit = f"the clock limit ({a['clock']:g} min)"
     else:

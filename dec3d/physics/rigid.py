@@ -563,6 +563,10 @@ class RigidEngine(ContactDetection):
                          [f"{k:<20}{v:9.3f}{100 * v / tot:7.1f}%" for k, v in rows])
 
 
+#: a step count at least this large means "no step limit" (a solve limited by time or ratio only)
+_OPEN_END = 2**60
+
+
 class _Progress:
     """On a terminal, a rich progress bar for runs longer than about a second; otherwise
     (output to a file or a pipe) a line every ``PROGRESS_SECONDS`` of wall time."""
@@ -585,7 +589,8 @@ class _Progress:
                 extra = ""
                 if e is not None:
                     extra = f", step {e.model.step}, ratio {e.ratio:.3g}"
-                print(f"cycling: {done} of {self.total} steps{extra} ({now - self.t0:.0f} s)", flush=True)
+                of = f" of {self.total}" if self.total < _OPEN_END else ""
+                print(f"cycling: {done}{of} steps{extra} ({now - self.t0:.0f} s)", flush=True)
             return
         if self.bar is None:
             if now - self.t0 < 1.0:
@@ -595,7 +600,7 @@ class _Progress:
             self.bar = Progress(TextColumn("cycling"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
                                 TimeRemainingColumn(), transient=True)
             self.bar.start()
-            self.task = self.bar.add_task("cycle", total=self.total)
+            self.task = self.bar.add_task("cycle", total=self.total if self.total < _OPEN_END else None)
         self.bar.update(self.task, completed=done)
 
     def close(self) -> None:

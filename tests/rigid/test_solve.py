@@ -181,3 +181,13 @@ def test_zero_stiffness_warning_before_cycling(session):
 def test_no_stiffness_warning_when_stiffness_is_set(session):
     _run(session, BASE + "model cycle 1\nmodel solve cycles 5\n")
     assert "warning" not in session.output.getvalue()
+
+
+def test_cap_holds_for_a_time_limit_joined_by_and(session, monkeypatch):
+    """`time t and` cannot end a solve whose ratio is never met: the cap ends it."""
+    monkeypatch.setattr(model_solve, "SOLVE_CYCLE_CAP", 40)
+    _run(session, "model new\nblock create brick 0 1 0 1 0 1\nblock property density 1000\nmodel gravity 0 0 -10\n"
+                  "model solve ratio 1e-3 time 1e-6 and\n")
+    assert session.model.step == 40
+    assert "not converged (ratio ≤ 0.001 not met): stopped by the step limit (40 steps, dec3d’s default cap)" \
+        in session.output.getvalue()
