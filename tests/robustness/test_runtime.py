@@ -232,3 +232,19 @@ def test_progress_lines_when_the_output_is_not_a_terminal(session, monkeypatch, 
     assert lines, "no progress line"
     assert all(re.fullmatch(r"cycling: \d+ of 30 steps, step \d+, ratio [0-9.e+-]+ \(\d+ s\)", ln) for ln in lines), lines
     assert lines[-1].startswith("cycling: 30 of 30 steps, step 30,")
+
+
+def test_kernel_calls_split_for_ctrl_c_change_no_number(tmp_path, monkeypatch):
+    """Batches run as kernel calls of about CHUNK_SECONDS; one step per call gives the same bits."""
+    import dec3d.physics.rigid as rigid
+    from dec3d.session import Session
+
+    runs = []
+    for seconds in (rigid.CHUNK_SECONDS, 1e-12):
+        monkeypatch.setattr(rigid, "CHUNK_SECONDS", seconds)
+        s = Session(out_dir=tmp_path, stdout=io.StringIO())
+        _run(s, STACK.replace("model cycle 20\n", "model update-interval 50\nblock initialize velocity-x 0.01 "
+                                                  "range position-z 1 2\nmodel cycle 120\n"))
+        runs.append((s.model.vertices["pos"].copy(), s.model.blocks["spin"].copy(), s.model.time))
+    assert np.array_equal(runs[0][0], runs[1][0]) and np.array_equal(runs[0][1], runs[1][1])
+    assert runs[0][2] == runs[1][2]
