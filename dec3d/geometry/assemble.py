@@ -24,7 +24,7 @@ import numpy as np
 from .mass import range_index, update_face_geometry, update_mass_properties
 from .polyhedron import Poly
 
-_KEEP_VERTEX = ("pos", "block")
+_KEEP_VERTEX = ("pos", "block", "origin")
 _KEEP_FACE = ("block", "vstart", "nvert", "normal", "area", "centroid")
 
 
@@ -61,7 +61,16 @@ def write_pieces(model, block_rows, pos, vsrc, piece_nv, fn, fsrc, piece_nf, fv)
     new_v = np.arange(vsl.start, vsl.stop, dtype=np.int64)
     vs.full("pos")[vsl] = pos
     vs.full("block")[vsl] = np.repeat(block_rows, piece_nv)
-    _copy_rows(vs, new_v, np.asarray(vsrc, dtype=np.int64), _KEEP_VERTEX)
+    vsrc = np.asarray(vsrc, dtype=np.int64)
+    _copy_rows(vs, new_v, vsrc, _KEEP_VERTEX)
+    # origin: a vertex keeps the displacement of its source vertex (a cut vertex: of the edge end
+    # it was made from); one without a source has moved as its block's centroid (a fresh block: not at all)
+    vpos, origin = vs.full("pos"), vs.full("origin")
+    has = vsrc >= 0
+    moved = np.empty((len(new_v), 3))
+    moved[has] = vpos[vsrc[has]] - origin[vsrc[has]]
+    moved[~has] = model.blocks["disp"][vs.full("block")[new_v[~has]]]
+    origin[new_v] = vpos[new_v] - moved
 
     piece_vstart = vsl.start + np.concatenate(([0], np.cumsum(piece_nv)[:-1])).astype(np.int64)
     fsl = fs.append(len(fn))
