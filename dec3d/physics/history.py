@@ -12,12 +12,19 @@ from typing import Callable
 
 import numpy as np
 
+from dec3d.model.kinematics import block_rotation, unwrap_rotation
+
 _XYZ = (("", None), ("-x", 0), ("-y", 1), ("-z", 2))
 #: block quantity -> (engine field, component or None for the magnitude)
 BLOCK_QUANTITIES = {f"{q}{s}": (fld, comp)
                     for q, fld in (("displacement", "disp"), ("velocity", "velocity"), ("rvelocity", "spin"),
                                    ("position", "centroid"))
                     for s, comp in _XYZ}
+#: the rotation of a block since it was made (``dec3d.model.kinematics``): components of the rotation
+#: vector θ n [rad] and θ itself, followed continuously from sample to sample
+ROTATION_QUANTITIES = ("rotation", "rotation-x", "rotation-y", "rotation-z")
+#: quantities that `point x y z` can follow at a point fixed to the block instead of at its centroid
+POINT_QUANTITIES = tuple(q for q in BLOCK_QUANTITIES if q.split("-")[0] in ("displacement", "velocity", "position"))
 #: dec3d's own block quantities (not 3DEC variables), worked out from the vertices each sample:
 #: angular momentum I(t) ω about the centroid, I(t) = R I₀ Rᵀ with R the best-fit rotation of the vertex
 #: arms since the history was made (Kabsch), and the shape error max |r − R r₀| [m] of the vertex arms
@@ -84,6 +91,67 @@ class HistorySet:
             return float(np.linalg.norm(v)) if comp is None else float(v[comp])
 
         return self.add(f"block {block_id} {quantity}", value, name)
+
+    def _row(self, block_id: int, cache: dict) -> int:
+        b = self.model.blocks
+        r = cache.get("row", -1)
+        if not (0 <= r < b.n and b["id"][r] == block_id):
+            r = cache["row"] = int(np.flatnonzero(b["id"] == block_id)[0])
+        return r
+
+    def add_rotation(self, quantity: str, block_id: int, name: str | None = None) -> History:
+        """A component of the block's rotation vector since it was made, or its angle [rad]; each
+        sample takes the equivalent vector (θ + 2πk) n nearest the previous one, so a block that keeps
+        turning about one axis gives ω t past θ = π."""
+        model = self.model
+        state: dict = {"prev": None}
+        comp = {"rotation": None, "rotation-x": 0, "rotation-y": 1, "rotation-z": 2}[quantity]
+
+        def value(eng) -> float:
+            r = self._row(block_id, state)
+            rv = unwrap_rotation(block_rotation(model, [r])[0], state["prev"])
+            state["prev"] = rv
+            return float(np.linalg.norm(rv)) if comp is None else float(rv[comp])
+
+        return self.add(f"block {block_id} {quantity}", value, name)
+
+    def add_point(self, quantity: str, block_id: int, point, name: str | None = None) -> History:
+        """Displacement (since the block was made), velocity or position of a point fixed to a block.
+
+        The point's arm from the mean of the block's vertices is carried by the best-fit rotation of
+        the vertex arms since the history was made: p(t) = x̄(t) + R(t) (p₀ − x̄₀). Its velocity is
+        v + ω × (p − c) of the block; its displacement is p(t) minus where the point was when the
+        block was made (x̄ of the vertex origins + Rcᵀ (p₀ − x̄₀), Rc the block's rotation then)."""
+        fld, comp = BLOCK_QUANTITIES[quantity]
+        model = self.model
+        b, v = model.blocks, model.vertices
+        cache: dict = {}
+        r0 = self._row(block_id, cache)
+        s, c = int(b["vert_start"][r0]), int(b["vert_count"][r0])
+        p0 = np.asarray(point, dtype=float)
+        pos0 = v["pos"][s:s + c]
+        arms0 = pos0 - pos0.mean(axis=0)
+        arm_p = p0 - pos0.mean(axis=0)
+        org = v["origin"][s:s + c]
+        rc = best_rotation(org - org.mean(axis=0), arms0)
+        p_origin = org.mean(axis=0) + rc.T @ arm_p
+
+        def value(eng) -> float:
+            bb, vv = model.blocks, model.vertices
+            r = self._row(block_id, cache)
+            st = int(bb["vert_start"][r])
+            pos = vv["pos"][st:st + c]
+            mean = pos.mean(axis=0)
+            p = mean + best_rotation(arms0, pos - mean) @ arm_p
+            if fld == "centroid":
+                out = p
+            elif fld == "disp":
+                out = p - p_origin
+            else:
+                out = bb["velocity"][r] + np.cross(bb["spin"][r], p - bb["centroid"][r])
+            return float(np.linalg.norm(out)) if comp is None else float(out[comp])
+
+        return self.add(f"block {block_id} {quantity} at point ({p0[0]:g} {p0[1]:g} {p0[2]:g})", value, name)
 
     def add_rigid(self, quantity: str, block_id: int, name: str | None = None) -> History:
         """Angular momentum [kg·m²/s] or shape error [m] of one block (``RIGID_QUANTITIES``)."""
