@@ -41,12 +41,12 @@ class HistoryRefs(ValueType):
 
 
 def _check_block(call):
-    point = call.args.get("point")
+    point = call.args.get("material_point")
     if call.args["position"] is not None and call.args["block_id"] is not None:
         raise BindError("give either `position <x y z>` or `block-id <i>`, not both", call.location)
     if call.args["position"] is None and call.args["block_id"] is None and point is None:
         raise BindError("give either `position <x y z>` or `block-id <i>`"
-                        + (" (or `point <x y z>`)" if "point" in call.args else ""), call.location)
+                        + (" (or `material-point <x y z>`)" if "material_point" in call.args else ""), call.location)
 
 
 def _name(session, call):
@@ -60,7 +60,7 @@ def _block_history(quantity, kind="block"):
     def handler(session, call):
         m = session.model
         name = _name(session, call)
-        point = call.args.get("point")
+        point = call.args.get("material_point")
         if call.args["block_id"] is not None:
             bid = int(call.args["block_id"])
             if not (m.blocks["id"] == bid).any():
@@ -87,16 +87,16 @@ _BLOCK_KW = [P("position", VEC3, "the block whose centroid is nearest this point
              P("block-id", Num(integer=True, lo=1), "the block with this id"),
              P("gridpointid", Num(integer=True), "a gridpoint of a deformable block", supported=False),
              P("zone-id", Num(integer=True), "a zone of a deformable block", supported=False)]
-_POINT_KW = [P("point", VEC3, "follow the point fixed to the block that is here when the command runs "
+_POINT_KW = [P("material-point", VEC3, "follow the point fixed to the block that is here when the command runs "
                             "(a corner: its vertex)", units="m")]
 _WHAT = {"displacement": "displacement", "velocity": "velocity", "rvelocity": "angular velocity",
          "position": "centroid position"}
 _WHICH = ("The block is the one whose centroid is nearest `position` when the command runs, or the "
           "block `block-id`. A leading `name '<s>'` names the history (default: its number).")
-_POINT = (" With `point x y z` (dec3d) the value is that of the point fixed to the block that is at "
+_POINT = (" With `material-point x y z` (dec3d) the value is that of the point fixed to the block that is at "
           "(x, y, z) when the command runs, instead of the centroid: its position now, its displacement "
           "since the block was made, its velocity v + ω × (p − c). Give a corner's coordinates to follow "
-          "a vertex. `point` alone picks the block whose centroid is nearest the point; add `block-id` "
+          "a vertex. `material-point` alone picks the block whose centroid is nearest the point; add `block-id` "
           "when the point is on several blocks.")
 
 for _q in BLOCK_QUANTITIES:
@@ -111,7 +111,7 @@ for _q in BLOCK_QUANTITIES:
                               " (dec3d: `rvelocity` and `position` are not 3DEC history variables.)")
             + (_POINT if _pt else ""),
             examples=[f"block history {_q} position 0.5 0.5 0.5", f"block history name 'h{_q[0]}' {_q} block-id 2"]
-            + ([f"block history {_q} block-id 2 point 1 0 1"] if _pt else []),
+            + ([f"block history {_q} block-id 2 material-point 1 0 1"] if _pt else []),
             )(_block_history(_q))
 
 for _q in ROTATION_QUANTITIES:

@@ -23,7 +23,7 @@ BLOCK_QUANTITIES = {f"{q}{s}": (fld, comp)
 #: the rotation of a block since it was made (``dec3d.model.kinematics``): components of the rotation
 #: vector θ n [rad] and θ itself, followed continuously from sample to sample
 ROTATION_QUANTITIES = ("rotation", "rotation-x", "rotation-y", "rotation-z")
-#: quantities that `point x y z` can follow at a point fixed to the block instead of at its centroid
+#: quantities that `material-point x y z` can follow at a point fixed to the block instead of at its centroid
 POINT_QUANTITIES = tuple(q for q in BLOCK_QUANTITIES if q.split("-")[0] in ("displacement", "velocity", "position"))
 #: dec3d's own block quantities (not 3DEC variables), worked out from the vertices each sample:
 #: angular momentum I(t) ω about the centroid, I(t) = R I₀ Rᵀ with R the best-fit rotation of the vertex

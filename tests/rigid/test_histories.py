@@ -153,11 +153,11 @@ def test_point_fixed_to_a_translating_and_spinning_block(session):
     (1, 2, 0.5) and an inner point (0.25, 0.5, 0.25) follow c(t) + Rz(θ)(p₀ − c₀)."""
     session.run_items(session.load_text(
         SPIN + "block initialize velocity-x 1 velocity-z 0.5 rvelocity-z 2 range id 1\n"
-        "block history name 'px' position-x point 1 2 0.5\nblock history name 'py' position-y block-id 1 point 1 2 0.5\n"
-        "block history name 'ux' displacement-x block-id 1 point 0.25 0.5 0.25\n"
-        "block history name 'uz' displacement-z block-id 1 point 0.25 0.5 0.25\n"
-        "block history name 'vy' velocity-y block-id 1 point 0.25 0.5 0.25\n"
-        "block history name 'v' velocity block-id 1 point 0.25 0.5 0.25\n"
+        "block history name 'px' position-x material-point 1 2 0.5\nblock history name 'py' position-y block-id 1 material-point 1 2 0.5\n"
+        "block history name 'ux' displacement-x block-id 1 material-point 0.25 0.5 0.25\n"
+        "block history name 'uz' displacement-z block-id 1 material-point 0.25 0.5 0.25\n"
+        "block history name 'vy' velocity-y block-id 1 material-point 0.25 0.5 0.25\n"
+        "block history name 'v' velocity block-id 1 material-point 0.25 0.5 0.25\n"
         "history interval 50\nmodel cycle 1000\n"
         "history export 'px' 'py' 'ux' 'uz' 'vy' 'v' file 'p.csv'\n"))
     t, th = 1.0, 1000 * 2 * math.atan(1e-3)
@@ -183,7 +183,7 @@ def test_point_and_rotation_errors(session):
 
     with pytest.raises(Dec3dError, match="not both"):
         session.run_items(session.load_text(SPIN + "block history position-x block-id 1 position 0 0 0\n"))
-    with pytest.raises(Dec3dError, match="point"):         # rvelocity is of the block, not of a point
-        session.run_items(session.load_text(SPIN + "block history rvelocity-z block-id 1 point 0 0 0\n"))
-    with pytest.raises(Dec3dError, match=r"`block-id <i>` \(or `point"):
+    with pytest.raises(Dec3dError, match="material-point"):         # rvelocity is of the block, not of a point
+        session.run_items(session.load_text(SPIN + "block history rvelocity-z block-id 1 material-point 0 0 0\n"))
+    with pytest.raises(Dec3dError, match=r"`block-id <i>` \(or `material-point"):
         session.run_items(session.load_text(SPIN + "block history displacement-x\n"))
