@@ -181,3 +181,31 @@ def test_rotation_vector_and_unwrap():
     short = rotation_vector(rot((0, 0, 1), 3.2)[None])[0]
     assert short[2] == pytest.approx(3.2 - 2 * math.pi)
     assert unwrap_rotation(short, prev)[2] == pytest.approx(3.2)
+
+
+def test_state_file_without_vertex_origins_restores_them(session, tmp_path):
+    """A file saved before vertices had an origin: each vertex is taken to have moved with its block."""
+    import json
+    import zipfile
+
+    from dec3d.io.state import restore_state, save_state
+
+    session.run_items(session.load_text(FALL))
+    src, old = tmp_path / "new.d3s", tmp_path / "old.d3s"
+    save_state(session.model, src)
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(old, "w") as zout:
+        for item in zin.infolist():
+            if item.filename == "vertices.origin.npy":
+                continue
+            data = zin.read(item.filename)
+            if item.filename.endswith(".json"):
+                meta = json.loads(data)
+                del meta["stores"]["vertices"]["fields"]["origin"]
+                del meta["sha256"]["vertices.origin"]
+                data = json.dumps(meta).encode()
+            zout.writestr(item, data)
+    model, _ = restore_state(old)
+    uz = -G * DT ** 2 * N * (N + 1) / 2
+    np.testing.assert_allclose((model.vertices["pos"] - model.vertices["origin"])[:, 2], uz, rtol=1e-9)
+    restored, _ = restore_state(src)
+    np.testing.assert_array_equal(restored.vertices["origin"], session.model.vertices["origin"])
