@@ -118,36 +118,36 @@ class HistorySet:
     def add_point(self, quantity: str, block_id: int, point, name: str | None = None) -> History:
         """Displacement (since the block was made), velocity or position of a point fixed to a block.
 
-        The point's arm from the mean of the block's vertices is carried by the best-fit rotation of
-        the vertex arms since the history was made: p(t) = x̄(t) + R(t) (p₀ − x̄₀). Its velocity is
-        v + ω × (p − c) of the block; its displacement is p(t) minus where the point was when the
-        block was made (x̄ of the vertex origins + Rcᵀ (p₀ − x̄₀), Rc the block's rotation then)."""
+        The point is kept in the block's frame at its making: p_o = x̄_o + Rᵀ (p − x̄), with x̄ the mean of
+        the block's vertices, x̄_o that of their origins and R the best-fit (Kabsch) rotation of the
+        origin arms onto the vertex arms. Each sample carries it along: p(t) = x̄(t) + R(t) (p_o − x̄_o)
+        (any set of the block's vertices will do, so a later cut does not lose it). The displacement
+        is p(t) − p_o; the velocity v + ω × (p − c) of the block."""
         fld, comp = BLOCK_QUANTITIES[quantity]
         model = self.model
-        b, v = model.blocks, model.vertices
         cache: dict = {}
-        r0 = self._row(block_id, cache)
-        s, c = int(b["vert_start"][r0]), int(b["vert_count"][r0])
         p0 = np.asarray(point, dtype=float)
-        pos0 = v["pos"][s:s + c]
-        arms0 = pos0 - pos0.mean(axis=0)
-        arm_p = p0 - pos0.mean(axis=0)
-        org = v["origin"][s:s + c]
-        rc = best_rotation(org - org.mean(axis=0), arms0)
-        p_origin = org.mean(axis=0) + rc.T @ arm_p
+
+        def frame(r):
+            b, v = model.blocks, model.vertices
+            st, c = int(b["vert_start"][r]), int(b["vert_count"][r])
+            pos, org = v["pos"][st:st + c], v["origin"][st:st + c]
+            mp, mo = pos.mean(axis=0), org.mean(axis=0)
+            return mp, mo, best_rotation(org - mo, pos - mp)
+
+        mp, mo, rot = frame(self._row(block_id, cache))
+        p_origin = mo + rot.T @ (p0 - mp)
 
         def value(eng) -> float:
-            bb, vv = model.blocks, model.vertices
             r = self._row(block_id, cache)
-            st = int(bb["vert_start"][r])
-            pos = vv["pos"][st:st + c]
-            mean = pos.mean(axis=0)
-            p = mean + best_rotation(arms0, pos - mean) @ arm_p
+            mp, mo, rot = frame(r)
+            p = mp + rot @ (p_origin - mo)
             if fld == "centroid":
                 out = p
             elif fld == "disp":
                 out = p - p_origin
             else:
+                bb = model.blocks
                 out = bb["velocity"][r] + np.cross(bb["spin"][r], p - bb["centroid"][r])
             return float(np.linalg.norm(out)) if comp is None else float(out[comp])
 

@@ -209,3 +209,19 @@ def test_state_file_without_vertex_origins_restores_them(session, tmp_path):
     np.testing.assert_allclose((model.vertices["pos"] - model.vertices["origin"])[:, 2], uz, rtol=1e-9)
     restored, _ = restore_state(src)
     np.testing.assert_array_equal(restored.vertices["origin"], session.model.vertices["origin"])
+
+
+def test_a_block_cut_after_it_turned_keeps_its_material_frame(session, tmp_path):
+    """Spin the brick by θ about z, then cut it: every vertex of the pieces, old or made by the cut, has
+    origin = c + Rz(θ)ᵀ (x − c) (the centroid c stays put), and each piece reads rotation θ about z."""
+    session.run_items(session.load_text(SPIN + "block cut joint-set dip 90 dip-direction 90 origin 0.5 0 0\n"
+                                               "block vtk 'cutspin'\n"))
+    m = session.model
+    assert m.blocks.n == 2
+    th = N * 2 * math.atan(W * DT / 2)
+    c = np.array([0.5, 1.0, 0.25])
+    rz = np.array([[math.cos(th), -math.sin(th), 0], [math.sin(th), math.cos(th), 0], [0, 0, 1]])
+    v = m.vertices
+    np.testing.assert_allclose(v["origin"], c + (v["pos"] - c) @ rz, atol=1e-12)
+    grid = pv.read(tmp_path / "cutspin_0000.vtu")
+    np.testing.assert_allclose(grid.cell_data["rotation"], [[0, 0, th], [0, 0, th]], atol=1e-12)
