@@ -48,19 +48,26 @@ class RegistryCompleter(Completer):
     def candidates_with_notes(done: list[str]) -> dict[str, str]:
         """Each candidate word and its note: "not supported yet" for a 3DEC command (or group of
         commands, or keyword) that dec3d knows by name but does not run, else ""."""
+        from .docs import READER_PAGES
+
         load_all()
         node = REGISTRY.root
+        path: tuple[str, ...] = ()
         i = 0
         while i < len(done):
             hits = matches(done[i], node.children) if node.children else []
             if len(hits) != 1:
                 break
             node = node.children[hits[0]]
+            path = tuple(node.alias_of) if node.alias_of else path + (hits[0],)
             if node.alias_of:
                 node = REGISTRY.node(node.alias_of)
             i += 1
         if i == len(done) and node.children:
             out = {name: ("" if _runs(child) else _NOT_YET) for name, child in node.children.items()}
+            for name in out:
+                if path + (name,) in READER_PAGES:
+                    out[name] = "kept, not run (FISH functions)"
             if node is REGISTRY.root and "plot" in out:
                 out["plot"] = "display only: skipped"
             if node is REGISTRY.root:

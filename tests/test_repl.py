@@ -78,6 +78,8 @@ def test_completion_marks_what_does_not_run():
     assert top["plot"] == "display only: skipped" and top["model"] == ""
     kws = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document("block history velocity "), None)}
     assert kws["gridpointid"] == "not supported yet" and kws["block-id"] == ""
+    fish = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document("fish "), None)}
+    assert fish["define"] == "kept, not run (FISH functions)" and fish["list"] == "not supported yet"
 
 
 def test_completion_of_words_and_keywords():
