@@ -183,5 +183,5 @@ def main(paths: list[str], verbose: bool = False) -> int:
             print(f"  dec3d run would stop before running anything, at {first.file}:{first.line}")
             worst = max(worst, 1)
         else:
-            print("  dec3d run would run every line")
+            print("  no line stops `dec3d run` before it starts (what happens while it runs is not checked)")
     return worst
