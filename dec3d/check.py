@@ -1,64 +1,149 @@
-"""`dec3d check deck.dat`: read a deck line by line and say what dec3d can run.
+"""`dec3d check deck.dat`: read a deck line by line and say what `dec3d run` would do with each.
 
-Unlike `dec3d run`, which stops at the first error, this binds every line on its own
-and reports each: runnable, not supported yet (a 3DEC command or FISH feature dec3d
-knows but does not implement), legacy 3DEC 5 syntax, or an error. Called files are
-not followed (each file is checked on its own), and FISH variables a file uses but
-never assigns are taken to come from the deck that calls it.
+`dec3d run` reads and binds the whole deck, with every file it calls by a literal name, before
+anything runs, and stops at the first line it cannot bind. `check` walks the same way (the
+same binder, the same FISH-name bookkeeping and the same resolution of called files as
+``Session``) but goes on after a bad line and reports every line, in the file it is in:
+
+- runnable: the line binds and its command runs;
+- does nothing: read but without effect (`plot …`, which is display only; a `fish define`
+  block, kept but never run because FISH functions are not supported yet; lines after a
+  `program return`, which are never read);
+- not supported yet: a 3DEC command or FISH feature dec3d knows but does not implement (this
+  stops a run);
+- legacy syntax: 3DEC 5 syntax (stops a run);
+- error: anything else that stops a run (a called file that is missing, an undefined FISH name,
+  a bad keyword or value).
+
+``standalone=True`` checks one file as a piece of a larger deck instead: calls are not
+followed and FISH names it never assigns are taken to come from the deck that calls it.
 """
 from __future__ import annotations
 
+import sys
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
 from .commands import load_all
 from .commands.binder import BindContext, Binder, CommandCall, LegacySyntaxError
-from .errors import Dec3dError, NotSupportedError
+from .commands.values import Deferred
+from .errors import Dec3dError, NotSupportedError, SourceLocation
 from .lang.parser import parse_deck
 
-RUNNABLE, NOT_SUPPORTED, LEGACY, ERROR = "runnable", "not supported yet", "legacy syntax", "error"
+RUNNABLE, DOES_NOTHING, NOT_SUPPORTED, LEGACY, ERROR = (
+    "runnable", "does nothing", "not supported yet", "legacy syntax", "error")
+#: the statuses that stop `dec3d run` before anything runs
+BLOCKERS = (NOT_SUPPORTED, LEGACY, ERROR)
+ORDER = (RUNNABLE, DOES_NOTHING, NOT_SUPPORTED, LEGACY, ERROR)
 
 
 @dataclass(frozen=True)
 class LineReport:
     line: int
     status: str
-    what: str          # command name, or the error message
+    what: str          # command name, what happens, or the error message
+    file: str = "<input>"
+    column: int = 1
 
 
-def check_text(text: str, filename: str = "<input>") -> list[LineReport]:
-    """Raises DeckSyntaxError if the text does not parse at all."""
-    load_all()
-    deck = parse_deck(text, filename)
-    ctx = BindContext({}, lenient_names=True)
-    binder = Binder(deck, ctx)
-    reports: list[LineReport] = []
-    fish = sorted(deck.fish, key=lambda b: b.line)
-    k = 0
-    for raw in deck.lines:
-        while k < len(fish) and fish[k].line < raw.line:
-            ctx.define_fish(fish[k])
-            reports.append(LineReport(fish[k].line, RUNNABLE, f"fish define {fish[k].name}"))
-            k += 1
+class _Walker:
+    def __init__(self, standalone: bool):
+        from .session import Session
+
+        load_all()
+        self.standalone = standalone
+        self.ctx = BindContext({}, lenient_names=standalone)
+        # the run's own resolution of called files (beside the calling deck, default extensions)
+        self.resolve = Session()._resolve_call_path
+        self.reports: list[LineReport] = []
+
+    def add(self, deck, line, status, what, column=1):
+        self.reports.append(LineReport(line, status, what, deck.filename, column))
+
+    def problem(self, deck, raw, status, exc):
+        loc = exc.location
+        col = loc.column if loc is not None and loc.line == raw.line and loc.file == deck.filename else 1
+        self.add(deck, raw.line, status, exc.message + (f" (hint: {exc.hint})" if getattr(exc, "hint", None) else ""),
+                 col)
+
+    def fish(self, deck, block):
+        self.ctx.define_fish(block)
+        self.add(deck, block.line, DOES_NOTHING,
+                 f"fish define {block.name}: kept, never run (FISH functions are not supported yet)")
+
+    def walk(self, text: str, filename: str, base_dir: Path, stack: tuple[SourceLocation, ...] = ()) -> None:
+        deck = parse_deck(text, filename, stack)
+        binder = Binder(deck, self.ctx, stack)
+        fish = sorted(deck.fish, key=lambda b: b.line)
+        k = 0
+        returned = False
+        for raw in deck.lines:
+            while k < len(fish) and fish[k].line < raw.line:
+                self.fish(deck, fish[k])
+                k += 1
+            if returned:
+                self.add(deck, raw.line, DOES_NOTHING, "after `program return`: never read")
+                continue
+            try:
+                item = binder.bind_line(raw)
+            except LegacySyntaxError as exc:
+                self.problem(deck, raw, LEGACY, exc)
+                continue
+            except NotSupportedError as exc:
+                self.problem(deck, raw, NOT_SUPPORTED, exc)
+                continue
+            except Dec3dError as exc:
+                self.problem(deck, raw, ERROR, exc)
+                continue
+            if not isinstance(item, CommandCall):
+                self.add(deck, raw.line, RUNNABLE, item.source)
+                continue
+            path = item.command.path
+            if path == ("plot",):
+                self.add(deck, raw.line, DOES_NOTHING, "plot: display only in dec3d, skipped")
+            elif path == ("program", "call"):
+                self.call(deck, raw, item, base_dir, stack)
+            else:
+                self.add(deck, raw.line, RUNNABLE, item.name)
+                returned = path == ("program", "return")
+        for b in fish[k:]:
+            self.fish(deck, b)
+
+    def call(self, deck, raw, item, base_dir, stack):
+        name = item.args["file"]
+        if isinstance(name, Deferred):
+            self.add(deck, raw.line, RUNNABLE, "program call: the file is named by an expression, "
+                                               "read when the line runs (not checked here)")
+            return
+        if self.standalone:
+            self.add(deck, raw.line, RUNNABLE, f"program call '{name}' (not followed)")
+            return
+        target = self.resolve(name, base_dir)
+        if any(Path(s.file) == target for s in stack) or Path(deck.filename) == target:
+            self.add(deck, raw.line, ERROR, f"`{target.name}` calls itself (directly or through other files)")
+            return
         try:
-            item = binder.bind_line(raw)
-            what = item.name if isinstance(item, CommandCall) else item.source
-            reports.append(LineReport(raw.line, RUNNABLE, what))
-        except LegacySyntaxError as exc:
-            reports.append(LineReport(raw.line, LEGACY, exc.message))
-        except NotSupportedError as exc:
-            reports.append(LineReport(raw.line, NOT_SUPPORTED, exc.message))
-        except Dec3dError as exc:
-            reports.append(LineReport(raw.line, ERROR, exc.format()))
-    for b in fish[k:]:
-        reports.append(LineReport(b.line, RUNNABLE, f"fish define {b.name}"))
-    return reports
+            text = target.read_text(encoding="utf-8", errors="replace")
+        except OSError as exc:
+            self.add(deck, raw.line, ERROR, f"cannot read deck `{target}`: {exc.strerror or exc}")
+            return
+        self.add(deck, raw.line, RUNNABLE, f"program call: reads {target}")
+        self.walk(text, str(target), target.parent, stack + (item.location,))
 
 
-def check_file(path: str | Path) -> list[LineReport]:
+def check_text(text: str, filename: str = "<input>", base_dir: Path | None = None,
+               standalone: bool = False) -> list[LineReport]:
+    """Reports for every line of ``text`` and of the files it calls (in reading order).
+    Raises DeckSyntaxError if the text does not parse at all."""
+    w = _Walker(standalone)
+    w.walk(text, filename, base_dir if base_dir is not None else Path.cwd())
+    return w.reports
+
+
+def check_file(path: str | Path, standalone: bool = False) -> list[LineReport]:
     p = Path(path)
-    return check_text(p.read_text(encoding="utf-8", errors="replace"), str(p))
+    return check_text(p.read_text(encoding="utf-8", errors="replace"), str(p), p.parent, standalone)
 
 
 def summary(reports: list[LineReport]) -> Counter:
@@ -66,18 +151,37 @@ def summary(reports: list[LineReport]) -> Counter:
 
 
 def main(paths: list[str], verbose: bool = False) -> int:
-    bad = 0
+    """Exit 0 when every deck would run, 1 when one would stop, 2 when a deck cannot be read."""
+    worst = 0
     for path in paths:
+        p = Path(path)
+        if not p.is_file():
+            why = "is a folder, not a deck file" if p.is_dir() else "does not exist"
+            print(f"dec3d check: error: `{path}` {why}", file=sys.stderr)
+            worst = 2
+            continue
         try:
-            reports = check_file(path)
+            reports = check_file(p)
         except Dec3dError as exc:
             print(exc.format())
-            bad += 1
+            worst = max(worst, 1)
+            continue
+        except OSError as exc:
+            print(f"dec3d check: error: cannot read `{path}`: {exc.strerror or exc}", file=sys.stderr)
+            worst = 2
             continue
         c = summary(reports)
-        print(f"{path}: " + ", ".join(f"{c[s]} {s}" for s in (RUNNABLE, NOT_SUPPORTED, LEGACY, ERROR) if c[s]))
+        files = {r.file for r in reports}
+        more = f" (in {len(files)} files)" if len(files) > 1 else ""
+        print(f"{path}: " + ", ".join(f"{c[s]} {s}" for s in ORDER if c[s]) + more)
+        blockers = [r for r in reports if r.status in BLOCKERS]
         for r in reports:
-            if r.status == ERROR or (verbose and r.status != RUNNABLE):
-                print(f"  line {r.line}: {r.status}: {r.what}")
-        bad += c[ERROR] > 0
-    return 1 if bad else 0
+            if r.status in BLOCKERS or verbose:
+                print(f"  {r.file}:{r.line}:{r.column}: {r.status}: {r.what}")
+        if blockers:
+            first = blockers[0]
+            print(f"  dec3d run would stop before running anything, at {first.file}:{first.line}")
+            worst = max(worst, 1)
+        else:
+            print("  no line stops `dec3d run` before it starts (what happens while it runs is not checked)")
+    return worst

@@ -87,9 +87,11 @@ def main(argv: list[str] | None = None) -> int:
     v.add_argument("--root", default=None, help="verification folder (default: ./verification)")
     v.set_defaults(fn=_verify)
     sub.add_parser("ssdem", help="static Winkler-spring slope stability (dec3d ssdem -h)")
-    c = sub.add_parser("check", help="say line by line what dec3d can run in a deck (runs nothing)")
+    c = sub.add_parser("check", help="say line by line what `dec3d run` would do with a deck and the files "
+                                     "it calls (runs nothing; exit 1 if the run would stop, 2 if a deck "
+                                     "cannot be read)")
     c.add_argument("decks", nargs="+")
-    c.add_argument("-v", "--verbose", action="store_true", help="list every line that is not runnable")
+    c.add_argument("-v", "--verbose", action="store_true", help="list every line with what happens to it")
     c.set_defaults(fn=lambda a: __import__("dec3d.check", fromlist=["main"]).main(a.decks, a.verbose))
     d = sub.add_parser("docs", help="write the command reference pages from the registry")
     d.add_argument("--dir", default="commands")

@@ -73,6 +73,21 @@ def render_range(reg: Registry) -> str:
     return "\n".join(out) + "\n"
 
 
+#: 3DEC statements the deck reader itself handles (no command declaration): their help pages
+READER_PAGES = {
+    ("fish", "define"): (
+        "# fish define\n\n"
+        "`fish define <name>` … `end` (also `fish def`, or `define`/`def` alone) defines a FISH function.\n\n"
+        "What dec3d does with it: the block is read (its lines are never bound as commands) and kept with its "
+        "text under its name; nothing in it runs. FISH functions are not supported yet, so a line that calls "
+        "the function (`@name` alone, `[name(...)]` in a value, a variable the function sets) stops the deck "
+        "before anything runs, with a \"not supported yet\" message naming the function. FISH in `[ ]` "
+        "outside functions (assignments, arithmetic, `math.*`, `string`, `io.out`) does run.\n\n"
+        "`dec3d check` reports a `fish define` block as \"does nothing\".\n\n"
+        "## Examples\n\n```\nfish define area(w, h)\n  area = w * h\nend\n[a = 2.0 * 3.0]\n```\n"),
+}
+
+
 def render_index(reg: Registry) -> str:
     out = ["# dec3d command reference", "",
            "One page per implemented command, written from its declaration by `dec3d docs`. "
@@ -85,7 +100,8 @@ def render_index(reg: Registry) -> str:
             "These bind to a clear \"not supported yet\" message instead of \"unknown command\".", ""]
     pending = []
     for path, node in reg.walk():
-        if node.known and node.command is None and not node.alias_of and not node.children:
+        if node.known and node.command is None and not node.alias_of and not node.children \
+                and tuple(path) not in READER_PAGES:
             pending.append(" ".join(path))
     out += [f"`{p}`" + ("," if k < len(pending) - 1 else "") for k, p in enumerate(pending)]
     return "\n".join(out) + "\n"
@@ -127,6 +143,8 @@ def page_for(words: list[str], folder: Path | None = None) -> str | None:
             node = REGISTRY.node(node.alias_of)
         else:
             path.append(hits[0])
+    if tuple(path) in READER_PAGES:
+        return READER_PAGES[tuple(path)]
     if node.command is None:
         if node.children:
             kids = sorted(node.children)

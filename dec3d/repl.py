@@ -1,7 +1,8 @@
 """`dec3d repl`: an interactive prompt on a Session (prompt_toolkit).
 
 Persistent history, completion of command words, keywords and range elements from
-the registry, `help <command>` showing the `commands/` page, continuation lines
+the registry (3DEC commands dec3d does not run yet are marked "not supported yet"),
+`help <command>` showing the `commands/` page rendered by rich, continuation lines
 (`&`, `...`) and FISH blocks read until `end`. An error is printed and the session
 goes on; Ctrl-D (or `program exit`) ends it.
 """
@@ -34,36 +35,66 @@ class RegistryCompleter(Completer):
         done = words if current == "" else words[:-1]
         if done[:1] == ["help"]:
             done = done[1:]
-        for cand in sorted(self.candidates(done)):
+        cands = self.candidates_with_notes(done)
+        for cand in sorted(cands):
             if cand.startswith(current.lower()):
-                yield Completion(cand, start_position=-len(current))
+                yield Completion(cand, start_position=-len(current), display_meta=cands[cand])
 
     @staticmethod
     def candidates(done: list[str]) -> list[str]:
+        return list(RegistryCompleter.candidates_with_notes(done))
+
+    @staticmethod
+    def candidates_with_notes(done: list[str]) -> dict[str, str]:
+        """Each candidate word and its note: "not supported yet" for a 3DEC command (or group of
+        commands, or keyword) that dec3d knows by name but does not run, else ""."""
+        from .docs import READER_PAGES
+
         load_all()
         node = REGISTRY.root
+        path: tuple[str, ...] = ()
         i = 0
         while i < len(done):
             hits = matches(done[i], node.children) if node.children else []
             if len(hits) != 1:
                 break
             node = node.children[hits[0]]
+            path = tuple(node.alias_of) if node.alias_of else path + (hits[0],)
             if node.alias_of:
                 node = REGISTRY.node(node.alias_of)
             i += 1
         if i == len(done) and node.children:
-            return list(node.children) + (["help"] if node is REGISTRY.root else [])
+            out = {name: ("" if _runs(child) else _NOT_YET) for name, child in node.children.items()}
+            for name in out:
+                if path + (name,) in READER_PAGES:
+                    out[name] = "kept, not run (FISH functions)"
+            if node is REGISTRY.root and "plot" in out:
+                out["plot"] = "display only: skipped"
+            if node is REGISTRY.root:
+                out["help"] = ""
+            return out
         cmd = node.command
         if cmd is None:
-            return []
-        names = [p.name for p in cmd.keywords]
+            return {}
+        names = {p.name: ("" if p.supported else _NOT_YET) for p in cmd.keywords}
         for p in cmd.positional:
             choices = getattr(p.value, "options", None)
             if choices:
-                names += list(choices)
+                names.update(dict.fromkeys(choices, ""))
         if cmd.range:
-            names += ["range"] + [n for n, e in REGISTRY.range_elements.items() if e.supported]
+            names["range"] = ""
+            names.update({n: "" for n, e in REGISTRY.range_elements.items() if e.supported})
         return names
+
+
+_NOT_YET = "not supported yet"
+
+
+def _runs(node) -> bool:
+    """Whether the command word leads to at least one command dec3d runs."""
+    if node.alias_of:
+        node = REGISTRY.node(node.alias_of)
+    return node.command is not None or any(_runs(c) for c in node.children.values())
 
 
 def run_repl(out_dir=None, history_file=None, input=None, output=None) -> int:
@@ -135,4 +166,17 @@ def _help(session, words: list[str]) -> None:
         return
     folder = Path(__file__).resolve().parent.parent / "commands"
     page = page_for(words, folder if folder.is_dir() else None)
-    session.write(page if page is not None else f"no command `{' '.join(words)}`; type `help` for the list")
+    if page is None:
+        session.write(f"no command `{' '.join(words)}`; type `help` for the list")
+        return
+    _print_markdown(session, page)
+
+
+def _print_markdown(session, text: str) -> None:
+    """Render a Markdown page (headings, tables, code) with rich on the session's output."""
+    from rich.console import Console
+    from rich.markdown import Markdown
+
+    out = session.stdout
+    tty = bool(getattr(out, "isatty", lambda: False)())
+    Console(file=out, force_terminal=tty, width=None if tty else 100, highlight=False).print(Markdown(text))

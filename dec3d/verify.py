@@ -23,6 +23,7 @@ Expectations are data; the runner knows no problem by name.
 from __future__ import annotations
 
 import math
+import sys
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -148,6 +149,12 @@ def main(names: list[str] | None = None, root: str | Path | None = None) -> int:
     root = Path(root) if root else default_root()
     folders = problems(root)
     if names:
+        unknown = [n for n in names if not any(f.name == n or f.name.startswith(n) for f in folders)]
+        if unknown:
+            known = ", ".join(f.name for f in folders) or "none"
+            print(f"dec3d verify: error: no verification problem named {', '.join(f'`{n}`' for n in unknown)} "
+                  f"in {root} (a name or the start of one; there are: {known})", file=sys.stderr)
+            return 2
         folders = [f for f in folders if f.name in names or any(f.name.startswith(n) for n in names)]
     rows: list[Check] = []
     failed = 0

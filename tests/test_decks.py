@@ -1,5 +1,9 @@
 """Every line of every shared 3DEC deck is read: it parses, then binds to a registered command
-or to a clear "not supported yet" (or, for 3DEC 5 decks, "legacy syntax") diagnostic."""
+or to a clear "not supported yet" (or, for 3DEC 5 decks, "legacy syntax") diagnostic.
+
+The shared decks are stored flat (their called files are not beside them under the names they
+call), so each is checked on its own (`standalone`): calls not followed, FISH names it never
+assigns taken to come from its caller. tests/test_check.py follows calls."""
 from collections import Counter
 
 import pytest
@@ -17,7 +21,7 @@ def test_decks_are_there():
 
 @pytest.mark.parametrize("path", MODERN, ids=lambda p: p.name[:60])
 def test_modern_deck_binds(path):
-    reports = check_file(path)
+    reports = check_file(path, standalone=True)
     counts = Counter(r.status for r in reports)
     print(f"{path.name}: {dict(counts)}")
     errors = [f"line {r.line}: {r.what}" for r in reports if r.status in (ERROR, LEGACY)]
@@ -28,7 +32,7 @@ def test_modern_deck_binds(path):
 
 @pytest.mark.parametrize("path", LEGACY_DECKS, ids=lambda p: p.name[:60])
 def test_legacy_deck_gets_clear_diagnostics(path):
-    reports = check_file(path)
+    reports = check_file(path, standalone=True)
     counts = Counter(r.status for r in reports)
     print(f"{path.name}: {dict(counts)}")
     errors = [f"line {r.line}: {r.what}" for r in reports if r.status == ERROR]
@@ -38,7 +42,7 @@ def test_legacy_deck_gets_clear_diagnostics(path):
 def test_totals(capsys):
     total = Counter()
     for p in MODERN + LEGACY_DECKS:
-        total.update(r.status for r in check_file(p))
+        total.update(r.status for r in check_file(p, standalone=True))
     with capsys.disabled():
         print(f"\nshared decks: {total[RUNNABLE]} runnable, {total[NOT_SUPPORTED]} not supported yet, "
               f"{total[LEGACY]} legacy syntax, {total[ERROR]} errors")

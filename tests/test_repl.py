@@ -27,8 +27,24 @@ def test_error_does_not_end_the_session(tmp_path):
 
 def test_help_shows_the_command_page(tmp_path):
     _, text = drive("help model grav\nhelp\nhelp model\n", tmp_path)
-    assert "# model gravity" in text and "model gravity 0 0 -9.81" in text
+    assert "model gravity" in text and "model gravity 0 0 -9.81" in text
     assert "Commands:" in text and "Subcommands:" in text and "gravity" in text
+
+
+def test_help_is_rendered_not_raw_markdown(tmp_path):
+    _, text = drive("help model grav\n", tmp_path)
+    text = text.split("\n", 1)[1]                       # after the greeting
+    lines = [ln.strip() for ln in text.splitlines()]
+    assert "model gravity" in lines                     # the heading, without its `#`
+    assert not any(ln.startswith("#") for ln in lines)
+    assert "```" not in text and "`" not in text and "|---" not in text and "| g |" not in text
+    assert any(ln.startswith("g ") and "m/s²" in ln for ln in lines)   # the table's row, rendered
+
+
+def test_help_fish_define_says_what_happens(tmp_path):
+    _, text = drive("help fish define\nhelp fish def\n", tmp_path)
+    assert "does not support" not in text
+    assert text.count("kept with its") == 2 and "nothing in it runs" in text
 
 
 def test_continuation_and_fish_block(tmp_path):
@@ -52,6 +68,18 @@ def test_exit_command_ends_the_session(tmp_path):
 
 def completions(text):
     return [c.text for c in RegistryCompleter().get_completions(Document(text), None)]
+
+
+def test_completion_marks_what_does_not_run():
+    notes = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document("block "), None)}
+    assert notes["zone"] == "not supported yet" and notes["copy"] == "not supported yet"
+    assert notes["create"] == "" and notes["contact"] == ""
+    top = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document(""), None)}
+    assert top["plot"] == "display only: skipped" and top["model"] == ""
+    kws = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document("block history velocity "), None)}
+    assert kws["gridpointid"] == "not supported yet" and kws["block-id"] == ""
+    fish = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document("fish "), None)}
+    assert fish["define"] == "kept, not run (FISH functions)" and fish["list"] == "not supported yet"
 
 
 def test_completion_of_words_and_keywords():

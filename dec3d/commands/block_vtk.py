@@ -14,9 +14,14 @@ from .values import FLAG, Num, P, Text
                      default=0),
                    P("off", FLAG, "stop writing snapshots every N steps", bare=True)],
          doc="Write the blocks to `<file>_<nnnn>.vtu` and list the snapshots in `<file>.pvd` (ParaView).",
-         details="Each block is a polyhedron cell with its faces. Cell data: block_id, group:<slot> (group "
-                 "codes; names in the field data `group_names`), density, volume, mass, hidden, leader_id, "
-                 "kind. Point data: displacement, velocity. Relative names are written in the output folder. "
+         details="Each block is a polyhedron cell with its faces (cells ordered by vertex count, then block; "
+                 "find a block by `block_id`). Cell data: block_id, group:<slot> (group codes; field data "
+                 "`group_code:<name>` gives each name's code), density, volume, mass, hidden, leader_id, kind, "
+                 "and the block's motion: displacement (of the centroid), velocity, spin, rotation (rotation "
+                 "vector θn since the block was made, radians, from the best fit of its vertices) and "
+                 "rotation_angle (θ). Point data: displacement (of each vertex since its block was made) and "
+                 "velocity (v + ω × r of its block). The files open in ParaView, PyVista and meshio (meshio "
+                 "reads no grid without cells). Relative names are written in the output folder. "
                  "With `interval n` a snapshot is also written every n steps while the model cycles.",
          examples=["block vtk", "block vtk 'jointed' interval 100", "block vtk filename 'out/blocks'",
                    "block vtk off"])

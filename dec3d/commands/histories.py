@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from ..errors import BindError, CommandError
 from ..io.history import write_csv, write_png
-from ..physics.history import (BLOCK_QUANTITIES, CONTACT_QUANTITIES, MODEL_QUANTITIES, RIGID_QUANTITIES, figures,
-                               histories, nearest_block_id)
+from ..physics.history import (BLOCK_QUANTITIES, CONTACT_QUANTITIES, MODEL_QUANTITIES, POINT_QUANTITIES,
+                               RIGID_QUANTITIES, ROTATION_QUANTITIES, figures, histories, nearest_block_id)
 from .registry import REGISTRY, command
 from .values import NUMBERISH, VEC3, Choice, Num, P, Text, ValueType, _number_literal
 
@@ -41,8 +41,12 @@ class HistoryRefs(ValueType):
 
 
 def _check_block(call):
-    if (call.args["position"] is None) == (call.args["block_id"] is None):
-        raise BindError("give either `position <x y z>` or `block-id <i>`", call.location)
+    point = call.args.get("material_point")
+    if call.args["position"] is not None and call.args["block_id"] is not None:
+        raise BindError("give either `position <x y z>` or `block-id <i>`, not both", call.location)
+    if call.args["position"] is None and call.args["block_id"] is None and point is None:
+        raise BindError("give either `position <x y z>` or `block-id <i>`"
+                        + (" (or `material-point <x y z>`)" if "material_point" in call.args else ""), call.location)
 
 
 def _name(session, call):
@@ -52,21 +56,26 @@ def _name(session, call):
     return name
 
 
-def _block_history(quantity, rigid=False):
+def _block_history(quantity, kind="block"):
     def handler(session, call):
         m = session.model
         name = _name(session, call)
+        point = call.args.get("material_point")
         if call.args["block_id"] is not None:
             bid = int(call.args["block_id"])
             if not (m.blocks["id"] == bid).any():
                 raise CommandError(f"there is no block {bid}", call.locations.get("block_id", call.location))
         else:
             try:
-                bid = nearest_block_id(m, call.args["position"])
+                bid = nearest_block_id(m, call.args["position"] if call.args["position"] is not None else point)
             except ValueError as exc:
                 raise CommandError(str(exc), call.location)
-        if rigid:
+        if point is not None:
+            histories(m).add_point(quantity, bid, point, name)
+        elif kind == "rigid":
             histories(m).add_rigid(quantity, bid, name)
+        elif kind == "rotation":
+            histories(m).add_rotation(quantity, bid, name)
         else:
             histories(m).add_block(quantity, bid, name)
 
@@ -78,22 +87,45 @@ _BLOCK_KW = [P("position", VEC3, "the block whose centroid is nearest this point
              P("block-id", Num(integer=True, lo=1), "the block with this id"),
              P("gridpointid", Num(integer=True), "a gridpoint of a deformable block", supported=False),
              P("zone-id", Num(integer=True), "a zone of a deformable block", supported=False)]
+_POINT_KW = [P("material-point", VEC3, "follow the point fixed to the block that is here when the command runs "
+                            "(a corner: its vertex)", units="m")]
 _WHAT = {"displacement": "displacement", "velocity": "velocity", "rvelocity": "angular velocity",
          "position": "centroid position"}
 _WHICH = ("The block is the one whose centroid is nearest `position` when the command runs, or the "
           "block `block-id`. A leading `name '<s>'` names the history (default: its number).")
+_POINT = (" With `material-point x y z` (dec3d) the value is that of the point fixed to the block that is at "
+          "(x, y, z) when the command runs, instead of the centroid: its position now, its displacement "
+          "since the block was made, its velocity v + ω × (p − c). Give a corner's coordinates to follow "
+          "a vertex. `material-point` alone picks the block whose centroid is nearest the point; add `block-id` "
+          "when the point is on several blocks.")
 
 for _q in BLOCK_QUANTITIES:
     _what = _WHAT[_q.split("-")[0]]
     _comp = f"{_q[-1]} component of the" if "-" in _q else "magnitude of the"
     if _q.startswith("position"):
         _comp = f"{_q[-1]} coordinate of the" if "-" in _q else "distance from the origin of the"
-    command(f"block history {_q}", keywords=_BLOCK_KW, check=_check_block,
+    _pt = _q in POINT_QUANTITIES
+    command(f"block history {_q}", keywords=_BLOCK_KW + (_POINT_KW if _pt else []), check=_check_block,
             doc=f"Record the {_comp} {_what} of one block every `history interval` steps.",
             details=_WHICH + ("" if _q.split("-")[0] in ("displacement", "velocity") else
-                              " (dec3d: `rvelocity` and `position` are not 3DEC history variables.)"),
-            examples=[f"block history {_q} position 0.5 0.5 0.5", f"block history name 'h{_q[0]}' {_q} block-id 2"],
+                              " (dec3d: `rvelocity` and `position` are not 3DEC history variables.)")
+            + (_POINT if _pt else ""),
+            examples=[f"block history {_q} position 0.5 0.5 0.5", f"block history name 'h{_q[0]}' {_q} block-id 2"]
+            + ([f"block history {_q} block-id 2 material-point 1 0 1"] if _pt else []),
             )(_block_history(_q))
+
+for _q in ROTATION_QUANTITIES:
+    _what = "angle θ [rad]" if _q == "rotation" else f"{_q[-1]} component θ n{_q[-1]} [rad] of the rotation vector"
+    command(f"block history {_q}", keywords=_BLOCK_KW, check=_check_block,
+            doc=f"Record the {_what} of one block's rotation since the block was made.",
+            details=_WHICH + " dec3d only (not a 3DEC variable). The rotation R of the block since it was made "
+                    "is the best (Kabsch) fit of its vertex arms now to its arms then (arms from the mean of "
+                    "the vertices); it is written as the rotation vector θ n (axis n, angle θ, radians). "
+                    "Each sample takes the equivalent vector (θ + 2πk) n nearest the previous sample, so a block "
+                    "turning about a fixed axis at ω reads ω t also past half a turn (sample at least twice "
+                    "per turn). `rotation` is the length of that vector.",
+            examples=[f"block history {_q} block-id 2", f"block history name 'r' {_q} position 0.5 0.5 0.5"],
+            )(_block_history(_q, kind="rotation"))
 
 for _q in RIGID_QUANTITIES:
     if _q == "shape-error":
@@ -105,7 +137,7 @@ for _q in RIGID_QUANTITIES:
     command(f"block history {_q}", keywords=_BLOCK_KW, check=_check_block, doc=_doc,
             details=_WHICH + " dec3d only (not a 3DEC variable): I(t) = R I₀ Rᵀ with I₀ the inertia tensor when "
                     "the history is made and R the best-fit (Kabsch) rotation of the vertex arms since then.",
-            examples=[f"block history {_q} position 0.5 0.5 0.5"])(_block_history(_q, rigid=True))
+            examples=[f"block history {_q} position 0.5 0.5 0.5"])(_block_history(_q, kind="rigid"))
 
 REGISTRY.node_keywords("block contact history", [P("name", Text(), "history name")])
 

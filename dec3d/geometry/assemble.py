@@ -24,7 +24,7 @@ import numpy as np
 from .mass import range_index, update_face_geometry, update_mass_properties
 from .polyhedron import Poly
 
-_KEEP_VERTEX = ("pos", "block")
+_KEEP_VERTEX = ("pos", "block", "origin")
 _KEEP_FACE = ("block", "vstart", "nvert", "normal", "area", "centroid")
 
 
@@ -51,6 +51,45 @@ def _copy_rows(store, dst: np.ndarray, src: np.ndarray, skip: tuple[str, ...]) -
             arr[d] = arr[s]
 
 
+def _set_origins(model, block_rows, new_v, vsrc, piece_nv) -> None:
+    """Origins of new vertices (where each was when its block was made; see ``dec3d.model.kinematics``).
+
+    A vertex where its source vertex is keeps the source's origin. Any other vertex of a piece of an
+    existing block (made by a cut or a refinement) is taken back through that block's rigid motion:
+    origin = x̄₀ + Rᵀ (x − x̄), fitted (Kabsch) on the old block's vertices and their origins, x̄ and x̄₀
+    their means. A vertex of a fresh block is its own origin (less the block's ``disp``, zero then).
+    Runs before the pieces' vertex ranges replace the old block's."""
+    vs, b = model.vertices, model.blocks
+    vpos, origin, vblock = vs.full("pos"), vs.full("origin"), vs.full("block")
+    src_ok = vsrc >= 0
+    same = src_ok.copy()
+    same[src_ok] = (vpos[new_v[src_ok]] == vpos[vsrc[src_ok]]).all(axis=1)
+    origin[new_v[same]] = origin[vsrc[same]]
+    rest = ~same
+    if not rest.any():
+        return
+    piece = np.repeat(np.arange(len(block_rows)), piece_nv)
+    parent = np.full(len(block_rows), -1, dtype=np.int64)
+    first = np.flatnonzero(src_ok)[::-1]                 # reversed: the first sourced vertex of a piece wins
+    parent[piece[first]] = vblock[vsrc[first]]
+    fresh = new_v[rest]
+    origin[fresh] = vpos[fresh] - b["disp"][block_rows[piece[rest]]]
+    for pr in np.unique(parent[piece[rest]]):
+        if pr < 0:
+            continue
+        sel = new_v[rest & (parent[piece] == pr)]
+        st, c = int(b["vert_start"][pr]), int(b["vert_count"][pr])
+        p_old, o_old = vpos[st:st + c], origin[st:st + c]
+        if (p_old == o_old).all():                      # the old block has not moved
+            origin[sel] = vpos[sel]
+            continue
+        mp, mo = p_old.mean(axis=0), o_old.mean(axis=0)
+        u, _, vt = np.linalg.svd((p_old - mp).T @ (o_old - mo))
+        d = np.sign(np.linalg.det(u @ vt)) or 1.0
+        rot = u @ np.diag([1.0, 1.0, d]) @ vt              # origin arms -> current arms
+        origin[sel] = mo + (vpos[sel] - mp) @ rot
+
+
 def write_pieces(model, block_rows, pos, vsrc, piece_nv, fn, fsrc, piece_nf, fv) -> None:
     """Give blocks ``block_rows`` (one per piece, rows already live) the pieces' geometry,
     then recompute their faces' geometry and their mass properties."""
@@ -61,7 +100,9 @@ def write_pieces(model, block_rows, pos, vsrc, piece_nv, fn, fsrc, piece_nf, fv)
     new_v = np.arange(vsl.start, vsl.stop, dtype=np.int64)
     vs.full("pos")[vsl] = pos
     vs.full("block")[vsl] = np.repeat(block_rows, piece_nv)
-    _copy_rows(vs, new_v, np.asarray(vsrc, dtype=np.int64), _KEEP_VERTEX)
+    vsrc = np.asarray(vsrc, dtype=np.int64)
+    _copy_rows(vs, new_v, vsrc, _KEEP_VERTEX)
+    _set_origins(model, block_rows, new_v, vsrc, piece_nv)
 
     piece_vstart = vsl.start + np.concatenate(([0], np.cumsum(piece_nv)[:-1])).astype(np.int64)
     fsl = fs.append(len(fn))

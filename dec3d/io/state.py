@@ -190,6 +190,10 @@ def _build(path: str, meta: dict, blobs: dict[str, bytes]) -> Model:
                 store.add_field(key, Field(tuple(fdesc["shape"]), arr.dtype, fdesc["fill"]))
             arrays[key] = arr
         store.load_arrays(arrays)
+    if "origin" not in meta["stores"].get("vertices", {}).get("fields", {"origin": 0}):
+        # a file from before vertices had an origin: take each vertex as having moved with its block's centroid
+        v = model.vertices
+        v["origin"][:] = v["pos"] - model.blocks["disp"][np.clip(v["block"], 0, None)] if model.blocks.n else v["pos"]
     _check_geometry(path, model)
     return model
 

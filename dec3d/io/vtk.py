@@ -4,11 +4,17 @@ Written by hand (XML UnstructuredGrid, inline base64 binary, UInt64 headers): sm
 exact (floats go out bit for bit) and deterministic (the same model gives the same
 bytes). Every live block is one VTK_POLYHEDRON cell (type 42) whose polygonal faces are
 given in the classic ``faces`` / ``faceoffsets`` layout that VTK 8-9 and ParaView read.
-Points are the vertex store's rows, in order.
+Points are the vertex store's rows, in order; cells go by vertex count, then block row
+(``cell_order``; find a block by the ``block_id`` cell array).
 
-Cell data: ``block_id``, ``group:<slot>`` (group code per slot, -1 none; names in the
-field data array ``group_names``, index = code), ``density``, ``volume``, ``mass``,
-``hidden``, ``leader_id``, ``kind``. Point data: ``displacement``, ``velocity``.
+Cell data: ``block_id``, ``group:<slot>`` (group code per slot, -1 none), ``density``,
+``volume``, ``mass``, ``hidden``, ``leader_id``, ``kind``, and the motion of each block:
+``displacement`` (of its centroid), ``velocity``, ``spin``, ``rotation`` (rotation vector
+since the block was made, radians) and ``rotation_angle`` (its length), as defined in
+``dec3d.model.kinematics``. Point data: ``displacement`` (pos − origin of each vertex) and
+``velocity`` (v + ω × r of its block). Field data: one ``group_code:<name>`` array per group
+name holding its code. Scalar arrays carry no ``NumberOfComponents`` (VTK's default 1) and
+every array is a numeric ``DataArray``, so VTK/ParaView, PyVista and meshio all read the files.
 """
 from __future__ import annotations
 
@@ -20,6 +26,7 @@ import numpy as np
 
 from dec3d.geometry.mass import range_index
 from dec3d.io.finite import require_finite
+from dec3d.model.kinematics import block_rotation, vertex_displacement, vertex_velocity
 
 VTK_POLYHEDRON = 42
 _TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.float32): "Float32",
@@ -27,52 +34,59 @@ _TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.float32): "Float32",
           np.dtype(np.uint8): "UInt8", np.dtype(np.int8): "Int8"}
 
 
-def _data_array(name: str, arr: np.ndarray, indent: str) -> str:
+def _data_array(name: str, arr: np.ndarray, indent: str, tuples: bool = False) -> str:
     require_finite(name, arr)
     arr = np.ascontiguousarray(arr)
     if arr.dtype == np.bool_:
         arr = arr.astype(np.uint8)
-    comps = 1 if arr.ndim == 1 else arr.shape[1]
+    # one component is VTK's default; meshio turns an explicit "1" into (n, 1) arrays that its
+    # polyhedron reader cannot regroup
+    comps = "" if arr.ndim == 1 else f'NumberOfComponents="{arr.shape[1]}" '
+    if tuples:                          # field data arrays must say their length
+        comps += f'NumberOfTuples="{arr.shape[0]}" '
     raw = arr.astype(arr.dtype.newbyteorder("<"), copy=False).tobytes()
     payload = base64.b64encode(np.uint64(len(raw)).astype("<u8").tobytes() + raw).decode("ascii")
     return (f'{indent}<DataArray type="{_TYPES[arr.dtype]}" Name={quoteattr(name)} '
-            f'NumberOfComponents="{comps}" format="binary">\n{indent}  {payload}\n'
+            f'{comps}format="binary">\n{indent}  {payload}\n'
             f"{indent}</DataArray>\n")
 
 
-def _string_array(name: str, values: list[str], indent: str) -> str:
-    # VTK stores strings as NUL-terminated chars, one tuple per string
-    raw = b"".join(v.encode("utf-8") + b"\0" for v in values)
-    payload = base64.b64encode(np.uint64(len(raw)).astype("<u8").tobytes() + raw).decode("ascii")
-    return (f'{indent}<Array type="String" Name={quoteattr(name)} '
-            f'NumberOfTuples="{len(values)}" format="binary">\n{indent}  {payload}\n'
-            f"{indent}</Array>\n")
+def cell_order(model) -> np.ndarray:
+    """Block rows in the order their cells are written: by vertex count, then by row.
+
+    meshio's polyhedron reader gathers cells of equal vertex count into blocks in the order the
+    counts first appear but hands out the cell data in ascending count order; cells already
+    sorted by count keep both in step (and every reader sees the same cell order)."""
+    return np.argsort(model.blocks["vert_count"], kind="stable")
 
 
-def block_cells(model):
-    """Connectivity, offsets, faces and faceoffsets arrays (int64) of every live block.
+def block_cells(model, rows=None):
+    """Connectivity, offsets, faces and faceoffsets arrays (int64) of the blocks ``rows``
+    (every live block, in row order, by default), one cell per block in that order.
 
     The face stream of a cell is: number of faces, then per face its number of points
     and the point ids.
     """
     b, f = model.blocks, model.faces
-    vcount = b["vert_count"]
-    connectivity = range_index(b["vert_start"], vcount)
+    rows = np.arange(b.n) if rows is None else np.asarray(rows, dtype=np.int64)
+    ncell = rows.size
+    vcount = b["vert_count"][rows]
+    connectivity = range_index(b["vert_start"][rows], vcount)
     offsets = np.cumsum(vcount)
-    fcount = b["face_count"]
-    frows = range_index(b["face_start"], fcount)
+    fcount = b["face_count"][rows]
+    frows = range_index(b["face_start"][rows], fcount)
     nvert = f["nvert"][frows]
     loops = model.face_vertices["vertex"][range_index(f["vstart"][frows], nvert)]
-    cell_of_face = np.repeat(np.arange(b.n), fcount)
+    cell_of_face = np.repeat(np.arange(ncell), fcount)
     chunk = 1 + nvert
     before = np.cumsum(chunk) - chunk                  # stream length of earlier faces
     face_pos = before + cell_of_face + 1               # +1 per cell count entry so far
-    stream = np.empty(int(chunk.sum()) + b.n, dtype=np.int64)
+    stream = np.empty(int(chunk.sum()) + ncell, dtype=np.int64)
     first_face = np.cumsum(fcount) - fcount
     stream[face_pos[first_face] - 1] = fcount
     stream[face_pos] = nvert
     stream[range_index(face_pos + 1, nvert)] = loops
-    faceoffsets = np.append(face_pos[first_face[1:]] - 1, stream.size) if b.n else np.zeros(0, np.int64)
+    faceoffsets = np.append(face_pos[first_face[1:]] - 1, stream.size) if ncell else np.zeros(0, np.int64)
     return connectivity, offsets, stream, faceoffsets.astype(np.int64)
 
 
@@ -80,7 +94,8 @@ def write_vtu(model, path: str | os.PathLike) -> str:
     """Write one snapshot of every live block; returns the path written."""
     path = os.fspath(path)
     b, v = model.blocks, model.vertices
-    conn, offs, faces, faceoffs = block_cells(model)
+    order = cell_order(model)
+    conn, offs, faces, faceoffs = block_cells(model, order)
     ind = "      "
     parts = ['<?xml version="1.0"?>\n',
              '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" '
@@ -88,21 +103,29 @@ def write_vtu(model, path: str | os.PathLike) -> str:
              '  <UnstructuredGrid>\n']
     names = list(model.groups.names)
     if names:
-        parts += ["    <FieldData>\n", _string_array("group_names", names, ind), "    </FieldData>\n"]
+        # a numeric array per name (code = its index): meshio reads no String arrays
+        parts.append("    <FieldData>\n")
+        for code, gname in enumerate(names):
+            parts.append(_data_array(f"group_code:{gname}", np.array([code], dtype=np.int32), ind,
+                                     tuples=True))
+        parts.append("    </FieldData>\n")
     parts.append(f'    <Piece NumberOfPoints="{v.n}" NumberOfCells="{b.n}">\n')
     parts.append('      <PointData Vectors="displacement">\n')
-    parts.append(_data_array("displacement", v["disp"], ind + "  "))
-    parts.append(_data_array("velocity", v["velocity"], ind + "  "))
+    parts.append(_data_array("displacement", vertex_displacement(model), ind + "  "))
+    parts.append(_data_array("velocity", vertex_velocity(model), ind + "  "))
     parts.append("      </PointData>\n")
     parts.append('      <CellData Scalars="block_id">\n')
     leader = b["leader"]
+    rot = block_rotation(model)
     cell = {"block_id": b["id"], "density": b["density"], "volume": b["volume"],
             "mass": b["mass"], "hidden": b["hidden"],
-            "leader_id": b["id"][leader] if b.n else b["id"], "kind": b["kind"]}
+            "leader_id": b["id"][leader] if b.n else b["id"], "kind": b["kind"],
+            "displacement": b["disp"], "velocity": b["velocity"], "spin": b["spin"],
+            "rotation": rot, "rotation_angle": np.linalg.norm(rot, axis=1)}
     for key, arr in cell.items():
-        parts.append(_data_array(key, arr, ind + "  "))
+        parts.append(_data_array(key, arr[order], ind + "  "))
     slots = model.groups.slot_names("blocks")
-    g = b["group"]
+    g = b["group"][order]
     for col, slot in enumerate(slots):
         parts.append(_data_array(f"group:{slot}", g[:, col], ind + "  "))
     parts.append("      </CellData>\n")

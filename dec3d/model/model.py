@@ -27,6 +27,9 @@ Stores (struct-of-arrays, see ``store.py``; shapes after the leading row dimensi
                      ``vertices`` and ``faces``
 ``vertices``     rigid-block vertices and deformable-block gridpoints alike
     pos, velocity, disp, force (3,) m, m/s, m, N; mass () kg; fixity () uint8; block () int64 row
+    origin (3,)      m      where the vertex was when its block was made (a vertex a cut adds: taken
+                     back through the block's rigid motion); pos − origin is what the vertex moved
+                     (``dec3d.model.kinematics``). The rigid engine moves ``pos`` only.
 ``faces``        polygons, counter-clockwise seen from outside
     block () int64 row; normal (3,) unit outward; area () m²; centroid (3,) m;
     vstart, nvert () int64 range in ``face_vertices``; group (nslots,) int32
@@ -85,6 +88,7 @@ def _block_fields() -> dict[str, Field]:
 def _vertex_fields() -> dict[str, Field]:
     return {
         "pos": Field((3,), _F, 0.0),
+        "origin": Field((3,), _F, 0.0),
         "velocity": Field((3,), _F, 0.0),
         "disp": Field((3,), _F, 0.0),
         "force": Field((3,), _F, 0.0),

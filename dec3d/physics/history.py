@@ -12,12 +12,19 @@ from typing import Callable
 
 import numpy as np
 
+from dec3d.model.kinematics import block_rotation, unwrap_rotation
+
 _XYZ = (("", None), ("-x", 0), ("-y", 1), ("-z", 2))
 #: block quantity -> (engine field, component or None for the magnitude)
 BLOCK_QUANTITIES = {f"{q}{s}": (fld, comp)
                     for q, fld in (("displacement", "disp"), ("velocity", "velocity"), ("rvelocity", "spin"),
                                    ("position", "centroid"))
                     for s, comp in _XYZ}
+#: the rotation of a block since it was made (``dec3d.model.kinematics``): components of the rotation
+#: vector θ n [rad] and θ itself, followed continuously from sample to sample
+ROTATION_QUANTITIES = ("rotation", "rotation-x", "rotation-y", "rotation-z")
+#: quantities that `material-point x y z` can follow at a point fixed to the block instead of at its centroid
+POINT_QUANTITIES = tuple(q for q in BLOCK_QUANTITIES if q.split("-")[0] in ("displacement", "velocity", "position"))
 #: dec3d's own block quantities (not 3DEC variables), worked out from the vertices each sample:
 #: angular momentum I(t) ω about the centroid, I(t) = R I₀ Rᵀ with R the best-fit rotation of the vertex
 #: arms since the history was made (Kabsch), and the shape error max |r − R r₀| [m] of the vertex arms
@@ -85,6 +92,67 @@ class HistorySet:
             return float(np.linalg.norm(v)) if comp is None else float(v[comp])
 
         return self.add(f"block {block_id} {quantity}", value, name)
+
+    def _row(self, block_id: int, cache: dict) -> int:
+        b = self.model.blocks
+        r = cache.get("row", -1)
+        if not (0 <= r < b.n and b["id"][r] == block_id):
+            r = cache["row"] = int(np.flatnonzero(b["id"] == block_id)[0])
+        return r
+
+    def add_rotation(self, quantity: str, block_id: int, name: str | None = None) -> History:
+        """A component of the block's rotation vector since it was made, or its angle [rad]; each
+        sample takes the equivalent vector (θ + 2πk) n nearest the previous one, so a block that keeps
+        turning about one axis gives ω t past θ = π."""
+        model = self.model
+        state: dict = {"prev": None}
+        comp = {"rotation": None, "rotation-x": 0, "rotation-y": 1, "rotation-z": 2}[quantity]
+
+        def value(eng) -> float:
+            r = self._row(block_id, state)
+            rv = unwrap_rotation(block_rotation(model, [r])[0], state["prev"])
+            state["prev"] = rv
+            return float(np.linalg.norm(rv)) if comp is None else float(rv[comp])
+
+        return self.add(f"block {block_id} {quantity}", value, name)
+
+    def add_point(self, quantity: str, block_id: int, point, name: str | None = None) -> History:
+        """Displacement (since the block was made), velocity or position of a point fixed to a block.
+
+        The point is kept in the block's frame at its making: p_o = x̄_o + Rᵀ (p − x̄), with x̄ the mean of
+        the block's vertices, x̄_o that of their origins and R the best-fit (Kabsch) rotation of the
+        origin arms onto the vertex arms. Each sample carries it along: p(t) = x̄(t) + R(t) (p_o − x̄_o)
+        (any set of the block's vertices will do, so a later cut does not lose it). The displacement
+        is p(t) − p_o; the velocity v + ω × (p − c) of the block."""
+        fld, comp = BLOCK_QUANTITIES[quantity]
+        model = self.model
+        cache: dict = {}
+        p0 = np.asarray(point, dtype=float)
+
+        def frame(r):
+            b, v = model.blocks, model.vertices
+            st, c = int(b["vert_start"][r]), int(b["vert_count"][r])
+            pos, org = v["pos"][st:st + c], v["origin"][st:st + c]
+            mp, mo = pos.mean(axis=0), org.mean(axis=0)
+            return mp, mo, best_rotation(org - mo, pos - mp)
+
+        mp, mo, rot = frame(self._row(block_id, cache))
+        p_origin = mo + rot.T @ (p0 - mp)
+
+        def value(eng) -> float:
+            r = self._row(block_id, cache)
+            mp, mo, rot = frame(r)
+            p = mp + rot @ (p_origin - mo)
+            if fld == "centroid":
+                out = p
+            elif fld == "disp":
+                out = p - p_origin
+            else:
+                bb = model.blocks
+                out = bb["velocity"][r] + np.cross(bb["spin"][r], p - bb["centroid"][r])
+            return float(np.linalg.norm(out)) if comp is None else float(out[comp])
+
+        return self.add(f"block {block_id} {quantity} at point ({p0[0]:g} {p0[1]:g} {p0[2]:g})", value, name)
 
     def add_rigid(self, quantity: str, block_id: int, name: str | None = None) -> History:
         """Angular momentum [kg·m²/s] or shape error [m] of one block (``RIGID_QUANTITIES``)."""

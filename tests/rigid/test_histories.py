@@ -124,3 +124,66 @@ def test_best_rotation_recovers_a_rotation():
     q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
     q *= np.sign(np.linalg.det(q))
     assert np.allclose(best_rotation(a, a @ q.T), q, atol=1e-12)
+
+
+SPIN = ("model new\nblock create brick 0 1 0 2 0 0.5\nblock create brick 3 4 0 1 0 1\nblock property density 2000\n"
+        "block mechanical damping none\nblock mechanical timestep 1e-3\n")
+
+
+def test_rotation_of_a_spinning_block_follows_omega_t_past_half_a_turn(session):
+    """A free spin ω = 2 rad/s about z for 2500 steps of 1 ms: the Cayley update turns the block by
+    2 atan(ω Δt / 2) per step, 5.0000 rad in all (past π, where the short rotation vector flips)."""
+    session.run_items(session.load_text(
+        SPIN + "block initialize rvelocity-z 2 range id 1\nblock history name 'r' rotation block-id 1\n"
+        "block history name 'rz' rotation-z block-id 1\nblock history name 'rx' rotation-x block-id 1\n"
+        "block history name 'r2' rotation block-id 2\nhistory interval 10\nmodel cycle 2500\n"
+        "history export 'r' 'rz' 'rx' 'r2' file 'r.csv'\n"))
+    per_step = 2 * math.atan(2 * 1e-3 / 2)
+    hs = histories(session.model)
+    rz = hs.find("rz")
+    np.testing.assert_allclose(rz.values, np.array(rz.steps) * per_step, rtol=1e-9)
+    assert session.results["r.final"] == pytest.approx(2500 * per_step, rel=1e-9)
+    assert session.results["r.final"] == pytest.approx(5.0, rel=1e-6)         # ω t
+    assert abs(session.results["rx.max"]) < 1e-9 and abs(session.results["rx.min"]) < 1e-9
+    assert session.results["r2.max"] == 0.0                                   # the other block never moved
+
+
+def test_point_fixed_to_a_translating_and_spinning_block(session):
+    """Block 1 moves at v = (1, 0, 0.5) m/s and spins at 2 rad/s about z; a point fixed to it at its top corner
+    (1, 2, 0.5) and an inner point (0.25, 0.5, 0.25) follow c(t) + Rz(θ)(p₀ − c₀)."""
+    session.run_items(session.load_text(
+        SPIN + "block initialize velocity-x 1 velocity-z 0.5 rvelocity-z 2 range id 1\n"
+        "block history name 'px' position-x material-point 1 2 0.5\nblock history name 'py' position-y block-id 1 material-point 1 2 0.5\n"
+        "block history name 'ux' displacement-x block-id 1 material-point 0.25 0.5 0.25\n"
+        "block history name 'uz' displacement-z block-id 1 material-point 0.25 0.5 0.25\n"
+        "block history name 'vy' velocity-y block-id 1 material-point 0.25 0.5 0.25\n"
+        "block history name 'v' velocity block-id 1 material-point 0.25 0.5 0.25\n"
+        "history interval 50\nmodel cycle 1000\n"
+        "history export 'px' 'py' 'ux' 'uz' 'vy' 'v' file 'p.csv'\n"))
+    t, th = 1.0, 1000 * 2 * math.atan(1e-3)
+    c0, c = np.array([0.5, 1.0, 0.25]), np.array([0.5 + t, 1.0, 0.25 + 0.5 * t])
+    rz = np.array([[math.cos(th), -math.sin(th), 0], [math.sin(th), math.cos(th), 0], [0, 0, 1]])
+    corner = c + rz @ (np.array([1, 2, 0.5]) - c0)
+    inner0 = np.array([0.25, 0.5, 0.25])
+    inner = c + rz @ (inner0 - c0)
+    r = session.results
+    assert r["px.final"] == pytest.approx(corner[0], abs=1e-12) and r["py.final"] == pytest.approx(corner[1], abs=1e-12)
+    # the corner is a vertex: the history is exactly where that vertex is
+    v = session.model.vertices
+    assert np.linalg.norm(v["pos"] - [r["px.final"], r["py.final"], corner[2]], axis=1).min() < 1e-12
+    assert r["ux.final"] == pytest.approx((inner - inner0)[0], abs=1e-12)
+    assert r["uz.final"] == pytest.approx(0.5 * t, rel=1e-12)
+    vel = np.array([1.0, 0.0, 0.5]) + np.cross([0, 0, 2.0], inner - c)
+    assert r["vy.final"] == pytest.approx(vel[1], rel=1e-9)
+    assert r["v.final"] == pytest.approx(np.linalg.norm(vel), rel=1e-9)
+
+
+def test_point_and_rotation_errors(session):
+    from dec3d.errors import Dec3dError
+
+    with pytest.raises(Dec3dError, match="not both"):
+        session.run_items(session.load_text(SPIN + "block history position-x block-id 1 position 0 0 0\n"))
+    with pytest.raises(Dec3dError, match="material-point"):         # rvelocity is of the block, not of a point
+        session.run_items(session.load_text(SPIN + "block history rvelocity-z block-id 1 material-point 0 0 0\n"))
+    with pytest.raises(Dec3dError, match=r"`block-id <i>` \(or `material-point"):
+        session.run_items(session.load_text(SPIN + "block history displacement-x\n"))
