@@ -37,4 +37,4 @@ def require_finite(name: str, values, missing_ok: bool = False) -> None:
     first = np.unravel_index(int(np.flatnonzero(~ok.ravel())[0]), a.shape)
     where = f" at row {first[0]}" if a.ndim else ""
     raise NonFiniteOutputError(f"refusing to write '{name}': it holds a non-finite value "
-                               f"({a[first]!r}{where}); nothing was written")
+                               f"({a[first].item()!r}{where}); nothing was written")

@@ -94,6 +94,7 @@ def write_vtu(model, path: str | os.PathLike) -> str:
     """Write one snapshot of every live block; returns the path written."""
     path = os.fspath(path)
     b, v = model.blocks, model.vertices
+    require_finite("Points", v["pos"])      # the fields below derive from it: name the source
     order = cell_order(model)
     conn, offs, faces, faceoffs = block_cells(model, order)
     ind = "      "

@@ -127,7 +127,7 @@ def test_writers_refuse_non_finite_values_and_write_nothing(session, tmp_path):
     before = sorted(os.listdir(tmp_path))
     session.model.vertices["pos"][5, 1] = np.nan
     with pytest.raises(Dec3dError, match=r"<input>:1:1: error: refusing to write 'Points': it holds a non-finite "
-                                         r"value \(np.float64\(nan\) at row 5\); nothing was written"):
+                                         r"value \(nan at row 5\); nothing was written"):
         _run(session, "block vtk 'bad'\n")
     with pytest.raises(Dec3dError, match=r"refusing to write 'vertices.pos'.*at row 5"):
         _run(session, "model save 'bad'\n")
