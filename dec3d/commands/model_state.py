@@ -1,7 +1,7 @@
 """`model save` / `model restore`: the whole model in one state file."""
 from __future__ import annotations
 
-from ..io.state import restore_state, save_state
+from ..io.state import StateFileError, restore_state, save_state
 from .registry import command
 from .values import FLAG, InPath, OutPath, P
 
@@ -18,8 +18,11 @@ RESTORE_NAME = InPath(exts=(".sav",))
          examples=["model save 'ElasticHole-Hex'", "model save 'stage1.sav' compress"])
 def model_save(session, call):
     where = call.locations.get("file", call.location)
-    save_state(session.model, session.out_path(SAVE_NAME.final(call.args["file"]), where),
-               records=list(session.record))
+    target = session.out_path(SAVE_NAME.final(call.args["file"]), where)
+    try:
+        save_state(session.model, target, records=list(session.record))
+    except StateFileError as exc:
+        raise exc.with_location(where) from None
 
 
 @command("model restore", positional=[P("file", RESTORE_NAME, "file written by `model save` (.sav tried when "
@@ -30,6 +33,10 @@ def model_save(session, call):
          examples=["model restore 'ElasticHole-Hex'"])
 def model_restore(session, call):
     where = call.locations.get("file", call.location)
-    model, meta = restore_state(session.in_path(call.args["file"], where, RESTORE_NAME.exts, "state file"))
+    try:
+        # everything is read and checked first: a file that fails leaves the model and record as they were
+        model, meta = restore_state(session.in_path(call.args["file"], where, RESTORE_NAME.exts, "state file"))
+    except StateFileError as exc:
+        raise exc.with_location(where) from None
     session.model = model
     session.record[:] = list(meta.get("records", []))
