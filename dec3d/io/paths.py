@@ -47,7 +47,7 @@ def _checked_name(name) -> Path:
     return p
 
 
-def _short(s: str, n: int = 60) -> str:
+def _short(s: str, n: int = 160) -> str:
     s = "".join(ch if ch.isprintable() else "?" for ch in s)
     return s if len(s) <= n else s[:n - 1] + "…"
 
