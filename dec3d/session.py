@@ -80,6 +80,7 @@ class Session:
         self.record: list[str] = []       # text of every command run, for save files
         self.results: dict[str, float] = {}  # named figures commands report (verification reads them)
         self.bind_context = BindContext(self.variables)
+        self._text_dirs: dict[str, Path] = {}  # folder of text given by load_text(base_dir=…)
 
     # ------------------------------------------------------------------ output
     def write(self, text: str) -> None:
@@ -117,7 +118,9 @@ class Session:
             raise exc.with_location(where)
 
     def _deck_folder(self, file: str) -> Path:
-        return Path.cwd() if file in PSEUDO_FILES else Path(file).parent
+        if file in PSEUDO_FILES:
+            return self._text_dirs.get(file) or Path.cwd()
+        return Path(file).parent
 
     def _read_bases(self, where) -> list[Path]:
         loc = getattr(where, "resolve", lambda: where)()
@@ -157,6 +160,8 @@ class Session:
                   stack: tuple[SourceLocation, ...] = ()) -> list[Item]:
         """Parse and bind text (and the files it calls); nothing runs."""
         deck = parse_deck(text, filename, stack)
+        if base_dir is not None and filename in PSEUDO_FILES:
+            self._text_dirs[filename] = Path(base_dir)     # where its calls and restores look first
         return self._bind_deck(deck, base_dir or Path.cwd(), stack)
 
     def load_file(self, path: str | Path, stack: tuple[SourceLocation, ...] = ()) -> list[Item]:

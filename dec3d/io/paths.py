@@ -166,7 +166,7 @@ def find_input(name, bases, roots, allow_outside: bool = False, exts: tuple[str,
     if odd is not None:
         raise PathError(f"`{_short(text)}` ({odd[0]}) is {odd[1]}, not a regular file: dec3d reads only "
                         "regular files")
-    looked = ", ".join(str(c) for c in cands)
+    looked = ", ".join(_short(str(c)) for c in cands)
     raise PathError(f"cannot read {what} `{_short(text)}`: no such file (looked for {looked})")
 
 

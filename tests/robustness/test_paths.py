@@ -299,3 +299,26 @@ def test_a_read_that_climbs_out_is_refused_when_bound(tree):
     assert err.message == ("`../outside/x` is outside the deck's folder and the output folder: a deck reads "
                            "only there")
     assert (err.location.line, err.location.column) == (4, 15) and s.model.blocks.n == 0
+
+
+@pytest.mark.skipif(hasattr(os, "geteuid") and os.geteuid() == 0, reason="root may write into a read-only folder")
+def test_cli_read_only_out_is_refused(tree):
+    ro = tree / "ro"
+    ro.mkdir()
+    ro.chmod(0o555)
+    deck = tree / "deck" / "d.dat"
+    deck.write_text(BRICK + "model save 's'\n")
+    try:
+        r = dec3d("run", deck, "--out", ro, "-q")
+    finally:
+        ro.chmod(0o755)
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert r.stderr.strip() == f"error: the output folder '{ro}' cannot be used: Permission denied"
+
+
+def test_a_deck_with_a_byte_order_mark_runs(tree):
+    deck = tree / "deck" / "bom.dat"
+    deck.write_bytes(b"\xef\xbb\xbf" + BRICK.encode())
+    s = Session(out_dir=tree / "out", stdout=io.StringIO())
+    s.call(deck)
+    assert s.model.blocks.n == 1
