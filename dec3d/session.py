@@ -169,7 +169,7 @@ class Session:
         the `program call` line): a file already on the stack is a cycle and is refused."""
         path = Path(path)
         where = stack[-1] if stack else None
-        kind = paths._kind(path)
+        kind = paths.file_kind(path)
         if kind is not None:
             raise CommandError(f"cannot read deck `{path}`: it is {kind}, not a regular file", where)
         if stack:
@@ -228,6 +228,16 @@ class Session:
         text = deck.source_lines[block.line - 1]
         loc = SourceLocation(deck.filename, block.line, 1, text, len(text.rstrip()), tuple(stack))
         return FishDefine(block, loc, text.strip())
+
+    def _resolve_call_path(self, name: str, base_dir: Path) -> Path:
+        """The file `program call '<name>'` from a deck in ``base_dir`` would read (the first candidate
+        that exists, else the name beside the deck); no checks — kept for tools such as `dec3d check`.
+        Running decks use ``find_deck``."""
+        for c in paths.input_candidates(name, [Path(base_dir), self.out_dir], (".dat", ".3ddat", ".fis", ".dec")):
+            if c.is_file():
+                return c
+        p = Path(name)
+        return p if p.is_absolute() else Path(base_dir) / p
 
     def find_deck(self, name: str, where) -> Path:
         """The file `program call '<name>'` reads (3DEC adds a default extension when there is none)."""

@@ -64,7 +64,7 @@ def within(p: Path, root: Path) -> bool:
     return p == root or root in p.parents
 
 
-def _kind(p: Path) -> str | None:
+def file_kind(p: Path) -> str | None:
     """None for a regular file or a missing one; else what it is."""
     try:
         st = p.stat()
@@ -105,7 +105,7 @@ def output_path(name, out_dir: str | os.PathLike, allow_outside: bool = False) -
                         hint=FLAG_HINT)
     if real == root:
         raise PathError(f"`{_short(text)}` names the output folder, not a file")
-    kind = _kind(real)
+    kind = file_kind(real)
     if kind is not None:
         raise PathError(f"`{_short(text)}` is {kind}, not a regular file: dec3d writes only regular files")
     return real
@@ -155,7 +155,7 @@ def find_input(name, bases, roots, allow_outside: bool = False, exts: tuple[str,
         if not exists:
             continue
         real = _resolve(c, text)
-        kind = _kind(real)
+        kind = file_kind(real)
         if kind is not None:
             odd = odd or (c, kind)         # a folder of that name: a later candidate may be the file
             continue
