@@ -396,11 +396,8 @@ def _build(path: str, meta: dict, blobs: dict[str, bytes]) -> Model:
         arrays = {}
         for key, fdesc in sdesc["fields"].items():
             name = f"{sname}.{key}"
-            arr = np.lib.format.read_array(io.BytesIO(blobs[name]), allow_pickle=False)
             shape = (int(sdesc["n"]), *fdesc["shape"])
-            if arr.shape != shape or arr.dtype.str != fdesc["dtype"]:
-                raise StateFileError(f"'{path}': array '{name}' has shape {arr.shape} "
-                                     f"{arr.dtype.str}, expected {shape} {fdesc['dtype']}")
+            arr = _read_npy(path, name, blobs[name], shape, fdesc["dtype"])
             if arr.dtype.kind == "f":
                 finite = np.isfinite(arr) if name != "contacts.prop" else ~np.isinf(arr)  # NaN: "not set"
                 if not finite.all():
@@ -421,8 +418,9 @@ def _build(path: str, meta: dict, blobs: dict[str, bytes]) -> Model:
         harrays = {}
         for it in h["items"]:
             for k in ("steps", "times", "values"):
-                harrays[f"{it['id']}.{k}"] = np.lib.format.read_array(
-                    io.BytesIO(blobs[f"{_HIST}{it['id']}.{k}"]), allow_pickle=False)
+                name = f"{_HIST}{it['id']}.{k}"
+                harrays[f"{it['id']}.{k}"] = _read_npy(path, name, blobs[name], None,
+                                                       "<i8" if k == "steps" else "<f8")
         try:
             model.history_set = HistorySet.from_state(model, h, harrays)
         except ValueError as exc:
@@ -431,6 +429,29 @@ def _build(path: str, meta: dict, blobs: dict[str, bytes]) -> Model:
 
         histories(model)          # hooked to the restored model's engine: sampling goes on
     return model
+
+
+def _read_npy(path: str, name: str, blob: bytes, shape, dtype: str) -> np.ndarray:
+    """One ``.npy`` member, its header checked against the schema before any array is made
+    (``shape`` None: any 1-D length the member's bytes can hold)."""
+    f = io.BytesIO(blob)
+    fmt = np.lib.format
+    try:
+        version = fmt.read_magic(f)
+        if version == (1, 0):
+            got, fortran, dt = fmt.read_array_header_1_0(f)
+        elif version == (2, 0):
+            got, fortran, dt = fmt.read_array_header_2_0(f)
+        else:
+            raise ValueError(f"npy format {version}")
+    except (ValueError, SyntaxError, TypeError, EOFError) as exc:
+        raise StateFileError(f"'{path}': array '{name}' has a malformed header ({exc})") from None
+    fits = (got == tuple(shape)) if shape is not None else (len(got) == 1 and got[0] * 8 <= len(blob))
+    if not fits or dt.str != dtype or fortran:
+        raise StateFileError(f"'{path}': array '{name}' has shape {got} {dt.str}, expected "
+                             f"{tuple(shape) if shape is not None else '(n,)'} {dtype}")
+    f.seek(0)
+    return fmt.read_array(f, allow_pickle=False)
 
 
 def _check_geometry(path: str, model: Model) -> None:

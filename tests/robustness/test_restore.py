@@ -244,3 +244,27 @@ def test_save_files_get_the_permissions_of_other_outputs(good, tmp_path):
     umask = os.umask(0)
     os.umask(umask)
     assert mode(tmp_path / "x.sav") == mode(tmp_path / "h.csv") == 0o666 & ~umask
+
+
+def test_an_array_header_larger_than_its_schema_is_refused_before_allocating(good, victim):
+    """The .npy header claims 10¹² rows: refused from the header, no array of that size is made."""
+    members = _members(good)
+    blob = members["blocks.mass.npy"]
+    hdr_end = blob.index(b"\n") + 1
+    header = blob[:hdr_end].replace(b"(2,)", b"(1000000000000,)")
+    pad = (64 - len(header) % 64) % 64
+    header = header[:-1] + b" " * pad + b"\n"
+    header = header[:8] + (len(header) - 10).to_bytes(2, "little") + header[10:]
+    forged = header + blob[hdr_end:]
+    victim_file = victim.out_dir / "bad.sav"
+
+    def fn(meta):
+        meta["sha256"]["blocks.mass"] = __import__("hashlib").sha256(forged).hexdigest()
+    _rewrite(good, victim_file, meta_fn=fn)
+    raw = _members(victim_file)
+    raw["blocks.mass.npy"] = forged
+    with zipfile.ZipFile(victim_file, "w") as zf:
+        for n, b in sorted(raw.items()):
+            zf.writestr(state._member(n), b)
+    _restore_fails(victim, victim_file, f"'{victim_file}': array 'blocks.mass' has shape (1000000000000,) <f8, "
+                                        "expected (2,) <f8")
