@@ -98,7 +98,7 @@ class Session:
                     handle.close()
                 except OSError:
                     pass
-                raise CommandError(f"cannot write the log file '{self.log_path}': {exc.strerror or exc}; "
+                raise CommandError(f"cannot write the log file '{self.log_path}': {paths.os_error_text(exc)}; "
                                    "logging is off") from None
 
     def out_path(self, name: str | Path, where=None) -> Path:
@@ -142,7 +142,7 @@ class Session:
             target.parent.mkdir(parents=True, exist_ok=True)
             handle = open(target, "a" if append else "w", encoding="utf-8")
         except OSError as exc:
-            raise CommandError(f"cannot open the log file '{target}': {exc.strerror or exc}", where) from None
+            raise CommandError(f"cannot open the log file '{target}': {paths.os_error_text(exc)}", where) from None
         self.close_log()
         self.log_path = target
         self._log_handle = handle
@@ -303,7 +303,7 @@ class Session:
         except OSError as exc:
             # a write or read the file system refused at run time (full disk, read-only folder, ...)
             name = f" '{exc.filename}'" if getattr(exc, "filename", None) else ""
-            raise CommandError(f"file error{name}: {exc.strerror or exc}", item.location) from None
+            raise CommandError(f"file error{name}: {paths.os_error_text(exc)}", item.location) from None
 
     def resolve(self, call: CommandCall) -> CommandCall:
         """Evaluate `[expr]`/`@name` values and convert them like literals; other values as bound."""

@@ -170,6 +170,19 @@ def find_input(name, bases, roots, allow_outside: bool = False, exts: tuple[str,
     raise PathError(f"cannot read {what} `{_short(text)}`: no such file (looked for {looked})")
 
 
+def os_error_text(exc: OSError) -> str:
+    """A one-line reason for a failed file operation (no traceback, no file contents)."""
+    import errno
+
+    if exc.errno in (errno.EEXIST, errno.ENOTDIR):
+        return "a file stands where a folder is needed"
+    if exc.errno == errno.ENOSPC:
+        return "no space left on the device"
+    if exc.errno == errno.ENAMETOOLONG:
+        return "the file name is too long"
+    return exc.strerror or str(exc) or type(exc).__name__
+
+
 def chmod_like_outputs(path: str | os.PathLike) -> None:
     """Give a file made by ``tempfile.mkstemp`` (mode 0600) the mode an ordinary ``open`` gives
     (0666 less the umask), so every output has the same permissions."""

@@ -124,7 +124,9 @@ def save_state(model: Model, path: str | os.PathLike, records: list[str] | None 
             os.unlink(tmp)
         except (OSError, NameError):
             pass
-        raise StateFileError(f"cannot write state file '{path}': {exc.strerror or exc}") from None
+        from .paths import os_error_text
+
+        raise StateFileError(f"cannot write state file '{path}': {os_error_text(exc)}") from None
     return path
 
 

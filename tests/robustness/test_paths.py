@@ -217,8 +217,8 @@ def test_a_full_disk_under_the_log_is_one_clean_error(tree, monkeypatch):
     s._log_handle = Full()
     with pytest.raises(Dec3dError) as e:
         s.command("[io.out('x')]")
-    assert e.value.message == (f"cannot write the log file '{tree / 'out' / 'dec3d.log'}': No space left on device; "
-                               "logging is off")
+    assert e.value.message == (f"cannot write the log file '{tree / 'out' / 'dec3d.log'}': no space left on the "
+                               "device; logging is off")
     s.command("[io.out('still here')]")          # the session goes on, logging off
     assert s.stdout.getvalue().splitlines()[-1] == "still here"
 
@@ -233,7 +233,7 @@ def test_an_os_error_while_writing_is_a_command_error(tree, monkeypatch):
     s = Session(out_dir=tree / "out", stdout=io.StringIO())
     with pytest.raises(Dec3dError) as e:
         s.command("block create brick 0 1 0 1 0 1\nblock vtk 'v'")
-    assert e.value.message == "file error 'v_0000.vtu': No space left on device"
+    assert e.value.message == "file error 'v_0000.vtu': no space left on the device"
     assert e.value.location.line == 2
 
 
@@ -272,7 +272,8 @@ def test_cli_run_time_write_failure_is_status_1_without_traceback(tree):
     deck.write_text(BRICK + "block vtk 'sub/v'\n")
     r = dec3d("run", deck, "--out", tree / "out", "-q")
     assert r.returncode == 1 and "Traceback" not in r.stderr
-    assert r.stderr.splitlines()[0].startswith(f"{deck}:3:1: error: file error '{tree / 'out' / 'sub'}'")
+    assert r.stderr.splitlines()[0] == (f"{deck}:3:1: error: file error '{tree / 'out' / 'sub'}': a file stands "
+                                        "where a folder is needed")
 
 
 def test_cli_flag_widens_the_rules(tree):
