@@ -81,6 +81,7 @@ class Session:
         self.results: dict[str, float] = {}  # named figures commands report (verification reads them)
         self.bind_context = BindContext(self.variables)
         self._text_dirs: dict[str, Path] = {}  # folder of text given by load_text(base_dir=…)
+        self.written: set[Path] = set()        # resolved files `model save` wrote (read first by restores)
 
     # ------------------------------------------------------------------ output
     def write(self, text: str) -> None:
@@ -110,10 +111,12 @@ class Session:
             raise exc.with_location(where) if where is not None else exc
 
     def in_path(self, name: str, where, exts: tuple[str, ...] = (), what: str = "file") -> Path:
-        """The file a deck's name reads: beside the deck of ``where``, then in the output folder."""
+        """The file a deck's name reads: beside the deck of ``where``, then in the output folder; a file
+        this session wrote (``self.written``) first, so a run never reads an older copy beside the deck
+        in place of the one it has just saved."""
         try:
             return paths.find_input(name, self._read_bases(where), self._read_roots(where),
-                                    self.allow_outside_paths, exts, what)
+                                    self.allow_outside_paths, exts, what, prefer=self.written)
         except paths.PathError as exc:
             raise exc.with_location(where)
 

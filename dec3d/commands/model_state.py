@@ -23,6 +23,7 @@ def model_save(session, call):
         save_state(session.model, target, records=list(session.record))
     except StateFileError as exc:
         raise exc.with_location(where) from None
+    session.written.add(target)
 
 
 @command("model restore", positional=[P("file", RESTORE_NAME, "file written by `model save` (.sav tried when "

@@ -138,13 +138,17 @@ def check_input_name(name, bases, roots, allow_outside: bool = False) -> None:
 
 
 def find_input(name, bases, roots, allow_outside: bool = False, exts: tuple[str, ...] = (),
-               what: str = "file") -> Path:
-    """The resolved file a read of ``name`` opens: the first candidate (``input_candidates``) that exists.
+               what: str = "file", prefer=()) -> Path:
+    """The resolved file a read of ``name`` opens: the first candidate (``input_candidates``) that exists;
+    a candidate in ``prefer`` (resolved paths: files this run wrote) comes before the others.
 
     Raises ``PathError`` when none exists (saying where it looked), when the one found is not a
     regular file, or when it lies outside every folder of ``roots`` (unless ``allow_outside``)."""
     text = os.fspath(name)
     cands = input_candidates(text, bases, exts)
+    if prefer:
+        mine = [c for c in cands if _resolve(c, text) in prefer]
+        cands = mine + [c for c in cands if c not in mine]
     real_roots = [_resolve(Path(r), os.fspath(r)) for r in roots]
     odd = None
     for c in cands:

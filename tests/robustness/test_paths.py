@@ -323,3 +323,10 @@ def test_a_deck_with_a_byte_order_mark_runs(tree):
     s = Session(out_dir=tree / "out", stdout=io.StringIO())
     s.call(deck)
     assert s.model.blocks.n == 1
+
+
+def test_a_restore_reads_what_the_run_saved_not_an_older_copy_beside_the_deck(tree):
+    s, err = run_deck_text(tree, BRICK + "block create brick 0 1 0 1 3 4\nmodel save 'stage'\n")
+    (tree / "out" / "stage.sav").rename(tree / "deck" / "stage.sav")          # 2 blocks, from an earlier run
+    s, err = run_deck_text(tree, BRICK + "model save 'stage'\nmodel new\nmodel restore 'stage'\n")
+    assert err is None and s.model.blocks.n == 1
