@@ -172,9 +172,10 @@ class Session:
         the `program call` line): a file already on the stack is a cycle and is refused."""
         path = Path(path)
         where = stack[-1] if stack else None
+        shown = paths.printable(str(path))
         kind = paths.file_kind(path)
         if kind is not None:
-            raise CommandError(f"cannot read deck `{path}`: it is {kind}, not a regular file", where)
+            raise CommandError(f"cannot read deck `{shown}`: it is {kind}, not a regular file", where)
         if stack:
             try:
                 me = path.resolve()
@@ -182,16 +183,16 @@ class Session:
             except (OSError, RuntimeError):
                 me, callers = path, []
             if me in callers:
-                raise BindError(f"`{path.name}` calls itself (directly or through other files)", where)
+                raise BindError(f"`{paths.printable(path.name)}` calls itself (directly or through other files)", where)
         try:
             size = path.stat().st_size
             if size > DECK_MAX_BYTES:
-                raise CommandError(f"cannot read deck `{path}`: {size} bytes is more than a deck "
+                raise CommandError(f"cannot read deck `{shown}`: {size} bytes is more than a deck "
                                    f"({DECK_MAX_BYTES // 2**20} MiB at most)", where)
             raw = path.read_bytes()
         except OSError as exc:
             # a called file: point at the `program call` line that names it
-            raise CommandError(f"cannot read deck `{path}`: {exc.strerror or exc}", where) from None
+            raise CommandError(f"cannot read deck `{shown}`: {paths.os_error_text(exc)}", where) from None
         if raw.startswith(b"\xef\xbb\xbf"):
             raw = raw[3:]                   # a UTF-8 byte-order mark
         text = raw.decode("utf-8", errors="replace")

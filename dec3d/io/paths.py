@@ -48,6 +48,7 @@ def _checked_name(name) -> Path:
 
 
 def _short(s: str, n: int = 160) -> str:
+    """A name fit for a message: control characters as '?', at most n characters."""
     s = "".join(ch if ch.isprintable() else "?" for ch in s)
     return s if len(s) <= n else s[:n - 1] + "…"
 
@@ -193,3 +194,6 @@ def chmod_like_outputs(path: str | os.PathLike) -> None:
     mask = os.umask(0)
     os.umask(mask)
     os.chmod(path, 0o666 & ~mask)
+
+
+printable = _short

@@ -330,3 +330,8 @@ def test_a_restore_reads_what_the_run_saved_not_an_older_copy_beside_the_deck(tr
     (tree / "out" / "stage.sav").rename(tree / "deck" / "stage.sav")          # 2 blocks, from an earlier run
     s, err = run_deck_text(tree, BRICK + "model save 'stage'\nmodel new\nmodel restore 'stage'\n")
     assert err is None and s.model.blocks.n == 1
+
+
+def test_control_characters_in_a_refused_name_are_not_echoed(tree):
+    s, err = run_deck_text(tree, BRICK + "model save '../\x1b[2Jx'\n")
+    assert err.message == f"`../?[2Jx.sav` is outside the output folder {tree / 'out'}: a deck writes only there"
