@@ -54,8 +54,9 @@ class _Walker:
         load_all()
         self.standalone = standalone
         self.ctx = BindContext({}, lenient_names=standalone)
-        # the run's own resolution of called files (beside the calling deck, default extensions)
-        self.resolve = Session()._resolve_call_path
+        # the run's own resolution and checks of called files (beside the calling deck, then the
+        # output folder; default extensions; only regular files under the deck's or output folder)
+        self.session = Session()
         self.reports: list[LineReport] = []
 
     def add(self, deck, line, status, what, column=1):
@@ -119,8 +120,13 @@ class _Walker:
         if self.standalone:
             self.add(deck, raw.line, RUNNABLE, f"program call '{name}' (not followed)")
             return
-        target = self.resolve(name, base_dir)
-        if any(Path(s.file) == target for s in stack) or Path(deck.filename) == target:
+        try:
+            target = self.session.find_deck(name, item.locations.get("file", item.location))
+        except Dec3dError as exc:
+            self.problem(deck, raw, ERROR, exc)
+            return
+        if any(Path(s.file).resolve() == target.resolve() for s in stack) or \
+                Path(deck.filename).resolve() == target.resolve():
             self.add(deck, raw.line, ERROR, f"`{target.name}` calls itself (directly or through other files)")
             return
         try:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -16,8 +17,15 @@ def _run(args) -> int:
 
         deck = Path(args.deck)
         out = Path(args.out) if args.out else deck.resolve().parent
-        out.mkdir(parents=True, exist_ok=True)
-        session = Session(out_dir=out, echo=not args.quiet)
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+            if not os.access(out, os.W_OK | os.X_OK):
+                raise PermissionError(13, "Permission denied")
+        except OSError as exc:
+            what = "is a file, not a folder" if out.exists() and not out.is_dir() else (exc.strerror or str(exc))
+            print(f"error: the output folder '{out}' cannot be used: {what}", file=sys.stderr)
+            return 2
+        session = Session(out_dir=out, echo=not args.quiet, allow_outside_paths=args.allow_outside_paths)
         try:
             items = session.load_file(deck)          # parse and bind everything first
         except Dec3dError as exc:
@@ -77,6 +85,9 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("deck")
     r.add_argument("--out", help="folder for outputs (default: the deck's folder)")
     r.add_argument("-q", "--quiet", action="store_true", help="do not echo commands")
+    r.add_argument("--allow-outside-paths", action="store_true",
+                   help="let the deck read and write files outside its folder and the output folder "
+                        "(only for decks you trust; see docs/safety.md)")
     r.set_defaults(fn=_run)
     q = sub.add_parser("repl", help="interactive command prompt")
     q.add_argument("--out", help="folder for outputs (default: current folder)")

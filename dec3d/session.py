@@ -18,8 +18,9 @@ from typing import Any, Iterable, TextIO
 
 from .commands import load_all
 from .commands.binder import BindContext, Binder, CommandCall, ExprStatement
-from .commands.values import Deferred
+from .commands.values import Deferred, InPath, OutPath
 from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation
+from .io import paths
 from .lang.expr import EvalContext, evaluate
 from .lang.parser import ParsedDeck, parse_deck
 from .lang.prepass import FishBlock
@@ -49,9 +50,24 @@ class StopDeck(Exception):
     """`program exit`: stop running, keep the model."""
 
 
+#: file names of text that does not come from a file (its folder is the working folder)
+PSEUDO_FILES = ("<input>", "<command>", "<repl>")
+#: largest deck file read (bytes): a deck is text, a bigger file is not one
+DECK_MAX_BYTES = 64 * 2**20
+
+
 class Session:
-    def __init__(self, out_dir: str | Path | None = None, echo: bool = False, stdout: TextIO | None = None):
+    """One model and the decks run on it.
+
+    out_dir: the output folder (default: the working folder); every file a deck writes stays
+    in it. allow_outside_paths: let decks read and write anywhere (regular files only) — only
+    for decks the user trusts (`dec3d run --allow-outside-paths`; docs/safety.md).
+    """
+
+    def __init__(self, out_dir: str | Path | None = None, echo: bool = False, stdout: TextIO | None = None,
+                 allow_outside_paths: bool = False):
         load_all()
+        self.allow_outside_paths = bool(allow_outside_paths)
         self.model = Model()
         self.variables: dict[str, Any] = {}
         self.fish: dict[str, FishBlock] = {}
@@ -65,29 +81,82 @@ class Session:
         self.results: dict[str, float] = {}  # named figures commands report (verification reads them)
         self.warnings: list[str] = []     # said again at the end of `dec3d run` (e.g. an unconverged solve)
         self.bind_context = BindContext(self.variables)
+        self._text_dirs: dict[str, Path] = {}  # folder of text given by load_text(base_dir=…)
+        self.written: set[Path] = set()        # resolved files `model save` wrote (read first by restores)
 
     # ------------------------------------------------------------------ output
     def write(self, text: str) -> None:
         """Print a line to the console (and the log file when logging is on)."""
         print(text, file=self.stdout)
         if self.log_on and self._log_handle is not None:
-            self._log_handle.write(text + "\n")
-            self._log_handle.flush()
+            try:
+                self._log_handle.write(text + "\n")
+                self._log_handle.flush()
+            except OSError as exc:
+                # a full disk, a removed medium: logging stops, the run is told once
+                self.log_on = False
+                handle, self._log_handle = self._log_handle, None
+                try:
+                    handle.close()
+                except OSError:
+                    pass
+                raise CommandError(f"cannot write the log file '{self.log_path}': {paths.os_error_text(exc)}; "
+                                   "logging is off") from None
 
-    def out_path(self, name: str | Path) -> Path:
-        """Where a file the deck names is written: relative names go under the output folder."""
-        p = Path(name)
-        return p if p.is_absolute() else self.out_dir / p
+    def out_path(self, name: str | Path, where=None) -> Path:
+        """The file a deck's name writes: under the output folder (``dec3d.io.paths.output_path``);
+        a name that leaves it, or is not a regular file, raises ``PathError`` at ``where``."""
+        try:
+            return paths.output_path(name, self.out_dir, self.allow_outside_paths)
+        except paths.PathError as exc:
+            raise exc.with_location(where) if where is not None else exc
 
-    def open_log(self, path: Path | None, append: bool = False) -> None:
+    def in_path(self, name: str, where, exts: tuple[str, ...] = (), what: str = "file") -> Path:
+        """The file a deck's name reads: beside the deck of ``where``, then in the output folder; a file
+        this session wrote (``self.written``) first, so a run never reads an older copy beside the deck
+        in place of the one it has just saved."""
+        try:
+            return paths.find_input(name, self._read_bases(where), self._read_roots(where),
+                                    self.allow_outside_paths, exts, what, prefer=self.written)
+        except paths.PathError as exc:
+            raise exc.with_location(where)
+
+    def _deck_folder(self, file: str) -> Path:
+        if file in PSEUDO_FILES:
+            return self._text_dirs.get(file) or Path.cwd()
+        return Path(file).parent
+
+    def _read_bases(self, where) -> list[Path]:
+        loc = getattr(where, "resolve", lambda: where)()
+        base = self._deck_folder(loc.file) if loc is not None else Path.cwd()
+        return [base, self.out_dir]
+
+    def _read_roots(self, where) -> list[Path]:
+        """Reads stay under the folder of the deck the run started from and the output folder."""
+        loc = getattr(where, "resolve", lambda: where)()
+        if loc is None:
+            return [Path.cwd(), self.out_dir]
+        top = loc.stack[0] if loc.stack else loc
+        return [self._deck_folder(top.file), self.out_dir]
+
+    def open_log(self, path: Path | None, append: bool = False, where=None) -> None:
+        target = path or self.log_path or self.out_path("dec3d.log", where)
+        target = self.out_path(target, where)          # checked again: a symlink may have appeared
+        try:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            handle = open(target, "a" if append else "w", encoding="utf-8")
+        except OSError as exc:
+            raise CommandError(f"cannot open the log file '{target}': {paths.os_error_text(exc)}", where) from None
         self.close_log()
-        self.log_path = path or self.log_path or self.out_path("dec3d.log")
-        self.log_path.parent.mkdir(parents=True, exist_ok=True)
-        self._log_handle = open(self.log_path, "a" if append else "w", encoding="utf-8")
+        self.log_path = target
+        self._log_handle = handle
 
     def close_log(self) -> None:
         if self._log_handle is not None:
-            self._log_handle.close()
+            try:
+                self._log_handle.close()
+            except OSError:
+                pass
             self._log_handle = None
 
     # ------------------------------------------------------------------ reading
@@ -95,16 +164,39 @@ class Session:
                   stack: tuple[SourceLocation, ...] = ()) -> list[Item]:
         """Parse and bind text (and the files it calls); nothing runs."""
         deck = parse_deck(text, filename, stack)
+        if base_dir is not None and filename in PSEUDO_FILES:
+            self._text_dirs[filename] = Path(base_dir)     # where its calls and restores look first
         return self._bind_deck(deck, base_dir or Path.cwd(), stack)
 
     def load_file(self, path: str | Path, stack: tuple[SourceLocation, ...] = ()) -> list[Item]:
+        """Read and bind a deck. With a ``stack`` the file is called by a deck (its last entry is
+        the `program call` line): a file already on the stack is a cycle and is refused."""
         path = Path(path)
+        where = stack[-1] if stack else None
+        shown = paths.printable(str(path))
+        kind = paths.file_kind(path)
+        if kind is not None:
+            raise CommandError(f"cannot read deck `{shown}`: it is {kind}, not a regular file", where)
+        if stack:
+            try:
+                me = path.resolve()
+                callers = [Path(s.file).resolve() for s in stack if s.file not in PSEUDO_FILES]
+            except (OSError, RuntimeError):
+                me, callers = path, []
+            if me in callers:
+                raise BindError(f"`{paths.printable(path.name)}` calls itself (directly or through other files)", where)
         try:
-            text = path.read_text(encoding="utf-8", errors="replace")
+            size = path.stat().st_size
+            if size > DECK_MAX_BYTES:
+                raise CommandError(f"cannot read deck `{shown}`: {size} bytes is more than a deck "
+                                   f"({DECK_MAX_BYTES // 2**20} MiB at most)", where)
+            raw = path.read_bytes()
         except OSError as exc:
             # a called file: point at the `program call` line that names it
-            raise CommandError(f"cannot read deck `{path}`: {exc.strerror or exc}",
-                               stack[-1] if stack else None) from None
+            raise CommandError(f"cannot read deck `{shown}`: {paths.os_error_text(exc)}", where) from None
+        if raw.startswith(b"\xef\xbb\xbf"):
+            raw = raw[3:]                   # a UTF-8 byte-order mark
+        text = raw.decode("utf-8", errors="replace")
         return self.load_text(text, str(path), path.parent, stack)
 
     def _bind_deck(self, deck: ParsedDeck, base_dir: Path, stack) -> list[Item]:
@@ -121,11 +213,10 @@ class Session:
                 items.append(call)
                 continue
             path = call.command.path
+            self._check_paths(call)
             if path == ("program", "call") and not isinstance(call.args["file"], Deferred):
                 # a literal name: the called file is read and bound now, in place of the call
-                target = self._resolve_call_path(call.args["file"], base_dir)
-                if any(Path(s.file) == target for s in stack) or Path(deck.filename) == target:
-                    raise BindError(f"`{target.name}` calls itself (directly or through other files)", call.location)
+                target = self.find_deck(call.args["file"], call.locations.get("file", call.location))
                 items.append(Enter(target, call.location, call.text))
                 items.extend(self.load_file(target, stack + (call.location,)))
                 continue
@@ -144,14 +235,37 @@ class Session:
         return FishDefine(block, loc, text.strip())
 
     def _resolve_call_path(self, name: str, base_dir: Path) -> Path:
+        """The file `program call '<name>'` from a deck in ``base_dir`` would read (the first candidate
+        that exists, else the name beside the deck); no checks — kept for tools such as `dec3d check`.
+        Running decks use ``find_deck``."""
+        for c in paths.input_candidates(name, [Path(base_dir), self.out_dir], (".dat", ".3ddat", ".fis", ".dec")):
+            if c.is_file():
+                return c
         p = Path(name)
-        if not p.is_absolute():
-            p = base_dir / p
-        if not p.exists() and not p.suffix:
-            for ext in (".dat", ".3ddat", ".fis", ".dec"):   # 3DEC adds a default extension
-                if p.with_suffix(ext).exists():
-                    return p.with_suffix(ext)
-        return p
+        return p if p.is_absolute() else Path(base_dir) / p
+
+    def find_deck(self, name: str, where) -> Path:
+        """The file `program call '<name>'` reads (3DEC adds a default extension when there is none)."""
+        return self.in_path(name, where, (".dat", ".3ddat", ".fis", ".dec"), "deck")
+
+    def _check_paths(self, call: CommandCall) -> None:
+        """Bind time: the literal file names of a call must be allowed (``dec3d.io.paths``)."""
+        for p in call.command.positional + call.command.keywords:
+            vt = p.value
+            if not isinstance(vt, (OutPath, InPath)):
+                continue
+            value = call.args.get(p.key)
+            if not isinstance(value, str):
+                continue                      # absent, or an [expr] checked when the command runs
+            where = call.locations.get(p.key, call.location)
+            try:
+                if isinstance(vt, OutPath):
+                    paths.output_path(vt.final(value), self.out_dir, self.allow_outside_paths)
+                else:
+                    paths.check_input_name(value, self._read_bases(call.location),
+                                           self._read_roots(call.location), self.allow_outside_paths)
+            except paths.PathError as exc:
+                raise exc.with_location(where) from None
 
     # ------------------------------------------------------------------ running
     def command(self, text: str) -> None:
@@ -172,15 +286,17 @@ class Session:
             pass
 
     def _run_one(self, item: Item) -> None:
-        if self.echo:
-            src = item.source if not isinstance(item, CommandCall) else _source_of(item)
-            if src:
-                self.write(f"dec3d> {src}")
         try:
+            if self.echo:
+                src = item.source if not isinstance(item, CommandCall) else _source_of(item)
+                if src:
+                    self.write(f"dec3d> {src}")
             if isinstance(item, CommandCall):
                 call = self.resolve(item)
                 item.command.handler(self, call)
-                self.record.append(_source_of(item))
+                if item.command.path != ("model", "restore"):
+                    # a restore takes the saved model's record as it is: restore → save gives the same file
+                    self.record.append(_source_of(item))
             elif isinstance(item, ExprStatement):
                 evaluate(item.node, EvalContext(self.variables, self.write))
                 self.bind_context.assigned.update(self.variables)
@@ -189,6 +305,10 @@ class Session:
                 self.bind_context.define_fish(item.block)
         except Dec3dError as exc:
             raise exc.with_location(item.location)
+        except OSError as exc:
+            # a write or read the file system refused at run time (full disk, read-only folder, ...)
+            name = f" '{exc.filename}'" if getattr(exc, "filename", None) else ""
+            raise CommandError(f"file error{name}: {paths.os_error_text(exc)}", item.location) from None
 
     def resolve(self, call: CommandCall) -> CommandCall:
         """Evaluate `[expr]`/`@name` values and convert them like literals; other values as bound."""
@@ -272,8 +392,10 @@ def _source_of(call: CommandCall) -> str:
     return call.text
 
 
-def run_deck(path: str | Path, out_dir: str | Path | None = None, echo: bool = False) -> Session:
+def run_deck(path: str | Path, out_dir: str | Path | None = None, echo: bool = False,
+             allow_outside_paths: bool = False) -> Session:
     """Run a deck in a new Session and return it."""
-    s = Session(out_dir=out_dir if out_dir is not None else Path(path).parent, echo=echo)
+    s = Session(out_dir=out_dir if out_dir is not None else Path(path).parent, echo=echo,
+                allow_outside_paths=allow_outside_paths)
     s.call(path)
     return s

@@ -1,15 +1,15 @@
 """`block vtk`: VTK snapshots of the blocks, now and every N steps."""
 from __future__ import annotations
 
-from pathlib import Path
-
 from ..io.vtk import request_vtk, stop_vtk
 from .registry import command
-from .values import FLAG, Num, P, Text
+from .values import FLAG, Num, OutPath, P
+
+STEM = OutPath(stem=True)
 
 
-@command("block vtk", positional=[P("file", Text(), "file name stem (default 'blocks')")],
-         keywords=[P("filename", Text(), "same as the positional file name"),
+@command("block vtk", positional=[P("file", STEM, "file name stem in the output folder (default 'blocks')")],
+         keywords=[P("filename", STEM, "same as the positional file name"),
                    P("interval", Num(integer=True, lo=0), "also write every this many steps (0: only now)",
                      default=0),
                    P("off", FLAG, "stop writing snapshots every N steps", bare=True)],
@@ -30,8 +30,10 @@ def block_vtk(session, call):
     if a["off"]:
         stop_vtk(session.model)
         return
-    name = a["filename"] or a["file"] or "blocks"
-    p = session.out_path(name)
-    if p.suffix.lower() in (".vtu", ".pvd", ".vtk"):
-        p = p.with_suffix("")
-    request_vtk(session.model, str(Path(p)), interval=a["interval"])
+    key = "filename" if a["filename"] else "file"
+    name = a[key] or "blocks"
+    where = call.locations.get(key, call.location)
+    pvd = session.out_path(STEM.final(name), where)       # <stem>.pvd, checked; the stem is beside it
+    # every snapshot file is checked too when it is written (a symlink may appear later)
+    request_vtk(session.model, str(pvd.with_suffix("")), interval=a["interval"],
+                guard=lambda f: str(session.out_path(f, where)))

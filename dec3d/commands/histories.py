@@ -11,7 +11,7 @@ from ..io.history import write_csv, write_png
 from ..physics.history import (BLOCK_QUANTITIES, CONTACT_QUANTITIES, MODEL_QUANTITIES, POINT_QUANTITIES,
                                RIGID_QUANTITIES, ROTATION_QUANTITIES, figures, histories, nearest_block_id)
 from .registry import REGISTRY, command
-from .values import NUMBERISH, VEC3, Choice, Num, P, Text, ValueType, _number_literal
+from .values import NUMBERISH, VEC3, Choice, Num, OutPath, P, Text, ValueType, _number_literal
 
 
 class HistoryRefs(ValueType):
@@ -204,7 +204,7 @@ def _find(hs, key, call, slot):
 @command("history export",
          positional=[P("ids", HistoryRefs(), "history numbers or names", required=True)],
          keywords=[P("vs", HistoryRefs(1), "plot and tabulate against this history instead of time"),
-                   P("file", Text(), "CSV file (under the output folder)", required=True)],
+                   P("file", OutPath(), "CSV file (in the output folder)", required=True)],
          doc="Write the histories to a CSV file and a PNG plot per history; report their figures.",
          details="Each history's `<name>.final`, `.min`, `.max` and `.frequency` (Hz, from the zero crossings "
                  "of the value minus its mean) go into the session results. The plots are `<file>_<name>.png`.",
@@ -216,9 +216,17 @@ def history_export(session, call):
     for i in call.args["ids"]:
         picked.append(_find(hs, i, call, "ids"))
     vs = None if call.args["vs"] is None else _find(hs, call.args["vs"], call, "vs")
-    path = session.out_path(call.args["file"])
+    where = call.locations.get("file", call.location)
+    path = session.out_path(call.args["file"], where)
+    # every file is checked before any is written: a history name becomes part of a file name
+    pngs = [session.out_path(path.with_name(f"{path.stem}_{_file_part(h.name)}.png"), where) for h in picked]
     write_csv(path, picked, vs)
-    for h in picked:
-        write_png(path.with_name(f"{path.stem}_{h.name}.png"), h, vs)
+    for h, png in zip(picked, pngs):
+        write_png(png, h, vs)
         for key, v in figures(h.times, h.values).items():
             session.results[f"{h.name}.{key}"] = v
+
+
+def _file_part(name: str) -> str:
+    """A history name as part of a file name: path separators and control characters become '_'."""
+    return "".join("_" if (ch in "/\\" or not ch.isprintable()) else ch for ch in str(name)) or "_"

@@ -1,19 +1,15 @@
 """`model save` / `model restore`: the whole model in one state file."""
 from __future__ import annotations
 
-from pathlib import Path
-
-from ..io.state import restore_state, save_state
+from ..io.state import StateFileError, restore_state, save_state
 from .registry import command
-from .values import FLAG, P, Text
+from .values import FLAG, InPath, OutPath, P
+
+SAVE_NAME = OutPath(suffix=".sav")       # 3DEC adds .sav
+RESTORE_NAME = InPath(exts=(".sav",))
 
 
-def _state_path(session, name: str) -> Path:
-    p = session.out_path(name)
-    return p if p.suffix else p.with_suffix(".sav")    # 3DEC adds .sav
-
-
-@command("model save", positional=[P("file", Text(), "file name (.sav added when there is no extension)",
+@command("model save", positional=[P("file", SAVE_NAME, "file name in the output folder (.sav added when there is no extension)",
                                      required=True)],
          keywords=[P("compress", FLAG, "accepted for 3DEC compatibility (files are always compressed)", bare=True)],
          doc="Save the model (every store, settings, groups and the commands run so far) to a file.",
@@ -21,14 +17,27 @@ def _state_path(session, name: str) -> Path:
                  "settings, command record). Saving the same model twice gives the same bytes.",
          examples=["model save 'ElasticHole-Hex'", "model save 'stage1.sav' compress"])
 def model_save(session, call):
-    save_state(session.model, _state_path(session, call.args["file"]), records=list(session.record))
+    where = call.locations.get("file", call.location)
+    target = session.out_path(SAVE_NAME.final(call.args["file"]), where)
+    try:
+        save_state(session.model, target, records=list(session.record))
+    except StateFileError as exc:
+        raise exc.with_location(where) from None
+    session.written.add(target)
 
 
-@command("model restore", positional=[P("file", Text(), "file written by `model save`", required=True)],
+@command("model restore", positional=[P("file", RESTORE_NAME, "file written by `model save` (.sav tried when "
+                                        "there is no extension): beside the deck, else in the output folder",
+                                        required=True)],
          doc="Replace the model by one saved with `model save`.",
          details="A file from a newer dec3d, or one that is damaged, is refused and the current model is kept.",
          examples=["model restore 'ElasticHole-Hex'"])
 def model_restore(session, call):
-    model, meta = restore_state(_state_path(session, call.args["file"]))
+    where = call.locations.get("file", call.location)
+    try:
+        # everything is read and checked first: a file that fails leaves the model and record as they were
+        model, meta = restore_state(session.in_path(call.args["file"], where, RESTORE_NAME.exts, "state file"))
+    except StateFileError as exc:
+        raise exc.with_location(where) from None
     session.model = model
     session.record[:] = list(meta.get("records", []))

@@ -2,25 +2,27 @@
 from __future__ import annotations
 
 from .registry import command
-from .values import FLAG, ONOFF, P, Text
+from .values import FLAG, ONOFF, InPath, OutPath, P, Text
 
 
-@command("program call", positional=[P("file", Text(), "deck to read, relative to the calling deck", required=True)],
+@command("program call", positional=[P("file", InPath(exts=(".dat", ".3ddat", ".fis", ".dec")),
+                                       "deck to read: beside the calling deck, else in the output folder",
+                                       required=True)],
          keywords=[P("suppress", FLAG, "do not echo the called file's commands"),
                    P("line", supported=False), P("label", Text(), supported=False)],
          doc="Read and run another deck file (`call` alone works too).",
          details="A literal file name is read, parsed and bound together with the calling deck, before anything "
                  "runs, so an error in a called file stops the run before any work is done; errors name the "
-                 "include stack. Without an extension, .dat, .3ddat, .fis and .dec are tried.",
+                 "include stack. Without an extension, .dat, .3ddat, .fis and .dec are tried. The file is looked "
+                 "for beside the calling deck, then in the output folder; it must be a regular file under the "
+                 "folder of the first deck or the output folder (docs/safety.md). A file that calls itself, "
+                 "directly or through others, is refused.",
          examples=["program call 'geometry.dat'", "call \"01_Geometry.dat\""])
 def program_call(session, call):
     # Only a file named by an expression (`program call [name]`) reaches this handler: a literal
     # name was read and bound together with the calling deck (Session._bind_deck).
-    from pathlib import Path
-
     loc = call.location
-    base = Path(loc.file).parent if loc.file not in ("<input>", "<command>", "<repl>") else Path.cwd()
-    items = session.load_file(session._resolve_call_path(call.args["file"], base), loc.stack + (loc,))
+    items = session.load_file(session.find_deck(call.args["file"], loc), loc.stack + (loc,))
     session.run_items(items)
 
 
@@ -50,18 +52,19 @@ def program_quit(session, call):
 def program_log(session, call):
     if call.args["mode"]:
         if session._log_handle is None:
-            session.open_log(None, append=call.args["append"])
+            session.open_log(None, append=call.args["append"], where=call.location)
         session.log_on = True
     else:
         session.log_on = False
 
 
-@command("program log-file", positional=[P("file", Text(), "log file name, relative to the output folder", required=True)],
+@command("program log-file", positional=[P("file", OutPath(), "log file name, in the output folder", required=True)],
          keywords=[P("append", FLAG, "add to an existing file"), P("truncate", FLAG, "start the file afresh (default)")],
          doc="Name the log file; logging continues there if it is on.",
          examples=["program log-file 'run.log'", "log-file 'init_state.txt'"])
 def program_log_file(session, call):
-    session.open_log(session.out_path(call.args["file"]), append=call.args["append"])
+    where = call.locations.get("file", call.location)
+    session.open_log(session.out_path(call.args["file"], where), append=call.args["append"], where=where)
 
 
 @command("program echo", positional=[P("mode", ONOFF, "on: print each command before it runs", required=True)],

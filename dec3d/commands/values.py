@@ -272,3 +272,37 @@ VEC3 = Nums(3, 3)
 TEXT = Text()
 ONOFF = OnOff()
 FLAG = Flag()
+
+
+@dataclass(frozen=True)
+class OutPath(Text):
+    """A file the command writes. The session checks a literal name when the deck is bound
+    (``dec3d.io.paths.output_path``: under the output folder, a regular file) and again, with the
+    value of an `[expr]`, when the command runs. `suffix`: added when the name has none
+    (`model save`: .sav); `stem=True`: the name is a stem, `.vtu|.pvd|.vtk` dropped and `.pvd` checked."""
+
+    label: str = "<file>"
+    suffix: str = ""
+    stem: bool = False
+
+    def final(self, name: str) -> str:
+        """The file name actually written for the name the deck gave."""
+        import os
+
+        if name.endswith(("/", os.sep)) or os.path.basename(name) in ("", ".", ".."):
+            return name           # a folder: refused as such by dec3d.io.paths.output_path
+        base, ext = os.path.splitext(name)
+        if self.stem:
+            return (base if ext.lower() in (".vtu", ".pvd", ".vtk") else name) + ".pvd"
+        if self.suffix and not ext:
+            return name + self.suffix
+        return name
+
+
+@dataclass(frozen=True)
+class InPath(Text):
+    """A file the command reads: looked for beside the calling deck, then in the output folder
+    (``dec3d.io.paths.find_input``); `exts` are tried when the name has no extension."""
+
+    label: str = "<file>"
+    exts: tuple[str, ...] = ()

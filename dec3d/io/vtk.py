@@ -170,9 +170,11 @@ class VtkSeries:
     any point leaves a readable collection.
     """
 
-    def __init__(self, stem: str | os.PathLike):
+    def __init__(self, stem: str | os.PathLike, guard=None):
         self.stem = os.fspath(stem)
         self.entries: list[tuple[float, str]] = []
+        #: guard(file) -> file: checks each file before it is written (``Session.out_path``)
+        self.guard = guard or (lambda f: f)
 
     @property
     def pvd_path(self) -> str:
@@ -182,20 +184,21 @@ class VtkSeries:
         folder = os.path.dirname(self.stem)
         if folder:
             os.makedirs(folder, exist_ok=True)
-        vtu = f"{self.stem}_{len(self.entries):04d}.vtu"
+        vtu = self.guard(f"{self.stem}_{len(self.entries):04d}.vtu")
         write_vtu(model, vtu)
         self.entries.append((float(time), vtu))
-        write_pvd(self.pvd_path, self.entries)
+        write_pvd(self.guard(self.pvd_path), self.entries)
         return vtu
 
 
-def request_vtk(model, stem: str, interval: int = 0) -> None:
+def request_vtk(model, stem: str, interval: int = 0, guard=None) -> None:
     """Ask for snapshots of ``model`` into the series ``stem`` (``<stem>_<nnnn>.vtu`` and
     ``<stem>.pvd``): one now, and every ``interval`` steps afterwards when interval > 0.
-    Requests for the same stem continue its series."""
+    Requests for the same stem continue its series. ``guard(file)`` checks each file before
+    it is written (the session's output-folder rule)."""
     req = model.outputs.get("vtk")
     if req is None or req["series"].stem != stem:
-        req = {"series": VtkSeries(stem), "interval": 0, "last_step": None}
+        req = {"series": VtkSeries(stem, guard), "interval": 0, "last_step": None}
         model.outputs["vtk"] = req
     req["interval"] = int(interval)
     req["series"].write(model, model.time)

@@ -43,6 +43,8 @@ class History:
     name: str
     label: str                                  # what is sampled, for the CSV header and the plot
     value: Callable[[object], float]            # value(engine) -> float
+    #: how to make it again (save files; ``HistorySet._make``): plain JSON. Every kind of history sets it
+    spec: dict = field(default_factory=dict)
     steps: list[int] = field(default_factory=list)
     times: list[float] = field(default_factory=list)
     values: list[float] = field(default_factory=list)
@@ -65,9 +67,120 @@ class HistorySet:
             for h in self.items:
                 h.sample(eng)
 
-    def add(self, label: str, value: Callable, name: str | None = None) -> History:
+    def add(self, label: str, value: Callable, name: str | None = None, spec: dict | None = None) -> History:
         hid = (self.items[-1].id + 1) if self.items else 1
-        h = History(hid, name or str(hid), label, value)
+        h = History(hid, name or str(hid), label, value, dict(spec or {}))
+        self.items.append(h)
+        return h
+
+    # ------------------------------------------------------------ save files
+    def to_state(self) -> tuple[dict, dict[str, np.ndarray]]:
+        """(JSON description, arrays) of every history, for ``dec3d.io.state``."""
+        items, arrays = [], {}
+        for h in self.items:
+            spec = dict(h.spec)
+            if spec.get("kind") == "contact":
+                ids = getattr(h, "follow", {}).get("ids")
+                spec["pair"] = [int(i) for i in ids] if ids else None
+            elif spec.get("kind") == "rotation":
+                prev = h.state["prev"]
+                spec["prev"] = None if prev is None else [float(x) for x in prev]
+            items.append({"id": h.id, "name": h.name, "label": h.label, "spec": spec})
+            arrays[f"{h.id}.steps"] = np.asarray(h.steps, dtype=np.int64)
+            arrays[f"{h.id}.times"] = np.asarray(h.times, dtype=np.float64)
+            arrays[f"{h.id}.values"] = np.asarray(h.values, dtype=np.float64)
+        return {"interval": self.interval, "items": items}, arrays
+
+    @classmethod
+    def from_state(cls, model, desc: dict, arrays: dict[str, np.ndarray]) -> "HistorySet":
+        """The inverse of ``to_state``; raises ValueError naming what is wrong (nothing is changed)."""
+        hs = cls(model)
+        interval = desc.get("interval")
+        if not isinstance(interval, int) or isinstance(interval, bool) or interval < 1:
+            raise ValueError(f"history interval {interval!r} is not a whole number ≥ 1")
+        hs.interval = interval
+        items = desc.get("items")
+        if not isinstance(items, list):
+            raise ValueError("the history list is not a list")
+        seen = set()
+        for it in items:
+            if not isinstance(it, dict):
+                raise ValueError("a history entry is not an object")
+            hid, name, label, spec = it.get("id"), it.get("name"), it.get("label"), it.get("spec")
+            if not isinstance(hid, int) or isinstance(hid, bool) or hid < 1 or hid in seen:
+                raise ValueError(f"history id {hid!r} is not a new whole number ≥ 1")
+            if hs.items and hid <= hs.items[-1].id:
+                raise ValueError(f"history ids are not increasing at {hid}")
+            seen.add(hid)
+            if not isinstance(name, str) or not isinstance(label, str) or not isinstance(spec, dict):
+                raise ValueError(f"history {hid}: name, label or spec has the wrong type")
+            h = hs._make(hid, name, label, spec)
+            steps, times, values = (arrays.get(f"{hid}.{k}") for k in ("steps", "times", "values"))
+            if steps is None or times is None or values is None:
+                raise ValueError(f"history {hid}: its samples are missing")
+            if not (steps.ndim == times.ndim == values.ndim == 1 and len(steps) == len(times) == len(values)):
+                raise ValueError(f"history {hid}: its sample arrays differ in length")
+            if steps.dtype.kind not in "iu" or times.dtype.kind != "f" or values.dtype.kind != "f":
+                raise ValueError(f"history {hid}: its sample arrays have the wrong types")
+            if not np.isfinite(times).all() or np.isinf(values).any():
+                raise ValueError(f"history {hid}: a sample time or value is not finite")
+            h.steps, h.times, h.values = steps.tolist(), times.tolist(), values.tolist()
+        return hs
+
+    def _make(self, hid: int, name: str, label: str, spec: dict) -> History:
+        kind = spec.get("kind")
+
+        def num_list(key, n):
+            v = spec.get(key)
+            if not (isinstance(v, list) and len(v) == n and all(isinstance(x, (int, float)) and
+                                                                not isinstance(x, bool) and np.isfinite(x)
+                                                                for x in v)):
+                raise ValueError(f"history {hid}: `{key}` is not {n} finite numbers")
+            return v
+
+        def block_id():
+            v = spec.get("block_id")
+            if not isinstance(v, int) or isinstance(v, bool) or v < 1:
+                raise ValueError(f"history {hid}: block id {v!r} is not a whole number ≥ 1")
+            return v
+
+        q = spec.get("quantity")
+        if kind == "block" and q in BLOCK_QUANTITIES:
+            h = self.add_block(q, block_id(), name)
+        elif kind == "rigid" and q in RIGID_QUANTITIES:
+            arms = spec.get("arms0")
+            if not (isinstance(arms, list) and arms and all(isinstance(a, list) for a in arms)):
+                raise ValueError(f"history {hid}: `arms0` is not a list of vectors")
+            for i, a in enumerate(arms):
+                if not (len(a) == 3 and all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                            and np.isfinite(x) for x in a)):
+                    raise ValueError(f"history {hid}: vertex arm {i} is not 3 finite numbers")
+            inertia = spec.get("inertia0")
+            if not (isinstance(inertia, list) and len(inertia) == 3):
+                raise ValueError(f"history {hid}: `inertia0` is not a 3 × 3 matrix")
+            for row in inertia:
+                if not (isinstance(row, list) and len(row) == 3 and all(
+                        isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) for x in row)):
+                    raise ValueError(f"history {hid}: `inertia0` is not a 3 × 3 matrix of finite numbers")
+            h = self.add_rigid(q, block_id(), name, arms0=np.array(arms, float), inertia0=np.array(inertia, float))
+        elif kind == "contact" and q in CONTACT_QUANTITIES:
+            pos = num_list("position", 3)
+            pair = spec.get("pair")
+            if pair is not None and not (isinstance(pair, list) and len(pair) == 2 and all(
+                    isinstance(x, int) and not isinstance(x, bool) for x in pair)):
+                raise ValueError(f"history {hid}: `pair` is not two block ids")
+            h = self.add_contact(q, pos, name, pair=tuple(pair) if pair else None)
+        elif kind == "rotation" and q in ROTATION_QUANTITIES:
+            prev = None if spec.get("prev") is None else num_list("prev", 3)
+            h = self.add_rotation(q, block_id(), name, prev=prev)
+        elif kind == "point" and q in BLOCK_QUANTITIES and BLOCK_QUANTITIES[q][0] in ("centroid", "disp", "velocity"):
+            h = self.add_point(q, block_id(), num_list("point", 3), name, p_origin=num_list("origin", 3))
+        elif kind == "model" and q in MODEL_QUANTITIES:
+            h = self.add_model(q, name)
+        else:
+            raise ValueError(f"history {hid}: unknown kind {kind!r} or quantity {q!r}")
+        self.items.pop()
+        h.id, h.label = hid, label
         self.items.append(h)
         return h
 
@@ -91,7 +204,8 @@ class HistorySet:
             v = b[fld][r]
             return float(np.linalg.norm(v)) if comp is None else float(v[comp])
 
-        return self.add(f"block {block_id} {quantity}", value, name)
+        return self.add(f"block {block_id} {quantity}", value, name,
+                        {"kind": "block", "quantity": quantity, "block_id": int(block_id)})
 
     def _row(self, block_id: int, cache: dict) -> int:
         b = self.model.blocks
@@ -100,12 +214,12 @@ class HistorySet:
             r = cache["row"] = int(np.flatnonzero(b["id"] == block_id)[0])
         return r
 
-    def add_rotation(self, quantity: str, block_id: int, name: str | None = None) -> History:
+    def add_rotation(self, quantity: str, block_id: int, name: str | None = None, prev=None) -> History:
         """A component of the block's rotation vector since it was made, or its angle [rad]; each
         sample takes the equivalent vector (θ + 2πk) n nearest the previous one, so a block that keeps
         turning about one axis gives ω t past θ = π."""
         model = self.model
-        state: dict = {"prev": None}
+        state: dict = {"prev": None if prev is None else np.asarray(prev, dtype=float)}
         comp = {"rotation": None, "rotation-x": 0, "rotation-y": 1, "rotation-z": 2}[quantity]
 
         def value(eng) -> float:
@@ -114,9 +228,12 @@ class HistorySet:
             state["prev"] = rv
             return float(np.linalg.norm(rv)) if comp is None else float(rv[comp])
 
-        return self.add(f"block {block_id} {quantity}", value, name)
+        h = self.add(f"block {block_id} {quantity}", value, name,
+                     {"kind": "rotation", "quantity": quantity, "block_id": int(block_id)})
+        h.state = state           # the last rotation vector (save files: unwrapping goes on after a restore)
+        return h
 
-    def add_point(self, quantity: str, block_id: int, point, name: str | None = None) -> History:
+    def add_point(self, quantity: str, block_id: int, point, name: str | None = None, p_origin=None) -> History:
         """Displacement (since the block was made), velocity or position of a point fixed to a block.
 
         The point is kept in the block's frame at its making: p_o = x̄_o + Rᵀ (p − x̄), with x̄ the mean of
@@ -136,8 +253,10 @@ class HistorySet:
             mp, mo = pos.mean(axis=0), org.mean(axis=0)
             return mp, mo, best_rotation(org - mo, pos - mp)
 
-        mp, mo, rot = frame(self._row(block_id, cache))
-        p_origin = mo + rot.T @ (p0 - mp)
+        if p_origin is None:
+            mp, mo, rot = frame(self._row(block_id, cache))
+            p_origin = mo + rot.T @ (p0 - mp)
+        p_origin = np.asarray(p_origin, dtype=float)
 
         def value(eng) -> float:
             r = self._row(block_id, cache)
@@ -152,16 +271,22 @@ class HistorySet:
                 out = bb["velocity"][r] + np.cross(bb["spin"][r], p - bb["centroid"][r])
             return float(np.linalg.norm(out)) if comp is None else float(out[comp])
 
-        return self.add(f"block {block_id} {quantity} at point ({p0[0]:g} {p0[1]:g} {p0[2]:g})", value, name)
+        return self.add(f"block {block_id} {quantity} at point ({p0[0]:g} {p0[1]:g} {p0[2]:g})", value, name,
+                        {"kind": "point", "quantity": quantity, "block_id": int(block_id),
+                         "point": [float(x) for x in p0], "origin": [float(x) for x in p_origin]})
 
-    def add_rigid(self, quantity: str, block_id: int, name: str | None = None) -> History:
-        """Angular momentum [kg·m²/s] or shape error [m] of one block (``RIGID_QUANTITIES``)."""
+    def add_rigid(self, quantity: str, block_id: int, name: str | None = None, arms0=None,
+                  inertia0=None) -> History:
+        """Angular momentum [kg·m²/s] or shape error [m] of one block (``RIGID_QUANTITIES``).
+        ``arms0``, ``inertia0``: the reference state (a restored history's); default: the block now."""
         model = self.model
         b = model.blocks
-        r0 = int(np.flatnonzero(b["id"] == block_id)[0])
-        s, c = int(b["vert_start"][r0]), int(b["vert_count"][r0])
-        arms0 = model.vertices["pos"][s:s + c] - b["centroid"][r0]
-        inertia0 = b["inertia"][r0].copy()
+        if arms0 is None:
+            r0 = int(np.flatnonzero(b["id"] == block_id)[0])
+            s, c = int(b["vert_start"][r0]), int(b["vert_count"][r0])
+            arms0 = model.vertices["pos"][s:s + c] - b["centroid"][r0]
+            inertia0 = b["inertia"][r0].copy()
+        c = len(arms0)
         comp = {"": None, "-x": 0, "-y": 1, "-z": 2}.get(quantity[len("angular-momentum"):], None)
 
         def value(eng) -> float:
@@ -175,16 +300,18 @@ class HistorySet:
             lm = rot @ inertia0 @ rot.T @ bb["spin"][r]
             return float(np.linalg.norm(lm)) if comp is None else float(lm[comp])
 
-        return self.add(f"block {block_id} {quantity}", value, name)
+        return self.add(f"block {block_id} {quantity}", value, name,
+                        {"kind": "rigid", "quantity": quantity, "block_id": int(block_id),
+                         "arms0": np.asarray(arms0, float).tolist(), "inertia0": np.asarray(inertia0, float).tolist()})
 
-    def add_contact(self, quantity: str, position, name: str | None = None) -> History:
+    def add_contact(self, quantity: str, position, name: str | None = None, pair=None) -> History:
         """A contact quantity summed (or averaged) over the sub-contacts of one contact: the contact whose
         centre is nearest ``position`` at the first sample, followed by its two blocks' ids afterwards
         (the ``contacts`` / ``subcontacts`` stores of the rigid engine)."""
         fld, how = CONTACT_QUANTITIES[quantity]
         model = self.model
         pos = np.asarray(position, dtype=float)
-        pair: dict = {}
+        pair: dict = {"ids": tuple(pair)} if pair else {}
 
         def value(eng) -> float:
             c, sc = _contact_view(model, eng)
@@ -210,13 +337,18 @@ class HistorySet:
                 return float(np.linalg.norm(v.mean(axis=0))) if v.size else 0.0
             return float(v[:, how].sum())
 
-        return self.add(f"contact near ({pos[0]:g} {pos[1]:g} {pos[2]:g}) {quantity}", value, name)
+        h = self.add(f"contact near ({pos[0]:g} {pos[1]:g} {pos[2]:g}) {quantity}", value, name,
+                     {"kind": "contact", "quantity": quantity, "position": [float(x) for x in pos]})
+        h.follow = pair           # the two block ids followed (set at the first sample), for save files
+        return h
 
     def add_model(self, quantity: str, name: str | None = None) -> History:
         if quantity.startswith(("ratio", "unbalanced")):   # the measures of `model solve` (RigidEngine.criteria)
-            return self.add(f"mechanical {quantity}", lambda eng: float(eng.criteria()[quantity]), name)
-        attr = {"time-total": "time", "kinetic-energy": "kinetic"}[quantity]
-        return self.add(f"mechanical {quantity}", lambda eng: float(getattr(eng, attr)), name)
+            value = lambda eng: float(eng.criteria()[quantity])   # noqa: E731
+        else:
+            attr = {"time-total": "time", "kinetic-energy": "kinetic"}[quantity]
+            value = lambda eng: float(getattr(eng, attr))          # noqa: E731
+        return self.add(f"mechanical {quantity}", value, name, {"kind": "model", "quantity": quantity})
 
 
 def _contact_view(model, eng):

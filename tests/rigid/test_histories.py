@@ -187,3 +187,25 @@ def test_point_and_rotation_errors(session):
         session.run_items(session.load_text(SPIN + "block history rvelocity-z block-id 1 material-point 0 0 0\n"))
     with pytest.raises(Dec3dError, match=r"`block-id <i>` \(or `material-point"):
         session.run_items(session.load_text(SPIN + "block history displacement-x\n"))
+
+
+def test_rotation_and_material_point_histories_continue_after_save_and_restore(tmp_path):
+    """Spin past π (rotation unwrapping) and a point fixed to a moving block: 1500 steps, save, restore,
+    1500 more give the same CSV as 3000 steps in one go — the unwrapping state and the point's place in
+    the block's frame travel in the save file."""
+    import io
+
+    from dec3d.session import Session
+
+    hist = ("block initialize velocity-x 1 rvelocity-z 2 range id 1\n"
+            "block history name 'rz' rotation-z block-id 1\n"
+            "block history name 'px' position-x block-id 1 material-point 1 2 0.5\nhistory interval 100\n")
+    a = Session(out_dir=tmp_path / "a", stdout=io.StringIO())
+    a.run_items(a.load_text(SPIN + hist + "model cycle 3000\nhistory export 'rz' 'px' file 'h.csv'\n"))
+    b = Session(out_dir=tmp_path / "b", stdout=io.StringIO())
+    b.run_items(b.load_text(SPIN + hist + "model cycle 1500\nmodel save 'half'\n"))
+    c = Session(out_dir=tmp_path / "b", stdout=io.StringIO())
+    c.run_items(c.load_text("model restore 'half'\nmodel cycle 1500\nhistory export 'rz' 'px' file 'h.csv'\n"))
+    ha, hc = (tmp_path / "a" / "h.csv").read_text(), (tmp_path / "b" / "h.csv").read_text()
+    assert ha == hc and len(ha.splitlines()) == 1 + 30
+    assert a.results["rz.final"] == pytest.approx(3000 * 2 * math.atan(1e-3), rel=1e-9)   # 6 rad: past π
