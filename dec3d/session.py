@@ -19,7 +19,7 @@ from typing import Any, Iterable, TextIO
 from .commands import load_all
 from .commands.binder import BindContext, Binder, CommandCall, ExprStatement
 from .commands.values import Deferred
-from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation
+from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation, StopDeck
 from .lang.expr import EvalContext, evaluate
 from .lang.parser import ParsedDeck, parse_deck
 from .lang.prepass import FishBlock
@@ -43,10 +43,6 @@ class Enter:
 
 
 Item = CommandCall | ExprStatement | FishDefine | Enter
-
-
-class StopDeck(Exception):
-    """`program exit`: stop running, keep the model."""
 
 
 class Session:

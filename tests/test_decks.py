@@ -5,8 +5,9 @@ from collections import Counter
 import pytest
 
 from dec3d.check import ERROR, LEGACY, NOT_SUPPORTED, RUNNABLE, check_file
-from conftest import DECKS
+from conftest import DECKS, require_decks
 
+require_decks()
 MODERN = sorted(DECKS.glob("*.dat"))
 LEGACY_DECKS = sorted((DECKS / "legacy_v5").glob("*.dat"))
 

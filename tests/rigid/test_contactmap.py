@@ -8,7 +8,7 @@ from dec3d.kernels.cycle import _move_points, run_steps
 from dec3d.kernels.jointlaw import subcontact_forces
 from dec3d.kernels.motion import rigid_motion_groups
 from dec3d.physics.rigid import engine
-from tests.reference import contactmap_ref as ref
+from reference import contactmap_ref as ref
 
 
 @pytest.mark.parametrize("seed", range(5))
