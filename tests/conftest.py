@@ -10,7 +10,7 @@ ROOT = Path(__file__).resolve().parent.parent
 SHARED = Path(os.environ.get("DEC3D_SHARED", ROOT.parent / "shared"))
 DECKS = SHARED / "decks"
 NO_DECKS = (f"public 3DEC decks not found at {DECKS}: set DEC3D_SHARED=<folder holding decks/> "
-            "or place shared/ beside the repository (see README, 'Tests')")
+            "or place shared/ beside the repository (README, 'Set up')")
 
 
 def require_decks():
