@@ -22,15 +22,6 @@ def hull_distance(va, vb):
     return math.sqrt(max(r.fun, 0.0))
 
 
-def sampled_best_gap(va, vb, n_dirs=40000, seed=0):
-    """max over many unit directions of min_B n·V − max_A n·V (a lower bound of the best gap)."""
-    rng = np.random.default_rng(seed)
-    d = rng.normal(size=(n_dirs, 3))
-    d /= np.linalg.norm(d, axis=1)[:, None]
-    g = (vb @ d.T).min(axis=0) - (va @ d.T).max(axis=0)
-    return float(g.max())
-
-
 def coulomb_ref(p, model, area, dun, dus, un, udil, fs, us, failed):
     """Scalar Coulomb slip law written from the text (Eqs. 24-43 with the ERRATA), plain Python.
     p: dict kn ks phi coh ten dil zdil phir cohr tenr (angles in radians)."""
