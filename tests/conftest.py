@@ -11,12 +11,9 @@ SHARED = Path(os.environ.get("DEC3D_SHARED", ROOT.parent / "shared"))
 DECKS = SHARED / "decks"
 NO_DECKS = (f"public 3DEC decks not found at {DECKS}: set DEC3D_SHARED=<folder holding decks/> "
             "or place shared/ beside the repository (README, 'Set up')")
-
-
-def require_decks():
-    """Skip the calling test module, with one reason, when the public decks are absent."""
-    if not DECKS.is_dir():
-        pytest.skip(NO_DECKS, allow_module_level=True)
+# a module that reads the decks starts with:
+#     if not DECKS.is_dir():
+#         pytest.skip(NO_DECKS, allow_module_level=True)
 
 
 @pytest.fixture
