@@ -95,3 +95,8 @@ class ExpressionError(Dec3dError):
 
 class CommandError(Dec3dError):
     """A command was bound correctly but could not be carried out."""
+
+
+class StopDeck(Exception):
+    """`program exit`: stop running, keep the model. (Control flow, not an error; it lives here so the
+    command handlers can raise it without importing the session above them.)"""

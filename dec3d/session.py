@@ -19,7 +19,7 @@ from typing import Any, Iterable, TextIO
 from .commands import load_all
 from .commands.binder import BindContext, Binder, CommandCall, ExprStatement
 from .commands.values import Deferred, InPath, OutPath
-from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation
+from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation, StopDeck
 from .io import paths
 from .lang.expr import EvalContext, evaluate
 from .lang.parser import ParsedDeck, parse_deck
@@ -44,10 +44,6 @@ class Enter:
 
 
 Item = CommandCall | ExprStatement | FishDefine | Enter
-
-
-class StopDeck(Exception):
-    """`program exit`: stop running, keep the model."""
 
 
 #: file names of text that does not come from a file (its folder is the working folder)

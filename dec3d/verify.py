@@ -5,9 +5,9 @@ Each folder of `verification/` holds a `problem.toml`:
     title = "..."; kind = "deck" | "ssdem"; source = "..."
     deck = "deck.dat"            # kind = "deck": quantities are FISH variables and session results
     input = "..."; args = [...]  # kind = "ssdem"
-    [[expect]]  quantity = "..."  value = 1.0  rel_tol = 0.01 | abs_tol = ...
+    [[expect]]  quantity = "..."  value = 1.0  rel_tol = 0.01 | abs_tol = ...  [note = "..."]
     [[expect]]  quantity = "..."  below = "<other quantity>"
-    [[expect]]  quantity = "..."  value = ...  report_only = true
+    [[expect]]  quantity = "..."  value = ...  not_comparable = "because ..."
     [[derive]]  name = "..."  kind = "slope" | "curvature" | "mean" | "max" | "min"
                 csv = "<history export file>"  history = "<name>"  [vs = "<name>"]
                 [t0 = <s>]  [t1 = <s>]       # window, seconds after the file's first sample
@@ -17,6 +17,11 @@ Each folder of `verification/` holds a `problem.toml`:
 slope d(history)/dt (or d(history)/d(vs) with `vs`), the curvature 2·c₂ of a least-squares quadratic
 c₀ + c₁t + c₂t² (an acceleration from a displacement), or the mean/max/min over the window; and the
 trend (clockwise from +y) and plunge (down from horizontal) of a vector of three other quantities.
+
+Every `[[expect]]` is either a bar the measurement must meet (a value with its tolerance, or `below`)
+or `not_comparable`: a published figure the measurement is shown against but cannot be held to, with
+the reason. The table prints the bars, then the count, then the not-comparable rows in a section of
+their own, so nothing that was not checked stands beside a PASS.
 
 Expectations are data; the runner knows no problem by name.
 """
@@ -36,7 +41,7 @@ class Check:
     quantity: str
     measured: float | None
     expected: str
-    passed: bool | None        # None: report only
+    passed: bool | None        # None: not comparable (shown with its reason, never counted)
     note: str = ""
 
 
@@ -116,11 +121,42 @@ def problems(root: Path) -> list[Path]:
     return sorted(p.parent for p in root.glob("*/problem.toml"))
 
 
+EXPECT_KEYS = {"quantity", "value", "rel_tol", "abs_tol", "below", "not_comparable", "note"}
+
+
+def _expect_error(e: dict) -> str | None:
+    """What is wrong with one [[expect]] entry, or None."""
+    if "report_only" in e:
+        return ("'report_only' is gone: give the quantity a bar (value with rel_tol or abs_tol, or below) "
+                "or say why it cannot have one: not_comparable = \"because ...\"")
+    unknown = sorted(set(e) - EXPECT_KEYS)
+    if unknown:
+        return f"unknown key(s) {', '.join(unknown)} (known: {', '.join(sorted(EXPECT_KEYS))})"
+    if "quantity" not in e:
+        return "no 'quantity'"
+    if "not_comparable" in e:
+        if not isinstance(e["not_comparable"], str) or not e["not_comparable"].strip():
+            return "'not_comparable' must be the reason, as text"
+        if "value" not in e or set(e) & {"rel_tol", "abs_tol", "below"}:
+            return "a not_comparable entry gives the published 'value' and no tolerance or 'below'"
+        return None
+    if "below" in e:
+        return None if not set(e) & {"value", "rel_tol", "abs_tol"} else "'below' takes no value or tolerance"
+    if "value" not in e or len(set(e) & {"rel_tol", "abs_tol"}) != 1:
+        return "a bar needs 'value' and exactly one of 'rel_tol', 'abs_tol'"
+    return None
+
+
 def check_problem(folder: Path) -> list[Check]:
-    spec = tomllib.loads((folder / "problem.toml").read_text(encoding="utf-8"))
+    where = folder / "problem.toml"
+    spec = tomllib.loads(where.read_text(encoding="utf-8"))
     kind = spec.get("kind")
     if kind not in KINDS:
-        raise ValueError(f"{folder / 'problem.toml'}: kind must be one of {sorted(KINDS)}, got {kind!r}")
+        raise ValueError(f"{where}: kind must be one of {sorted(KINDS)}, got {kind!r}")
+    for i, e in enumerate(spec.get("expect", []), start=1):
+        err = _expect_error(e)
+        if err:
+            raise ValueError(f"{where}: [[expect]] number {i} ({e.get('quantity', '?')}): {err}")
     q = KINDS[kind](folder, spec)
     checks = []
     for e in spec.get("expect", []):
@@ -130,19 +166,42 @@ def check_problem(folder: Path) -> list[Check]:
             other = q.get(e["below"])
             ok = m is not None and other is not None and m < other
             checks.append(Check(folder.name, name, m, f"< {e['below']} ({other:.4g})" if other is not None else
-                                f"< {e['below']} (missing)", ok))
+                                f"< {e['below']} (missing)", ok, e.get("note", "")))
             continue
         v = float(e["value"])
+        if "not_comparable" in e:
+            checks.append(Check(folder.name, name, m, f"{v:.6g}", None, e["not_comparable"].strip()))
+            continue
         if "rel_tol" in e:
             tol = abs(v) * float(e["rel_tol"])
             exp = f"{v:.6g} ± {100 * float(e['rel_tol']):g} %"
         else:
-            tol = float(e.get("abs_tol", 0.0))
+            tol = float(e["abs_tol"])
             exp = f"{v:.6g} ± {tol:g}"
         ok = m is not None and math.isfinite(m) and abs(m - v) <= tol
-        checks.append(Check(folder.name, name, m, exp, None if e.get("report_only") else ok,
-                            e.get("note", "")))
+        checks.append(Check(folder.name, name, m, exp, ok, e.get("note", "")))
     return checks
+
+
+def render(rows: list[Check]) -> str:
+    """The verify table: the checked rows with PASS/FAIL and their count, then, in a section of their
+    own, the rows shown beside a published figure they are not comparable with, each with the reason."""
+    def meas(c: Check) -> str:
+        return "-" if c.measured is None else f"{c.measured:.6g}"
+
+    checked = [c for c in rows if c.passed is not None]
+    shown = [c for c in rows if c.passed is None]
+    out = [f"{'problem':32s} {'quantity':22s} {'measured':>12s}  {'expected':28s} result"]
+    for c in checked:
+        out.append(f"{c.problem:32s} {c.quantity:22s} {meas(c):>12s}  {c.expected:28s} "
+                   f"{'PASS' if c.passed else 'FAIL'}" + (f"  {c.note}" if c.note else ""))
+    out.append(f"{sum(c.passed is True for c in checked)} passed, {sum(c.passed is False for c in checked)} failed")
+    if shown:
+        out += ["", "Not comparable (shown beside a published figure, not checked):",
+                f"{'problem':32s} {'quantity':22s} {'measured':>12s}  {'published':>10s}  because"]
+        for c in shown:
+            out.append(f"{c.problem:32s} {c.quantity:22s} {meas(c):>12s}  {c.expected:>10s}  {c.note}")
+    return "\n".join(out)
 
 
 def main(names: list[str] | None = None, root: str | Path | None = None) -> int:
@@ -157,17 +216,10 @@ def main(names: list[str] | None = None, root: str | Path | None = None) -> int:
             return 2
         folders = [f for f in folders if f.name in names or any(f.name.startswith(n) for n in names)]
     rows: list[Check] = []
-    failed = 0
     for f in folders:
         try:
             rows += check_problem(f)
         except Exception as exc:  # a crashing problem is a failed problem, reported, and the others still run
             rows.append(Check(f.name, "(run)", None, "runs", False, f"{type(exc).__name__}: {exc}"))
-    print(f"{'problem':32s} {'quantity':22s} {'measured':>12s}  {'expected':28s} result")
-    for c in rows:
-        meas = "-" if c.measured is None else f"{c.measured:.6g}"
-        res = "report" if c.passed is None else ("PASS" if c.passed else "FAIL")
-        failed += c.passed is False
-        print(f"{c.problem:32s} {c.quantity:22s} {meas:>12s}  {c.expected:28s} {res}" + (f"  {c.note}" if c.note else ""))
-    print(f"{sum(c.passed is True for c in rows)} passed, {failed} failed")
-    return 1 if failed else 0
+    print(render(rows))
+    return 1 if any(c.passed is False for c in rows) else 0

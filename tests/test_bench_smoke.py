@@ -1,4 +1,5 @@
 """bench/rigid_bench.py runs on a tiny stack and prints its figures (no timing asserted)."""
+import os
 import subprocess
 import sys
 
@@ -7,7 +8,9 @@ from conftest import ROOT
 
 def test_rigid_bench_runs_and_prints_the_figures():
     out = subprocess.run([sys.executable, str(ROOT / "bench" / "rigid_bench.py"), "--n", "2", "--steps", "5",
-                          "--repeat", "1"], capture_output=True, text=True, timeout=120, cwd=ROOT)
+                          "--repeat", "1"], capture_output=True, text=True, timeout=120, cwd=ROOT,
+                         env={**os.environ, "PYTHONPATH": os.pathsep.join(    # this checkout's dec3d
+                             [str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])})
     assert out.returncode == 0, out.stderr
     lines = out.stdout.splitlines()
     assert lines[0].startswith("machine: ")

@@ -9,8 +9,10 @@ from collections import Counter
 import pytest
 
 from dec3d.check import ERROR, LEGACY, NOT_SUPPORTED, RUNNABLE, check_file
-from conftest import DECKS
+from conftest import DECKS, NO_DECKS
 
+if not DECKS.is_dir():
+    pytest.skip(NO_DECKS, allow_module_level=True)
 MODERN = sorted(DECKS.glob("*.dat"))
 LEGACY_DECKS = sorted((DECKS / "legacy_v5").glob("*.dat"))
 

@@ -17,23 +17,55 @@ def test_problem_meets_its_bar(folder):
     assert not failed, "\n".join(f"{c.quantity}: measured {c.measured}, expected {c.expected}" for c in failed)
 
 
-def test_verify_table(tmp_path, capsys):
-    """`dec3d verify` on a made-up problem: passes, fails and report-only rows are shown and counted."""
-    from dec3d.verify import main
+def test_every_verification_problem_is_there():
+    assert {f.name for f in FOLDERS} >= {"R1_inclined_plane", "R2_wedge", "R3_block_on_spring", "R4_bounce",
+                                         "R5_stack", "R6_joint_shear", "R7_spinning_block",
+                                         "S1_fredlund_krahn_slope", "S1_ru025", "S2_kim_dam"}
 
+
+def _demo(tmp_path, expects: str):
     p = tmp_path / "X1_demo"
     p.mkdir()
     (p / "deck.dat").write_text("[a = 2.0 * 3]\n[b = 7.0]\n")
-    (p / "problem.toml").write_text(
-        'title = "demo"\nkind = "deck"\ndeck = "deck.dat"\nsource = "arithmetic"\n'
-        '[[expect]]\nquantity = "a"\nvalue = 6.0\nrel_tol = 1e-12\n'
-        '[[expect]]\nquantity = "a"\nbelow = "b"\n'
-        '[[expect]]\nquantity = "b"\nvalue = 8.0\nabs_tol = 0.5\n'
-        '[[expect]]\nquantity = "b"\nvalue = 1.0\nreport_only = true\n')
+    (p / "problem.toml").write_text('title = "demo"\nkind = "deck"\ndeck = "deck.dat"\nsource = "arithmetic"\n'
+                                    + expects)
+    return p
+
+
+def test_verify_table(tmp_path, capsys):
+    """`dec3d verify` on a made-up problem: passes and fails are counted; a not-comparable row is shown
+    after the count, in its own section with its reason, and never beside a PASS."""
+    from dec3d.verify import main
+
+    _demo(tmp_path, '[[expect]]\nquantity = "a"\nvalue = 6.0\nrel_tol = 1e-12\n'
+                    '[[expect]]\nquantity = "a"\nbelow = "b"\n'
+                    '[[expect]]\nquantity = "b"\nvalue = 8.0\nabs_tol = 0.5\n'
+                    '[[expect]]\nquantity = "b"\nvalue = 1.0\nnot_comparable = "because the demo says so"\n')
     assert main(root=tmp_path) == 1
-    out = capsys.readouterr().out
-    assert out.count("PASS") == 2 and out.count("FAIL") == 1 and "report" in out
-    assert "2 passed, 1 failed" in out
+    out = capsys.readouterr().out.splitlines()
+    count = out.index("2 passed, 1 failed")
+    assert [ln.split()[-1] for ln in out[1:count]] == ["PASS", "PASS", "FAIL"]
+    assert out[count + 2] == "Not comparable (shown beside a published figure, not checked):"
+    row = out[count + 4].split()
+    assert row[:4] == ["X1_demo", "b", "7", "1"] and " ".join(row[4:]) == "because the demo says so"
+    assert len(out) == count + 5
+
+
+@pytest.mark.parametrize("expect, message", [
+    ('quantity = "b"\nvalue = 1.0\nreport_only = true\n', "'report_only' is gone: give the quantity a bar"),
+    ('quantity = "b"\nvalue = 1.0\n', "a bar needs 'value' and exactly one of 'rel_tol', 'abs_tol'"),
+    ('quantity = "b"\nvalue = 1.0\nreltol = 0.1\n', "unknown key(s) reltol"),
+    ('quantity = "b"\nvalue = 1.0\nrel_tol = 0.1\nnot_comparable = "x"\n', "no tolerance or 'below'"),
+    ('quantity = "b"\nvalue = 1.0\nnot_comparable = " "\n', "'not_comparable' must be the reason, as text"),
+])
+def test_problem_toml_entries_are_either_a_bar_or_not_comparable(tmp_path, expect, message):
+    from dec3d.verify import check_problem
+
+    p = _demo(tmp_path, '[[expect]]\nquantity = "a"\nvalue = 6.0\nrel_tol = 0.1\n[[expect]]\n' + expect)
+    with pytest.raises(ValueError) as err:
+        check_problem(p)
+    assert str(err.value).startswith(f"{p / 'problem.toml'}: [[expect]] number 2 (b): ")
+    assert message in str(err.value)
 
 
 def test_derive_from_history_files(tmp_path):

@@ -35,7 +35,7 @@ def program_return(session, call):
 
 @command("program exit", doc="Stop running the deck (the model is kept).", examples=["program exit", "exit"])
 def program_exit(session, call):
-    from ..session import StopDeck
+    from ..errors import StopDeck
 
     raise StopDeck()
 

@@ -22,15 +22,6 @@ def hull_distance(va, vb):
     return math.sqrt(max(r.fun, 0.0))
 
 
-def sampled_best_gap(va, vb, n_dirs=40000, seed=0):
-    """max over many unit directions of min_B n·V − max_A n·V (a lower bound of the best gap)."""
-    rng = np.random.default_rng(seed)
-    d = rng.normal(size=(n_dirs, 3))
-    d /= np.linalg.norm(d, axis=1)[:, None]
-    g = (vb @ d.T).min(axis=0) - (va @ d.T).max(axis=0)
-    return float(g.max())
-
-
 def coulomb_ref(p, model, area, dun, dus, un, udil, fs, us, failed):
     """Scalar Coulomb slip law written from the text (Eqs. 24-43 with the ERRATA), plain Python.
     p: dict kn ks phi coh ten dil zdil phir cohr tenr (angles in radians)."""
@@ -89,16 +80,24 @@ def _sgn(x):
 def motion_groups_ref(dt, gravity, damp_mode, alpha, servo, full_inertia,
                       gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
                       mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp,
-                      vstart, vcount, vpos, vmax, out):
-    """Slow twin of rigid_motion_groups; same arguments, updated in place, same return."""
-    NS = 10
+                      vstart, vcount, vpos, vmax, out, rule=None):
+    """Slow twin of rigid_motion_groups; same arguments, updated in place, same return.
+
+    rule: the adaptive servo's bounds, needed with damp_mode 3 and given by the caller from the
+    documented rule (dict start, floor, cap, each times 1/Δt); the target ratio, window and factor
+    are read from the servo array, which the caller fills. Nothing is defaulted here, so no constant
+    of the kernel is repeated in this twin."""
+    NS = 10                                  # servo layout (motion.py docstring): 10 scalars, then 6 per group
     ng = len(gstart) - 1
     g_vec = np.asarray(gravity, float)
     hist = damp_mode == 2 and servo[8] != 0
     av = 0.0
     if damp_mode == 3:
-        av = servo[0] if servo[0] > 0 else 0.02 / dt
-        av = min(max(av, 1e-4 / dt), 1.0 / dt)
+        if rule is None or not (servo[4] > 0 and servo[5] >= 1 and servo[6] > 1):
+            raise ValueError("adaptive damping: give the servo rule and fill ratio, window, factor")
+        lo, hi = rule["floor"] / dt, rule["cap"] / dt
+        av = servo[0] if servo[0] > 0 else rule["start"] / dt
+        av = min(max(av, lo), hi)
         servo[0] = av
     al = alpha if damp_mode in (1, 2) else 0.0
     D1, D2 = 1 - av * dt / 2, 1 / (1 + av * dt / 2)
@@ -204,13 +203,12 @@ def motion_groups_ref(dt, gravity, damp_mode, alpha, servo, full_inertia,
         servo[1] += work
         servo[2] += dek
         servo[3] += 1
-        if servo[3] >= (servo[5] if servo[5] >= 1 else 10):
+        if servo[3] >= servo[5]:
             if servo[2] > 0:
                 r = servo[1] / servo[2]
                 servo[7] = r
-                f = servo[6] if servo[6] > 1 else 1.1
-                ratio = servo[4] if servo[4] > 0 else 0.5
-                servo[0] = min(max(servo[0] * f if r < ratio else servo[0] / f, 1e-4 / dt), 1 / dt)
+                f, ratio = servo[6], servo[4]
+                servo[0] = min(max(servo[0] * f if r < ratio else servo[0] / f, lo), hi)
             servo[1] = servo[2] = servo[3] = 0.0
     servo[9] += 1
     out[:] = (fmax, fsum, ke, av)

@@ -2,13 +2,12 @@
 import numpy as np
 import pytest
 
-from dec3d.kernels.commonplane import common_plane, contact_type
+from dec3d.kernels.commonplane import CONTACT_TYPE_NAMES, common_plane, contact_type
 from dec3d.kernels.contactmap import carry_over, cp_batch, envelopes, match_sorted
 from dec3d.kernels.cycle import _move_points, run_steps
-from dec3d.kernels.jointlaw import subcontact_forces
-from dec3d.kernels.motion import rigid_motion_groups
 from dec3d.physics.rigid import engine
-from tests.reference import contactmap_ref as ref
+from reference import commonplane_ref as cpref
+from reference import contactmap_ref as ref
 
 
 @pytest.mark.parametrize("seed", range(5))
@@ -86,87 +85,141 @@ block fix range position-z -1 0
 """
 
 
-def test_cp_batch_equals_common_plane_pair_by_pair(session):
-    m, e = _model(session, STACK)
-    b, cs = m.blocks, e.contacts
-    ra, rb = cs["a"].copy(), cs["b"].copy()
-    prev = np.arange(cs.n, dtype=np.int64)
-    prev[0] = -1
-    k = cs.n
+def _box(lo, hi):
+    return np.array([[x, y, z] for z in (lo[2], hi[2]) for y in (lo[1], hi[1]) for x in (lo[0], hi[0])], float)
+
+
+def _turn(v, axis, deg):
+    axis = np.asarray(axis, float) / np.linalg.norm(axis)
+    t = np.radians(deg)
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    R = np.eye(3) + np.sin(t) * K + (1 - np.cos(t)) * K @ K
+    c = v.mean(0)
+    return (v - c) @ R.T + c
+
+
+def _cp_batch_kernel(blocks, pairs, prev, old_n, old_c, reach):
+    """The kernel call, kept thin: blocks (list of vertex arrays), pairs (k, 2) rows A → B."""
+    vpos = np.vstack(blocks)
+    count = np.array([len(v) for v in blocks], np.int64)
+    start = np.concatenate([[0], np.cumsum(count)[:-1]]).astype(np.int64)
+    cen = np.array([v.mean(0) for v in blocks])
+    k = len(pairs)
     nn, cc, gap, ct = np.empty((k, 3)), np.empty((k, 3)), np.empty(k), np.empty(k, np.int64)
-    vp, vs, vc = m.vertices["pos"], b["vert_start"], b["vert_count"]
-    reach = np.full(k, e.tolerance())
-    cp_batch(ra, rb, prev, vp, vs, vc, b["centroid"], cs["normal"], cs["pos"], reach, nn, cc, gap, ct)
-    for i in range(k):
-        a, bb = ra[i], rb[i]
-        if prev[i] >= 0:
-            n0, c = cs["normal"][i].copy(), cs["pos"][i].copy()
-        else:
-            n0, c = b["centroid"][bb] - b["centroid"][a], 0.5 * (b["centroid"][a] + b["centroid"][bb])
-        n = np.empty(3)
-        g, na, nb, _ = common_plane(vp[vs[a]:vs[a] + vc[a]], vp[vs[bb]:vs[bb] + vc[bb]], n0, e.tolerance(),
-                                    prev[i] >= 0, n, c)
-        assert g == gap[i] and np.array_equal(n, nn[i]) and np.array_equal(c, cc[i])
-        assert ct[i] == contact_type(na, nb)
+    cp_batch(pairs[:, 0].copy(), pairs[:, 1].copy(), prev, vpos, start, count, cen, old_n, old_c,
+             reach, nn, cc, gap, ct)
+    return nn, cc, gap, [CONTACT_TYPE_NAMES[t] for t in ct]
 
 
-def test_run_steps_equals_the_kernels_step_by_step(session):
-    """The many-steps kernel against a Python loop over its parts (joint law, motion, Eq. 11)."""
+def test_cp_batch_against_the_best_plane_of_each_pair():
+    """Every pair of a batch against the c-p's definition (tests/reference/commonplane_ref.py): the
+    largest gap over all normals (separating axes when touching or overlapping, the closest points
+    when apart), the reference point midway, and the contact type of ERRATA Table 1; new pairs start
+    from the line of centroids, an existing one from its old normal, a pair beyond reach is none."""
+    rng = np.random.default_rng(11)
+    g0 = 1e-4
+    base = _box((0, 0, 0), (1, 1, 1))
+    blocks = [
+        base,                                                              # 0
+        _box((0.3, 0.2, 1 + g0), (0.8, 0.7, 1.5 + g0)),                    # 1 face on 0's top, apart by g0
+        None,                                                              # 2 edge down on 0's top (below)
+        rng.normal(size=(12, 3)) * [0.4, 0.6, 0.5],                        # 3 a convex-hull cloud
+        rng.normal(size=(10, 3)) * [0.5, 0.3, 0.4] + [1.5, -2.0, 2.5],     # 4 another, 3 m away
+        _box((0.1, 0.1, 1 - 2e-4), (0.9, 0.6, 1.4)),                       # 5 sunk 0.2 mm into 0 (existing)
+        _box((5, 5, 5), (6, 6, 6)),                                        # 6 far from 0
+    ]
+    edge = _turn(_box((0.2, 0.2, 0), (0.7, 0.7, 0.5)), (1, 0, 0), 45)
+    blocks[2] = edge - [0, 0, edge[:, 2].min() - 1 - g0]
+    pairs = np.array([[0, 1], [0, 2], [3, 4], [0, 5], [0, 6]], np.int64)
+    tilted = np.array([np.sin(np.radians(0.5)), 0.0, np.cos(np.radians(0.5))])
+    prev = np.array([-1, -1, -1, 0, -1], np.int64)
+    old_n, old_c = tilted[None].copy(), np.array([[0.5, 0.4, 1.0]])
+    reach = np.array([1e-3, 1e-3, 1e9, 1e-3, 1e-3])
+    nn, cc, gap, types = _cp_batch_kernel(blocks, pairs, prev, old_n, old_c, reach)
+
+    for i, (a, b) in enumerate(pairs):
+        va, vb = blocks[a], blocks[b]
+        v = np.vstack([va, vb])
+        res = 2.0 * np.tan(np.radians(0.01)) * np.linalg.norm(v.max(0) - v.min(0))   # the search's resolution
+        if i == 4:                                                          # beyond reach: no contact
+            assert gap[i] > reach[i] and types[i] == "none"
+            continue
+        best, bn = cpref.best_plane(va, vb)
+        assert abs(np.linalg.norm(nn[i]) - 1.0) < 1e-12
+        assert gap[i] == pytest.approx(cpref.gap(va, vb, nn[i]), abs=1e-12)  # the gap is that of its normal
+        assert best - res <= gap[i] <= best + 1e-9                          # and the best there is
+        hi_a, lo_b = (va @ nn[i]).max(), (vb @ nn[i]).min()
+        assert cc[i] @ nn[i] == pytest.approx(0.5 * (hi_a + lo_b), abs=1e-9)  # midway (Eqs. 8-9)
+        if i != 2:                      # a reach of 1e9 m makes every vertex "touch": no type to check
+            assert types[i] == cpref.type_name(*cpref.touching(va, vb, bn, reach[i]))
+    assert [round(x, 9) for x in gap[[0, 1, 3]]] == [g0, g0, -2e-4]
+    assert types[:2] + types[3:4] == ["face-face", "edge-face", "face-face"]
+    assert gap[2] == pytest.approx(cpref.best_plane(blocks[3], blocks[4])[0], abs=1e-6) and gap[2] > 1.0
+
+
+def _run_steps_kernel(st, nsteps, dt, g, damp_mode, alpha, servo):
+    """The kernel call, kept thin (arrays of the state dict `st`, updated in place)."""
+    G, B, C, S = st["groups"], st["blocks"], st["contacts"], st["sub"]
+    nb = len(B["mass"])
+    done, bad = run_steps(nsteps, dt, g, damp_mode, alpha, servo, False,
+                          G["gstart"], G["gmember"], G["gmass"], G["gimass"], G["giscalar"], G["gprin"],
+                          G["gaxes"], G["gcentroid"], B["mass"], B["fixity"], B["force"], B["moment"], B["fapp"],
+                          B["mapp"], B["vel"], B["spin"], B["centroid"], B["disp"], B["vstart"], B["vcount"],
+                          st["verts"], C["a"], C["b"], C["normal"], C["pos"], np.arange(len(C["a"]), dtype=np.int64),
+                          C["jmodel"], C["prop"], S["contact"], S["pos"], S["area"], S["fn"], S["fs"], S["un"],
+                          S["udil"], S["us"], S["state"], 1e6, st["out"], np.ones(nb), np.zeros(nb), 1e9, np.zeros(2))
+    return done, bad
+
+
+def test_run_steps_against_the_cycle_written_from_the_equations(session):
+    """40 steps of the many-steps kernel against tests/reference/cycle_ref.py (Eq. 15, the joint law,
+    Eqs. 28-32, the group motion, Eq. 11 in plain Python), on a block overhanging another on a base.
+    The joint law's properties are the deck's, written here, not read from the kernel's columns."""
+    import copy
+    import math
+
+    from dec3d.physics.bodies import group_properties, new_servo
+    from reference.cycle_ref import step_ref
+
     m, e = _model(session, STACK)
     b, cs, ss = m.blocks, e.contacts, e.subcontacts
     gstart, gmember = e._groups()
-    from dec3d.physics.bodies import group_properties, new_servo
-
     inertia = np.einsum("bij,bj,bkj->bik", b["principal_axes"], b["principal_moment"], b["principal_axes"])
     gm, gc, _, gp, ga, gi = group_properties(gstart, gmember, b["mass"], b["centroid"], inertia, b["inertia_approx"])
-    g = np.array([0.0, 0.0, -10.0])
-    dt = e.timestep()
+    st0 = {"groups": dict(gstart=gstart, gmember=gmember, gmass=gm, gimass=gm.copy(), giscalar=gi, gprin=gp,
+                          gaxes=ga, gcentroid=gc),
+           "blocks": dict(mass=b["mass"], fixity=b["fixity"], force=b["force"], moment=b["moment"], fapp=b["fapp"],
+                          mapp=b["mapp"], vel=b["velocity"], spin=b["spin"], centroid=b["centroid"], disp=b["disp"],
+                          vstart=b["vert_start"], vcount=b["vert_count"]),
+           "verts": m.vertices["pos"], "out": np.zeros(4),
+           "contacts": dict(a=cs["a"], b=cs["b"], normal=cs["normal"], pos=cs["pos"], jmodel=cs["jmodel"],
+                            prop=cs["prop"]),
+           "sub": {k: ss[k] for k in ("contact", "pos", "area", "fn", "fs", "un", "udil", "us", "state")}}
+    st0 = copy.deepcopy(st0)                      # plain copies of every array
+    fast, slow = copy.deepcopy(st0), copy.deepcopy(st0)
+    g, dt, n = np.array([0.0, 0.0, -10.0]), e.timestep(), 40
+    assert _run_steps_kernel(fast, n, dt, g, 1, 0.8, new_servo(len(gm))) == (n, -1)
 
-    def state():
-        return {"b": {k: b[k].copy() for k in ("force", "moment", "velocity", "spin", "centroid", "disp")},
-                "v": m.vertices["pos"].copy(), "cc": cs["pos"].copy(),
-                "s": {k: ss[k].copy() for k in ("pos", "fn", "fs", "un", "udil", "us", "state")},
-                "g": (gc.copy(), ga.copy())}
+    phi = math.radians(30.0)                      # the deck: mohr, kn = ks = 1e8 Pa/m, friction 30°
+    law = [("mohr", dict(kn=1e8, ks=1e8, phi=phi, coh=0.0, ten=0.0, dil=0.0, zdil=0.0, phir=phi, cohr=0.0,
+                         tenr=0.0))] * len(cs["a"])
+    servo = new_servo(len(gm))
+    for _ in range(n):
+        assert step_ref(dt, g, 1, 0.8, servo, False, slow["groups"], slow["blocks"], slow["verts"],
+                        slow["contacts"], law, slow["sub"], 1e6, slow["out"]) == -1
 
-    s0 = state()
+    def close(x, y, what):
+        x, y = np.asarray(x, float), np.asarray(y, float)
+        np.testing.assert_allclose(x, y, rtol=1e-9, atol=1e-9 * (1e-12 + np.abs(y).max()), err_msg=what)
 
-    def put(st):
-        for k, v in st["b"].items():
-            b[k][...] = v
-        m.vertices["pos"][...] = st["v"]
-        cs["pos"][...] = st["cc"]
-        for k, v in st["s"].items():
-            ss[k][...] = v
-        return st["g"][0].copy(), st["g"][1].copy()
-
-    fix = b["fixity"].copy()
-    common = lambda gcen, gax: (gstart, gmember, gm, gm.copy(), gi, gp, gax, gcen, b["mass"], fix, b["force"],
-                                b["moment"], b["fapp"], b["mapp"], b["velocity"], b["spin"], b["centroid"],
-                                b["disp"], b["vert_start"], b["vert_count"], m.vertices["pos"])
-    sc = lambda: (ss["contact"], ss["pos"], ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"])
-    own = np.arange(cs.n, dtype=np.int64)
-    gcen, gax = put(s0)
-    out = np.zeros(4)
-    done, bad = run_steps(7, dt, g, 1, 0.8, new_servo(len(gm)), False, *common(gcen, gax), cs["a"], cs["b"],
-                          cs["normal"], cs["pos"], own, cs["jmodel"], cs["prop"], *sc(), 1e6, out,
-                          np.ones(b.n), np.zeros(b.n), 1e9, np.zeros(2))
-    assert (done, bad) == (7, -1)
-    fast = state()
-    gcen, gax = put(s0)
-    for _ in range(7):
-        subcontact_forces(dt, b["centroid"], b["velocity"], b["spin"], b["force"], b["moment"], cs["a"], cs["b"],
-                          cs["normal"], cs["jmodel"], cs["prop"], *sc())
-        assert rigid_motion_groups(dt, g, 1, 0.8, new_servo(len(gm)), False, *common(gcen, gax), 1e6, out) == -1
-        cs["pos"][...] = ref.move_points(dt, cs["a"], cs["b"], own, cs["pos"], b["centroid"], b["velocity"], b["spin"])
-        ss["pos"][...] = ref.move_points(dt, cs["a"], cs["b"], ss["contact"], ss["pos"], b["centroid"],
-                                         b["velocity"], b["spin"])
-    slow = state()
-    for part in ("b", "s"):
-        for k in fast[part]:
-            assert np.allclose(fast[part][k], slow[part][k], rtol=1e-12, atol=1e-15), k
-    assert np.allclose(fast["v"], slow["v"], rtol=1e-12, atol=1e-15)
-    assert np.allclose(fast["cc"], slow["cc"], rtol=1e-12, atol=1e-15)
-    assert np.abs(fast["b"]["disp"]).max() > 0          # something moved
+    for part in ("blocks", "sub"):
+        for k in ("vel", "spin", "centroid", "disp") if part == "blocks" else ("pos", "fn", "fs", "un", "us"):
+            close(fast[part][k], slow[part][k], f"{part}.{k}")
+    close(fast["sub"]["state"] & 1, slow["sub"]["state"], "sub.state (failed)")
+    close(fast["verts"], slow["verts"], "vertices")
+    close(fast["contacts"]["pos"], slow["contacts"]["pos"], "contact points")
+    assert np.abs(slow["blocks"]["disp"]).max() > 1e-6          # the blocks moved
+    assert (slow["sub"]["fn"] > 0).sum() >= 8                    # the joints carry load
 
 
 def test_move_points_against_twin():

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from dec3d.physics.rigid import engine
-from tests.rigid.test_engine import DECK
+from test_engine import DECK
 
 SPRING = DECK          # the block on a joint spring of test_engine.py
 

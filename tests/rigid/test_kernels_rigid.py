@@ -8,7 +8,8 @@ from dec3d.kernels.commonplane import (CT_EE, CT_EF, CT_FF, CT_VE, CT_VF, CT_VV,
                                        contact_type)
 from dec3d.kernels.jointlaw import NPROP, coulomb_one, rotate_shear
 from dec3d.kernels.motion import block_timestep, rigid_motion
-from reference.rigid_ref import coulomb_ref, hull_distance, rotate_rodrigues, sampled_best_gap
+from reference.commonplane_ref import best_plane
+from reference.rigid_ref import coulomb_ref, hull_distance, rotate_rodrigues
 
 
 def _cloud(rng, centre, n=10):
@@ -59,10 +60,12 @@ def test_common_plane_overlapping_fast_path(seed):
     n = np.empty(3)
     gap, *_ = common_plane(va, vb, n0, 1e9, True, n, np.zeros(3))
     assert gap < 0
-    # never worse than the normal it started from; no better than the best of many directions
-    # (the hill-climb may stop on a local optimum of the overlap: see the report)
+    # never worse than the normal it started from, and never better than the best plane there is
+    # (the exact maximum over the separating axes, tests/reference/commonplane_ref.py). The search
+    # may stop short of that maximum: the start normal is a local optimum of the overlap here, and
+    # on these clouds the best plane is up to 9 mm better than where the fast path stays.
     assert gap >= -delta - 1e-12
-    assert gap <= sampled_best_gap(va, vb, 2000) + _res(va, vb) or gap <= 0
+    assert gap <= best_plane(va, vb)[0] + 1e-12
 
 
 def test_early_exit_beyond_ctol():
