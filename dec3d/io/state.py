@@ -337,9 +337,29 @@ def _meta_problem(meta: dict) -> str | None:
     return _settings_problem(meta["settings"])
 
 
-def _settings_problem(d: dict) -> str | None:
-    from dec3d.physics.jmodels import JOINT_MODELS
+#: What a save file may name that a higher layer defines (the import arrows run physics -> io, so
+#: physics registers it here when imported: ``physics.jmodels`` the joint models' names and codes,
+#: ``physics.history`` how histories are made again from their description).
+KNOWN: dict = {}
 
+
+def register_known(**entries) -> None:
+    """Called by the physics layer at import: ``joint_models`` (names), ``joint_model_codes``,
+    ``histories`` (``load(model, desc, arrays)``, raising ValueError naming what is wrong)."""
+    for k, v in entries.items():
+        if isinstance(v, (set, frozenset)):
+            KNOWN.setdefault(k, set()).update(v)
+        else:
+            KNOWN[k] = v
+
+
+def _known() -> dict:
+    if not {"joint_models", "joint_model_codes", "histories"} <= KNOWN.keys():   # pragma: no cover
+        raise RuntimeError("dec3d.physics registers what save files may name: import it before a restore")
+    return KNOWN
+
+
+def _settings_problem(d: dict) -> str | None:
     if not isinstance(d.get("title", ""), str):
         return "the title is not text"
     g = d.get("gravity", [0, 0, 0])
@@ -357,7 +377,7 @@ def _settings_problem(d: dict) -> str | None:
     if not isinstance(m, dict):
         return "the mechanical settings are not an object"
     choices = {"damping": ("local", "combined", "global", "none"), "mass_scale": ("on", "off", "auto"),
-               "inertia": ("full", "scalar", "auto"), "jmodel": tuple(JOINT_MODELS)}
+               "inertia": ("full", "scalar", "auto"), "jmodel": tuple(sorted(_known()["joint_models"]))}
     for k, options in choices.items():
         if k in m and m[k] not in options:
             return f"mechanical setting `{k}` is {m[k]!r}, not one of {', '.join(options)}"
@@ -422,8 +442,6 @@ def _build(path: str, meta: dict, blobs: dict[str, bytes]) -> Model:
     _check_contacts(path, model)
     h = meta.get("histories")
     if h is not None:
-        from dec3d.physics.history import HistorySet
-
         harrays = {}
         for it in h["items"]:
             for k in ("steps", "times", "values"):
@@ -431,12 +449,9 @@ def _build(path: str, meta: dict, blobs: dict[str, bytes]) -> Model:
                 harrays[f"{it['id']}.{k}"] = _read_npy(path, name, blobs[name], None,
                                                        "<i8" if k == "steps" else "<f8")
         try:
-            model.history_set = HistorySet.from_state(model, h, harrays)
+            _known()["histories"](model, h, harrays)    # hooked to the restored engine: sampling goes on
         except ValueError as exc:
             raise StateFileError(f"'{path}': {exc}") from None
-        from dec3d.physics.history import histories
-
-        histories(model)          # hooked to the restored model's engine: sampling goes on
     return model
 
 
@@ -488,8 +503,6 @@ def _check_contacts(path: str, model: Model) -> None:
     stores = model.stores
     if "contacts" not in stores:
         return
-    from dec3d.physics.jmodels import MODEL_BY_CODE
-
     c = stores["contacts"]
     sc = stores.get("subcontacts")
     nb = model.blocks.n
@@ -508,7 +521,7 @@ def _check_contacts(path: str, model: Model) -> None:
             need(s0.min() >= 0 and k.min() >= 0 and (s0 + k).max() <= nsc,
                  "contact sub-contact ranges point outside the sub-contacts")
         if "jmodel" in c:
-            need(np.isin(c["jmodel"], list(MODEL_BY_CODE)).all(), "a contact has an unknown joint model code")
+            need(np.isin(c["jmodel"], sorted(_known()["joint_model_codes"])).all(), "a contact has an unknown joint model code")
         if "type" in c:
             need(c["type"].min() >= 0 and c["type"].max() <= 6, "a contact has an unknown contact type")
     if sc is not None and sc.n:

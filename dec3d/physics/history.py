@@ -12,6 +12,7 @@ from typing import Callable
 
 import numpy as np
 
+from dec3d.io.state import register_known
 from dec3d.model.kinematics import block_rotation, unwrap_rotation
 
 _XYZ = (("", None), ("-x", 0), ("-y", 1), ("-z", 2))
@@ -388,6 +389,15 @@ def histories(model) -> HistorySet:
     if hs not in eng.step_hooks:
         eng.step_hooks.append(hs)
     return hs
+
+
+def _restore_histories(model, desc: dict, arrays: dict) -> None:
+    """``dec3d.io.state``'s loader of the histories in a save file (ValueError: nothing is changed)."""
+    model.history_set = HistorySet.from_state(model, desc, arrays)
+    histories(model)          # hooked to the restored model's engine: sampling goes on
+
+
+register_known(histories=_restore_histories)
 
 
 def figures(times, values) -> dict[str, float]:

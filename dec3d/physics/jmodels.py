@@ -18,6 +18,8 @@ from typing import Callable
 
 import numpy as np
 
+from dec3d.io.state import register_known
+
 from dec3d.kernels.jointlaw import (MODEL_ELASTIC, MODEL_MOHR, NPROP, P_COH, P_COH_RES, P_KN, P_KS, P_TANDIL,
                                     P_TANF, P_TANF_RES, P_TEN, P_TEN_RES, P_ZDIL)
 
@@ -82,6 +84,7 @@ def jmodel(name: str, code: int, doc: str, props: list[Prop]) -> JointModel:
     m = JointModel(name, code, doc, {p.name: p for p in props})
     JOINT_MODELS[name] = m
     MODEL_BY_CODE[code] = m
+    register_known(joint_models={name}, joint_model_codes={code})     # what a save file may name
     return m
 
 
