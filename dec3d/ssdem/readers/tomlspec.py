@@ -16,6 +16,11 @@ from typing import Any
 from .errors import SsdemInputError
 
 REQUIRED = object()
+#: load steps and secant iterations per step at most (each is at least one linear solve)
+MAX_STEPS = 10_000
+MAX_ITERATIONS = 10_000
+#: deepest nesting of arrays and inline tables the input may use (points need 2)
+MAX_NESTING = 32
 
 
 @dataclass(frozen=True)
@@ -83,9 +88,11 @@ SECTIONS: dict[str, tuple[Field, ...]] = {
         Field("bottom", "float", None, unit="length", doc="critical: lowest elevation a circle may reach"),
     ),
     "analysis": (
-        Field("steps", "int", 10, lo=1, doc="load increments to full load"),
+        Field("steps", "int", 10, lo=1, hi=MAX_STEPS, doc="load increments to full load"),
         Field("tolerance", "float", 1e-3, positive=True, doc="convergence: max |dk_s|/k_s0 within a step"),
-        Field("max_iterations", "int", 200, lo=1, doc="secant iterations per step at most"),
+        Field("max_iterations", "int", 200, lo=1, hi=MAX_ITERATIONS, doc="secant iterations per step at most"),
+        Field("strength_reduction", "bool", False,
+              doc="also find the factor on c' and tan(phi') at which the static solution fails"),
     ),
 }
 ARRAY_TABLES = {"layer", "surcharge"}
