@@ -116,6 +116,24 @@ def test_appendix_a_extra_column_names_its_line_and_record(tmp_path, capsys):
     assert rc == 2 and first_line(err).startswith(f"{f}:27:14: error: field 'angles[1]': line 27 holds 5 values")
 
 
+def test_appendix_a_every_single_line_defect_is_named_at_its_line():
+    """A value dropped from the end or the start of any line, or one added, of the
+    example: the error names that line (the stream reading alone named line 18 or 30)."""
+    from dec3d.ssdem.readers.appendix_a import read_appendix_a
+    from dec3d.ssdem.readers.errors import SsdemInputError
+    lines = APPENDIX.read_text().splitlines()
+    checked = 0
+    for no, line in enumerate(lines, start=1):
+        toks = line.split()
+        edits = [line + " 3"] + ([" ".join(toks[:-1]), " ".join(toks[1:])] if len(toks) > 1 else [])
+        for new in edits:
+            with pytest.raises(SsdemInputError) as exc:
+                read_appendix_a(Path("a.txt"), text=lines_with(no, new))
+            assert exc.value.line == no, (no, new, exc.value.message)
+            checked += 1
+    assert checked == 28 * 3 + 6          # 28 lines of several numbers, 6 of one
+
+
 def test_appendix_a_free_layout_still_reads(tmp_path, capsys):
     """Line breaks are free in the format: all numbers on one line read as before."""
     rc, _, _ = run(tmp_path, capsys, "oneline.txt", " ".join(APPENDIX.read_text().split()) + "\n")

@@ -123,46 +123,49 @@ def _records(n: int, nb_of):
 
 
 def _layout_defect(tk: _Tokens) -> SsdemInputError | None:
-    """The first line that holds more or fewer numbers than its record, if the file is
-    laid out one record per line up to there (else None: free layout, or no defect)."""
+    """The line that holds more or fewer numbers than its record, when the file is laid
+    out one record per line: either every other line holds exactly its record (a single
+    defect, anywhere), or at least the first two lines did up to the first defect.
+    None for a free layout or no defect."""
     lines: dict[int, list[int]] = {}
     for k, (_, line, _) in enumerate(tk.items):
         lines.setdefault(line, []).append(k)
     rows = sorted(lines.items())
-    if not rows or len(rows[0][1]) != 1:
+    if len(rows) < 3:
         return None
     try:
         n = int(tk.items[0][0])
     except ValueError:
         return None
-    nb = {}
-
-    def nb_of():
-        return nb.get("v", 0)
-    matched = 0
-    for (field, names), (line, idx) in zip(_records(max(n, 0), nb_of), rows):
-        if len(idx) != len(names):
-            if matched < 2:
-                return None
-            text = tk.lines[line - 1]
-            cols = "" if names == ("",) else f" ({' '.join(names)})"
-            want = f"{len(names)} value{'s' if len(names) > 1 else ''}{cols}"
-            if len(idx) < len(names):
-                last_tok, _, col = tk.items[idx[-1]]
-                return SsdemInputError(f"line {line} holds {len(idx)} of the {want} of this record: "
-                                       f"{len(names) - len(idx)} missing", tk.file, line, field, text,
-                                       col + len(last_tok), "each record of Appendix A is on a line of its own here")
-            _, _, col = tk.items[idx[len(names)]]
-            return SsdemInputError(f"line {line} holds {len(idx)} values, the record has {want}: "
-                                   f"{len(idx) - len(names)} extra", tk.file, line, field, text, col,
-                                   "each record of Appendix A is on a line of its own here")
-        if field == "n_boundary":
-            try:
-                nb["v"] = max(0, int(tk.items[idx[0]][0]))
-            except ValueError:
-                return None
-        matched += 1
-    return None
+    if not 0 < n <= len(rows):
+        return None
+    nb: dict = {}
+    try:
+        at = 1 + 3 * n                                                   # the n_boundary line
+        if at < len(rows) and len(rows[at][1]) == 1:
+            nb["v"] = min(max(0, int(tk.items[rows[at][1][0]][0])), n)
+    except ValueError:
+        pass
+    records = list(_records(n, lambda: nb.get("v", 0)))
+    defects = [i for i, ((_, names), (_, idx)) in enumerate(zip(records, rows)) if len(idx) != len(names)]
+    if not defects:
+        return None
+    first = defects[0]
+    if not ((len(defects) == 1 and len(records) == len(rows)) or first >= 2):
+        return None
+    (field, names), (line, idx) = records[first], rows[first]
+    text = tk.lines[line - 1]
+    cols = "" if names == ("",) else f" ({' '.join(names)})"
+    want = f"{len(names)} value{'s' if len(names) > 1 else ''}{cols}"
+    hint = "each record of Appendix A is on a line of its own here"
+    if len(idx) < len(names):
+        last_tok, _, col = tk.items[idx[-1]]
+        return SsdemInputError(f"line {line} holds {len(idx)} of the {want} of this record: "
+                               f"{len(names) - len(idx)} missing", tk.file, line, field, text,
+                               col + len(last_tok), hint)
+    _, _, col = tk.items[idx[len(names)]]
+    return SsdemInputError(f"line {line} holds {len(idx)} values, the record has {want}: "
+                           f"{len(idx) - len(names)} extra", tk.file, line, field, text, col, hint)
 
 
 def _read(tk: _Tokens, path: Path, units: str, tensile_strength, tol: float, max_iter: int, max_blocks: int):
