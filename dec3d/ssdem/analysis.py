@@ -28,7 +28,8 @@ def analyse(path: str | Path, fmt: str = "auto", compare_bishop: bool = False,
     t0 = time.perf_counter()
     prob = read(path, fmt, **reader_options)
     out = run_problem(prob, compare_bishop, progress, strength_reduction)
-    out.timings["read"] = time.perf_counter() - t0 - out.timings["solve"] - out.timings["post"]
+    t = out.timings
+    t["read"] = time.perf_counter() - t0 - t["solve"] - t["post"] - t["reduction"]
     return out
 
 
