@@ -52,6 +52,11 @@ def _positive_int(text: str) -> int:
     return v
 
 
+def _trial_line(factor: float, held: bool) -> None:
+    """One line per strength-reduction trial (each is a full analysis)."""
+    print(f"strength reduction: F = {factor:.3f} {'holds' if held else 'fails'}", flush=True)
+
+
 def _error(message: str) -> int:
     print(f"dec3d ssdem: error: {message}", file=sys.stderr)
     return 2
@@ -114,7 +119,8 @@ def main(argv: list[str] | None = None) -> int:
     ctx, update = _progress(prob.blocks.n, args.quiet)
     with ctx:
         an = run_problem(prob, compare_bishop=args.compare == "bishop", progress=update,
-                         strength_reduction=args.strength_reduction)
+                         strength_reduction=args.strength_reduction,
+                         reduction_progress=None if args.quiet else _trial_line)
     an.timings["read"] = t_read
     try:
         files = report.write_all(an, out)
