@@ -143,3 +143,15 @@ def test_prescribed_circle_in_two_masses_is_an_error_naming_the_surface():
     with pytest.raises(SsdemInputError) as exc:
         read_toml(Path("acads.toml"), text=text)
     assert exc.value.field == "surface.type" and "more than once" in exc.value.message
+
+
+def test_a_slope_facing_right_is_the_mirror_image():
+    """The same slope mirrored (ground falling to the right) has the mirrored minimum."""
+    s = simple(10.0, 20.0, 3e3, 19.6)
+    m = simple(10.0, 20.0, 3e3, 19.6)
+    m.profile = np.column_stack([-s.profile[::-1, 0], s.profile[::-1, 1]])
+    a, b = bishop.search(s, bottom=-5.0), bishop.search(m, bottom=-5.0)
+    assert b["fs"] == pytest.approx(a["fs"], rel=1e-3)
+    assert b["centre"][0] == pytest.approx(-a["centre"][0], abs=0.05)
+    assert b["centre"][1] == pytest.approx(a["centre"][1], abs=0.05)
+    surface_mesh(m, dict(type="circle", centre=b["centre"], radius=b["radius"], search=b), 20, 2)
