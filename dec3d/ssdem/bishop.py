@@ -29,6 +29,11 @@ def _extent(slope: Slope, xc, yc, R):
 
 
 def _slices(slope: Slope, xc, yc, R, n, span=None):
+    with np.errstate(all="ignore"):
+        return _slices_raw(slope, xc, yc, R, n, span)
+
+
+def _slices_raw(slope: Slope, xc, yc, R, n, span):
     x_in, x_out = _extent(slope, xc, yc, R) if span is None else span
     e = x_in[:, None] + (x_out - x_in)[:, None] * np.linspace(0, 1, n + 1)[None, :]
     xm = 0.5 * (e[:, 1:] + e[:, :-1])
@@ -41,7 +46,7 @@ def fs_circles(slope: Slope, xc, yc, R, n: int = 60, ordinary: bool = False, tol
     """Bishop (or ordinary) FS of many circles; inf where a circle misses the slope or m_alpha <= 0.
 
     span: the circles' (x_in, x_out) when already known (_extent)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(all="ignore"):
         return _fs_circles(slope, xc, yc, R, n, ordinary, tol, span)
 
 
@@ -85,7 +90,9 @@ def _fs_circles(slope, xc, yc, R, n, ordinary, tol, span):
                 break
         m = ca + psi * tp * sa / F[:, None]
         F = np.where(np.all(m > 0.05, axis=1), F, np.inf)
-    bad = ~np.isfinite(x_in) | (x_out - x_in <= 0) | (drive <= 0)
+    # no driving moment (beyond round-off of the weights' moments): no slip to resist
+    scale = np.sum(np.abs((W + Q) * sa), axis=1)
+    bad = ~np.isfinite(x_in) | (x_out - x_in <= 0) | ~(drive > 1e-9 * scale)
     return np.where(bad, np.inf, F)
 
 
@@ -118,7 +125,8 @@ def search(slope: Slope, bottom: float | None = None, grid: int = 14, n: int = 4
     prof = slope.profile
     x0, x1 = float(prof[0, 0]), float(prof[-1, 0])
     g0, g1 = float(prof[:, 1].min()), float(prof[:, 1].max())
-    H = max(g1 - g0, 1e-6)
+    # the height scale of the grid: the slope, but not less than 5 % of the section width
+    H = max(g1 - g0, 0.05 * (x1 - x0), 1e-6)
     lo_y = bottom if bottom is not None else g0 - H
     depth_min = 0.02 * H if min_depth is None else min_depth
     xs = np.linspace(x0, x1, grid)
@@ -161,7 +169,7 @@ def _lowest(slope: Slope, xc, yc, R, span=None):
     """Lowest elevation of each slip surface (the arc between entry and exit)."""
     x_in, x_out = _extent(slope, xc, yc, R) if span is None else span
     xl = np.clip(xc, x_in, x_out)
-    with np.errstate(invalid="ignore"):
+    with np.errstate(all="ignore"):
         return np.where(np.isfinite(x_in), yc - np.sqrt(np.clip(R * R - (xl - xc) ** 2, 0, None)), np.inf)
 
 

@@ -125,7 +125,7 @@ class Slope:
         search proposes is one the mesher accepts.
         """
         xc, yc, R = (np.atleast_1d(np.asarray(v, float)) for v in (xc, yc, R))
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(all="ignore"):
             return self._circle_spans(xc, yc, R)
 
     def _circle_spans(self, xc, yc, R):

@@ -229,3 +229,24 @@ def test_default_output_folder_is_named_after_the_input_beside_the_working_folde
     assert [q.name for q in work.iterdir()] == ["..slope_ssdem"]
     assert sorted(q.name for q in tmp_path.iterdir()) == ["in", "work"]
     assert sorted(q.name for q in deck.parent.iterdir()) == ["..slope.toml"]
+
+
+def test_coordinates_that_would_overflow_are_refused(tmp_path, capsys):
+    text = SLOPE.replace("[30.0, 10.0], [45.0, 10.0]", "[30.0, 1e300], [45.0, 1e300]")
+    rc, err, f = run(tmp_path, capsys, "huge.toml", text)
+    assert rc == 2
+    assert first_line(err) == (f"{f}:3:1: error: field 'profile.points': coordinates must be between -1e+09 "
+                               "and 1e+09, got 1e+300")
+    rc, err, f = run(tmp_path, capsys, "radius.toml", SLOPE.replace("radius = 24.0", "radius = 1e200"))
+    assert rc == 2
+    assert first_line(err) == f"{f}:13:1: error: field 'surface.radius': must be between -1e+09 and 1e+09, got 1e+200"
+
+
+def test_critical_circle_on_flat_ground_is_a_clean_error(tmp_path, capsys):
+    """Nothing drives a slip on flat unloaded ground: no circle, said so (not FS 1e15)."""
+    text = SLOPE.replace("[[0.0, 0.0], [10.0, 0.0], [30.0, 10.0], [45.0, 10.0]]", "[[0.0, 0.0], [45.0, 0.0]]")
+    text = text.replace('type = "circle"\ncentre = [12.0, 24.0]\nradius = 24.0', 'type = "critical"\nbottom = -10.0')
+    rc, err, f = run(tmp_path, capsys, "flat.toml", text)
+    assert rc == 2
+    assert first_line(err) == f"{f}:11:1: error: field 'surface.type': the circle search found no valid slip circle"
+    assert "RuntimeWarning" not in err
