@@ -13,6 +13,7 @@ formulation rebuilt in shared/seeds/ERRATA.md.  Layout, one idea per module:
     solve.py      load steps, secant iteration, removal of unstable blocks
     safety.py     interface FS, yield, failure surface, global FS
     bishop.py     Bishop's simplified method and circle search
+    reduction.py  strength-reduction factor of safety (--strength-reduction)
     readers/      Appendix A and TOML inputs;  report.py, plot.py  outputs
     analysis.py   one run end to end;  cli.py  `dec3d ssdem`;  verify.py  `dec3d verify` hook
 """

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import bishop, safety, solve
+from . import bishop, reduction, safety, solve
 from .model import Problem
 from .readers import read
 
@@ -18,21 +18,25 @@ class Analysis:
     state: solve.State
     safety: safety.Safety
     bishop: dict | None = None
+    reduction: dict | None = None     # strength-reduction search (reduction.search)
     timings: dict = field(default_factory=dict)
 
 
 def analyse(path: str | Path, fmt: str = "auto", compare_bishop: bool = False,
-            progress=None, **reader_options) -> Analysis:
+            progress=None, strength_reduction: bool = False, **reader_options) -> Analysis:
     """Read `path` and run it (see `run_problem`)."""
     t0 = time.perf_counter()
     prob = read(path, fmt, **reader_options)
-    out = run_problem(prob, compare_bishop, progress)
-    out.timings["read"] = time.perf_counter() - t0 - out.timings["solve"] - out.timings["post"]
+    out = run_problem(prob, compare_bishop, progress, strength_reduction)
+    t = out.timings
+    t["read"] = time.perf_counter() - t0 - t["solve"] - t["post"] - t["reduction"]
     return out
 
 
-def run_problem(prob: Problem, compare_bishop: bool = False, progress=None) -> Analysis:
-    """Solve, evaluate the factors of safety and optionally compare with Bishop."""
+def run_problem(prob: Problem, compare_bishop: bool = False, progress=None,
+                strength_reduction: bool = False, reduction_progress=None) -> Analysis:
+    """Solve, evaluate the factors of safety, optionally compare with Bishop and search
+    the strength-reduction factor (also when the input's [analysis] asks for it)."""
     t1 = time.perf_counter()
     st = solve.run(prob, progress=progress)
     t2 = time.perf_counter()
@@ -40,9 +44,20 @@ def run_problem(prob: Problem, compare_bishop: bool = False, progress=None) -> A
     out = Analysis(problem=prob, state=st, safety=saf)
     if compare_bishop:
         out.bishop = compare(prob, saf)
-    out.timings = dict(solve=t2 - t1, post=time.perf_counter() - t2,
+    t3 = time.perf_counter()
+    if strength_reduction or prob.settings.strength_reduction:
+        out.reduction = reduction.search(prob, guess=_guess(prob, out.bishop), progress=reduction_progress)
+    out.timings = dict(solve=t2 - t1, post=t3 - t2, reduction=time.perf_counter() - t3,
                        per_step=(t2 - t1) / max(prob.settings.n_steps, 1))
     return out
+
+
+def _guess(prob: Problem, bishop_result: dict | None) -> float:
+    """Where the strength-reduction bracket starts: a Bishop FS of this slope if known."""
+    for res in ((bishop_result or {}).get("on_surface"), (prob.surface or {}).get("search")):
+        if res and res.get("fs") is not None and np.isfinite(res["fs"]):
+            return float(res["fs"])
+    return 1.0
 
 
 def compare(prob: Problem, saf: safety.Safety) -> dict:
@@ -93,4 +108,6 @@ def summary_numbers(an: Analysis) -> dict:
             q["fs_ordinary"] = b["on_surface"]["fs_ordinary"]
         if b.get("search") and b["search"].get("fs") is not None:
             q["fs_bishop_min"] = b["search"]["fs"]
+    if an.reduction is not None and an.reduction.get("fs") is not None:
+        q["fs_reduction"] = an.reduction["fs"]
     return q

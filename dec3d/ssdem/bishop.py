@@ -20,38 +20,21 @@ from scipy.optimize import minimize
 
 from .soil import Slope
 
-N_SAMPLE = 600          # points along a circle used to find where it cuts the ground
-
 
 def _extent(slope: Slope, xc, yc, R):
-    """Entry / exit x of each circle's lower arc below the ground (nan when none)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return _extent_raw(slope, xc, yc, R)
+    """Entry / exit x of each circle's slip mass: the widest stretch of its lower arc
+    below the ground (nan when none); see Slope.circle_spans."""
+    x_in, x_out, _ = slope.circle_spans(xc, yc, R)
+    return x_in, x_out
 
 
-def _extent_raw(slope, xc, yc, R):
-    t = np.linspace(0.0, 1.0, N_SAMPLE)
-    x = (xc - R)[:, None] + (2 * R)[:, None] * t[None, :]
-    y = yc[:, None] - np.sqrt(np.clip(R[:, None] ** 2 - (x - xc[:, None]) ** 2, 0, None))
-    f = slope.ground(x) - y
-    inside = f > 0
-    has = inside.any(axis=1)
-    first = np.argmax(inside, axis=1)
-    last = N_SAMPLE - 1 - np.argmax(inside[:, ::-1], axis=1)
-    rows = np.arange(len(xc))
-
-    def cross(i0, i1):
-        # linear interpolation of the sign change between samples i0 (outside) and i1 (inside)
-        f0, f1 = f[rows, i0], f[rows, i1]
-        w = np.where(f1 != f0, f0 / (f0 - f1), 0.0)
-        return x[rows, i0] + w * (x[rows, i1] - x[rows, i0])
-    x_in = np.where(first > 0, cross(np.maximum(first - 1, 0), first), x[rows, first])
-    x_out = np.where(last < N_SAMPLE - 1, cross(np.minimum(last + 1, N_SAMPLE - 1), last), x[rows, last])
-    return np.where(has, x_in, np.nan), np.where(has, x_out, np.nan)
+def _slices(slope: Slope, xc, yc, R, n, span=None):
+    with np.errstate(all="ignore"):
+        return _slices_raw(slope, xc, yc, R, n, span)
 
 
-def _slices(slope: Slope, xc, yc, R, n):
-    x_in, x_out = _extent(slope, xc, yc, R)
+def _slices_raw(slope: Slope, xc, yc, R, n, span):
+    x_in, x_out = _extent(slope, xc, yc, R) if span is None else span
     e = x_in[:, None] + (x_out - x_in)[:, None] * np.linspace(0, 1, n + 1)[None, :]
     xm = 0.5 * (e[:, 1:] + e[:, :-1])
     b = np.diff(e, axis=1)
@@ -59,15 +42,17 @@ def _slices(slope: Slope, xc, yc, R, n):
     return x_in, x_out, xm, b, yb
 
 
-def fs_circles(slope: Slope, xc, yc, R, n: int = 60, ordinary: bool = False, tol: float = 1e-7):
-    """Bishop (or ordinary) FS of many circles; inf where a circle misses the slope or m_alpha <= 0."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return _fs_circles(slope, xc, yc, R, n, ordinary, tol)
+def fs_circles(slope: Slope, xc, yc, R, n: int = 60, ordinary: bool = False, tol: float = 1e-7, span=None):
+    """Bishop (or ordinary) FS of many circles; inf where a circle misses the slope or m_alpha <= 0.
+
+    span: the circles' (x_in, x_out) when already known (_extent)."""
+    with np.errstate(all="ignore"):
+        return _fs_circles(slope, xc, yc, R, n, ordinary, tol, span)
 
 
-def _fs_circles(slope, xc, yc, R, n, ordinary, tol):
+def _fs_circles(slope, xc, yc, R, n, ordinary, tol, span):
     xc, yc, R = (np.atleast_1d(np.asarray(v, float)) for v in (xc, yc, R))
-    x_in, x_out, xm, b, yb = _slices(slope, xc, yc, R, n)
+    x_in, x_out, xm, b, yb = _slices(slope, xc, yc, R, n, span)
     k, ns = xm.shape
     fx, fy = xm.ravel(), yb.ravel()
     top = slope.ground(fx)
@@ -92,17 +77,22 @@ def _fs_circles(slope, xc, yc, R, n, ordinary, tol):
         F = np.sum(c * l + (psi * N - u * l) * tp, axis=1) / drive
     else:
         F = np.full(k, 1.5)
+        act = np.arange(k)                  # circles still iterating (finite, not yet converged)
         for _ in range(200):
-            m = ca + psi * tp * sa / F[:, None]
-            N = (W + Q - (c * l - u * l * tp) * sa / F[:, None]) / m
-            Fn = np.sum(c * l + (psi * N - u * l) * tp, axis=1) / drive
-            done = np.all(np.abs(Fn - F) <= tol * np.abs(Fn)) if np.all(np.isfinite(Fn)) else False
-            F = Fn
-            if done:
+            Fa = F[act][:, None]
+            m = ca[act] + psi * tp[act] * sa[act] / Fa
+            N = (W[act] + Q[act] - (c[act] * l[act] - u[act] * l[act] * tp[act]) * sa[act] / Fa) / m
+            Fn = np.sum(c[act] * l[act] + (psi * N - u[act] * l[act]) * tp[act], axis=1) / drive[act]
+            moving = np.isfinite(Fn) & ~(np.abs(Fn - F[act]) <= tol * np.abs(Fn))
+            F[act] = Fn
+            act = act[moving]
+            if not len(act):
                 break
         m = ca + psi * tp * sa / F[:, None]
         F = np.where(np.all(m > 0.05, axis=1), F, np.inf)
-    bad = ~np.isfinite(x_in) | (x_out - x_in <= 0) | (drive <= 0)
+    # no driving moment (beyond round-off of the weights' moments): no slip to resist
+    scale = np.sum(np.abs((W + Q) * sa), axis=1)
+    bad = ~np.isfinite(x_in) | (x_out - x_in <= 0) | ~(drive > 1e-9 * scale)
     return np.where(bad, np.inf, F)
 
 
@@ -135,7 +125,8 @@ def search(slope: Slope, bottom: float | None = None, grid: int = 14, n: int = 4
     prof = slope.profile
     x0, x1 = float(prof[0, 0]), float(prof[-1, 0])
     g0, g1 = float(prof[:, 1].min()), float(prof[:, 1].max())
-    H = max(g1 - g0, 1e-6)
+    # the height scale of the grid: the slope, but not less than 5 % of the section width
+    H = max(g1 - g0, 0.05 * (x1 - x0), 1e-6)
     lo_y = bottom if bottom is not None else g0 - H
     depth_min = 0.02 * H if min_depth is None else min_depth
     xs = np.linspace(x0, x1, grid)
@@ -150,10 +141,11 @@ def search(slope: Slope, bottom: float | None = None, grid: int = 14, n: int = 4
     R = R.ravel()
 
     def objective(xc, yc, r):
-        f = fs_circles(slope, xc, yc, r, n)
-        sag = _depth(slope, xc, yc, r)
+        span = _extent(slope, xc, yc, r)
+        f = fs_circles(slope, xc, yc, r, n, span=span)
+        sag = _depth(slope, xc, yc, r, span)
         f = np.where(sag < depth_min, np.inf, f)
-        f = np.where(yc - r < lo_y - 1e-9, np.inf, f)
+        f = np.where(_lowest(slope, xc, yc, r, span) < lo_y - 1e-9, np.inf, f)
         return f
     F = objective(XC, YC, R)
     order = np.argsort(F)[:5]
@@ -173,8 +165,16 @@ def search(slope: Slope, bottom: float | None = None, grid: int = 14, n: int = 4
     return out
 
 
-def _depth(slope: Slope, xc, yc, R):
+def _lowest(slope: Slope, xc, yc, R, span=None):
+    """Lowest elevation of each slip surface (the arc between entry and exit)."""
+    x_in, x_out = _extent(slope, xc, yc, R) if span is None else span
+    xl = np.clip(xc, x_in, x_out)
+    with np.errstate(all="ignore"):
+        return np.where(np.isfinite(x_in), yc - np.sqrt(np.clip(R * R - (xl - xc) ** 2, 0, None)), np.inf)
+
+
+def _depth(slope: Slope, xc, yc, R, span=None):
     """Largest vertical depth of each slip mass (0 when the circle misses)."""
-    x_in, x_out, xm, b, yb = _slices(slope, np.atleast_1d(xc), np.atleast_1d(yc), np.atleast_1d(R), 20)
+    x_in, x_out, xm, b, yb = _slices(slope, np.atleast_1d(xc), np.atleast_1d(yc), np.atleast_1d(R), 20, span)
     d = slope.ground(xm) - yb
     return np.where(np.isfinite(x_in), np.nanmax(np.where(np.isfinite(d), d, 0), axis=1), 0.0)

@@ -62,14 +62,15 @@ def block_loads(blocks, slope: Slope) -> np.ndarray:
     return f
 
 
-def from_slope(slope: Slope, mesh: dict, surface: dict | None, settings: Settings, title: str = "") -> Problem:
-    """Mesh the slope and set up every array the solver needs."""
+def from_slope(slope: Slope, mesh: dict, surface: dict | None, settings: Settings, title: str = "",
+               max_blocks: float = np.inf) -> Problem:
+    """Mesh the slope and set up every array the solver needs (mesh.MeshTooLarge past max_blocks)."""
     base_pairs = None
     if surface is not None:
-        verts, offsets, fixed, base_pairs = surface_mesh(slope, surface, mesh["slices"], mesh.get("rows"))
+        verts, offsets, fixed, base_pairs = surface_mesh(slope, surface, mesh["slices"], mesh.get("rows"), max_blocks)
         bottom = None
     else:
-        verts, offsets, fix = grid_mesh(slope, mesh["size"], mesh["bottom"])
+        verts, offsets, fix = grid_mesh(slope, mesh["size"], mesh["bottom"], max_blocks)
         fixed = fix.all(axis=1)
         bottom = mesh["bottom"]
     blocks = make_blocks(verts, offsets, fixed, fix=None if surface is not None else fix)

@@ -46,9 +46,29 @@ def column_breaks(x0: float, x1: float, size: float, must: np.ndarray) -> np.nda
     return np.concatenate(xs)
 
 
-def grid_mesh(slope: Slope, size: float, bottom: float):
+class MeshTooLarge(ValueError):
+    """A mesh estimated above the block budget (raised before anything is allocated)."""
+
+    def __init__(self, estimate: float, budget: int, what: str, key: str):
+        self.estimate, self.budget, self.key = estimate, budget, key
+        super().__init__(f"the mesh would have about {estimate:.3g} blocks ({what}); the budget is "
+                         f"{budget} blocks (about {budget * 31 / 1000 / 1024:.3g} GiB)")
+
+
+def grid_estimate(slope: Slope, size: float, bottom: float) -> float:
+    """Blocks of grid_mesh, from the section's area and width (within a few %)."""
+    prof = slope.profile
+    area = float(np.sum(np.diff(prof[:, 0]) * (0.5 * (prof[1:, 1] + prof[:-1, 1]) - bottom)))
+    width = float(prof[-1, 0] - prof[0, 0])
+    return max(area, 0.0) / size ** 2 + width / size + len(prof)
+
+
+def grid_mesh(slope: Slope, size: float, bottom: float, max_blocks: float = np.inf):
     """Blocks of the whole section; returns (verts, offsets, fix) with fix (n, 3) DOF fixity."""
     prof = slope.profile
+    est = grid_estimate(slope, size, bottom)
+    if est > max_blocks:
+        raise MeshTooLarge(est, int(max_blocks), f"block size {size:g} over the section", "size")
     xb = column_breaks(prof[0, 0], prof[-1, 0], size, prof[:, 0])
     top = slope.ground(xb)
     if np.any(top <= bottom):
@@ -120,15 +140,31 @@ def slip_extent(slope: Slope, ys, xlim) -> tuple[float, float]:
     return float(x_in), float(x_out)
 
 
-def surface_mesh(slope: Slope, surface: dict, slices: int, rows: int | None):
+def surface_mesh(slope: Slope, surface: dict, slices: int, rows: int | None, max_blocks: float = np.inf):
     """Slices above a slip surface plus one fixed ground block under each base chord.
 
     Returns (verts, offsets, fixed, base_pairs) where base_pairs (k, 2) lists
-    (slice block, ground block) whose shared edge is on the surface.
+    (slice block, ground block) whose shared edge is on the surface.  A circle's slip
+    mass is the widest stretch of its arc below the ground (Slope.circle_spans, the
+    same rule as the Bishop search); a circle prescribed by the user must leave the
+    ground only once, as a polyline must.
     """
     ys, own_x, xlim = surface_function(surface)
-    x_in, x_out = slip_extent(slope, ys, xlim)
+    if surface["type"] == "circle":
+        x_in, x_out, n = (float(v[0]) for v in slope.circle_spans(*surface["centre"], surface["radius"]))
+        if n == 0:
+            raise ValueError("the slip surface does not pass below the ground surface")
+        if n > 1 and "search" not in surface:         # the search's circles: the widest mass
+            raise ValueError("the slip surface comes out of the ground more than once")
+    else:
+        x_in, x_out = slip_extent(slope, ys, xlim)
     width = (x_out - x_in) / slices
+    xs = np.linspace(x_in, x_out, 201)
+    h_est = float(np.nanmax(slope.ground(xs) - ys(xs), initial=0.0))
+    est = (slices + len(slope.profile) + len(own_x)) * ((rows if rows else max(1.0, h_est / width)) + 1)
+    if est > max_blocks:
+        raise MeshTooLarge(est, int(max_blocks), f"{slices} slices" + (f" of {rows} rows" if rows else ""),
+                           "rows" if rows and rows > slices else "slices")
     must = np.concatenate([slope.profile[:, 0], own_x])
     must = must[(must > x_in + 0.3 * width) & (must < x_out - 0.3 * width)]
     xb = column_breaks(x_in, x_out, width * (1 + 1e-9), must)

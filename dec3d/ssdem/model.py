@@ -97,6 +97,7 @@ class Settings:
     ru, ru_mode: pore pressure ratio and its meaning ("standard": u = r_u*gamma*h
         is in Interfaces.u_pore; "listing": sigma'_n = (1 - r_u)*sigma_n)
     pivot_tol: a pivot d_j with d_j / K_jj below this marks DOF j as unstable
+    strength_reduction: also search the strength-reduction factor (reduction.py)
     """
 
     n_steps: int = 10
@@ -105,6 +106,7 @@ class Settings:
     ru: float = 0.0
     ru_mode: str = "standard"
     pivot_tol: float = 1e-9
+    strength_reduction: bool = False
 
 
 @dataclass

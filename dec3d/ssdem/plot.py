@@ -10,7 +10,17 @@ from .units import factors
 
 
 def figure(an: Analysis, path: Path) -> None:
-    """Mesh coloured by displacement, failure surface in red, unstable blocks crossed."""
+    """Write figure.png (see build_figure), cropped to what is drawn."""
+    import matplotlib.pyplot as plt
+    fig = build_figure(an)
+    fig.savefig(path, bbox_inches="tight", pad_inches=0.1)
+    plt.close(fig)
+
+
+def build_figure(an: Analysis):
+    """Mesh coloured by displacement, failure surface in red, unstable blocks crossed.
+
+    Returns the matplotlib figure; its first axes hold the model, the second the colour bar."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -21,12 +31,30 @@ def figure(an: Analysis, path: Path) -> None:
     blk, itf = p.blocks, p.interfaces
     polys = [blk.polygon(i) / L for i in range(blk.n)]
     mag = np.hypot(st.u[:, 0], st.u[:, 1]) / L
-    fig, ax = plt.subplots(figsize=(11, 6), dpi=110)
+    # the axes take the model's proportions (equal scales), so no empty band is left
+    # above or beside it; the colour bar is cut to the height of the axes
+    pts = blk.verts / L if p.profile is None else np.vstack([blk.verts, p.profile]) / L
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    span = np.maximum(hi - lo, 1e-9 * max(float(np.abs(pts).max()), 1.0))
+    pad = 0.03 * span.max()
+    lo, hi = lo - pad, hi + pad
+    dx, dy = hi - lo
+    w_ax = 9.0
+    h_ax = min(max(w_ax * dy / dx, 1.0), 8.0)
+    if w_ax * dy / dx > 8.0:
+        w_ax = max(8.0 * dx / dy, 2.0)
+    fig = plt.figure(figsize=(w_ax + 2.0, h_ax + 1.6), dpi=110)
+    ax = fig.add_axes((0.06, 0.12, w_ax / (w_ax + 2.0), h_ax / (h_ax + 1.6)))
     cmap = matplotlib.colormaps["viridis"].with_extremes(bad="0.85")   # fixed and removed blocks grey
     pc = PolyCollection(polys, array=np.where(st.removed | blk.fixed, np.nan, mag), cmap=cmap,
                         edgecolors="0.35", linewidths=0.3)
     ax.add_collection(pc)
-    fig.colorbar(pc, ax=ax, label=f"displacement magnitude ({p.units.split('-')[1] if '-' in p.units else 'm'})")
+    from mpl_toolkits.axes_grid1 import make_axes_locatable
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal", adjustable="box")
+    cax = make_axes_locatable(ax).append_axes("right", size=0.2, pad=0.15)
+    fig.colorbar(pc, cax=cax, label=f"displacement magnitude ({p.units.split('-')[1] if '-' in p.units else 'm'})")
     if st.removed.any():
         ax.add_collection(PolyCollection([polys[i] for i in np.flatnonzero(st.removed)], facecolors="none",
                                          edgecolors="crimson", hatch="xx", linewidths=0.6))
@@ -60,15 +88,15 @@ def figure(an: Analysis, path: Path) -> None:
             inside = (xs >= c["x_entry"]) & (xs <= c["x_exit"]) & (ys <= c["centre"][1])
             ax.plot(np.where(inside, xs, np.nan) / L, np.where(inside, ys, np.nan) / L, style, lw=1.5,
                     label=f"{name}: FS {c['fs']:.3f}")
-    ax.autoscale_view()
-    ax.set_aspect("equal")
     fs = s.fs_global
     ax.set_title(f"{p.title}\nstatic DEM FS = {fs:.3f}" if np.isfinite(fs) else p.title)
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(loc="upper left", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    handles = ax.get_legend_handles_labels()[0]
+    if handles:          # below the axes, so that it hides nothing of the model
+        from matplotlib.transforms import offset_copy
+        below = offset_copy(ax.transAxes, fig=fig, y=-22, units="points")     # under the tick labels
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=below,
+                  ncol=min(3, len(handles)), fontsize=8, frameon=False)
+    return fig
 
 
 def vtk(an: Analysis, out: Path) -> list[Path]:

@@ -114,6 +114,13 @@ def summary_text(an: Analysis) -> str:
                 L = factors(p.units)["length"]
                 out.append(f"Bishop simplified, minimum over circles: {_num(sr['fs'])} at centre "
                            f"({sr['centre'][0] / L:.3f}, {sr['centre'][1] / L:.3f}), radius {sr['radius'] / L:.3f} {lab['length']}")
+    r = an.reduction
+    if r is not None:
+        if r.get("fs") is not None:
+            out.append(f"FS (strength reduction of c' and tan phi' until the static DEM fails): {r['fs']:.3f} "
+                       f"(holds at {r['holds_at']:.3f}, fails at {r['fails_at']:.3f}; {len(r['trials'])} trials)")
+        else:
+            out.append(f"FS (strength reduction): n/a - {r['reason']}")
     for note in p.notes:
         out.append(f"note: {note}")
     out.append(f"time: read {an.timings.get('read', 0):.2f} s, solve {an.timings.get('solve', 0):.2f} s "
@@ -126,7 +133,8 @@ def _num(v) -> str:
 
 
 def record(an: Analysis) -> dict:
-    """Everything, for result.json."""
+    """Everything but the timings (timings.json), for result.json: the same input gives
+    the same bytes."""
     p, st = an.problem, an.state
     blocks, interfaces = tables(an)
     return _clean(dict(
@@ -136,7 +144,7 @@ def record(an: Analysis) -> dict:
                              averaged=int(an.safety.n_averaged),
                              definition="fs_dem = sum(tau_available*L)/sum(tau_mobilised*L) over the failure surface"),
         steps=[vars(r) for r in st.steps], unstable_blocks=np.flatnonzero(st.removed),
-        bishop=an.bishop, surface=p.surface, notes=p.notes, timings=an.timings,
+        bishop=an.bishop, strength_reduction=an.reduction, surface=p.surface, notes=p.notes,
         blocks=blocks, interfaces=interfaces,
     ))
 
@@ -144,11 +152,13 @@ def record(an: Analysis) -> dict:
 def write_all(an: Analysis, out: Path) -> list[Path]:
     out.mkdir(parents=True, exist_ok=True)
     blocks, interfaces = tables(an)
-    files = [out / "summary.txt", out / "blocks.csv", out / "interfaces.csv", out / "steps.csv", out / "result.json"]
+    files = [out / "summary.txt", out / "blocks.csv", out / "interfaces.csv", out / "steps.csv", out / "result.json",
+             out / "timings.json"]
     files[0].write_text(summary_text(an))
     write_csv(files[1], blocks)
     write_csv(files[2], interfaces)
     steps = an.state.steps
     write_csv(files[3], {k: [getattr(r, k) for r in steps] for k in vars(steps[0])} if steps else {"step": []})
     files[4].write_text(json.dumps(record(an), indent=1))
+    files[5].write_text(json.dumps(_clean(an.timings), indent=1, sort_keys=True))
     return files

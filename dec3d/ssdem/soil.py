@@ -110,3 +110,78 @@ class Slope:
         with np.errstate(divide="ignore", invalid="ignore"):
             xbar = np.where(force > 0, moment / force, 0.5 * (x0 + x1))
         return force, xbar
+
+    def circle_spans(self, xc, yc, R):
+        """Where the lower arcs of circles run below the ground, found exactly.
+
+        The arc y = yc - sqrt(R^2 - (x - xc)^2) is intersected with every segment of
+        the profile (a quadratic per segment), inside the profile's x range.  Between
+        consecutive crossings the arc is either below the ground (a slip mass) or
+        above it; a circle that just touches the ground splits there.  Returns
+        (x_in, x_out, n_masses): the widest stretch below the ground of each circle
+        (nan when none) and how many separate stretches there are.  A stretch must begin
+        and end where the arc meets the ground inside the profile's x range.  The Bishop search
+        and the slip-surface mesher both use the widest stretch, so every circle the
+        search proposes is one the mesher accepts.
+        """
+        xc, yc, R = (np.atleast_1d(np.asarray(v, float)) for v in (xc, yc, R))
+        with np.errstate(all="ignore"):
+            return self._circle_spans(xc, yc, R)
+
+    def _circle_spans(self, xc, yc, R):
+        p = self.profile
+        x0, y0, x1, y1 = p[:-1, 0], p[:-1, 1], p[1:, 0], p[1:, 1]
+        lo = np.maximum(xc - R, p[0, 0])
+        hi = np.minimum(xc + R, p[-1, 0])
+        # segment k: (x, y) = (x0 + t dx, y0 + t dy); |(x, y) - (xc, yc)|^2 = R^2
+        dx, dy = (x1 - x0)[None, :], (y1 - y0)[None, :]
+        ex, ey = x0[None, :] - xc[:, None], y0[None, :] - yc[:, None]
+        a = dx * dx + dy * dy
+        b = 2 * (ex * dx + ey * dy)
+        c = ex * ex + ey * ey - (R * R)[:, None]
+        disc = b * b - 4 * a * c
+        sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
+        cuts = []
+        for t in ((-b - sq) / (2 * a), (-b + sq) / (2 * a)):
+            y = y0[None, :] + t * dy
+            ok = (t >= 0) & (t <= 1) & (y <= yc[:, None])      # on the segment and on the lower arc
+            cuts.append(np.where(ok, x0[None, :] + t * dx, np.nan))
+        pts = np.concatenate([lo[:, None], hi[:, None]] + cuts, axis=1)
+        pts = np.where((pts >= lo[:, None]) & (pts <= hi[:, None]), pts, np.nan)
+        pts = np.sort(pts, axis=1)                                # nan last
+        xm = 0.5 * (pts[:, 1:] + pts[:, :-1])
+        arc = yc[:, None] - np.sqrt(np.clip((R * R)[:, None] - (xm - xc[:, None]) ** 2, 0, None))
+        width = np.diff(pts, axis=1)
+        below = (self.ground(np.nan_to_num(xm)) - arc > 0) & (width > 0) & np.isfinite(xm)
+        below &= lo[:, None] < hi[:, None]
+        # runs of consecutive stretches below the ground; the widest run is the slip mass.
+        # A run must meet the ground at both ends: one that reaches the side of the
+        # circle (x = xc -/+ R) under the ground is no slip surface (the arc turns up
+        # underground), and one cut off by an end of the profile leaves the section.
+        r = np.arange(len(xc))
+        last_col = np.maximum(np.isfinite(pts).sum(axis=1) - 2, 0)
+        run = self._runs(below)
+        first_run, last_run = run[:, 0], run[r, last_col]
+        below &= ~(((run == first_run[:, None]) & (first_run[:, None] >= 0)) |
+                   ((run == last_run[:, None]) & (last_run[:, None] >= 0)))
+        run = self._runs(below)
+        n_runs = run.max(axis=1, initial=-1) + 1
+        k = max(int(n_runs.max(initial=0)), 1)
+        tot = np.zeros((len(xc), k))
+        rows = np.repeat(np.arange(len(xc)), run.shape[1])
+        sel = run.ravel() >= 0
+        np.add.at(tot, (rows[sel], run.ravel()[sel]), np.nan_to_num(width).ravel()[sel])
+        best = np.argmax(tot, axis=1)
+        inrun = run == best[:, None]
+        first = np.argmax(inrun, axis=1)
+        last = inrun.shape[1] - 1 - np.argmax(inrun[:, ::-1], axis=1)
+        has = n_runs > 0
+        x_in = np.where(has, pts[r, first], np.nan)
+        x_out = np.where(has, pts[r, np.minimum(last + 1, pts.shape[1] - 1)], np.nan)
+        return x_in, x_out, n_runs
+
+    @staticmethod
+    def _runs(below: np.ndarray) -> np.ndarray:
+        """Index of the run of consecutive True entries each entry belongs to (-1: False)."""
+        start = below & ~np.concatenate([np.zeros((len(below), 1), bool), below[:, :-1]], axis=1)
+        return np.where(below, np.cumsum(start, axis=1) - 1, -1)

@@ -174,8 +174,12 @@ def stresses(prob: Problem, st: State, load: float):
     return sigma_n, tau, sig_eff
 
 
-def run(prob: Problem, progress=None) -> State:
-    """Run the whole load history; `progress(step, n_steps, iteration)` is called if given."""
+def run(prob: Problem, progress=None, stop_on_failure: bool = False) -> State:
+    """Run the whole load history; `progress(step, n_steps, iteration)` is called if given.
+
+    stop_on_failure: return after the first load step that does not converge or
+    removes a block (the strength-reduction search only needs to know that it fails).
+    """
     blk, itf, cfg = prob.blocks, prob.interfaces, prob.settings
     Ta, Tb = transfer_matrices(blk, itf)
     st = State(kn=itf.kn.copy(), ks=itf.ks.copy(), cracked=np.zeros(itf.m, bool),
@@ -223,4 +227,6 @@ def run(prob: Problem, progress=None) -> State:
                                    n_unstable=int(st.removed.sum()),
                                    max_displacement=float(disp[~st.removed].max(initial=0.0)),
                                    max_change=change))
+        if stop_on_failure and not (converged and not st.removed.any()):
+            break
     return st

@@ -9,7 +9,8 @@ from .analysis import analyse, summary_numbers
 def quantities(problem_dir: pathlib.Path, spec: dict) -> dict[str, float]:
     """Run `spec["input"]` (relative to problem_dir) with `spec["args"]`; see analysis.summary_numbers.
 
-    Understood args: "--compare bishop", "--format F", "--units U", "--tensile-strength T".
+    Understood args: "--compare bishop", "--format F", "--units U", "--tensile-strength T",
+    "--strength-reduction" (adds fs_reduction).
     """
     args = list(spec.get("args", []))
     opts: dict = {}
@@ -19,6 +20,10 @@ def quantities(problem_dir: pathlib.Path, spec: dict) -> dict[str, float]:
     while i < len(args):
         a = args[i]
         val = args[i + 1] if i + 1 < len(args) else None
+        if a == "--strength-reduction":
+            opts["strength_reduction"] = True
+            i += 1
+            continue
         if a == "--compare" and val == "bishop":
             compare = True
         elif a == "--format":

@@ -30,7 +30,9 @@ import numpy as np
 from .. import geometry
 from ..model import Settings, Problem, find_interfaces, make_blocks
 from ..units import factors
+from . import DEFAULT_MAX_BLOCKS, read_text
 from .errors import SsdemInputError
+from .tomlspec import MAX_STEPS
 
 SIDES = ("right", "top", "left", "bottom")
 ANGLE_TOL = 2.0        # degrees: a side angle may differ this much from the geometry
@@ -76,19 +78,105 @@ class _Tokens:
 
 
 def read_appendix_a(path: str | Path, text: str | None = None, units: str = "kN-m",
-                    tensile_strength: float | None = None, tol: float = 1e-3, max_iter: int = 200):
+                    tensile_strength: float | None = None, tol: float = 1e-3, max_iter: int = 200,
+                    max_blocks: int = DEFAULT_MAX_BLOCKS):
     """Read an Appendix A file into a `Problem` (units: the file's force-length system).
 
     tensile_strength: None leaves the tension cut-off off, as the thesis program ran
     (its test is commented out); a value (file stress units) turns it on.
     """
     path = Path(path)
-    text = path.read_text() if text is None else text
+    text = read_text(path) if text is None else text
     tk = _Tokens(text, str(path))
+    try:
+        return _read(tk, path, units, tensile_strength, tol, max_iter, max_blocks)
+    except SsdemInputError as exc:
+        # in a file laid out one record per line, a value missing from (or added to) a
+        # line shifts every later number, and the stream reading trips far below it:
+        # name the line that does not hold its record instead
+        defect = _layout_defect(tk)
+        if defect is not None and defect.line <= exc.line:
+            raise defect from None
+        raise
+
+
+def _records(n: int, nb_of):
+    """(field, column names) of every record in the order of Appendix A, one per line."""
+    yield "n_blocks", ("",)
+    for i in range(n):
+        yield f"centroid[{i}]", ("x", "y")
+    for i in range(n):
+        yield f"nodes[{i}]", ("x1", "y1", "x2", "y2", "x3", "y3", "x4", "y4")
+    for i in range(n):
+        yield f"force[{i}]", ("fx", "fy", "m")
+    yield "n_boundary", ("",)
+    for j in range(nb_of()):
+        yield f"boundary[{j}]", ("x", "y")
+    yield "strength", ("c_peak", "phi_peak", "c_res", "phi_res")
+    names = tuple(f"{kind}_{s}" for s in SIDES for kind in ("kn", "ks"))
+    for i in range(n):
+        yield f"springs[{i}]", names
+    for i in range(n):
+        yield f"angles[{i}]", tuple(f"a_{s}" for s in SIDES)
+    for name in ("iterations", "delta_peak", "delta_res", "ru"):
+        yield name, ("",)
+
+
+def _layout_defect(tk: _Tokens) -> SsdemInputError | None:
+    """The line that holds more or fewer numbers than its record, when the file is laid
+    out one record per line: either every other line holds exactly its record (a single
+    defect, anywhere), or at least the first two lines did up to the first defect.
+    None for a free layout or no defect."""
+    lines: dict[int, list[int]] = {}
+    for k, (_, line, _) in enumerate(tk.items):
+        lines.setdefault(line, []).append(k)
+    rows = sorted(lines.items())
+    if len(rows) < 3:
+        return None
+    try:
+        n = int(tk.items[0][0])
+    except ValueError:
+        return None
+    if not 0 < n <= len(rows):
+        return None
+    nb: dict = {}
+    try:
+        at = 1 + 3 * n                                                   # the n_boundary line
+        if at < len(rows) and len(rows[at][1]) == 1:
+            nb["v"] = min(max(0, int(tk.items[rows[at][1][0]][0])), n)
+    except ValueError:
+        pass
+    records = list(_records(n, lambda: nb.get("v", 0)))
+    defects = [i for i, ((_, names), (_, idx)) in enumerate(zip(records, rows)) if len(idx) != len(names)]
+    if not defects:
+        return None
+    first = defects[0]
+    if not ((len(defects) == 1 and len(records) == len(rows)) or first >= 2):
+        return None
+    (field, names), (line, idx) = records[first], rows[first]
+    text = tk.lines[line - 1]
+    cols = "" if names == ("",) else f" ({' '.join(names)})"
+    want = f"{len(names)} value{'s' if len(names) > 1 else ''}{cols}"
+    hint = "each record of Appendix A is on a line of its own here"
+    if len(idx) < len(names):
+        last_tok, _, col = tk.items[idx[-1]]
+        return SsdemInputError(f"line {line} holds {len(idx)} of the {want} of this record: "
+                               f"{len(names) - len(idx)} missing", tk.file, line, field, text,
+                               col + len(last_tok), hint)
+    _, _, col = tk.items[idx[len(names)]]
+    return SsdemInputError(f"line {line} holds {len(idx)} values, the record has {want}: "
+                           f"{len(idx) - len(names)} extra", tk.file, line, field, text, col, hint)
+
+
+def _read(tk: _Tokens, path: Path, units: str, tensile_strength, tol: float, max_iter: int, max_blocks: int):
     fac = factors(units)
     n = int(tk.number("n_blocks", integer=True))
     if n < 1:
         raise tk.error("must be at least 1", "n_blocks")
+    if n > max_blocks:
+        raise tk.error(f"{n} blocks is over the budget of {max_blocks} blocks "
+                       f"(about {n * 31 / 1000 / 1024:.3g} GiB of memory)", "n_blocks",
+                       hint="raise the budget with --max-blocks N if the machine can hold it")
     cen, cen_at = np.zeros((n, 2)), np.zeros(n, int)
     for i in range(n):
         vals, cen_at[i] = tk.row(f"centroid[{i}]", ("x", "y"))
@@ -118,8 +206,8 @@ def read_appendix_a(path: str | Path, text: str | None = None, units: str = "kN-
     for i in range(n):
         angles[i], angle_at[i] = tk.row(f"angles[{i}]", tuple(f"a_{s}" for s in SIDES))
     n_steps = int(tk.number("iterations", integer=True))
-    if n_steps < 1:
-        raise tk.error("must be at least 1", "iterations")
+    if not 1 <= n_steps <= MAX_STEPS:
+        raise tk.error(f"must be between 1 and {MAX_STEPS}, got {n_steps}", "iterations")
     tk.number("delta_peak")
     del_res = tk.number("delta_res")
     if del_res <= 0:

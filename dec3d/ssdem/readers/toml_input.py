@@ -16,19 +16,59 @@ import numpy as np
 
 from .. import bishop
 from ..build import from_slope
+from ..mesh import MeshTooLarge
 from ..model import Settings
 from ..soil import Layer, Slope
 from ..units import factors
+from . import DEFAULT_MAX_BLOCKS, read_text
 from .errors import SsdemInputError
-from .tomlspec import SECTIONS, Locator, bind
+from .tomlspec import MAX_NESTING, SECTIONS, Locator, bind
 
 
-def read_toml(path: str | Path, text: str | None = None, **_ignored):
-    """Parse, validate and mesh a TOML slope file; returns a `Problem`."""
+def _too_deep(text: str, path: Path) -> SsdemInputError | None:
+    """Arrays or inline tables nested deeper than MAX_NESTING (tomllib would recurse
+    without bound): an error at the line and column where the limit is passed.
+    Brackets inside one-line strings and comments do not count."""
+    depth = 0
+    for no, line in enumerate(text.splitlines(), start=1):
+        quote, escaped = None, False
+        for i, ch in enumerate(line):
+            if quote:
+                if escaped:
+                    escaped = False
+                elif ch == "\\" and quote == '"':
+                    escaped = True
+                elif ch == quote:
+                    quote = None
+            elif ch in "'\"":
+                quote = ch
+            elif ch == "#":
+                break
+            elif ch in "[{":
+                depth += 1
+                if depth > MAX_NESTING:
+                    return SsdemInputError(f"arrays or tables nested more than {MAX_NESTING} deep",
+                                           str(path), no, "(syntax)", line, i + 1,
+                                           "a slope input needs two levels: [[x, y], ...]")
+            elif ch in "]}":
+                depth = max(0, depth - 1)
+    return None
+
+
+def read_toml(path: str | Path, text: str | None = None, max_blocks: int = DEFAULT_MAX_BLOCKS, **_ignored):
+    """Parse, validate and mesh a TOML slope file; returns a `Problem`.
+
+    max_blocks: the block budget; a mesh estimated larger is refused before it is made.
+    """
     path = Path(path)
-    text = path.read_text() if text is None else text
+    text = read_text(path) if text is None else text
+    deep = _too_deep(text, path)
+    if deep is not None:
+        raise deep
     try:
         data = tomllib.loads(text)
+    except RecursionError:
+        raise SsdemInputError("arrays or tables nested too deeply", str(path), 1, "(syntax)") from None
     except tomllib.TOMLDecodeError as exc:
         m = re.search(r"line (\d+), column (\d+)", str(exc))
         line, col = (int(m.group(1)), int(m.group(2))) if m else (1, 1)
@@ -67,7 +107,7 @@ def read_toml(path: str | Path, text: str | None = None, **_ignored):
         slope.kh = sections["loads"]["kh"]
     an = sections["analysis"] or bind(loc, "analysis", 0, {}, fac)
     settings = Settings(n_steps=an["steps"], tol=an["tolerance"], max_iter=an["max_iterations"],
-                        ru=slope.ru, ru_mode=slope.ru_mode)
+                        ru=slope.ru, ru_mode=slope.ru_mode, strength_reduction=an["strength_reduction"])
     mesh = sections["mesh"] or bind(loc, "mesh", 0, {}, fac)
     surface = _surface(loc, slope, sections["surface"], mesh)
     if surface is None:
@@ -76,7 +116,9 @@ def read_toml(path: str | Path, text: str | None = None, **_ignored):
         if mesh["bottom"] is None:
             mesh["bottom"] = float(profile[:, 1].min() - np.ptp(profile[:, 1]))
     try:
-        prob = from_slope(slope, mesh, surface, settings, title=top["title"])
+        prob = from_slope(slope, mesh, surface, settings, title=top["title"], max_blocks=max_blocks)
+    except MeshTooLarge as exc:
+        raise loc.error("mesh", 0, exc.key, str(exc), "a coarser mesh, or raise the budget with --max-blocks N") from None
     except ValueError as exc:
         key = ("surface", "type") if surface is not None else ("mesh", "bottom")
         raise loc.error(key[0], 0, key[1], str(exc)) from None

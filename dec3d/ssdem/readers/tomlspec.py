@@ -16,6 +16,13 @@ from typing import Any
 from .errors import SsdemInputError
 
 REQUIRED = object()
+#: load steps and secant iterations per step at most (each is at least one linear solve)
+MAX_STEPS = 10_000
+MAX_ITERATIONS = 10_000
+#: deepest nesting of arrays and inline tables the input may use (points need 2)
+MAX_NESTING = 32
+#: largest coordinate or length, in the input's units (beyond it the geometry loses all precision)
+MAX_COORD = 1e9
 
 
 @dataclass(frozen=True)
@@ -83,9 +90,11 @@ SECTIONS: dict[str, tuple[Field, ...]] = {
         Field("bottom", "float", None, unit="length", doc="critical: lowest elevation a circle may reach"),
     ),
     "analysis": (
-        Field("steps", "int", 10, lo=1, doc="load increments to full load"),
+        Field("steps", "int", 10, lo=1, hi=MAX_STEPS, doc="load increments to full load"),
         Field("tolerance", "float", 1e-3, positive=True, doc="convergence: max |dk_s|/k_s0 within a step"),
-        Field("max_iterations", "int", 200, lo=1, doc="secant iterations per step at most"),
+        Field("max_iterations", "int", 200, lo=1, hi=MAX_ITERATIONS, doc="secant iterations per step at most"),
+        Field("strength_reduction", "bool", False,
+              doc="also find the factor on c' and tan(phi') at which the static solution fails"),
     ),
 }
 ARRAY_TABLES = {"layer", "surcharge"}
@@ -198,20 +207,31 @@ def _convert(loc, table, index, f: Field, v, fac):
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
             raise bad("expected a finite number")
         _bounds(bad, f, v)
+        if f.unit == "length" and abs(v) > MAX_COORD:
+            raise bad(f"must be between -{MAX_COORD:g} and {MAX_COORD:g}, got {v}")
         return float(v) * scale
     if f.kind == "pair":
         if not (isinstance(v, list) and len(v) == 2 and all(_num(x) for x in v)):
             raise bad("expected [x, y]")
+        _coords(bad, v)
         return [float(x) * scale for x in v]
     if f.kind == "points":
         if not (isinstance(v, list) and len(v) >= 2 and all(isinstance(p, list) and len(p) == 2 and all(_num(x) for x in p) for p in v)):
             raise bad("expected a list of at least two [x, y] points")
+        for p in v:
+            _coords(bad, p)
         xs = [p[0] for p in v]
         if any(b <= a for a, b in zip(xs[:-1], xs[1:])):
             raise bad("x must increase strictly from point to point (left to right)")
         scale = fac["length"]
         return [[float(p[0]) * scale, float(p[1]) * scale] for p in v]
     raise AssertionError(f.kind)
+
+
+def _coords(bad, p) -> None:
+    for x in p:
+        if abs(x) > MAX_COORD:
+            raise bad(f"coordinates must be between -{MAX_COORD:g} and {MAX_COORD:g}, got {x}")
 
 
 def _num(x) -> bool:
