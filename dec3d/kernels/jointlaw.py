@@ -185,19 +185,3 @@ def subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment,
         bmoment[a, 0] -= ra1 * g2 - ra2 * g1
         bmoment[a, 1] -= ra2 * g0 - ra0 * g2
         bmoment[a, 2] -= ra0 * g1 - ra1 * g0
-
-
-@njit(cache=True)
-def rotate_shear(sc_contact, n_old, n_new, sc_fs):
-    """Eq. (23): Fˢ := Fˢ − Fˢ × (n_old × n_new), for every sub-contact (contact normals (nc, 3))."""
-    for s in range(sc_contact.shape[0]):
-        c = sc_contact[s]
-        k0 = n_old[c, 1] * n_new[c, 2] - n_old[c, 2] * n_new[c, 1]
-        k1 = n_old[c, 2] * n_new[c, 0] - n_old[c, 0] * n_new[c, 2]
-        k2 = n_old[c, 0] * n_new[c, 1] - n_old[c, 1] * n_new[c, 0]
-        f0 = sc_fs[s, 0]
-        f1 = sc_fs[s, 1]
-        f2 = sc_fs[s, 2]
-        sc_fs[s, 0] = f0 - (f1 * k2 - f2 * k1)
-        sc_fs[s, 1] = f1 - (f2 * k0 - f0 * k2)
-        sc_fs[s, 2] = f2 - (f0 * k1 - f1 * k0)
