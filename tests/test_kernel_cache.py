@@ -1,4 +1,4 @@
-"""The numba cache guard of dec3d/kernels/__init__.py (issue 9: caches that cannot go stale,
+"""The numba cache guard of dec3d/kcache.py (issue 9: caches that cannot go stale,
 a notice on a cold start) and the kernel twin tests run once more with NUMBA_DISABLE_JIT=1."""
 import os
 import shutil
@@ -9,7 +9,7 @@ from pathlib import Path
 
 from conftest import ROOT
 
-from dec3d import kernels as K
+from dec3d import kcache as K
 
 
 def _copy_kernels(dst: Path) -> Path:
@@ -73,18 +73,20 @@ _CALLEE = "from numba import njit\n\n\n@njit(cache=True)\ndef g():\n    return {
 
 
 def test_edited_callee_reaches_the_cached_caller(tmp_path):
-    """A package laid out like dec3d.kernels (the guard as its __init__, a cached kernel that
+    """A package laid out like dec3d (the guard run by its __init__, a cached kernel that
     calls a cached kernel of another file). Editing the callee's file changes what the
     caller returns in the next process; numba alone would keep the caller's old code. The
     notice is printed while compiling on a cold cache, not on a warm one."""
     pkg = tmp_path / "fakedec" / "kernels"
     pkg.mkdir(parents=True)
-    (tmp_path / "fakedec" / "__init__.py").write_text("")
-    shutil.copy(ROOT / "dec3d" / "kernels" / "__init__.py", pkg / "__init__.py")
+    (tmp_path / "fakedec" / "__init__.py").write_text(
+        "from pathlib import Path\nfrom dec3d.kcache import guard\n"
+        "guard(Path(__file__).parent / 'kernels', 'fakedec.kernels')\n")
+    (pkg / "__init__.py").write_text("")
     (pkg / "caller.py").write_text(_CALLER)
     (pkg / "callee.py").write_text(_CALLEE.format(1))
     env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
-    env["PYTHONPATH"] = str(tmp_path)
+    env["PYTHONPATH"] = os.pathsep.join([str(tmp_path), str(ROOT)])
 
     def run():
         out = subprocess.run([sys.executable, "-c", "from fakedec.kernels.caller import f; print(f())"],
