@@ -64,6 +64,9 @@ def one(n: int, steps: int, jmodel: str, full: bool = False) -> dict:
     import resource
     import tempfile
 
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    if os.path.isdir(os.path.join(root, "dec3d")) and root not in sys.path:
+        sys.path.insert(0, root)       # the checkout's dec3d (also when it is not installed)
     import dec3d
 
     if full:

@@ -1,6 +1,10 @@
 """dec3d: an open-source, 3DEC-style three-dimensional distinct element program."""
 __version__ = "0.1.0"
 
+from .kcache import guard as _guard
+
+_guard()      # before any kernel is imported: stale cached kernels cleared, cold-start notice
+
 
 def __getattr__(name):
     # Session and run_deck import the language layer; loaded on first use so that

@@ -161,7 +161,9 @@ def cell_pairs(lo, hi, active, origin, size, ncell):
     for c in range(ntot):
         count[c + 1] += count[c]
     ent = np.empty(count[ntot], dtype=np.int64)
-    fill = count[:ntot].copy()
+    fill = np.empty(ntot, dtype=np.int64)
+    for c in range(ntot):
+        fill[c] = count[c]
     for b in range(n):
         if not active[b]:
             continue
@@ -216,28 +218,39 @@ def cell_pairs(lo, hi, active, origin, size, ncell):
                             continue
                         if m == buf.shape[0]:
                             nb = np.empty(2 * m, dtype=np.int64)
-                            nb[:m] = buf
+                            for e2 in range(m):
+                                nb[e2] = buf[e2]
                             buf = nb
                         buf[m] = j
                         m += 1
-        # sort this block's partners (insertion sort: usually a few dozen), then append
-        if m > 32:
-            buf[:m] = np.sort(buf[:m])
-        for p in range(1, m):
-            v = buf[p]
-            q = p - 1
-            while q >= 0 and buf[q] > v:
-                buf[q + 1] = buf[q]
-                q -= 1
-            buf[q + 1] = v
+        # sort this block's partners (Shell sort, gaps 1, 4, 13, ...: usually a few dozen;
+        # np.sort would add seconds of compilation for this), then append
+        gap = 1
+        while gap < m // 3:
+            gap = 3 * gap + 1
+        while gap > 0:
+            for p in range(gap, m):
+                v = buf[p]
+                q = p
+                while q >= gap and buf[q - gap] > v:
+                    buf[q] = buf[q - gap]
+                    q -= gap
+                buf[q] = v
+            gap //= 3
         if k + m > cap:
             ncap = max(2 * cap, k + m)
             no = np.empty((ncap, 2), dtype=np.int64)
-            no[:k] = out[:k]
+            for r in range(k):
+                no[r, 0] = out[r, 0]
+                no[r, 1] = out[r, 1]
             out = no
             cap = ncap
         for p in range(m):
             out[k, 0] = i
             out[k, 1] = buf[p]
             k += 1
-    return out[:k].copy()
+    res = np.empty((k, 2), dtype=np.int64)     # element loops, not slice copies: those
+    for r in range(k):                         # compile seconds of shape checks
+        res[r, 0] = out[r, 0]
+        res[r, 1] = out[r, 1]
+    return res

@@ -64,24 +64,8 @@ def contact_type(na, nb):
 
 
 @njit(cache=True)
-def cp_gap(va, vb, n):
-    """g(n) = min_B n·V − max_A n·V for vertex arrays va (na, 3), vb (nb, 3) [m]."""
-    da = -1e300
-    for i in range(va.shape[0]):
-        d = n[0] * va[i, 0] + n[1] * va[i, 1] + n[2] * va[i, 2]
-        if d > da:
-            da = d
-    db = 1e300
-    for i in range(vb.shape[0]):
-        d = n[0] * vb[i, 0] + n[1] * vb[i, 1] + n[2] * vb[i, 2]
-        if d < db:
-            db = d
-    return db - da
-
-
-@njit(cache=True)
 def _gap3(va, vb, n0, n1, n2):
-    """cp_gap with the normal as three scalars."""
+    """g(n) = min_B n·V − max_A n·V for vertex arrays va (na, 3), vb (nb, 3) [m], n = (n0, n1, n2)."""
     da = -1e300
     for i in range(va.shape[0]):
         d = n0 * va[i, 0] + n1 * va[i, 1] + n2 * va[i, 2]

@@ -7,8 +7,13 @@
 - ``carry_over``: the state of each new sub-contact from the old sub-contacts of the same
   contact: the sub-contact with the same identity (kind and vertex, or the two edges)
   keeps its displacements and state and its shear force scaled by the area ratio (the
-  stress is kept); a new one gets the mean stresses of the old contact (smooth
-  reallocation, as in UDEC), or for a new contact the contact gap.
+  stress is kept); a new one gets the mean shear stress and dilation of the old contact
+  (smooth reallocation, as in UDEC) and, like every sub-contact of a new contact, its own
+  gap as uⁿ (``subcontact_gaps``), flagged ``ST_NEW`` (its first force update adds no
+  increment: the gap was measured after the step's motion). The old contact's mean opening
+  would put a new corner sub-contact of a rocking block up to CTOL/2 inside its base.
+- ``subcontact_gaps``: the gap of each sub-contact along the contact normal, from the two
+  blocks' surfaces over its point.
 
 Sub-contact kinds (``subgeom``): 0 vertex of A on a face of B, 1 vertex of B on a face of A,
 2 edge-edge crossing, 3 point of a lower contact type. A vertex sub-contact keeps its
@@ -22,6 +27,7 @@ import numpy as np
 from numba import njit
 
 from .commonplane import common_plane, contact_type
+from .jointlaw import ST_NEW
 
 
 @njit(cache=True)
@@ -81,14 +87,85 @@ def cp_batch(ra, rb, prev, vpos, bvstart, bvcount, centroid, old_n, old_c, reach
 
 
 @njit(cache=True)
-def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, cgap,
+def subcontact_gaps(sc_contact, pos, ca, cb, cn, cgap, centroid, vpos, bfstart, bfcount, fvstart,
+                    fnvert, fverts, out):
+    """Gap [m] of each sub-contact: along the contact normal n (A → B) through its point x,
+    the distance from A's surface to B's surface (negative: overlap).
+
+    A convex block is the intersection of its face half-spaces, so on the line x + t n its
+    side facing B ends at t_A = min over A's faces with outward normal m, m·n > 0, of
+    m·(f − x) / m·n (f a point of the face), and B begins at t_B = max over B's faces with
+    m·n < 0 of the same; gap = t_B − t_A. Exact for a point over both blocks, a plane
+    continuation just beside one. Face normals by Newell's formula from the current vertices,
+    turned outward with the block centroid. The contact gap ``cgap`` (nc,) when a side has no
+    such face (degenerate). sc_contact (ns,), pos (ns, 3) [m]; ca, cb (nc,) block rows;
+    cn (nc, 3); centroid (nb, 3); faces as in ``subgeom.subcontacts_batch``; writes out (ns,).
+    """
+    for s in range(sc_contact.shape[0]):
+        c = sc_contact[s]
+        n0 = cn[c, 0]
+        n1 = cn[c, 1]
+        n2 = cn[c, 2]
+        ta = math.inf
+        tb = -math.inf
+        for side in range(2):
+            b = ca[c] if side == 0 else cb[c]
+            for f in range(bfstart[b], bfstart[b] + bfcount[b]):
+                m = fnvert[f]
+                if m < 3:
+                    continue
+                mx = 0.0
+                my = 0.0
+                mz = 0.0
+                fx = 0.0
+                fy = 0.0
+                fz = 0.0
+                for j in range(m):
+                    p = fverts[fvstart[f] + j]
+                    q = fverts[fvstart[f] + (j + 1) % m]
+                    mx += (vpos[p, 1] - vpos[q, 1]) * (vpos[p, 2] + vpos[q, 2])
+                    my += (vpos[p, 2] - vpos[q, 2]) * (vpos[p, 0] + vpos[q, 0])
+                    mz += (vpos[p, 0] - vpos[q, 0]) * (vpos[p, 1] + vpos[q, 1])
+                    fx += vpos[p, 0]
+                    fy += vpos[p, 1]
+                    fz += vpos[p, 2]
+                ln = math.sqrt(mx * mx + my * my + mz * mz)
+                if ln == 0.0:
+                    continue
+                fx /= m
+                fy /= m
+                fz /= m
+                mx /= ln
+                my /= ln
+                mz /= ln
+                if mx * (fx - centroid[b, 0]) + my * (fy - centroid[b, 1]) + mz * (fz - centroid[b, 2]) < 0.0:
+                    mx = -mx
+                    my = -my
+                    mz = -mz
+                mn = mx * n0 + my * n1 + mz * n2
+                if abs(mn) <= 1e-9:
+                    continue
+                t = (mx * (fx - pos[s, 0]) + my * (fy - pos[s, 1]) + mz * (fz - pos[s, 2])) / mn
+                if side == 0 and mn > 0.0 and t < ta:
+                    ta = t
+                if side == 1 and mn < 0.0 and t > tb:
+                    tb = t
+        if ta == math.inf or tb == -math.inf:
+            out[s] = cgap[c]
+        else:
+            out[s] = tb - ta
+
+
+@njit(cache=True)
+def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, sgap,
                old_start, old_count, old_kind, old_key0, old_key1, old_area,
                old_fs, old_un, old_udil, old_us, old_state, old_n, new_n,
                fs, un, udil, us, state):
     """State of the new sub-contacts from the old ones (see the module docstring).
 
     cprev (nc,) old contact row of each new contact or -1; new_sc_* (ns,) the new
-    sub-contacts, ordered by contact; cgap (nc,) contact gap [m]; old_start/old_count
+    sub-contacts, ordered by contact; sgap (ns,) their own gaps [m] (``subcontact_gaps``),
+    the uⁿ of every sub-contact without an old twin (state ``ST_NEW``); old_start/old_count
     (nold,) CSR of the old sub-contacts per old contact; old_* the old sub-contact arrays;
     old_n (nold, 3) / new_n (nc, 3) contact normals: old shear forces are first turned to
     the new plane by Eq. (23). Writes fs (ns, 3) N, un, udil (ns,) m, us (ns, 3) m, state (ns,).
@@ -102,8 +179,8 @@ def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, cg
             fs[s, d] = 0.0
             us[s, d] = 0.0
         udil[s] = 0.0
-        state[s] = 0
-        un[s] = cgap[c]
+        state[s] = ST_NEW
+        un[s] = sgap[s]
         if p < 0:
             continue
         k0 = old_n[p, 1] * new_n[c, 2] - old_n[p, 2] * new_n[c, 1]
@@ -134,16 +211,15 @@ def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, cg
             udil[s] = old_udil[hit]
             state[s] = old_state[hit]
             continue
-        # no old twin: the mean stresses of the old contact, its failure state
+        # no old twin: the mean shear stress and dilation of the old contact, its failure
+        # state; its own gap
         atot = 0.0
-        mun = 0.0
         mdil = 0.0
         st = 0
         for d in range(3):
             mean_fs[d] = 0.0
         for o in range(lo, hi):
             atot += old_area[o]
-            mun += old_un[o] * old_area[o]
             mdil += old_udil[o] * old_area[o]
             for d in range(3):
                 mean_fs[d] += old_fs[o, d]
@@ -158,9 +234,8 @@ def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, cg
         rot[2] = f2 - (f0 * k1 - f1 * k0)
         for d in range(3):
             fs[s, d] = rot[d] / atot * new_area[s]
-        un[s] = mun / atot
         udil[s] = mdil / atot
-        state[s] = st
+        state[s] = st | ST_NEW
 
 
 @njit(cache=True)

@@ -7,7 +7,9 @@ Per sub-contact s of contact c (blocks A = ca[c], B = cb[c], normal n = cn[c], A
   V   = ẋ_B + ω_B × (x − B) − ẋ_A − ω_A × (x − A)              (Eq. 15)
   ΔU  = V Δt,  ΔUⁿ = ΔU·n,  ΔUˢ = ΔU − ΔUⁿ n                   (Eqs. 20-22)
   Fˢ := Fˢ − Fˢ × (n_old × n)                                 (Eq. 23)
-  uⁿ := uⁿ + ΔUⁿ (total normal displacement, starting at the gap when the sub-contact is made)
+  uⁿ := uⁿ + ΔUⁿ (total normal displacement, starting at the sub-contact's own gap when it is
+        made; that gap already holds the last step's motion, so its first update (ST_NEW) adds
+        no increment: counting it twice made impacts engage one step, v Δt, early)
   Fⁿ  = −Kn A (uⁿ − u_dil)  (Eq. 24 integrated: compression positive, zero while open)
   Fˢ := Fˢ − Ks A ΔUˢ                                          (Eqs. 25, 27)
   intact: Tmax = −T A (Eq. 34), Fˢmax = c A + Fⁿ tan φ (Eq. 35 per ERRATA)
@@ -41,6 +43,10 @@ NPROP = 10
 ST_FAILED = 1
 ST_SLIP = 2
 ST_TENSION = 4
+#: set on a sub-contact made at a detection: its uⁿ is its own gap at the current positions,
+#: which already hold the motion of the step just taken, so its first update adds no
+#: displacement increment (cleared by that update)
+ST_NEW = 8
 
 MODEL_ELASTIC = 0
 MODEL_MOHR = 1
@@ -140,12 +146,19 @@ def subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment,
         du1 = v1 * dt
         du2 = v2 * dt
         dun = du0 * n0 + du1 * n1 + du2 * n2
+        st0 = sc_state[s]
+        if st0 & ST_NEW:
+            du0 = 0.0
+            du1 = 0.0
+            du2 = 0.0
+            dun = 0.0
+            st0 &= ~ST_NEW
         p = cprop[c]
         fn, f0, f1, f2, un, ud, u0, u1, u2, st = coulomb_one(
             p[P_KN], p[P_KS], p[P_TANF], p[P_COH], p[P_TEN], p[P_TANDIL], p[P_ZDIL],
             p[P_TANF_RES], p[P_COH_RES], p[P_TEN_RES], cmodel[c], sc_area[s],
             dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s], sc_udil[s],
-            sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], sc_state[s])
+            sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
         sc_fn[s] = fn
         sc_fs[s, 0] = f0
         sc_fs[s, 1] = f1
@@ -172,19 +185,3 @@ def subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment,
         bmoment[a, 0] -= ra1 * g2 - ra2 * g1
         bmoment[a, 1] -= ra2 * g0 - ra0 * g2
         bmoment[a, 2] -= ra0 * g1 - ra1 * g0
-
-
-@njit(cache=True)
-def rotate_shear(sc_contact, n_old, n_new, sc_fs):
-    """Eq. (23): Fˢ := Fˢ − Fˢ × (n_old × n_new), for every sub-contact (contact normals (nc, 3))."""
-    for s in range(sc_contact.shape[0]):
-        c = sc_contact[s]
-        k0 = n_old[c, 1] * n_new[c, 2] - n_old[c, 2] * n_new[c, 1]
-        k1 = n_old[c, 2] * n_new[c, 0] - n_old[c, 0] * n_new[c, 2]
-        k2 = n_old[c, 0] * n_new[c, 1] - n_old[c, 1] * n_new[c, 0]
-        f0 = sc_fs[s, 0]
-        f1 = sc_fs[s, 1]
-        f2 = sc_fs[s, 2]
-        sc_fs[s, 0] = f0 - (f1 * k2 - f2 * k1)
-        sc_fs[s, 1] = f1 - (f2 * k0 - f0 * k2)
-        sc_fs[s, 2] = f2 - (f0 * k1 - f1 * k0)

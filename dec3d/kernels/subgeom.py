@@ -149,8 +149,8 @@ def subcontacts_one(ci, ca, cb, n, c, ctol, point_area, vpos, bvstart, bvcount, 
     vs[0] = bvstart[ca]
     vs[1] = bvstart[cb]
     blk = (ca, cb)
-    nh0 = 0
-    nh1 = 0
+    nh0 = np.int64(0)   # np.int64, not a literal: a literal argument compiles the callee twice
+    nh1 = np.int64(0)
     for s in range(2):
         b = blk[s]
         nv = bvcount[b]
@@ -233,6 +233,7 @@ def _face_face(ci, n, c, p, q, ctol, vs, fvstart, fnvert, fverts, scratch, nh0, 
     nord = ints[4:6]
     ne = ints[6:8]
     nh = (nh0, nh1)
+    four = np.int64(4)
     area = clip_area(hull[0], nh0, hull[1], nh1, b1, b2)
     if area <= SLIVER * min(abs(shoelace(hull[0], nh0)), abs(shoelace(hull[1], nh1))):
         return k      # faces touching along an edge or at a corner (a sliver of round-off): none
@@ -262,7 +263,7 @@ def _face_face(ci, n, c, p, q, ctol, vs, fvstart, fnvert, fverts, scratch, nh0, 
                     loop[2, 1] = gy
                     loop[3, 0] = 0.5 * (sxy[s, v, 0] + sxy[s, vp, 0])
                     loop[3, 1] = 0.5 * (sxy[s, v, 1] + sxy[s, vp, 1])
-                    share[s, v] += clip_area(loop, 4, hull[o], nh[o], b1, b2)
+                    share[s, v] += clip_area(loop, four, hull[o], nh[o], b1, b2)
         for i in range(nord[s]):
             v = sord[s, i]
             if inside(sxy[s, v, 0], sxy[s, v, 1], hull[o], nh[o], 1.0, ctol):
@@ -336,7 +337,7 @@ def _face_face(ci, n, c, p, q, ctol, vs, fvstart, fnvert, fverts, scratch, nh0, 
     for i in range(nc):
         ea = cedge[i, 0]
         eb = cedge[i, 1]
-        k = _emit(k, out_contact, out_kind, out_key0, out_key1, out_pos, out_area, ci, K_EE,
+        k = _emit(k, out_contact, out_kind, out_key0, out_key1, out_pos, out_area, ci, np.int64(K_EE),
                   edge_code(vs[0] + edges[0, ea, 0], vs[0] + edges[0, ea, 1]),
                   edge_code(vs[1] + edges[1, eb, 0], vs[1] + edges[1, eb, 1]),
                   cxy[i, 0], cxy[i, 1], c, p, q, cshare[i] * scale)
@@ -390,7 +391,7 @@ def _points(ci, c, p, q, ctol, point_area, vs, fvstart, fnvert, fverts, scratch,
         else:
             k1 = vs[o] + e0[o]
         return _emit(k, out_contact, out_kind, out_key0, out_key1, out_pos, out_area,
-                     ci, K_PT, vs[s] + v, k1, x, y, c, p, q, point_area)
+                     ci, np.int64(K_PT), vs[s] + v, k1, x, y, c, p, q, point_area)
     if wa == 1 and wb == 1:
         # edge-edge: crossing of the lines, clamped to A's edge; parallel: mean of midpoints
         ax = sxy[0, e0[0], 0]
@@ -408,7 +409,7 @@ def _points(ci, c, p, q, ctol, point_area, vs, fvstart, fnvert, fverts, scratch,
             t = min(max(t, 0.0), 1.0)
             x = ax + t * dx1
             y = ay + t * dy1
-        return _emit(k, out_contact, out_kind, out_key0, out_key1, out_pos, out_area, ci, K_PT,
+        return _emit(k, out_contact, out_kind, out_key0, out_key1, out_pos, out_area, ci, np.int64(K_PT),
                      edge_code(vs[0] + e0[0], vs[0] + e1[0]),
                      edge_code(vs[1] + e0[1], vs[1] + e1[1]), x, y, c, p, q, point_area)
     # edge-face: the edge (from its lower row to its higher) clipped by the face polygon
@@ -440,7 +441,7 @@ def _points(ci, c, p, q, ctol, point_area, vs, fvstart, fnvert, fverts, scratch,
         x = ax + (bx - ax) * t
         y = ay + (by - ay) * t
         fo = _face_under(x, y, o, nsf, sfaces, fvstart, fnvert, fverts, vs, sxy, loop, ctol)
-        k = _emit(k, out_contact, out_kind, out_key0, out_key1, out_pos, out_area, ci, K_PT,
+        k = _emit(k, out_contact, out_kind, out_key0, out_key1, out_pos, out_area, ci, np.int64(K_PT),
                   vs[s] + (e0[s] if end == 0 else e1[s]), fo, x, y, c, p, q, point_area)
     return k
 
@@ -459,9 +460,9 @@ def subcontacts_batch(vpos, bvstart, bvcount, bfstart, bfcount, fvstart, fnvert,
     the c-p), out_area (cap,) m², ordered by contact row then kind then loop order, and
     nothing beyond cap = len(out_contact). Returns the number of sub-contacts needed.
     """
-    maxv = 1
-    maxf = 1
-    maxfv = 1
+    maxv = np.int64(1)
+    maxf = np.int64(1)
+    maxfv = np.int64(1)
     for b in range(bvstart.shape[0]):
         maxv = max(maxv, bvcount[b])
         maxf = max(maxf, bfcount[b])
@@ -470,7 +471,7 @@ def subcontacts_batch(vpos, bvstart, bvcount, bfstart, bfcount, fvstart, fnvert,
             m += fnvert[f]
         maxfv = max(maxfv, m)
     scratch = _scratch(maxv, maxf, maxfv)
-    k = 0
+    k = np.int64(0)
     for i in range(ca.shape[0]):
         k = subcontacts_one(i, ca[i], cb[i], cn[i], cc[i], ctol, point_area, vpos, bvstart,
                             bvcount, bfstart, bfcount, fvstart, fnvert, fverts, scratch, k,

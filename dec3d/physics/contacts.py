@@ -13,7 +13,8 @@ steps, default 10, and as soon as a block has moved CTOL/2 since the last one):
      from the previous plane, face snap); a pair is a contact while its gap is at most
      CTOL plus the distance its two blocks can close in one step;
   3. sub-contacts of every contact (kernel ``subgeom``), their state carried over from the
-     previous pass by identity (kernel ``contactmap.carry_over``).
+     previous pass by identity (kernel ``contactmap.carry_over``); a sub-contact without
+     a twin starts from its own gap (kernel ``contactmap.subcontact_gaps``).
   Pairs whose blocks have both moved less than QUIET·CTOL since they were last looked at
   keep their contact and sub-contacts as they are.
 
@@ -28,7 +29,7 @@ import numpy as np
 
 from dec3d.kernels.cellmap import cell_grid, cell_pairs, outside_grid
 from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, match_sorted,
-                                      vertex_point_areas)
+                                      subcontact_gaps, vertex_point_areas)
 from dec3d.kernels.jointlaw import NPROP
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.groups import group_field
@@ -289,12 +290,15 @@ class ContactDetection:
         if not live.all():
             sc_c, kind, key0, key1, pos, area = (x[live] for x in (sc_c, kind, key0, key1, pos, area))
         ns = len(sc_c)
+        sgap = np.empty(ns)
+        subcontact_gaps(sc_c, pos, f_ra, f_rb, f_n, f_gap, b["centroid"], vpos, b["face_start"],
+                        b["face_count"], f["vstart"], f["nvert"], fv["vertex"], sgap)
         fs = np.empty((ns, 3))
         un = np.empty(ns)
         udil = np.empty(ns)
         us = np.empty((ns, 3))
         state = np.empty(ns, _I)
-        carry_over(f_prev, sc_c, kind, key0, key1, area, f_gap, cs["sub_start"], cs["sub_count"], ss["kind"],
+        carry_over(f_prev, sc_c, kind, key0, key1, area, sgap, cs["sub_start"], cs["sub_count"], ss["kind"],
                    ss["key0"], ss["key1"], ss["area"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"],
                    cs["normal"], f_n, fs, un, udil, us, state)
         nf = len(fresh)

@@ -546,7 +546,9 @@ class RigidEngine(ContactDetection):
             turn = np.einsum("gij,gkj->gik", gaxes, axes0)
             gid = np.repeat(np.arange(ng), np.diff(gstart))
             pa = b["principal_axes"]
-            pa[gmember] = np.einsum("bij,bjk->bik", turn[gid], pa[gmember])
+            # re-orthonormalised (polar factor): a slightly skew frame would grow threefold per
+            # call (Q A Aᵀ A), and after ~30 `model cycle` commands Euler's equations blow up
+            pa[gmember] = _orthonormal(np.einsum("bij,bjk->bik", turn[gid], pa[gmember]))
             b["inertia"][gmember] = np.einsum("bij,bj,bkj->bik", pa[gmember], b["principal_moment"][gmember],
                                               pa[gmember])
             if mode == DAMP_ADAPTIVE:
@@ -565,6 +567,14 @@ class RigidEngine(ContactDetection):
 
 #: a step count at least this large means "no step limit" (a solve limited by time or ratio only)
 _OPEN_END = 2**60
+
+
+def _orthonormal(a: np.ndarray) -> np.ndarray:
+    """The nearest rotation to each (3, 3) matrix of ``a`` (the polar factor U Vᵀ of its SVD)."""
+    if not len(a):
+        return a
+    u, _, vt = np.linalg.svd(a)
+    return u @ vt
 
 
 class _Progress:

@@ -24,7 +24,10 @@ def _turn(f, n_old, n_new):
     return f - np.cross(f, np.cross(n_old, n_new))
 
 
-def carry_over(cprev, sc_contact, kind, key0, key1, area, cgap, old_start, old_count, old_kind, old_key0,
+NEW = 8   # the state bit of a sub-contact whose uⁿ is a freshly measured gap
+
+
+def carry_over(cprev, sc_contact, kind, key0, key1, area, sgap, old_start, old_count, old_kind, old_key0,
                old_key1, old_area, old_fs, old_un, old_udil, old_us, old_state, old_n, new_n):
     ns = len(sc_contact)
     fs, us = np.zeros((ns, 3)), np.zeros((ns, 3))
@@ -32,7 +35,8 @@ def carry_over(cprev, sc_contact, kind, key0, key1, area, cgap, old_start, old_c
     for s in range(ns):
         c = sc_contact[s]
         p = cprev[c]
-        un[s] = cgap[c]
+        un[s] = sgap[s]          # no twin: its own gap, first increment already in it
+        state[s] = NEW
         if p < 0:
             continue
         olds = list(range(old_start[p], old_start[p] + old_count[p]))
@@ -48,9 +52,8 @@ def carry_over(cprev, sc_contact, kind, key0, key1, area, cgap, old_start, old_c
         if atot <= 0:
             continue
         fs[s] = _turn(sum(old_fs[o] for o in olds), old_n[p], new_n[c]) / atot * area[s]
-        un[s] = sum(old_un[o] * old_area[o] for o in olds) / atot
         udil[s] = sum(old_udil[o] * old_area[o] for o in olds) / atot
-        state[s] = int(np.bitwise_or.reduce([old_state[o] & 1 for o in olds]))
+        state[s] = int(np.bitwise_or.reduce([old_state[o] & 1 for o in olds])) | NEW
     return fs, un, udil, us, state
 
 

@@ -56,9 +56,9 @@ def test_carry_over_against_twin(seed):
     key0 = rng.integers(0, 5, 30)
     key1 = rng.integers(0, 3, 30)
     area = rng.uniform(0.1, 1.0, 30)
-    cgap = rng.normal(size=nnew) * 1e-3
+    sgap = rng.normal(size=30) * 1e-3
     out = (np.empty((30, 3)), np.empty(30), np.empty(30), np.empty((30, 3)), np.empty(30, np.int64))
-    args = (cprev, sc_contact, kind, key0, key1, area, cgap, old_start, old_count, old_kind, old_key0, old_key1,
+    args = (cprev, sc_contact, kind, key0, key1, area, sgap, old_start, old_count, old_kind, old_key0, old_key1,
             old_area, old_fs, old_un, old_udil, old_us, old_state, old_n, new_n)
     carry_over(*args, *out)
     want = ref.carry_over(*args)

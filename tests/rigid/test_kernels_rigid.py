@@ -6,7 +6,7 @@ import pytest
 
 from dec3d.kernels.commonplane import (CT_EE, CT_EF, CT_FF, CT_VE, CT_VF, CT_VV, common_plane,
                                        contact_type)
-from dec3d.kernels.jointlaw import NPROP, coulomb_one, rotate_shear
+from dec3d.kernels.jointlaw import NPROP, coulomb_one
 from dec3d.kernels.motion import block_timestep, rigid_motion
 from reference.commonplane_ref import best_plane
 from reference.rigid_ref import coulomb_ref, hull_distance, rotate_rodrigues
@@ -152,15 +152,6 @@ def test_coulomb_kernel_matches_scalar_reference():
             assert ud == pytest.approx(rud, rel=1e-12, abs=1e-15)
             if model == "mohr":
                 assert bool(st & 1) == rfail
-
-
-def test_rotate_shear_eq23_keeps_shear_in_plane():
-    n_old = np.array([[0.0, 0.0, 1.0]])
-    t = math.radians(0.5)
-    n_new = np.array([[math.sin(t), 0.0, math.cos(t)]])
-    fs = np.array([[100.0, 20.0, 0.0]])
-    rotate_shear(np.array([0]), n_old, n_new, fs)
-    assert abs(fs[0] @ n_new[0]) < 100 * t * t
 
 
 def test_motion_free_spin_is_rigid_and_matches_cayley_rotation():

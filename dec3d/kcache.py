@@ -1,0 +1,168 @@
+"""The guard of the numba kernels' on-disk cache (``dec3d/kernels``); run by ``dec3d/__init__``
+before any kernel module is imported (the kernels themselves import only numpy, numba, math).
+
+Numba's ``cache=True`` keys a cached kernel on its own source file only: a kernel compiled
+into another (``cycle.run_steps`` holds ``jointlaw`` and ``motion``; ``contactmap.cp_batch``
+holds ``commonplane``; ``subgeom`` holds ``polygon2d``) keeps the callee's old code after the
+callee's file changes. So, at the import of ``dec3d`` (``guard``):
+
+1. ``cache_dir()`` is where numba will write the caches of these files: ``NUMBA_CACHE_DIR``
+   when the user set it, else ``__pycache__`` beside the sources when it is writable, else
+   (a read-only install) ``NUMBA_CACHE_DIR`` is pointed at a per-user folder
+   (``$XDG_CACHE_HOME`` or ``~/.cache``, ``dec3d/numba``), else at a fresh temporary folder
+   (kernels then compile in every process, nothing is kept);
+2. ``source_hash()`` is the SHA-256 of every ``*.py`` of this package (names and contents)
+   with the numba and Python versions; it is kept in ``STAMP`` in that folder. When it
+   differs, every cached kernel of the package (``*.nbi``, ``*.nbc``) there is deleted
+   (``clear_stale``) and the new hash is written: one kernel edited → all recompile once.
+3. Cold start: when no cached kernel index is there (``is_cold``), the first compilation of a
+   dec3d kernel in the process prints one line on stderr (``NOTICE``).
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent / "kernels"
+#: file in the cache folder holding the source hash the cached kernels were built from
+STAMP = "dec3d-kernels.sha256"
+NOTICE = "dec3d: compiling kernels, first run only (a few seconds to a minute) …"
+
+
+def source_hash(folder: Path = HERE) -> str:
+    """SHA-256 over the names and contents of ``folder/*.py`` (sorted by name), numba's and
+    Python's versions."""
+    import numba
+
+    h = hashlib.sha256()
+    h.update(f"numba {numba.__version__} python {sys.version_info[:2]}\n".encode())
+    for p in sorted(folder.glob("*.py")):
+        h.update(p.name.encode() + b"\0")
+        h.update(p.read_bytes())
+        h.update(b"\0")
+    return h.hexdigest()
+
+
+def _writable(d: Path) -> bool:
+    try:
+        d.mkdir(parents=True, exist_ok=True)
+        tempfile.TemporaryFile(dir=d).close()
+        return True
+    except OSError:
+        return False
+
+
+def _subpath(folder: Path) -> str:
+    """The folder numba uses under a cache root for sources in ``folder`` (numba's
+    ``_CacheLocator.get_suitable_cache_subpath``: parent name + SHA-1 of the path)."""
+    sub = os.path.abspath(folder)
+    return "_".join([os.path.split(sub)[-1], hashlib.sha1(sub.encode()).hexdigest()])
+
+
+def cache_dir(folder: Path = HERE, config=None) -> Path:
+    """Where numba caches the kernels of ``folder``; points numba's ``CACHE_DIR`` at a
+    per-user (else a temporary) folder when the sources' own ``__pycache__`` is read-only.
+    ``config``: numba's config module (a stand-in in tests)."""
+    if config is None:
+        from numba.core import config
+    if config.CACHE_DIR:
+        return Path(config.CACHE_DIR) / _subpath(folder)
+    tree = folder / "__pycache__"
+    if _writable(tree):
+        return tree
+    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "dec3d" / "numba"
+    if not _writable(base / _subpath(folder)):
+        base = Path(tempfile.mkdtemp(prefix="dec3d-numba-"))
+    config.CACHE_DIR = str(base)
+    return base / _subpath(folder)
+
+
+def _module_names(folder: Path) -> set[str]:
+    return {p.stem for p in folder.glob("*.py")}
+
+
+def clear_stale(cdir: Path, digest: str, folder: Path = HERE) -> bool:
+    """Delete the cached kernels of ``folder``'s modules in ``cdir`` unless ``cdir/STAMP``
+    holds ``digest``; then write it. Returns True when something was stale (or no stamp).
+    A folder that cannot be written is left alone (numba then finds no usable cache)."""
+    stamp = cdir / STAMP
+    try:
+        if stamp.read_text().strip() == digest:
+            return False
+    except OSError:
+        pass
+    mods = _module_names(folder)
+    try:
+        cdir.mkdir(parents=True, exist_ok=True)
+        for p in cdir.iterdir():
+            if p.suffix in (".nbi", ".nbc") and p.name.split(".", 1)[0] in mods:
+                p.unlink()
+        tmp = cdir / f"{STAMP}.{os.getpid()}"
+        tmp.write_text(digest + "\n")
+        os.replace(tmp, stamp)
+    except OSError:
+        pass
+    return True
+
+
+def is_cold(cdir: Path, folder: Path = HERE) -> bool:
+    """True when no kernel of ``folder`` has a cache index (``*.nbi``) in ``cdir``."""
+    mods = _module_names(folder)
+    try:
+        return not any(p.suffix == ".nbi" and p.name.split(".", 1)[0] in mods for p in cdir.iterdir())
+    except OSError:
+        return True
+
+
+def _notice_listener(stream=None, package="dec3d.kernels"):
+    """A ``_ColdNotice`` that is a numba event ``Listener`` (numba imported only here)."""
+    from numba.core.event import Listener
+
+    cls = type("ColdNotice", (_ColdNotice, Listener), {})
+    return cls(stream, package)
+
+
+class _ColdNotice:
+    """numba "compile" event listener: prints ``NOTICE`` once, at the first compilation of a
+    kernel of package ``package`` (compilations only: loads from the cache raise no event)."""
+
+    def __init__(self, stream=None, package="dec3d.kernels"):
+        self.stream = stream
+        self.package = package
+        self.shown = False
+
+    def on_start(self, event):
+        if self.shown:
+            return
+        disp = (event.data or {}).get("dispatcher")
+        mod = getattr(getattr(disp, "py_func", None), "__module__", "") or ""
+        if not mod.startswith(self.package):
+            return
+        self.shown = True
+        stream = self.stream or sys.stderr
+        try:
+            stream.write(NOTICE + "\n")
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+
+    def on_end(self, event):
+        pass
+
+
+def guard(folder: Path = HERE, package: str = "dec3d.kernels") -> None:
+    """Clear stale cached kernels of ``folder`` (module ``package``) and arm the cold-start
+    notice; nothing when numba's JIT is disabled."""
+    from numba.core import config
+
+    if config.DISABLE_JIT:
+        return
+    cdir = cache_dir(folder)
+    clear_stale(cdir, source_hash(folder), folder)
+    if is_cold(cdir, folder):
+        from numba.core import event as ev
+
+        ev.register("numba:compile", _notice_listener(package=package))
