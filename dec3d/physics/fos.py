@@ -45,31 +45,46 @@ class FosResult:
 
 
 def bracket_fos(trial, lo: float | None = None, hi: float | None = None,
-                resolution: float = DEFAULT_RESOLUTION) -> FosResult:
+                resolution: float = DEFAULT_RESOLUTION, points: int = 1, run_many=None) -> FosResult:
     """Find the factor of safety with ``trial(F) -> bool`` (True: stable at strengths / F).
 
     With ``lo``/``hi`` (the `bracket`), ``lo`` must be stable and ``hi`` unstable, else
     ``FosError`` says on which side the factor of safety lies. Without them F = 1 is tried and
     doubled (stable) or halved (unstable) until the other state is met (at most MAX_DOUBLINGS
-    times). Then the bracket is halved while it is wider than ``resolution``. The trials are
-    run one after the other; the result depends only on ``trial``.
+    times). Then, while the bracket [s, u] is wider than ``resolution``, each round tries the
+    ``points`` factors s + (u − s) i / (points + 1), i = 1..points (1: bisection) and keeps the
+    lowest unstable one and the highest stable one below it. ``run_many(list of F) -> list of
+    bool`` runs the factors of one round (in parallel, say; default: ``trial`` on each in turn):
+    the factors tried depend only on ``points`` and the answers, never on how a round is run.
     """
     if resolution is None or not resolution > 0.0:
         raise FosError(f"the resolution must be > 0 (got {resolution!r})")
+    if int(points) < 1:
+        raise FosError(f"the trials per round must be at least 1 (got {points!r})")
+    points = int(points)
     runs: list[tuple[float, bool]] = []
+    many = run_many if run_many is not None else (lambda fs: [bool(trial(f)) for f in fs])
+
+    def run_round(fs: list[float]) -> list[bool]:
+        oks = [bool(x) for x in many(list(fs))]
+        runs.extend(zip(fs, oks))
+        return oks
 
     def run(f: float) -> bool:
-        ok = bool(trial(f))
-        runs.append((f, ok))
-        return ok
+        return run_round([f])[0]
 
     if lo is not None or hi is not None:
         if lo is None or hi is None or not (0.0 < lo < hi):
             raise FosError(f"the bracket must be two factors 0 < lo < hi (got {lo!r} {hi!r})")
-        if not run(lo):
+        if points > 1:
+            ok_lo, ok_hi = run_round([lo, hi])
+        else:
+            ok_lo = run(lo)
+            ok_hi = run(hi) if ok_lo else False
+        if not ok_lo:
             raise FosError(f"the model is unstable at the lower bracket F = {lo:g}: the factor of safety is "
                            f"below the bracket")
-        if run(hi):
+        if ok_hi:
             raise FosError(f"the model is stable at the upper bracket F = {hi:g}: the factor of safety is "
                            f"above the bracket")
         s, u = lo, hi
@@ -96,11 +111,13 @@ def bracket_fos(trial, lo: float | None = None, hi: float | None = None,
                 raise FosError(f"the model is still unstable at F = {f:g}: the factor of safety is below it")
             s = f
     while u - s > resolution:
-        mid = 0.5 * (s + u)
-        if run(mid):
-            s = mid
-        else:
-            u = mid
+        fs = [s + (u - s) * i / (points + 1) for i in range(1, points + 1)]
+        oks = run_round(fs)
+        first_bad = next((i for i, ok in enumerate(oks) if not ok), None)
+        if first_bad is not None:
+            u = fs[first_bad]
+            oks, fs = oks[:first_bad], fs[:first_bad]
+        s = max([s] + [f for f, ok in zip(fs, oks) if ok])
     return FosResult(fs=s, stable=s, unstable=u, trials=runs)
 
 
@@ -203,3 +220,59 @@ class ContactStrengthTrials:
     def finish(self) -> None:
         self._reset()
         self.e.step_hooks = self.hooks
+
+
+def _trial_from_file(path: str, rows: np.ndarray, all_contacts: bool, associated: bool, steps: int,
+                     ratio: float, factor: float) -> tuple[bool, int, float]:
+    """One trial on a model read from the state file ``path`` (in this process or a worker process):
+    (stable?, steps, final ratio). The same file and factor give the same numbers in any process."""
+    from dec3d.io.state import restore_state
+    from dec3d.physics.rigid import engine
+
+    model, _ = restore_state(path)
+    e = engine(model)
+    e.ensure_contacts()
+    mask = None
+    if not all_contacts:
+        mask = np.zeros(e.contacts.n, dtype=bool)
+        mask[rows] = True
+    t = ContactStrengthTrials(e, mask, associated=associated, steps=steps, ratio=ratio)
+    ok = t(factor)
+    _, _, done, r = t.log[-1]
+    return ok, done, r
+
+
+class FileTrials:
+    """The trials of one round run on copies of the model read from a state file written once
+    (``dec3d.io.state.save_state``), by ``workers`` processes (1: in this process, one after the
+    other). Every trial, whichever process runs it, starts from the same file, so the answers do
+    not depend on the number of workers. ``log`` gets (F, stable, steps, ratio) like
+    ``ContactStrengthTrials.log``."""
+
+    def __init__(self, path: str, trials: ContactStrengthTrials, workers: int = 1):
+        self.path = str(path)
+        self.args = (trials.rows.copy(), trials.all_contacts, trials.associated, trials.steps, trials.ratio)
+        self.workers = max(1, int(workers))
+        self.log: list[tuple[float, bool, int, float]] = []
+        self._pool = None
+
+    def __call__(self, fs: list[float]) -> list[bool]:
+        if self.workers > 1 and len(fs) > 1:
+            if self._pool is None:
+                import multiprocessing
+                from concurrent.futures import ProcessPoolExecutor
+
+                self._pool = ProcessPoolExecutor(max_workers=self.workers,
+                                                 mp_context=multiprocessing.get_context("fork"))
+            futures = [self._pool.submit(_trial_from_file, self.path, *self.args, f) for f in fs]
+            out = [fu.result() for fu in futures]
+        else:
+            out = [_trial_from_file(self.path, *self.args, f) for f in fs]
+        for f, (ok, done, r) in zip(fs, out):
+            self.log.append((float(f), bool(ok), int(done), float(r)))
+        return [ok for ok, _, _ in out]
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None

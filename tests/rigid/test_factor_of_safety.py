@@ -183,3 +183,43 @@ def test_bad_input_names_file_and_line(session):
         _run(session, "model factor-of-safety bracket 1.6 2.0 cycles 2000\n")
     assert e.value.location.line == 1 and "factor of safety is below the bracket" in str(e.value)
     _same(before, _state(session.model))
+
+
+@pytest.mark.parametrize("points", [2, 3, 5])
+def test_rounds_of_several_points_find_the_threshold(points):
+    threshold = 1.2345
+    rounds = []
+
+    def run_many(fs):
+        rounds.append(list(fs))
+        return [f <= threshold for f in fs]
+
+    res = bracket_fos(None, 0.25, 4.0, resolution=0.001, points=points, run_many=run_many)
+    assert res.stable <= threshold < res.unstable and res.unstable - res.stable <= 0.001
+    assert rounds[0] == [0.25, 4.0]                                  # both bracket ends in one round
+    assert all(len(r) == points for r in rounds[1:])
+    assert rounds[1] == pytest.approx([0.25 + 3.75 * i / (points + 1) for i in range(1, points + 1)])
+    # each round shrinks the bracket points + 1 times: ceil(log(3750) / log(points + 1)) rounds
+    assert len(rounds) - 1 == math.ceil(math.log(3750) / math.log(points + 1))
+
+
+def test_parallel_rounds_do_not_depend_on_the_worker_count(session, tmp_path):
+    _run(session, INCLINE)
+    before = _state(session.model)
+    line = "model factor-of-safety bracket 1.3 1.6 resolution 0.01 cycles 3000 trials-per-round 3 workers {}\n"
+    n0 = len(session.output.getvalue())
+    _run(session, line.format(1))
+    n1 = len(session.output.getvalue())
+    one = session.output.getvalue()[n0:n1]
+    _same(before, _state(session.model))
+    _run(session, line.format(2))
+    two = session.output.getvalue()[n1:]
+    _same(before, _state(session.model))
+    trials = lambda text: [ln for ln in text.splitlines() if ln.startswith("  F = ")]  # noqa: E731
+    assert trials(one) and trials(one) == trials(two)                # same factors, steps and ratios
+    assert session.results["fos.1"] == session.results["fos.2"]
+    assert abs(session.results["fos"] - FS_INCLINE) / FS_INCLINE < 0.01
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fos_mechanism.vtu"]   # the state file is gone
+    with pytest.raises(BindError) as e:
+        session.load_text("model factor-of-safety trials-per-round 0\n")
+    assert e.value.location.line == 1
