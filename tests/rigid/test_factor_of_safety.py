@@ -176,6 +176,9 @@ def test_bad_input_names_file_and_line(session):
         _run(session, elastic + "model factor-of-safety\n")
     assert e.value.location.line == 10 and "no contact has the `mohr` joint model" in str(e.value)
     assert "fos" not in session.results
+    with pytest.raises(CommandError) as e:
+        _run(session, INCLINE + "model factor-of-safety range position-z 50 60\n")
+    assert e.value.location.line == 10 and "no contact in range has the `mohr` joint model" in str(e.value)
     # a bracket that misses: an error at the line, the model as it was
     _run(session, INCLINE)
     before = _state(session.model)
@@ -223,3 +226,11 @@ def test_parallel_rounds_do_not_depend_on_the_worker_count(session, tmp_path):
     with pytest.raises(BindError) as e:
         session.load_text("model factor-of-safety trials-per-round 0\n")
     assert e.value.location.line == 1
+
+
+def test_a_range_reduces_only_the_contacts_in_it(session):
+    """The base contact (z = 0) in range: the same factor as without a range; a range that holds it out of
+    the reduction would never make the block slide."""
+    _run(session, INCLINE + "model factor-of-safety bracket 1.3 1.6 resolution 0.005 cycles 3000 "
+                            "range position-z -0.1 0.1\n")
+    assert abs(session.results["fos"] - FS_INCLINE) / FS_INCLINE < 0.01
