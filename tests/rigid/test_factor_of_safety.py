@@ -229,8 +229,8 @@ def test_parallel_rounds_do_not_depend_on_the_worker_count(session, tmp_path):
 
 
 def test_a_range_reduces_only_the_contacts_in_it(session):
-    """The base contact (z = 0) in range: the same factor as without a range; a range that holds it out of
-    the reduction would never make the block slide."""
+    """The base contact (z = 0) in range: the same factor as without a range (the contacts in range are
+    reduced and kept reduced through re-detection; the material-table defaults are not touched)."""
     _run(session, INCLINE + "model factor-of-safety bracket 1.3 1.6 resolution 0.005 cycles 3000 "
                             "range position-z -0.1 0.1\n")
     assert abs(session.results["fos"] - FS_INCLINE) / FS_INCLINE < 0.01
