@@ -12,7 +12,7 @@ from .registry import REGISTRY, RangeElement
 from .values import Num, P, Text
 
 _GROUPS = {
-    "model": "calm clean configure creep cycle deterministic domain dynamic energy factor-of-safety fluid gravity "
+    "model": "calm clean configure creep cycle deterministic domain dynamic energy fluid gravity "
              "history large-strain list mechanical new orientation-tracking precision random range restore "
              "result save solve step thermal title update-interval",
     "program": "call continue directory echo echo-line encrypt exit floating-point-check license list load log "
