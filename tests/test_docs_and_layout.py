@@ -50,6 +50,7 @@ BASE = {"errors", "config"}                      # imported by every layer
 MAY_IMPORT = {
     "errors": set(),
     "config": set(),
+    "kcache": set(),                             # run by dec3d/__init__ before any kernel loads
     "kernels": {"config"},                       # and numpy, numba, math only (next test)
     "lang": {"errors"},                          # knows no commands
     "geometry": BASE | {"kernels"},

@@ -571,10 +571,13 @@ _OPEN_END = 2**60
 
 def _orthonormal(a: np.ndarray) -> np.ndarray:
     """The nearest rotation to each (3, 3) matrix of ``a`` (the polar factor U Vᵀ of its SVD)."""
-    if not len(a):
+    ok = np.isfinite(a).all(axis=(1, 2))       # a blown-up run is rolled back; leave its NaN frames alone
+    if not ok.any():
         return a
-    u, _, vt = np.linalg.svd(a)
-    return u @ vt
+    out = a.copy()
+    u, _, vt = np.linalg.svd(a[ok])
+    out[ok] = u @ vt
+    return out
 
 
 class _Progress:
