@@ -95,12 +95,11 @@ class BindContext:
             self.fish_variables.setdefault(v, block.name)
 
     def classify(self, name: str) -> str | None:
-        if name in self.fish_functions:
-            return "fish-function"
-        if name in self.assigned or name in self.session_variables:
+        # FISH functions and the variables their bodies set are run by dec3d.fish
+        if name in self.fish_functions or name in self.assigned or name in self.session_variables:
             return None
         if name in self.fish_variables:
-            return "fish-variable"
+            return None
         return None if self.lenient_names else "undefined"
 
 
@@ -136,6 +135,8 @@ class Binder:
         problems = check_names(node, self.ctx.classify)
         for kind, name, col in problems:
             if node[0] == "assign" and kind == "undefined" and name == node[1]:
+                continue
+            if kind in ("intrinsic", "unknown-function") and _fish_knows(name, self.ctx):
                 continue
             self._raise_name_problem(kind, name, tok, tok.column + col)
         return node
@@ -462,6 +463,13 @@ class Binder:
         i = self._bind_params(what, elem.positional, names, by_name, toks, i, args, [], {}, other)
         self._fill_defaults(what, elem.positional + elem.keywords, args, toks)
         return args, i
+
+
+def _fish_knows(name: str, ctx: BindContext) -> bool:
+    """A name dec3d's FISH runs: a FISH function of the deck or an implemented intrinsic."""
+    from ..fish import intrinsics
+
+    return name in ctx.fish_functions or intrinsics.resolve(name) is not None
 
 
 class LegacySyntaxError(BindError):
