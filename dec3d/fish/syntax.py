@@ -127,17 +127,46 @@ def tokenize_line(src: FishSource, line: int, text: str) -> tuple[list[Tok], boo
     return toks, cont
 
 
+_CMD_COMMENT = re.compile(r""";(?=(?:[^'"]|'[^']*'|"[^"]*")*$).*""")
+_CMD_CONT = re.compile(r"(?:&|\.\.\.)\s*$")
+
+
 def logical_lines(src: FishSource) -> list[list[Tok]]:
+    """Token lines; lines of a `command ... endcommand` section are kept raw (one `raw` token
+    per physical line), to be read later by the deck reader."""
     out: list[list[Tok]] = []
     current: list[Tok] = []
+    in_command = False
     for k, text in enumerate(src.lines):
         line = src.first_line + k
+        if in_command and not current:
+            bare = _CMD_COMMENT.sub("", text).strip()
+            word = bare.split()[0].lower() if bare.split() else ""
+            if word in ("endcommand", "end_command"):
+                in_command = False
+            elif not bare:
+                continue
+            else:
+                raw = [Tok("raw", text, line, 1, text)]
+                if _CMD_CONT.search(bare):
+                    current = raw
+                else:
+                    out.append(raw)
+                continue
+        elif in_command and current:
+            current.append(Tok("raw", text, line, 1, text))
+            if not _CMD_CONT.search(_CMD_COMMENT.sub("", text).strip()):
+                out.append(current)
+                current = []
+            continue
         toks, cont = tokenize_line(src, line, text)
         current.extend(toks)
         if cont:
             continue
         if current:
             out.append(current)
+            if len(current) == 1 and current[0].is_word("command"):
+                in_command = True
         current = []
     if current:
         out.append(current)
