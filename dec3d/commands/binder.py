@@ -158,11 +158,10 @@ class Binder:
         if kind == "intrinsic":
             raise NotSupportedError(f"FISH intrinsic `{name}` is not supported yet", loc)
         if kind == "unknown-function":
-            raise NotSupportedError(f"`{name}` is not a FISH intrinsic dec3d knows; FISH functions are not supported yet", loc,
-                                    hint="dec3d evaluates math.*, string(), string.build(), io.out() in [ ]")
+            raise NotSupportedError(f"`{name}` is neither a FISH function of the deck nor a FISH intrinsic dec3d "
+                                    "knows", loc, hint="define the function with `fish define` before this line")
         if at:
-            raise NotSupportedError(f"`@{name}` is neither a variable set earlier nor a known value; "
-                                    "FISH functions are not supported yet", loc)
+            raise NotSupportedError(f"`@{name}` is neither a variable set earlier nor a FISH function", loc)
         raise BindError(f"undefined FISH variable `{name}`", loc, hint="assign it first, e.g. [name = 1.0]")
 
     # ------------------------------------------------------------ commands

@@ -72,7 +72,8 @@ def lift_fish(text: str, filename: str) -> tuple[str, list[FishBlock]]:
         for b in body_lines:
             g = _GLOBAL.match(b)
             if g:
-                variables.update(v.strip().lower() for v in g.group(1).split(";")[0].split(",") if v.strip())
+                variables.update(v.split("=")[0].strip().lower() for v in g.group(1).split(";")[0].split(",")
+                                 if v.split("=")[0].strip())
                 continue
             a = _ASSIGN.match(b)
             if a:
