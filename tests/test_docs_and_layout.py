@@ -49,6 +49,7 @@ LAYERS = {  # module -> packages of dec3d it must not import
     "model": {"commands", "lang", "session", "repl", "cli"},
     "geometry": {"commands", "lang", "session", "repl", "cli"},
     "physics": {"commands", "lang", "session", "repl", "cli"},
+    "fish": {"session", "repl", "cli", "kernels"},
 }
 
 
