@@ -175,7 +175,7 @@ class Binder:
                 self.ctx.assigned.add(node[1])   # later lines may use the variable
             return ExprStatement(node, self.deck.location(first, self.stack), self.source(raw))
         if len(toks) == 1 and first.type == "ATNAME":
-            self.deferred(first)                 # a FISH function call raises "not supported yet"
+            self.deferred(first)                 # checks the name; a FISH function is called when it runs
             return ExprStatement(("name", str(first)[1:].lower(), 1), self.deck.location(first, self.stack),
                                  str(first))
         return self.bind(raw)
@@ -184,8 +184,9 @@ class Binder:
         toks = raw.tokens
         first = toks[0]
         if first.type == "ATNAME":
-            self.deferred(first)          # a FISH function: raises "not supported yet"
-            raise NotSupportedError(f"FISH function calls (`{first}(...)`) are not supported yet", self.where(first))
+            self.deferred(first)
+            raise NotSupportedError(f"`{first}` followed by more words is not supported yet: write `[f(args)]` "
+                                    "to call a FISH function with arguments", self.where(first))
         if first.type != "WORD":
             raise BindError(f"a command starts with a command word, not {str(first)!r}", self.where(first),
                             hint="`[ ... ]` and `@name` stand alone on a line or as values")

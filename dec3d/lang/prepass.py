@@ -1,8 +1,8 @@
 """Pre-pass over deck text: lift `fish define ... end` blocks out of the command stream.
 
 FISH bodies have a syntax of their own (if/loop/local/command...endcommand) that the
-line grammar does not describe. They are kept as raw text for a later FISH
-interpreter; their lines are blanked (not removed) so every other line keeps its
+line grammar does not describe. They are kept as raw text for dec3d.fish, which
+parses and compiles them; their lines are blanked (not removed) so every other line keeps its
 true line number. 3DEC accepts `def` as an abbreviation of `define` and, in data
 files, a bare `define`/`def` opening a function (3DEC 7 manual, "FISH in data files").
 """
