@@ -128,6 +128,9 @@ class Binder:
         try:
             node = parse_expression(text)
         except DeckSyntaxError as exc:
+            fish = _fish_inline(text)        # FISH syntax beyond expr.lark (v->x, ::list); run by dec3d.fish
+            if fish is not None:
+                return fish
             col = tok.column + getattr(exc, "column_in_expr", 1)
             loc = self.deck.location(tok, self.stack)
             raise DeckSyntaxError(exc.message, SourceLocation(loc.file, loc.line, col, loc.text, 1, loc.stack),
@@ -463,6 +466,20 @@ class Binder:
         i = self._bind_params(what, elem.positional, names, by_name, toks, i, args, [], {}, other)
         self._fill_defaults(what, elem.positional + elem.keywords, args, toks)
         return args, i
+
+
+def _fish_inline(text: str):
+    """A tree for an inline fragment only dec3d.fish reads: ("assign", name, ...) for an assignment
+    (so later lines may use the name), ("fish", text) otherwise; None if FISH cannot parse it either."""
+    from ..fish import FishSource, parse_inline
+
+    try:
+        node, _ = parse_inline(text, FishSource("<inline>", 1, [text]))
+    except Exception:
+        return None
+    if node[0] == "assign" and node[1][0] == "name":
+        return ("assign", node[1][1], node[2], ("fish", text), 0)
+    return ("fish", text)
 
 
 def _fish_knows(name: str, ctx: BindContext) -> bool:

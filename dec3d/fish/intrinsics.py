@@ -437,3 +437,5 @@ def _mech_time_total(rt):
 @intrinsic("global.title")
 def _title(rt):
     return rt.session.model.settings.title
+
+from . import block_intrinsics  # noqa: E402,F401  (registers block.*)
