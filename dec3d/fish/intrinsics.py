@@ -439,3 +439,4 @@ def _title(rt):
     return rt.session.model.settings.title
 
 from . import block_intrinsics  # noqa: E402,F401  (registers block.*)
+from . import table_intrinsics  # noqa: E402,F401  (registers table.*)

@@ -91,6 +91,7 @@ class FishRuntime:
         self.callstack: list = []
         self.inline_cache: dict = {}
         self.command_scope: list = []        # (closures by id(deferred), frame) while a command section runs
+        self.tables: dict = {}               # FISH tables by id (table_intrinsics)
 
     @property
     def globals(self) -> dict:
@@ -157,6 +158,7 @@ class FishRuntime:
     def clear(self) -> None:
         self.functions.clear()
         self.inline_cache.clear()
+        self.tables.clear()
         self.auto_create = True
 
 

@@ -205,3 +205,12 @@ class _StopNow:
         from dec3d.fish import request_stop
         request_stop()
         return 0
+
+
+def test_tables_as_the_elastic_hole_deck_fills_them(session):
+    out = run(session, "fish define fill\n local t = table.get(1)\n table.label(t) = 'analytic'\n"
+                       " table(t, 2.0) = 20\n table(t, 1.0) = 10\n table(t, 2.0) = 40\n"
+                       " io.out(table.size(t))\n io.out(table(t, 1.5))\n io.out(table(1, 9))\n"
+                       " io.out(table.label(1))\nend\n@fill")
+    # points (1, 10) and (2, 40) after the replacement: halfway 25, beyond the end the last value
+    assert out == ["2", "25.0", "40.0", "analytic"]
