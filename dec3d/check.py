@@ -6,12 +6,13 @@ same binder, the same FISH-name bookkeeping and the same resolution of called fi
 ``Session``) but goes on after a bad line and reports every line, in the file it is in:
 
 - runnable: the line binds and its command runs;
-- does nothing: read but without effect (`plot …`, which is display only; a `fish define`
-  block, kept but never run because FISH functions are not supported yet; lines after a
+- does nothing: read but without effect (`plot …`, which is display only; lines after a
   `program return`, which are never read);
 - not supported yet: a 3DEC command or FISH feature dec3d knows but does not implement (this
   stops a run);
 - legacy syntax: 3DEC 5 syntax (stops a run);
+- a `fish define` is compiled as the run compiles it: runnable, or not supported yet when it
+  uses FISH intrinsics dec3d lacks (they fail when the function is called), or legacy syntax;
 - error: anything else that stops a run (a called file that is missing, an undefined FISH name,
   a bad keyword or value).
 
@@ -69,9 +70,11 @@ class _Walker:
                  col)
 
     def fish(self, deck, block):
+        """A `fish define`: parsed, its command lines bound and its body compiled, as `dec3d run`
+        does when it reads the deck (nothing runs)."""
         self.ctx.define_fish(block)
-        self.add(deck, block.line, DOES_NOTHING,
-                 f"fish define {block.name}: kept, never run (FISH functions are not supported yet)")
+        for r in _check_fish(block, deck, self.ctx):
+            self.add(deck, r.line, r.status, r.what)
 
     def walk(self, text: str, filename: str, base_dir: Path, stack: tuple[SourceLocation, ...] = ()) -> None:
         deck = parse_deck(text, filename, stack)
@@ -136,6 +139,94 @@ class _Walker:
             return
         self.add(deck, raw.line, RUNNABLE, f"program call: reads {target}")
         self.walk(text, str(target), target.parent, stack + (item.location,))
+
+
+def _check_fish(block, deck, ctx) -> list[LineReport]:
+    """A `fish define`: parsed, its command lines bound and its body compiled (nothing runs).
+    Intrinsics dec3d does not implement make it "not supported yet", naming them."""
+    from .fish import FishRuntime, compile_function, parse_block
+    from .fish.compiler import _deferreds  # noqa: F401  (the compiler walks bound lines itself)
+
+    what = f"fish define {block.name}"
+    out: list[LineReport] = []
+    try:
+        fdef = parse_block(block, deck.filename, deck.source_lines)
+    except LegacySyntaxError as exc:
+        return [LineReport(exc.location.line if exc.location else block.line, LEGACY, exc.message)]
+    except NotSupportedError as exc:
+        return [LineReport(block.line, NOT_SUPPORTED, exc.message)]
+    except Dec3dError as exc:
+        return [LineReport(exc.location.line if exc.location else block.line, ERROR, exc.format())]
+    bound = {}
+    sub_ctx = BindContext({}, lenient_names=True)
+    sub_ctx.fish_functions.update(ctx.fish_functions)
+    for node in fdef.commands:
+        items = []
+        for first, last in node[1]:
+            text = "\n" * (first - 1) + "\n".join(deck.source_lines[first - 1:last])
+            sub = parse_deck(text, deck.filename)
+            binder = Binder(sub, sub_ctx)
+            for raw in sub.lines:
+                try:
+                    item = binder.bind_line(raw)
+                    items.append(item)
+                    name = item.name if isinstance(item, CommandCall) else item.source
+                    out.append(LineReport(raw.line, RUNNABLE, name))
+                except LegacySyntaxError as exc:
+                    out.append(LineReport(raw.line, LEGACY, exc.message))
+                except NotSupportedError as exc:
+                    out.append(LineReport(raw.line, NOT_SUPPORTED, exc.message))
+                except Dec3dError as exc:
+                    out.append(LineReport(raw.line, ERROR, exc.format()))
+        bound[id(node)] = items
+
+    class _Quiet:
+        variables: dict = {}
+
+        def write(self, text):
+            pass
+
+    rt = FishRuntime(_Quiet())
+    try:
+        fn = compile_function(rt, fdef, bound)
+    except Dec3dError as exc:
+        return out + [LineReport(exc.location.line if exc.location else block.line, ERROR, exc.format())]
+    legacy = sorted(n for n in _called_names(fdef.body) if n in LEGACY_FISH and n not in ctx.fish_functions)
+    if legacy:
+        hints = "; ".join(f"`{n}` -> {LEGACY_FISH[n]}" for n in legacy)
+        return out + [LineReport(block.line, LEGACY, f"{what} uses 3DEC 5 (legacy) FISH intrinsics: {hints}")]
+    if fn.unsupported:
+        names = ", ".join(f"`{n}`" for n in sorted(fn.unsupported))
+        return out + [LineReport(block.line, NOT_SUPPORTED, f"{what}: FISH intrinsic(s) not supported yet: {names}")]
+    return out + [LineReport(block.line, RUNNABLE, what)]
+
+
+#: 3DEC 5 FISH intrinsics and their 3DEC 7+ spelling (reference section 9 and 13)
+LEGACY_FISH = {
+    "out": "io.out", "sqrt": "math.sqrt", "abs": "math.abs", "sin": "math.sin", "cos": "math.cos",
+    "atan": "math.atan", "atan2": "math.atan2", "block_head": "block.list", "b_next": "loop foreach over block.list",
+    "b_zone": "block.zone.list", "z_next": "loop foreach over block.zone.list", "b_gp": "block.gplist",
+    "gp_next": "loop foreach over block.gp.list", "gp_x": "block.gp.pos.x", "gp_y": "block.gp.pos.y",
+    "gp_z": "block.gp.pos.z", "z_sxx": "block.zone.stress.xx", "z_sig1": "block.zone.stress.prin.x",
+    "z_sig3": "block.zone.stress.prin.z", "open": "file.open", "write": "file.write", "close": "file.close",
+    "lose_array": "(lists are freed automatically)", "c_near": "block.contact.near",
+}
+
+
+def _called_names(body) -> set:
+    names: set = set()
+
+    def walk(n):
+        if isinstance(n, tuple):
+            if n and n[0] in ("call", "name") and isinstance(n[1], str):
+                names.add(n[1])
+            for x in n:
+                walk(x)
+        elif isinstance(n, list):
+            for x in n:
+                walk(x)
+    walk(body)
+    return names
 
 
 def check_text(text: str, filename: str = "<input>", base_dir: Path | None = None,

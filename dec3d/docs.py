@@ -78,12 +78,12 @@ READER_PAGES = {
     ("fish", "define"): (
         "# fish define\n\n"
         "`fish define <name>` … `end` (also `fish def`, or `define`/`def` alone) defines a FISH function.\n\n"
-        "What dec3d does with it: the block is read (its lines are never bound as commands) and kept with its "
-        "text under its name; nothing in it runs. FISH functions are not supported yet, so a line that calls "
-        "the function (`@name` alone, `[name(...)]` in a value, a variable the function sets) stops the deck "
-        "before anything runs, with a \"not supported yet\" message naming the function. FISH in `[ ]` "
-        "outside functions (assignments, arithmetic, `math.*`, `string`, `io.out`) does run.\n\n"
-        "`dec3d check` reports a `fish define` block as \"does nothing\".\n\n"
+        "What dec3d does with it: the function is parsed and compiled when the deck is read (a syntax error "
+        "stops the deck before anything runs, with file:line:col inside the body) and defined when the line "
+        "runs. It is called by `@name` alone on a line, `[name(...)]` in a value or in a FISH statement, and "
+        "its `command … endcommand` sections are bound like deck lines. FISH intrinsics dec3d lacks (zones, "
+        "gridpoints, contacts) compile and fail with \"not supported yet\" when the function is called; "
+        "`dec3d check` names them. The language and intrinsics are described in `docs/architecture.md` (FISH).\n\n"
         "## Examples\n\n```\nfish define area(w, h)\n  area = w * h\nend\n[a = 2.0 * 3.0]\n```\n"),
 }
 

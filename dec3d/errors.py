@@ -100,3 +100,7 @@ class CommandError(Dec3dError):
 class StopDeck(Exception):
     """`program exit`: stop running, keep the model. (Control flow, not an error; it lives here so the
     command handlers can raise it without importing the session above them.)"""
+
+
+class LegacySyntaxError(BindError):
+    """A 3DEC 4/5 command in a 3DEC 7+ deck."""

@@ -67,7 +67,7 @@ class RegistryCompleter(Completer):
             out = {name: ("" if _runs(child) else _NOT_YET) for name, child in node.children.items()}
             for name in out:
                 if path + (name,) in READER_PAGES:
-                    out[name] = "kept, not run (FISH functions)"
+                    out[name] = "FISH function definition"
             if node is REGISTRY.root and "plot" in out:
                 out["plot"] = "display only: skipped"
             if node is REGISTRY.root:

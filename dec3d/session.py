@@ -20,8 +20,8 @@ from .commands import load_all
 from .commands.binder import BindContext, Binder, CommandCall, ExprStatement
 from .commands.values import Deferred, InPath, OutPath
 from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation, StopDeck
+from .fish import FishRuntime, compile_function, compile_inline, inline_source, parse_block, parse_inline
 from .io import paths
-from .lang.expr import EvalContext, evaluate
 from .lang.parser import ParsedDeck, parse_deck
 from .lang.prepass import FishBlock
 from .model.model import Model
@@ -32,6 +32,8 @@ class FishDefine:
     block: FishBlock
     location: SourceLocation
     source: str
+    fdef: Any = None          # dec3d.fish.FishDef: parsed when the deck is read
+    bound: Any = None         # id(command node) -> bound command lines of its command sections
 
 
 @dataclass(frozen=True)
@@ -67,6 +69,7 @@ class Session:
         self.model = Model()
         self.variables: dict[str, Any] = {}
         self.fish: dict[str, FishBlock] = {}
+        self.fish_rt = FishRuntime(self)
         self.out_dir = Path(out_dir) if out_dir is not None else Path.cwd()
         self.echo = echo
         self.stdout = stdout if stdout is not None else sys.stdout
@@ -228,7 +231,30 @@ class Session:
         self.bind_context.define_fish(block)
         text = deck.source_lines[block.line - 1]
         loc = SourceLocation(deck.filename, block.line, 1, text, len(text.rstrip()), tuple(stack))
-        return FishDefine(block, loc, text.strip())
+        fdef = parse_block(block, deck.filename, deck.source_lines, stack)
+        bound = self.bind_fish_commands(fdef, deck, stack)
+        return FishDefine(block, loc, text.strip(), fdef, bound)
+
+    def bind_fish_commands(self, fdef, deck: ParsedDeck, stack) -> dict:
+        """Bind the lines of a function's `command ... endcommand` sections, as deck lines
+        (their `[ ]`/`@` names may be the function's own locals and globals)."""
+        bound = {}
+        if not fdef.commands:
+            return bound
+        ctx = BindContext(self.variables)
+        ctx.fish_functions.update(self.bind_context.fish_functions)
+        ctx.fish_variables.update(self.bind_context.fish_variables)
+        ctx.assigned |= self.bind_context.assigned | fdef.locals | fdef.globals | fdef.assigned | set(fdef.params)
+        for node in fdef.commands:
+            items = []
+            for first, last in node[1]:
+                text = "\n" * (first - 1) + "\n".join(deck.source_lines[first - 1:last])
+                sub = parse_deck(text, deck.filename, stack)
+                binder = Binder(sub, ctx, stack)
+                for raw in sub.lines:
+                    items.append(binder.bind_line(raw))
+            bound[id(node)] = items
+        return bound
 
     def _resolve_call_path(self, name: str, base_dir: Path) -> Path:
         """The file `program call '<name>'` from a deck in ``base_dir`` would read (the first candidate
@@ -294,11 +320,10 @@ class Session:
                     # a restore takes the saved model's record as it is: restore → save gives the same file
                     self.record.append(_source_of(item))
             elif isinstance(item, ExprStatement):
-                evaluate(item.node, EvalContext(self.variables, self.write))
+                self.run_statement(item)
                 self.bind_context.assigned.update(self.variables)
             elif isinstance(item, FishDefine):
-                self.fish[item.block.name.lower()] = item.block
-                self.bind_context.define_fish(item.block)
+                self.define_fish(item)
         except Dec3dError as exc:
             raise exc.with_location(item.location)
         except OSError as exc:
@@ -358,16 +383,81 @@ class Session:
         return value
 
     def evaluate(self, d: Deferred, where: SourceLocation | None = None):
+        """A `[expr]` or `@name` value, evaluated by dec3d.fish (inside a FISH command section,
+        in the scope of the running function)."""
+        rt = self.fish_rt
         try:
-            return evaluate(d.node, EvalContext(self.variables, self.write))
+            if rt.command_scope:
+                closures, frame = rt.command_scope[-1]
+                c = closures.get(id(d))
+                if c is not None:
+                    return c(frame)
+            tok = d.token
+            if where is not None and hasattr(where, "resolve"):
+                where = where.resolve()
+            file = where.file if where is not None else "<input>"
+            key = (str(tok), file, tok.line, tok.column)
+            c = rt.inline_cache.get(key)
+            if c is None:
+                text = where.text if where is not None else str(tok)
+                stack = where.stack if where is not None else ()
+                if d.kind == "at":
+                    src = inline_source(file, tok.line, tok.column + 1, str(tok)[1:], text, stack)
+                else:
+                    src = inline_source(file, tok.line, tok.column + 1, str(tok)[1:-1], text, stack)
+                node, _ = parse_inline(src.lines[0], src)
+                c, _sc = compile_inline(rt, node, src)
+                if len(rt.inline_cache) > 100_000:
+                    rt.inline_cache.clear()
+                rt.inline_cache[key] = c
+            return c([0])
         except ExpressionError as exc:
             raise exc.with_location(where) if where else exc
+
+    def run_statement(self, item: ExprStatement) -> None:
+        """A line holding only `[ ... ]` or `@name`: run it as a FISH statement."""
+        text = item.source.strip()
+        loc = item.location
+        rt = self.fish_rt
+        key = (text, loc.file, loc.line, loc.column)
+        c = rt.inline_cache.get(key)
+        if c is None:
+            inner = text[1:] if text.startswith("@") else text[1:-1]
+            src = inline_source(loc.file, loc.line, loc.column + 1, inner, loc.text, loc.stack)
+            node, _ = parse_inline(inner, src)
+            c, _sc = compile_inline(rt, node, src)
+            rt.inline_cache[key] = c
+        c([0])
+
+    def define_fish(self, item: FishDefine) -> None:
+        """`fish define` runs: compile the function (names checked now if automatic-create is off)."""
+        rt = self.fish_rt
+        fn = compile_function(rt, item.fdef, item.bound, item.location)
+        for name in (item.fdef.globals | item.fdef.assigned) - item.fdef.locals - {fn.name}:
+            if "." not in name and name not in rt.functions and name not in self.variables:
+                self.variables[name] = 0           # FISH creates the variables a function names when it is defined
+        rt.define(fn)
+        self.fish[item.block.name.lower()] = item.block
+        self.bind_context.define_fish(item.block)
+
+    def run_fish_command(self, item, stack=()) -> None:
+        """A line of a FISH `command ... endcommand` section (bound when the deck was read)."""
+        try:
+            call = self.resolve(item)
+            item.command.handler(self, call)
+            self.record.append(_source_of(item))
+        except Dec3dError as exc:
+            if exc.location is None and stack:
+                loc = item.location
+                exc.location = SourceLocation(loc.file, loc.line, loc.column, loc.text, loc.length, tuple(stack))
+            raise exc.with_location(item.location)
 
     def new_model(self) -> None:
         """`model new`: a fresh model; FISH variables and functions are cleared too (as in 3DEC)."""
         self.model = Model()
         self.variables.clear()
         self.fish.clear()
+        self.fish_rt.clear()
         self.bind_context = BindContext(self.variables)
 
 

@@ -21,3 +21,10 @@ def test_rigid_bench_runs_and_prints_the_figures():
     assert row[:2] == ["2", "8"]
     float(row[6])                      # seconds
     assert float(row[8]) > 0           # block-cycles/s
+
+
+def test_fish_bench_runs_and_prints_its_rate():
+    out = subprocess.run([sys.executable, str(ROOT / "bench" / "fish_bench.py"), "--n", "2000", "--runs", "1"],
+                         capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.startswith("FISH loop: 2000 passes x 5 statements") and "statements/s" in out.stdout

@@ -53,13 +53,14 @@ MAY_IMPORT = {
     "kcache": set(),                             # run by dec3d/__init__ before any kernel loads
     "kernels": {"config"},                       # and numpy, numba, math only (next test)
     "lang": {"errors"},                          # knows no commands
+    "fish": BASE | {"lang"},                     # the FISH language: knows no commands or model layout
     "geometry": BASE | {"kernels"},
     "model": BASE | {"geometry", "kernels"},
     "io": BASE | {"model", "geometry", "kernels"},
     "physics": BASE | {"model", "geometry", "kernels", "io"},
-    "commands": BASE | {"lang", "model", "geometry", "kernels", "io", "physics"},
-    "session": BASE | {"lang", "commands", "model", "geometry", "kernels", "io", "physics"},
-    "check": BASE | {"lang", "commands", "session"},
+    "commands": BASE | {"lang", "fish", "model", "geometry", "kernels", "io", "physics"},
+    "session": BASE | {"lang", "fish", "commands", "model", "geometry", "kernels", "io", "physics"},
+    "check": BASE | {"lang", "fish", "commands", "session"},
     "docs": BASE | {"lang", "commands"},
     "ssdem": {"errors"},                         # independent of the rest; only the CLI and verify reach it
     "verify": None, "repl": None, "cli": None, "__init__": None, "__main__": None,   # top: anything

@@ -44,7 +44,7 @@ def test_help_is_rendered_not_raw_markdown(tmp_path):
 def test_help_fish_define_says_what_happens(tmp_path):
     _, text = drive("help fish define\nhelp fish def\n", tmp_path)
     assert "does not support" not in text
-    assert text.count("kept with its") == 2 and "nothing in it runs" in text
+    assert text.count("compiled when the deck is read") == 2 and "not supported yet" in text
 
 
 def test_continuation_and_fish_block(tmp_path):
@@ -79,7 +79,7 @@ def test_completion_marks_what_does_not_run():
     kws = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document("block history velocity "), None)}
     assert kws["gridpointid"] == "not supported yet" and kws["block-id"] == ""
     fish = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document("fish "), None)}
-    assert fish["define"] == "kept, not run (FISH functions)" and fish["list"] == "not supported yet"
+    assert fish["define"] == "FISH function definition" and fish["list"] == "" and fish["callback"] == "not supported yet"
 
 
 def test_completion_of_words_and_keywords():

@@ -12,7 +12,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..errors import BindError, DeckSyntaxError, LazyLocation, NotSupportedError, SourceLocation
+from ..errors import BindError, DeckSyntaxError, LazyLocation, LegacySyntaxError, NotSupportedError, SourceLocation  # noqa: F401
 from ..lang.abbrev import matches, suggest
 from ..lang.expr import check_names, parse_expression
 from ..lang.parser import ParsedDeck, RawLine
@@ -95,12 +95,11 @@ class BindContext:
             self.fish_variables.setdefault(v, block.name)
 
     def classify(self, name: str) -> str | None:
-        if name in self.fish_functions:
-            return "fish-function"
-        if name in self.assigned or name in self.session_variables:
+        # FISH functions and the variables their bodies set are run by dec3d.fish
+        if name in self.fish_functions or name in self.assigned or name in self.session_variables:
             return None
         if name in self.fish_variables:
-            return "fish-variable"
+            return None
         return None if self.lenient_names else "undefined"
 
 
@@ -129,6 +128,9 @@ class Binder:
         try:
             node = parse_expression(text)
         except DeckSyntaxError as exc:
+            fish = _fish_inline(text)        # FISH syntax beyond expr.lark (v->x, ::list); run by dec3d.fish
+            if fish is not None:
+                return fish
             col = tok.column + getattr(exc, "column_in_expr", 1)
             loc = self.deck.location(tok, self.stack)
             raise DeckSyntaxError(exc.message, SourceLocation(loc.file, loc.line, col, loc.text, 1, loc.stack),
@@ -136,6 +138,8 @@ class Binder:
         problems = check_names(node, self.ctx.classify)
         for kind, name, col in problems:
             if node[0] == "assign" and kind == "undefined" and name == node[1]:
+                continue
+            if kind in ("intrinsic", "unknown-function") and _fish_knows(name, self.ctx):
                 continue
             self._raise_name_problem(kind, name, tok, tok.column + col)
         return node
@@ -157,11 +161,10 @@ class Binder:
         if kind == "intrinsic":
             raise NotSupportedError(f"FISH intrinsic `{name}` is not supported yet", loc)
         if kind == "unknown-function":
-            raise NotSupportedError(f"`{name}` is not a FISH intrinsic dec3d knows; FISH functions are not supported yet", loc,
-                                    hint="dec3d evaluates math.*, string(), string.build(), io.out() in [ ]")
+            raise NotSupportedError(f"`{name}` is neither a FISH function of the deck nor a FISH intrinsic dec3d "
+                                    "knows", loc, hint="define the function with `fish define` before this line")
         if at:
-            raise NotSupportedError(f"`@{name}` is neither a variable set earlier nor a known value; "
-                                    "FISH functions are not supported yet", loc)
+            raise NotSupportedError(f"`@{name}` is neither a variable set earlier nor a FISH function", loc)
         raise BindError(f"undefined FISH variable `{name}`", loc, hint="assign it first, e.g. [name = 1.0]")
 
     # ------------------------------------------------------------ commands
@@ -175,7 +178,7 @@ class Binder:
                 self.ctx.assigned.add(node[1])   # later lines may use the variable
             return ExprStatement(node, self.deck.location(first, self.stack), self.source(raw))
         if len(toks) == 1 and first.type == "ATNAME":
-            self.deferred(first)                 # a FISH function call raises "not supported yet"
+            self.deferred(first)                 # checks the name; a FISH function is called when it runs
             return ExprStatement(("name", str(first)[1:].lower(), 1), self.deck.location(first, self.stack),
                                  str(first))
         return self.bind(raw)
@@ -184,8 +187,9 @@ class Binder:
         toks = raw.tokens
         first = toks[0]
         if first.type == "ATNAME":
-            self.deferred(first)          # a FISH function: raises "not supported yet"
-            raise NotSupportedError(f"FISH function calls (`{first}(...)`) are not supported yet", self.where(first))
+            self.deferred(first)
+            raise NotSupportedError(f"`{first}` followed by more words is not supported yet: write `[f(args)]` "
+                                    "to call a FISH function with arguments", self.where(first))
         if first.type != "WORD":
             raise BindError(f"a command starts with a command word, not {str(first)!r}", self.where(first),
                             hint="`[ ... ]` and `@name` stand alone on a line or as values")
@@ -464,5 +468,22 @@ class Binder:
         return args, i
 
 
-class LegacySyntaxError(BindError):
-    """A 3DEC 4/5 command in a 3DEC 7+ deck."""
+def _fish_inline(text: str):
+    """A tree for an inline fragment only dec3d.fish reads: ("assign", name, ...) for an assignment
+    (so later lines may use the name), ("fish", text) otherwise; None if FISH cannot parse it either."""
+    from ..fish import FishSource, parse_inline
+
+    try:
+        node, _ = parse_inline(text, FishSource("<inline>", 1, [text]))
+    except Exception:
+        return None
+    if node[0] == "assign" and node[1][0] == "name":
+        return ("assign", node[1][1], node[2], ("fish", text), 0)
+    return ("fish", text)
+
+
+def _fish_knows(name: str, ctx: BindContext) -> bool:
+    """A name dec3d's FISH runs: a FISH function of the deck or an implemented intrinsic."""
+    from ..fish import intrinsics
+
+    return name in ctx.fish_functions or intrinsics.resolve(name) is not None

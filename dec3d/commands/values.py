@@ -13,20 +13,9 @@ from typing import Any
 
 from ..errors import BindError
 from ..lang.abbrev import matches
+from ..lang.deferred import Deferred  # noqa: F401  (commands and FISH share it)
 
 NUMBERISH = ("NUMBER", "EXPR", "ATNAME")
-
-
-@dataclass(frozen=True, slots=True)
-class Deferred:
-    """A value known only when the command runs: `[expr]` (node) or `@name`."""
-
-    kind: str            # "expr" or "at"
-    node: Any            # parsed expression tree (for "at": ("name", name, col))
-    token: Any           # the lark token, for error locations
-
-    def __repr__(self) -> str:
-        return str(self.token)
 
 
 class ValueType:

@@ -1,8 +1,8 @@
 """Pre-pass over deck text: lift `fish define ... end` blocks out of the command stream.
 
 FISH bodies have a syntax of their own (if/loop/local/command...endcommand) that the
-line grammar does not describe. They are kept as raw text for a later FISH
-interpreter; their lines are blanked (not removed) so every other line keeps its
+line grammar does not describe. They are kept as raw text for dec3d.fish, which
+parses and compiles them; their lines are blanked (not removed) so every other line keeps its
 true line number. 3DEC accepts `def` as an abbreviation of `define` and, in data
 files, a bare `define`/`def` opening a function (3DEC 7 manual, "FISH in data files").
 """
@@ -72,7 +72,8 @@ def lift_fish(text: str, filename: str) -> tuple[str, list[FishBlock]]:
         for b in body_lines:
             g = _GLOBAL.match(b)
             if g:
-                variables.update(v.strip().lower() for v in g.group(1).split(";")[0].split(",") if v.strip())
+                variables.update(v.split("=")[0].strip().lower() for v in g.group(1).split(";")[0].split(",")
+                                 if v.split("=")[0].strip())
                 continue
             a = _ASSIGN.match(b)
             if a:

@@ -60,19 +60,16 @@ def test_recursive_call_is_an_error(tmp_path, session):
     assert "calls itself" in e.value.message
 
 
-def test_fish_call_not_supported_names_the_line(tmp_path, session):
+def test_fish_call_runs_the_function(tmp_path, session):
     deck = tmp_path / "deck.dat"
     deck.write_text("model new\nfish define props\n  dens = 2600\nend\nmodel title 'x'\n@props\n")
-    with pytest.raises(NotSupportedError) as e:
-        session.call(deck)
-    assert "FISH functions are not supported yet" in e.value.message and e.value.location.line == 6
-    assert session.model.settings.title == ""      # nothing ran
+    session.call(deck)
+    assert session.variables["dens"] == 2600 and session.model.settings.title == "x"
 
 
-def test_variable_set_by_a_fish_function_is_not_supported(session):
-    with pytest.raises(NotSupportedError) as e:
-        session.command("fish def f\n  knj = 1e9\nend\nmodel gravity 0 0 @knj")
-    assert "set by FISH function `f`" in e.value.message
+def test_variable_set_by_a_fish_function_is_usable_after_the_call(session):
+    session.command("fish def f\n  knj = 2.5\nend\n@f\nmodel gravity 0 0 @knj")
+    assert session.model.settings.gravity == (0.0, 0.0, 2.5)
 
 
 def test_cli_exit_codes(tmp_path):

@@ -1,0 +1,170 @@
+"""The FISH run time: global variables, compiled functions, the call stack, limits.
+
+One `FishRuntime` per Session. Globals live in `session.variables` (the same mapping
+inline `[ ]` expressions and `@name` read); functions in `functions`. A function call
+makes a frame (a Python list: slot 0 the function's value, then parameters, then
+locals) and runs the closures the compiler made. Errors raised inside carry the
+location in the FISH body and the FISH call stack (outermost caller first).
+"""
+from __future__ import annotations
+
+import sys
+
+from ..errors import Dec3dError, ExpressionError, NotSupportedError, SourceLocation
+from .values import FishValueError
+
+MAX_DEPTH = 200            # nested FISH calls
+STOP_CHECK = 1023          # loops look at the stop flag every STOP_CHECK + 1 iterations
+
+_STOP = [False]
+
+if sys.getrecursionlimit() < 20000:      # each FISH call is a few Python frames deep
+    sys.setrecursionlimit(20000)
+
+
+def request_stop() -> None:
+    """Ask running FISH loops to stop (they raise KeyboardInterrupt at their next check)."""
+    _STOP[0] = True
+
+
+def clear_stop() -> None:
+    _STOP[0] = False
+
+
+def check_stop() -> None:
+    if _STOP[0]:
+        _STOP[0] = False
+        raise KeyboardInterrupt
+
+
+class FishError(ExpressionError):
+    """A FISH statement failed while running."""
+
+
+class SystemErrorRaised(FishError):
+    """`system.error = '...'`: the deck stops with the message."""
+
+
+class FishFunction:
+    __slots__ = ("name", "params", "nparams", "nslots", "body", "fdef", "unsupported", "rt", "location")
+
+    def __init__(self, rt, name, params, nslots, body, fdef, unsupported, location):
+        self.rt = rt
+        self.name = name
+        self.params = params
+        self.nparams = len(params)
+        self.nslots = nslots
+        self.body = body
+        self.fdef = fdef
+        self.unsupported = unsupported
+        self.location = location
+
+    def invoke(self, args, site):
+        """Run with `args`; `site` is (FishSource, pos) or a SourceLocation of the caller."""
+        rt = self.rt
+        if len(args) != self.nparams:
+            want = f"{self.nparams} argument{'s' if self.nparams != 1 else ''}"
+            if self.nparams:
+                want += f" ({', '.join(self.params)})"
+            raise rt.error_at(site, f"FISH function `{self.name}` takes {want}, got {len(args)}")
+        if rt.depth >= MAX_DEPTH:
+            raise rt.error_at(site, f"FISH calls nested deeper than {MAX_DEPTH} (runaway recursion in `{self.name}`?)")
+        f = [0] * self.nslots
+        if args:
+            f[1:1 + self.nparams] = args
+        rt.depth += 1
+        rt.callstack.append(site)
+        try:
+            self.body(f)
+        finally:
+            rt.depth -= 1
+            rt.callstack.pop()
+        return f[0]
+
+
+class FishRuntime:
+    def __init__(self, session):
+        self.session = session
+        self.functions: dict[str, FishFunction] = {}
+        self.auto_create = True
+        self.depth = 0
+        self.callstack: list = []
+        self.inline_cache: dict = {}
+        self.command_scope: list = []        # (closures by id(deferred), frame) while a command section runs
+        self.tables: dict = {}               # FISH tables by id (table_intrinsics)
+
+    @property
+    def globals(self) -> dict:
+        return self.session.variables
+
+    def write(self, text: str) -> None:
+        self.session.write(text)
+
+    # ------------------------------------------------------------ errors
+    def _site_location(self, site) -> SourceLocation | None:
+        if site is None:
+            return None
+        if isinstance(site, SourceLocation):
+            return site
+        src, pos = site
+        return src.location(pos)
+
+    def stack(self) -> tuple:
+        out = []
+        for s in self.callstack:
+            loc = self._site_location(s)
+            if loc is None:
+                continue
+            if isinstance(s, SourceLocation) and not out:
+                out.extend(loc.stack)        # the deck's include stack comes first
+                loc = SourceLocation(loc.file, loc.line, loc.column, loc.text, loc.length, ())
+            out.append(loc)
+        return tuple(out)
+
+    def error_at(self, site, msg, cls=FishError, hint=None):
+        """An error located at `site`, with the FISH call stack up to (not including) it."""
+        loc = self._site_location(site)
+        if loc is not None:
+            stack = self.stack()
+            if stack and stack[-1] == loc:
+                stack = stack[:-1]
+            loc = SourceLocation(loc.file, loc.line, loc.column, loc.text, loc.length, stack)
+        return cls(msg, loc, hint)
+
+    def locate(self, exc: BaseException, src, pos, length: int = 1):
+        """Turn an exception raised while running the statement at `pos` into a located Dec3dError."""
+        if isinstance(exc, Dec3dError):
+            if exc.location is None:
+                exc.location = self.error_at((src, pos), "").location
+                if length > 1 and exc.location is not None:
+                    loc = exc.location
+                    exc.location = SourceLocation(loc.file, loc.line, loc.column, loc.text, length, loc.stack)
+            return exc
+        if isinstance(exc, ZeroDivisionError):
+            return self.error_at((src, pos), "division by zero")
+        if isinstance(exc, OverflowError):
+            return self.error_at((src, pos), "numeric overflow: the result is not a finite number")
+        if isinstance(exc, RecursionError):
+            return self.error_at((src, pos), "FISH calls nested too deep (runaway recursion?)")
+        if isinstance(exc, (ValueError, TypeError)):
+            return self.error_at((src, pos), f"bad value: {exc}")
+        return exc
+
+    # ------------------------------------------------------------ names
+    def define(self, fn: FishFunction) -> None:
+        self.functions[fn.name] = fn
+        self.globals.pop(fn.name, None)   # a function and a variable cannot share a name
+
+    def clear(self) -> None:
+        self.functions.clear()
+        self.inline_cache.clear()
+        self.tables.clear()
+        self.auto_create = True
+
+
+def not_supported(name: str) -> NotSupportedError:
+    return NotSupportedError(f"FISH intrinsic `{name}` is not supported yet")
+
+
+__all__ = ["FishRuntime", "FishFunction", "FishError", "SystemErrorRaised", "FishValueError", "request_stop",
+           "clear_stop", "check_stop", "not_supported", "MAX_DEPTH"]
