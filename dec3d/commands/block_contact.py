@@ -8,18 +8,24 @@ from ..physics.jmodels import ALL_PROPS, JOINT_MODELS, MODEL_BY_CODE
 from ..physics.contacts import default_row
 from ..physics.rigid import engine, mech
 from .registry import command
-from .values import FLAG, Choice, Num, P, Text
+from .values import FLAG, Choice, Num, P, Text, ValueRangeError
 
 PROPS = ALL_PROPS
 _UNITS = {p.name: p.units for m in JOINT_MODELS.values() for p in m.props.values()}
 _DOCS = {p.name: p.doc for m in JOINT_MODELS.values() for p in m.props.values()}
-_KW = [P(name, Num(), _DOCS[name], units=_UNITS[name]) for name in PROPS]
+_BOUNDS = {p.name: (p.lo, p.hi, p.hi_open) for m in JOINT_MODELS.values() for p in m.props.values()}
+_KW = [P(name, Num(lo=_BOUNDS[name][0], hi=_BOUNDS[name][1], hi_open=_BOUNDS[name][2]), _DOCS[name],
+         units=_UNITS[name]) for name in PROPS]
 
 
 def _given(call):
     out = {name: call.args[name.replace("-", "_")] for name in PROPS if call.args[name.replace("-", "_")] is not None}
     for k, v in call.extra.items():
-        out[k] = float(v)
+        # a user joint-model property: any finite number (an `[expr]` may give a string or inf)
+        try:
+            out[k] = Num().convert(v, call.location)
+        except ValueRangeError as exc:
+            raise exc.named(k) from None
     return out
 
 
