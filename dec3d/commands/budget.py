@@ -61,7 +61,7 @@ def _count(n) -> str:
 
 
 @command("model budget",
-         keywords=[P("blocks", Num(integer=True, lo=1, hi=10**12), "largest number of blocks a command may leave",
+         keywords=[P("blocks", Num(integer=True, lo=1, hi=1e12), "largest number of blocks a command may leave",
                      default=None),
                    P("memory", Num(lo=0, lo_open=True, hi=2**20), "memory the blocks may take, GiB "
                      f"(estimated at {BYTES_PER_BLOCK // 1024} KiB a block)", default=None, units="GiB")],
