@@ -93,8 +93,9 @@ def _check_default(call):
                  "point, its own groups and the groups of its two blocks.",
          examples=["block contact jmodel assign mohr", "block contact jmodel assign elastic range group 'base'"])
 def jmodel_assign(session, call):
-    e, sel = _contacts_in_range(session, call)
     name = _model_arg(call, "model")
+    _check_model_name(name, call.locations.get("model", call.location))    # an [expr] is known only now
+    e, sel = _contacts_in_range(session, call)
     jm = JOINT_MODELS[name]
     c = e.contacts
     c["jmodel"][sel] = jm.code
@@ -142,6 +143,7 @@ def contact_property(session, call):
 def material_default(session, call):
     s = mech(session.model)
     name = _model_arg(call, "jmodel")
+    _check_model_name(name, call.locations.get("jmodel", call.location))   # an [expr] is known only now
     props = _given(call)
     props.pop("property", None)
     _check(call, name or s["jmodel"], props)

@@ -7,7 +7,7 @@ import sys
 import pytest
 
 from dec3d.commands.values import ValueRangeError
-from dec3d.errors import ExpressionError
+from dec3d.errors import ExpressionError, NotSupportedError
 from dec3d.physics.rigid import mech
 
 from conftest import ROOT
@@ -131,3 +131,16 @@ def test_the_range_is_on_the_command_page():
     page = (ROOT / "commands" / "block_contact_property.md").read_text()
     assert "| `friction` | <f> in [0, 90] |" in page and "| `dilation` | <f> in [0, 90) |" in page
     assert "| `stiffness-normal` | <f> ≥ 0 |" in page
+
+
+@pytest.mark.parametrize("line, column", [("block contact material-table default jmodel [1]", 45),
+                                          ("block contact jmodel assign ['zz']", 29)])
+def test_a_joint_model_name_from_an_expression_is_checked_when_it_runs(session, line, column):
+    # found by the fuzz test: `jmodel [1]` reached the model table as '1' (KeyError)
+    with pytest.raises(NotSupportedError) as e:
+        session.command(line)
+    name = "1" if "[1]" in line else "zz"
+    assert e.value.message == (f"joint model `{name}` is not a built-in model; user-defined joint models "
+                               "(`block contact jmodel load`) are not supported yet")
+    assert e.value.location.column == column
+    assert mech(session.model)["jmodel"] == "mohr"
