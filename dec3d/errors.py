@@ -6,7 +6,32 @@ like a compiler: location, the line, a caret under the offending token, a hint.
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
+
+# C0 controls (tab kept), DEL, C1 controls, and the bidirectional overrides/isolates that
+# reorder what a terminal shows: deck text echoed in a message must not drive the terminal
+_CONTROL = re.compile("[\x00-\x08\x0a-\x1f\x7f-\x9f\u200e\u200f\u202a-\u202e\u2066-\u2069\ufeff]")
+
+
+#: the same characters, as refused inside deck strings and expressions
+CONTROL_CHARS = _CONTROL
+
+
+def _escape(m) -> str:
+    c = m.group()
+    return f"\\x{ord(c):02x}" if ord(c) < 0x100 else f"\\u{ord(c):04x}"
+
+
+def printable(text: str, newlines: bool = False) -> str:
+    """`text` with control characters written as visible escapes (`\\x1b`, `\\u202e`).
+
+    newlines=True keeps line breaks (console output of several lines)."""
+    if not _CONTROL.search(text):
+        return text
+    if newlines:
+        return "\n".join(_CONTROL.sub(_escape, part) for part in text.split("\n"))
+    return _CONTROL.sub(_escape, text)
 
 
 @dataclass(frozen=True)
@@ -59,22 +84,28 @@ class Dec3dError(Exception):
         """Compiler-style report: location, message, source line, caret, hint, include stack."""
         out = []
         loc = self.location
+        message = printable(self.message)
         if loc is None:
-            out.append(f"error: {self.message}")
+            out.append(f"error: {message}")
         else:
-            out.append(f"{loc}: error: {self.message}")
+            out.append(f"{printable(str(loc))}: error: {message}")
             if loc.text:
-                line = loc.text.rstrip("\n").expandtabs(1)
+                raw = loc.text.rstrip("\n")
+                line = printable(raw.expandtabs(1))
+                # the caret sits under the token as shown (escapes widen what precedes it)
+                col = len(printable(raw[:max(0, loc.column - 1)].expandtabs(1)))
                 out.append(f"    {line}")
-                out.append("    " + " " * (loc.column - 1) + "^" * max(1, loc.length))
+                out.append("    " + " " * col + "^" * max(1, loc.length))
             for caller in reversed(loc.stack):
-                out.append(f"  called from {caller}")
+                out.append(f"  called from {printable(str(caller))}")
         if self.hint:
-            out.append(f"  hint: {self.hint}")
+            out.append(f"  hint: {printable(self.hint)}")
         return "\n".join(out)
 
     def __str__(self) -> str:
-        return self.format()
+        # the message alone: a caller that wraps this error in another one (`CommandError(str(exc))`)
+        # must not repeat "error:" and the location; `format()` is the full report
+        return self.message
 
 
 class DeckSyntaxError(Dec3dError):
@@ -91,6 +122,10 @@ class NotSupportedError(Dec3dError):
 
 class ExpressionError(Dec3dError):
     """An inline [expression] failed to evaluate (unknown name, division by zero, ...)."""
+
+
+class ResourceError(Dec3dError):
+    """A command would need more blocks, memory or digits than the budget allows (`model budget`)."""
 
 
 class CommandError(Dec3dError):

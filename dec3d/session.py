@@ -18,8 +18,8 @@ from typing import Any, Iterable, TextIO
 
 from .commands import load_all
 from .commands.binder import BindContext, Binder, CommandCall, ExprStatement
-from .commands.values import Deferred, InPath, OutPath
-from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation, StopDeck
+from .commands.values import Deferred, InPath, OutPath, ValueRangeError
+from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation, StopDeck, printable
 from .fish import FishRuntime, compile_function, compile_inline, inline_source, parse_block, parse_inline
 from .io import paths
 from .lang.parser import ParsedDeck, parse_deck
@@ -85,7 +85,11 @@ class Session:
 
     # ------------------------------------------------------------------ output
     def write(self, text: str) -> None:
-        """Print a line to the console (and the log file when logging is on)."""
+        """Print a line to the console (and the log file when logging is on).
+
+        Control characters (from deck text: echoed commands, `io.out` strings) are written as
+        visible escapes, so a deck cannot drive the terminal."""
+        text = printable(text, newlines=True)
         print(text, file=self.stdout)
         if self.log_on and self._log_handle is not None:
             try:
@@ -343,10 +347,10 @@ class Session:
                 continue
             where = call.locations.get(key, call.location)
             if p.repeat:
-                args[key] = [self._value(p.value, v, where) for v in value]
+                args[key] = [self._value(p.value, v, where, p.name) for v in value]
             else:
-                args[key] = self._value(p.value, value, where)
-        extra = {k: (self.evaluate(v) if isinstance(v, Deferred) else v) for k, v in call.extra.items()}
+                args[key] = self._value(p.value, value, where, p.name)
+        extra = {k: (self.evaluate(v, v.where) if isinstance(v, Deferred) else v) for k, v in call.extra.items()}
         return CommandCall(call.command, args, call.given, call.range, call.location, extra, call.locations)
 
     def range_mask(self, call: CommandCall, store: str):
@@ -360,8 +364,14 @@ class Session:
         masks = []
         for rc in call.range.elements:
             params = {p.key: p for p in rc.element.positional + rc.element.keywords}
-            args = {k: (self._value(params[k].value, v, rc.location) if k in params and _contains_deferred(v) else v)
-                    for k, v in rc.args.items()}
+            args = {}
+            for k, v in rc.args.items():
+                p = params.get(k)
+                if p is not None and _contains_deferred(v):
+                    # a repeated keyword (`group 'a' or [x] or [y]`) holds a list of values
+                    v = ([self._value(p.value, x, rc.location, p.name) for x in v] if p.repeat
+                         else self._value(p.value, v, rc.location, p.name))
+                args[k] = v
             try:
                 m = np.asarray(rc.element.mask(self, store, args), dtype=bool)
             except Dec3dError as exc:
@@ -374,12 +384,28 @@ class Session:
             return np.logical_or.reduce(masks)
         return np.logical_and.reduce(masks)
 
-    def _value(self, vtype, value, where):
-        if isinstance(value, tuple):
-            raw = tuple(self.evaluate(v, where) if isinstance(v, Deferred) else v for v in value)
-            return vtype.convert(raw, where)
-        if isinstance(value, Deferred):
-            return vtype.convert(self.evaluate(value, where), where)
+    def _value(self, vtype, value, where, name: str = ""):
+        """A deferred value evaluated and converted by its type; `name` (the keyword) is put in
+        front of a range error."""
+        try:
+            if isinstance(value, tuple):
+                item = getattr(vtype, "item", None)
+                if item is None:
+                    raw = tuple(self.evaluate(v, where) if isinstance(v, Deferred) else v for v in value)
+                    return vtype.convert(raw, where)
+                # each evaluated number is checked at its own position
+                return tuple(item.convert(self.evaluate(v, v.where or where), v.where or where)
+                             if isinstance(v, Deferred) else v for v in value)
+            if isinstance(value, Deferred):
+                at = value.where or where
+                return vtype.convert(self.evaluate(value, at), at)
+        except ValueRangeError as exc:
+            raise exc.named(name) if name else exc
+        except ExpressionError as exc:
+            if name and not exc.message.startswith("value of `"):
+                exc.message = f"value of `{name}`: {exc.message}"
+                exc.args = (exc.message,)
+            raise
         return value
 
     def evaluate(self, d: Deferred, where: SourceLocation | None = None):

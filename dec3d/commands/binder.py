@@ -18,11 +18,17 @@ from ..lang.expr import check_names, parse_expression
 from ..lang.parser import ParsedDeck, RawLine
 from .legacy import legacy_hint
 from .registry import REGISTRY, Command, Node, RangeElement, Registry
-from .values import MISSING, Deferred, Flag, Param
+from .values import FLOAT, MISSING, Deferred, Flag, Param, ValueRangeError
 
 
 # a `;` comment that is not inside a quoted string
 _COMMENT = re.compile(r""";(?=(?:[^'"]|'[^']*'|"[^"]*")*$).*""")
+
+
+def _shown(tok, limit: int = 60) -> str:
+    """A token as quoted in a message: a very long one is cut (the caret still marks all of it)."""
+    t = str(tok)
+    return t if len(t) <= limit else t[:limit - 1] + "…"
 
 
 def source_text(lines, first: int, last: int) -> str:
@@ -118,9 +124,9 @@ class Binder:
         if tok.type == "ATNAME":
             name = str(tok)[1:].lower()
             self._check_name_use([("name", name, 1)], tok, at=True)
-            return Deferred("at", ("name", name, 1), tok)
+            return Deferred("at", ("name", name, 1), tok, self.where(tok))
         node = self.expression(tok)
-        return Deferred("expr", node, tok)
+        return Deferred("expr", node, tok, self.where(tok))
 
     def expression(self, tok):
         """Parse `[...]` and check its names; errors point into the bracket."""
@@ -191,7 +197,7 @@ class Binder:
             raise NotSupportedError(f"`{first}` followed by more words is not supported yet: write `[f(args)]` "
                                     "to call a FISH function with arguments", self.where(first))
         if first.type != "WORD":
-            raise BindError(f"a command starts with a command word, not {str(first)!r}", self.where(first),
+            raise BindError(f"a command starts with a command word, not `{_shown(first)}`", self.where(first),
                             hint="`[ ... ]` and `@name` stand alone on a line or as values")
         node, i, path, pre, prekw = self._resolve(toks)
         cmd = node.command
@@ -237,7 +243,7 @@ class Binder:
                 # a command whose keywords could also take this word binds it as a keyword
                 if node.command and any(matches(word, [p.name for p in node.command.keywords])):
                     break
-                raise BindError(f"`{tok}` is ambiguous after `{' '.join(path) or 'the start of a line'}`: "
+                raise BindError(f"`{_shown(tok)}` is ambiguous after `{' '.join(path) or 'the start of a line'}`: "
                                 f"could be {', '.join(hits)}", self.where(tok),
                                 hint="type more letters of the word")
             kw = matches(word, [p.name for p in prekw]) if prekw else []
@@ -261,12 +267,12 @@ class Binder:
                 head = str(toks[0]).lower() if path else str(tok).lower()
                 hint = legacy_hint(head)
                 if hint and path:
-                    raise LegacySyntaxError(f"`{toks[0]} {tok}` is 3DEC 5 (legacy) syntax, not 3DEC 7+",
+                    raise LegacySyntaxError(f"`{_shown(toks[0])} {_shown(tok)}` is 3DEC 5 (legacy) syntax, not 3DEC 7+",
                                             self.where(toks[0]), hint)
                 if hint:
-                    raise LegacySyntaxError(f"`{tok}` is 3DEC 5 (legacy) syntax, not 3DEC 7+", self.where(tok), hint)
+                    raise LegacySyntaxError(f"`{_shown(tok)}` is 3DEC 5 (legacy) syntax, not 3DEC 7+", self.where(tok), hint)
             close = suggest(str(tok), cands)
-            where = f"`{name} {tok}`" if name else f"`{tok}`"
+            where = f"`{name} {_shown(tok)}`" if name else f"`{_shown(tok)}`"
             if close:
                 hint = "did you mean " + " or ".join(f"`{(name + ' ' + c).strip()}`" for c in close) + "?"
             else:
@@ -277,10 +283,17 @@ class Binder:
         cands = sorted(node.children)
         hint = legacy_hint(str(toks[0]).lower()) if len(path) == 1 and i < len(toks) else None
         if hint:                                 # `hist @var` (3DEC 5): a value where 3DEC 7 wants a word
-            raise LegacySyntaxError(f"`{toks[0]} {toks[i]}` is 3DEC 5 (legacy) syntax, not 3DEC 7+",
+            raise LegacySyntaxError(f"`{_shown(toks[0])} {_shown(toks[i])}` is 3DEC 5 (legacy) syntax, not 3DEC 7+",
                                     self.where(toks[0]), hint)
         raise BindError(f"`{name}` needs a subcommand", self.where(toks[min(i, len(toks)) - 1]),
                         hint=f"one of: {', '.join(cands)}")
+
+    def _take(self, param: Param, toks, i):
+        """The value of `param` at toks[i]; an out-of-range value names its keyword."""
+        try:
+            return param.value.take(toks, i, self)
+        except ValueRangeError as exc:
+            raise exc.named(param.name) from None
 
     def _take_value(self, param: Param, toks, i, kwtok):
         if not param.supported:
@@ -289,10 +302,10 @@ class Binder:
         if isinstance(vt, Flag):          # present means True; it takes no value
             return True, i
         if i < len(toks) and vt.fits(toks[i]):
-            return vt.take(toks, i, self)
+            return self._take(param, toks, i)
         if param.bare is not MISSING:
             return param.bare, i
-        got = f"`{toks[i]}`" if i < len(toks) else "the end of the line"
+        got = f"`{_shown(toks[i])}`" if i < len(toks) else "the end of the line"
         raise BindError(f"`{param.name}` needs a value {vt.describe()}, got {got}",
                         self.where(toks[i] if i < len(toks) else kwtok))
 
@@ -312,17 +325,17 @@ class Binder:
                 if p.value.fits(tok) and not (tok.type == "WORD" and matches(str(tok), names)):
                     pos.pop(0)
                     locs[p.key] = self.where(tok)
-                    args[p.key], i = p.value.take(toks, i, self)
+                    args[p.key], i = self._take(p, toks, i)
                     given.append(p.key)
                     continue
                 if p.required:
-                    raise BindError(f"{what} needs {p.name} {p.value.describe()} here, got `{tok}`",
+                    raise BindError(f"{what} needs {p.name} {p.value.describe()} here, got `{_shown(tok)}`",
                                     self.where(tok), hint=p.doc or None)
                 pos.pop(0)
                 continue
             hits = matches(str(tok), names) if tok.type == "WORD" else []
             if len(hits) > 1:
-                raise BindError(f"keyword `{tok}` is ambiguous: could be {', '.join(hits)}", self.where(tok))
+                raise BindError(f"keyword `{_shown(tok)}` is ambiguous: could be {', '.join(hits)}", self.where(tok))
             if len(hits) == 1:
                 p = by_name[hits[0]]
                 value, j = self._take_value(p, toks, i + 1, tok)
@@ -363,7 +376,7 @@ class Binder:
             nonlocal rng
             tok = toks[i]
             if tok.type != "WORD":
-                raise BindError(f"unexpected value `{tok}`", self.where(tok), hint=self._keyword_hint(cmd))
+                raise BindError(f"unexpected value `{_shown(tok)}`", self.where(tok), hint=self._keyword_hint(cmd))
             word = str(tok).lower()
             if cmd.range and (word == "range" or (len(word) >= 2 and matches(word, ["range"]) == ["range"])):
                 rng = self._bind_range(toks, i + 1, cmd)
@@ -376,13 +389,16 @@ class Binder:
                 if vt.type == "STRING":
                     extra[word] = str(vt)[1:-1]
                 elif vt.type == "NUMBER":
-                    extra[word] = float(str(vt))
+                    try:
+                        extra[word] = FLOAT.convert(float(str(vt)), self.where(vt))
+                    except ValueRangeError as exc:
+                        raise exc.named(word) from None
                 else:
                     extra[word] = self.deferred(vt)
                 return i + 2
             cands = list(cmd.keyword_names) + (["range"] + sorted(self.reg.range_elements) if cmd.range else [])
             close = suggest(word, cands)
-            raise BindError(f"unknown keyword `{tok}` for `{cmd.name}`", self.where(tok),
+            raise BindError(f"unknown keyword `{_shown(tok)}` for `{cmd.name}`", self.where(tok),
                             hint=f"did you mean {' or '.join(f'`{c}`' for c in close)}?" if close
                             else self._keyword_hint(cmd))
 
@@ -418,7 +434,7 @@ class Binder:
         while i < n:
             tok = toks[i]
             if tok.type != "WORD":
-                raise BindError(f"expected a range element, got `{tok}`", self.where(tok),
+                raise BindError(f"expected a range element, got `{_shown(tok)}`", self.where(tok),
                                 hint=f"range elements: {', '.join(names)}")
             word = str(tok).lower()
             if word in ("not", "no") or matches(word, ["not"]) == ["not"] and word not in self.reg.range_elements:
@@ -435,8 +451,8 @@ class Binder:
             hits = matches(word, names)
             if len(hits) != 1:
                 close = suggest(word, names)
-                msg = (f"range element `{tok}` is ambiguous: could be {', '.join(hits)}" if hits
-                       else f"unknown range element `{tok}`")
+                msg = (f"range element `{_shown(tok)}` is ambiguous: could be {', '.join(hits)}" if hits
+                       else f"unknown range element `{_shown(tok)}`")
                 raise BindError(msg, self.where(tok), hint=f"did you mean {' or '.join(close)}?" if close else
                                 f"range elements: {', '.join(names)}")
             elem = self.reg.range_elements[hits[0]]
@@ -457,7 +473,7 @@ class Binder:
         def other(i):
             tok = toks[i]
             if tok.type != "WORD":
-                raise BindError(f"unexpected value `{tok}` in range element `{elem.name}`", self.where(tok))
+                raise BindError(f"unexpected value `{_shown(tok)}` in range element `{elem.name}`", self.where(tok))
             return None                    # the next element, or a modifier
 
         names = tuple(p.name for p in elem.keywords)

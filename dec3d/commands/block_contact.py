@@ -8,18 +8,24 @@ from ..physics.jmodels import ALL_PROPS, JOINT_MODELS, MODEL_BY_CODE
 from ..physics.contacts import default_row
 from ..physics.rigid import engine, mech
 from .registry import command
-from .values import FLAG, Choice, Num, P, Text
+from .values import FLAG, Choice, Num, P, Text, ValueRangeError
 
 PROPS = ALL_PROPS
 _UNITS = {p.name: p.units for m in JOINT_MODELS.values() for p in m.props.values()}
 _DOCS = {p.name: p.doc for m in JOINT_MODELS.values() for p in m.props.values()}
-_KW = [P(name, Num(), _DOCS[name], units=_UNITS[name]) for name in PROPS]
+_BOUNDS = {p.name: (p.lo, p.hi, p.hi_open) for m in JOINT_MODELS.values() for p in m.props.values()}
+_KW = [P(name, Num(lo=_BOUNDS[name][0], hi=_BOUNDS[name][1], hi_open=_BOUNDS[name][2]), _DOCS[name],
+         units=_UNITS[name]) for name in PROPS]
 
 
 def _given(call):
     out = {name: call.args[name.replace("-", "_")] for name in PROPS if call.args[name.replace("-", "_")] is not None}
     for k, v in call.extra.items():
-        out[k] = float(v)
+        # a user joint-model property: any finite number (an `[expr]` may give a string or inf)
+        try:
+            out[k] = Num().convert(v, call.location)
+        except ValueRangeError as exc:
+            raise exc.named(k) from None
     return out
 
 
@@ -87,8 +93,9 @@ def _check_default(call):
                  "point, its own groups and the groups of its two blocks.",
          examples=["block contact jmodel assign mohr", "block contact jmodel assign elastic range group 'base'"])
 def jmodel_assign(session, call):
-    e, sel = _contacts_in_range(session, call)
     name = _model_arg(call, "model")
+    _check_model_name(name, call.locations.get("model", call.location))    # an [expr] is known only now
+    e, sel = _contacts_in_range(session, call)
     jm = JOINT_MODELS[name]
     c = e.contacts
     c["jmodel"][sel] = jm.code
@@ -136,6 +143,7 @@ def contact_property(session, call):
 def material_default(session, call):
     s = mech(session.model)
     name = _model_arg(call, "jmodel")
+    _check_model_name(name, call.locations.get("jmodel", call.location))   # an [expr] is known only now
     props = _given(call)
     props.pop("property", None)
     _check(call, name or s["jmodel"], props)

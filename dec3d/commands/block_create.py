@@ -9,10 +9,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry.polyhedron import brick, polyhedron_from_faces, prism, tetrahedron
-from ..geometry.tunnel import tunnel
+from ..geometry.tunnel import tunnel, tunnel_block_count
 from ..model.blocks import add_blocks
+from .budget import check_blocks
 from .registry import command
-from .values import ANGLE, VEC3, Nums, Num, P, Text
+from .values import ANGLE, COORD, LENGTH, POINT, Nums, Num, P, Text
 
 GROUP_KW = [P("group", Text(), "group of the new blocks"),
             P("slot", Text(), "group slot (default 'Default')"),
@@ -22,6 +23,7 @@ GROUP_KW = [P("group", Text(), "group of the new blocks"),
 
 def _add(session, call, polys) -> None:
     m = session.model
+    check_blocks(session, len(polys), f"`{call.name}`", call.location)
     rows = add_blocks(m, polys, group=call.args["group"], slot=call.args["slot"])
     if call.args["face_group"] is not None:
         fs = m.blocks["face_start"][rows]
@@ -31,7 +33,7 @@ def _add(session, call, polys) -> None:
 
 
 @command("block create brick",
-         positional=[P("bounds", Nums(2, 6, counts=(2, 4, 6)), "x1 x2 [y1 y2 [z1 z2]]", required=True, units="m")],
+         positional=[P("bounds", Nums(2, 6, counts=(2, 4, 6), item=COORD), "x1 x2 [y1 y2 [z1 z2]]", required=True, units="m")],
          keywords=GROUP_KW,
          doc="Create a block spanning x1..x2, y1..y2, z1..z2 (a pair left out repeats the one before).",
          examples=["block create brick 0 1.292 -0.05 0 0.0 0.210 group 'S'", "block create brick 0 10",
@@ -44,7 +46,7 @@ def create_brick(session, call):
 
 
 @command("block create polyhedron",
-         keywords=[P("face", Nums(9, 10**6, multiple_of=3), "the corners x,y,z of one face, in order around it",
+         keywords=[P("face", Nums(9, 10**6, multiple_of=3, item=COORD), "the corners x,y,z of one face, in order around it",
                      repeat=True, units="m"), *GROUP_KW],
          doc="Create a convex block from its faces (every face given, either winding).",
          details="Corners closer than the tolerance are merged. The faces must be planar and close the "
@@ -60,8 +62,8 @@ def create_polyhedron(session, call):
 
 
 @command("block create prism",
-         keywords=[P("face-1", Nums(9, 10**6, multiple_of=3), "corners of one end face", required=True, units="m"),
-                   P("face-2", Nums(9, 10**6, multiple_of=3), "corners of the other end, in the same order",
+         keywords=[P("face-1", Nums(9, 10**6, multiple_of=3, item=COORD), "corners of one end face", required=True, units="m"),
+                   P("face-2", Nums(9, 10**6, multiple_of=3, item=COORD), "corners of the other end, in the same order",
                      required=True, units="m"), *GROUP_KW],
          doc="Create a prism between two polygons with as many corners (corner i joined to corner i).",
          examples=["block create prism face-1 0 0 0 1 0 0 0 1 0 face-2 0 0 1 1 0 1 0 1 1 group 'p'"])
@@ -71,7 +73,7 @@ def create_prism(session, call):
 
 
 @command("block create tetrahedron",
-         positional=[P("corners", Nums(12, 12), "four corners v1 v2 v3 v4", required=True, units="m")],
+         positional=[P("corners", Nums(12, 12, item=COORD), "four corners v1 v2 v3 v4", required=True, units="m")],
          keywords=GROUP_KW,
          doc="Create a tetrahedron on four corners.",
          examples=["block create tetrahedron 0 0 0 1 0 0 0 1 0 0 0 1"])
@@ -83,16 +85,16 @@ def create_tetrahedron(session, call):
 @command("block create tunnel",
          keywords=[P("dip", ANGLE, "plunge of the axis, degrees", default=0.0),
                    P("dip-direction", ANGLE, "trend of the axis, degrees clockwise from +y", default=0.0),
-                   P("radius", Num(lo=0, lo_open=True), "radius of the opening", required=True, units="m"),
-                   P("length", Nums(2, 2), "axial start and end, from the origin", required=True, units="m"),
-                   P("origin", VEC3, "a point of the axis", default=(0.0, 0.0, 0.0), units="m"),
+                   P("radius", LENGTH, "radius of the opening", required=True, units="m"),
+                   P("length", Nums(2, 2, item=COORD), "axial start and end, from the origin", required=True, units="m"),
+                   P("origin", POINT, "a point of the axis", default=(0.0, 0.0, 0.0), units="m"),
                    P("blocks-axial", Num(integer=True, lo=1), "blocks along the axis", default=1),
                    P("blocks-radial", Num(integer=True, lo=1), "rings between the opening and the boundary",
                      default=1),
                    P("blocks-tangential", Num(integer=True, lo=1), "blocks per 45° around the axis", default=1),
-                   P("boundary", Num(lo=0, lo_open=True), "distance from the opening to the square boundary",
+                   P("boundary", LENGTH, "distance from the opening to the square boundary",
                      required=True, units="m"),
-                   P("radius-ratio", Num(lo=0, lo_open=True), "growth of the ring widths outwards", default=1.0),
+                   P("radius-ratio", Num(lo=0, lo_open=True, hi=1000), "growth of the ring widths outwards", default=1.0),
                    *GROUP_KW],
          doc="Create the blocks of a square rock mass around a circular tunnel (opening filled).",
          details="The axis runs along the dip vector (dip 0, dip-direction 0: along +y). The section is the "
@@ -104,6 +106,8 @@ def create_tetrahedron(session, call):
                    "blocks-radial 10 blocks-tangential 5 boundary 9 radius-ratio 1.4"])
 def create_tunnel(session, call):
     a = call.args
+    check_blocks(session, tunnel_block_count(a["blocks_axial"], a["blocks_radial"], a["blocks_tangential"]),
+                 "this tunnel", call.location)
     polys = tunnel(a["dip"], a["dip_direction"], a["radius"], a["length"], a["blocks_axial"],
                    a["blocks_radial"], a["blocks_tangential"], a["boundary"], a["radius_ratio"],
                    origin=a["origin"], tol=session.model.tolerance)

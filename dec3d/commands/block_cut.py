@@ -1,16 +1,17 @@
 """`block cut joint-set` and `block tolerance`."""
 from __future__ import annotations
 
-from ..geometry.cutting import cut_joint_set
+from ..geometry.cutting import cut_joint_set, joint_set_estimate
+from .budget import check_blocks
 from .registry import command
-from .values import ANGLE, FLAG, VEC3, Num, P
+from .values import ANGLE, FLAG, LENGTH, POINT, Num, P
 
 
 @command("block cut joint-set",
          keywords=[P("dip", ANGLE, "dip of the joints, degrees down from horizontal", default=0.0),
                    P("dip-direction", ANGLE, "dip direction, degrees clockwise from +y (north)", default=0.0),
-                   P("origin", VEC3, "a point on the first joint", default=(0.0, 0.0, 0.0), units="m"),
-                   P("spacing", Num(lo=0, lo_open=True), "distance between joints (none: one joint)", units="m"),
+                   P("origin", POINT, "a point on the first joint", default=(0.0, 0.0, 0.0), units="m"),
+                   P("spacing", LENGTH, "distance between joints (none: one joint)", units="m"),
                    P("number", Num(integer=True, lo=1), "number of joints, from the origin along the normal"),
                    P("join", FLAG, "join the pieces of each block (one rigid body)", bare=True),
                    P("persistence", Num(lo=0, hi=1), "fraction of blocks cut", supported=False),
@@ -30,6 +31,9 @@ from .values import ANGLE, FLAG, VEC3, Num, P
 def block_cut_joint_set(session, call):
     a = call.args
     mask = session.range_mask(call, "block")
+    new = joint_set_estimate(session.model, a["dip"], a["dip_direction"], origin=a["origin"], spacing=a["spacing"],
+                             number=a["number"], mask=mask)
+    check_blocks(session, new, "this joint set", call.location)
     made = cut_joint_set(session.model, a["dip"], a["dip_direction"], origin=a["origin"], spacing=a["spacing"],
                          number=a["number"], mask=mask, join=bool(a["join"]))
     session.results["blocks_made"] = float(made)

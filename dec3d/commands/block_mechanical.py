@@ -5,7 +5,7 @@ import numpy as np
 
 from ..physics.rigid import engine, mech
 from .registry import command
-from .values import FLAG, Choice, Num, Nums, P
+from .values import FLAG, Choice, Deferred, Num, Nums, P, ValueRangeError
 
 
 _DAMPING_NOT_YET = ("rayleigh", "maxwell")
@@ -24,14 +24,29 @@ def _check_damping(call):
         raise BindError(f"{mode} damping takes one value", where)
     if mode == "none" and call.args["alpha"]:
         raise BindError("`damping none` takes no value", where)
-    if call.args["alpha"] and call.args["alpha"][0] < 0:
-        raise BindError("the damping value must be ≥ 0", where)
+    if call.args["alpha"] and not isinstance(call.args["alpha"][0], Deferred):
+        _alpha(mode, call.args["alpha"][0], where)      # an [expr] is checked when the command runs
+
+
+#: local and combined damping remove the fraction α of the unbalanced force's power: α = 1 would stop
+#: every motion, α < 0 feed energy in (3DEC theory Eq. 79: 0 ≤ α < 1); the global servo's target
+#: ratio is any positive number
+_ALPHA = {"local": Num(lo=0, hi=1, hi_open=True), "combined": Num(lo=0, hi=1, hi_open=True),
+          "global": Num(lo=0, lo_open=True)}
+
+
+def _alpha(mode, value, where) -> float:
+    rule = _ALPHA.get(mode, Num())
+    try:
+        return rule.convert(value, where)
+    except ValueRangeError as exc:
+        raise exc.named(f"{mode} damping") from None
 
 
 @command("block mechanical damping",
          positional=[P("mode", Choice(("local", "global", "combined", "none", "rayleigh", "maxwell")),
                        "damping form", required=True),
-                     P("alpha", Nums(0, 6), "coefficient α of local and combined damping; target ratio of global",
+                     P("alpha", Nums(0, 6), "coefficient α of local and combined damping, in [0, 1); target ratio of global, > 0",
                        default=())],
          check=_check_damping,
          doc="Set the mechanical damping (default: local, α = 0.8, with density scaling).",
@@ -45,12 +60,14 @@ def _check_damping(call):
 def damping(session, call):
     s = mech(session.model)
     mode = call.args["mode"]
+    where = call.locations.get("alpha", call.location)
+    alpha = _alpha(mode, call.args["alpha"][0], where) if call.args["alpha"] else None
     s["damping"] = mode
     if mode in ("local", "combined"):
-        s["alpha"] = float(call.args["alpha"][0]) if call.args["alpha"] else 0.8
+        s["alpha"] = alpha if alpha is not None else 0.8
     if mode == "global":
         s["servo"] = []
-        s["servo_ratio"] = float(call.args["alpha"][0]) if call.args["alpha"] else 0.5
+        s["servo_ratio"] = alpha if alpha is not None else 0.5
 
 
 @command("block mechanical mass-scale",

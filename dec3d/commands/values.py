@@ -53,15 +53,46 @@ def _number_literal(tok):
     return int(s)
 
 
+class ValueRangeError(BindError):
+    """A value of the right kind outside what its keyword accepts.
+
+    `detail` is the rule and the value ("must be in [0, 90) degrees, got 95"); the binder and
+    the session put the keyword in front (`named`), so the message says which value is wrong."""
+
+    def __init__(self, detail: str, location=None):
+        super().__init__(f"value {detail}", location)
+        self.detail = detail
+
+    def named(self, name: str) -> "ValueRangeError":
+        self.message = f"`{name}` {self.detail}"
+        self.args = (self.message,)
+        return self
+
+
+#: largest coordinate or length dec3d accepts (m): beyond it float64 geometry loses every digit
+#: of a block's size (1e12 m leaves 1e-4 m of resolution) and squares of lengths overflow sooner
+COORD_LIMIT = 1e12
+#: integers are 64-bit (as FISH integers); a larger count could not be held by any array
+INT_LIMIT = 2**63 - 1
+
+
+def _g(x) -> str:
+    return f"{x:g}" if isinstance(x, float) else str(x)
+
+
 @dataclass(frozen=True)
 class Num(ValueType):
-    """A real number. `angle=True`: given in degrees, stored in radians."""
+    """A real number. `angle=True`: given in degrees, stored in radians.
+
+    Every number must be finite; `lo`/`hi` bound it (`lo_open`/`hi_open`: the bound itself
+    excluded); an integer must fit 64 bits."""
 
     integer: bool = False
     angle: bool = False
     lo: float | None = None
     hi: float | None = None
     lo_open: bool = False     # lo itself excluded (strictly positive, ...)
+    hi_open: bool = False     # hi itself excluded (friction < 90°, damping < 1)
 
     @property
     def label(self):  # type: ignore[override]
@@ -70,32 +101,56 @@ class Num(ValueType):
     def literal(self, tok):
         return _number_literal(tok)
 
+    def range_text(self) -> str:
+        """The valid range in words: `in [0, 90) degrees`, `> 0`, `≥ 1`; "" when unbounded."""
+        unit = " degrees" if self.angle else ""
+        lo, hi = self.lo, self.hi
+        if lo is not None and hi is not None:
+            return f"in {'(' if self.lo_open else '['}{_g(lo)}, {_g(hi)}{')' if self.hi_open else ']'}{unit}"
+        if lo is not None:
+            return f"{'>' if self.lo_open else '≥'} {_g(lo)}{unit}"
+        if hi is not None:
+            return f"{'<' if self.hi_open else '≤'} {_g(hi)}{unit}"
+        return ""
+
     def convert(self, value, where):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise BindError(f"expected a number, got {value!r}", where)
+        if isinstance(value, float) and not math.isfinite(value):
+            raise ValueRangeError(f"must be a finite number, got {value!r}", where)
         if self.integer:
             if isinstance(value, float):
                 if value != int(value):
                     raise BindError(f"expected an integer, got {value!r}", where)
                 value = int(value)
+            if abs(value) > INT_LIMIT:
+                raise ValueRangeError(f"must be an integer of at most 64 bits (|n| ≤ 2^63 - 1), got {_big(value)}",
+                                      where)
         else:
-            value = float(value)
-            if not math.isfinite(value):
-                raise BindError(f"expected a finite number, got {value!r}", where)
-        if self.lo is not None and (value < self.lo or (self.lo_open and value == self.lo)):
-            rel = ">" if self.lo_open else "≥"
-            raise BindError(f"value {value:g} out of range: must be {rel} {self.lo:g}", where)
-        if self.hi is not None and value > self.hi:
-            raise BindError(f"value {value:g} out of range: must be ≤ {self.hi:g}", where)
+            try:
+                value = float(value)
+            except OverflowError:
+                raise ValueRangeError(f"must be a finite number, got {_big(value)}", where) from None
+        lo, hi = self.lo, self.hi
+        if ((lo is not None and (value < lo or (self.lo_open and value == lo)))
+                or (hi is not None and (value > hi or (self.hi_open and value == hi)))):
+            raise ValueRangeError(f"must be {self.range_text()}, got {_g(value)}", where)
         if self.angle:
             value = math.radians(value)
         return value
 
     def describe(self):
-        s = self.label
-        if self.angle:
-            s += " (degrees)"
-        return s
+        rng = self.range_text()
+        if rng:
+            return f"{self.label} {rng}"
+        return self.label + (" (degrees)" if self.angle else "")
+
+
+def _big(n) -> str:
+    """An integer too large to print whole (Python refuses str() beyond 4300 digits)."""
+    if isinstance(n, int) and n.bit_length() > 64:
+        return f"an integer of {n.bit_length()} bits"
+    return _g(n)
 
 
 @dataclass(frozen=True)
@@ -130,11 +185,13 @@ class Nums(ValueType):
 
     def describe(self):
         lab = self.item.label
+        rng = self.item.range_text()
+        each = f", each {rng}" if rng else ""
         if self.least == self.most == 3:
-            return "<v>" + (" (degrees)" if self.item.angle else "")
+            return "<v>" + (" (degrees)" if self.item.angle and not rng else "") + each
         if self.least == self.most:
-            return " ".join([lab] * self.least)
-        return f"{lab} ×{self.least}..{self.most if self.most < 10**6 else 'n'}"
+            return " ".join([lab] * self.least) + each
+        return f"{lab} ×{self.least}..{self.most if self.most < 10**6 else 'n'}" + each
 
 
 @dataclass(frozen=True)
@@ -254,10 +311,16 @@ def P(name: str, value: ValueType | None = None, doc: str = "", **kw) -> Param:
 
 
 FLOAT = Num()
+#: a coordinate (m)
+COORD = Num(lo=-COORD_LIMIT, hi=COORD_LIMIT)
+#: a length or distance (m), > 0
+LENGTH = Num(lo=0, lo_open=True, hi=COORD_LIMIT)
 INT = Num(integer=True)
 POS_INT = Num(integer=True, lo=0)
 ANGLE = Num(angle=True)
 VEC3 = Nums(3, 3)
+#: a point (m)
+POINT = Nums(3, 3, item=COORD)
 TEXT = Text()
 ONOFF = OnOff()
 FLAG = Flag()

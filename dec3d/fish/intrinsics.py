@@ -96,7 +96,9 @@ def _math1(name, f, domain=None):
         _number(x, f"`{name}`: the argument")
         try:
             return _finite(f(x))
-        except (ValueError, OverflowError):
+        except OverflowError:
+            raise FishValueError(f"`{name}`: numeric overflow: the result for {to_string(x)} is too large") from None
+        except ValueError:
             raise FishValueError(f"`{name}`: {to_string(x)} is outside its domain{domain or ''}") from None
     intrinsic(name, 1)(fn)
 

@@ -50,15 +50,50 @@ def joint_set_offsets(normal, origin, spacing: float | None, number: int | None,
         return np.array([d0])
     if not spacing > 0:
         raise GeometryError(f"joint set: spacing must be positive, got {spacing:g}")
-    if number is not None:
-        if number < 1:
-            raise GeometryError(f"joint set: number must be at least 1, got {number}")
-        return d0 + spacing * np.arange(int(number), dtype=np.float64)
-    k0 = math.floor((smin - d0) / spacing)
-    k1 = math.ceil((smax - d0) / spacing)
+    k0, k1 = _plane_range(d0, spacing, number, smin, smax)
     if k1 - k0 > 10_000_000:
         raise GeometryError(f"joint set: {k1 - k0} planes of spacing {spacing:g} m: spacing too small")
     return d0 + spacing * np.arange(k0, k1 + 1, dtype=np.float64)
+
+
+def _plane_range(d0: float, spacing: float, number: int | None, smin: float, smax: float) -> tuple[int, int]:
+    """Indices k0..k1 of the planes d0 + k·spacing that may meet [smin, smax] (one plane of margin
+    each side); with `number`, only k = 0 .. number−1 (planes beyond the blocks cut nothing, so a
+    large `number` costs nothing)."""
+    if number is not None and number < 1:
+        raise GeometryError(f"joint set: number must be at least 1, got {number}")
+    span = max(abs(smin - d0), abs(smax - d0)) / spacing
+    if not span < 1e15:
+        raise GeometryError(f"joint set: spacing {spacing:g} m is too small for blocks {smax - smin:g} m across")
+    k0 = math.floor((smin - d0) / spacing)
+    k1 = math.ceil((smax - d0) / spacing)
+    if number is not None:
+        k0, k1 = max(k0, 0), min(k1, int(number) - 1)
+    return k0, k1
+
+
+def joint_set_estimate(model, dip: float, dip_direction: float, origin=(0.0, 0.0, 0.0),
+                       spacing: float | None = None, number: int | None = None, mask=None) -> int:
+    """At most how many new blocks `cut_joint_set` with these arguments makes, worked out from
+    each block's extent along the set's normal before anything is allocated per plane: a convex
+    block crossed by m parallel planes falls into at most m + 1 pieces. (Capped at 10^18.)"""
+    rows = _selection(model, mask)
+    if rows.size == 0 or spacing is None:
+        return int(rows.size)                     # one plane: each block in two at most
+    n = dip_normal(dip, dip_direction)
+    b = model.blocks
+    starts, counts = b["vert_start"][rows], b["vert_count"][rows]
+    s = model.vertices["pos"][range_index(starts, counts)] @ n
+    offs = np.concatenate(([0], np.cumsum(counts)[:-1])).astype(np.int64)
+    lo, hi = np.minimum.reduceat(s, offs), np.maximum.reduceat(s, offs)
+    d0 = float(np.dot(n, np.asarray(origin, dtype=np.float64)))
+    # planes strictly inside each block's extent: k with lo < d0 + k·spacing < hi
+    first = np.floor((lo - d0) / spacing) + 1
+    last = np.ceil((hi - d0) / spacing) - 1
+    if number is not None:
+        first, last = np.maximum(first, 0), np.minimum(last, int(number) - 1)
+    total = float(np.clip(last - first + 1, 0, None).sum())
+    return int(total) if total < 1e18 else 10**18
 
 
 def cut_by_planes(model, normal, offsets, mask=None, join: bool = False) -> int:
@@ -125,4 +160,6 @@ def cut_joint_set(model, dip: float, dip_direction: float, origin=(0.0, 0.0, 0.0
     s = model.vertices["pos"][vidx] @ n
     offsets = joint_set_offsets(n, np.asarray(origin, dtype=np.float64), spacing, number,
                                 float(s.min()), float(s.max()))
+    if offsets.size == 0:
+        return 0
     return cut_by_planes(model, n, offsets, mask=mask, join=join)

@@ -47,9 +47,17 @@ def _section_points(radius: float, half: float, nr: int, nt: int, ratio: float):
     if abs(ratio - 1.0) < 1e-12:
         frac = np.arange(nr + 1) / nr
     else:
-        frac = (ratio ** np.arange(nr + 1) - 1.0) / (ratio ** nr - 1.0)
+        with np.errstate(over="ignore", invalid="ignore"):
+            frac = (ratio ** np.arange(nr + 1) - 1.0) / (ratio ** nr - 1.0)
     frac[-1] = 1.0
+    if not (np.isfinite(frac).all() and (np.diff(frac) > 0).all()):
+        raise GeometryError(f"tunnel: radius-ratio {ratio:g} over {nr} rings makes rings of zero width")
     return inner[:, None, :] + frac[None, :, None] * (outer - inner)[:, None, :]
+
+
+def tunnel_block_count(blocks_axial: int, blocks_radial: int, blocks_tangential: int) -> int:
+    """Blocks `tunnel` makes: per axial slice, 8·nt rays, each with one opening prism and nr rings."""
+    return int(blocks_axial) * 8 * int(blocks_tangential) * (int(blocks_radial) + 1)
 
 
 def tunnel(dip: float, dip_direction: float, radius: float, length: tuple[float, float],

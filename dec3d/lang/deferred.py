@@ -13,6 +13,7 @@ class Deferred:
     kind: str            # "expr" or "at"
     node: Any            # parsed expression tree (for "at": ("name", name, col))
     token: Any           # the lark token, for error locations
+    where: Any = None    # its LazyLocation (errors of the evaluated value point at the value itself)
 
     def __repr__(self) -> str:
         return str(self.token)

@@ -183,23 +183,25 @@ def check_names(node: Node, known: Callable[[str], str | None]) -> list[tuple[st
 
     `known(name)` returns None when the name is fine, else a kind: "undefined",
     "fish-function", "fish-variable", "intrinsic" (not supported), "unknown-function".
+    The walk keeps its own stack (a 10 000-term sum is a tree that deep).
     """
     problems: list[tuple[str, str, int]] = []
-
-    def walk(n):
+    stack = [node]
+    while stack:
+        n = stack.pop()
         tag = n[0]
         if tag == "const":
-            return
+            continue
         if tag == "name":
             if n[1] in CONSTANTS:
-                return
+                continue
             if "." in n[1] and n[1].startswith(_KNOWN_NAMESPACES):
                 problems.append(("intrinsic", n[1], n[2]))
-                return
+                continue
             k = known(n[1])
             if k:
                 problems.append((k, n[1], n[2]))
-            return
+            continue
         if tag == "call":
             name = n[1]
             if name not in INTRINSICS:
@@ -207,17 +209,12 @@ def check_names(node: Node, known: Callable[[str], str | None]) -> list[tuple[st
                 if k is None or k == "undefined":
                     k = "intrinsic" if name.startswith(_KNOWN_NAMESPACES) else "unknown-function"
                 problems.append((k, name, n[3]))
-            for a in n[2]:
-                walk(a)
-            return
+            stack.extend(reversed(n[2]))
+            continue
         if tag == "assign":
-            walk(n[3])
-            return
-        for child in n[1:]:
-            if isinstance(child, tuple):
-                walk(child)
-
-    walk(node)
+            stack.append(n[3])
+            continue
+        stack.extend(reversed([c for c in n[1:] if isinstance(c, tuple)]))
     return problems
 
 
@@ -229,56 +226,111 @@ class EvalContext:
         self.write = write
 
 
+#: FISH integers are 64-bit signed (Itasca FISH reference, "Data Types")
+INT_MIN, INT_MAX = -(2**63), 2**63 - 1
+#: longest string an expression may make (characters)
+MAX_STRING = 1_000_000
+
+
+def _checked(v):
+    """A value an expression made, refused when it is not finite, wider than 64 bits or too long."""
+    if isinstance(v, float):
+        if not math.isfinite(v):
+            raise ExpressionError(f"numeric overflow: the result is {v!r}, not a finite number")
+    elif isinstance(v, int) and not isinstance(v, bool):
+        if not INT_MIN <= v <= INT_MAX:
+            raise ExpressionError("integer overflow: the result is beyond the 64-bit range of FISH integers "
+                                  "(±9.2e18)", hint="write a real number (e.g. 2.0 instead of 2) to compute in reals")
+    elif isinstance(v, str) and len(v) > MAX_STRING:
+        raise ExpressionError(f"string too long: {len(v):,} characters (at most {MAX_STRING:,})")
+    return v
+
+
 def evaluate(node: Node, ctx: EvalContext) -> Any:
-    """Evaluate a parsed statement or expression. Assignment stores and returns the value."""
-    tag = node[0]
-    if tag == "const":
-        return node[1]
-    if tag == "name":
-        name = node[1]
-        if name in ctx.variables:
-            return ctx.variables[name]
-        if name in CONSTANTS:
-            return CONSTANTS[name]
-        raise ExpressionError(f"undefined FISH variable `{name}`")
-    if tag == "bin":
-        return _binary(node[1], evaluate(node[2], ctx), evaluate(node[3], ctx))
-    if tag == "neg":
-        v = evaluate(node[1], ctx)
-        if isinstance(v, (str, bool)):
-            raise ExpressionError(f"cannot negate {v!r}")
-        return -v
-    if tag == "cmp":
-        return _compare(node[1], evaluate(node[2], ctx), evaluate(node[3], ctx))
-    if tag == "and":
-        return bool(evaluate(node[1], ctx)) and bool(evaluate(node[2], ctx))
-    if tag == "or":
-        return bool(evaluate(node[1], ctx)) or bool(evaluate(node[2], ctx))
-    if tag == "not":
-        return not bool(evaluate(node[1], ctx))
-    if tag == "call":
-        name = node[1]
-        if name not in INTRINSICS:
-            raise NotSupportedError(f"FISH function `{name}` is not supported yet")
-        fn, lo, hi = INTRINSICS[name]
-        args = [evaluate(a, ctx) for a in node[2]]
-        if len(args) < lo or (hi is not None and len(args) > hi):
-            want = str(lo) if lo == hi else f"{lo}..{hi if hi is not None else 'n'}"
-            raise ExpressionError(f"`{name}` takes {want} argument(s), got {len(args)}")
-        try:
-            return fn(ctx, *args)
-        except (ValueError, OverflowError, TypeError) as exc:
-            raise ExpressionError(f"`{name}`: {exc}") from None
-    if tag == "assign":
-        _, name, op, rhs, _col = node
-        value = evaluate(rhs, ctx)
-        if op != "=":
-            if name not in ctx.variables:
+    """Evaluate a parsed statement or expression. Assignment stores and returns the value.
+
+    The walk keeps its own stack of pending nodes and values, so a tree of any depth (a
+    generated 10 000-term sum) evaluates without Python recursion. Every intermediate result
+    is checked (`_checked`): finite reals, 64-bit integers, strings of at most MAX_STRING.
+    """
+    vals: list[Any] = []
+    todo: list[tuple[Node, int]] = [(node, 0)]
+    while todo:
+        n, step = todo.pop()
+        tag = n[0]
+        if tag == "const":
+            vals.append(_checked(n[1]))
+        elif tag == "name":
+            name = n[1]
+            if name in ctx.variables:
+                vals.append(ctx.variables[name])
+            elif name in CONSTANTS:
+                vals.append(CONSTANTS[name])
+            else:
                 raise ExpressionError(f"undefined FISH variable `{name}`")
-            value = _binary(op[0], ctx.variables[name], value)
-        ctx.variables[name] = value
-        return value
-    raise ExpressionError(f"cannot evaluate {tag}")  # pragma: no cover - the grammar makes no other tags
+        elif tag in ("bin", "cmp"):
+            if step == 0:
+                todo += [(n, 1), (n[3], 0), (n[2], 0)]     # left, then right, then the operator
+            else:
+                b = vals.pop()
+                a = vals.pop()
+                vals.append(_checked(_binary(n[1], a, b)) if tag == "bin" else _compare(n[1], a, b))
+        elif tag in ("neg", "not"):
+            if step == 0:
+                todo += [(n, 1), (n[1], 0)]
+            else:
+                v = vals.pop()
+                if tag == "not":
+                    vals.append(not bool(v))
+                elif isinstance(v, (str, bool)):
+                    raise ExpressionError(f"cannot negate {v!r}")
+                else:
+                    vals.append(_checked(-v))
+        elif tag in ("and", "or"):
+            if step == 0:
+                todo += [(n, 1), (n[1], 0)]
+            elif step == 1:
+                a = bool(vals.pop())
+                if a == (tag == "or"):         # decided by the left side: the right is not evaluated
+                    vals.append(a)
+                else:
+                    todo += [(n, 2), (n[2], 0)]
+            else:
+                vals.append(bool(vals.pop()))
+        elif tag == "call":
+            name = n[1]
+            if step == 0:
+                if name not in INTRINSICS:
+                    raise NotSupportedError(f"FISH function `{name}` is not supported yet")
+                todo.append((n, 1))
+                todo += [(a, 0) for a in reversed(n[2])]
+            else:
+                fn, lo, hi = INTRINSICS[name]
+                k = len(n[2])
+                args = vals[len(vals) - k:] if k else []
+                del vals[len(vals) - k:]
+                if len(args) < lo or (hi is not None and len(args) > hi):
+                    want = str(lo) if lo == hi else f"{lo}..{hi if hi is not None else 'n'}"
+                    raise ExpressionError(f"`{name}` takes {want} argument(s), got {len(args)}")
+                try:
+                    vals.append(_checked(fn(ctx, *args)))
+                except (ValueError, OverflowError, TypeError) as exc:
+                    raise ExpressionError(f"`{name}`: {exc}") from None
+        elif tag == "assign":
+            _, name, op, rhs, _col = n
+            if step == 0:
+                todo += [(n, 1), (rhs, 0)]
+            else:
+                value = vals.pop()
+                if op != "=":
+                    if name not in ctx.variables:
+                        raise ExpressionError(f"undefined FISH variable `{name}`")
+                    value = _checked(_binary(op[0], ctx.variables[name], value))
+                ctx.variables[name] = value
+                vals.append(value)
+        else:  # pragma: no cover - the grammar makes no other tags
+            raise ExpressionError(f"cannot evaluate {tag}")
+    return vals[0]
 
 
 def _binary(op: str, a, b):
@@ -301,12 +353,19 @@ def _binary(op: str, a, b):
             return a / b
         if op == "^":
             if isinstance(a, int) and isinstance(b, int) and b >= 0:
+                if abs(a) > 1 and b * math.log2(abs(a)) > 64:     # refused before the digits are made
+                    raise ExpressionError(f"integer overflow: {a}^{b} is beyond the 64-bit range of FISH "
+                                          "integers (±9.2e18)",
+                                          hint="write a real number (e.g. 2.0 instead of 2) to compute in reals")
                 return a ** b
-            return float(a) ** float(b)
+            r = float(a) ** float(b)
+            if isinstance(r, complex):
+                raise ExpressionError(f"{a}^{b} is not a real number")
+            return r
     except ZeroDivisionError:
         raise ExpressionError("division by zero") from None
     except OverflowError:
-        raise ExpressionError("numeric overflow") from None
+        raise ExpressionError(f"numeric overflow: {_to_string(a)} {op} {_to_string(b)} is too large") from None
     raise ExpressionError(f"unknown operator {op}")  # pragma: no cover
 
 

@@ -18,7 +18,7 @@ from pathlib import Path
 from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
-from ..errors import DeckSyntaxError, SourceLocation
+from ..errors import CONTROL_CHARS, DeckSyntaxError, SourceLocation, printable
 from .prepass import FishBlock, lift_fish
 
 _GRAMMAR_DIR = Path(__file__).parent
@@ -59,7 +59,12 @@ class ParsedDeck:
 
 
 def normalise(text: str) -> str:
-    """CRLF/CR to LF, a final newline, tabs kept (carets expand them)."""
+    """A leading UTF-8 byte-order mark and a trailing DOS end-of-file mark dropped, CRLF/CR to LF,
+    a final newline, tabs kept (carets expand them)."""
+    if text.startswith("\ufeff"):
+        text = text[1:]
+    if text.endswith("\x1a"):            # a DOS end-of-file mark (Ctrl-Z) after the last line
+        text = text[:-1]
     text = text.replace("\r\n", "\n").replace("\r", "\n")
     if not text.endswith("\n"):
         text += "\n"
@@ -80,12 +85,27 @@ def parse_deck(text: str, filename: str = "<input>", stack=()) -> ParsedDeck:
                     lines.append(RawLine(tuple(current)))
                     current = []
             else:
+                if tok.type in ("STRING", "EXPR"):
+                    _no_control(tok, filename, source_lines, stack)
                 current.append(tok)
     except UnexpectedInput as exc:
         raise _syntax_error(exc, filename, source_lines, stack) from None
     if current:
         lines.append(RawLine(tuple(current)))
     return ParsedDeck(filename, source_lines, lines, fish)
+
+
+def _no_control(tok: Token, filename, source_lines, stack) -> None:
+    """Quoted text and `[...]` may hold any printable character, but no control character: they
+    would reach file names (a NUL) or the terminal (ESC sequences, bidirectional overrides)."""
+    m = CONTROL_CHARS.search(str(tok))
+    if m is None:
+        return
+    text = source_lines[tok.line - 1] if 0 < tok.line <= len(source_lines) else ""
+    what = "a string" if tok.type == "STRING" else "an inline expression"
+    raise DeckSyntaxError(f"control character {printable(m.group())} in {what}",
+                          SourceLocation(filename, tok.line, tok.column + m.start(), text, 1, tuple(stack)),
+                          "a deck is plain text: remove the character (or write it out in words)")
 
 
 def _syntax_error(exc: UnexpectedInput, filename, source_lines, stack) -> DeckSyntaxError:
@@ -99,6 +119,8 @@ def _syntax_error(exc: UnexpectedInput, filename, source_lines, stack) -> DeckSy
             msg, hint = "unterminated inline expression", "close `[` with `]` on the same line"
         elif ch == "]":
             msg, hint = "`]` without a matching `[`", None
+        elif ch == "\ufffd":
+            msg, hint = "bytes that are not UTF-8 text", "save the deck as UTF-8 (or plain ASCII)"
         else:
             msg = f"unexpected character {ch!r}"
             hint = "delimiters are space , ( ) =; comments start with ;; continue a line with & or ..."

@@ -41,6 +41,20 @@ class Prop:
     to_column: Callable[[float], float] = float
     from_column: Callable[[float], float] = float
     default: float = 0.0
+    #: valid user values: [lo, hi], `hi_open` excludes hi (angles below 90°); None: unbounded
+    lo: float | None = 0.0
+    hi: float | None = None
+    hi_open: bool = False
+
+
+def _angle(name, column, doc, hi_open=True, **kw) -> Prop:
+    """An angle property: degrees in [0, 90), kept as its tangent. Above 90° the tangent turns
+    negative (a block would slide that 30° holds)."""
+    return Prop(name, column, doc, "deg", _tan_deg, _atan_deg, hi=90.0, hi_open=hi_open, **kw)
+
+
+# friction 90 is a 3DEC idiom for "never slips" (shared decks use it): tan 90° in floating point is
+# 1.6e16, finite, so 90 itself is accepted for the friction angles; the dilation angle stays below 90
 
 
 @dataclass
@@ -95,13 +109,13 @@ jmodel("elastic", MODEL_ELASTIC, "linear elastic joint, no tension (3DEC's `elas
 
 jmodel("mohr", MODEL_MOHR, "Coulomb slip with tension cut-off, cohesion and tension lost at first failure, "
        "residual values and dilation (3DEC theory Eqs. 33-43 with the errata)", _STIFF + [
-           Prop("friction", P_TANF, "friction angle φ", "deg", _tan_deg, _atan_deg),
+           _angle("friction", P_TANF, "friction angle φ (90: never slips)", hi_open=False),
            Prop("cohesion", P_COH, "cohesion c", "Pa"),
            Prop("tension", P_TEN, "tensile strength T", "Pa"),
-           Prop("dilation", P_TANDIL, "dilation angle ψ", "deg", _tan_deg, _atan_deg),
+           _angle("dilation", P_TANDIL, "dilation angle ψ"),
            Prop("dilation-zero", P_ZDIL, "shear displacement at which dilation stops (0: never)", "m"),
-           Prop("friction-residual", P_TANF_RES, "residual friction angle (default: the friction angle)", "deg",
-                _tan_deg, _atan_deg, default=math.nan),
+           _angle("friction-residual", P_TANF_RES, "residual friction angle (default: the friction angle)",
+                  hi_open=False, default=math.nan),
            Prop("cohesion-residual", P_COH_RES, "residual cohesion", "Pa"),
            Prop("tension-residual", P_TEN_RES, "residual tensile strength", "Pa"),
        ])

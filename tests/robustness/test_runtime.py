@@ -126,9 +126,10 @@ def test_writers_refuse_non_finite_values_and_write_nothing(session, tmp_path):
     _run(session, STACK)
     before = sorted(os.listdir(tmp_path))
     session.model.vertices["pos"][5, 1] = np.nan
-    with pytest.raises(Dec3dError, match=r"<input>:1:1: error: refusing to write 'Points': it holds a non-finite "
-                                         r"value \(nan at row 5\); nothing was written"):
+    with pytest.raises(Dec3dError, match=r"refusing to write 'Points': it holds a non-finite "
+                                         r"value \(nan at row 5\); nothing was written") as e:
         _run(session, "block vtk 'bad'\n")
+    assert e.value.format().startswith("<input>:1:1: error: refusing to write 'Points'")
     with pytest.raises(Dec3dError, match=r"refusing to write 'vertices.pos'.*at row 5"):
         _run(session, "model save 'bad'\n")
     session.model.vertices["pos"][5, 1] = 0.0
