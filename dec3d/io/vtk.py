@@ -139,7 +139,7 @@ def write_vtu(model, path: str | os.PathLike) -> str:
     parts.append(_data_array("faces", faces, ind + "  "))
     parts.append(_data_array("faceoffsets", faceoffs, ind + "  "))
     parts.append("      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n")
-    with open(path, "w", encoding="ascii", newline="\n") as fh:
+    with open(path, "w", encoding="utf-8", newline="\n") as fh:
         fh.write("".join(parts))
     return path
 
@@ -158,7 +158,7 @@ def write_pvd(path: str | os.PathLike, entries: list[tuple[float, str]]) -> str:
         rel = os.path.relpath(os.path.abspath(f), base)
         lines.append(f'    <DataSet timestep="{float(t)!r}" group="" part="0" file={quoteattr(rel)}/>\n')
     lines.append("  </Collection>\n</VTKFile>\n")
-    with open(path, "w", encoding="ascii", newline="\n") as fh:
+    with open(path, "w", encoding="utf-8", newline="\n") as fh:
         fh.write("".join(lines))
     return path
 
