@@ -4,7 +4,7 @@ Commands that can make blocks in numbers the deck does not state directly (a joi
 with a small spacing, a tunnel with many rings) estimate what they will make before doing
 any work, and refuse with the estimate when it is over the budget; nothing is changed.
 The budget belongs to the session (`model new` keeps it) and is raised or lowered by
-`model budget`. Expressions have fixed limits of their own (`dec3d.lang.expr`).
+`model budget`. Expressions have fixed limits of their own (`dec3d.fish.values`).
 """
 from __future__ import annotations
 

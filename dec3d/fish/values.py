@@ -12,7 +12,7 @@ import math
 from ..errors import ExpressionError
 
 INT_MAX = 2 ** 63 - 1
-MAX_STRING = 1_000_000           # characters in one FISH string (as lang/expr's bind-time evaluator)
+MAX_STRING = 1_000_000           # characters in one FISH string
 MAX_LIST = 10_000_000            # items in one FISH list / array
 
 
