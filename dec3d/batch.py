@@ -270,7 +270,7 @@ def _run_shipped(task: dict) -> dict:
 # ------------------------------------------------------------------ the batch
 def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch", *, mode: str = "grid",
         workers: int | None = None, scheduler: str | None = None, client=None, retries: int = 3,
-        rerun_failed: bool = False, progress: bool | None = None,
+        rerun_failed: bool = False, progress: bool | str | None = None,
         on_result: Callable[[dict], None] | None = None, warn: Callable[[str], None] | None = None):
     """Run ``deck`` once per combination of ``params`` ({name: [values]}); return the table (a pandas
     DataFrame when pandas is installed, else a list of dicts), also written to ``out/results.csv``.
@@ -278,7 +278,7 @@ def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch"
     workers: processes of the local pool (default: the CPU count). scheduler: a Dask scheduler address
     (``tcp://host:port``) or ``"local"`` (a LocalCluster of ``workers`` processes); client: a
     ``dask.distributed.Client`` to use instead. retries: times Dask runs a task again after losing its
-    worker. progress: a bar (True), a line per run (False), None: a bar on a terminal.
+    worker. progress: a bar (True), a line per run (False), None: a bar on a terminal, "off": nothing.
     on_result(row) is called in the calling process as each run finishes.
     """
     deck = Path(deck)
@@ -502,7 +502,10 @@ class _Progress:
 
     def __init__(self, total: int, done: int, bar: bool | None):
         self.total, self.count = total, done
-        if bar is None:
+        self.silent = bar == "off"
+        if self.silent:
+            bar = False
+        elif bar is None:
             bar = sys.stderr.isatty()
         self.bar = None
         if bar:
@@ -512,13 +515,15 @@ class _Progress:
                                 TimeElapsedColumn(), transient=False)
             self.bar.start()
             self.task = self.bar.add_task("batch", total=total, completed=done)
-        elif done:
+        elif done and not self.silent:
             print(f"{done} of {total} runs already finished (skipped)", flush=True)
 
     def done(self, row: dict) -> None:
         self.count += 1
         if self.bar is not None:
             self.bar.update(self.task, advance=1, description=row["run"])
+            return
+        if self.silent:
             return
         wall = row.get("wall_s")
         t = f" in {wall:.2f} s" if isinstance(wall, float) else ""
