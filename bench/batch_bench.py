@@ -1,7 +1,7 @@
 """`dec3d batch` speed: 16 runs of the wedge deck serially (a pool of 1 process), on a pool of 2
 processes, and on a Dask LocalCluster of 2 worker processes.
 
-    python bench/batch_bench.py [--runs 16] [--ncycles 12000] [--no-dask]
+    python bench/batch_bench.py [--runs 16] [--ncycles 12000] [--repeat 1] [--no-dask]
 
 Each batch starts fresh worker processes (the pool's and, for Dask, the cluster's are started
 before the clock and not warmed), so the times include each worker's first-run cost (numba
@@ -32,12 +32,20 @@ def _rows(t):
     return t.to_dict("records") if hasattr(t, "to_dict") else t
 
 
+REPEAT = 1
+
+
 def timed(params, out, **kw):
-    t0 = time.perf_counter()
-    rows = _rows(batch.run(DECK, params, out, progress="off", **kw))
-    wall = time.perf_counter() - t0
-    assert all(r["status"] == "ok" for r in rows), [r["error"] for r in rows if r["status"] != "ok"]
-    return wall, sum(r["wall_s"] for r in rows), rows
+    """Best of REPEAT batches (each into a fresh folder, so nothing is skipped): wall, Σ run wall, rows."""
+    best = None
+    for k in range(REPEAT):
+        t0 = time.perf_counter()
+        rows = _rows(batch.run(DECK, params, Path(f"{out}-{k}"), progress="off", **kw))
+        wall = time.perf_counter() - t0
+        assert all(r["status"] == "ok" for r in rows), [r["error"] for r in rows if r["status"] != "ok"]
+        if best is None or wall < best[0]:
+            best = (wall, sum(r["wall_s"] for r in rows), rows)
+    return best
 
 
 def main(argv=None) -> int:
@@ -45,7 +53,10 @@ def main(argv=None) -> int:
     ap.add_argument("--runs", type=int, default=16)
     ap.add_argument("--ncycles", type=int, default=12000, help="cycles after the friction drop (the deck's ncycles)")
     ap.add_argument("--no-dask", action="store_true")
+    ap.add_argument("--repeat", type=int, default=1, help="batches per mode; the fastest counts")
     a = ap.parse_args(argv)
+    global REPEAT
+    REPEAT = max(1, a.repeat)
     angles = [round(30.0 + 0.5 * i, 1) for i in range(a.runs)]
     params = {"phi": angles, "ncycles": [a.ncycles]}
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python "

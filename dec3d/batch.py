@@ -362,7 +362,8 @@ def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch"
             import multiprocessing
 
             n = max(1, min(workers or os.cpu_count() or 1, len(todo)))
-            with ProcessPoolExecutor(max_workers=n, mp_context=multiprocessing.get_context("spawn")) as pool:
+            with _one_thread_each(), \
+                    ProcessPoolExecutor(max_workers=n, mp_context=multiprocessing.get_context("spawn")) as pool:
                 futures = {pool.submit(_run_local, {"deck": str(deck), "values": values, "out": str(rdir)}):
                            (i, values, rdir) for i, values, rdir in todo}
                 for fut in as_completed(futures):
@@ -387,6 +388,27 @@ def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch"
     except ImportError:
         return [{c: r.get(c) for c in columns} for r in table]
     return pd.DataFrame([{c: r.get(c) for c in columns} for r in table], columns=columns)
+
+
+#: thread-pool sizes of the numerical libraries, one per worker process (as Dask's nanny sets them): a
+#: run is one thread of work, and BLAS threads spinning in every process of a pool steal the cores
+_THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")
+
+
+class _one_thread_each:
+    """Spawned pool workers inherit the environment: one library thread each unless the user set it."""
+
+    def __enter__(self):
+        self.saved = {k: os.environ.get(k) for k in _THREAD_VARS}
+        for k, v in self.saved.items():
+            if v is None:
+                os.environ[k] = "1"
+
+    def __exit__(self, *exc):
+        for k, v in self.saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+        return False
 
 
 def _run_shipped_task(task: dict) -> dict:
