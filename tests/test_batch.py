@@ -152,3 +152,15 @@ def test_dask_gives_the_same_table_and_survives_a_killed_worker(pool_batch, tmp_
             assert a[c] == b[c] or (isinstance(a[c], float) and math.isnan(a[c]) and math.isnan(b[c])), (c, a, b)
     # the runs' files came back from the workers into the run folders
     assert all((tmp_path / r["run"] / "output.txt").is_file() for r in rows)
+
+
+def test_cli_warns_of_a_parameter_the_deck_does_not_use(tmp_path, capsys):
+    code = main(["batch", str(WEDGE), "--param", "phi=40", "--param", "ncycles=10", "--param", "spacing=1",
+                 "--workers", "1", "--out", str(tmp_path)])
+    cap = capsys.readouterr()
+    assert code == 0
+    assert ("warning: --param spacing: the deck does not use `spacing` (no [ … ] or @spacing mentions it); "
+            "it changes nothing") in cap.err
+    assert "1 runs, 0 failed" in cap.out
+    rows = batch.read_table(tmp_path / "results.csv")
+    assert rows[0]["run"] == "run-0001-phi=40-ncycles=10-spacing=1" and rows[0]["status"] == "ok"
