@@ -125,10 +125,10 @@ def _fmt(v) -> str:
 
 
 # ------------------------------------------------------------------ what the deck uses
-def _deck_files(deck: Path, sample: dict[str, Any]) -> tuple[list[Path], set[str]]:
+def _deck_files(deck: Path, samples: list[dict[str, Any]]) -> tuple[list[Path], set[str]]:
     """Files the deck reads (itself, files it calls, literal input names) and the FISH names its lines
-    use. Found by binding the deck with the first run's values; a deck that does not bind gives just
-    itself (each run then reports the binding error)."""
+    use. Found by binding the deck with the runs' values, the first set that binds; a deck that binds
+    with none gives just itself (each run then reports its binding error)."""
     from .commands.binder import CommandCall
     from .commands.values import InPath
     from .errors import Dec3dError
@@ -137,11 +137,14 @@ def _deck_files(deck: Path, sample: dict[str, Any]) -> tuple[list[Path], set[str
 
     files = [deck]
     with tempfile.TemporaryDirectory() as tmp:
-        s = Session(out_dir=tmp, parameters=sample, stdout=io.StringIO())
-        try:
-            items = s.load_file(deck)
-        except Dec3dError:
-            items = []
+        items = []
+        for sample in samples:
+            s = Session(out_dir=tmp, parameters=sample, stdout=io.StringIO())
+            try:
+                items = s.load_file(deck)
+                break
+            except Dec3dError:
+                continue
         for it in items:
             if isinstance(it, Enter):
                 files.append(Path(it.path))
@@ -179,7 +182,7 @@ def _deck_files(deck: Path, sample: dict[str, Any]) -> tuple[list[Path], set[str
 def unused_parameters(deck: str | Path, names: Iterable[str]) -> list[str]:
     """Parameter names no `[ … ]` or `@name` of the deck (or the files it calls) mentions."""
     deck = Path(deck)
-    _, used = _deck_files(deck, {n: 0 for n in names})
+    _, used = _deck_files(deck, [{n: 0 for n in names}])
     return [n for n in names if n.lower() not in used]
 
 
@@ -250,7 +253,7 @@ def _run_shipped(task: dict) -> dict:
         row = run_one(str(src / task["deck_rel"]), task["values"], str(out))
         if row.get("error"):
             # the message names the deck where the user has it, not the worker's temporary copy
-            row["error"] = row["error"].replace(str(src) + os.sep, task["deck_dir"] + os.sep)
+            row["error"] = row["error"].replace(str(src) + os.sep, task["deck_dir"])
         files, total = {}, 0
         for p in sorted(out.rglob("*")):
             if p.is_file() and not p.is_symlink():
@@ -262,8 +265,8 @@ def _run_shipped(task: dict) -> dict:
                 total += size
                 files[p.relative_to(out).as_posix()] = p.read_bytes()
         if row.get("error"):
-            files["output.txt"] = files.get("output.txt", b"").replace(str(src).encode() + os.sep.encode(),
-                                                                        task["deck_dir"].encode() + os.sep.encode())
+            files["output.txt"] = files.get("output.txt", b"").replace((str(src) + os.sep).encode(),
+                                                                        task["deck_dir"].encode())
         return {"row": row, "files": files}
 
 
@@ -277,8 +280,8 @@ def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch"
 
     workers: processes of the local pool (default: the CPU count). scheduler: a Dask scheduler address
     (``tcp://host:port``) or ``"local"`` (a LocalCluster of ``workers`` processes); client: a
-    ``dask.distributed.Client`` to use instead. retries: times Dask runs a task again after losing its
-    worker. progress: a bar (True), a line per run (False), None: a bar on a terminal, "off": nothing.
+    ``dask.distributed.Client`` to use instead. retries: times Dask runs a task again when it raises
+    (a run lost with its worker is rescheduled by Dask itself, up to its ``allowed-failures``). progress: a bar (True), a line per run (False), None: a bar on a terminal, "off": nothing.
     on_result(row) is called in the calling process as each run finishes.
     """
     deck = Path(deck)
@@ -291,7 +294,7 @@ def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch"
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise BatchError(f"the output folder '{out}' cannot be used: {exc.strerror or exc}") from None
-    files, used = _deck_files(deck, runs[0])
+    files, used = _deck_files(deck, runs)
     say = warn or (lambda m: print(f"warning: {m}", file=sys.stderr))
     for n in names:
         if n not in used:
@@ -343,7 +346,9 @@ def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch"
             futures = {}
             for i, values, rdir in todo:
                 task = {"files": shipped, "deck_rel": deck.resolve().relative_to(base).as_posix(),
-                        "deck_dir": str(deck.parent) if str(deck.parent) != "." else ".", "values": values}
+                        # the folder as the user named it, so messages read as in a local run
+                        "deck_dir": "" if str(deck.parent) == "." else str(deck.parent) + os.sep,
+                        "values": values}
                 fut = client.submit(_run_shipped_task, task, retries=retries, pure=False,
                                     key=f"dec3d-batch-{os.getpid()}-{time.time_ns()}-{i}")
                 futures[fut] = (i, values, rdir)
