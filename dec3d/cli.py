@@ -1,4 +1,4 @@
-"""The `dec3d` command line: run, repl, verify, ssdem, docs."""
+"""The `dec3d` command line: run, batch, repl, verify, ssdem, docs."""
 from __future__ import annotations
 
 import argparse
@@ -52,6 +52,35 @@ def _run(args) -> int:
         return 130
 
 
+def _batch(args) -> int:
+    from .batch import BatchError, combinations, parse_param, run
+
+    try:
+        params = {}
+        for text in args.param:
+            name, values = parse_param(text)
+            if name in params:
+                raise BatchError(f"--param {name} is given twice")
+            params[name] = values
+        scheduler = "local" if args.dask == "local" else args.scheduler
+        if args.dask not in (None, "local"):
+            raise BatchError(f"--dask {args.dask!r}: only `local` (a LocalCluster); use --scheduler for a cluster")
+        combinations(params, "zip" if args.zip else "grid")     # bad combinations stop here
+        table = run(args.deck, params, args.out, mode="zip" if args.zip else "grid", workers=args.workers,
+                    scheduler=scheduler, rerun_failed=args.rerun_failed)
+    except BatchError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        print("nothing was run", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("interrupted: finished runs are kept; run the same command again to do the rest", file=sys.stderr)
+        return 130
+    rows = table.to_dict("records") if hasattr(table, "to_dict") else table
+    failed = [r for r in rows if r["status"] != "ok"]
+    print(f"{len(rows)} runs, {len(failed)} failed; table: {Path(args.out) / 'results.csv'}")
+    return 1 if failed else 0
+
+
 def _repl(args) -> int:
     from .repl import run_repl
 
@@ -89,6 +118,23 @@ def main(argv: list[str] | None = None) -> int:
                    help="let the deck read and write files outside its folder and the output folder "
                         "(only for decks you trust; see docs/safety.md)")
     r.set_defaults(fn=_run)
+    b = sub.add_parser("batch", help="run a deck for many parameter values (process pool or Dask) and "
+                                     "collect one table")
+    b.add_argument("deck")
+    b.add_argument("--param", action="append", default=[], metavar="NAME=V1,V2,...",
+                   help="a FISH variable of the deck and its values (repeat for more parameters)")
+    mode = b.add_mutually_exclusive_group()
+    mode.add_argument("--grid", action="store_true", help="every combination of the values (default)")
+    mode.add_argument("--zip", action="store_true", help="the i-th value of every parameter together")
+    where = b.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", help="address of a Dask scheduler (tcp://host:port); needs dec3d[dask]")
+    where.add_argument("--dask", metavar="local", help="`local`: a Dask LocalCluster of --workers processes")
+    b.add_argument("--workers", type=int, default=None, help="worker processes (default: the CPU count; "
+                                                            "2 for --dask local)")
+    b.add_argument("--out", required=True, help="folder for the runs' folders and results.csv")
+    b.add_argument("--rerun-failed", action="store_true", help="run again the runs that failed last time "
+                                                              "(finished runs are always skipped)")
+    b.set_defaults(fn=_batch)
     q = sub.add_parser("repl", help="interactive command prompt")
     q.add_argument("--out", help="folder for outputs (default: current folder)")
     q.add_argument("--history", help="history file (default: ~/.dec3d_history)")

@@ -63,11 +63,14 @@ class Session:
     """
 
     def __init__(self, out_dir: str | Path | None = None, echo: bool = False, stdout: TextIO | None = None,
-                 allow_outside_paths: bool = False):
+                 allow_outside_paths: bool = False, parameters: dict[str, Any] | None = None):
         load_all()
         self.allow_outside_paths = bool(allow_outside_paths)
         self.model = Model()
-        self.variables: dict[str, Any] = {}
+        # values set from outside the deck (`dec3d batch --param`): FISH variables from the start, kept
+        # through `model new`, and a deck's own assignment of one (its default) does not replace it
+        self.parameters: dict[str, Any] = dict(parameters or {})
+        self.variables: dict[str, Any] = dict(self.parameters)
         self.fish: dict[str, FishBlock] = {}
         self.fish_rt = FishRuntime(self)
         self.out_dir = Path(out_dir) if out_dir is not None else Path.cwd()
@@ -324,6 +327,8 @@ class Session:
                     # a restore takes the saved model's record as it is: restore → save gives the same file
                     self.record.append(_source_of(item))
             elif isinstance(item, ExprStatement):
+                if item.node[0] == "assign" and item.node[2] == "=" and item.node[1] in self.parameters:
+                    return          # the deck's default of a batch parameter: the parameter's value stays
                 self.run_statement(item)
                 self.bind_context.assigned.update(self.variables)
             elif isinstance(item, FishDefine):
@@ -482,6 +487,7 @@ class Session:
         """`model new`: a fresh model; FISH variables and functions are cleared too (as in 3DEC)."""
         self.model = Model()
         self.variables.clear()
+        self.variables.update(self.parameters)
         self.fish.clear()
         self.fish_rt.clear()
         self.bind_context = BindContext(self.variables)

@@ -61,6 +61,7 @@ MAY_IMPORT = {
     "commands": BASE | {"lang", "fish", "model", "geometry", "kernels", "io", "physics"},
     "session": BASE | {"lang", "fish", "commands", "model", "geometry", "kernels", "io", "physics"},
     "check": BASE | {"lang", "fish", "commands", "session"},
+    "batch": BASE | {"lang", "commands", "session"},      # runs decks in sessions, in processes or on Dask
     "docs": BASE | {"lang", "commands"},
     "ssdem": {"errors"},                         # independent of the rest; only the CLI and verify reach it
     "verify": None, "repl": None, "cli": None, "__init__": None, "__main__": None,   # top: anything
