@@ -1,4 +1,6 @@
+import importlib.util
 import os
+import sys
 from pathlib import Path
 
 import pytest
@@ -14,6 +16,21 @@ NO_DECKS = (f"public 3DEC decks not found at {DECKS}: set DEC3D_SHARED=<folder h
 # a module that reads the decks starts with:
 #     if not DECKS.is_dir():
 #         pytest.skip(NO_DECKS, allow_module_level=True)
+
+
+#: what the tests import: dec3d's dependencies and its test extras (pyproject.toml)
+NEEDED = ("numpy", "numba", "lark", "scipy", "meshio", "pyvista", "prompt_toolkit", "rich", "matplotlib",
+          "hypothesis", "dask")
+
+
+def pytest_configure(config):
+    """A Python without dec3d's dependencies (a `pytest` from another environment) gets one clear
+    message instead of an import error for every test module."""
+    missing = [m for m in NEEDED if importlib.util.find_spec(m) is None]
+    if missing:
+        pytest.exit(f"this Python ({sys.executable}) lacks {', '.join(missing)}: install dec3d and its test "
+                    "extras into it first, `pip install -e \".[test]\"` (README, 'Set up'), or run the "
+                    "`pytest` of the environment where you did", returncode=4)
 
 
 @pytest.fixture

@@ -5,6 +5,8 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 from conftest import ROOT
 
 
@@ -24,3 +26,18 @@ def test_plain_pytest_collects_every_module_and_skips_the_deck_tests_with_one_re
         assert any(f" {m}:" in s and reason in s for s in skips), f"{m} not collected:\n{out}"
     assert all(reason in s for s in skips), out
     assert "empty parameter" not in out and "ERROR" not in out
+
+
+def test_a_python_without_the_dependencies_gets_one_clear_message(monkeypatch):
+    """`pytest` of another environment (no numba, lark, …): one message saying what to install, not an
+    import error per test module."""
+    import importlib.util
+
+    import conftest
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name in ("numba", "lark") else real(name, *a))
+    with pytest.raises(pytest.exit.Exception) as e:
+        conftest.pytest_configure(None)
+    assert e.value.returncode == 4
+    assert "lacks numba, lark: install dec3d and its test extras into it first" in str(e.value)
