@@ -145,7 +145,6 @@ def _check_fish(block, deck, ctx) -> list[LineReport]:
     """A `fish define`: parsed, its command lines bound and its body compiled (nothing runs).
     Intrinsics dec3d does not implement make it "not supported yet", naming them."""
     from .fish import FishRuntime, compile_function, parse_block
-    from .fish.compiler import _deferreds  # noqa: F401  (the compiler walks bound lines itself)
 
     what = f"fish define {block.name}"
     out: list[LineReport] = []
