@@ -225,9 +225,9 @@ def test_ctrl_c_in_dec3d_run_prints_one_line_and_exits_130(tmp_path):
 
 
 def test_progress_lines_when_the_output_is_not_a_terminal(session, monkeypatch, capsys):
-    import dec3d.physics.rigid as rigid
+    import dec3d.physics.runcontrol as runcontrol
 
-    monkeypatch.setattr(rigid, "PROGRESS_SECONDS", 0.0)      # a line at every batch instead of every 10 s
+    monkeypatch.setattr(runcontrol, "PROGRESS_SECONDS", 0.0)      # a line at every batch instead of every 10 s
     _run(session, STACK.replace("model cycle 20\n", "model cycle 30\n"))
     lines = capsys.readouterr().out.splitlines()
     assert lines, "no progress line"
