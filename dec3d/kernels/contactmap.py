@@ -87,6 +87,22 @@ def cp_batch(ra, rb, prev, vpos, bvstart, bvcount, centroid, old_n, old_c, reach
 
 
 @njit(cache=True)
+def newell(vpos, fverts, start, m):
+    """Newell's vector of the face whose m vertex indices start at ``fverts[start]``: 2 × area ×
+    unit normal for a planar face (outward for counter-clockwise vertices seen from outside)."""
+    nx = 0.0
+    ny = 0.0
+    nz = 0.0
+    for j in range(m):
+        p = fverts[start + j]
+        q = fverts[start + (j + 1) % m]
+        nx += (vpos[p, 1] - vpos[q, 1]) * (vpos[p, 2] + vpos[q, 2])
+        ny += (vpos[p, 2] - vpos[q, 2]) * (vpos[p, 0] + vpos[q, 0])
+        nz += (vpos[p, 0] - vpos[q, 0]) * (vpos[p, 1] + vpos[q, 1])
+    return nx, ny, nz
+
+
+@njit(cache=True)
 def subcontact_gaps(sc_contact, pos, ca, cb, cn, cgap, centroid, vpos, bfstart, bfcount, fvstart,
                     fnvert, fverts, out):
     """Gap [m] of each sub-contact: along the contact normal n (A → B) through its point x,
@@ -114,18 +130,12 @@ def subcontact_gaps(sc_contact, pos, ca, cb, cn, cgap, centroid, vpos, bfstart, 
                 m = fnvert[f]
                 if m < 3:
                     continue
-                mx = 0.0
-                my = 0.0
-                mz = 0.0
+                mx, my, mz = newell(vpos, fverts, fvstart[f], m)
                 fx = 0.0
                 fy = 0.0
                 fz = 0.0
                 for j in range(m):
                     p = fverts[fvstart[f] + j]
-                    q = fverts[fvstart[f] + (j + 1) % m]
-                    mx += (vpos[p, 1] - vpos[q, 1]) * (vpos[p, 2] + vpos[q, 2])
-                    my += (vpos[p, 2] - vpos[q, 2]) * (vpos[p, 0] + vpos[q, 0])
-                    mz += (vpos[p, 0] - vpos[q, 0]) * (vpos[p, 1] + vpos[q, 1])
                     fx += vpos[p, 0]
                     fy += vpos[p, 1]
                     fz += vpos[p, 2]
@@ -309,14 +319,6 @@ def vertex_point_areas(sc_contact, kind, key0, ctype, cn, vpos, vblock, bfstart,
             if not has:
                 continue
             # Newell's vector: 2 × area × unit normal of the (planar) face
-            nx = 0.0
-            ny = 0.0
-            nz = 0.0
-            for j in range(m):
-                p = fverts[fvstart[f] + j]
-                q = fverts[fvstart[f] + (j + 1) % m]
-                nx += (vpos[p, 1] - vpos[q, 1]) * (vpos[p, 2] + vpos[q, 2])
-                ny += (vpos[p, 2] - vpos[q, 2]) * (vpos[p, 0] + vpos[q, 0])
-                nz += (vpos[p, 0] - vpos[q, 0]) * (vpos[p, 1] + vpos[q, 1])
+            nx, ny, nz = newell(vpos, fverts, fvstart[f], m)
             tot += 0.5 * abs(nx * cn[c, 0] + ny * cn[c, 1] + nz * cn[c, 2]) / m
         area[s] = max(point_area, tot)
