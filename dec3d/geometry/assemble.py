@@ -124,15 +124,17 @@ def write_pieces(model, block_rows, pos, vsrc, piece_nv, fn, fsrc, piece_nf, fv)
     update_mass_properties(model, block_rows)
 
 
-def compact_geometry(model) -> None:
-    """Drop vertex, face and face-loop rows that no live block's ranges cover."""
+def compact_geometry(model) -> np.ndarray | None:
+    """Drop vertex, face and face-loop rows that no live block's ranges cover. Returns the
+    old-row -> new-row map of the vertices (-1: dropped), or None when nothing moved, so
+    that stores holding vertex rows (zones, gridpoint links) can follow."""
     b, vs, fs, fvs = model.blocks, model.vertices, model.faces, model.face_vertices
     vkeep = np.zeros(vs.n, dtype=bool)
     vkeep[range_index(b["vert_start"], b["vert_count"])] = True
     fkeep = np.zeros(fs.n, dtype=bool)
     fkeep[range_index(b["face_start"], b["face_count"])] = True
     if vkeep.all() and fkeep.all():
-        return
+        return None
     fvkeep = np.zeros(fvs.n, dtype=bool)
     fvkeep[range_index(fs["vstart"][fkeep], fs["nvert"][fkeep])] = True
     vmap = vs.compact(vkeep)
@@ -142,6 +144,7 @@ def compact_geometry(model) -> None:
     fs["vstart"][:] = fvmap[fs["vstart"]]
     b["vert_start"][:] = vmap[b["vert_start"]]
     b["face_start"][:] = fmap[b["face_start"]]
+    return vmap
 
 
 def block_poly(model, row: int) -> Poly:

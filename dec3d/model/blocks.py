@@ -15,6 +15,7 @@ from dec3d.geometry.mass import update_mass_properties
 from dec3d.geometry.polyhedron import Poly
 
 from .model import KIND_RIGID, Model
+from .zones import follow_geometry
 
 
 def add_blocks(model: Model, polys: Sequence[Poly], group: str | None = None,
@@ -71,7 +72,7 @@ def delete_blocks(model: Model, mask) -> int:
     fblock = model.faces["block"]
     vblock[:] = np.where(vblock >= 0, remap[vblock], -1)
     fblock[:] = np.where(fblock >= 0, remap[fblock], -1)
-    compact_geometry(model)
+    follow_geometry(model, compact_geometry(model), remap)
     return int(rows.size)
 
 
