@@ -501,6 +501,11 @@ class RigidEngine(ContactDetection):
             # re-orthonormalised (polar factor): a slightly skew frame would grow threefold per
             # call (Q A Aᵀ A), and after ~30 `model cycle` commands Euler's equations blow up
             pa[gmember] = _orthonormal(np.einsum("bij,bjk->bik", turn[gid], pa[gmember]))
+            # a lone block takes back the kernel's own frame unchanged: the next run starts from
+            # exactly the axes this one ended with, so splitting a run into several `model cycle`
+            # commands (or save/restore between them) changes no bit
+            lone = np.diff(gstart) == 1
+            pa[gmember[gstart[:-1][lone]]] = gaxes[lone]
             b["inertia"][gmember] = np.einsum("bij,bj,bkj->bik", pa[gmember], b["principal_moment"][gmember],
                                               pa[gmember])
             if mode == DAMP_ADAPTIVE:
