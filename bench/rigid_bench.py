@@ -32,8 +32,10 @@ import time
 WARMUP = 5
 
 
-def deck(n: int, jmodel: str) -> str:
-    """Command lines building the scene (no cycling)."""
+def deck(n: int, jmodel: str, dynamic: bool = False) -> str:
+    """Command lines building the scene (no cycling).  ``dynamic``: every block keeps moving —
+    gravity tilted (4, 0, -9.81) m/s², friction 5° (tan 5° < 4/9.81), no damping: the whole
+    stack slides and accelerates along x on the base."""
     lines = ["model new", f"block create brick 0 {n} 0 {n} -1 0"]
     for i in range(n):
         for j in range(n):
@@ -41,12 +43,12 @@ def deck(n: int, jmodel: str) -> str:
                 lines.append(f"block create brick {i} {i + 1} {j} {j + 1} {k} {k + 1}")
     props = "stiffness-normal 1e9 stiffness-shear 1e9"
     if jmodel == "mohr":
-        props += " friction 34.38 cohesion 0 tension 0"
+        props += f" friction {5 if dynamic else 34.38} cohesion 0 tension 0"
     lines += [
         "block property density 2600",
         "block fix range position-z -1 0",
-        "model gravity 0 0 -9.81",
-        "block mechanical damping local 0.8",
+        "model gravity 4 0 -9.81" if dynamic else "model gravity 0 0 -9.81",
+        "block mechanical damping none" if dynamic else "block mechanical damping local 0.8",
         f"block contact jmodel assign {jmodel}",
         f"block contact material-table default property {props}",
     ]
@@ -59,7 +61,8 @@ def _counts(session) -> tuple:
     return stores["contacts"].n, stores["subcontacts"].n
 
 
-def one(n: int, steps: int, jmodel: str, full: bool = False, threads: int | None = None) -> dict:
+def one(n: int, steps: int, jmodel: str, full: bool = False, threads: int | None = None,
+        dynamic: bool = False) -> dict:
     """Build, warm up and time in this process. ``full``: every pair is looked at again at
     every detection (the engine's incremental rule off: the worst case, a model in which
     every block keeps moving)."""
@@ -84,7 +87,7 @@ def one(n: int, steps: int, jmodel: str, full: bool = False, threads: int | None
     with tempfile.TemporaryDirectory() as d:
         s = dec3d.Session(out_dir=d, stdout=io.StringIO())
         t0 = time.perf_counter()
-        s.command(deck(n, jmodel))
+        s.command(deck(n, jmodel, dynamic))
         t1 = time.perf_counter()
         s.command(f"model cycle {WARMUP}")
         t2 = time.perf_counter()
@@ -187,6 +190,9 @@ def main() -> int:
     ap.add_argument("--equilibrium", action="store_true",
                     help="time to equilibrium (base reaction within 0.1 %% of the weight, "
                          "largest speed < 1e-5 m/s) instead of per-step speed")
+    ap.add_argument("--dynamic", action="store_true",
+                    help="every block keeps moving (the stack slides on the base; with "
+                         "--full-detection: detection at every step)")
     ap.add_argument("--child", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.equilibrium:
@@ -200,12 +206,13 @@ def main() -> int:
         return 0
     if args.child:
         print(json.dumps(one(args.child, args.steps, args.jmodel, args.full_detection,
-                             args.threads)))
+                             args.threads, args.dynamic)))
         return 0
     print(f"machine: {machine()}")
     print(f"scene: n^3 unit cubes on a fixed base, jmodel {args.jmodel}, kn = ks = 1e9 Pa/m, "
           f"{WARMUP} warm-up + {args.steps} timed steps, median of {args.repeat}"
-          + (", full detection" if args.full_detection else ""))
+          + (", full detection" if args.full_detection else "")
+          + (", dynamic (sliding, no damping)" if args.dynamic else ""))
     print(f"{'n':>3} {'blocks':>7} {'contacts':>8} {'subcont':>8} {'build s':>8} {'warmup s':>8} "
           f"{'seconds':>8} {'min..max':>15} {'blk-cyc/s':>10} {'subc-upd/s':>11} {'peak MiB':>9}")
     for n in args.n:
@@ -214,7 +221,7 @@ def main() -> int:
             out = subprocess.run([sys.executable, os.path.abspath(__file__), "--child", str(n),
                                   "--steps", str(args.steps), "--jmodel", args.jmodel]
                                  + (["--full-detection"] if args.full_detection else [])
-                                 + (["--threads", str(args.threads)] if args.threads else []),
+                                 + (["--threads", str(args.threads, args.dynamic)] if args.threads else []),
                                  capture_output=True, text=True)
             if out.returncode != 0:
                 sys.stderr.write(out.stderr)
