@@ -13,7 +13,10 @@ sub-contact counts are the rows of the model's ``contacts`` and ``subcontacts`` 
 process (peak RSS from resource.getrusage is per process); the median is printed.
 
     python bench/rigid_bench.py [--n 10 20] [--steps 100] [--repeat 3] [--jmodel mohr|elastic]
-                                [--full-detection]
+                                [--full-detection] [--threads N]
+
+``--threads N`` calls numba.set_num_threads(N) in each run; the numba threading layer and the
+thread count actually used are printed (a layer of "n/a" means no parallel kernel ran).
 """
 from __future__ import annotations
 
@@ -29,8 +32,10 @@ import time
 WARMUP = 5
 
 
-def deck(n: int, jmodel: str) -> str:
-    """Command lines building the scene (no cycling)."""
+def deck(n: int, jmodel: str, dynamic: bool = False) -> str:
+    """Command lines building the scene (no cycling).  ``dynamic``: every block keeps moving —
+    gravity tilted (4, 0, -9.81) m/s², friction 5° (tan 5° < 4/9.81), no damping: the whole
+    stack slides and accelerates along x on the base."""
     lines = ["model new", f"block create brick 0 {n} 0 {n} -1 0"]
     for i in range(n):
         for j in range(n):
@@ -38,12 +43,12 @@ def deck(n: int, jmodel: str) -> str:
                 lines.append(f"block create brick {i} {i + 1} {j} {j + 1} {k} {k + 1}")
     props = "stiffness-normal 1e9 stiffness-shear 1e9"
     if jmodel == "mohr":
-        props += " friction 34.38 cohesion 0 tension 0"
+        props += f" friction {5 if dynamic else 34.38} cohesion 0 tension 0"
     lines += [
         "block property density 2600",
         "block fix range position-z -1 0",
-        "model gravity 0 0 -9.81",
-        "block mechanical damping local 0.8",
+        "model gravity 4 0 -9.81" if dynamic else "model gravity 0 0 -9.81",
+        "block mechanical damping none" if dynamic else "block mechanical damping local 0.8",
         f"block contact jmodel assign {jmodel}",
         f"block contact material-table default property {props}",
     ]
@@ -56,7 +61,8 @@ def _counts(session) -> tuple:
     return stores["contacts"].n, stores["subcontacts"].n
 
 
-def one(n: int, steps: int, jmodel: str, full: bool = False) -> dict:
+def one(n: int, steps: int, jmodel: str, full: bool = False, threads: int | None = None,
+        dynamic: bool = False) -> dict:
     """Build, warm up and time in this process. ``full``: every pair is looked at again at
     every detection (the engine's incremental rule off: the worst case, a model in which
     every block keeps moving)."""
@@ -67,6 +73,10 @@ def one(n: int, steps: int, jmodel: str, full: bool = False) -> dict:
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     if os.path.isdir(os.path.join(root, "dec3d")) and root not in sys.path:
         sys.path.insert(0, root)       # the checkout's dec3d (also when it is not installed)
+    import numba
+
+    if threads:
+        numba.set_num_threads(threads)
     import dec3d
 
     if full:
@@ -77,7 +87,7 @@ def one(n: int, steps: int, jmodel: str, full: bool = False) -> dict:
     with tempfile.TemporaryDirectory() as d:
         s = dec3d.Session(out_dir=d, stdout=io.StringIO())
         t0 = time.perf_counter()
-        s.command(deck(n, jmodel))
+        s.command(deck(n, jmodel, dynamic))
         t1 = time.perf_counter()
         s.command(f"model cycle {WARMUP}")
         t2 = time.perf_counter()
@@ -85,8 +95,69 @@ def one(n: int, steps: int, jmodel: str, full: bool = False) -> dict:
         t3 = time.perf_counter()
         nc, nsc = _counts(s)
     rss_kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    return dict(blocks=n ** 3, contacts=nc, subcontacts=nsc, build_s=t1 - t0, warmup_s=t2 - t1,
+    try:
+        layer = numba.threading_layer()
+    except ValueError:                 # no parallel kernel has run in this process
+        layer = "n/a"
+    return dict(threads=numba.get_num_threads(), layer=layer, blocks=n ** 3, contacts=nc, subcontacts=nsc, build_s=t1 - t0, warmup_s=t2 - t1,
                 seconds=t3 - t2, peak_rss_mib=rss_kib / 1024.0)
+
+
+def base_reaction(session, base: int = 0) -> float:
+    """Vertical force the sub-contacts on block ``base`` carry [N] (the base reaction)."""
+    import numpy as np
+
+    c = session.model.stores["contacts"].to_arrays()
+    sc = session.model.stores["subcontacts"].to_arrays()
+    on_base = (c["a"] == base) | (c["b"] == base)
+    rows = on_base[sc["contact"]]
+    return float(abs(np.sum(sc["fn"][rows] * c["normal"][sc["contact"][rows], 2])))
+
+
+def at_equilibrium(session, rtol: float = 1e-3, vtol: float = 1e-5) -> tuple:
+    """(done, reaction error, largest speed): the base reaction within ``rtol`` of the
+    weight of the free blocks and every free block slower than ``vtol`` m/s."""
+    import numpy as np
+
+    b = session.model.blocks
+    free = b["fixity"] == 0
+    weight = float(b["mass"][free].sum()) * 9.81
+    err = abs(base_reaction(session) - weight) / weight
+    vmax = float(np.sqrt((b["velocity"][free] ** 2).sum(axis=1)).max())
+    return err <= rtol and vmax < vtol, err, vmax
+
+
+def equilibrium(n: int, jmodel: str = "mohr", chunk: int = 10, cap: int = 100000,
+                solve: str | None = None) -> dict:
+    """Wall time and steps from the first cycle until ``at_equilibrium`` (checked every
+    ``chunk`` steps; the check is inside the timed wall).  Kernels are compiled first on a
+    one-cube scene so the figure is the warm time.  ``solve``: extra command lines (damping
+    etc.) given after the scene."""
+    import io
+    import tempfile
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    if os.path.isdir(os.path.join(root, "dec3d")) and root not in sys.path:
+        sys.path.insert(0, root)
+    import dec3d
+
+    with tempfile.TemporaryDirectory() as d:
+        w = dec3d.Session(out_dir=d, stdout=io.StringIO())
+        w.command(deck(1, jmodel))
+        w.command("model cycle 3")
+        s = dec3d.Session(out_dir=d, stdout=io.StringIO())
+        s.command(deck(n, jmodel) + (solve or ""))
+        steps, t0 = 0, time.perf_counter()
+        done, err, vmax = False, 1.0, 1.0
+        while steps < cap:
+            s.command(f"model cycle {chunk}")
+            steps += chunk
+            done, err, vmax = at_equilibrium(s)
+            if done:
+                break
+        wall = time.perf_counter() - t0
+    return dict(blocks=n ** 3, steps=steps, seconds=wall, reached=done, reaction_error=err,
+                max_speed=vmax)
 
 
 def machine() -> str:
@@ -114,15 +185,34 @@ def main() -> int:
     ap.add_argument("--jmodel", choices=("mohr", "elastic"), default="mohr")
     ap.add_argument("--full-detection", action="store_true",
                     help="look at every pair at every detection (no incremental skipping): the worst case")
+    ap.add_argument("--threads", type=int, default=None,
+                    help="numba threads per run (numba.set_num_threads); default: numba's own")
+    ap.add_argument("--equilibrium", action="store_true",
+                    help="time to equilibrium (base reaction within 0.1 %% of the weight, "
+                         "largest speed < 1e-5 m/s) instead of per-step speed")
+    ap.add_argument("--dynamic", action="store_true",
+                    help="every block keeps moving (the stack slides on the base; with "
+                         "--full-detection: detection at every step)")
     ap.add_argument("--child", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.equilibrium:
+        print(f"machine: {machine()}")
+        for n in args.n:
+            runs = [equilibrium(n, args.jmodel) for _ in range(args.repeat)]
+            print(f"n {n}: steps {runs[0]['steps']} reached {runs[0]['reached']} "
+                  f"reaction err {runs[0]['reaction_error']:.2e} vmax {runs[0]['max_speed']:.2e} "
+                  f"wall median {statistics.median(r['seconds'] for r in runs):.2f} s "
+                  f"(runs {[round(r['seconds'], 2) for r in runs]})", flush=True)
+        return 0
     if args.child:
-        print(json.dumps(one(args.child, args.steps, args.jmodel, args.full_detection)))
+        print(json.dumps(one(args.child, args.steps, args.jmodel, args.full_detection,
+                             args.threads, args.dynamic)))
         return 0
     print(f"machine: {machine()}")
     print(f"scene: n^3 unit cubes on a fixed base, jmodel {args.jmodel}, kn = ks = 1e9 Pa/m, "
           f"{WARMUP} warm-up + {args.steps} timed steps, median of {args.repeat}"
-          + (", full detection" if args.full_detection else ""))
+          + (", full detection" if args.full_detection else "")
+          + (", dynamic (sliding, no damping)" if args.dynamic else ""))
     print(f"{'n':>3} {'blocks':>7} {'contacts':>8} {'subcont':>8} {'build s':>8} {'warmup s':>8} "
           f"{'seconds':>8} {'min..max':>15} {'blk-cyc/s':>10} {'subc-upd/s':>11} {'peak MiB':>9}")
     for n in args.n:
@@ -130,7 +220,8 @@ def main() -> int:
         for _ in range(args.repeat):
             out = subprocess.run([sys.executable, os.path.abspath(__file__), "--child", str(n),
                                   "--steps", str(args.steps), "--jmodel", args.jmodel]
-                                 + (["--full-detection"] if args.full_detection else []),
+                                 + (["--full-detection"] if args.full_detection else [])
+                                 + (["--threads", str(args.threads, args.dynamic)] if args.threads else []),
                                  capture_output=True, text=True)
             if out.returncode != 0:
                 sys.stderr.write(out.stderr)
@@ -139,6 +230,7 @@ def main() -> int:
         sec = [r["seconds"] for r in runs]
         t = statistics.median(sec)
         r0 = runs[0]
+        print(f"    threads {r0['threads']}, threading layer {r0['layer']}", flush=True)
         bcs = r0["blocks"] * args.steps / t if t > 0 else float("inf")
         scu = "n/a" if r0["subcontacts"] is None else f"{r0['subcontacts'] * args.steps / t:.3g}"
         print(f"{n:>3} {r0['blocks']:>7} {_fmt(r0['contacts']):>8} {_fmt(r0['subcontacts']):>8} "
