@@ -1,0 +1,42 @@
+"""Mesher checks on a convex block: positive tetrahedra, volumes summing to the block volume,
+boundary triangles lying on block faces and covering the surface area."""
+import numpy as np
+
+from dec3d.geometry.zoning import mesh_convex, min_dihedral_deg
+
+
+def _brick(a, b, c):
+    v = np.array([[x, y, z] for z in (0, c) for y in (0, b) for x in (0, a)], float)
+    # outward counterclockwise loops
+    loops = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]]
+    return v, np.arange(0, 25, 4), np.array(loops).ravel()
+
+
+def test_brick_volume_and_positivity():
+    v, ptr, loops = _brick(1.0, 0.7, 1.3)
+    pts, tets, tris, src = mesh_convex(v, ptr, loops, 0.2)
+    a, b, c, d = (pts[tets[:, k]] for k in range(4))
+    vol = np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a) / 6
+    assert (vol > 0).all()
+    assert abs(vol.sum() - 0.91) < 1e-12 * 0.91
+    area = 0.5 * np.linalg.norm(np.cross(pts[tris[:, 1]] - pts[tris[:, 0]],
+                                         pts[tris[:, 2]] - pts[tris[:, 0]]), axis=1)
+    assert abs(area.sum() - 2 * (0.7 + 0.91 + 1.3)) < 1e-10
+    cen = pts[tris].mean(axis=1)
+    on_face = np.isclose(cen, 0).any(axis=1) | np.isclose(cen, [1.0, 0.7, 1.3]).any(axis=1)
+    assert on_face.all()
+    # closed surface: every boundary edge in two triangles; Euler V - E + F - T = 1 for a ball
+    e = np.sort(np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]]), axis=1)
+    _, cnt = np.unique(e, axis=0, return_counts=True)
+    assert (cnt == 2).all()
+    te = np.sort(tets[:, [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]]].reshape(-1, 2), axis=1)
+    tf = np.sort(tets[:, [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]]].reshape(-1, 3), axis=1)
+    E, F = len(np.unique(te, axis=0)), len(np.unique(tf, axis=0))
+    assert len(np.unique(tets)) - E + F - len(tets) == 1
+    assert min_dihedral_deg(pts, tets) > 5.0
+
+
+def test_min_dihedral_regular_tet():
+    # regular tetrahedron: arccos(1/3) = 70.5288 degrees
+    p = np.array([[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]], float)
+    assert abs(min_dihedral_deg(p, np.array([[0, 1, 2, 3]])) - np.degrees(np.arccos(1 / 3))) < 1e-9
