@@ -84,8 +84,10 @@ def block_face_apply(session, call):
 
 
 @command("block face apply-remove", range="face",
+         keywords=[P("stress", FLAG, "the applied stresses (the only face load here; accepted as 3DEC writes it)",
+                     bare=True)],
          doc="Remove the stresses applied to the faces in range (`block face apply`).",
-         examples=["block face apply-remove", "block face apply-remove range position-z 1"])
+         examples=["block face apply-remove", "block face apply-remove stress range position-z 1"])
 def block_face_apply_remove(session, call):
     from ..model.face_loads import remove_face_stress
     remove_face_stress(session.model, session.range_mask(call, "face"))

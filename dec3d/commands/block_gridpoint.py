@@ -83,3 +83,33 @@ def block_gridpoint_apply_remove(session, call):
             v["vapp"][rows, i] = 0.0
         if everything or a["force"] or a[f"force_{ax}"]:
             v["fapp"][rows, i] = 0.0
+
+
+@command("block gridpoint initialize",
+         keywords=[P("displacement", Nums(3, 3), "dx dy dz", units="m"),
+                   *[P(f"displacement-{a}", Num(), f"the {a} component", units="m") for a in _AX],
+                   P("velocity", Nums(3, 3), "vx vy vz", units="m/s"),
+                   *[P(f"velocity-{a}", Num(), f"the {a} component", units="m/s") for a in _AX]],
+         range="gridpoint",
+         doc="Set the displacement or velocity of the gridpoints of zoned blocks in range.",
+         details="Displacement is the accumulated record (positions do not move), as decks use it to "
+                 "zero displacements after an initial equilibrium.",
+         examples=["block gridpoint initialize displacement 0 0 0", "block gridpoint initialize velocity-x 0.1"])
+def block_gridpoint_initialize(session, call):
+    a = call.args
+    pairs = [("displacement", "disp"), ("velocity", "velocity")]
+    given = [k for base, _ in pairs for k in (base, *(f"{base}_{ax}" for ax in _AX)) if a[k] is not None]
+    if not given:
+        raise BindError("`block gridpoint initialize` needs displacement[-x|-y|-z] or velocity[-x|-y|-z]",
+                        call.location)
+    for k in given:
+        if not np.isfinite(np.asarray(a[k], float)).all():
+            raise BindError(f"`{k.replace('_', '-')}` must be finite", call.locations.get(k, call.location))
+    rows = _gridpoints(session, call, "block gridpoint initialize")
+    v = session.model.vertices
+    for base, field in pairs:
+        if a[base] is not None:
+            v[field][rows] = np.asarray(a[base], float)
+        for i, ax in enumerate(_AX):
+            if a[f"{base}_{ax}"] is not None:
+                v[field][rows, i] = a[f"{base}_{ax}"]

@@ -32,7 +32,7 @@ def test_full_tensor_on_side_face(session):
     sig = np.array([[s[0], s[3], s[4]], [s[3], s[1], s[5]], [s[4], s[5], s[2]]])
     expect = sig @ np.array([-1.0, 0.0, 0.0]) * 1.0          # outward normal of x = 0 times area 1
     np.testing.assert_allclose(m.vertices["fface"].sum(axis=0), expect, rtol=1e-12)
-    session.command("block face apply-remove range position-z 1")      # other faces: nothing changes
+    session.command("block face apply-remove stress range position-z 1")      # other faces: nothing changes
     np.testing.assert_allclose(m.vertices["fface"].sum(axis=0), expect, rtol=1e-12)
     session.command("block face apply-remove range position-x 0")
     assert np.all(m.vertices["fface"] == 0.0)

@@ -43,3 +43,17 @@ def test_no_condition_is_an_error(session):
     _zoned(session)
     with pytest.raises(Dec3dError, match="needs velocity"):
         session.command("block gridpoint apply range position-z 0")
+
+
+def test_initialize_displacement_and_velocity(session):
+    m = _zoned(session)
+    v = m.vertices
+    v["disp"][:] = 0.25
+    pos0 = v["pos"].copy()
+    session.command("block gridpoint initialize displacement 0 0 0")
+    assert np.all(v["disp"][v["zoned"]] == 0.0) and np.all(v["disp"][~v["zoned"]] == 0.25)
+    np.testing.assert_array_equal(v["pos"], pos0)
+    session.command("block gridpoint initialize velocity-y 0.5 range position-y 1")
+    hit = v["zoned"] & np.isclose(v["pos"][:, 1], 1.0)
+    np.testing.assert_array_equal(v["velocity"][hit, 1], 0.5)
+    assert np.all(v["velocity"][~hit] == 0.0)
