@@ -7,7 +7,7 @@ from ..errors import BindError
 from ..geometry.triangulate import triangulate_blocks
 from ..model.blocks import group_faces
 from .registry import command
-from .values import FLAG, Num, P, Text
+from .values import FLAG, Num, Nums, P, Text
 
 
 @command("block face group", positional=[P("name", Text(), "group name", required=True)],
@@ -42,3 +42,52 @@ def block_face_triangulate(session, call):
                         call.location)
     rows = np.flatnonzero(session.range_mask(call, "block"))
     triangulate_blocks(session.model, rows, modes[0], a["edge_max"])
+
+
+_STRESS_KEYS = ("stress-xx", "stress-yy", "stress-zz", "stress-xy", "stress-xz", "stress-yz")
+
+
+@command("block face apply",
+         keywords=[P("stress", Nums(6, 6), "sxx syy szz sxy sxz syz", units="Pa"),
+                   *[P(k, Num(), f"the {k[-2:]} component alone", units="Pa") for k in _STRESS_KEYS],
+                   P("stress-normal", Num(), "normal stress (tension positive)", units="Pa")],
+         range="face",
+         doc="Apply a stress to the boundary triangles of zoned blocks in range (located by centroid).",
+         details="The traction t = σ·n on each triangle, times its area, goes a third to each of its "
+                 "gridpoints every step. Loads add to what is there; only faces on the outside of a "
+                 "joined continuum take them. `block face apply-remove` clears them.",
+         examples=["block face apply stress-normal -1e6 range position-z 1",
+                   "block face apply stress -1e6 -2e6 -1e6 0 0 0 range group 'hole'"])
+def block_face_apply(session, call):
+    from ..model.face_loads import apply_face_stress
+    a = call.args
+    s = np.zeros(6)
+    given = 0
+    if a["stress"] is not None:
+        s += np.asarray(a["stress"], float)
+        given += 1
+    for i, k in enumerate(_STRESS_KEYS):
+        if a[k.replace("-", "_")] is not None:
+            s[i] += a[k.replace("-", "_")]
+            given += 1
+    if a["stress_normal"] is not None:
+        s[:3] += a["stress_normal"]
+        given += 1
+    if not given:
+        raise BindError("`block face apply` needs stress <6 values>, stress-xx … or stress-normal <f>", call.location)
+    if not np.isfinite(s).all():
+        raise BindError("`block face apply`: the stress must be finite", call.location)
+    n = apply_face_stress(session.model, session.range_mask(call, "face"), s)
+    if n == 0:
+        session.write(f"warning: {call.location}: `block face apply` selected no boundary face of a zoned "
+                      "block (faces of rigid blocks take no applied stress)")
+
+
+@command("block face apply-remove", range="face",
+         keywords=[P("stress", FLAG, "the applied stresses (the only face load here; accepted as 3DEC writes it)",
+                     bare=True)],
+         doc="Remove the stresses applied to the faces in range (`block face apply`).",
+         examples=["block face apply-remove", "block face apply-remove stress range position-z 1"])
+def block_face_apply_remove(session, call):
+    from ..model.face_loads import remove_face_stress
+    remove_face_stress(session.model, session.range_mask(call, "face"))

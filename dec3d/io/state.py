@@ -440,6 +440,7 @@ def _build(path: str, meta: dict, blobs: dict[str, bytes]) -> Model:
         v["origin"][:] = v["pos"] - model.blocks["disp"][np.clip(v["block"], 0, None)] if model.blocks.n else v["pos"]
     _check_geometry(path, model)
     _check_contacts(path, model)
+    _check_zones(path, model)
     h = meta.get("histories")
     if h is not None:
         harrays = {}
@@ -496,6 +497,38 @@ def _check_geometry(path: str, model: Model) -> None:
     for store in (b, f):
         g = store["group"].ravel() + 1
         within(f"{store.name} group codes", g, g, len(model.groups.names))
+
+
+def _check_zones(path: str, model: Model) -> None:
+    """The ``zones`` store (dec3d.model.zones): gridpoint rows within the vertices, block rows
+    within the blocks, gridpoint links valid, 4- or 10-node zones, known constitutive codes."""
+    from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_MOHR, ZMODEL_NULL
+
+    v, nb = model.vertices, model.blocks.n
+
+    def need(ok, what):
+        if not ok:
+            raise StateFileError(f"'{path}': {what}")
+
+    if "link" in v and v.n:
+        link = v["link"]
+        need(((link == -1) | ((link >= 0) & (link < v.n))).all(), "a gridpoint link points outside the vertices")
+    if "zones" not in model.stores:
+        return
+    zs = model.store("zones")
+    if not zs.n:
+        return
+    for key in ("block", "gp", "nnode", "cmodel"):
+        need(key in zs, f"the zones store lacks its '{key}' field")
+    need(zs["block"].min() >= 0 and zs["block"].max() < nb, "zone block rows point outside the blocks")
+    nn = zs["nnode"]
+    need(np.isin(nn, (4, 10)).all(), "a zone has a node count other than 4 or 10")
+    gp = zs["gp"]
+    used = np.arange(10)[None, :] < nn[:, None].astype(np.int64)
+    need(((gp[used] >= 0) & (gp[used] < v.n)).all(), "zone gridpoint rows point outside the vertices")
+    need((gp[~used] == -1).all(), "a zone has gridpoint rows past its node count")
+    need(np.isin(zs["cmodel"], (ZMODEL_NULL, ZMODEL_ELASTIC, ZMODEL_MOHR)).all(),
+         "a zone has an unknown constitutive model code")
 
 
 def _check_contacts(path: str, model: Model) -> None:

@@ -1,0 +1,115 @@
+"""`block gridpoint apply` and `block gridpoint apply-remove`: conditions on the gridpoints of zoned blocks."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import BindError
+from ..model.zones import zone_stores
+from .registry import command
+from .values import FLAG, Num, Nums, P
+
+_AX = ("x", "y", "z")
+
+
+def _gridpoints(session, call, what: str) -> np.ndarray:
+    """Rows of zoned-block gridpoints in range; a warning naming file:line when there are none."""
+    m = session.model
+    zone_stores(m)
+    sel = session.range_mask(call, "gridpoint")
+    rows = np.flatnonzero(sel & m.vertices["zoned"])
+    if not len(rows):
+        why = (" (the range holds only vertices of rigid blocks, which are not gridpoints)" if sel.any()
+               else "")
+        session.write(f"warning: {call.location}: `{what}` selected no gridpoint{why}")
+    return rows
+
+
+@command("block gridpoint apply",
+         keywords=[P("velocity", Nums(3, 3), "vx vy vz: all three components held", units="m/s"),
+                   *[P(f"velocity-{a}", Num(), f"the {a} component held", units="m/s") for a in _AX],
+                   P("force", Nums(3, 3), "fx fy fz applied force", units="N"),
+                   *[P(f"force-{a}", Num(), f"the {a} component of the applied force", units="N") for a in _AX]],
+         range="gridpoint",
+         doc="Hold velocity components, or apply a force, at the gridpoints of zoned blocks in range.",
+         details="A velocity condition holds the component at the value every step; a force is added to "
+                 "the gridpoint's unbalanced force every step (a new value replaces the old one). Vertices "
+                 "of rigid blocks are not gridpoints (use `block fix` / `block apply` for them).",
+         examples=["block gridpoint apply velocity-z 0 range position-z 0",
+                   "block gridpoint apply velocity 0 0 0 range position-x 0",
+                   "block gridpoint apply force 0 0 -1e3 range position 0 0 1"])
+def block_gridpoint_apply(session, call):
+    a = call.args
+    given = [k for k in ("velocity", "velocity_x", "velocity_y", "velocity_z", "force", "force_x", "force_y",
+                         "force_z") if a[k] is not None]
+    if not given:
+        raise BindError("`block gridpoint apply` needs velocity[-x|-y|-z] or force[-x|-y|-z]", call.location)
+    for k in given:
+        if not np.isfinite(np.asarray(a[k], float)).all():
+            raise BindError(f"`{k.replace('_', '-')}` must be finite", call.locations.get(k, call.location))
+    rows = _gridpoints(session, call, "block gridpoint apply")
+    v = session.model.vertices
+    if a["velocity"] is not None:
+        v["vapp"][rows] = np.asarray(a["velocity"], float)
+        v["apply_fix"][rows] |= np.uint8(7)
+    for i, ax in enumerate(_AX):
+        if a[f"velocity_{ax}"] is not None:
+            v["vapp"][rows, i] = a[f"velocity_{ax}"]
+            v["apply_fix"][rows] |= np.uint8(1 << i)
+    if a["force"] is not None:
+        v["fapp"][rows] = np.asarray(a["force"], float)
+    for i, ax in enumerate(_AX):
+        if a[f"force_{ax}"] is not None:
+            v["fapp"][rows, i] = a[f"force_{ax}"]
+
+
+@command("block gridpoint apply-remove",
+         keywords=[P("velocity", FLAG, "all velocity conditions", bare=True),
+                   *[P(f"velocity-{a}", FLAG, f"the {a} velocity condition", bare=True) for a in _AX],
+                   P("force", FLAG, "the applied force", bare=True),
+                   *[P(f"force-{a}", FLAG, f"the {a} component of the applied force", bare=True) for a in _AX]],
+         range="gridpoint",
+         doc="Remove gridpoint conditions (all of them when no keyword is given) in range.",
+         examples=["block gridpoint apply-remove", "block gridpoint apply-remove velocity-z range position-z 0"])
+def block_gridpoint_apply_remove(session, call):
+    a = call.args
+    keys = [k for k in ("velocity", "velocity_x", "velocity_y", "velocity_z", "force", "force_x", "force_y",
+                        "force_z") if a[k]]
+    everything = not keys
+    rows = _gridpoints(session, call, "block gridpoint apply-remove")
+    v = session.model.vertices
+    for i, ax in enumerate(_AX):
+        if everything or a["velocity"] or a[f"velocity_{ax}"]:
+            v["apply_fix"][rows] &= np.uint8(~(1 << i) & 0xFF)
+            v["vapp"][rows, i] = 0.0
+        if everything or a["force"] or a[f"force_{ax}"]:
+            v["fapp"][rows, i] = 0.0
+
+
+@command("block gridpoint initialize",
+         keywords=[P("displacement", Nums(3, 3), "dx dy dz", units="m"),
+                   *[P(f"displacement-{a}", Num(), f"the {a} component", units="m") for a in _AX],
+                   P("velocity", Nums(3, 3), "vx vy vz", units="m/s"),
+                   *[P(f"velocity-{a}", Num(), f"the {a} component", units="m/s") for a in _AX]],
+         range="gridpoint",
+         doc="Set the displacement or velocity of the gridpoints of zoned blocks in range.",
+         details="Displacement is the accumulated record (positions do not move), as decks use it to "
+                 "zero displacements after an initial equilibrium.",
+         examples=["block gridpoint initialize displacement 0 0 0", "block gridpoint initialize velocity-x 0.1"])
+def block_gridpoint_initialize(session, call):
+    a = call.args
+    pairs = [("displacement", "disp"), ("velocity", "velocity")]
+    given = [k for base, _ in pairs for k in (base, *(f"{base}_{ax}" for ax in _AX)) if a[k] is not None]
+    if not given:
+        raise BindError("`block gridpoint initialize` needs displacement[-x|-y|-z] or velocity[-x|-y|-z]",
+                        call.location)
+    for k in given:
+        if not np.isfinite(np.asarray(a[k], float)).all():
+            raise BindError(f"`{k.replace('_', '-')}` must be finite", call.locations.get(k, call.location))
+    rows = _gridpoints(session, call, "block gridpoint initialize")
+    v = session.model.vertices
+    for base, field in pairs:
+        if a[base] is not None:
+            v[field][rows] = np.asarray(a[base], float)
+        for i, ax in enumerate(_AX):
+            if a[f"{base}_{ax}"] is not None:
+                v[field][rows, i] = a[f"{base}_{ax}"]
