@@ -442,3 +442,4 @@ def _title(rt):
 
 from . import block_intrinsics  # noqa: E402,F401  (registers block.*)
 from . import table_intrinsics  # noqa: E402,F401  (registers table.*)
+from . import zone_intrinsics  # noqa: E402,F401  (registers block.zone.*)
