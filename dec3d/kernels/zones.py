@@ -1,0 +1,63 @@
+"""Elastic 4-node tetrahedral zones: strain increment, stress update, nodal forces.
+
+3DEC theory text, deformable blocks (000_*, "zone strain rates and stresses", "nodal forces"):
+the velocity gradient of a constant-strain tetrahedron follows from Gauss's divergence theorem,
+grad v = -(1/3V) sum_n v^n n^(n) S^(n), where face (n) is the face opposite node n, n^(n) its unit
+outward normal and S^(n) its area; the nodal force of a zone is the contour integral
+f^n = (1/3) sigma . n^(n) S^(n). Stresses are tension positive, order xx yy zz xy xz yz.
+Partial: mixed discretization, 10-node tetrahedra, masses and the motion loop are not here yet.
+"""
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def _face_vector(a, b, c, opp):
+    """Area vector (normal * area) of triangle abc, oriented away from point opp."""
+    ux = b[0] - a[0]; uy = b[1] - a[1]; uz = b[2] - a[2]
+    wx = c[0] - a[0]; wy = c[1] - a[1]; wz = c[2] - a[2]
+    nx = 0.5 * (uy * wz - uz * wy)
+    ny = 0.5 * (uz * wx - ux * wz)
+    nz = 0.5 * (ux * wy - uy * wx)
+    d = (opp[0] - a[0]) * nx + (opp[1] - a[1]) * ny + (opp[2] - a[2]) * nz
+    if d > 0.0:
+        nx = -nx; ny = -ny; nz = -nz
+    return nx, ny, nz
+
+
+@njit(cache=True)
+def tet_elastic_step(pos, vel, gp, bulk, shear, dt, stress, force):
+    """One elastic step for every 4-node zone: stress += D : (sym grad v) dt, then
+    force[gp] += (1/3) sigma . n S per face opposite each node. Returns nothing."""
+    nz = gp.shape[0]
+    fv = np.empty((4, 3))
+    for z in range(nz):
+        vol = 0.0
+        for n in range(4):
+            i1 = gp[z, (n + 1) % 4]; i2 = gp[z, (n + 2) % 4]; i3 = gp[z, (n + 3) % 4]
+            ax, ay, az = _face_vector(pos[i1], pos[i2], pos[i3], pos[gp[z, n]])
+            fv[n, 0] = ax; fv[n, 1] = ay; fv[n, 2] = az
+        p0 = pos[gp[z, 0]]; p1 = pos[gp[z, 1]]; p2 = pos[gp[z, 2]]; p3 = pos[gp[z, 3]]
+        vol = abs((p1[0] - p0[0]) * ((p2[1] - p0[1]) * (p3[2] - p0[2]) - (p2[2] - p0[2]) * (p3[1] - p0[1]))
+                  - (p1[1] - p0[1]) * ((p2[0] - p0[0]) * (p3[2] - p0[2]) - (p2[2] - p0[2]) * (p3[0] - p0[0]))
+                  + (p1[2] - p0[2]) * ((p2[0] - p0[0]) * (p3[1] - p0[1]) - (p2[1] - p0[1]) * (p3[0] - p0[0]))) / 6.0
+        g = np.zeros((3, 3))   # g[i, j] = d v_i / d x_j
+        for n in range(4):
+            for i in range(3):
+                for j in range(3):
+                    g[i, j] -= vel[gp[z, n], i] * fv[n, j]
+        g /= 3.0 * vol
+        e = np.array([g[0, 0], g[1, 1], g[2, 2], 0.5 * (g[0, 1] + g[1, 0]),
+                      0.5 * (g[0, 2] + g[2, 0]), 0.5 * (g[1, 2] + g[2, 1])]) * dt
+        ev = e[0] + e[1] + e[2]
+        lam = bulk[z] - 2.0 * shear[z] / 3.0
+        for k in range(3):
+            stress[z, k] += lam * ev + 2.0 * shear[z] * e[k]
+        for k in range(3, 6):
+            stress[z, k] += 2.0 * shear[z] * e[k]
+        s = stress[z]
+        for n in range(4):
+            r = gp[z, n]
+            force[r, 0] += (s[0] * fv[n, 0] + s[3] * fv[n, 1] + s[4] * fv[n, 2]) / 3.0
+            force[r, 1] += (s[3] * fv[n, 0] + s[1] * fv[n, 1] + s[5] * fv[n, 2]) / 3.0
+            force[r, 2] += (s[4] * fv[n, 0] + s[5] * fv[n, 1] + s[2] * fv[n, 2]) / 3.0
