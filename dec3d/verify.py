@@ -12,6 +12,9 @@ Each folder of `verification/` holds a `problem.toml`:
                 csv = "<history export file>"  history = "<name>"  [vs = "<name>"]
                 [t0 = <s>]  [t1 = <s>]       # window, seconds after the file's first sample
     [[derive]]  name = "..."  kind = "trend" | "plunge"  of = ["<qx>", "<qy>", "<qz>"]   # degrees
+    [[derive]]  name = "..."  kind = "kirsch"  p1 = …  p2 = …  a = …  bulk = …  shear = …
+                # a closed-form field against the model state (``dec3d.verify_fields``): adds
+                # "<name>.<measure>" for each of its measures (kirsch: sigr, sigt, disp, in %)
 
 `derive` adds quantities worked out from exported history files (kind = "deck"): the least-squares
 slope d(history)/dt (or d(history)/d(vs) with `vs`), the curvature 2·c₂ of a least-squares quadratic
@@ -33,6 +36,8 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
+
+from .verify_fields import FIELDS
 
 
 @dataclass
@@ -56,8 +61,22 @@ def _deck_quantities(folder: Path, spec: dict) -> dict[str, float]:
         q = {k: float(v) for k, v in s.variables.items() if isinstance(v, (int, float)) and not isinstance(v, bool)}
         q.update(s.results)
         for d in spec.get("derive", []):
-            q[d["name"]] = derive(d, q, Path(out))
+            if d["kind"] in FIELDS:
+                q.update(field_errors(d, s.model))
+            else:
+                q[d["name"]] = derive(d, q, Path(out))
         return q
+
+
+def field_errors(d: dict, model) -> dict[str, float]:
+    """The measures of a closed-form field (``dec3d.verify_fields``) on the model, as
+    "<name>.<measure>" quantities."""
+    func, params = FIELDS[d["kind"]]
+    missing = [p for p in params if p not in d]
+    if missing:
+        raise ValueError(f"derive {d.get('name', d['kind'])}: kind {d['kind']!r} needs {', '.join(missing)}")
+    got = func(model, **{p: float(d[p]) for p in params})
+    return {f"{d['name']}.{k}": v for k, v in got.items()}
 
 
 def _column(rows: list[list[str]], name: str, path: Path):

@@ -64,6 +64,7 @@ MAY_IMPORT = {
     "batch": BASE | {"lang", "commands", "session"},      # runs decks in sessions, in processes or on Dask
     "docs": BASE | {"lang", "commands"},
     "ssdem": {"errors"},                         # independent of the rest; only the CLI and verify reach it
+    "verify_fields": BASE | {"model"},            # closed-form fields verify compares the model with
     "verify": None, "repl": None, "cli": None, "__init__": None, "__main__": None,   # top: anything
 }
 

@@ -93,3 +93,73 @@ def test_derive_from_history_files(tmp_path):
         derive({**d, "kind": "slope", "history": "nope"}, {}, tmp_path)
     with pytest.raises(ValueError, match="too few"):
         derive({**d, "kind": "slope", "history": "v", "t0": 5.0}, {}, tmp_path)
+
+
+# ---------------------------------------------------------------- D3: the elastic hole
+D3 = {"D3_elastic_hole_hex": "Hex", "D3_elastic_hole_tet": "tet", "D3_elastic_hole_ho": "HO"}
+
+
+def _command_lines(text: str) -> list[str]:
+    return [ln.split(";")[0].rstrip() for ln in text.splitlines() if ln.split(";")[0].strip()]
+
+
+@pytest.mark.parametrize("folder,name", sorted(D3.items()))
+def test_d3_decks_hold_the_public_decks_command_lines(folder, name):
+    """The issue's condition: the model lines are exactly those of Itasca's three decks (less the
+    FISH post-processing call, the save and the return)."""
+    from conftest import DECKS, NO_DECKS
+
+    src = DECKS / f"peterzhu6667__pinn-cp-3dec__Elastic_Hole__ElasticHole-{name}.dat"
+    if not src.exists():
+        pytest.skip(NO_DECKS)
+    theirs = [ln for ln in _command_lines(src.read_text()) if not ln.lower().startswith(
+        ("program call", "model save", "program return"))]
+    ours = _command_lines((ROOT / "verification" / folder / "deck.dat").read_text())
+    assert ours == theirs
+
+
+def test_kirsch_errors_vanish_on_the_exact_field_and_measure_a_known_offset():
+    """The Python error measures of the hole problem, on a model whose zone stresses and gridpoint
+    displacements are set from the closed form written out here (independently of
+    dec3d.verify_fields): zero error; then a uniform 1 % stress offset gives 1 % radial error."""
+    import math
+
+    import numpy as np
+
+    from dec3d.model.model import Model
+    from dec3d.model.zones import zone_stores
+    from dec3d.verify_fields import kirsch_errors
+
+    m = Model()
+    zs = zone_stores(m)
+    rng = np.random.default_rng(7)
+    pts = np.column_stack([rng.uniform(1.2, 6.0, 400), rng.uniform(0, 1, 400), rng.uniform(0.0, 6.0, 400)])
+    vs = m.vertices
+    sl = vs.append(len(pts))
+    vs["pos"][sl] = pts
+    vs["zoned"][sl] = True
+    # one degenerate "zone" per gridpoint (its four corners at the point): the centroid is the point
+    zsl = zs.append(len(pts))
+    zs["gp"][zsl, :4] = np.arange(len(pts))[:, None]
+    p1, p2, a, K, G = 30e6, 15e6, 1.0, 3.9e9, 2.8e9
+    nu = (3 * K - 2 * G) / (6 * K + 2 * G)
+    for i, (x, _, z) in enumerate(pts):
+        r, th = math.hypot(x, z), math.atan2(z, x)
+        q = (a / r) ** 2
+        srr = 0.5 * (p1 + p2) * (1 - q) + 0.5 * (p1 - p2) * (1 - 4 * q + 3 * q * q) * math.cos(2 * th)
+        stt = 0.5 * (p1 + p2) * (1 + q) - 0.5 * (p1 - p2) * (1 + 3 * q * q) * math.cos(2 * th)
+        srt = -0.5 * (p1 - p2) * (1 + 2 * q - 3 * q * q) * math.sin(2 * th)
+        c, s = math.cos(th), math.sin(th)
+        # compression positive (r, θ) -> tension positive (x, z)
+        sxx = -(srr * c * c + stt * s * s - 2 * srt * s * c)
+        szz = -(srr * s * s + stt * c * c + 2 * srt * s * c)
+        sxz = -((srr - stt) * s * c + srt * (c * c - s * s))
+        zs["stress"][i] = (sxx, -30e6, szz, 0.0, sxz, 0.0)
+        ur = a * a / (4 * G * r) * ((p1 + p2) + (p1 - p2) * (4 * (1 - nu) - q) * math.cos(2 * th))
+        vs["disp"][i] = (-ur * c, 0.0, -ur * s)
+    e = kirsch_errors(m, p1, p2, a, K, G)
+    assert e["sigr"] < 1e-9 and e["sigt"] < 1e-9 and e["disp"] < 1e-9
+    zs["stress"][:, 0] -= 0.01 * p1          # 1 % more compression in x, at θ = 0 all radial
+    zs["stress"][:, 2] -= 0.01 * p1          # and in z: σ_r and σ_θ both 1 % of p1 off everywhere
+    e = kirsch_errors(m, p1, p2, a, K, G)
+    assert e["sigr"] == pytest.approx(1.0, rel=1e-9) and e["sigt"] == pytest.approx(1.0, rel=1e-9)

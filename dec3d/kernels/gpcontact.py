@@ -1,0 +1,229 @@
+"""Sub-contacts on deformable (zoned) blocks: where a sub-contact sits on a zoned block's
+surface, the velocity of that point and the share of the contact force each gridpoint takes
+(3DEC theory, "Deformable blocks": a sub-contact on a deformable block moves with the
+gridpoints of the surface it lies on, and its force goes to those gridpoints — on the vertex
+side to the vertex gridpoint, on the face side shared among the face's gridpoints by the
+interpolation factors of the point in the face triangle).
+
+Every sub-contact gets, for each of its two sides, up to three gridpoint rows and weights
+(``nodes`` (k, 3) int64, ``w`` (k, 3)): the surface triangle of that block nearest to the
+point and the barycentric coordinates of the nearest point of the triangle (clamped to it,
+so they are ≥ 0 and sum to 1). A vertex sub-contact gets weight 1 on its vertex, one on an
+edge the two edge weights. A rigid side gets node -1 and moves with its block (Eq. 11).
+
+With the weights fixed between two detection passes, one step is:
+  V = v_B(x) − v_A(x), v_side(x) = Σ wᵢ vᵢ (zoned) or ẋ + ω × (x − x̄) (rigid)   (Eq. 15)
+  the joint law of ``jointlaw.coulomb_one`` unchanged;
+  force on B: + (Fⁿ n + Fˢ), on A: −; to a zoned side's gridpoints in proportion wᵢ, to a
+  rigid side's centroid with its moment (ERRATA Eqs. 28-32).
+"""
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from .jointlaw import (P_COH, P_COH_RES, P_KN, P_KS, P_TANDIL, P_TANF, P_TANF_RES, P_TEN, P_TEN_RES, P_ZDIL,
+                       ST_NEW, coulomb_one)
+
+
+@njit(cache=True)
+def _closest_on_triangle(p0, p1, p2, a, b, c):
+    """Barycentric (u, v, w) of the point of triangle abc nearest to p, and the squared distance."""
+    ab0, ab1, ab2 = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+    ac0, ac1, ac2 = c[0] - a[0], c[1] - a[1], c[2] - a[2]
+    ap0, ap1, ap2 = p0 - a[0], p1 - a[1], p2 - a[2]
+    d00 = ab0 * ab0 + ab1 * ab1 + ab2 * ab2
+    d01 = ab0 * ac0 + ab1 * ac1 + ab2 * ac2
+    d11 = ac0 * ac0 + ac1 * ac1 + ac2 * ac2
+    d20 = ap0 * ab0 + ap1 * ab1 + ap2 * ab2
+    d21 = ap0 * ac0 + ap1 * ac1 + ap2 * ac2
+    den = d00 * d11 - d01 * d01
+    best_u, best_v, best_w, best_d = 1.0, 0.0, 0.0, math.inf
+    if den > 0.0:
+        v = (d11 * d20 - d01 * d21) / den
+        w = (d00 * d21 - d01 * d20) / den
+        u = 1.0 - v - w
+        if u >= 0.0 and v >= 0.0 and w >= 0.0:
+            q0 = a[0] + v * ab0 + w * ac0 - p0
+            q1 = a[1] + v * ab1 + w * ac1 - p1
+            q2 = a[2] + v * ab2 + w * ac2 - p2
+            return u, v, w, q0 * q0 + q1 * q1 + q2 * q2
+    # outside (or degenerate): the nearest point of the three edges
+    for e in range(3):
+        if e == 0:
+            s, t = a, b
+        elif e == 1:
+            s, t = b, c
+        else:
+            s, t = c, a
+        e0, e1, e2 = t[0] - s[0], t[1] - s[1], t[2] - s[2]
+        ll = e0 * e0 + e1 * e1 + e2 * e2
+        f = 0.0
+        if ll > 0.0:
+            f = ((p0 - s[0]) * e0 + (p1 - s[1]) * e1 + (p2 - s[2]) * e2) / ll
+            f = min(1.0, max(0.0, f))
+        q0 = s[0] + f * e0 - p0
+        q1 = s[1] + f * e1 - p1
+        q2 = s[2] + f * e2 - p2
+        d = q0 * q0 + q1 * q1 + q2 * q2
+        if d < best_d:
+            best_d = d
+            if e == 0:
+                best_u, best_v, best_w = 1.0 - f, f, 0.0
+            elif e == 1:
+                best_u, best_v, best_w = 0.0, 1.0 - f, f
+            else:
+                best_u, best_v, best_w = f, 0.0, 1.0 - f
+    return best_u, best_v, best_w, best_d
+
+
+@njit(cache=True)
+def surface_weights(owner, pts, ca, cb, zoned, vpos, bfstart, bfcount, fvstart, fnvert, fverts,
+                    nodes_a, w_a, nodes_b, w_b):
+    """For points pts (k, 3) of contacts owner (k,): per side, the nearest surface triangle of a
+    zoned block (zoned (nb,) bool) and the barycentric weights of the point in it; -1 and 0 for a
+    rigid side (or a face that is not a triangle)."""
+    for i in range(owner.shape[0]):
+        c = owner[i]
+        for side in range(2):
+            blk = ca[c] if side == 0 else cb[c]
+            nodes = nodes_a if side == 0 else nodes_b
+            w = w_a if side == 0 else w_b
+            for j in range(3):
+                nodes[i, j] = -1
+                w[i, j] = 0.0
+            if not zoned[blk]:
+                continue
+            best = math.inf
+            for f in range(bfstart[blk], bfstart[blk] + bfcount[blk]):
+                if fnvert[f] != 3:
+                    continue
+                k0 = fverts[fvstart[f]]
+                k1 = fverts[fvstart[f] + 1]
+                k2 = fverts[fvstart[f] + 2]
+                u, v, ww, d = _closest_on_triangle(pts[i, 0], pts[i, 1], pts[i, 2], vpos[k0], vpos[k1], vpos[k2])
+                if d < best:
+                    best = d
+                    nodes[i, 0] = k0
+                    nodes[i, 1] = k1
+                    nodes[i, 2] = k2
+                    w[i, 0] = u
+                    w[i, 1] = v
+                    w[i, 2] = ww
+
+
+@njit(cache=True)
+def _side_velocity(x0, x1, x2, blk, nodes, w, i, bpos, bvel, bspin, gvel):
+    if nodes[i, 0] < 0:
+        r0 = x0 - bpos[blk, 0]
+        r1 = x1 - bpos[blk, 1]
+        r2 = x2 - bpos[blk, 2]
+        wv = bspin[blk]
+        return (bvel[blk, 0] + wv[1] * r2 - wv[2] * r1,
+                bvel[blk, 1] + wv[2] * r0 - wv[0] * r2,
+                bvel[blk, 2] + wv[0] * r1 - wv[1] * r0)
+    v0 = 0.0
+    v1 = 0.0
+    v2 = 0.0
+    for j in range(3):
+        g = nodes[i, j]
+        if g >= 0:
+            v0 += w[i, j] * gvel[g, 0]
+            v1 += w[i, j] * gvel[g, 1]
+            v2 += w[i, j] * gvel[g, 2]
+    return v0, v1, v2
+
+
+@njit(cache=True)
+def _side_force(sign, g0, g1, g2, x0, x1, x2, blk, nodes, w, i, bpos, bforce, bmoment, gforce):
+    f0 = sign * g0
+    f1 = sign * g1
+    f2 = sign * g2
+    if nodes[i, 0] < 0:
+        r0 = x0 - bpos[blk, 0]
+        r1 = x1 - bpos[blk, 1]
+        r2 = x2 - bpos[blk, 2]
+        bforce[blk, 0] += f0
+        bforce[blk, 1] += f1
+        bforce[blk, 2] += f2
+        bmoment[blk, 0] += r1 * f2 - r2 * f1
+        bmoment[blk, 1] += r2 * f0 - r0 * f2
+        bmoment[blk, 2] += r0 * f1 - r1 * f0
+        return
+    for j in range(3):
+        g = nodes[i, j]
+        if g >= 0:
+            gforce[g, 0] += w[i, j] * f0
+            gforce[g, 1] += w[i, j] * f1
+            gforce[g, 2] += w[i, j] * f2
+
+
+@njit(cache=True)
+def mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce,
+                            ca, cb, cn, cmodel, cprop,
+                            sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
+                            nodes_a, w_a, nodes_b, w_b):
+    """One force update of every sub-contact when some blocks are zoned: as
+    ``jointlaw.subcontact_forces``, with each zoned side's velocity interpolated from its
+    gridpoints (gvel (nv, 3)) and its force shared to them (added to gforce (nv, 3))."""
+    for s in range(sc_contact.shape[0]):
+        c = sc_contact[s]
+        a = ca[c]
+        b = cb[c]
+        n0 = cn[c, 0]
+        n1 = cn[c, 1]
+        n2 = cn[c, 2]
+        x0 = sc_pos[s, 0]
+        x1 = sc_pos[s, 1]
+        x2 = sc_pos[s, 2]
+        va0, va1, va2 = _side_velocity(x0, x1, x2, a, nodes_a, w_a, s, bpos, bvel, bspin, gvel)
+        vb0, vb1, vb2 = _side_velocity(x0, x1, x2, b, nodes_b, w_b, s, bpos, bvel, bspin, gvel)
+        du0 = (vb0 - va0) * dt
+        du1 = (vb1 - va1) * dt
+        du2 = (vb2 - va2) * dt
+        dun = du0 * n0 + du1 * n1 + du2 * n2
+        st0 = sc_state[s]
+        if st0 & ST_NEW:
+            du0 = 0.0
+            du1 = 0.0
+            du2 = 0.0
+            dun = 0.0
+            st0 &= ~ST_NEW
+        p = cprop[c]
+        fn, f0, f1, f2, un, ud, u0, u1, u2, st = coulomb_one(
+            p[P_KN], p[P_KS], p[P_TANF], p[P_COH], p[P_TEN], p[P_TANDIL], p[P_ZDIL],
+            p[P_TANF_RES], p[P_COH_RES], p[P_TEN_RES], cmodel[c], sc_area[s],
+            dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s], sc_udil[s],
+            sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
+        sc_fn[s] = fn
+        sc_fs[s, 0] = f0
+        sc_fs[s, 1] = f1
+        sc_fs[s, 2] = f2
+        sc_un[s] = un
+        sc_udil[s] = ud
+        sc_us[s, 0] = u0
+        sc_us[s, 1] = u1
+        sc_us[s, 2] = u2
+        sc_state[s] = st
+        g0 = fn * n0 + f0
+        g1 = fn * n1 + f1
+        g2 = fn * n2 + f2
+        _side_force(1.0, g0, g1, g2, x0, x1, x2, b, nodes_b, w_b, s, bpos, bforce, bmoment, gforce)
+        _side_force(-1.0, g0, g1, g2, x0, x1, x2, a, nodes_a, w_a, s, bpos, bforce, bmoment, gforce)
+
+
+@njit(cache=True)
+def mixed_move_points(dt, ca, cb, owner, pts, bpos, bvel, bspin, gvel, nodes_a, w_a, nodes_b, w_b):
+    """Eq. (11) with zoned sides: each point moves by the mean of the two sides' displacement
+    at it (a rigid side's rigid motion, a zoned side's interpolated gridpoint velocity) × Δt."""
+    for i in range(owner.shape[0]):
+        c = owner[i]
+        x0 = pts[i, 0]
+        x1 = pts[i, 1]
+        x2 = pts[i, 2]
+        va0, va1, va2 = _side_velocity(x0, x1, x2, ca[c], nodes_a, w_a, i, bpos, bvel, bspin, gvel)
+        vb0, vb1, vb2 = _side_velocity(x0, x1, x2, cb[c], nodes_b, w_b, i, bpos, bvel, bspin, gvel)
+        pts[i, 0] += 0.5 * dt * (va0 + vb0)
+        pts[i, 1] += 0.5 * dt * (va1 + vb1)
+        pts[i, 2] += 0.5 * dt * (va2 + vb2)

@@ -1,0 +1,65 @@
+"""Closed-form fields that verification problems compare the whole model state with
+(`[[derive]]` kinds of ``dec3d verify`` that read the model, not a history file).
+
+``kirsch``: a circular hole of radius a in an infinite, isotropic, linear elastic medium
+under far-field stresses p1 (along x) and p2 (along z), hole axis along y, plane strain
+(Kirsch; Jaeger & Cook, "Fundamentals of Rock Mechanics", §10.4). Compressive stresses and
+the inward displacement are positive in the formulas, as in Itasca's verification
+"Cylindrical Hole in an Infinite Elastic Medium" (3DEC verification problems). The error
+measures are the ones that verification defines (its FISH file ``ElasticHole.fis``):
+
+- radial and tangential stress: the mean over every zone of |σ − σ_exact| / p1, in %, the
+  numerical σ_r, σ_θ from the zone stress at the zone centroid;
+- displacement: Σ over every gridpoint of ||u_xz| − u_exact| / (N · u_edge), in %, where
+  u_edge is the exact radial displacement at the hole wall on the x axis and N the number of
+  gridpoints (shared gridpoints of joined blocks counted once per block, as 3DEC lists them).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def kirsch_exact(x: np.ndarray, z: np.ndarray, p1: float, p2: float, a: float, shear: float, nu: float):
+    """(σ_r, σ_θ, u_r) at points (x, z): stresses compression positive [Pa], u_r the radial
+    displacement towards the hole [m] caused by making the hole."""
+    r = np.hypot(x, z)
+    th = np.arctan2(z, x)
+    q2 = (a / r) ** 2
+    c2 = np.cos(2.0 * th)
+    sr = 0.5 * (p1 + p2) * (1.0 - q2) + 0.5 * (p1 - p2) * (1.0 - 4.0 * q2 + 3.0 * q2 * q2) * c2
+    st = 0.5 * (p1 + p2) * (1.0 + q2) - 0.5 * (p1 - p2) * (1.0 + 3.0 * q2 * q2) * c2
+    ur = 0.25 * ((p1 + p2) + (p1 - p2) * (4.0 * (1.0 - nu) - q2) * c2) * (a / r) * a / shear
+    return sr, st, ur
+
+
+def kirsch_errors(model, p1: float, p2: float, a: float, bulk: float, shear: float) -> dict[str, float]:
+    """The three error measures (%) of the module docstring over the model's zones and gridpoints."""
+    zs = model.store("zones")
+    vs = model.vertices
+    if zs.n == 0:
+        raise ValueError("kirsch: the model has no zones")
+    nu = (3.0 * bulk - 2.0 * shear) / (6.0 * bulk + 2.0 * shear)
+    pos = vs["pos"]
+    cen = pos[zs["gp"][:, :4]].mean(axis=1)
+    x, z = cen[:, 0], cen[:, 2]
+    sr_e, st_e, _ = kirsch_exact(x, z, p1, p2, a, shear, nu)
+    s = zs["stress"]
+    th = np.arctan2(z, x)
+    mean = 0.5 * (s[:, 0] + s[:, 2])
+    half = 0.5 * (s[:, 0] - s[:, 2])
+    sxz = s[:, 4]
+    sr = -(mean + half * np.cos(2.0 * th) + sxz * np.sin(2.0 * th))
+    st = -(mean - half * np.cos(2.0 * th) - sxz * np.sin(2.0 * th))
+    err_sr = 100.0 * float(np.mean(np.abs(sr - sr_e))) / p1
+    err_st = 100.0 * float(np.mean(np.abs(st - st_e))) / p1
+    gp = np.flatnonzero(vs["zoned"])
+    gx, gz = pos[gp, 0], pos[gp, 2]
+    _, _, u_e = kirsch_exact(gx, gz, p1, p2, a, shear, nu)
+    u = np.hypot(vs["disp"][gp, 0], vs["disp"][gp, 2])
+    u_edge = 0.25 * ((p1 + p2) + (p1 - p2) * (4.0 * (1.0 - nu) - 1.0)) / shear
+    err_d = 100.0 * float(np.sum(np.abs(u - u_e))) / (u_edge * len(gp))
+    return {"sigr": err_sr, "sigt": err_st, "disp": err_d}
+
+
+#: derive kinds that read the model: name -> (function, its parameter names)
+FIELDS = {"kirsch": (kirsch_errors, ("p1", "p2", "a", "bulk", "shear"))}
