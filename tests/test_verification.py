@@ -95,29 +95,7 @@ def test_derive_from_history_files(tmp_path):
         derive({**d, "kind": "slope", "history": "v", "t0": 5.0}, {}, tmp_path)
 
 
-# ---------------------------------------------------------------- D3: the elastic hole
-D3 = {"D3_elastic_hole_hex": "Hex", "D3_elastic_hole_tet": "tet", "D3_elastic_hole_ho": "HO"}
-
-
-def _command_lines(text: str) -> list[str]:
-    return [ln.split(";")[0].rstrip() for ln in text.splitlines() if ln.split(";")[0].strip()]
-
-
-@pytest.mark.parametrize("folder,name", sorted(D3.items()))
-def test_d3_decks_hold_the_public_decks_command_lines(folder, name):
-    """The issue's condition: the model lines are exactly those of Itasca's three decks (less the
-    FISH post-processing call, the save and the return)."""
-    from conftest import DECKS, NO_DECKS
-
-    src = DECKS / f"peterzhu6667__pinn-cp-3dec__Elastic_Hole__ElasticHole-{name}.dat"
-    if not src.exists():
-        pytest.skip(NO_DECKS)
-    theirs = [ln for ln in _command_lines(src.read_text()) if not ln.lower().startswith(
-        ("program call", "model save", "program return"))]
-    ours = _command_lines((ROOT / "verification" / folder / "deck.dat").read_text())
-    assert ours == theirs
-
-
+# ---------------------------------------------------------------- the elastic-hole error measures
 def test_kirsch_errors_vanish_on_the_exact_field_and_measure_a_known_offset():
     """The Python error measures of the hole problem, on a model whose zone stresses and gridpoint
     displacements are set from the closed form written out here (independently of
