@@ -76,11 +76,11 @@ def test_blockers_in_called_decks_are_reported_with_their_file(tmp_path, capsys)
     assert [(r.file, r.line, r.status) for r in bad] == [(str(geo), 2, NOT_SUPPORTED)]
     assert main(["check", str(deck)]) == 1
     out = capsys.readouterr().out
-    assert f"{geo}:2:1: not supported yet: `block zone generate` is not supported yet" in out
+    assert f"{geo}:2:21: not supported yet: keyword `hexahedra` is not supported yet" in out
     assert "(in 2 files)" in out
     # the run stops at the same line
     assert main(["run", str(deck), "--out", str(tmp_path / "out"), "-q"]) != 0
-    assert f"{geo}:2:1: error: `block zone generate` is not supported yet" in capsys.readouterr().err
+    assert f"{geo}:2:21: error: keyword `hexahedra` is not supported yet" in capsys.readouterr().err
 
 
 def test_a_file_that_calls_itself(tmp_path):

@@ -72,7 +72,7 @@ def completions(text):
 
 def test_completion_marks_what_does_not_run():
     notes = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document("block "), None)}
-    assert notes["zone"] == "not supported yet" and notes["copy"] == "not supported yet"
+    assert notes["copy"] == "not supported yet"
     assert notes["create"] == "" and notes["contact"] == ""
     top = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document(""), None)}
     assert top["plot"] == "display only: skipped" and top["model"] == ""

@@ -28,7 +28,9 @@ def _gridpoints(session, call, what: str) -> np.ndarray:
          keywords=[P("velocity", Nums(3, 3), "vx vy vz: all three components held", units="m/s"),
                    *[P(f"velocity-{a}", Num(), f"the {a} component held", units="m/s") for a in _AX],
                    P("force", Nums(3, 3), "fx fy fz applied force", units="N"),
-                   *[P(f"force-{a}", Num(), f"the {a} component of the applied force", units="N") for a in _AX]],
+                   *[P(f"force-{a}", Num(), f"the {a} component of the applied force", units="N") for a in _AX],
+                   P("table", Num(integer=True), "the value is multiplied by this table of time",
+                     supported=False)],
          range="gridpoint",
          doc="Hold velocity components, or apply a force, at the gridpoints of zoned blocks in range.",
          details="A velocity condition holds the component at the value every step; a force is added to "

@@ -9,7 +9,7 @@ from ..geometry.assemble import block_poly
 from ..geometry.zoning import mesh_convex
 from ..model.zones import install_block_mesh, zone_stores
 from .registry import command
-from .values import Num, P
+from .values import FLAG, Num, Nums, P
 
 # Memory budget: about 1 kB per zone (issue 10); refuse beyond this many zones per command.
 ZONE_BUDGET = 20_000_000
@@ -19,7 +19,11 @@ _TETS_PER_CELL = 6.0
 
 @command("block zone generate",
          keywords=[P("edgelength", Num(lo=0, lo_open=True), "target edge length", units="m"),
-                   P("edge-length", Num(lo=0, lo_open=True), "same as edgelength", units="m")],
+                   P("edge-length", Num(lo=0, lo_open=True), "same as edgelength", units="m"),
+                   P("hexahedra", FLAG, "hexahedral zones of two overlaid 5-tetrahedron sets", supported=False),
+                   P("divisions", Nums(3, 3), "n1 n2 n3 hexahedra along the block's edges", supported=False),
+                   P("high-order-tetra", FLAG, "10-node tetrahedra (after model configure highorder)",
+                     supported=False)],
          range="block",
          doc="Zone the blocks in range into 4-node tetrahedra of about the given edge length.",
          details="Blocks already zoned are left as they are, so a deck zones fine regions first and "

@@ -24,6 +24,7 @@ from dec3d.kernels.cycle import run_steps
 from dec3d.kernels.jointlaw import P_KN, P_KS
 from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST, block_timestep
 from dec3d.model.store import Store
+from dec3d.model.zones import has_zones
 
 from .bodies import group_properties, inertial_masses, new_servo
 from .contacts import ContactDetection, contact_stores, default_row
@@ -385,6 +386,9 @@ class RigidEngine(ContactDetection):
         m = self.model
         b = m.blocks
         live = ~b["hidden"]
+        if has_zones(m):
+            raise RunError("zoned (deformable) blocks do not cycle yet: `block zone generate` has made zones, "
+                           "but the zone mechanics are not in this version (issue 10); nothing was cycled")
         if (b["mass"][live] <= 0).any():
             raise RunError("a block has no mass: set `block property density` before cycling")
         s = self.settings()
