@@ -354,8 +354,13 @@ def register_known(**entries) -> None:
 
 
 def _known() -> dict:
-    if not {"joint_models", "joint_model_codes", "histories"} <= KNOWN.keys():   # pragma: no cover
-        raise RuntimeError("dec3d.physics registers what save files may name: import it before a restore")
+    if not {"joint_models", "joint_model_codes", "histories"} <= KNOWN.keys():
+        # a restore called before anything imported the physics layer (e.g. ``dec3d.io.state``
+        # used on its own): load the registering modules by name, which keeps the import arrows
+        # of the layers (physics -> io) as they are
+        import importlib
+        for name in ("dec3d.physics.jmodels", "dec3d.physics.history"):
+            importlib.import_module(name)
     return KNOWN
 
 
