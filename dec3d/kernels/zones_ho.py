@@ -1,0 +1,282 @@
+"""Elastic 10-node (higher-order) tetrahedral zones: Gauss-point strains and stresses,
+nodal forces by integration of the Gauss-point stresses, lumped masses, nodal stiffness.
+
+3DEC theory text (000_*), "Higher-Order Tetrahedral Elements": ``block zone generate
+high-order-tetra`` adds a node at the midpoint of every zone edge, giving quadratic
+displacement interpolation; "for the 10-node tetrahedra, there are 4 Gauss points, where
+strains and stresses are calculated"; "nodal forces are obtained from the Gauss point stresses
+by numerical integration, so that the stiffness matrix is not calculated"; the constitutive
+model is applied at each Gauss point every step. The text gives neither the shape functions,
+the quadrature nor a mass lumping for these zones; what is used here is standard finite-element
+practice (Zienkiewicz & Taylor, The Finite Element Method, vol. 1, tetrahedral elements;
+Hughes 1987 for the quadrature and for HRZ lumping), named where used.
+
+Node order (``zones.gp``): corners 0-3, then the mid-edge nodes of edges 01 12 20 03 13 23.
+With volume coordinates L0..L3 (L0 = 1 - xi1 - xi2 - xi3, Lk = xi_k), the shape functions are
+N_i = L_i (2 L_i - 1) at corner i and N = 4 L_i L_j at the node of edge ij (isoparametric:
+the same functions map the reference tetrahedron to the zone's current positions).
+
+Quadrature: the symmetric 4-point rule for tetrahedra (exact for quadratics), Gauss point g
+at L_g = a, the other three L = b, a = 0.5854101966249685, b = 0.1381966011250105 (a = (5 + 3
+sqrt 5)/20, b = (5 - sqrt 5)/20), weight 1/24 each in the reference volume 1/6. Gauss point g
+is the one nearest corner g; ``gstress[z, g]`` is its stress (xx yy zz xy xz yz, tension
+positive) and ``stress[z]`` the mean of the four.
+
+Sign convention as ``kernels/zones.tet_elastic_step``: ``force[r]`` accumulates the force the
+zone exerts on gridpoint r, the negative of the internal-force vector, -int B^T sigma dV.
+"""
+import numpy as np
+from numba import njit
+
+GA = 0.5854101966249685     # (5 + 3 sqrt 5) / 20
+GB = 0.1381966011250105     # (5 - sqrt 5) / 20
+GW = 1.0 / 24.0             # weight of each point (reference tetrahedron volume 1/6)
+
+#: HRZ fractions of the zone mass for a straight-edged 10-node tetrahedron (see tet10_lumped_mass)
+HRZ_CORNER = 1.0 / 36.0
+HRZ_MID = 4.0 / 27.0
+
+@njit(cache=True)
+def ref_derivs():
+    """dN_a/dxi_k at the 4 Gauss points: array (4, 10, 3). Returns a new array."""
+    d = np.zeros((4, 10, 3))
+    ei = np.array([0, 1, 2, 0, 1, 2])   # corners (i, j) of the edge of mid-edge node 4 + e
+    ej = np.array([1, 2, 0, 3, 3, 3])
+    for g in range(4):
+        L = np.full(4, GB)
+        L[g] = GA
+        # dN/dL_m for every node, then dN/dxi_k = dN/dL_k - dN/dL_0 (L0 = 1 - sum xi)
+        dl = np.zeros((10, 4))
+        for i in range(4):
+            dl[i, i] = 4.0 * L[i] - 1.0
+        for e in range(6):
+            dl[4 + e, ei[e]] = 4.0 * L[ej[e]]
+            dl[4 + e, ej[e]] = 4.0 * L[ei[e]]
+        for a in range(10):
+            for k in range(3):
+                d[g, a, k] = dl[a, k + 1] - dl[a, 0]
+    return d
+
+
+@njit(cache=True)
+def _grad_n(pos, nodes, dxi, dn):
+    """Cartesian shape-function gradients at one Gauss point: fills dn (10, 3) with dN_a/dx_j
+    from dxi (10, 3) = dN_a/dxi_k and the nodal positions. Returns det J (signed).
+    Scalars only (no temporary arrays: this runs 4 times per zone per step)."""
+    # J[i, k] = dx_i / dxi_k
+    j00 = 0.0; j01 = 0.0; j02 = 0.0
+    j10 = 0.0; j11 = 0.0; j12 = 0.0
+    j20 = 0.0; j21 = 0.0; j22 = 0.0
+    for a in range(10):
+        p = pos[nodes[a]]
+        d0 = dxi[a, 0]; d1 = dxi[a, 1]; d2 = dxi[a, 2]
+        j00 += p[0] * d0; j01 += p[0] * d1; j02 += p[0] * d2
+        j10 += p[1] * d0; j11 += p[1] * d1; j12 += p[1] * d2
+        j20 += p[2] * d0; j21 += p[2] * d1; j22 += p[2] * d2
+    c00 = j11 * j22 - j12 * j21
+    c01 = j12 * j20 - j10 * j22
+    c02 = j10 * j21 - j11 * j20
+    det = j00 * c00 + j01 * c01 + j02 * c02
+    r = 1.0 / det
+    # inverse: i{k}{i} = dxi_k / dx_i
+    i00 = c00 * r
+    i10 = c01 * r
+    i20 = c02 * r
+    i01 = (j02 * j21 - j01 * j22) * r
+    i11 = (j00 * j22 - j02 * j20) * r
+    i21 = (j01 * j20 - j00 * j21) * r
+    i02 = (j01 * j12 - j02 * j11) * r
+    i12 = (j02 * j10 - j00 * j12) * r
+    i22 = (j00 * j11 - j01 * j10) * r
+    for a in range(10):
+        d0 = dxi[a, 0]; d1 = dxi[a, 1]; d2 = dxi[a, 2]
+        dn[a, 0] = d0 * i00 + d1 * i10 + d2 * i20
+        dn[a, 1] = d0 * i01 + d1 * i11 + d2 * i21
+        dn[a, 2] = d0 * i02 + d1 * i12 + d2 * i22
+    return det
+
+
+@njit(cache=True)
+def tet10_step(pos, vel, gp, rows, bulk, shear, dt, gstress, stress, force):
+    """One elastic step of the 10-node zones in ``rows``.
+
+    pos, vel (nv, 3): gridpoint positions (current) and velocities; gp (nz, 10) node rows;
+    rows (k,) int64 zone rows to update; bulk, shear (nz,) moduli by zone row [Pa]; dt [s].
+    At each Gauss point g: grad v = sum_a v_a (x) grad N_a (isoparametric, Jacobian from pos),
+    strain increment = sym(grad v) dt, gstress[z, g] += lambda tr(de) I + 2 G de (the text's
+    Eq. 59 with the 3-term volumetric strain of the errata). Then stress[z] = mean over g, and
+    force[gp[z, a]] -= sum_g w |det J_g| sigma_g . grad N_a(g).
+    Modifies gstress, stress, force.
+    """
+    dref = ref_derivs()
+    dn = np.empty((10, 3))
+    nodes = np.empty(10, np.int64)
+    for kk in range(rows.shape[0]):
+        z = rows[kk]
+        for a in range(10):
+            nodes[a] = gp[z, a]
+        lam = bulk[z] - 2.0 * shear[z] / 3.0
+        g2 = 2.0 * shear[z]
+        for c in range(6):
+            stress[z, c] = 0.0
+        for g in range(4):
+            det = _grad_n(pos, nodes, dref[g], dn)
+            # velocity gradient L[i, j] = dv_i/dx_j
+            l00 = 0.0; l01 = 0.0; l02 = 0.0
+            l10 = 0.0; l11 = 0.0; l12 = 0.0
+            l20 = 0.0; l21 = 0.0; l22 = 0.0
+            for a in range(10):
+                v = vel[nodes[a]]
+                l00 += v[0] * dn[a, 0]; l01 += v[0] * dn[a, 1]; l02 += v[0] * dn[a, 2]
+                l10 += v[1] * dn[a, 0]; l11 += v[1] * dn[a, 1]; l12 += v[1] * dn[a, 2]
+                l20 += v[2] * dn[a, 0]; l21 += v[2] * dn[a, 1]; l22 += v[2] * dn[a, 2]
+            exx = l00 * dt; eyy = l11 * dt; ezz = l22 * dt
+            exy = 0.5 * (l01 + l10) * dt
+            exz = 0.5 * (l02 + l20) * dt
+            eyz = 0.5 * (l12 + l21) * dt
+            ev = exx + eyy + ezz
+            s = gstress[z, g]
+            s[0] += lam * ev + g2 * exx
+            s[1] += lam * ev + g2 * eyy
+            s[2] += lam * ev + g2 * ezz
+            s[3] += g2 * exy
+            s[4] += g2 * exz
+            s[5] += g2 * eyz
+            for c in range(6):
+                stress[z, c] += 0.25 * s[c]
+            wd = GW * abs(det)
+            for a in range(10):
+                r = nodes[a]
+                force[r, 0] -= wd * (s[0] * dn[a, 0] + s[3] * dn[a, 1] + s[4] * dn[a, 2])
+                force[r, 1] -= wd * (s[3] * dn[a, 0] + s[1] * dn[a, 1] + s[5] * dn[a, 2])
+                force[r, 2] -= wd * (s[4] * dn[a, 0] + s[5] * dn[a, 1] + s[2] * dn[a, 2])
+
+
+@njit(cache=True)
+def tet10_forces(pos, gp, rows, gstress, force):
+    """Nodal forces of the given Gauss-point stresses, no stress update (for a state just set,
+    e.g. in-situ stresses): force[gp[z, a]] -= sum_g w |det J_g| sigma_g . grad N_a(g).
+    Modifies force."""
+    dref = ref_derivs()
+    dn = np.empty((10, 3))
+    nodes = np.empty(10, np.int64)
+    for kk in range(rows.shape[0]):
+        z = rows[kk]
+        for a in range(10):
+            nodes[a] = gp[z, a]
+        for g in range(4):
+            det = _grad_n(pos, nodes, dref[g], dn)
+            s = gstress[z, g]
+            wd = GW * abs(det)
+            for a in range(10):
+                r = nodes[a]
+                force[r, 0] -= wd * (s[0] * dn[a, 0] + s[3] * dn[a, 1] + s[4] * dn[a, 2])
+                force[r, 1] -= wd * (s[3] * dn[a, 0] + s[1] * dn[a, 1] + s[5] * dn[a, 2])
+                force[r, 2] -= wd * (s[4] * dn[a, 0] + s[5] * dn[a, 1] + s[2] * dn[a, 2])
+
+
+@njit(cache=True)
+def tet10_volume(pos, gp, rows, volume):
+    """Zone volumes by the 4-point rule, sum_g w |det J_g| (exact for straight edges).
+    Writes volume[z] for z in rows."""
+    dref = ref_derivs()
+    dn = np.empty((10, 3))
+    nodes = np.empty(10, np.int64)
+    for kk in range(rows.shape[0]):
+        z = rows[kk]
+        for a in range(10):
+            nodes[a] = gp[z, a]
+        v = 0.0
+        for g in range(4):
+            v += GW * abs(_grad_n(pos, nodes, dref[g], dn))
+        volume[z] = v
+
+
+@njit(cache=True)
+def tet10_lumped_mass(pos, gp, rows, density, mass):
+    """Lumped gridpoint masses of 10-node zones, added to mass[gp] (density by zone row).
+
+    The 3DEC text prescribes no lumping for these zones (its "one third of the tetrahedra
+    masses" rule is for 4-node zones). Row sums of the consistent mass matrix are negative at
+    the corners (-M/20 each, +M/5 at mid-edge nodes), so HRZ diagonal scaling is used
+    (Hinton, Rock & Zienkiewicz 1976; Hughes 1987, section 7.3.2): each node gets the
+    consistent diagonal int rho N_a^2 dV scaled so that the masses sum to the zone mass. For a
+    straight-edged zone these fractions are fixed, M/36 per corner and 4M/27 per mid-edge node,
+    all positive; they are applied to M = rho V with V from the same 4-point rule as the forces
+    (exact for straight edges; for edges curved by large strain the straight-edge fractions are
+    kept). Modifies mass.
+    """
+    dref = ref_derivs()
+    dn = np.empty((10, 3))
+    nodes = np.empty(10, np.int64)
+    for kk in range(rows.shape[0]):
+        z = rows[kk]
+        for a in range(10):
+            nodes[a] = gp[z, a]
+        v = 0.0
+        for g in range(4):
+            v += GW * abs(_grad_n(pos, nodes, dref[g], dn))
+        m = density[z] * v
+        for a in range(4):
+            mass[nodes[a]] += HRZ_CORNER * m
+        for a in range(4, 10):
+            mass[nodes[a]] += HRZ_MID * m
+
+
+@njit(cache=True)
+def tet10_stiffness(pos, gp, rows, bulk, shear, kdiag):
+    """Nodal stiffness measure k_i of the text's Eq. (84)-(85) (dt_n = 2 min sqrt(m_i / k_i))
+    for 10-node zones, added to kdiag[gp].
+
+    The text's Eq. (86) is written for 4-node zones; for 10-node zones this uses a bound that
+    is safe by construction: the element stiffness K = sum_g w |det J| B^T D B (never used for
+    forces, only here) and, per node a, the largest absolute row sum of its three rows. Summed
+    over zones it bounds the global row sums, so by Gershgorin's theorem the largest
+    eigenvalue of M^-1 K is at most max_i k_i / m_i for any diagonal mass, and the explicit
+    step is stable at dt <= 2 min sqrt(m_i / k_i). Modifies kdiag.
+    """
+    dref = ref_derivs()
+    dn = np.empty((10, 3))
+    nodes = np.empty(10, np.int64)
+    B = np.zeros((6, 30))
+    K = np.empty((30, 30))
+    DB = np.empty((6, 30))
+    for kk in range(rows.shape[0]):
+        z = rows[kk]
+        for a in range(10):
+            nodes[a] = gp[z, a]
+        lam = bulk[z] - 2.0 * shear[z] / 3.0
+        G = shear[z]
+        K[:, :] = 0.0
+        for g in range(4):
+            wd = GW * abs(_grad_n(pos, nodes, dref[g], dn))
+            for a in range(10):
+                c = 3 * a
+                B[0, c] = dn[a, 0]; B[1, c + 1] = dn[a, 1]; B[2, c + 2] = dn[a, 2]
+                # engineering shear strains xy xz yz
+                B[3, c] = dn[a, 1]; B[3, c + 1] = dn[a, 0]
+                B[4, c] = dn[a, 2]; B[4, c + 2] = dn[a, 0]
+                B[5, c + 1] = dn[a, 2]; B[5, c + 2] = dn[a, 1]
+            for col in range(30):
+                ev = B[0, col] + B[1, col] + B[2, col]
+                DB[0, col] = lam * ev + 2.0 * G * B[0, col]
+                DB[1, col] = lam * ev + 2.0 * G * B[1, col]
+                DB[2, col] = lam * ev + 2.0 * G * B[2, col]
+                DB[3, col] = G * B[3, col]
+                DB[4, col] = G * B[4, col]
+                DB[5, col] = G * B[5, col]
+            for r in range(30):
+                for col in range(30):
+                    acc = 0.0
+                    for q in range(6):
+                        acc += B[q, r] * DB[q, col]
+                    K[r, col] += wd * acc
+        for a in range(10):
+            best = 0.0
+            for i in range(3):
+                rs = 0.0
+                for col in range(30):
+                    rs += abs(K[3 * a + i, col])
+                if rs > best:
+                    best = rs
+            kdiag[nodes[a]] += best

@@ -1,0 +1,397 @@
+"""10-node tetrahedral zones (kernels/zones_ho.py) against an independent numpy twin, and the
+analytical checks: patch test, rigid motion, lumped mass, force balance, an explicit loop.
+
+The twin builds each zone's 30x30 stiffness matrix from shape functions written as plain
+polynomials of the volume coordinates, their derivatives by central differences (exact for
+quadratics), and the quadrature points from their closed form; it never calls the kernels.
+"""
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+from dec3d.kernels.zones_ho import (tet10_forces, tet10_lumped_mass, tet10_step,
+                                    tet10_stiffness, tet10_volume)
+
+EDGES = [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)]     # zones.gp order of mid-edge nodes
+
+
+# ----------------------------------------------------------------------------- the twin
+def shape(xi):
+    """The 10 quadratic shape functions at reference point xi = (L1, L2, L3)."""
+    L = [1.0 - xi[0] - xi[1] - xi[2], xi[0], xi[1], xi[2]]
+    n = [L[i] * (2 * L[i] - 1) for i in range(4)]
+    n += [4 * L[i] * L[j] for i, j in EDGES]
+    return np.array(n)
+
+
+def dshape(xi, h=0.25):
+    """dN/dxi (10, 3) by central differences: exact for quadratic polynomials."""
+    d = np.empty((10, 3))
+    for k in range(3):
+        e = np.zeros(3); e[k] = h
+        d[:, k] = (shape(xi + e) - shape(xi - e)) / (2 * h)
+    return d
+
+
+def gauss_points():
+    s5 = math.sqrt(5.0)
+    a, b = (5 + 3 * s5) / 20, (5 - s5) / 20
+    pts = []
+    for g in range(4):
+        L = [b] * 4; L[g] = a
+        pts.append(np.array(L[1:]))
+    return pts, [1.0 / 24] * 4
+
+
+def d_matrix(K, G):
+    lam = K - 2 * G / 3
+    D = np.zeros((6, 6))
+    D[:3, :3] = lam
+    D[:3, :3] += 2 * G * np.eye(3)
+    D[3:, 3:] = G * np.eye(3)        # engineering shear strains
+    return D
+
+
+def b_matrix(x, xi):
+    """B (6, 30) for engineering strain (xx yy zz 2xy 2xz 2yz) and |det J| at xi; x (10, 3)."""
+    dn = dshape(xi)
+    J = x.T @ dn
+    gn = np.linalg.solve(J.T, dn.T).T          # gn[a] = J^-T dN_a/dxi
+    B = np.zeros((6, 30))
+    for a in range(10):
+        gx, gy, gz = gn[a]
+        B[:, 3 * a:3 * a + 3] = [[gx, 0, 0], [0, gy, 0], [0, 0, gz],
+                                 [gy, gx, 0], [gz, 0, gx], [0, gz, gy]]
+    return B, abs(np.linalg.det(J))
+
+
+def twin_stiffness(x, K, G):
+    D = d_matrix(K, G)
+    pts, w = gauss_points()
+    Ke = np.zeros((30, 30))
+    for p, wg in zip(pts, w):
+        B, dj = b_matrix(x, p)
+        Ke += wg * dj * B.T @ D @ B
+    return Ke
+
+
+def twin_step(pos, vel, gp, K, G, dt, gstress, stress, force):
+    """Stress increment D B (v dt) per Gauss point; forces -sum w detJ B^T sigma."""
+    pts, w = gauss_points()
+    for z in range(gp.shape[0]):
+        D = d_matrix(K[z], G[z])
+        x = pos[gp[z]]
+        u = (vel[gp[z]] * dt).ravel()
+        f = np.zeros(30)
+        for g, (p, wg) in enumerate(zip(pts, w)):
+            B, dj = b_matrix(x, p)
+            gstress[z, g] += D @ (B @ u)
+            f -= wg * dj * B.T @ gstress[z, g]
+        stress[z] = gstress[z].mean(axis=0)
+        force[gp[z]] += f.reshape(10, 3)
+
+
+def add_midnodes(points, tets):
+    """Corner tetrahedra (m, 4) -> 10-node tetrahedra with shared mid-edge points."""
+    pts = [tuple(p) for p in points]
+    key = {}
+    out = []
+    for t in tets:
+        row = list(t)
+        for i, j in EDGES:
+            e = (min(t[i], t[j]), max(t[i], t[j]))
+            if e not in key:
+                key[e] = len(pts)
+                pts.append(tuple(0.5 * (np.asarray(points[t[i]]) + np.asarray(points[t[j]]))))
+            row.append(key[e])
+        out.append(row)
+    return np.array(pts, float), np.array(out, np.int64)
+
+
+def cube_mesh(n, size=1.0):
+    """n^3 cubes, each cut into the 6 Kuhn tetrahedra (conforming), as 10-node zones."""
+    idx = lambda i, j, k: (i * (n + 1) + j) * (n + 1) + k
+    points = np.array([[i, j, k] for i in range(n + 1) for j in range(n + 1) for k in range(n + 1)],
+                      float) * size / n
+    tets = []
+    for i, j, k in itertools.product(range(n), repeat=3):
+        for perm in itertools.permutations(range(3)):
+            c = np.array([i, j, k]); vs = [idx(*c)]
+            for ax in perm:
+                c = c.copy(); c[ax] += 1; vs.append(idx(*c))
+            p = points[vs]
+            if np.linalg.det(p[1:] - p[0]) < 0:
+                vs[1], vs[2] = vs[2], vs[1]
+            tets.append(vs)
+    return add_midnodes(points, np.array(tets))
+
+
+def random_tets(rng, m, curved=0.0):
+    """m separate well-shaped 10-node tetrahedra (perturbed regular ones), optionally with the
+    mid-edge nodes moved off the midpoints by `curved` (isoparametric, curved edges)."""
+    reg = np.array([[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]], float)
+    pts, gps = [], []
+    for z in range(m):
+        c = reg * (0.5 + rng.random()) + 0.15 * rng.normal(size=(4, 3)) + rng.normal(size=3)
+        if np.linalg.det(c[1:] - c[0]) < 0:
+            c[[1, 2]] = c[[2, 1]]
+        mids = np.array([0.5 * (c[i] + c[j]) for i, j in EDGES]) + curved * rng.normal(size=(6, 3))
+        gps.append(np.arange(10) + 10 * z)
+        pts.append(np.vstack([c, mids]))
+    return np.vstack(pts), np.array(gps, np.int64)
+
+
+# ----------------------------------------------------------------------------- twin comparison
+@pytest.mark.parametrize("curved", [0.0, 0.05])
+def test_step_matches_twin(curved):
+    rng = np.random.default_rng(11)
+    m = 5
+    pos, gp = random_tets(rng, m, curved)
+    vel = rng.normal(size=pos.shape)
+    K = 1e9 * (1 + rng.random(m)); G = 5e8 * (1 + rng.random(m))
+    s0 = rng.normal(size=(m, 4, 6)) * 1e5
+    rows = np.arange(m, dtype=np.int64)
+    dt = 1e-4
+    ga, gb = s0.copy(), s0.copy()
+    sa, sb = np.zeros((m, 6)), np.zeros((m, 6))
+    fa, fb = np.zeros_like(pos), np.zeros_like(pos)
+    tet10_step(pos, vel, gp, rows, K, G, dt, ga, sa, fa)
+    twin_step(pos, vel, gp, K, G, dt, gb, sb, fb)
+    scale_s = np.abs(gb).max()
+    assert np.abs(ga - gb).max() <= 1e-10 * scale_s
+    assert np.abs(sa - sb).max() <= 1e-10 * scale_s
+    assert np.abs(fa - fb).max() <= 1e-10 * np.abs(fb).max()
+
+
+def test_force_is_minus_k_u_from_zero_stress():
+    rng = np.random.default_rng(3)
+    pos, gp = random_tets(rng, 3)
+    vel = rng.normal(size=pos.shape)
+    K = np.array([2e9, 3e9, 1e9]); G = np.array([1e9, 0.7e9, 0.4e9])
+    dt = 1e-3
+    gs = np.zeros((3, 4, 6)); s = np.zeros((3, 6)); f = np.zeros_like(pos)
+    tet10_step(pos, vel, gp, np.arange(3, dtype=np.int64), K, G, dt, gs, s, f)
+    for z in range(3):
+        Ke = twin_stiffness(pos[gp[z]], K[z], G[z])
+        expect = -(Ke @ (vel[gp[z]] * dt).ravel()).reshape(10, 3)
+        assert np.abs(f[gp[z]] - expect).max() <= 1e-10 * np.abs(expect).max()
+
+
+def test_only_listed_rows_change():
+    rng = np.random.default_rng(5)
+    pos, gp = random_tets(rng, 3)
+    vel = rng.normal(size=pos.shape)
+    gs = np.zeros((3, 4, 6)); s = np.zeros((3, 6)); f = np.zeros_like(pos)
+    tet10_step(pos, vel, gp, np.array([1], np.int64), np.full(3, 1e9), np.full(3, 1e9), 1e-3, gs, s, f)
+    assert np.abs(gs[1]).max() > 0 and not gs[[0, 2]].any() and not s[[0, 2]].any()
+    assert not f[gp[0]].any() and not f[gp[2]].any() and np.abs(f[gp[1]]).max() > 0
+
+
+# ----------------------------------------------------------------------------- analytical
+def test_patch_test_linear_velocity_uniform_strain():
+    """Linear velocity field on a 2x2x2-cube mesh: every Gauss point gets the exact strain and
+    stress, and every interior node is in balance."""
+    pos, gp = cube_mesh(2, 2.0)
+    m = len(gp)
+    rng = np.random.default_rng(1)
+    A = rng.normal(size=(3, 3)) * 1e-3          # v = A x + c
+    vel = pos @ A.T + rng.normal(size=3)
+    Kb, G, dt = 3e9, 1.2e9, 0.5
+    gs = np.zeros((m, 4, 6)); s = np.zeros((m, 6)); f = np.zeros_like(pos)
+    tet10_step(pos, vel, gp, np.arange(m, dtype=np.int64), np.full(m, Kb), np.full(m, G), dt, gs, s, f)
+    e = 0.5 * (A + A.T) * dt
+    sig = (Kb - 2 * G / 3) * np.trace(e) * np.eye(3) + 2 * G * e
+    expect = np.array([sig[0, 0], sig[1, 1], sig[2, 2], sig[0, 1], sig[0, 2], sig[1, 2]])
+    scale = np.abs(expect).max()
+    assert np.abs(gs - expect).max() <= 1e-12 * scale
+    assert np.abs(s - expect).max() <= 1e-12 * scale
+    interior = np.all((pos > 1e-9) & (pos < 2.0 - 1e-9), axis=1)
+    # the centre corner, the mid-points of the 6 inner cube edges, of the 12 inner face
+    # diagonals (face centres) and of the 8 body diagonals (cube centres)
+    assert interior.sum() == 1 + 6 + 12 + 8
+    assert np.abs(f[interior]).max() <= 1e-12 * np.abs(f).max()
+    # virial identity: sum_a x_a (x) f_a = -V sigma for a uniform stress
+    vir = pos.T @ f
+    assert np.abs(vir + 8.0 * sig).max() <= 1e-11 * 8.0 * scale
+
+
+def test_rigid_motion_gives_no_strain():
+    rng = np.random.default_rng(2)
+    pos, gp = random_tets(rng, 4, curved=0.05)
+    m = len(gp)
+    w = rng.normal(size=3)                       # rotation rate, plus a translation
+    vel = np.cross(w, pos) + rng.normal(size=3)
+    gs = np.zeros((m, 4, 6)); s = np.zeros((m, 6)); f = np.zeros_like(pos)
+    Kb = 2e9
+    tet10_step(pos, vel, gp, np.arange(m, dtype=np.int64), np.full(m, Kb), np.full(m, 1e9), 1e-3, gs, s, f)
+    # compare with the stress one such rate would give if it were a strain rate
+    ref = Kb * np.abs(w).max() * 1e-3
+    assert np.abs(gs).max() <= 1e-12 * ref
+    assert np.abs(f).max() <= 1e-12 * ref * np.abs(pos).max() ** 2
+
+
+def test_forces_balance_for_any_stress():
+    rng = np.random.default_rng(4)
+    pos, gp = random_tets(rng, 6, curved=0.08)
+    m = len(gp)
+    gs = rng.normal(size=(m, 4, 6)) * 1e6
+    vel = rng.normal(size=pos.shape)
+    f = np.zeros_like(pos); s = np.zeros((m, 6))
+    tet10_step(pos, vel, gp, np.arange(m, dtype=np.int64), np.full(m, 1e9), np.full(m, 1e9), 1e-3, gs, s, f)
+    for z in range(m):
+        fz = f[gp[z]]
+        assert np.abs(fz.sum(axis=0)).max() <= 1e-12 * np.abs(fz).max()
+    # moments balance too: sum_a x_a x f_a = 0 (the Gauss-point stresses are symmetric)
+    for z in range(m):
+        mom = np.cross(pos[gp[z]], f[gp[z]]).sum(axis=0)
+        assert np.abs(mom).max() <= 1e-11 * np.abs(f[gp[z]]).max() * np.abs(pos).max()
+    # tet10_forces gives the same forces for the stresses now held
+    f2 = np.zeros_like(pos)
+    tet10_forces(pos, gp, np.arange(m, dtype=np.int64), gs, f2)
+    assert np.allclose(f2, f, rtol=0, atol=1e-12 * np.abs(f).max())
+
+
+# ----------------------------------------------------------------------------- mass and stiffness
+def monomial_integral(powers, vol):
+    """int L0^a L1^b L2^c L3^d dV = a! b! c! d! 3! V / (a+b+c+d+3)! (exact)."""
+    num = math.prod(math.factorial(p) for p in powers) * 6
+    return num * vol / math.factorial(sum(powers) + 3)
+
+
+def consistent_mass_tet10(vol, rho):
+    """Consistent mass matrix (10x10 scalar) of a straight-edged 10-node tetrahedron, exact,
+    from the shape functions expanded as polynomials of the volume coordinates."""
+    # each shape function as {powers tuple: coefficient}
+    def mono(*idx):
+        p = [0, 0, 0, 0]
+        for i in idx:
+            p[i] += 1
+        return tuple(p)
+    polys = [{mono(i, i): 2.0, mono(i): -1.0} for i in range(4)]
+    polys += [{mono(i, j): 4.0} for i, j in EDGES]
+    M = np.zeros((10, 10))
+    for a in range(10):
+        for b in range(10):
+            acc = 0.0
+            for pa, ca in polys[a].items():
+                for pb, cb in polys[b].items():
+                    acc += ca * cb * monomial_integral(tuple(x + y for x, y in zip(pa, pb)), vol)
+            M[a, b] = rho * acc
+    return M
+
+
+def test_lumped_mass_is_hrz_positive_and_total():
+    rng = np.random.default_rng(6)
+    pos, gp = random_tets(rng, 3)
+    rho = np.array([2500.0, 2700.0, 1800.0])
+    mass = np.zeros(len(pos))
+    tet10_lumped_mass(pos, gp, np.arange(3, dtype=np.int64), rho, mass)
+    for z in range(3):
+        c = pos[gp[z, :4]]
+        vol = abs(np.linalg.det(c[1:] - c[0])) / 6
+        M = consistent_mass_tet10(vol, rho[z])
+        assert abs(M.sum() - rho[z] * vol) <= 1e-12 * rho[z] * vol
+        rowsum = M.sum(axis=1)
+        assert (rowsum[:4] < 0).all()            # why row-sum lumping is not usable
+        hrz = np.diag(M) * (rho[z] * vol / np.trace(M))
+        assert np.allclose(mass[gp[z]], hrz, rtol=1e-12)
+        assert (mass[gp[z]] > 0).all()
+        assert abs(mass[gp[z]].sum() - rho[z] * vol) <= 1e-12 * rho[z] * vol
+
+
+def test_mesh_mass_and_volume_totals():
+    pos, gp = cube_mesh(2, 3.0)
+    m = len(gp)
+    rows = np.arange(m, dtype=np.int64)
+    mass = np.zeros(len(pos)); vol = np.zeros(m)
+    tet10_lumped_mass(pos, gp, rows, np.full(m, 2000.0), mass)
+    tet10_volume(pos, gp, rows, vol)
+    assert (mass > 0).all()
+    assert abs(mass.sum() - 2000.0 * 27.0) <= 1e-12 * 2000.0 * 27.0
+    assert abs(vol.sum() - 27.0) <= 1e-12 * 27.0 and (vol > 0).all()
+
+
+def test_stiffness_matches_twin_row_sums_and_bounds_the_spectrum():
+    pos, gp = cube_mesh(1, 1.0)
+    rng = np.random.default_rng(8)
+    pos = pos + 0.03 * rng.normal(size=pos.shape)      # distorted, curved edges
+    m = len(gp)
+    Kb = 1e9 * (1 + rng.random(m)); G = 4e8 * (1 + rng.random(m))
+    kd = np.zeros(len(pos))
+    tet10_stiffness(pos, gp, np.arange(m, dtype=np.int64), Kb, G, kd)
+    twin = np.zeros(len(pos))
+    Kglob = np.zeros((3 * len(pos), 3 * len(pos)))
+    for z in range(m):
+        Ke = twin_stiffness(pos[gp[z]], Kb[z], G[z])
+        twin[gp[z]] += np.abs(Ke).sum(axis=1).reshape(10, 3).max(axis=1)
+        dof = (3 * gp[z][:, None] + np.arange(3)).ravel()
+        Kglob[np.ix_(dof, dof)] += Ke
+    assert np.allclose(kd, twin, rtol=1e-10)
+    mass = np.zeros(len(pos))
+    tet10_lumped_mass(pos, gp, np.arange(m, dtype=np.int64), np.full(m, 2500.0), mass)
+    minv = np.repeat(1.0 / np.sqrt(mass), 3)
+    lam_max = np.linalg.eigvalsh(minv[:, None] * Kglob * minv[None, :]).max()
+    bound = (kd / mass).max()
+    assert lam_max <= bound * (1 + 1e-12)
+    assert bound <= 20 * lam_max                         # a bound, not a wild overestimate
+
+
+# ----------------------------------------------------------------------------- explicit loop
+def face_loads(pos, gp, axis, value, traction):
+    """Consistent nodal loads of a uniform traction on the zone faces lying on x_axis = value:
+    on a 6-node triangle, int N dA is 0 at the corners and A/3 at each mid-edge node."""
+    faces = [(0, 1, 2, 4, 5, 6), (0, 1, 3, 4, 8, 7), (1, 2, 3, 5, 9, 8), (2, 0, 3, 6, 7, 9)]
+    # local (corner corner corner, mid mid mid) for faces 012, 013, 123, 203
+    f = np.zeros_like(pos)
+    for z in range(len(gp)):
+        for fc in faces:
+            nodes = gp[z, list(fc)]
+            if np.all(np.abs(pos[nodes, axis] - value) < 1e-12):
+                c = pos[nodes[:3]]
+                area = 0.5 * np.linalg.norm(np.cross(c[1] - c[0], c[2] - c[0]))
+                f[nodes[3:]] += traction * area / 3.0
+    return f
+
+
+def test_explicit_relaxation_uniaxial_cube():
+    """Dynamic relaxation of a 10-node cube on rollers under a top pressure: eps = sigma / E,
+    lateral = -nu sigma / E, stress uniform."""
+    E, nu, p = 1e9, 0.25, -1e5                   # sigma_zz = p (compression), tension positive
+    Kb, G = E / (3 * (1 - 2 * nu)), E / (2 * (1 + nu))
+    L = 1.0
+    pos0, gp = cube_mesh(2, L)
+    m = len(gp); rows = np.arange(m, dtype=np.int64)
+    K = np.full(m, Kb); Gs = np.full(m, G)
+    kd = np.zeros(len(pos0))
+    tet10_stiffness(pos0, gp, rows, K, Gs, kd)
+    dt = 1.0
+    mass = kd * dt * dt / 4.0 * 1.1              # density scaling: stable at dt = 1 (Eq. 84)
+    fext = face_loads(pos0, gp, 2, L, np.array([0.0, 0.0, p]))
+    assert abs(fext[:, 2].sum() - p * L * L) <= 1e-12 * abs(p)
+    fix = np.zeros_like(pos0, bool)
+    for ax in range(3):
+        fix[np.abs(pos0[:, ax]) < 1e-12, ax] = True    # rollers on x=0, y=0, z=0
+    pos = pos0.copy(); vel = np.zeros_like(pos0); disp = np.zeros_like(pos0)
+    gs = np.zeros((m, 4, 6)); s = np.zeros((m, 6))
+    alpha = 0.8
+    for step in range(20000):
+        f = fext.copy()
+        tet10_step(pos, vel, gp, rows, K, Gs, dt, gs, s, f)
+        if step > 50 and np.abs(f[~fix]).max() < 1e-10 * abs(p) * L * L:
+            break
+        f = f - alpha * np.abs(f) * np.sign(vel)      # local damping (3DEC)
+        vel = vel + f * dt / mass[:, None]
+        vel[fix] = 0.0
+        disp += vel * dt                                 # small strain: positions not updated
+    else:
+        pytest.fail("did not converge")
+    top = np.abs(pos0[:, 2] - L) < 1e-12
+    side = np.abs(pos0[:, 0] - L) < 1e-12
+    eps_z = disp[top, 2].mean() / L
+    eps_x = disp[side, 0].mean() / L
+    assert abs(eps_z - p / E) <= 1e-6 * abs(p / E)
+    assert abs(eps_x + nu * p / E) <= 1e-6 * abs(nu * p / E)
+    assert np.abs(gs[..., 2] - p).max() <= 1e-6 * abs(p)
+    assert np.abs(gs[..., [0, 1, 3, 4, 5]]).max() <= 1e-6 * abs(p)
