@@ -157,7 +157,7 @@ def test_step_matches_twin(curved):
     ga, gb = s0.copy(), s0.copy()
     sa, sb = np.zeros((m, 6)), np.zeros((m, 6))
     fa, fb = np.zeros_like(pos), np.zeros_like(pos)
-    tet10_step(pos, vel, gp, rows, K, G, dt, ga, sa, fa)
+    assert tet10_step(pos, vel, gp, rows, K, G, dt, ga, sa, fa) == -1
     twin_step(pos, vel, gp, K, G, dt, gb, sb, fb)
     scale_s = np.abs(gb).max()
     assert np.abs(ga - gb).max() <= 1e-10 * scale_s
@@ -187,6 +187,29 @@ def test_only_listed_rows_change():
     tet10_step(pos, vel, gp, np.array([1], np.int64), np.full(3, 1e9), np.full(3, 1e9), 1e-3, gs, s, f)
     assert np.abs(gs[1]).max() > 0 and not gs[[0, 2]].any() and not s[[0, 2]].any()
     assert not f[gp[0]].any() and not f[gp[2]].any() and np.abs(f[gp[1]]).max() > 0
+
+
+def test_inverted_or_flat_zone_is_skipped_and_named():
+    rng = np.random.default_rng(9)
+    pos, gp = random_tets(rng, 3)
+    gp[1, [1, 2]] = gp[1, [2, 1]]                # zone 1 inverted (mid-edge nodes follow)
+    gp[1, 4:] = gp[1, [6, 5, 4, 7, 9, 8]]   # edges 01 12 20 03 13 23 were 20 12 01 03 23 13
+    pos[gp[2, 3]] = pos[gp[2, :3]].mean(axis=0)   # zone 2 flat: apex in the base plane
+    pos[gp[2, 7:]] = 0.5 * (pos[gp[2, :3]] + pos[gp[2, 3]])
+    m = 3; rows = np.arange(m, dtype=np.int64)
+    vel = rng.normal(size=pos.shape)
+    gs = np.ones((m, 4, 6)); s = np.zeros((m, 6)); f = np.zeros_like(pos)
+    one = np.full(m, 1e9)
+    assert tet10_step(pos, vel, gp, rows, one, one, 1e-3, gs, s, f) == 1
+    assert np.isfinite(gs).all() and np.isfinite(f).all()
+    assert (gs[1:] == 1).all() and not s[1:].any() and not f[gp[1]].any() and not f[gp[2]].any()
+    assert np.abs(gs[0] - 1).max() > 0
+    assert tet10_step(pos, vel, gp, np.array([2, 0], np.int64), one, one, 1e-3, gs, s, f) == 2
+    for kern, args in [(tet10_forces, (gs, np.zeros_like(pos))), (tet10_volume, (np.zeros(m),)),
+                       (tet10_lumped_mass, (one, np.zeros(len(pos)))),
+                       (tet10_stiffness, (one, one, np.zeros(len(pos))))]:
+        assert kern(pos, gp, rows, *args) == 1
+        assert all(np.isfinite(a).all() for a in args)
 
 
 # ----------------------------------------------------------------------------- analytical

@@ -24,6 +24,11 @@ positive) and ``stress[z]`` the mean of the four.
 
 Sign convention as ``kernels/zones.tet_elastic_step``: ``force[r]`` accumulates the force the
 zone exerts on gridpoint r, the negative of the internal-force vector, -int B^T sigma dV.
+
+Zones must be positively oriented (corners 0-3 right-handed, as the mesher makes them). Every
+kernel skips a zone whose det J is not positive at a Gauss point (inverted or flat), so no NaN
+or infinity reaches the stores, and returns the first such zone row (-1 if none) for the host
+to report as an error naming the zone.
 """
 import numpy as np
 from numba import njit
@@ -61,7 +66,8 @@ def ref_derivs():
 @njit(cache=True)
 def _grad_n(pos, nodes, dxi, dn):
     """Cartesian shape-function gradients at one Gauss point: fills dn (10, 3) with dN_a/dx_j
-    from dxi (10, 3) = dN_a/dxi_k and the nodal positions. Returns det J (signed).
+    from dxi (10, 3) = dN_a/dxi_k and the nodal positions. Returns det J (signed); when it is
+    not positive, dn is left as it was.
     Scalars only (no temporary arrays: this runs 4 times per zone per step)."""
     # J[i, k] = dx_i / dxi_k
     j00 = 0.0; j01 = 0.0; j02 = 0.0
@@ -77,6 +83,8 @@ def _grad_n(pos, nodes, dxi, dn):
     c01 = j12 * j20 - j10 * j22
     c02 = j10 * j21 - j11 * j20
     det = j00 * c00 + j01 * c01 + j02 * c02
+    if not det > 0.0:            # inverted, flat or NaN: the caller skips the zone
+        return det
     r = 1.0 / det
     # inverse: i{k}{i} = dxi_k / dx_i
     i00 = c00 * r
@@ -97,30 +105,66 @@ def _grad_n(pos, nodes, dxi, dn):
 
 
 @njit(cache=True)
+def _zone_grads(pos, nodes, dref, dn4, wd4):
+    """Shape-function gradients dn4 (4, 10, 3) and weights w det J (4,) at the 4 Gauss points
+    of one zone. False when det J is not positive at some point (inverted or flat zone: the
+    mesher makes positively oriented zones, corners 0-3 right-handed)."""
+    for g in range(4):
+        det = _grad_n(pos, nodes, dref[g], dn4[g])
+        if not det > 0.0:
+            return False
+        wd4[g] = GW * det
+    return True
+
+
+@njit(cache=True)
+def _scatter(nodes, dn4, wd4, s4, force):
+    """force[nodes[a]] -= sum_g wd4[g] s4[g] . dn4[g, a] (s4 (4, 6) Gauss-point stresses)."""
+    for g in range(4):
+        s = s4[g]
+        wd = wd4[g]
+        dn = dn4[g]
+        for a in range(10):
+            r = nodes[a]
+            force[r, 0] -= wd * (s[0] * dn[a, 0] + s[3] * dn[a, 1] + s[4] * dn[a, 2])
+            force[r, 1] -= wd * (s[3] * dn[a, 0] + s[1] * dn[a, 1] + s[5] * dn[a, 2])
+            force[r, 2] -= wd * (s[4] * dn[a, 0] + s[5] * dn[a, 1] + s[2] * dn[a, 2])
+
+
+@njit(cache=True)
 def tet10_step(pos, vel, gp, rows, bulk, shear, dt, gstress, stress, force):
     """One elastic step of the 10-node zones in ``rows``.
 
     pos, vel (nv, 3): gridpoint positions (current) and velocities; gp (nz, 10) node rows;
-    rows (k,) int64 zone rows to update; bulk, shear (nz,) moduli by zone row [Pa]; dt [s].
+    rows (k,) int64 zone rows to update; bulk, shear (nz,) moduli by zone row [Pa]; dt [s];
+    gstress (nz, 4, 6), stress (nz, 6) [Pa]; force (nv, 3) [N].
     At each Gauss point g: grad v = sum_a v_a (x) grad N_a (isoparametric, Jacobian from pos),
     strain increment = sym(grad v) dt, gstress[z, g] += lambda tr(de) I + 2 G de (the text's
     Eq. 59 with the 3-term volumetric strain of the errata). Then stress[z] = mean over g, and
-    force[gp[z, a]] -= sum_g w |det J_g| sigma_g . grad N_a(g).
-    Modifies gstress, stress, force.
+    force[gp[z, a]] -= sum_g w det J_g sigma_g . grad N_a(g).
+    Modifies gstress, stress, force. A zone whose det J is not positive at a Gauss point
+    (inverted or flat) is left untouched, so no NaN spreads; the first such row is returned
+    (-1 if none) for the caller to report.
     """
     dref = ref_derivs()
-    dn = np.empty((10, 3))
+    dn4 = np.empty((4, 10, 3))
+    wd4 = np.empty(4)
     nodes = np.empty(10, np.int64)
+    bad = -1
     for kk in range(rows.shape[0]):
         z = rows[kk]
         for a in range(10):
             nodes[a] = gp[z, a]
+        if not _zone_grads(pos, nodes, dref, dn4, wd4):
+            if bad < 0:
+                bad = z
+            continue
         lam = bulk[z] - 2.0 * shear[z] / 3.0
         g2 = 2.0 * shear[z]
         for c in range(6):
             stress[z, c] = 0.0
         for g in range(4):
-            det = _grad_n(pos, nodes, dref[g], dn)
+            dn = dn4[g]
             # velocity gradient L[i, j] = dv_i/dx_j
             l00 = 0.0; l01 = 0.0; l02 = 0.0
             l10 = 0.0; l11 = 0.0; l12 = 0.0
@@ -144,52 +188,53 @@ def tet10_step(pos, vel, gp, rows, bulk, shear, dt, gstress, stress, force):
             s[5] += g2 * eyz
             for c in range(6):
                 stress[z, c] += 0.25 * s[c]
-            wd = GW * abs(det)
-            for a in range(10):
-                r = nodes[a]
-                force[r, 0] -= wd * (s[0] * dn[a, 0] + s[3] * dn[a, 1] + s[4] * dn[a, 2])
-                force[r, 1] -= wd * (s[3] * dn[a, 0] + s[1] * dn[a, 1] + s[5] * dn[a, 2])
-                force[r, 2] -= wd * (s[4] * dn[a, 0] + s[5] * dn[a, 1] + s[2] * dn[a, 2])
+        _scatter(nodes, dn4, wd4, gstress[z], force)
+    return bad
 
 
 @njit(cache=True)
 def tet10_forces(pos, gp, rows, gstress, force):
-    """Nodal forces of the given Gauss-point stresses, no stress update (for a state just set,
-    e.g. in-situ stresses): force[gp[z, a]] -= sum_g w |det J_g| sigma_g . grad N_a(g).
-    Modifies force."""
+    """Nodal forces of the Gauss-point stresses as they are, no stress update (for a state
+    just set, e.g. in-situ stresses): force[gp[z, a]] -= sum_g w det J_g sigma_g . grad N_a(g).
+    Modifies force; returns the first zone row skipped as inverted or flat, -1 if none."""
     dref = ref_derivs()
-    dn = np.empty((10, 3))
+    dn4 = np.empty((4, 10, 3))
+    wd4 = np.empty(4)
     nodes = np.empty(10, np.int64)
+    bad = -1
     for kk in range(rows.shape[0]):
         z = rows[kk]
         for a in range(10):
             nodes[a] = gp[z, a]
-        for g in range(4):
-            det = _grad_n(pos, nodes, dref[g], dn)
-            s = gstress[z, g]
-            wd = GW * abs(det)
-            for a in range(10):
-                r = nodes[a]
-                force[r, 0] -= wd * (s[0] * dn[a, 0] + s[3] * dn[a, 1] + s[4] * dn[a, 2])
-                force[r, 1] -= wd * (s[3] * dn[a, 0] + s[1] * dn[a, 1] + s[5] * dn[a, 2])
-                force[r, 2] -= wd * (s[4] * dn[a, 0] + s[5] * dn[a, 1] + s[2] * dn[a, 2])
+        if not _zone_grads(pos, nodes, dref, dn4, wd4):
+            if bad < 0:
+                bad = z
+            continue
+        _scatter(nodes, dn4, wd4, gstress[z], force)
+    return bad
 
 
 @njit(cache=True)
 def tet10_volume(pos, gp, rows, volume):
-    """Zone volumes by the 4-point rule, sum_g w |det J_g| (exact for straight edges).
-    Writes volume[z] for z in rows."""
+    """Zone volumes by the 4-point rule, sum_g w det J_g (exact for straight edges).
+    Writes volume[z] for z in rows (0 for an inverted or flat zone); returns the first such
+    row, -1 if none."""
     dref = ref_derivs()
-    dn = np.empty((10, 3))
+    dn4 = np.empty((4, 10, 3))
+    wd4 = np.empty(4)
     nodes = np.empty(10, np.int64)
+    bad = -1
     for kk in range(rows.shape[0]):
         z = rows[kk]
         for a in range(10):
             nodes[a] = gp[z, a]
-        v = 0.0
-        for g in range(4):
-            v += GW * abs(_grad_n(pos, nodes, dref[g], dn))
-        volume[z] = v
+        if not _zone_grads(pos, nodes, dref, dn4, wd4):
+            volume[z] = 0.0
+            if bad < 0:
+                bad = z
+            continue
+        volume[z] = wd4[0] + wd4[1] + wd4[2] + wd4[3]
+    return bad
 
 
 @njit(cache=True)
@@ -204,23 +249,27 @@ def tet10_lumped_mass(pos, gp, rows, density, mass):
     straight-edged zone these fractions are fixed, M/36 per corner and 4M/27 per mid-edge node,
     all positive; they are applied to M = rho V with V from the same 4-point rule as the forces
     (exact for straight edges; for edges curved by large strain the straight-edge fractions are
-    kept). Modifies mass.
+    kept). Modifies mass; returns the first zone row skipped as inverted or flat, -1 if none.
     """
     dref = ref_derivs()
-    dn = np.empty((10, 3))
+    dn4 = np.empty((4, 10, 3))
+    wd4 = np.empty(4)
     nodes = np.empty(10, np.int64)
+    bad = -1
     for kk in range(rows.shape[0]):
         z = rows[kk]
         for a in range(10):
             nodes[a] = gp[z, a]
-        v = 0.0
-        for g in range(4):
-            v += GW * abs(_grad_n(pos, nodes, dref[g], dn))
-        m = density[z] * v
+        if not _zone_grads(pos, nodes, dref, dn4, wd4):
+            if bad < 0:
+                bad = z
+            continue
+        m = density[z] * (wd4[0] + wd4[1] + wd4[2] + wd4[3])
         for a in range(4):
             mass[nodes[a]] += HRZ_CORNER * m
         for a in range(4, 10):
             mass[nodes[a]] += HRZ_MID * m
+    return bad
 
 
 @njit(cache=True)
@@ -229,48 +278,43 @@ def tet10_stiffness(pos, gp, rows, bulk, shear, kdiag):
     for 10-node zones, added to kdiag[gp].
 
     The text's Eq. (86) is written for 4-node zones; for 10-node zones this uses a bound that
-    is safe by construction: the element stiffness K = sum_g w |det J| B^T D B (never used for
+    is safe by construction: the element stiffness K = sum_g w det J B^T D B (never used for
     forces, only here) and, per node a, the largest absolute row sum of its three rows. Summed
     over zones it bounds the global row sums, so by Gershgorin's theorem the largest
     eigenvalue of M^-1 K is at most max_i k_i / m_i for any diagonal mass, and the explicit
-    step is stable at dt <= 2 min sqrt(m_i / k_i). Modifies kdiag.
+    step is stable at dt <= 2 min sqrt(m_i / k_i). Modifies kdiag; returns the first zone row
+    skipped as inverted or flat, -1 if none.
     """
     dref = ref_derivs()
-    dn = np.empty((10, 3))
+    dn4 = np.empty((4, 10, 3))
+    wd4 = np.empty(4)
     nodes = np.empty(10, np.int64)
-    B = np.zeros((6, 30))
     K = np.empty((30, 30))
-    DB = np.empty((6, 30))
+    bad = -1
     for kk in range(rows.shape[0]):
         z = rows[kk]
         for a in range(10):
             nodes[a] = gp[z, a]
+        if not _zone_grads(pos, nodes, dref, dn4, wd4):
+            if bad < 0:
+                bad = z
+            continue
         lam = bulk[z] - 2.0 * shear[z] / 3.0
         G = shear[z]
         K[:, :] = 0.0
         for g in range(4):
-            wd = GW * abs(_grad_n(pos, nodes, dref[g], dn))
+            dn = dn4[g]
+            wd = wd4[g]
+            # block ab of B^T D B: lambda g_a g_b^T + G g_b g_a^T + G (g_a . g_b) I, g = grad N
             for a in range(10):
-                c = 3 * a
-                B[0, c] = dn[a, 0]; B[1, c + 1] = dn[a, 1]; B[2, c + 2] = dn[a, 2]
-                # engineering shear strains xy xz yz
-                B[3, c] = dn[a, 1]; B[3, c + 1] = dn[a, 0]
-                B[4, c] = dn[a, 2]; B[4, c + 2] = dn[a, 0]
-                B[5, c + 1] = dn[a, 2]; B[5, c + 2] = dn[a, 1]
-            for col in range(30):
-                ev = B[0, col] + B[1, col] + B[2, col]
-                DB[0, col] = lam * ev + 2.0 * G * B[0, col]
-                DB[1, col] = lam * ev + 2.0 * G * B[1, col]
-                DB[2, col] = lam * ev + 2.0 * G * B[2, col]
-                DB[3, col] = G * B[3, col]
-                DB[4, col] = G * B[4, col]
-                DB[5, col] = G * B[5, col]
-            for r in range(30):
-                for col in range(30):
-                    acc = 0.0
-                    for q in range(6):
-                        acc += B[q, r] * DB[q, col]
-                    K[r, col] += wd * acc
+                for b in range(10):
+                    dot = dn[a, 0] * dn[b, 0] + dn[a, 1] * dn[b, 1] + dn[a, 2] * dn[b, 2]
+                    for i in range(3):
+                        for j in range(3):
+                            kij = lam * dn[a, i] * dn[b, j] + G * dn[b, i] * dn[a, j]
+                            if i == j:
+                                kij += G * dot
+                            K[3 * a + i, 3 * b + j] += wd * kij
         for a in range(10):
             best = 0.0
             for i in range(3):
@@ -280,3 +324,4 @@ def tet10_stiffness(pos, gp, rows, bulk, shear, kdiag):
                 if rs > best:
                     best = rs
             kdiag[nodes[a]] += best
+    return bad
