@@ -11,8 +11,9 @@ import math
 import numpy as np
 import pytest
 
-from dec3d.kernels.zones_ho import (tet10_forces, tet10_lumped_mass, tet10_step,
-                                    tet10_stiffness, tet10_volume)
+from dec3d.kernels.zones_ho import (tet10_body_force, tet10_forces, tet10_lumped_mass,
+                                    tet10_step, tet10_stiffness, tet10_volume,
+                                    tri6_traction_loads)
 
 EDGES = [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)]     # zones.gp order of mid-edge nodes
 
@@ -110,13 +111,15 @@ def add_midnodes(points, tets):
     return np.array(pts, float), np.array(out, np.int64)
 
 
-def cube_mesh(n, size=1.0):
-    """n^3 cubes, each cut into the 6 Kuhn tetrahedra (conforming), as 10-node zones."""
-    idx = lambda i, j, k: (i * (n + 1) + j) * (n + 1) + k
-    points = np.array([[i, j, k] for i in range(n + 1) for j in range(n + 1) for k in range(n + 1)],
-                      float) * size / n
+def box_mesh(counts, sizes):
+    """A box of counts[0] x counts[1] x counts[2] cells, sizes its edge lengths, each cell cut
+    into the 6 Kuhn tetrahedra (conforming across cells), as 10-node zones."""
+    nx, ny, nz = counts
+    idx = lambda i, j, k: (i * (ny + 1) + j) * (nz + 1) + k
+    points = np.array([[i / nx, j / ny, k / nz] for i in range(nx + 1) for j in range(ny + 1)
+                       for k in range(nz + 1)]) * np.asarray(sizes, float)
     tets = []
-    for i, j, k in itertools.product(range(n), repeat=3):
+    for i, j, k in itertools.product(range(nx), range(ny), range(nz)):
         for perm in itertools.permutations(range(3)):
             c = np.array([i, j, k]); vs = [idx(*c)]
             for ax in perm:
@@ -126,6 +129,10 @@ def cube_mesh(n, size=1.0):
                 vs[1], vs[2] = vs[2], vs[1]
             tets.append(vs)
     return add_midnodes(points, np.array(tets))
+
+
+def cube_mesh(n, size=1.0):
+    return box_mesh((n, n, n), (size, size, size))
 
 
 def random_tets(rng, m, curved=0.0):
@@ -207,7 +214,8 @@ def test_inverted_or_flat_zone_is_skipped_and_named():
     assert tet10_step(pos, vel, gp, np.array([2, 0], np.int64), one, one, 1e-3, gs, s, f) == 2
     for kern, args in [(tet10_forces, (gs, np.zeros_like(pos))), (tet10_volume, (np.zeros(m),)),
                        (tet10_lumped_mass, (one, np.zeros(len(pos)))),
-                       (tet10_stiffness, (one, one, np.zeros(len(pos))))]:
+                       (tet10_stiffness, (one, one, np.zeros(len(pos)))),
+                       (tet10_body_force, (one, np.array([0, 0, -9.81]), np.zeros_like(pos)))]:
         assert kern(pos, gp, rows, *args) == 1
         assert all(np.isfinite(a).all() for a in args)
 
@@ -362,59 +370,164 @@ def test_stiffness_matches_twin_row_sums_and_bounds_the_spectrum():
 
 
 # ----------------------------------------------------------------------------- explicit loop
-def face_loads(pos, gp, axis, value, traction):
-    """Consistent nodal loads of a uniform traction on the zone faces lying on x_axis = value:
-    on a 6-node triangle, int N dA is 0 at the corners and A/3 at each mid-edge node."""
-    faces = [(0, 1, 2, 4, 5, 6), (0, 1, 3, 4, 8, 7), (1, 2, 3, 5, 9, 8), (2, 0, 3, 6, 7, 9)]
-    # local (corner corner corner, mid mid mid) for faces 012, 013, 123, 203
-    f = np.zeros_like(pos)
+FACES6 = [(0, 1, 2, 4, 5, 6), (0, 1, 3, 4, 8, 7), (1, 2, 3, 5, 9, 8), (2, 0, 3, 6, 7, 9)]
+# the 4 faces of a 10-node zone as 6-node triangles: corners, then mid-edge nodes 01 12 20
+
+
+def faces_on(pos, gp, axis, value):
+    """The 6-node zone faces lying on the plane x_axis = value, (k, 6) gridpoint rows."""
+    out = []
     for z in range(len(gp)):
-        for fc in faces:
+        for fc in FACES6:
             nodes = gp[z, list(fc)]
             if np.all(np.abs(pos[nodes, axis] - value) < 1e-12):
-                c = pos[nodes[:3]]
-                area = 0.5 * np.linalg.norm(np.cross(c[1] - c[0], c[2] - c[0]))
-                f[nodes[3:]] += traction * area / 3.0
+                out.append(nodes)
+    return np.array(out, np.int64)
+
+
+def twin_tri6_loads(pos, tri, traction):
+    """int N_a dA t by the 3-point rule from its closed form, shape-function derivatives by
+    central differences (exact for quadratics)."""
+    def n6(x):
+        L = [1 - x[0] - x[1], x[0], x[1]]
+        return np.array([L[i] * (2 * L[i] - 1) for i in range(3)]
+                        + [4 * L[0] * L[1], 4 * L[1] * L[2], 4 * L[2] * L[0]])
+    f = np.zeros_like(pos)
+    for k, t in enumerate(tri):
+        x = pos[t]
+        for q in range(3):
+            L = np.full(3, 1 / 6); L[q] = 2 / 3
+            xi = L[1:]
+            h = 0.1
+            d = [(n6(xi + h * e) - n6(xi - h * e)) / (2 * h) for e in np.eye(2)]
+            da = np.linalg.norm(np.cross(d[0] @ x, d[1] @ x))
+            f[t] += np.outer(n6(xi), traction[k]) * da / 6
     return f
 
 
+@pytest.mark.parametrize("curved", [0.0, 0.05])
+def test_tri6_traction_loads_match_twin_and_exact_shares(curved):
+    rng = np.random.default_rng(12)
+    c = rng.normal(size=(4, 3, 3))
+    pos = []
+    for t in c:
+        mids = np.array([0.5 * (t[i] + t[j]) for i, j in [(0, 1), (1, 2), (2, 0)]])
+        pos.append(np.vstack([t, mids + curved * rng.normal(size=(3, 3))]))
+    pos = np.vstack(pos)
+    tri = np.arange(24, dtype=np.int64).reshape(4, 6)
+    trac = rng.normal(size=(4, 3)) * 1e6
+    f = np.zeros_like(pos)
+    tri6_traction_loads(pos, tri, trac, f)
+    ft = twin_tri6_loads(pos, tri, trac)
+    assert np.abs(f - ft).max() <= 1e-12 * np.abs(ft).max()
+    if curved == 0.0:
+        for k, t in enumerate(c):
+            area = 0.5 * np.linalg.norm(np.cross(t[1] - t[0], t[2] - t[0]))
+            assert np.abs(f[tri[k, :3]]).max() <= 1e-12 * np.abs(trac[k]).max() * area
+            assert np.allclose(f[tri[k, 3:]], trac[k] * area / 3, rtol=1e-12, atol=0)
+
+
+def twin_body_force(pos, gp, rho, gvec):
+    pts, w = gauss_points()
+    f = np.zeros_like(pos)
+    for z in range(len(gp)):
+        x = pos[gp[z]]
+        for p, wg in zip(pts, w):
+            dj = abs(np.linalg.det(x.T @ dshape(p)))
+            f[gp[z]] += rho[z] * wg * dj * np.outer(shape(p), gvec)
+    return f
+
+
+@pytest.mark.parametrize("curved", [0.0, 0.05])
+def test_body_force_matches_twin_and_exact_shares(curved):
+    rng = np.random.default_rng(13)
+    pos, gp = random_tets(rng, 4, curved)
+    rho = 2000 + 1000 * rng.random(4)
+    gvec = np.array([0.3, -1.0, -9.81])
+    f = np.zeros_like(pos)
+    assert tet10_body_force(pos, gp, np.arange(4, dtype=np.int64), rho, gvec, f) == -1
+    ft = twin_body_force(pos, gp, rho, gvec)
+    assert np.abs(f - ft).max() <= 1e-12 * np.abs(ft).max()
+    if curved == 0.0:              # exact: int N dV = -V/20 at corners, V/5 at mid-edge nodes
+        for z in range(4):
+            c = pos[gp[z, :4]]
+            W = rho[z] * abs(np.linalg.det(c[1:] - c[0])) / 6 * gvec
+            M = consistent_mass_tet10(1.0, 1.0)       # int N_a N_b dV for V = 1
+            share = M.sum(axis=1)                     # sum_b N_b = 1: int N_a dV / V
+            assert np.allclose(share[:4], -1 / 20, rtol=1e-12) and np.allclose(share[4:], 1 / 5, rtol=1e-12)
+            assert np.allclose(f[gp[z]], np.outer(share, W), rtol=1e-12, atol=1e-12 * np.abs(W).max())
+
+
+def relax(pos, gp, Kb, G, fext, fix, tol, alpha=0.8, max_steps=50000):
+    """Explicit dynamic relaxation with the kernels alone: density-scaled masses from
+    tet10_stiffness (stable at dt = 1 by Eq. 84), local damping, small strain. Returns
+    (displacements, Gauss-point stresses, steps)."""
+    m = len(gp); rows = np.arange(m, dtype=np.int64)
+    K = np.full(m, Kb); Gs = np.full(m, G)
+    kd = np.zeros(len(pos))
+    tet10_stiffness(pos, gp, rows, K, Gs, kd)
+    dt = 1.0
+    mass = kd * dt * dt / 4.0 * 1.1
+    vel = np.zeros_like(pos); disp = np.zeros_like(pos)
+    gs = np.zeros((m, 4, 6)); s = np.zeros((m, 6))
+    for step in range(max_steps):
+        f = fext.copy()
+        tet10_step(pos, vel, gp, rows, K, Gs, dt, gs, s, f)
+        if step > 50 and np.abs(f[~fix]).max() < tol:
+            return disp, gs, step
+        f = f - alpha * np.abs(f) * np.sign(vel)          # local damping (3DEC)
+        vel = vel + f * dt / mass[:, None]
+        vel[fix] = 0.0
+        disp += vel * dt                                     # positions not updated
+    pytest.fail("did not converge")
+
+
 def test_explicit_relaxation_uniaxial_cube():
-    """Dynamic relaxation of a 10-node cube on rollers under a top pressure: eps = sigma / E,
-    lateral = -nu sigma / E, stress uniform."""
+    """D1 with 10-node zones: a cube on rollers under a top pressure; eps = sigma / E,
+    lateral = -nu sigma / E, stress uniform to 1e-6."""
     E, nu, p = 1e9, 0.25, -1e5                   # sigma_zz = p (compression), tension positive
     Kb, G = E / (3 * (1 - 2 * nu)), E / (2 * (1 + nu))
     L = 1.0
     pos0, gp = cube_mesh(2, L)
-    m = len(gp); rows = np.arange(m, dtype=np.int64)
-    K = np.full(m, Kb); Gs = np.full(m, G)
-    kd = np.zeros(len(pos0))
-    tet10_stiffness(pos0, gp, rows, K, Gs, kd)
-    dt = 1.0
-    mass = kd * dt * dt / 4.0 * 1.1              # density scaling: stable at dt = 1 (Eq. 84)
-    fext = face_loads(pos0, gp, 2, L, np.array([0.0, 0.0, p]))
+    top = faces_on(pos0, gp, 2, L)
+    assert len(top) == 8
+    fext = np.zeros_like(pos0)
+    tri6_traction_loads(pos0, top, np.tile([0.0, 0.0, p], (len(top), 1)), fext)
     assert abs(fext[:, 2].sum() - p * L * L) <= 1e-12 * abs(p)
     fix = np.zeros_like(pos0, bool)
     for ax in range(3):
         fix[np.abs(pos0[:, ax]) < 1e-12, ax] = True    # rollers on x=0, y=0, z=0
-    pos = pos0.copy(); vel = np.zeros_like(pos0); disp = np.zeros_like(pos0)
-    gs = np.zeros((m, 4, 6)); s = np.zeros((m, 6))
-    alpha = 0.8
-    for step in range(20000):
-        f = fext.copy()
-        tet10_step(pos, vel, gp, rows, K, Gs, dt, gs, s, f)
-        if step > 50 and np.abs(f[~fix]).max() < 1e-10 * abs(p) * L * L:
-            break
-        f = f - alpha * np.abs(f) * np.sign(vel)      # local damping (3DEC)
-        vel = vel + f * dt / mass[:, None]
-        vel[fix] = 0.0
-        disp += vel * dt                                 # small strain: positions not updated
-    else:
-        pytest.fail("did not converge")
-    top = np.abs(pos0[:, 2] - L) < 1e-12
+    disp, gs, steps = relax(pos0, gp, Kb, G, fext, fix, 1e-10 * abs(p) * L * L)
+    topn = np.abs(pos0[:, 2] - L) < 1e-12
     side = np.abs(pos0[:, 0] - L) < 1e-12
-    eps_z = disp[top, 2].mean() / L
-    eps_x = disp[side, 0].mean() / L
-    assert abs(eps_z - p / E) <= 1e-6 * abs(p / E)
-    assert abs(eps_x + nu * p / E) <= 1e-6 * abs(nu * p / E)
+    assert abs(disp[topn, 2].mean() / L - p / E) <= 1e-6 * abs(p / E)
+    assert abs(disp[side, 0].mean() / L + nu * p / E) <= 1e-6 * abs(nu * p / E)
+    assert np.ptp(disp[topn, 2]) <= 1e-6 * abs(p / E) * L      # the top stays flat
     assert np.abs(gs[..., 2] - p).max() <= 1e-6 * abs(p)
     assert np.abs(gs[..., [0, 1, 3, 4, 5]]).max() <= 1e-6 * abs(p)
+
+
+def test_explicit_relaxation_self_weight_column():
+    """D2 with 10-node zones and consistent gravity loads (tet10_body_force): H = 10 m,
+    rho = 2500, g = 10, E = 10 GPa, nu = 0.25, lateral rollers; sigma_zz = rho g (H - z) at
+    every Gauss point and top settlement rho g H^2 / (2 M) = 0.1042 mm, both to 1e-6."""
+    E, nu, rho, g, H = 10e9, 0.25, 2500.0, 10.0, 10.0
+    Kb, G = E / (3 * (1 - 2 * nu)), E / (2 * (1 + nu))
+    Mod = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
+    pos0, gp = box_mesh((1, 1, 5), (1.0, 1.0, H))
+    m = len(gp)
+    fext = np.zeros_like(pos0)
+    tet10_body_force(pos0, gp, np.arange(m, dtype=np.int64), np.full(m, rho), np.array([0, 0, -g]), fext)
+    assert abs(fext[:, 2].sum() + rho * g * H) <= 1e-12 * rho * g * H
+    fix = np.zeros_like(pos0, bool)
+    for ax in range(2):
+        fix[(np.abs(pos0[:, ax]) < 1e-9) | (np.abs(pos0[:, ax] - 1.0) < 1e-9), ax] = True
+    fix[np.abs(pos0[:, 2]) < 1e-9, :] = True
+    disp, gs, steps = relax(pos0, gp, Kb, G, fext, fix, 1e-10 * rho * g * H)
+    pts, _ = gauss_points()
+    zg = np.array([[shape(q) @ pos0[gp[z], 2] for q in pts] for z in range(m)])
+    assert np.abs(gs[..., 2] + rho * g * (H - zg)).max() <= 1e-6 * rho * g * H
+    settle = -disp[np.abs(pos0[:, 2] - H) < 1e-9, 2]
+    expect = rho * g * H * H / (2 * Mod)
+    assert abs(expect - 0.1042e-3) < 0.0001e-3
+    assert np.abs(settle - expect).max() <= 1e-6 * expect

@@ -325,3 +325,102 @@ def tet10_stiffness(pos, gp, rows, bulk, shear, kdiag):
                     best = rs
             kdiag[nodes[a]] += best
     return bad
+
+
+@njit(cache=True)
+def tet10_body_force(pos, gp, rows, density, gvec, force):
+    """Consistent nodal forces of gravity on 10-node zones, added to force[gp]:
+    F_a = rho g int N_a dV, by the 4-point rule (exact for straight edges).
+
+    The FE-block text (003_*, "Gravity Forces", Eq. 8: F_I = int N_I g dV, evaluated
+    numerically), which the 3DEC text names as the model of its 10-node zones. Unlike the
+    masses these loads are not all positive: for a straight-edged zone of weight W each corner
+    gets -W/20 and each mid-edge node W/5; with them a quadratic zone reproduces the linear
+    stress of a self-weight column exactly (lumped HRZ loads do not). density (nz,) [kg/m3] by
+    zone row, gvec (3,) [m/s2]. Modifies force; returns the first zone row skipped as inverted
+    or flat, -1 if none."""
+    dref = ref_derivs()
+    dn4 = np.empty((4, 10, 3))
+    wd4 = np.empty(4)
+    nodes = np.empty(10, np.int64)
+    shp = np.empty((4, 10))
+    ei = np.array([0, 1, 2, 0, 1, 2])
+    ej = np.array([1, 2, 0, 3, 3, 3])
+    for g in range(4):           # N_a at Gauss point g: L_g = a, the others b
+        for i in range(4):
+            li = GA if i == g else GB
+            shp[g, i] = li * (2.0 * li - 1.0)
+        for e in range(6):
+            i = ei[e]
+            j = ej[e]
+            li = GA if i == g else GB
+            lj = GA if j == g else GB
+            shp[g, 4 + e] = 4.0 * li * lj
+    bad = -1
+    for kk in range(rows.shape[0]):
+        z = rows[kk]
+        for a in range(10):
+            nodes[a] = gp[z, a]
+        if not _zone_grads(pos, nodes, dref, dn4, wd4):
+            if bad < 0:
+                bad = z
+            continue
+        for a in range(10):
+            w = 0.0
+            for g in range(4):
+                w += wd4[g] * shp[g, a]
+            w *= density[z]
+            r = nodes[a]
+            force[r, 0] += w * gvec[0]
+            force[r, 1] += w * gvec[1]
+            force[r, 2] += w * gvec[2]
+    return bad
+
+
+@njit(cache=True)
+def tri6_traction_loads(pos, tri, traction, force):
+    """Consistent nodal forces of a uniform traction on the 6-node faces of 10-node zones:
+    force[tri[f, a]] += traction[f] int N_a dA (the FE-block text's Eq. 8 and 9 applied to a
+    surface load: nodal forces are the load weighted by the shape functions).
+
+    tri (k, 6): corners 0-2 then the mid-edge nodes of edges 01 12 20; traction (k, 3) [Pa],
+    constant over the face. Quadratic triangle N_i = L_i (2 L_i - 1), N_ij = 4 L_i L_j,
+    integrated with the 3-point rule (L = 2/3, 1/6, 1/6; weight 1/6 each in the reference area
+    1/2; exact for flat faces with straight edges, where it gives 0 at the corners and A/3 at
+    each mid-edge node). Splitting the face in 4 triangles and sharing each by thirds (the
+    4-node way) would instead give A/12 and A/4, and a 10-node mesh would then not carry a
+    uniform stress exactly. Modifies force."""
+    n = np.empty(6)
+    d1 = np.empty(6)
+    d2 = np.empty(6)
+    for f in range(tri.shape[0]):
+        for q in range(3):
+            L0 = 1.0 / 6.0; L1 = 1.0 / 6.0; L2 = 1.0 / 6.0
+            if q == 0:
+                L0 = 2.0 / 3.0
+            elif q == 1:
+                L1 = 2.0 / 3.0
+            else:
+                L2 = 2.0 / 3.0
+            n[0] = L0 * (2.0 * L0 - 1.0); n[1] = L1 * (2.0 * L1 - 1.0); n[2] = L2 * (2.0 * L2 - 1.0)
+            n[3] = 4.0 * L0 * L1; n[4] = 4.0 * L1 * L2; n[5] = 4.0 * L2 * L0
+            # dN/dxi1 (xi1 = L1) and dN/dxi2 (xi2 = L2), with L0 = 1 - xi1 - xi2
+            d1[0] = -(4.0 * L0 - 1.0); d1[1] = 4.0 * L1 - 1.0; d1[2] = 0.0
+            d1[3] = 4.0 * (L0 - L1); d1[4] = 4.0 * L2; d1[5] = -4.0 * L2
+            d2[0] = -(4.0 * L0 - 1.0); d2[1] = 0.0; d2[2] = 4.0 * L2 - 1.0
+            d2[3] = -4.0 * L1; d2[4] = 4.0 * L1; d2[5] = 4.0 * (L0 - L2)
+            t1x = 0.0; t1y = 0.0; t1z = 0.0; t2x = 0.0; t2y = 0.0; t2z = 0.0
+            for a in range(6):
+                p = pos[tri[f, a]]
+                t1x += d1[a] * p[0]; t1y += d1[a] * p[1]; t1z += d1[a] * p[2]
+                t2x += d2[a] * p[0]; t2y += d2[a] * p[1]; t2z += d2[a] * p[2]
+            cx = t1y * t2z - t1z * t2y
+            cy = t1z * t2x - t1x * t2z
+            cz = t1x * t2y - t1y * t2x
+            da = np.sqrt(cx * cx + cy * cy + cz * cz) / 6.0
+            for a in range(6):
+                r = tri[f, a]
+                w = da * n[a]
+                force[r, 0] += w * traction[f, 0]
+                force[r, 1] += w * traction[f, 1]
+                force[r, 2] += w * traction[f, 2]
