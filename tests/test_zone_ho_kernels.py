@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from dec3d.kernels.zones_ho import (tet10_body_force, tet10_forces, tet10_lumped_mass,
-                                    tet10_step, tet10_stiffness, tet10_volume,
-                                    tri6_traction_loads)
+                                    tet10_gauss_positions, tet10_step, tet10_stiffness,
+                                    tet10_volume, tri6_traction_loads)
 
 EDGES = [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)]     # zones.gp order of mid-edge nodes
 
@@ -218,6 +218,19 @@ def test_inverted_or_flat_zone_is_skipped_and_named():
                        (tet10_body_force, (one, np.array([0, 0, -9.81]), np.zeros_like(pos)))]:
         assert kern(pos, gp, rows, *args) == 1
         assert all(np.isfinite(a).all() for a in args)
+
+
+def test_gauss_positions_match_twin_and_lie_near_their_corner():
+    rng = np.random.default_rng(14)
+    pos, gp = random_tets(rng, 3, curved=0.05)
+    out = np.zeros((3, 4, 3))
+    tet10_gauss_positions(pos, gp, np.arange(3, dtype=np.int64), out)
+    pts, _ = gauss_points()
+    twin = np.array([[shape(q) @ pos[gp[z]] for q in pts] for z in range(3)])
+    assert np.abs(out - twin).max() <= 1e-13 * np.abs(twin).max()
+    for z in range(3):                        # point g is the one nearest corner g
+        d = np.linalg.norm(out[z][:, None, :] - pos[gp[z, :4]][None, :, :], axis=2)
+        assert (d.argmin(axis=1) == np.arange(4)).all()
 
 
 # ----------------------------------------------------------------------------- analytical

@@ -26,7 +26,7 @@ Sign convention as ``kernels/zones.tet_elastic_step``: ``force[r]`` accumulates 
 zone exerts on gridpoint r, the negative of the internal-force vector, -int B^T sigma dV.
 
 Zones must be positively oriented (corners 0-3 right-handed, as the mesher makes them). Every
-kernel skips a zone whose det J is not positive at a Gauss point (inverted or flat), so no NaN
+kernel that integrates over zones skips a zone whose det J is not positive at a Gauss point (inverted or flat), so no NaN
 or infinity reaches the stores, and returns the first such zone row (-1 if none) for the host
 to report as an error naming the zone.
 """
@@ -424,3 +424,29 @@ def tri6_traction_loads(pos, tri, traction, force):
                 force[r, 0] += w * traction[f, 0]
                 force[r, 1] += w * traction[f, 1]
                 force[r, 2] += w * traction[f, 2]
+
+
+@njit(cache=True)
+def tet10_gauss_positions(pos, gp, rows, out):
+    """Positions of the 4 Gauss points of the zones in rows: out[z, g] = sum_a N_a(g) x_a
+    (out (nz, 4, 3)), for stresses that vary in space (in-situ gradients), histories and
+    output at the points where the stresses live. Modifies out."""
+    ei = np.array([0, 1, 2, 0, 1, 2])
+    ej = np.array([1, 2, 0, 3, 3, 3])
+    for kk in range(rows.shape[0]):
+        z = rows[kk]
+        for g in range(4):
+            x = 0.0; y = 0.0; w = 0.0
+            for a in range(10):
+                if a < 4:
+                    li = GA if a == g else GB
+                    n = li * (2.0 * li - 1.0)
+                else:
+                    li = GA if ei[a - 4] == g else GB
+                    lj = GA if ej[a - 4] == g else GB
+                    n = 4.0 * li * lj
+                p = pos[gp[z, a]]
+                x += n * p[0]; y += n * p[1]; w += n * p[2]
+            out[z, g, 0] = x
+            out[z, g, 1] = y
+            out[z, g, 2] = w
