@@ -261,6 +261,27 @@ def test_patch_test_linear_velocity_uniform_strain():
     assert np.abs(vir + 8.0 * sig).max() <= 1e-11 * 8.0 * scale
 
 
+def test_same_convention_as_the_4_node_kernel():
+    """Under a linear velocity field a straight-edged 10-node zone and the 4-node zone of its
+    corners get the same stress, and their forces the same resultant moment tensor
+    sum_a x_a (x) f_a = -V sigma: same signs and units as kernels/zones.tet_elastic_step."""
+    from dec3d.kernels.zones import tet_elastic_step
+    rng = np.random.default_rng(15)
+    pos, gp = random_tets(rng, 2)
+    A = rng.normal(size=(3, 3))
+    vel = pos @ A.T
+    K = np.array([2e9, 1e9]); G = np.array([1e9, 3e8])
+    gs = np.zeros((2, 4, 6)); s10 = np.zeros((2, 6)); f10 = np.zeros_like(pos)
+    tet10_step(pos, vel, gp, np.arange(2, dtype=np.int64), K, G, 1e-4, gs, s10, f10)
+    s4 = np.zeros((2, 6)); f4 = np.zeros_like(pos)
+    tet_elastic_step(pos, vel, np.ascontiguousarray(gp[:, :4]), K, G, 1e-4, s4, f4)
+    assert np.abs(s10 - s4).max() <= 1e-10 * np.abs(s4).max()
+    for z in range(2):
+        v10 = pos[gp[z]].T @ f10[gp[z]]
+        v4 = pos[gp[z, :4]].T @ f4[gp[z, :4]]
+        assert np.abs(v10 - v4).max() <= 1e-10 * np.abs(v4).max()
+
+
 def test_rigid_motion_gives_no_strain():
     rng = np.random.default_rng(2)
     pos, gp = random_tets(rng, 4, curved=0.05)
