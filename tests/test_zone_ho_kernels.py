@@ -11,9 +11,10 @@ import math
 import numpy as np
 import pytest
 
-from dec3d.kernels.zones_ho import (tet10_body_force, tet10_forces, tet10_lumped_mass,
-                                    tet10_gauss_positions, tet10_step, tet10_stiffness,
-                                    tet10_volume, tri6_traction_loads)
+from dec3d.kernels.zones_ho import (node_lists, tet10_body_force, tet10_forces,
+                                    tet10_gauss_positions, tet10_lumped_mass, tet10_step,
+                                    tet10_step_parallel, tet10_stiffness, tet10_volume,
+                                    tri6_traction_loads)
 
 EDGES = [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)]     # zones.gp order of mid-edge nodes
 
@@ -194,6 +195,34 @@ def test_only_listed_rows_change():
     tet10_step(pos, vel, gp, np.array([1], np.int64), np.full(3, 1e9), np.full(3, 1e9), 1e-3, gs, s, f)
     assert np.abs(gs[1]).max() > 0 and not gs[[0, 2]].any() and not s[[0, 2]].any()
     assert not f[gp[0]].any() and not f[gp[2]].any() and np.abs(f[gp[1]]).max() > 0
+
+
+def test_parallel_step_is_bit_identical_to_serial_for_any_thread_count():
+    import numba
+    pos, gp = cube_mesh(5, 1.0)                  # 750 zones: several chunks
+    rng = np.random.default_rng(16)
+    pos = pos + 0.01 * rng.normal(size=pos.shape)
+    m = len(gp)
+    pos[gp[300, 3]] = pos[gp[300, :3]].mean(axis=0)          # one flat zone
+    rows = np.r_[np.arange(0, 600), np.arange(650, m)].astype(np.int64)   # not all zones
+    vel = rng.normal(size=pos.shape)
+    K = 1e9 * (1 + rng.random(m)); G = 5e8 * (1 + rng.random(m))
+    g0 = rng.normal(size=(m, 4, 6)) * 1e5
+    f0 = rng.normal(size=pos.shape)
+    ref_g, ref_s, ref_f = g0.copy(), np.zeros((m, 6)), f0.copy()
+    bad = tet10_step(pos, vel, gp, rows, K, G, 1e-4, ref_g, ref_s, ref_f)
+    assert bad != -1 and np.isfinite(ref_f).all()
+    nstart, nent = node_lists(len(pos), gp, rows)
+    before = numba.get_num_threads()
+    try:
+        for nt in sorted({1, before}):
+            numba.set_num_threads(nt)
+            gs, s, f = g0.copy(), np.zeros((m, 6)), f0.copy()
+            zf = np.empty((len(rows), 10, 3)); ok = np.empty(len(rows), np.bool_)
+            assert tet10_step_parallel(pos, vel, gp, rows, K, G, 1e-4, gs, s, f, zf, ok, nstart, nent) == bad
+            assert np.array_equal(gs, ref_g) and np.array_equal(s, ref_s) and np.array_equal(f, ref_f)
+    finally:
+        numba.set_num_threads(before)
 
 
 def test_inverted_or_flat_zone_is_skipped_and_named():

@@ -31,7 +31,7 @@ or infinity reaches the stores, and returns the first such zone row (-1 if none)
 to report as an error naming the zone.
 """
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 GA = 0.5854101966249685     # (5 + 3 sqrt 5) / 20
 GB = 0.1381966011250105     # (5 - sqrt 5) / 20
@@ -118,17 +118,62 @@ def _zone_grads(pos, nodes, dref, dn4, wd4):
 
 
 @njit(cache=True)
-def _scatter(nodes, dn4, wd4, s4, force):
-    """force[nodes[a]] -= sum_g wd4[g] s4[g] . dn4[g, a] (s4 (4, 6) Gauss-point stresses)."""
+def _zone_force(dn4, wd4, s4, fz):
+    """fz[a] = -sum_g wd4[g] s4[g] . dn4[g, a]: the force of one zone on each of its nodes
+    (s4 (4, 6) Gauss-point stresses), summed over g in order. Fills fz (10, 3)."""
+    for a in range(10):
+        fz[a, 0] = 0.0
+        fz[a, 1] = 0.0
+        fz[a, 2] = 0.0
     for g in range(4):
         s = s4[g]
         wd = wd4[g]
         dn = dn4[g]
         for a in range(10):
-            r = nodes[a]
-            force[r, 0] -= wd * (s[0] * dn[a, 0] + s[3] * dn[a, 1] + s[4] * dn[a, 2])
-            force[r, 1] -= wd * (s[3] * dn[a, 0] + s[1] * dn[a, 1] + s[5] * dn[a, 2])
-            force[r, 2] -= wd * (s[4] * dn[a, 0] + s[5] * dn[a, 1] + s[2] * dn[a, 2])
+            fz[a, 0] -= wd * (s[0] * dn[a, 0] + s[3] * dn[a, 1] + s[4] * dn[a, 2])
+            fz[a, 1] -= wd * (s[3] * dn[a, 0] + s[1] * dn[a, 1] + s[5] * dn[a, 2])
+            fz[a, 2] -= wd * (s[4] * dn[a, 0] + s[5] * dn[a, 1] + s[2] * dn[a, 2])
+
+
+@njit(cache=True)
+def _zone_step(z, pos, vel, gp, bulk, shear, dt, gstress, stress, dref, dn4, wd4, nodes, fz):
+    """Stress update and nodal forces (into fz (10, 3)) of zone row z. False, changing
+    nothing, when the zone is inverted or flat."""
+    for a in range(10):
+        nodes[a] = gp[z, a]
+    if not _zone_grads(pos, nodes, dref, dn4, wd4):
+        return False
+    lam = bulk[z] - 2.0 * shear[z] / 3.0
+    g2 = 2.0 * shear[z]
+    for c in range(6):
+        stress[z, c] = 0.0
+    for g in range(4):
+        dn = dn4[g]
+        # velocity gradient L[i, j] = dv_i/dx_j
+        l00 = 0.0; l01 = 0.0; l02 = 0.0
+        l10 = 0.0; l11 = 0.0; l12 = 0.0
+        l20 = 0.0; l21 = 0.0; l22 = 0.0
+        for a in range(10):
+            v = vel[nodes[a]]
+            l00 += v[0] * dn[a, 0]; l01 += v[0] * dn[a, 1]; l02 += v[0] * dn[a, 2]
+            l10 += v[1] * dn[a, 0]; l11 += v[1] * dn[a, 1]; l12 += v[1] * dn[a, 2]
+            l20 += v[2] * dn[a, 0]; l21 += v[2] * dn[a, 1]; l22 += v[2] * dn[a, 2]
+        exx = l00 * dt; eyy = l11 * dt; ezz = l22 * dt
+        exy = 0.5 * (l01 + l10) * dt
+        exz = 0.5 * (l02 + l20) * dt
+        eyz = 0.5 * (l12 + l21) * dt
+        ev = exx + eyy + ezz
+        s = gstress[z, g]
+        s[0] += lam * ev + g2 * exx
+        s[1] += lam * ev + g2 * eyy
+        s[2] += lam * ev + g2 * ezz
+        s[3] += g2 * exy
+        s[4] += g2 * exz
+        s[5] += g2 * eyz
+        for c in range(6):
+            stress[z, c] += 0.25 * s[c]
+    _zone_force(dn4, wd4, gstress[z], fz)
+    return True
 
 
 @njit(cache=True)
@@ -141,7 +186,7 @@ def tet10_step(pos, vel, gp, rows, bulk, shear, dt, gstress, stress, force):
     At each Gauss point g: grad v = sum_a v_a (x) grad N_a (isoparametric, Jacobian from pos),
     strain increment = sym(grad v) dt, gstress[z, g] += lambda tr(de) I + 2 G de (the text's
     Eq. 59 with the 3-term volumetric strain of the errata). Then stress[z] = mean over g, and
-    force[gp[z, a]] -= sum_g w det J_g sigma_g . grad N_a(g).
+    force[gp[z, a]] -= sum_g w det J_g sigma_g . grad N_a(g), zone by zone in the order of rows.
     Modifies gstress, stress, force. A zone whose det J is not positive at a Gauss point
     (inverted or flat) is left untouched, so no NaN spreads; the first such row is returned
     (-1 if none) for the caller to report.
@@ -150,45 +195,19 @@ def tet10_step(pos, vel, gp, rows, bulk, shear, dt, gstress, stress, force):
     dn4 = np.empty((4, 10, 3))
     wd4 = np.empty(4)
     nodes = np.empty(10, np.int64)
+    fz = np.empty((10, 3))
     bad = -1
     for kk in range(rows.shape[0]):
         z = rows[kk]
-        for a in range(10):
-            nodes[a] = gp[z, a]
-        if not _zone_grads(pos, nodes, dref, dn4, wd4):
+        if not _zone_step(z, pos, vel, gp, bulk, shear, dt, gstress, stress, dref, dn4, wd4, nodes, fz):
             if bad < 0:
                 bad = z
             continue
-        lam = bulk[z] - 2.0 * shear[z] / 3.0
-        g2 = 2.0 * shear[z]
-        for c in range(6):
-            stress[z, c] = 0.0
-        for g in range(4):
-            dn = dn4[g]
-            # velocity gradient L[i, j] = dv_i/dx_j
-            l00 = 0.0; l01 = 0.0; l02 = 0.0
-            l10 = 0.0; l11 = 0.0; l12 = 0.0
-            l20 = 0.0; l21 = 0.0; l22 = 0.0
-            for a in range(10):
-                v = vel[nodes[a]]
-                l00 += v[0] * dn[a, 0]; l01 += v[0] * dn[a, 1]; l02 += v[0] * dn[a, 2]
-                l10 += v[1] * dn[a, 0]; l11 += v[1] * dn[a, 1]; l12 += v[1] * dn[a, 2]
-                l20 += v[2] * dn[a, 0]; l21 += v[2] * dn[a, 1]; l22 += v[2] * dn[a, 2]
-            exx = l00 * dt; eyy = l11 * dt; ezz = l22 * dt
-            exy = 0.5 * (l01 + l10) * dt
-            exz = 0.5 * (l02 + l20) * dt
-            eyz = 0.5 * (l12 + l21) * dt
-            ev = exx + eyy + ezz
-            s = gstress[z, g]
-            s[0] += lam * ev + g2 * exx
-            s[1] += lam * ev + g2 * eyy
-            s[2] += lam * ev + g2 * ezz
-            s[3] += g2 * exy
-            s[4] += g2 * exz
-            s[5] += g2 * eyz
-            for c in range(6):
-                stress[z, c] += 0.25 * s[c]
-        _scatter(nodes, dn4, wd4, gstress[z], force)
+        for a in range(10):
+            r = nodes[a]
+            force[r, 0] += fz[a, 0]
+            force[r, 1] += fz[a, 1]
+            force[r, 2] += fz[a, 2]
     return bad
 
 
@@ -201,6 +220,7 @@ def tet10_forces(pos, gp, rows, gstress, force):
     dn4 = np.empty((4, 10, 3))
     wd4 = np.empty(4)
     nodes = np.empty(10, np.int64)
+    fz = np.empty((10, 3))
     bad = -1
     for kk in range(rows.shape[0]):
         z = rows[kk]
@@ -210,8 +230,88 @@ def tet10_forces(pos, gp, rows, gstress, force):
             if bad < 0:
                 bad = z
             continue
-        _scatter(nodes, dn4, wd4, gstress[z], force)
+        _zone_force(dn4, wd4, gstress[z], fz)
+        for a in range(10):
+            r = nodes[a]
+            force[r, 0] += fz[a, 0]
+            force[r, 1] += fz[a, 1]
+            force[r, 2] += fz[a, 2]
     return bad
+
+
+#: zones per task of the parallel pass (scratch arrays are made once per task)
+CHUNK = 256
+
+
+@njit(cache=True, parallel=True)
+def tet10_zone_pass(pos, vel, gp, rows, bulk, shear, dt, gstress, stress, zf, ok):
+    """The zone half of ``tet10_step_parallel``, in parallel over chunks of rows (each zone
+    writes only its own rows): stress update, and zf[k] (10, 3) = the force of zone rows[k] on
+    each of its nodes; ok[k] = False for an inverted or flat zone (left untouched)."""
+    n = rows.shape[0]
+    nchunk = (n + CHUNK - 1) // CHUNK
+    for c in prange(nchunk):
+        dref = ref_derivs()
+        dn4 = np.empty((4, 10, 3))
+        wd4 = np.empty(4)
+        nodes = np.empty(10, np.int64)
+        for kk in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            ok[kk] = _zone_step(rows[kk], pos, vel, gp, bulk, shear, dt, gstress, stress,
+                                dref, dn4, wd4, nodes, zf[kk])
+
+
+@njit(cache=True)
+def node_lists(nv, gp, rows):
+    """Per gridpoint, the (zone, node) entries that add to it, in a fixed order (CSR): the
+    entries of gridpoint r are nent[nstart[r]:nstart[r + 1]], each 10 k + a (node a of zone
+    rows[k]), ascending: the order of the serial scatter of ``tet10_step``. Made once per mesh.
+    Returns (nstart (nv + 1,), nent (10 k,)) int64."""
+    m = rows.shape[0]
+    nstart = np.zeros(nv + 1, dtype=np.int64)
+    for kk in range(m):
+        for a in range(10):
+            nstart[gp[rows[kk], a] + 1] += 1
+    for r in range(nv):
+        nstart[r + 1] += nstart[r]
+    fill = nstart[:nv].copy()
+    nent = np.empty(10 * m, dtype=np.int64)
+    for kk in range(m):
+        for a in range(10):
+            r = gp[rows[kk], a]
+            nent[fill[r]] = 10 * kk + a
+            fill[r] += 1
+    return nstart, nent
+
+
+@njit(cache=True, parallel=True)
+def node_sums(force, zf, ok, nstart, nent):
+    """force[r] += the zone forces zf of gridpoint r's entries (``node_lists``) in their fixed
+    order, in parallel over gridpoints: the sums do not depend on the thread count and equal the
+    serial scatter. Entries of zones with ok False are skipped."""
+    for r in prange(nstart.shape[0] - 1):
+        f0 = force[r, 0]; f1 = force[r, 1]; f2 = force[r, 2]
+        for e in range(nstart[r], nstart[r + 1]):
+            kk = nent[e] // 10
+            if ok[kk]:
+                a = nent[e] - 10 * kk
+                f0 += zf[kk, a, 0]; f1 += zf[kk, a, 1]; f2 += zf[kk, a, 2]
+        force[r, 0] = f0; force[r, 1] = f1; force[r, 2] = f2
+
+
+@njit(cache=True)
+def tet10_step_parallel(pos, vel, gp, rows, bulk, shear, dt, gstress, stress, force,
+                        zf, ok, nstart, nent):
+    """``tet10_step`` on several threads, bit for bit the same result whatever the thread
+    count (and the same as ``tet10_step``): a parallel zone pass into the scratch zf
+    (len(rows), 10, 3) [N] and ok (len(rows),) bool, then fixed-order sums per gridpoint over
+    the lists of ``node_lists(len(force), gp, rows)``. Returns the first inverted or flat zone
+    row in the order of rows (-1 none); such zones are left untouched."""
+    tet10_zone_pass(pos, vel, gp, rows, bulk, shear, dt, gstress, stress, zf, ok)
+    node_sums(force, zf, ok, nstart, nent)
+    for kk in range(rows.shape[0]):
+        if not ok[kk]:
+            return rows[kk]
+    return -1
 
 
 @njit(cache=True)
