@@ -6,10 +6,12 @@ Histories are sampled by the rigid engine every `history interval` steps (dec3d.
 """
 from __future__ import annotations
 
+import numpy as np
+
 from ..errors import BindError, CommandError
 from ..io.history import write_csv, write_png
-from ..physics.history import (BLOCK_QUANTITIES, CONTACT_QUANTITIES, MODEL_QUANTITIES, POINT_QUANTITIES,
-                               RIGID_QUANTITIES, ROTATION_QUANTITIES, figures, histories, nearest_block_id)
+from ..physics.history import (BLOCK_QUANTITIES, CONTACT_QUANTITIES, MODEL_QUANTITIES, NODE_QUANTITIES,
+                               POINT_QUANTITIES, RIGID_QUANTITIES, ROTATION_QUANTITIES, figures, histories, nearest_block_id)
 from .registry import REGISTRY, command
 from .values import NUMBERISH, VEC3, Choice, Num, OutPath, P, Text, ValueType, _number_literal
 
@@ -42,11 +44,52 @@ class HistoryRefs(ValueType):
 
 def _check_block(call):
     point = call.args.get("material_point")
-    if call.args["position"] is not None and call.args["block_id"] is not None:
-        raise BindError("give either `position <x y z>` or `block-id <i>`, not both", call.location)
-    if call.args["position"] is None and call.args["block_id"] is None and point is None:
+    given = [k for k in ("position", "block_id", "gridpointid", "zone_id") if call.args.get(k) is not None]
+    if len(given) > 1 and not (point is not None and given == ["block_id"]):
+        words = " and ".join("`" + k.replace("_", "-") + "`" for k in given)
+        raise BindError(f"give one of `position <x y z>`, `block-id <i>`, `gridpointid <i>` or `zone-id <i>`, "
+                        f"not {words}", call.location)
+    if not given and point is None:
         raise BindError("give either `position <x y z>` or `block-id <i>`"
                         + (" (or `material-point <x y z>`)" if "material_point" in call.args else ""), call.location)
+    if point is not None and (call.args.get("gridpointid") is not None or call.args.get("zone_id") is not None):
+        raise BindError("`material-point` follows a point of a rigid block: not with `gridpointid` or `zone-id`",
+                        call.location)
+
+
+def _node_history(session, call, quantity) -> bool:
+    """`gridpointid <i>` / `zone-id <i>`: a history of one gridpoint or zone of a zoned block. False when
+    neither is given."""
+    m = session.model
+    gid, zid = call.args.get("gridpointid"), call.args.get("zone_id")
+    if gid is None and zid is None:
+        return False
+    slot = "gridpointid" if gid is not None else "zone_id"
+    where = call.locations.get(slot, call.location)
+    word = slot.replace("_", "-")
+    if quantity not in NODE_QUANTITIES:
+        raise CommandError(f"`{word}` records displacement, velocity or position, not `{quantity}`", where)
+    name = _name(session, call)
+    v = m.vertices
+    if gid is not None:
+        row = int(gid) - 1
+        if not (0 <= row < v.n) or "zoned" not in v or not bool(v["zoned"][row]):
+            raise CommandError(f"there is no gridpoint {gid}: gridpoints are those of zoned blocks (`block zone "
+                               "generate`), numbered as `block.zone.gp` gives them", where)
+        brow = int(v["block"][row])
+        offset = row - int(m.blocks["vert_start"][brow])
+        histories(m).add_gridpoint(quantity, int(m.blocks["id"][brow]), offset, name, gp_id=int(gid))
+    else:
+        z = m.stores.get("zones")
+        rows = np.flatnonzero(z["id"] == int(zid)) if z is not None and z.n else ()
+        if len(rows) == 0:
+            raise CommandError(f"there is no zone {zid}" + ("" if z is not None and z.n else
+                                                               ": no block is zoned (`block zone generate`)"), where)
+        zr = int(rows[0])
+        brow = int(z["block"][zr])
+        offset = int(np.searchsorted(np.flatnonzero(z["block"] == brow), zr))
+        histories(m).add_zone(quantity, int(m.blocks["id"][brow]), offset, name, zone_id=int(zid))
+    return True
 
 
 def _name(session, call):
@@ -59,6 +102,8 @@ def _name(session, call):
 def _block_history(quantity, kind="block"):
     def handler(session, call):
         m = session.model
+        if _node_history(session, call, quantity):
+            return
         name = _name(session, call)
         point = call.args.get("material_point")
         if call.args["block_id"] is not None:
@@ -85,14 +130,18 @@ def _block_history(quantity, kind="block"):
 
 _BLOCK_KW = [P("position", VEC3, "the block whose centroid is nearest this point", units="m"),
              P("block-id", Num(integer=True, lo=1), "the block with this id"),
-             P("gridpointid", Num(integer=True), "a gridpoint of a deformable block", supported=False),
-             P("zone-id", Num(integer=True), "a zone of a deformable block", supported=False)]
+             P("gridpointid", Num(integer=True, lo=1), "a gridpoint of a zoned block, by number "
+               "(displacement, velocity, position)"),
+             P("zone-id", Num(integer=True, lo=1), "a zone, at its centroid (displacement, velocity, position)")]
 _POINT_KW = [P("material-point", VEC3, "follow the point fixed to the block that is here when the command runs "
                             "(a corner: its vertex)", units="m")]
 _WHAT = {"displacement": "displacement", "velocity": "velocity", "rvelocity": "angular velocity",
          "position": "centroid position"}
 _WHICH = ("The block is the one whose centroid is nearest `position` when the command runs, or the "
           "block `block-id`. A leading `name '<s>'` names the history (default: its number).")
+_NODES = (" `gridpointid <i>` records gridpoint i of a zoned block instead (numbered as `block.zone.gp` gives "
+          "them), `zone-id <i>` the value at the centroid of zone i (its nodes weighted by the element's shape "
+          "functions there); both follow their block when rows of other blocks move.")
 _POINT = (" With `material-point x y z` (dec3d) the value is that of the point fixed to the block that is at "
           "(x, y, z) when the command runs, instead of the centroid: its position now, its displacement "
           "since the block was made, its velocity v + ω × (p − c). Give a corner's coordinates to follow "
@@ -107,7 +156,8 @@ for _q in BLOCK_QUANTITIES:
     _pt = _q in POINT_QUANTITIES
     command(f"block history {_q}", keywords=_BLOCK_KW + (_POINT_KW if _pt else []), check=_check_block,
             doc=f"Record the {_comp} {_what} of one block every `history interval` steps.",
-            details=_WHICH + ("" if _q.split("-")[0] in ("displacement", "velocity") else
+            details=_WHICH + (_NODES if _q in NODE_QUANTITIES else "")
+            + ("" if _q.split("-")[0] in ("displacement", "velocity") else
                               " (dec3d: `rvelocity` and `position` are not 3DEC history variables.)")
             + (_POINT if _pt else ""),
             examples=[f"block history {_q} position 0.5 0.5 0.5", f"block history name 'h{_q[0]}' {_q} block-id 2"]
@@ -199,6 +249,35 @@ def _find(hs, key, call, slot):
     if h is None:
         raise CommandError(f"there is no history {key}", call.locations.get(slot, call.location))
     return h
+
+
+@command("history name", positional=[P("id", HistoryRefs(1), "the history, by number or name", required=True)],
+         keywords=[P("label", Text(), "the new label", required=True)],
+         doc="Give a history a label (what CSV headers and plots show beside its name).",
+         details="3DEC 7 writes it `history name '3' label 'C2_MiddleSail'`: `name` picks the history (a number "
+                 "or a name given when it was made), `label` replaces the description dec3d made for it.",
+         examples=["history name '3' label 'C2_MiddleSail'", "history name 1 label 'Unbalanced Force'"])
+def history_label(session, call):
+    h = _find(histories(session.model), call.args["id"], call, "id")
+    h.label = call.args["label"]
+
+
+@command("history rename", positional=[P("new", Text(), "the new name", required=True)],
+         keywords=[P("name", HistoryRefs(1), "the history to rename, by number or current name", required=True)],
+         doc="Rename a history: `history rename 'new' name 'old'`.",
+         details="As 3DEC 9 decks write it after `fish history @x`: `history rename \"x\" name \"1\"` gives "
+                 "history 1 the name x. Its number stays; a name another history has is refused.",
+         examples=["history rename \"norm_bedjoint_B\" name \"1\"", "history rename 'settle' name 2"])
+def history_rename(session, call):
+    hs = histories(session.model)
+    h = _find(hs, call.args["name"], call, "name")
+    new = call.args["new"]
+    other = hs.find(new)
+    if other is not None and other is not h:
+        raise CommandError(f"history {other.id} is named '{new}' already", call.locations.get("new", call.location))
+    if not str(new).strip():
+        raise CommandError("a history name cannot be empty", call.locations.get("new", call.location))
+    h.name = str(new)
 
 
 @command("history export",

@@ -73,6 +73,12 @@ def _block_mass(rt, b):
     return float(m.blocks["mass"][r])
 
 
+@intrinsic("block.region", 1)
+def _block_region(rt, b):
+    m, r = _row(rt, b, "block.region")
+    return int(m.blocks["region"][r])
+
+
 @intrinsic("block.vol", 1)
 def _block_vol(rt, b):
     m, r = _row(rt, b, "block.vol")

@@ -21,6 +21,10 @@ BLOCK_QUANTITIES = {f"{q}{s}": (fld, comp)
                     for q, fld in (("displacement", "disp"), ("velocity", "velocity"), ("rvelocity", "spin"),
                                    ("position", "centroid"))
                     for s, comp in _XYZ}
+#: what a gridpoint or zone history (`gridpointid`, `zone-id`) records: vertex-store fields
+NODE_QUANTITIES = {q: v for q, v in BLOCK_QUANTITIES.items() if q.split("-")[0] in ("displacement", "velocity",
+                                                                                     "position")}
+NODE_QUANTITIES = {q: (("pos" if f == "centroid" else f), c) for q, (f, c) in NODE_QUANTITIES.items()}
 #: the rotation of a block since it was made (``dec3d.model.kinematics``): components of the rotation
 #: vector θ n [rad] and θ itself, followed continuously from sample to sample
 ROTATION_QUANTITIES = ("rotation", "rotation-x", "rotation-y", "rotation-z")
@@ -178,6 +182,11 @@ class HistorySet:
             h = self.add_point(q, block_id(), num_list("point", 3), name, p_origin=num_list("origin", 3))
         elif kind == "model" and q in MODEL_QUANTITIES:
             h = self.add_model(q, name)
+        elif kind in ("gridpoint", "zone") and q in NODE_QUANTITIES:
+            off = spec.get("offset")
+            if not isinstance(off, int) or isinstance(off, bool) or off < 0:
+                raise ValueError(f"history {hid}: `offset` {off!r} is not a whole number ≥ 0")
+            h = (self.add_gridpoint if kind == "gridpoint" else self.add_zone)(q, block_id(), off, name)
         else:
             raise ValueError(f"history {hid}: unknown kind {kind!r} or quantity {q!r}")
         self.items.pop()
@@ -342,6 +351,47 @@ class HistorySet:
                      {"kind": "contact", "quantity": quantity, "position": [float(x) for x in pos]})
         h.follow = pair           # the two block ids followed (set at the first sample), for save files
         return h
+
+    def add_gridpoint(self, quantity: str, block_id: int, offset: int, name: str | None = None,
+                      gp_id: int | None = None) -> History:
+        """A gridpoint of a zoned block: the ``offset``-th of its block's gridpoints (so it is followed
+        when rows of other blocks move); its own displacement, velocity or position."""
+        fld, comp = NODE_QUANTITIES[quantity]
+        model = self.model
+        cache: dict = {}
+
+        def value(eng) -> float:
+            r = self._row(block_id, cache)
+            v = model.vertices[fld][int(model.blocks["vert_start"][r]) + offset]
+            return float(np.linalg.norm(v)) if comp is None else float(v[comp])
+
+        what = f"gridpoint {gp_id}" if gp_id is not None else f"gridpoint {offset + 1} of block {block_id}"
+        return self.add(f"{what} {quantity}", value, name,
+                        {"kind": "gridpoint", "quantity": quantity, "block_id": int(block_id), "offset": int(offset)})
+
+    def add_zone(self, quantity: str, block_id: int, offset: int, name: str | None = None,
+                 zone_id: int | None = None) -> History:
+        """A zone (the ``offset``-th zone row of its block): the value at its centroid, interpolated
+        from its nodes with the element's shape functions there (4-node tetrahedron: each corner 1/4;
+        10-node: corners -1/8, mid-edge nodes 1/4)."""
+        fld, comp = NODE_QUANTITIES[quantity]
+        model = self.model
+        cache: dict = {}
+
+        def value(eng) -> float:
+            r = self._row(block_id, cache)
+            z = model.stores["zones"]
+            rows = np.flatnonzero(z["block"] == r)
+            zr = int(rows[offset])
+            nn = int(z["nnode"][zr])
+            gp = z["gp"][zr, :nn]
+            w = np.full(nn, 0.25) if nn == 4 else np.concatenate([np.full(4, -0.125), np.full(6, 0.25)])
+            v = w @ model.vertices[fld][gp]
+            return float(np.linalg.norm(v)) if comp is None else float(v[comp])
+
+        what = f"zone {zone_id}" if zone_id is not None else f"zone {offset + 1} of block {block_id}"
+        return self.add(f"{what} {quantity}", value, name,
+                        {"kind": "zone", "quantity": quantity, "block_id": int(block_id), "offset": int(offset)})
 
     def add_model(self, quantity: str, name: str | None = None) -> History:
         if quantity.startswith(("ratio", "unbalanced")):   # the measures of `model solve` (RigidEngine.criteria)
