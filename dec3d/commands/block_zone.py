@@ -85,7 +85,6 @@ def stress_updates(model, rows, comp: int, value, how: str = "set") -> list:
     centroids and Gauss points. A 10-node zone takes the value at each Gauss point, its stress
     being their mean. Returns [(field, index, values)] for ``write_updates`` (nothing written yet,
     so a command can check every value first)."""
-    from ..model.zone_quality import centroids
     zs = model.store("zones")
     rows = np.asarray(rows, dtype=np.int64)
     ho = rows[zs["nnode"][rows] == 10]
@@ -94,6 +93,12 @@ def stress_updates(model, rows, comp: int, value, how: str = "set") -> list:
     def combine(old, new):
         return new if how == "set" else old + new if how == "add" else old * new
 
+    with np.errstate(over="ignore", invalid="ignore"):     # checked by write_updates
+        return _stress_updates(model, zs, lo, ho, comp, value, combine)
+
+
+def _stress_updates(model, zs, lo, ho, comp, value, combine) -> list:
+    from ..model.zone_quality import centroids
     out = []
     if lo.size:
         out.append(("stress", (lo, comp), combine(zs["stress"][lo, comp], value(centroids(model, lo)))))
@@ -242,7 +247,8 @@ def block_insitu(session, call):
         updates += stress_updates(m, zrows, i, lambda x, i=i: stress_at(x)[..., i])
     contact = None
     if "contacts" in m.stores and m.store("contacts").n:
-        contact = insitu_contact_forces(m, session.range_mask(call, "contact"), stress_at)
+        with np.errstate(over="ignore", invalid="ignore"):      # checked below
+            contact = insitu_contact_forces(m, session.range_mask(call, "contact"), stress_at)
     if contact is not None and not all(np.isfinite(v).all() for v in contact[1:]):
         raise CommandError("a sub-contact force would not be finite; nothing was changed", call.location)
     write_updates(m, updates, call.location)
