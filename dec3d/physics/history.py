@@ -187,7 +187,12 @@ class HistorySet:
             local = spec.get("local")
             if not isinstance(local, int) or isinstance(local, bool) or local < 0:
                 raise ValueError(f"history {hid}: gridpoint index {local!r} is not a whole number ≥ 0")
-            h = self.add_gridpoint(q, block_id(), local, name)
+            bid = block_id()
+            b = self.model.blocks
+            rows = np.flatnonzero(b["id"] == bid)
+            if rows.size == 0 or local >= int(b["vert_count"][rows[0]]):
+                raise ValueError(f"history {hid}: block {bid} has no gridpoint {local + 1}")
+            h = self.add_gridpoint(q, bid, local, name)
         elif kind == "zone" and q in ZONE_QUANTITIES:
             zid = spec.get("zone_id")
             if not isinstance(zid, int) or isinstance(zid, bool) or zid < 1:
