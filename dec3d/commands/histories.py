@@ -47,8 +47,10 @@ class HistoryRefs(ValueType):
 def _check_block(call):
     point = call.args.get("material_point")
     given = [k for k in ("position", "block_id", "gridpointid") if call.args.get(k) is not None]
+    if call.args["position"] is not None and call.args["block_id"] is not None:
+        raise BindError("give either `position <x y z>` or `block-id <i>`, not both", call.location)
     if len(given) > 1:
-        raise BindError("give one of `position <x y z>`, `block-id <i>` or `gridpointid <i>`, not several",
+        raise BindError("`gridpointid <i>` names the gridpoint alone: give no `position` or `block-id` with it",
                         call.location)
     if given == ["gridpointid"] and point is not None:
         raise BindError("`material-point` follows a point of a block, not a gridpoint", call.location)

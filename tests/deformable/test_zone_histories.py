@@ -87,7 +87,7 @@ def test_block_history_gridpointid(session):
     ("block zone history stress-xx zone-id 99", "there is no zone 99"),
     ("block history velocity-x gridpointid 999", "there is no gridpoint 999"),
     ("block history rotation gridpointid 1", "not a gridpoint quantity"),
-    ("block history velocity-x gridpointid 1 position 0 0 0", "not several"),
+    ("block history velocity-x gridpointid 1 position 0 0 0", "names the gridpoint alone"),
 ])
 def test_bad_input(session, line, message):
     m = _model(session)
