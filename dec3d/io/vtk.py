@@ -19,7 +19,8 @@ every array is a numeric ``DataArray``, so VTK/ParaView, PyVista and meshio all 
 Zoned (deformable) blocks are written as their zones instead: VTK_TETRA cells (type 10), or
 VTK_QUADRATIC_TETRA (24) for 10-node zones, whose node order (corners, then mid-edge nodes of
 edges 01 12 20 03 13 23) is the zones store's. Zone cells follow the polyhedra, 4-node ones first,
-each by zone row; they carry their block's cell data and ``zone_id`` (0 on polyhedra), ``stress``
+each by zone row; they carry their block's cell data and ``zone_id`` (0 on polyhedra), ``overlay``
+(0 or 1: which 5-tetrahedron set of a mixed-discretization hexahedron; -1 otherwise), ``stress``
 (six components in VTK's symmetric-tensor order XX YY ZZ XY YZ XZ, tension positive),
 ``mean_stress``, ``principal_stress`` (ascending: most compressive first) and ``von_mises`` (zero on
 polyhedra). Gridpoints' point data are their own displacement and velocity. meshio reads no file
@@ -136,7 +137,7 @@ def _zone_cells(model, cells: str):
 
 
 def _zone_cell_data(model, zrows, npoly: int) -> dict:
-    """Cell arrays of the zones (zero on the polyhedron cells of rigid blocks): zone_id, the stress
+    """Cell arrays of the zones (zero on the polyhedron cells of rigid blocks): zone_id, overlay, the stress
     tensor in VTK's symmetric-tensor order, mean stress, principal stresses and von Mises stress."""
     from dec3d.model.zone_quality import mean_stress, principal_stresses, von_mises
     zs = model.store("zones")
@@ -147,7 +148,9 @@ def _zone_cell_data(model, zrows, npoly: int) -> dict:
         out[npoly:] = a
         return out
 
-    return {"zone_id": pad(zs["id"][zrows]), "stress": pad(st[:, VTK_TENSOR_ORDER]),
+    overlay = np.full(npoly + len(zrows), -1, dtype=np.int8)
+    overlay[npoly:] = zs["overlay"][zrows]
+    return {"zone_id": pad(zs["id"][zrows]), "overlay": overlay, "stress": pad(st[:, VTK_TENSOR_ORDER]),
             "mean_stress": pad(mean_stress(st)), "principal_stress": pad(principal_stresses(st)),
             "von_mises": pad(von_mises(st))}
 

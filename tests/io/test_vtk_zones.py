@@ -55,6 +55,7 @@ def test_zones_read_back_with_pyvista(tmp_path):
     assert grid.n_cells == 1 + zs.n and grid.n_points == m.vertices.n
     np.testing.assert_array_equal(grid.celltypes, [42] + [10] * 5 + [24])
     np.testing.assert_array_equal(grid.cell_data["zone_id"], np.concatenate([[0], zs["id"][rows]]))
+    np.testing.assert_array_equal(grid.cell_data["overlay"], -1)
     np.testing.assert_array_equal(grid.cell_data["block_id"], [3, 1, 1, 1, 1, 1, 2])
     np.testing.assert_array_equal(grid.cell_data["stress"][1:], s[:, _VTK])
     np.testing.assert_array_equal(grid.cell_data["stress"][0], 0.0)
@@ -118,6 +119,18 @@ def test_all_zoned_model_is_one_file_meshio_reads(tmp_path):
     rows, s, ev, vm = _expected(m)
     np.testing.assert_allclose(np.concatenate(mesh.cell_data["principal_stress"]), ev, rtol=1e-9, atol=1e-6)
     np.testing.assert_array_equal(mesh.points, m.vertices["pos"])
+
+
+def test_overlay_of_mixed_hexahedral_zones(tmp_path):
+    m = Model()
+    add_blocks(m, [brick(0, 1, 0, 1, 0, 1)], density=2000.0)
+    zone_brick(m, 0, mixed=True)
+    grid = pv.read(write_vtu(m, tmp_path / "hex.vtu"))
+    assert grid.n_cells == 10
+    np.testing.assert_array_equal(grid.cell_data["overlay"], [0] * 5 + [1] * 5)
+    sizes = grid.compute_cell_sizes(length=False, area=False)["Volume"]
+    for k in (0, 1):                               # each set fills the cube once
+        assert sizes[grid.cell_data["overlay"] == k].sum() == pytest.approx(1.0, rel=1e-14)
 
 
 def test_rigid_only_output_is_unchanged_by_an_empty_zones_store(tmp_path):
