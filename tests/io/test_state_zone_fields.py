@@ -6,8 +6,6 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-import dec3d.physics.history  # noqa: F401  (with rigid: registers what save files may name)
-import dec3d.physics.rigid  # noqa: F401
 from dec3d.geometry.polyhedron import brick, tetrahedron
 from dec3d.io.state import StateFileError, restore_state, save_state
 from dec3d.model.blocks import add_blocks
