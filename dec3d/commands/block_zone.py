@@ -247,8 +247,15 @@ def block_insitu(session, call):
         updates += stress_updates(m, zrows, i, lambda x, i=i: stress_at(x)[..., i])
     contact = None
     if "contacts" in m.stores and m.store("contacts").n:
-        with np.errstate(over="ignore", invalid="ignore"):      # checked below
-            contact = insitu_contact_forces(m, session.range_mask(call, "contact"), stress_at)
+        try:
+            cmask = session.range_mask(call, "contact")
+        except CommandError as exc:              # an element contacts lack (`id`): the zones only
+            cmask = None
+            session.write(f"warning: {call.location}: `block insitu`: the range does not select contacts "
+                          f"({exc.message}); their forces are left as they are")
+        if cmask is not None:
+            with np.errstate(over="ignore", invalid="ignore"):      # checked below
+                contact = insitu_contact_forces(m, cmask, stress_at)
     if contact is not None and not all(np.isfinite(v).all() for v in contact[1:]):
         raise CommandError("a sub-contact force would not be finite; nothing was changed", call.location)
     write_updates(m, updates, call.location)

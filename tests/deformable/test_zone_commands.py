@@ -168,6 +168,18 @@ def test_insitu_range_selects_contacts_and_zones(session):
     np.testing.assert_array_equal(m.store("zones")["stress"][:, :3], -1.0)
 
 
+def test_insitu_range_that_contacts_lack_sets_zones_and_says_so(session):
+    m = _contact_model(session)
+    session.command("block create brick 5 6 0 1 0 1")
+    zone_brick(m, int(np.flatnonzero(m.blocks["id"] == 3)[0]))
+    zid = int(m.store("zones")["id"][2])
+    session.command(f"block insitu stress -1 -1 -1 0 0 0 range id {zid}")
+    zs = m.store("zones")
+    np.testing.assert_array_equal(zs["stress"][:, 0], np.where(zs["id"] == zid, -1.0, 0.0))
+    assert (m.store("subcontacts")["fn"] == 0).all()
+    assert "the range does not select contacts (contacts have no id)" in session.output.getvalue()
+
+
 @pytest.mark.parametrize("line, message, exc", [
     ("block insitu", "needs stress", Dec3dError),
     ("block insitu stress 1 2 3", "expected 6 numbers, got 3", Dec3dError),
