@@ -183,14 +183,14 @@ def test_gridpoint_and_zone_histories_read_their_nodes(session):
     pos_before = v["pos"][gp_row].copy()
     session.command("block delete range id 1")
     assert hs.find(3).value(engine(m)) == pos_before[1]
-    assert hs.find(1).label.startswith(f"gridpoint {gp_row + 1} displacement-z")
+    assert hs.find("zv").label == f"zone {int(zs['id'][2])} centroid velocity-x"
 
 
 @pytest.mark.parametrize("line, message", [
-    ("block history displacement-z gridpointid 1", r"there is no gridpoint 1: gridpoints are those of zoned blocks"),
+    ("block history displacement-z gridpointid 1", r"there is no gridpoint 1"),
     ("block history displacement-z zone-id 1", r"there is no zone 1: no block is zoned"),
-    ("block history rvelocity-x gridpointid 1", r"`gridpointid` records displacement, velocity or position"),
-    ("block history displacement-z gridpointid 1 block-id 1", r"give one of .* not `block-id` and `gridpointid`"),
+    ("block history rvelocity-x zone-id 1", r"`rvelocity-x` is not a zone quantity"),
+    ("block history displacement-z zone-id 1 block-id 1", r"give no `position` or `block-id`"),
     ("block history displacement-z block-id 5", r"there is no block 5"),
 ])
 def test_gridpoint_zone_block_history_errors(session, line, message):

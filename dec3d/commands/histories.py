@@ -10,8 +10,10 @@ import numpy as np
 
 from ..errors import BindError, CommandError
 from ..io.history import write_csv, write_png
-from ..physics.history import (BLOCK_QUANTITIES, CONTACT_QUANTITIES, MODEL_QUANTITIES, NODE_QUANTITIES,
-                               POINT_QUANTITIES, RIGID_QUANTITIES, ROTATION_QUANTITIES, figures, histories, nearest_block_id)
+from ..physics.history import (BLOCK_QUANTITIES, CONTACT_QUANTITIES, GRIDPOINT_QUANTITIES, MODEL_QUANTITIES,
+                               POINT_QUANTITIES, RIGID_QUANTITIES, ROTATION_QUANTITIES, ZONE_QUANTITIES, figures,
+                               histories, nearest_block_id, nearest_gridpoint, zone_at)
+from ..model.model import KIND_DEFORMABLE
 from .registry import REGISTRY, command
 from .values import NUMBERISH, VEC3, Choice, Num, OutPath, P, Text, ValueType, _number_literal
 
@@ -45,51 +47,20 @@ class HistoryRefs(ValueType):
 def _check_block(call):
     point = call.args.get("material_point")
     given = [k for k in ("position", "block_id", "gridpointid", "zone_id") if call.args.get(k) is not None]
-    if len(given) > 1 and not (point is not None and given == ["block_id"]):
-        words = " and ".join("`" + k.replace("_", "-") + "`" for k in given)
-        raise BindError(f"give one of `position <x y z>`, `block-id <i>`, `gridpointid <i>` or `zone-id <i>`, "
-                        f"not {words}", call.location)
+    if call.args["position"] is not None and call.args["block_id"] is not None:
+        raise BindError("give either `position <x y z>` or `block-id <i>`, not both", call.location)
+    if len(given) > 1:
+        word = "gridpointid" if "gridpointid" in given else "zone-id"
+        what = "gridpoint" if word == "gridpointid" else "zone"
+        if given == ["gridpointid", "zone_id"]:
+            raise BindError("give `gridpointid <i>` or `zone-id <i>`, not both", call.location)
+        raise BindError(f"`{word} <i>` names the {what} alone: give no `position` or `block-id` with it",
+                        call.location)
+    if given in (["gridpointid"], ["zone_id"]) and point is not None:
+        raise BindError("`material-point` follows a point of a block, not a gridpoint or zone", call.location)
     if not given and point is None:
         raise BindError("give either `position <x y z>` or `block-id <i>`"
                         + (" (or `material-point <x y z>`)" if "material_point" in call.args else ""), call.location)
-    if point is not None and (call.args.get("gridpointid") is not None or call.args.get("zone_id") is not None):
-        raise BindError("`material-point` follows a point of a rigid block: not with `gridpointid` or `zone-id`",
-                        call.location)
-
-
-def _node_history(session, call, quantity) -> bool:
-    """`gridpointid <i>` / `zone-id <i>`: a history of one gridpoint or zone of a zoned block. False when
-    neither is given."""
-    m = session.model
-    gid, zid = call.args.get("gridpointid"), call.args.get("zone_id")
-    if gid is None and zid is None:
-        return False
-    slot = "gridpointid" if gid is not None else "zone_id"
-    where = call.locations.get(slot, call.location)
-    word = slot.replace("_", "-")
-    if quantity not in NODE_QUANTITIES:
-        raise CommandError(f"`{word}` records displacement, velocity or position, not `{quantity}`", where)
-    name = _name(session, call)
-    v = m.vertices
-    if gid is not None:
-        row = int(gid) - 1
-        if not (0 <= row < v.n) or "zoned" not in v or not bool(v["zoned"][row]):
-            raise CommandError(f"there is no gridpoint {gid}: gridpoints are those of zoned blocks (`block zone "
-                               "generate`), numbered as `block.zone.gp` gives them", where)
-        brow = int(v["block"][row])
-        offset = row - int(m.blocks["vert_start"][brow])
-        histories(m).add_gridpoint(quantity, int(m.blocks["id"][brow]), offset, name, gp_id=int(gid))
-    else:
-        z = m.stores.get("zones")
-        rows = np.flatnonzero(z["id"] == int(zid)) if z is not None and z.n else ()
-        if len(rows) == 0:
-            raise CommandError(f"there is no zone {zid}" + ("" if z is not None and z.n else
-                                                               ": no block is zoned (`block zone generate`)"), where)
-        zr = int(rows[0])
-        brow = int(z["block"][zr])
-        offset = int(np.searchsorted(np.flatnonzero(z["block"] == brow), zr))
-        histories(m).add_zone(quantity, int(m.blocks["id"][brow]), offset, name, zone_id=int(zid))
-    return True
 
 
 def _name(session, call):
@@ -102,10 +73,14 @@ def _name(session, call):
 def _block_history(quantity, kind="block"):
     def handler(session, call):
         m = session.model
-        if _node_history(session, call, quantity):
-            return
         name = _name(session, call)
         point = call.args.get("material_point")
+        if call.args.get("gridpointid") is not None:
+            _gridpoint_history(session, call, quantity, name)
+            return
+        if call.args.get("zone_id") is not None:
+            _zone_centroid_history(session, call, quantity, name)
+            return
         if call.args["block_id"] is not None:
             bid = int(call.args["block_id"])
             if not (m.blocks["id"] == bid).any():
@@ -115,7 +90,13 @@ def _block_history(quantity, kind="block"):
                 bid = nearest_block_id(m, call.args["position"] if call.args["position"] is not None else point)
             except ValueError as exc:
                 raise CommandError(str(exc), call.location)
-        if point is not None:
+        row = int(np.flatnonzero(m.blocks["id"] == bid)[0])
+        if (point is None and call.args["position"] is not None and quantity in GRIDPOINT_QUANTITIES
+                and m.blocks["kind"][row] == KIND_DEFORMABLE):
+            # a zoned block: the gridpoint of the nearest block nearest the point
+            local = nearest_gridpoint(m, row, call.args["position"])
+            histories(m).add_gridpoint(quantity, bid, local, name)
+        elif point is not None:
             histories(m).add_point(quantity, bid, point, name)
         elif kind == "rigid":
             histories(m).add_rigid(quantity, bid, name)
@@ -128,20 +109,51 @@ def _block_history(quantity, kind="block"):
     return handler
 
 
+def _gridpoint_history(session, call, quantity, name):
+    """`block history <q> gridpointid <i>`: the gridpoint with id i (its vertex row + 1)."""
+    m = session.model
+    gid = int(call.args["gridpointid"])
+    where = call.locations.get("gridpointid", call.location)
+    if quantity not in GRIDPOINT_QUANTITIES:
+        raise CommandError(f"`{quantity}` is not a gridpoint quantity (displacement, velocity or position)", where)
+    v = m.vertices
+    row = gid - 1
+    if not (0 <= row < v.n) or "zoned" not in v or not v["zoned"][row]:
+        raise CommandError(f"there is no gridpoint {gid} (gridpoints are the vertices of zoned blocks)", where)
+    brow = int(v["block"][row])
+    histories(m).add_gridpoint(quantity, int(m.blocks["id"][brow]), row - int(m.blocks["vert_start"][brow]), name)
+
+
+def _zone_centroid_history(session, call, quantity, name):
+    """`block history <q> zone-id <i>`: the value at the centroid of zone i, from its nodes."""
+    m = session.model
+    zid = int(call.args["zone_id"])
+    where = call.locations.get("zone_id", call.location)
+    if quantity not in GRIDPOINT_QUANTITIES:
+        raise CommandError(f"`{quantity}` is not a zone quantity (displacement, velocity or position)", where)
+    z = m.stores.get("zones")
+    if z is None or not z.n or not (z["id"] == zid).any():
+        raise CommandError(f"there is no zone {zid}" + ("" if z is not None and z.n else
+                                                           ": no block is zoned (`block zone generate`)"), where)
+    histories(m).add_zone_centroid(quantity, zid, name)
+
+
 _BLOCK_KW = [P("position", VEC3, "the block whose centroid is nearest this point", units="m"),
              P("block-id", Num(integer=True, lo=1), "the block with this id"),
-             P("gridpointid", Num(integer=True, lo=1), "a gridpoint of a zoned block, by number "
-               "(displacement, velocity, position)"),
-             P("zone-id", Num(integer=True, lo=1), "a zone, at its centroid (displacement, velocity, position)")]
+             P("gridpointid", Num(integer=True), "a gridpoint of a zoned block by id (displacement, velocity, "
+               "position)"),
+             P("zone-id", Num(integer=True, lo=1), "a zone: the value at its centroid (displacement, velocity, "
+               "position)")]
 _POINT_KW = [P("material-point", VEC3, "follow the point fixed to the block that is here when the command runs "
                             "(a corner: its vertex)", units="m")]
 _WHAT = {"displacement": "displacement", "velocity": "velocity", "rvelocity": "angular velocity",
          "position": "centroid position"}
 _WHICH = ("The block is the one whose centroid is nearest `position` when the command runs, or the "
           "block `block-id`. A leading `name '<s>'` names the history (default: its number).")
-_NODES = (" `gridpointid <i>` records gridpoint i of a zoned block instead (numbered as `block.zone.gp` gives "
-          "them), `zone-id <i>` the value at the centroid of zone i (its nodes weighted by the element's shape "
-          "functions there); both follow their block when rows of other blocks move.")
+_GP = (" When that block is zoned (deformable), `position` records the gridpoint of it nearest the point "
+       "instead; `gridpointid <i>` names a gridpoint directly (its id is its vertex row + 1); `zone-id <i>` "
+       "records the value at the centroid of zone i (its nodes weighted by the element's shape functions "
+       "there: 1/4 each for a 4-node zone, -1/8 per corner and 1/4 per mid-edge node for a 10-node one).")
 _POINT = (" With `material-point x y z` (dec3d) the value is that of the point fixed to the block that is at "
           "(x, y, z) when the command runs, instead of the centroid: its position now, its displacement "
           "since the block was made, its velocity v + ω × (p − c). Give a corner's coordinates to follow "
@@ -156,7 +168,7 @@ for _q in BLOCK_QUANTITIES:
     _pt = _q in POINT_QUANTITIES
     command(f"block history {_q}", keywords=_BLOCK_KW + (_POINT_KW if _pt else []), check=_check_block,
             doc=f"Record the {_comp} {_what} of one block every `history interval` steps.",
-            details=_WHICH + (_NODES if _q in NODE_QUANTITIES else "")
+            details=_WHICH + (_GP if _q in GRIDPOINT_QUANTITIES else "")
             + ("" if _q.split("-")[0] in ("displacement", "velocity") else
                               " (dec3d: `rvelocity` and `position` are not 3DEC history variables.)")
             + (_POINT if _pt else ""),
@@ -190,6 +202,46 @@ for _q in RIGID_QUANTITIES:
             examples=[f"block history {_q} position 0.5 0.5 0.5"])(_block_history(_q, kind="rigid"))
 
 REGISTRY.node_keywords("block contact history", [P("name", Text(), "history name")])
+REGISTRY.node_keywords("block zone history", [P("name", Text(), "history name")])
+
+
+def _check_zone(call):
+    if (call.args["position"] is None) == (call.args["zone_id"] is None):
+        raise BindError("give either `position <x y z>` or `zone-id <i>`", call.location)
+
+
+def _zone_history(quantity):
+    def handler(session, call):
+        m = session.model
+        name = _name(session, call)
+        if call.args["zone_id"] is not None:
+            zid = int(call.args["zone_id"])
+            if "zones" not in m.stores or not (m.store("zones")["id"] == zid).any():
+                raise CommandError(f"there is no zone {zid}", call.locations.get("zone_id", call.location))
+        else:
+            try:
+                zid = zone_at(m, call.args["position"])
+            except ValueError as exc:
+                raise CommandError(str(exc), call.location)
+        histories(m).add_zone(quantity, zid, name)
+
+    handler.__name__ = "zone_history_" + quantity.replace("-", "_")
+    return handler
+
+
+for _q in ZONE_QUANTITIES:
+    command(f"block zone history {_q}",
+            keywords=[P("position", VEC3, "the zone containing this point (else the one whose centroid is nearest)",
+                        units="m"),
+                      P("zone-id", Num(integer=True, lo=1), "the zone with this id")],
+            check=_check_zone,
+            doc=f"Record the {_q[-2:]} stress [Pa, tension positive] of one zone every `history interval` steps.",
+            details="The zone is the one containing `position` when the command runs (the first by number when "
+                    "the point is on a face shared by several), or, when no zone contains it, the zone whose "
+                    "centroid is nearest; or the zone `zone-id`. A leading `name '<s>'` names the history. The "
+                    "value is NaN once the zone is gone.",
+            examples=[f"block zone history {_q} position 0.5 0.5 0.5",
+                      f"block zone history name 's' {_q} zone-id 12"])(_zone_history(_q))
 
 
 def _contact_history(quantity):

@@ -21,10 +21,6 @@ BLOCK_QUANTITIES = {f"{q}{s}": (fld, comp)
                     for q, fld in (("displacement", "disp"), ("velocity", "velocity"), ("rvelocity", "spin"),
                                    ("position", "centroid"))
                     for s, comp in _XYZ}
-#: what a gridpoint or zone history (`gridpointid`, `zone-id`) records: vertex-store fields
-NODE_QUANTITIES = {q: v for q, v in BLOCK_QUANTITIES.items() if q.split("-")[0] in ("displacement", "velocity",
-                                                                                     "position")}
-NODE_QUANTITIES = {q: (("pos" if f == "centroid" else f), c) for q, (f, c) in NODE_QUANTITIES.items()}
 #: the rotation of a block since it was made (``dec3d.model.kinematics``): components of the rotation
 #: vector θ n [rad] and θ itself, followed continuously from sample to sample
 ROTATION_QUANTITIES = ("rotation", "rotation-x", "rotation-y", "rotation-z")
@@ -38,6 +34,11 @@ RIGID_QUANTITIES = tuple(f"angular-momentum{s}" for s, _ in _XYZ) + ("shape-erro
 CONTACT_QUANTITIES = {"force-normal": ("fn", "sum"), "force-shear": ("fs", "norm"),
                       "force-shear-x": ("fs", 0), "force-shear-y": ("fs", 1), "force-shear-z": ("fs", 2),
                       "displacement-normal": ("un", "mean"), "displacement-shear": ("us", "norm-mean")}
+#: gridpoint quantity -> (vertex field, component or None for the magnitude); ``block history`` on a zoned block
+GRIDPOINT_QUANTITIES = {q: ({"centroid": "pos"}.get(fld, fld), comp) for q, (fld, comp) in BLOCK_QUANTITIES.items()
+                        if fld in ("disp", "velocity", "centroid")}
+#: zone quantity -> column of ``zones.stress``; ``block zone history``
+ZONE_QUANTITIES = {f"stress-{c}": i for i, c in enumerate(("xx", "yy", "zz", "xy", "xz", "yz"))}
 MODEL_QUANTITIES = ("unbalanced-maximum", "ratio", "ratio-average", "ratio-local", "ratio-maximum", "time-total",
                     "kinetic-energy")
 
@@ -182,11 +183,26 @@ class HistorySet:
             h = self.add_point(q, block_id(), num_list("point", 3), name, p_origin=num_list("origin", 3))
         elif kind == "model" and q in MODEL_QUANTITIES:
             h = self.add_model(q, name)
-        elif kind in ("gridpoint", "zone") and q in NODE_QUANTITIES:
-            off = spec.get("offset")
-            if not isinstance(off, int) or isinstance(off, bool) or off < 0:
-                raise ValueError(f"history {hid}: `offset` {off!r} is not a whole number ≥ 0")
-            h = (self.add_gridpoint if kind == "gridpoint" else self.add_zone)(q, block_id(), off, name)
+        elif kind == "gridpoint" and q in GRIDPOINT_QUANTITIES:
+            local = spec.get("local")
+            if not isinstance(local, int) or isinstance(local, bool) or local < 0:
+                raise ValueError(f"history {hid}: gridpoint index {local!r} is not a whole number ≥ 0")
+            bid = block_id()
+            b = self.model.blocks
+            rows = np.flatnonzero(b["id"] == bid)
+            if rows.size == 0 or local >= int(b["vert_count"][rows[0]]):
+                raise ValueError(f"history {hid}: block {bid} has no gridpoint {local + 1}")
+            h = self.add_gridpoint(q, bid, local, name)
+        elif kind == "zone-centroid" and q in GRIDPOINT_QUANTITIES:
+            zid = spec.get("zone_id")
+            if not isinstance(zid, int) or isinstance(zid, bool) or zid < 1:
+                raise ValueError(f"history {hid}: zone id {zid!r} is not a whole number ≥ 1")
+            h = self.add_zone_centroid(q, zid, name)
+        elif kind == "zone" and q in ZONE_QUANTITIES:
+            zid = spec.get("zone_id")
+            if not isinstance(zid, int) or isinstance(zid, bool) or zid < 1:
+                raise ValueError(f"history {hid}: zone id {zid!r} is not a whole number ≥ 1")
+            h = self.add_zone(q, zid, name)
         else:
             raise ValueError(f"history {hid}: unknown kind {kind!r} or quantity {q!r}")
         self.items.pop()
@@ -352,46 +368,70 @@ class HistorySet:
         h.follow = pair           # the two block ids followed (set at the first sample), for save files
         return h
 
-    def add_gridpoint(self, quantity: str, block_id: int, offset: int, name: str | None = None,
-                      gp_id: int | None = None) -> History:
-        """A gridpoint of a zoned block: the ``offset``-th of its block's gridpoints (so it is followed
-        when rows of other blocks move); its own displacement, velocity or position."""
-        fld, comp = NODE_QUANTITIES[quantity]
+    def add_gridpoint(self, quantity: str, block_id: int, local: int, name: str | None = None) -> History:
+        """Displacement, velocity or position of one gridpoint of a zoned block: the ``local``-th row of
+        the block's vertex range (kept by block id and index, so the history survives other blocks
+        being zoned or deleted, which moves vertex rows). A gridpoint shared by joined blocks reads its
+        master's motion."""
+        fld, comp = GRIDPOINT_QUANTITIES[quantity]
         model = self.model
         cache: dict = {}
 
         def value(eng) -> float:
             r = self._row(block_id, cache)
-            v = model.vertices[fld][int(model.blocks["vert_start"][r]) + offset]
-            return float(np.linalg.norm(v)) if comp is None else float(v[comp])
+            v = model.vertices
+            row = int(model.blocks["vert_start"][r]) + local
+            if v["link"][row] >= 0:
+                row = int(v["link"][row])
+            x = v[fld][row]
+            return float(np.linalg.norm(x)) if comp is None else float(x[comp])
 
-        what = f"gridpoint {gp_id}" if gp_id is not None else f"gridpoint {offset + 1} of block {block_id}"
-        return self.add(f"{what} {quantity}", value, name,
-                        {"kind": "gridpoint", "quantity": quantity, "block_id": int(block_id), "offset": int(offset)})
+        return self.add(f"block {block_id} gridpoint {local + 1} {quantity}", value, name,
+                        {"kind": "gridpoint", "quantity": quantity, "block_id": int(block_id), "local": int(local)})
 
-    def add_zone(self, quantity: str, block_id: int, offset: int, name: str | None = None,
-                 zone_id: int | None = None) -> History:
-        """A zone (the ``offset``-th zone row of its block): the value at its centroid, interpolated
-        from its nodes with the element's shape functions there (4-node tetrahedron: each corner 1/4;
-        10-node: corners -1/8, mid-edge nodes 1/4)."""
-        fld, comp = NODE_QUANTITIES[quantity]
+    def add_zone(self, quantity: str, zone_id: int, name: str | None = None) -> History:
+        """A stress component [Pa, tension positive] of the zone with id ``zone_id``."""
+        col = ZONE_QUANTITIES[quantity]
         model = self.model
-        cache: dict = {}
+        cache = {"row": -1}
 
         def value(eng) -> float:
-            r = self._row(block_id, cache)
-            z = model.stores["zones"]
-            rows = np.flatnonzero(z["block"] == r)
-            zr = int(rows[offset])
-            nn = int(z["nnode"][zr])
-            gp = z["gp"][zr, :nn]
+            zs = model.store("zones")
+            r = cache["row"]
+            if not (0 <= r < zs.n and zs["id"][r] == zone_id):
+                hit = np.flatnonzero(zs["id"] == zone_id)
+                if hit.size == 0:
+                    return float("nan")          # the zone has gone (its block deleted)
+                r = cache["row"] = int(hit[0])
+            return float(zs["stress"][r, col])
+
+        return self.add(f"zone {zone_id} {quantity}", value, name,
+                        {"kind": "zone", "quantity": quantity, "zone_id": int(zone_id)})
+
+    def add_zone_centroid(self, quantity: str, zone_id: int, name: str | None = None) -> History:
+        """Displacement, velocity or position at the centroid of the zone ``zone_id``, interpolated from
+        its nodes with the element's shape functions there (4-node tetrahedron: each corner 1/4; 10-node:
+        corners -1/8, mid-edge nodes 1/4). NaN once the zone is gone."""
+        fld, comp = GRIDPOINT_QUANTITIES[quantity]
+        model = self.model
+        cache = {"row": -1}
+
+        def value(eng) -> float:
+            zs = model.store("zones")
+            r = cache["row"]
+            if not (0 <= r < zs.n and zs["id"][r] == zone_id):
+                hit = np.flatnonzero(zs["id"] == zone_id)
+                if hit.size == 0:
+                    return float("nan")
+                r = cache["row"] = int(hit[0])
+            nn = int(zs["nnode"][r])
+            gp = zs["gp"][r, :nn]
             w = np.full(nn, 0.25) if nn == 4 else np.concatenate([np.full(4, -0.125), np.full(6, 0.25)])
-            v = w @ model.vertices[fld][gp]
-            return float(np.linalg.norm(v)) if comp is None else float(v[comp])
+            x = w @ model.vertices[fld][gp]
+            return float(np.linalg.norm(x)) if comp is None else float(x[comp])
 
-        what = f"zone {zone_id}" if zone_id is not None else f"zone {offset + 1} of block {block_id}"
-        return self.add(f"{what} {quantity}", value, name,
-                        {"kind": "zone", "quantity": quantity, "block_id": int(block_id), "offset": int(offset)})
+        return self.add(f"zone {zone_id} centroid {quantity}", value, name,
+                        {"kind": "zone-centroid", "quantity": quantity, "zone_id": int(zone_id)})
 
     def add_model(self, quantity: str, name: str | None = None) -> History:
         if quantity.startswith(("ratio", "unbalanced")):   # the measures of `model solve` (RigidEngine.criteria)
@@ -425,6 +465,36 @@ def nearest_block_id(model, position) -> int:
         raise ValueError("there are no blocks")
     d = np.linalg.norm(b["centroid"][rows] - np.asarray(position, dtype=float), axis=1)
     return int(b["id"][rows[int(np.argmin(d))]])
+
+
+def nearest_gridpoint(model, block_row: int, position) -> int:
+    """Index, within block ``block_row``'s vertex range, of its gridpoint nearest ``position``."""
+    b = model.blocks
+    s, c = int(b["vert_start"][block_row]), int(b["vert_count"][block_row])
+    d = np.linalg.norm(model.vertices["pos"][s:s + c] - np.asarray(position, dtype=float), axis=1)
+    return int(np.argmin(d))
+
+
+def zone_at(model, position) -> int:
+    """Id of the zone containing ``position`` (the first one, by row, when it lies on shared faces), or
+    of the zone whose centroid is nearest when no zone contains it. ValueError when there are no zones."""
+    from dec3d.model.zone_quality import corners
+    if "zones" not in model.stores or model.store("zones").n == 0:
+        raise ValueError("there are no zones (`block zone generate` makes them)")
+    zs = model.store("zones")
+    x = np.asarray(position, dtype=float)
+    p = corners(model)
+    # barycentric coordinates: solve [p1-p0 p2-p0 p3-p0] l = x - p0
+    m = np.transpose(p[:, 1:] - p[:, :1], (0, 2, 1))
+    ok = np.abs(np.linalg.det(m)) > 0.0
+    lam = np.full((zs.n, 3), -1.0)
+    if ok.any():
+        lam[ok] = np.linalg.solve(m[ok], (x - p[ok, 0])[..., None])[..., 0]
+    bary = np.column_stack([1.0 - lam.sum(axis=1), lam])
+    inside = np.flatnonzero((bary >= -1e-9).all(axis=1))
+    if inside.size:
+        return int(zs["id"][inside[0]])
+    return int(zs["id"][int(np.argmin(np.linalg.norm(p.mean(axis=1) - x, axis=1)))])
 
 
 def histories(model) -> HistorySet:
