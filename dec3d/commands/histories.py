@@ -230,3 +230,31 @@ def history_export(session, call):
 def _file_part(name: str) -> str:
     """A history name as part of a file name: path separators and control characters become '_'."""
     return "".join("_" if (ch in "/\\" or not ch.isprintable()) else ch for ch in str(name)) or "_"
+
+
+@command("history rename", positional=[P("old", HistoryRefs(1), "the history's number or name", required=True)],
+         keywords=[P("name", Text(), "its new name", required=True)],
+         doc="Give a history a new name (what `history export` and result figures use).",
+         details="The history is found by name, else by number; a name another history has is refused.",
+         examples=["history rename 'shearforce' name '5'", "history rename 1 name 'settle'"])
+def history_rename(session, call):
+    hs = histories(session.model)
+    h = _find(hs, call.args["old"], call, "old")
+    new = str(call.args["name"])
+    if not new.strip():
+        raise CommandError("a history name cannot be empty", call.locations.get("name", call.location))
+    other = hs.find(new)
+    if other is not None and other is not h:
+        raise CommandError(f"a history named '{new}' exists already", call.locations.get("name", call.location))
+    h.name = new
+
+
+@command("history list", doc="Print every history: number, name, what it records and its number of samples.",
+         examples=["history list"])
+def history_list(session, call):
+    hs = histories(session.model)
+    if not hs.items:
+        session.write("no histories")
+    for h in hs.items:
+        last = f", last {h.values[-1]:.6g} at step {h.steps[-1]}" if h.values else ""
+        session.write(f"{h.id:4d}  '{h.name}'  {h.label}  ({len(h.values)} samples{last})")

@@ -7,6 +7,7 @@ keeps the step and the total time of each sample beside the value.
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -34,6 +35,8 @@ RIGID_QUANTITIES = tuple(f"angular-momentum{s}" for s, _ in _XYZ) + ("shape-erro
 CONTACT_QUANTITIES = {"force-normal": ("fn", "sum"), "force-shear": ("fs", "norm"),
                       "force-shear-x": ("fs", 0), "force-shear-y": ("fs", 1), "force-shear-z": ("fs", 2),
                       "displacement-normal": ("un", "mean"), "displacement-shear": ("us", "norm-mean")}
+#: a FISH name a `fish history` records (``HistorySet.add_fish``)
+FISH_NAME = re.compile(r"[a-z_][a-z0-9_]{0,127}")
 MODEL_QUANTITIES = ("unbalanced-maximum", "ratio", "ratio-average", "ratio-local", "ratio-maximum", "time-total",
                     "kinetic-energy")
 
@@ -65,8 +68,13 @@ class HistorySet:
     def __call__(self, eng) -> None:
         """Step hook: sample every history when the step count is a multiple of the interval."""
         if self.items and eng.step % self.interval == 0:
-            for h in self.items:
-                h.sample(eng)
+            # every value first: one that fails (a FISH history's function) leaves no history a sample ahead
+            values = [float(h.value(eng)) for h in self.items]
+            step, time = int(eng.step), float(eng.time)
+            for h, v in zip(self.items, values):
+                h.steps.append(step)
+                h.times.append(time)
+                h.values.append(v)
 
     def add(self, label: str, value: Callable, name: str | None = None, spec: dict | None = None) -> History:
         hid = (self.items[-1].id + 1) if self.items else 1
@@ -178,6 +186,8 @@ class HistorySet:
             h = self.add_point(q, block_id(), num_list("point", 3), name, p_origin=num_list("origin", 3))
         elif kind == "model" and q in MODEL_QUANTITIES:
             h = self.add_model(q, name)
+        elif kind == "fish" and isinstance(q, str) and FISH_NAME.fullmatch(q):
+            h = self.add_fish(q, name)
         else:
             raise ValueError(f"history {hid}: unknown kind {kind!r} or quantity {q!r}")
         self.items.pop()
@@ -350,6 +360,21 @@ class HistorySet:
             attr = {"time-total": "time", "kinetic-energy": "kinetic"}[quantity]
             value = lambda eng: float(getattr(eng, attr))          # noqa: E731
         return self.add(f"mechanical {quantity}", value, name, {"kind": "model", "quantity": quantity})
+
+
+    def add_fish(self, var: str, name: str | None = None) -> History:
+        """`fish history`: the value of a FISH global variable, or of a FISH function called at each
+        sample. The FISH run time reaches the model as ``model.fish_probe(var)`` (set by the session's
+        FISH commands; physics knows nothing of FISH)."""
+        model = self.model
+
+        def value(eng) -> float:
+            probe = getattr(model, "fish_probe", None)
+            if probe is None:
+                raise ValueError(f"FISH history `{var}`: no FISH run time is attached to the model")
+            return probe(var)
+
+        return self.add(f"fish {var}", value, name, {"kind": "fish", "quantity": var})
 
 
 def _contact_view(model, eng):
