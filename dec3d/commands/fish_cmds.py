@@ -18,6 +18,8 @@ from ..lang.abbrev import matches
 from .registry import command
 from .values import FLAG, INT, NUMBERISH, ONOFF, InPath, Nums, P, Text, ValueType
 
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+
 
 @command("fish automatic-create", positional=[P("mode", ONOFF, "off: every FISH name must be declared "
                                                 "`global` or `local` before use", required=True)],
@@ -30,7 +32,25 @@ def fish_automatic_create(session, call):
     session.fish_rt.auto_create = bool(call.args["mode"])
 
 
-@command("fish list", positional=[P("name", Text(), "a variable or function; omitted lists all", default="")],
+class _ListName(ValueType):
+    """The name `fish list` prints: `x`, `'x'`, `@x` or `[x]` all name the variable x (not its value)."""
+
+    label = "<name>"
+    fits_types = ("WORD", "STRING", "ATNAME", "EXPR")
+
+    def take(self, toks, i, binder):
+        tok = toks[i]
+        text = str(tok)
+        if tok.type in ("STRING", "EXPR"):
+            text = text[1:-1].strip()
+        elif tok.type == "ATNAME":
+            text = text[1:]
+        if not _NAME.match(text):
+            raise BindError(f"`fish list` takes a FISH name, not `{text}`", binder.where(tok))
+        return text, i + 1
+
+
+@command("fish list", positional=[P("name", _ListName(), "a variable or function; omitted lists all", default="")],
          doc="Print FISH global variables and functions with their values.",
          details="Functions are listed with their parameters; `fish list [x]` (or `fish list x`) prints one name.",
          examples=["fish list", "fish list 'errsr'"])
@@ -92,8 +112,6 @@ def attach_fish(session, model=None) -> None:
 
 
 # ------------------------------------------------------------------ fish history
-
-_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 
 
 class FishHistoryArgs(ValueType):
