@@ -258,3 +258,28 @@ def history_list(session, call):
     for h in hs.items:
         last = f", last {h.values[-1]:.6g} at step {h.steps[-1]}" if h.values else ""
         session.write(f"{h.id:4d}  '{h.name}'  {h.label}  ({len(h.values)} samples{last})")
+
+
+@command("history name", positional=[P("history", HistoryRefs(1), "the history's name or number", required=True)],
+         keywords=[P("label", Text(), "its new label (the CSV header and plot title)", required=True)],
+         doc="Set the label of a history (what `history export` writes as its column header and plot title).",
+         details="The history is found by name, else by number (a history's name is its number unless it was "
+                 "given one).",
+         examples=["history name '1' label 'Unbalanced Force'", "history name 3 label 'C2_MiddleSail'"])
+def history_name(session, call):
+    h = _find(histories(session.model), call.args["history"], call, "history")
+    h.label = str(call.args["label"])
+
+
+@command("history delete", positional=[P("ids", HistoryRefs(), "history numbers or names; omitted: every history")],
+         doc="Delete histories (all of them when none is named) with their samples.",
+         details="Histories made afterwards are numbered on from the last one left (from 1 when none is left).",
+         examples=["history delete", "history delete 2 'settle'"])
+def history_delete(session, call):
+    hs = histories(session.model)
+    ids = call.args["ids"]
+    if not ids:
+        hs.items.clear()
+        return
+    gone = {id(_find(hs, key, call, "ids")) for key in ids}
+    hs.items[:] = [h for h in hs.items if id(h) not in gone]

@@ -263,6 +263,21 @@ def _system_error(rt, message):
     raise SystemErrorRaised(to_string(message))
 
 
+@intrinsic("system.directory.create", 1)
+def _directory_create(rt, name):
+    """Make a folder (and its parents) under the output folder; 0 when it exists afterwards. A name that
+    leaves the output folder is refused as every file a deck writes (dec3d.io.paths)."""
+    if type(name) is not str:
+        raise FishValueError(f"`system.directory.create` takes a folder name (a string), not a {type_name(name)}")
+    # checked as a file inside the folder: the folder itself may exist already
+    path = rt.session.out_path((name.rstrip("/\\") or name) + "/.dec3d-folder").parent
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise FishValueError(f"`system.directory.create`: cannot make '{name}': {exc.strerror or exc}") from None
+    return 0
+
+
 @intrinsic("time.kernel")
 def _time_kernel(rt):
     """Milliseconds of processor time spent by dec3d (Itasca: time in calculations, ms)."""

@@ -253,3 +253,36 @@ def test_a_value_that_cannot_be_saved_is_named(session):
     with pytest.raises(FishStateError) as e:
         encode(float("inf"), "FISH variable `w`")
     assert "FISH variable `w`: inf is not a finite number" in e.value.message
+
+
+def test_history_name_sets_the_label_that_export_writes(session, tmp_path):
+    session.command(BRICK + "model history mechanical time-total\nhistory name '1' label 'Time'\n"
+                    "[k = 1]\nfish history k\nhistory name 'k' label 'counter'\nhistory interval 1\nmodel cycle 2\n"
+                    "history export 1 2 file 'n.csv'")
+    hs = session.model.history_set
+    assert [h.label for h in hs.items] == ["Time", "counter"]
+    header = (tmp_path / "n.csv").read_text().splitlines()[0]
+    assert "Time" in header and "counter" in header
+    with pytest.raises(CommandError) as e:
+        session.command("history name 7 label 'x'")
+    assert "there is no history 7" in e.value.message
+
+
+def test_history_delete(session):
+    session.command(BRICK + "[a = 1]\n[b = 2]\nfish history a\nfish history b\nhistory delete 'a'")
+    hs = session.model.history_set
+    assert [h.name for h in hs.items] == ["b"]
+    session.command("history delete\nfish history a")
+    assert [(h.id, h.name) for h in hs.items] == [(1, "a")]
+    with pytest.raises(CommandError) as e:
+        session.command("history delete 'zz'")
+    assert "there is no history zz" in e.value.message
+
+
+def test_system_directory_create_stays_in_the_output_folder(session, tmp_path):
+    session.command("[r = system.directory.create('NUM/run_rev1')]\n[r2 = system.directory.create('NUM/run_rev1')]")
+    assert (tmp_path / "NUM" / "run_rev1").is_dir() and session.variables["r"] == session.variables["r2"] == 0
+    with pytest.raises(Dec3dError) as e:
+        session.command("[r = system.directory.create('../elsewhere')]")
+    assert "outside the output folder" in e.value.message
+    assert not (tmp_path.parent / "elsewhere").exists()
