@@ -102,7 +102,7 @@ for _c, _k in enumerate(_COMP):
 
 
 @intrinsic("block.zone.gp", 2)
-def _gp(rt, z, i):
+def _zone_gp(rt, z, i):
     _, st, r = _row(rt, z, "block.zone.gp")
     n = int(st["nnode"][r])
     if type(i) is not int or not 1 <= i <= n:
@@ -112,7 +112,7 @@ def _gp(rt, z, i):
 
 # ---------------------------------------------------------------- gridpoints (block.gp.*)
 
-def _gp(rt, g, name):
+def _gprow(rt, g, name):
     """(model, vertex row) of gridpoint index `g`."""
     if type(g) is not int:
         raise FishValueError(f"`{name}` takes a gridpoint (from block.gp.list, block.gp.near or block.zone.gp), "
@@ -172,12 +172,12 @@ def _gp_find(rt, g):
 
 @intrinsic("block.gp.id", 1)
 def _gp_id(rt, g):
-    _gp(rt, g, "block.gp.id")
+    _gprow(rt, g, "block.gp.id")
     return g
 
 
 def _host(rt, g, name="block.gp.block"):
-    m, r = _gp(rt, g, name)
+    m, r = _gprow(rt, g, name)
     return int(m.blocks["id"][int(m.vertices["block"][r])])
 
 
@@ -187,7 +187,7 @@ intrinsic("block.gp.hostblock", 1)(lambda rt, g: _host(rt, g, "block.gp.hostbloc
 
 @intrinsic("block.gp.zoned", 1)
 def _gp_is_zoned(rt, g):
-    m, r = _gp(rt, g, "block.gp.zoned")
+    m, r = _gprow(rt, g, "block.gp.zoned")
     return _zoned(m, r)
 
 
@@ -207,13 +207,13 @@ def _gp_near(rt, *xyz):
 
 def _gp_family(name, get):
     def whole(rt, g):
-        m, r = _gp(rt, g, name)
+        m, r = _gprow(rt, g, name)
         a = get(m, r, name)
         return Vec(float(a[0]), float(a[1]), float(a[2]))
     intrinsic(name, 1)(whole)
     for k, c in (("x", 0), ("y", 1), ("z", 2)):
         def comp(rt, g, c=c, full=f"{name}.{k}"):
-            m, r = _gp(rt, g, full)
+            m, r = _gprow(rt, g, full)
             return float(get(m, r, full)[c])
         intrinsic(f"{name}.{k}", 1)(comp)
 
@@ -240,7 +240,7 @@ def _gplist(rt, b):
 @intrinsic("block.gp.next", 1)
 def _gp_next(rt, g):
     """The next gridpoint of the same block, 0 after its last."""
-    m, r = _gp(rt, g, "block.gp.next")
+    m, r = _gprow(rt, g, "block.gp.next")
     k = int(m.vertices["block"][r])
     end = int(m.blocks["vert_start"][k]) + int(m.blocks["vert_count"][k])
     return g + 1 if r + 1 < end else 0
