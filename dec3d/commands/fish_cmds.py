@@ -14,6 +14,7 @@ import re
 from functools import reduce
 
 from ..errors import BindError, CommandError, Dec3dError
+from ..fish import contact_intrinsics
 from ..lang.abbrev import matches
 from .registry import command
 from .values import FLAG, INT, NUMBERISH, ONOFF, InPath, Nums, P, Text, ValueType
@@ -109,6 +110,19 @@ def attach_fish(session, model=None) -> None:
         hooks = engine(model).step_hooks
         if not any(isinstance(h, FishCallbackHook) and h.rt is rt for h in hooks):
             hooks.insert(0, FishCallbackHook(rt))
+
+
+def _current_contacts(model):
+    """The contact stores with the contacts up to date (detected when the blocks changed since the last
+    detection), for FISH's block.contact.* intrinsics."""
+    from ..physics.rigid import engine
+
+    eng = engine(model)
+    eng.ensure_contacts()
+    return eng.contacts, eng.subcontacts
+
+
+contact_intrinsics.CONTACTS[0] = _current_contacts
 
 
 # ------------------------------------------------------------------ fish history

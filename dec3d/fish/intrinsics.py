@@ -299,7 +299,8 @@ _START = _time.perf_counter()
 def _type(rt, v):
     """Itasca's type codes: 1 integer, 2 float, 3 string, 4 pointer/index, 5 vector (2-D), 6 vector (3-D),
     7 boolean, ... 10 list, 11 map; dec3d returns the ones it has."""
-    return {int: 1, float: 2, str: 3, Vec: 6, bool: 7, list: 10, dict: 11}.get(type(v), 0)
+    code = {int: 1, float: 2, str: 3, Vec: 6, bool: 7, list: 10, dict: 11}.get(type(v))
+    return code if code is not None else (4 if hasattr(v, "kind") and hasattr(v, "key") else 0)
 
 
 @intrinsic("list", 0, None)
@@ -456,5 +457,6 @@ def _title(rt):
     return rt.session.model.settings.title
 
 from . import block_intrinsics  # noqa: E402,F401  (registers block.*)
+from . import contact_intrinsics  # noqa: E402,F401  (registers block.contact.*, block.subcontact.*)
 from . import table_intrinsics  # noqa: E402,F401  (registers table.*)
 from . import zone_intrinsics  # noqa: E402,F401  (registers block.zone.*)

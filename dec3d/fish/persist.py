@@ -7,7 +7,8 @@ functions, tables, callbacks and settings by the snapshot's, compiling the funct
 
 Values: integers, floats, booleans, strings and null are JSON's own; a list is a JSON array; a
 vector is ``{"vec": [x, y, z]}``, a map ``{"map": [[key, value], …]}``, a table reference
-``{"table": id}``. Other values (none today) are refused when saving, naming the variable.
+``{"table": id}``, a contact ``{"contact": [ida, idb]}``, a sub-contact ``{"subcontact": [ida, idb, k]}``.
+Other values are refused when saving, naming the variable.
 """
 from __future__ import annotations
 
@@ -45,9 +46,12 @@ def encode(v, what: str, depth: int = 0):
         return [encode(x, what, depth + 1) for x in v]
     if t is dict:
         return {"map": [[encode(k, what, depth + 1), encode(x, what, depth + 1)] for k, x in v.items()]}
+    from .contact_intrinsics import ContactPtr
     from .table_intrinsics import Table
     if t is Table:
         return {"table": v.id}
+    if t is ContactPtr:
+        return {v.kind: list(v.key)}
     raise FishStateError(f"{what}: a {type_name(v)} cannot be saved")
 
 
@@ -81,6 +85,10 @@ def decode(v, what: str, tables: dict, depth: int = 0):
                     raise ValueError(f"{what}: a map entry is not a [key, value] pair with a plain key")
                 out[kv[0]] = decode(kv[1], what, tables, depth + 1)
             return out
+        if tag in ("contact", "subcontact") and type(body) is list and len(body) == (2 if tag == "contact" else 3) \
+                and all(_int(x) for x in body):
+            from .contact_intrinsics import ContactPtr
+            return ContactPtr(tag, tuple(body))
         if tag == "table" and type(body) in (int, str):
             key = body.lower() if type(body) is str else body
             if key not in tables:
