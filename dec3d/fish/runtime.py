@@ -96,6 +96,7 @@ class FishRuntime:
         self.callbacks: list = []
         #: `fish history`: FISH name -> where the command was (errors of a sample point there)
         self.history_sites: dict = {}
+        self.in_callback = 0                 # > 0 while a callback runs (sections refuse cycling commands)
 
     @property
     def globals(self) -> dict:
@@ -174,7 +175,11 @@ class FishRuntime:
         site = self.history_sites.get(name)
         fn = self.functions.get(name)
         if fn is not None:
-            v = fn.invoke([], site)
+            self.in_callback += 1            # sampled while the cycle goes on, as a callback is
+            try:
+                v = fn.invoke([], site)
+            finally:
+                self.in_callback -= 1
         elif name in self.globals:
             v = self.globals[name]
         else:
@@ -196,7 +201,11 @@ class FishRuntime:
             fn = self.functions.get(name)
             if fn is None:
                 raise self.error_at(site, f"FISH callback `{name}` is not a FISH function any more")
-            fn.invoke([], site)
+            self.in_callback += 1
+            try:
+                fn.invoke([], site)
+            finally:
+                self.in_callback -= 1
 
 
 def not_supported(name: str) -> NotSupportedError:

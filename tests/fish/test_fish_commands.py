@@ -286,3 +286,15 @@ def test_system_directory_create_stays_in_the_output_folder(session, tmp_path):
         session.command("[r = system.directory.create('../elsewhere')]")
     assert "outside the output folder" in e.value.message
     assert not (tmp_path.parent / "elsewhere").exists()
+
+
+def test_a_callback_cannot_cycle_or_replace_the_model(session, tmp_path):
+    deck = _deck(tmp_path, "d.dat", BRICK + "fish define again\n  command\n    model cycle 5\n  endcommand\nend\n"
+                 "fish callback add again 0.0\nmodel cycle 3\n")
+    with pytest.raises(ExpressionError) as e:
+        session.call(deck)
+    assert "`model cycle` cannot run in a FISH callback" in e.value.message
+    assert (e.value.location.file, e.value.location.line) == (str(deck), 6)
+    assert session.model.step == 0 and session.fish_rt.in_callback == 0
+    session.command("fish callback remove again\nmodel cycle 3\n[n = mech.cycle]")   # outside callbacks it runs
+    assert session.variables["n"] == 3
