@@ -32,7 +32,13 @@ def _row(rt, z, name):
     if type(z) is not int:
         raise FishValueError(f"`{name}` takes a zone (its id from block.zone.list), not a {type_name(z)}")
     st = _zones(rt)
-    rows = np.nonzero(st["id"] == z)[0] if st is not None and st.n else ()
+    if st is not None and 0 < z <= st.n:
+        ids = st["id"]
+        if ids[z - 1] == z:                 # zones numbered 1..n in row order (the mesher's): no search
+            return rt.session.model, st, z - 1
+        rows = np.nonzero(ids == z)[0]
+    else:
+        rows = np.nonzero(st["id"] == z)[0] if st is not None and st.n else ()
     if len(rows) == 0:
         raise FishValueError(f"`{name}`: there is no zone with id {z}")
     return rt.session.model, st, int(rows[0])
