@@ -14,7 +14,7 @@ import re
 from functools import reduce
 
 from ..errors import BindError, CommandError, Dec3dError
-from ..fish import contact_intrinsics
+from ..fish import contact_intrinsics, intrinsics
 from ..lang.abbrev import matches
 from .registry import command
 from .values import FLAG, INT, NUMBERISH, ONOFF, InPath, Nums, P, Text, ValueType
@@ -122,7 +122,14 @@ def _current_contacts(model):
     return eng.contacts, eng.subcontacts
 
 
+def _engine(model):
+    from ..physics.rigid import engine
+
+    return engine(model)
+
+
 contact_intrinsics.CONTACTS[0] = _current_contacts
+intrinsics.ENGINE[0] = _engine
 
 
 # ------------------------------------------------------------------ fish history

@@ -255,3 +255,54 @@ def _sub_fs_mag(rt, s):
 def _sub_us_mag(rt, s):
     ss, k = _sub_row(rt, s, "block.subcontact.disp.shear.mag")
     return float(np.linalg.norm(ss["us"][k]))
+
+
+@intrinsic("block.contact.type", 1)
+def _c_type(rt, c):
+    """The contact's type code as the engine keeps it (dec3d.kernels.commonplane CT_*)."""
+    cs, r = _contact_row(rt, c, "block.contact.type")
+    return int(cs["type"][r])
+
+
+@intrinsic("block.contact.head")
+def _c_head(rt):
+    """The first contact (0 when there is none); walk on with block.contact.next."""
+    cs, _ = _stores(rt, current=True)
+    return _ptr(cs, 0) if cs is not None and cs.n else 0
+
+
+@intrinsic("block.contact.next", 1)
+def _c_next(rt, c):
+    cs, r = _contact_row(rt, c, "block.contact.next")
+    return _ptr(cs, r + 1) if r + 1 < cs.n else 0
+
+
+@intrinsic("block.subcontact.next", 1)
+def _sub_next(rt, s):
+    """The next sub-contact of the same contact, 0 after its last."""
+    _sub_row(rt, s, "block.subcontact.next")
+    cs = rt.session.model.stores["contacts"]
+    ida, idb, k = s.key
+    return ContactPtr("subcontact", (ida, idb, k + 1), s.hint) if k + 1 < int(cs["sub_count"][s.hint]) else 0
+
+
+def _per_area(ss, k, name):
+    a = float(ss["area"][k])
+    if not a > 0.0:
+        raise FishValueError(f"`{name}`: the sub-contact has no area (a point contact): use its force")
+    return a
+
+
+@intrinsic("block.subcontact.stress.norm", 1)
+def _sub_sn(rt, s):
+    """Normal stress [Pa]: normal force / area, compression positive as the force."""
+    ss, k = _sub_row(rt, s, "block.subcontact.stress.norm")
+    return float(ss["fn"][k]) / _per_area(ss, k, "block.subcontact.stress.norm")
+
+
+@intrinsic("block.subcontact.stress.shear", 1)
+def _sub_ss(rt, s):
+    """Shear stress vector [Pa]: shear force on block B / area."""
+    ss, k = _sub_row(rt, s, "block.subcontact.stress.shear")
+    a = _per_area(ss, k, "block.subcontact.stress.shear")
+    return _vec(ss["fs"][k] / a)

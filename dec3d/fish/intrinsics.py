@@ -452,6 +452,39 @@ def _mech_time_total(rt):
     return float(rt.session.model.time)
 
 
+#: ``ENGINE[0](model)`` -> the model's rigid engine (registered by dec3d.commands.fish_cmds; FISH imports
+#: no physics). mech.timestep and mech.solve read it.
+ENGINE: list = [None]
+
+
+def _engine(rt, name):
+    if ENGINE[0] is None:                     # pragma: no cover - the commands layer registers it at import
+        raise FishValueError(f"`{name}`: no cycling engine is attached")
+    return ENGINE[0](rt.session.model)
+
+
+@intrinsic("mech.timestep")
+def _mech_timestep(rt):
+    """The time step [s] of the last cycle (0 before the model has cycled)."""
+    return float(_engine(rt, "mech.timestep").dt)
+
+
+_SOLVE = ("ratio", "ratio-average", "ratio-local", "ratio-maximum", "unbalanced-maximum")
+
+
+@intrinsic("mech.solve", 1)
+def _mech_solve(rt, what):
+    """An equilibrium measure of the last step, as `model solve` uses it: 'ratio', 'ratio-average',
+    'ratio-local', 'ratio-maximum' or 'unbalanced-maximum' (abbreviations as for the command)."""
+    if type(what) is not str:
+        raise FishValueError(f"`mech.solve` takes the name of a measure (a string), not a {type_name(what)}")
+    key = what.lower()
+    hits = [k for k in _SOLVE if k == key] or [k for k in _SOLVE if k.startswith(key)]
+    if len(hits) != 1:
+        raise FishValueError(f"`mech.solve`: '{what}' is {'ambiguous' if hits else 'not'} one of {', '.join(_SOLVE)}")
+    return float(_engine(rt, "mech.solve").criteria()[hits[0]])
+
+
 @intrinsic("global.title")
 def _title(rt):
     return rt.session.model.settings.title

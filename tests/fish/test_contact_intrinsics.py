@@ -67,3 +67,20 @@ def test_contact_pointers_survive_a_save_file(session):
     session.command(SETUP + "[cl = block.contact.list]\n[c = cl(1)]\nmodel save 'k'\nmodel new\nmodel restore 'k'\n"
                     "[b = block.contact.b2(c)]")
     assert session.variables["b"] == 2 and repr(session.variables["c"]) == "contact(1,2)"
+
+
+def test_contact_walks_and_subcontact_stress(session):
+    session.command(SETUP + "model cycle 3000\n"
+                    "fish define walk\n  global nc = 0\n  global ns = 0\n  global smax = 0.0\n"
+                    "  local c = block.contact.head\n  loop while c # 0\n    nc = nc + 1\n"
+                    "    local sl = block.contact.subcontactlist(c)\n    local s = sl(1)\n    loop while s # 0\n"
+                    "      ns = ns + 1\n"
+                    "      smax = math.max(smax, block.subcontact.stress.norm(s))\n"
+                    "      s = block.subcontact.next(s)\n    endloop\n    c = block.contact.next(c)\n  endloop\n"
+                    "end\n@walk\n[t = block.contact.type(block.contact.head)]")
+    v = session.variables
+    cs = session.model.stores["contacts"]
+    ss = session.model.stores["subcontacts"]
+    assert v["nc"] == cs.n == 1 and v["ns"] == int(cs["sub_count"][0]) == ss.n
+    assert v["smax"] == pytest.approx(max(ss["fn"][k] / ss["area"][k] for k in range(ss.n)), rel=1e-12)
+    assert v["t"] == int(cs["type"][0])
