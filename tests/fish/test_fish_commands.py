@@ -298,3 +298,12 @@ def test_a_callback_cannot_cycle_or_replace_the_model(session, tmp_path):
     assert session.model.step == 0 and session.fish_rt.in_callback == 0
     session.command("fish callback remove again\nmodel cycle 3\n[n = mech.cycle]")   # outside callbacks it runs
     assert session.variables["n"] == 3
+
+
+def test_fish_history_and_callback_go_on_after_a_restore(session):
+    session.command(BRICK + "fish define count\n  global n = n + 1\nend\n[n = 0]\nfish callback add count 1.0\n"
+                    "history interval 2\nfish history n\nmodel cycle 4\nmodel save 'r'\nmodel new\nmodel restore 'r'\n"
+                    "model cycle 4")
+    h = session.model.history_set.find("n")
+    assert h.steps == [2, 4, 6, 8] and h.values == [2.0, 4.0, 6.0, 8.0]
+    assert session.variables["n"] == 8
