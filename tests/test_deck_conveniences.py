@@ -31,7 +31,7 @@ def test_history_name_label_sets_the_label_shown_in_the_csv(session, tmp_path):
 
 def test_history_rename_then_refer_by_the_new_name(session):
     hs = _two_histories(session)
-    session.command("history rename \"dz\" name \"2\"\nhistory name 'dz' label 'settlement'")
+    session.command("history rename \"2\" name \"dz\"\nhistory name 'dz' label 'settlement'")
     h = hs.find("dz")
     assert (h.id, h.name, h.label) == (2, "dz", "settlement")
     assert hs.find("2") is None
@@ -39,16 +39,16 @@ def test_history_rename_then_refer_by_the_new_name(session):
 
 def test_history_rename_and_label_survive_save_and_restore(session):
     _two_histories(session)
-    session.command("history rename 'dz' name 2\nhistory name 'dz' label 'sink'\nmodel save 'h'\n"
+    session.command("history rename 2 name 'dz'\nhistory name 'dz' label 'sink'\nmodel save 'h'\n"
                     "model new\nmodel restore 'h'")
     h = histories(session.model).find("dz")
     assert (h.id, h.label) == (2, "sink")
 
 
 @pytest.mark.parametrize("line, message", [
-    ("history rename 'x' name 9", r"there is no history 9"),
+    ("history rename 9 name 'x'", r"there is no history 9"),
     ("history name 'nope' label 'x'", r"there is no history nope"),
-    ("history rename '1' name 2", r"history 1 is named '1' already"),
+    ("history rename 2 name '1'", r"a history named '1' exists already"),
     ("history name 1", r"label"),
 ])
 def test_history_rename_and_label_errors(session, line, message):

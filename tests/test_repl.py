@@ -82,7 +82,8 @@ def test_completion_marks_what_does_not_run():
             for c in RegistryCompleter().get_completions(Document("block contact history force-normal "), None)}
     assert ckws["contact-id"] == "not supported yet" and ckws["position"] == ""
     fish = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document("fish "), None)}
-    assert fish["define"] == "FISH function definition" and fish["list"] == "" and fish["callback"] == "not supported yet"
+    assert fish["define"] == "FISH function definition" and fish["list"] == "" and fish["callback"] == ""
+    assert fish["debug"] == "not supported yet"
 
 
 def test_completion_of_words_and_keywords():

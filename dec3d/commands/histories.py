@@ -303,35 +303,6 @@ def _find(hs, key, call, slot):
     return h
 
 
-@command("history name", positional=[P("id", HistoryRefs(1), "the history, by number or name", required=True)],
-         keywords=[P("label", Text(), "the new label", required=True)],
-         doc="Give a history a label (what CSV headers and plots show beside its name).",
-         details="3DEC 7 writes it `history name '3' label 'C2_MiddleSail'`: `name` picks the history (a number "
-                 "or a name given when it was made), `label` replaces the description dec3d made for it.",
-         examples=["history name '3' label 'C2_MiddleSail'", "history name 1 label 'Unbalanced Force'"])
-def history_label(session, call):
-    h = _find(histories(session.model), call.args["id"], call, "id")
-    h.label = call.args["label"]
-
-
-@command("history rename", positional=[P("new", Text(), "the new name", required=True)],
-         keywords=[P("name", HistoryRefs(1), "the history to rename, by number or current name", required=True)],
-         doc="Rename a history: `history rename 'new' name 'old'`.",
-         details="As 3DEC 9 decks write it after `fish history @x`: `history rename \"x\" name \"1\"` gives "
-                 "history 1 the name x. Its number stays; a name another history has is refused.",
-         examples=["history rename \"norm_bedjoint_B\" name \"1\"", "history rename 'settle' name 2"])
-def history_rename(session, call):
-    hs = histories(session.model)
-    h = _find(hs, call.args["name"], call, "name")
-    new = call.args["new"]
-    other = hs.find(new)
-    if other is not None and other is not h:
-        raise CommandError(f"history {other.id} is named '{new}' already", call.locations.get("new", call.location))
-    if not str(new).strip():
-        raise CommandError("a history name cannot be empty", call.locations.get("new", call.location))
-    h.name = str(new)
-
-
 @command("history export",
          positional=[P("ids", HistoryRefs(), "history numbers or names", required=True)],
          keywords=[P("vs", HistoryRefs(1), "plot and tabulate against this history instead of time"),
@@ -361,3 +332,56 @@ def history_export(session, call):
 def _file_part(name: str) -> str:
     """A history name as part of a file name: path separators and control characters become '_'."""
     return "".join("_" if (ch in "/\\" or not ch.isprintable()) else ch for ch in str(name)) or "_"
+
+
+@command("history rename", positional=[P("old", HistoryRefs(1), "the history's number or name", required=True)],
+         keywords=[P("name", Text(), "its new name", required=True)],
+         doc="Give a history a new name (what `history export` and result figures use).",
+         details="The history is found by name, else by number; a name another history has is refused.",
+         examples=["history rename 'shearforce' name '5'", "history rename 1 name 'settle'"])
+def history_rename(session, call):
+    hs = histories(session.model)
+    h = _find(hs, call.args["old"], call, "old")
+    new = str(call.args["name"])
+    if not new.strip():
+        raise CommandError("a history name cannot be empty", call.locations.get("name", call.location))
+    other = hs.find(new)
+    if other is not None and other is not h:
+        raise CommandError(f"a history named '{new}' exists already", call.locations.get("name", call.location))
+    h.name = new
+
+
+@command("history list", doc="Print every history: number, name, what it records and its number of samples.",
+         examples=["history list"])
+def history_list(session, call):
+    hs = histories(session.model)
+    if not hs.items:
+        session.write("no histories")
+    for h in hs.items:
+        last = f", last {h.values[-1]:.6g} at step {h.steps[-1]}" if h.values else ""
+        session.write(f"{h.id:4d}  '{h.name}'  {h.label}  ({len(h.values)} samples{last})")
+
+
+@command("history name", positional=[P("history", HistoryRefs(1), "the history's name or number", required=True)],
+         keywords=[P("label", Text(), "its new label (the CSV header and plot title)", required=True)],
+         doc="Set the label of a history (what `history export` writes as its column header and plot title).",
+         details="The history is found by name, else by number (a history's name is its number unless it was "
+                 "given one).",
+         examples=["history name '1' label 'Unbalanced Force'", "history name 3 label 'C2_MiddleSail'"])
+def history_name(session, call):
+    h = _find(histories(session.model), call.args["history"], call, "history")
+    h.label = str(call.args["label"])
+
+
+@command("history delete", positional=[P("ids", HistoryRefs(), "history numbers or names; omitted: every history")],
+         doc="Delete histories (all of them when none is named) with their samples.",
+         details="Histories made afterwards are numbered on from the last one left (from 1 when none is left).",
+         examples=["history delete", "history delete 2 'settle'"])
+def history_delete(session, call):
+    hs = histories(session.model)
+    ids = call.args["ids"]
+    if not ids:
+        hs.items.clear()
+        return
+    gone = {id(_find(hs, key, call, "ids")) for key in ids}
+    hs.items[:] = [h for h in hs.items if id(h) not in gone]

@@ -7,6 +7,7 @@ keeps the step and the total time of each sample beside the value.
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -39,6 +40,8 @@ GRIDPOINT_QUANTITIES = {q: ({"centroid": "pos"}.get(fld, fld), comp) for q, (fld
                         if fld in ("disp", "velocity", "centroid")}
 #: zone quantity -> column of ``zones.stress``; ``block zone history``
 ZONE_QUANTITIES = {f"stress-{c}": i for i, c in enumerate(("xx", "yy", "zz", "xy", "xz", "yz"))}
+#: a FISH name a `fish history` records (``HistorySet.add_fish``)
+FISH_NAME = re.compile(r"[a-z_][a-z0-9_]{0,127}")
 MODEL_QUANTITIES = ("unbalanced-maximum", "ratio", "ratio-average", "ratio-local", "ratio-maximum", "time-total",
                     "kinetic-energy")
 
@@ -70,8 +73,13 @@ class HistorySet:
     def __call__(self, eng) -> None:
         """Step hook: sample every history when the step count is a multiple of the interval."""
         if self.items and eng.step % self.interval == 0:
-            for h in self.items:
-                h.sample(eng)
+            # every value first: one that fails (a FISH history's function) leaves no history a sample ahead
+            values = [float(h.value(eng)) for h in self.items]
+            step, time = int(eng.step), float(eng.time)
+            for h, v in zip(self.items, values):
+                h.steps.append(step)
+                h.times.append(time)
+                h.values.append(v)
 
     def add(self, label: str, value: Callable, name: str | None = None, spec: dict | None = None) -> History:
         hid = (self.items[-1].id + 1) if self.items else 1
@@ -203,6 +211,8 @@ class HistorySet:
             if not isinstance(zid, int) or isinstance(zid, bool) or zid < 1:
                 raise ValueError(f"history {hid}: zone id {zid!r} is not a whole number ≥ 1")
             h = self.add_zone(q, zid, name)
+        elif kind == "fish" and isinstance(q, str) and FISH_NAME.fullmatch(q):
+            h = self.add_fish(q, name)
         else:
             raise ValueError(f"history {hid}: unknown kind {kind!r} or quantity {q!r}")
         self.items.pop()
@@ -440,6 +450,21 @@ class HistorySet:
             attr = {"time-total": "time", "kinetic-energy": "kinetic"}[quantity]
             value = lambda eng: float(getattr(eng, attr))          # noqa: E731
         return self.add(f"mechanical {quantity}", value, name, {"kind": "model", "quantity": quantity})
+
+
+    def add_fish(self, var: str, name: str | None = None) -> History:
+        """`fish history`: the value of a FISH global variable, or of a FISH function called at each
+        sample. The FISH run time reaches the model as ``model.fish_probe(var)`` (set by the session's
+        FISH commands; physics knows nothing of FISH)."""
+        model = self.model
+
+        def value(eng) -> float:
+            probe = getattr(model, "fish_probe", None)
+            if probe is None:
+                raise ValueError(f"FISH history `{var}`: no FISH run time is attached to the model")
+            return probe(var)
+
+        return self.add(f"fish {var}", value, name, {"kind": "fish", "quantity": var})
 
 
 def _contact_view(model, eng):
