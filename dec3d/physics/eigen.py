@@ -156,7 +156,7 @@ def eigenmodes(model, nmodes: int) -> Modes:
         raise EigenError(f"{nmodes} modes asked for, but the free blocks have only {nf} degrees of freedom")
     Kf = K[idx][:, idx]
     Mf = M[idx][:, idx]
-    if nf <= DENSE_LIMIT:
+    if nf <= DENSE_LIMIT or nmodes >= nf - 1:      # eigsh needs k < n - 1
         w2, vec = linalg.eigh(Kf.toarray(), Mf.toarray(), subset_by_index=[0, nmodes - 1])
     else:
         scale = float(np.mean(Kf.diagonal() / Mf.diagonal()))

@@ -205,3 +205,19 @@ def test_public_eigen_deck_runs_to_the_end(tmp_path):
     ref = np.sqrt(np.clip(linalg.eigh(K, M, eigvals_only=True), 0, None)) / (2 * math.pi)
     assert got == pytest.approx(ref[:8], rel=1e-9)
     assert (tmp_path / "out" / "eigen_modes.vtu").is_file() and (tmp_path / "out" / "sqpmodes.sav").is_file()
+
+
+def test_sparse_shift_invert_path_agrees_with_the_dense_one(tmp_path, monkeypatch):
+    from dec3d.physics import eigen
+
+    (tmp_path / "d").mkdir()
+    (tmp_path / "s").mkdir()
+    dense = _session(tmp_path / "d")
+    _base_and_block(dense, 1.0, 0.5, more="block create brick -0.5 0.5 -0.5 0.5 0.5 1\n")
+    dense.command("block dynamic eigen modes 5")
+    monkeypatch.setattr(eigen, "DENSE_LIMIT", 0)
+    sparse = _session(tmp_path / "s")
+    _base_and_block(sparse, 1.0, 0.5, more="block create brick -0.5 0.5 -0.5 0.5 0.5 1\n")
+    sparse.command("block dynamic eigen modes 5")
+    got = [sparse.results[f"eigen.f{i}"] for i in range(1, 6)]
+    assert got == pytest.approx([dense.results[f"eigen.f{i}"] for i in range(1, 6)], rel=1e-8)
