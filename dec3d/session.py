@@ -202,8 +202,30 @@ class Session:
             raise CommandError(f"cannot read deck `{shown}`: {paths.os_error_text(exc)}", where) from None
         if raw.startswith(b"\xef\xbb\xbf"):
             raw = raw[3:]                   # a UTF-8 byte-order mark
+        if path.suffix.lower() == ".dec":
+            return self._load_dec(raw, path, shown, where, stack)
         text = raw.decode("utf-8", errors="replace")
         return self.load_text(text, str(path), path.parent, stack)
+
+    def _load_dec(self, raw: bytes, path: Path, shown: str, where, stack) -> list:
+        """A `.dec` file: read as a deck when it holds 3DEC commands; 3DEC's legacy binary/tabular
+        block-geometry format (not documented) is refused by name."""
+        from .errors import NotSupportedError
+
+        why = ("3DEC's legacy .dec block-geometry files are not supported (their format is not documented); "
+               "a .dec file that holds 3DEC commands is read as a deck")
+        if b"\x00" in raw[:4096]:
+            raise NotSupportedError(f"`{shown}` is a binary file, not a deck: {why}", where)
+        try:
+            return self.load_text(raw.decode("utf-8", errors="replace"), str(path), path.parent, stack)
+        except NotSupportedError:
+            raise
+        except Dec3dError as exc:
+            loc = exc.location
+            if loc is not None and loc.file == str(path):
+                raise NotSupportedError(f"`{shown}` is not a deck of commands (line {loc.line}: {exc.message}): "
+                                        f"{why}", where) from None
+            raise
 
     def _bind_deck(self, deck: ParsedDeck, base_dir: Path, stack) -> list[Item]:
         binder = Binder(deck, self.bind_context, stack)

@@ -204,3 +204,34 @@ def test_block_id_history_follows_that_block(session):
                     "block property density 100\nblock history velocity-x block-id 2\nblock initialize velocity-x 0.5 range id 2\n"
                     "history interval 1\nmodel cycle 3")
     assert histories(session.model).find(1).values == [0.5, 0.5, 0.5]
+
+
+# ----------------------------------------------------------------------------- legacy .dec files
+def _call_dec(tmp_path, content: bytes):
+    import io
+
+    from dec3d.session import Session
+
+    (tmp_path / "Groningen.dec").write_bytes(content)
+    (tmp_path / "main.dat").write_text("model new\ncall 'Groningen.dec'\nblock create brick 5 6\n", encoding="utf-8")
+    s = Session(out_dir=tmp_path, stdout=io.StringIO())
+    s.run_items(s.load_file(tmp_path / "main.dat"))
+    return s
+
+
+def test_a_dec_file_of_commands_is_read_as_a_deck(tmp_path):
+    s = _call_dec(tmp_path, b"; geometry\nblock create brick 0 1 0 1 0 1 group 'S'\n")
+    assert s.model.blocks.n == 2
+
+
+@pytest.mark.parametrize("content, message", [
+    (b"\x00\x01DEC\x00" + bytes(range(256)), r"`.*Groningen\.dec` is a binary file, not a deck: 3DEC's legacy \.dec"),
+    (b"POLY 1 1 1\n  0.0 0.0 0.0  1.0 0.0 0.0\n", r"`.*Groningen\.dec` is not a deck of commands \(line 1: .*\): "
+                                                  r"3DEC's legacy \.dec block-geometry files are not supported"),
+])
+def test_legacy_dec_geometry_is_refused_by_name(tmp_path, content, message):
+    from dec3d.errors import NotSupportedError
+
+    with pytest.raises(NotSupportedError, match=message) as ei:
+        _call_dec(tmp_path, content)
+    assert ei.value.location.line == 2        # the `call` line of the calling deck
