@@ -120,7 +120,9 @@ def create_tunnel(session, call):
 @command("block generate from-vrml",
          keywords=[P("filename", InPath(exts=(".wrl",)), "the VRML 2.0 file: beside the calling deck, else in the "
                      "output folder (.wrl tried when there is no extension)", required=True),
-                   P("group", Text(), "group of the new blocks"), P("slot", Text(), "group slot (default 'Default')")],
+                   P("group", Text(), "group of the new blocks"), P("slot", Text(), "group slot (default 'Default')"),
+                   P("tolerance", Num(lo=0, lo_open=True), "planarity and convexity tolerance for this file "
+                     "(dec3d; default the model tolerance, `block tolerance`)", units="m")],
          doc="Create one convex block per IndexedFaceSet of a VRML 2.0 (.wrl) file.",
          details="The file's node tree is read with DEF/USE; Transform nodes (translation, rotation, scale, "
                  "scaleOrientation, center) place their children; Group, Anchor, Collision and Switch hold "
@@ -128,9 +130,12 @@ def create_tunnel(session, call):
                  "split into triangles are merged back where neighbours lie in one plane (within the model "
                  "tolerance). Every shape must be closed and convex: a refused shape is named by its number and "
                  "the file's line, and no block of the file is added. Other geometry nodes (Box, Sphere, ...), "
-                 "PROTO and Inline are refused by name.",
+                 "PROTO and Inline are refused by name. CAD exports of curved masonry may fold a brick's faces by "
+                 "a fraction of a millimetre (the scaffree dome bricks: 0.7 mm on 0.1 m, a concave fold): "
+                 "`tolerance 0.001` reads each folded face as one face, its corners within 1 mm of its plane.",
          examples=["block generate from-vrml filename 'dome_herringbone_5_1_65_8_1_1_0_0.wrl'",
-                   "block generate from-vrml filename 'course_1' group 'C1'"])
+                   "block generate from-vrml filename 'course_1' group 'C1'",
+                   "block generate from-vrml filename 'dome.wrl' tolerance 0.001"])
 def generate_from_vrml(session, call):
     from ..io.vrml import VrmlError, vrml_polys
     from ..errors import CommandError
@@ -144,8 +149,13 @@ def generate_from_vrml(session, call):
     except OSError as exc:
         raise CommandError(f"cannot read VRML file '{name}': {os_error_text(exc)}").with_location(where) from None
     text = raw.decode("utf-8", errors="replace")
+    tol = call.args["tolerance"] if call.args.get("tolerance") is not None else session.model.tolerance
     try:
-        polys = vrml_polys(text, path.name, session.model.tolerance)
+        polys = vrml_polys(text, path.name, float(tol))
     except VrmlError as exc:
+        if "not convex" in exc.message or "not planar" in exc.message:
+            exc.hint = exc.hint or (f"faces are counted after merging coplanar triangles; a shape folded by less "
+                                    f"than a millimetre (a CAD export of curved masonry) reads with a larger "
+                                    f"`tolerance`, e.g. `block generate from-vrml filename '{name}' tolerance 0.001`")
         raise exc.with_location(where) from None
     _add(session, call, polys)

@@ -158,3 +158,19 @@ def test_read_vrml_shapes_keeps_file_order_and_lines():
     assert [s.line for s in shapes] == lines
     assert [len(s.faces) for s in shapes] == [12, 6]
     assert math.isclose(float(np.sum([f.shape[0] for f in shapes[1].faces])), 24.0)
+
+
+def test_a_concave_fold_below_the_tolerance_reads_with_a_larger_tolerance(tmp_path):
+    # a unit cube whose bottom corner (1, 0, 0) is pulled 0.5 mm out of the block: the bottom's two triangles
+    # meet in a concave fold along the diagonal 0-2 (as CAD exports of curved bricks do)
+    pts = CUBE_PTS.replace("1 0 0,", "1 0 -0.0005,", 1)
+    text = wrl(shape(pts, CUBE_TRI))
+    with pytest.raises(Dec3dError, match=r"fold\.wrl:\d+: shape 1: not convex") as ei:
+        run(tmp_path, {"fold.wrl": text}, "block generate from-vrml filename 'fold.wrl'\n")
+    assert "tolerance 0.001" in ei.value.hint
+    s = run(tmp_path, {"fold.wrl": text}, "block generate from-vrml filename 'fold.wrl' tolerance 0.001\n")
+    b = s.model.blocks
+    assert b["face_count"][0] == 6
+    # the cube and the sliver under the folded bottom: 0.0005/6 m³ as the file's triangles have it, 0.0005/4
+    # as dec3d's mass properties take the merged (non-planar) face, through its centroid
+    assert b["volume"][0] == pytest.approx(1.0 + 0.0005 / 4, rel=1e-12)
