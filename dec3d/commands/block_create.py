@@ -122,7 +122,7 @@ def create_tunnel(session, call):
                      "output folder (.wrl tried when there is no extension)", required=True),
                    P("group", Text(), "group of the new blocks"), P("slot", Text(), "group slot (default 'Default')"),
                    P("tolerance", Num(lo=0, lo_open=True), "planarity and convexity tolerance for this file "
-                     "(dec3d; default the model tolerance, `block tolerance`)", units="m")],
+                     "(dec3d; default 0.5 % of each shape's size, at least `block tolerance`)", units="m")],
          doc="Create one convex block per IndexedFaceSet of a VRML 2.0 (.wrl) file.",
          details="The file's node tree is read with DEF/USE; Transform nodes (translation, rotation, scale, "
                  "scaleOrientation, center) place their children; Group, Anchor, Collision and Switch hold "
@@ -130,12 +130,14 @@ def create_tunnel(session, call):
                  "split into triangles are merged back where neighbours lie in one plane (within the model "
                  "tolerance). Every shape must be closed and convex: a refused shape is named by its number and "
                  "the file's line, and no block of the file is added. Other geometry nodes (Box, Sphere, ...), "
-                 "PROTO and Inline are refused by name. CAD exports of curved masonry may fold a brick's faces by "
-                 "a fraction of a millimetre (the scaffree dome bricks: 0.7 mm on 0.1 m, a concave fold): "
-                 "`tolerance 0.001` reads each folded face as one face, its corners within 1 mm of its plane.",
+                 "PROTO and Inline are refused by name. CAD exports of curved masonry fold a brick's faces by a "
+                 "fraction of a millimetre (the public scaffree dome bricks: 0.7 mm, a concave fold), so each "
+                 "shape is checked with a tolerance of 0.5 % of its size (its bounding-box diagonal; at least the "
+                 "model tolerance): a face folded by less is read as one face, its corners within that distance "
+                 "of its plane. `tolerance <f>` gives the tolerance in metres instead (`tolerance 1e-6`: strict).",
          examples=["block generate from-vrml filename 'dome_herringbone_5_1_65_8_1_1_0_0.wrl'",
                    "block generate from-vrml filename 'course_1' group 'C1'",
-                   "block generate from-vrml filename 'dome.wrl' tolerance 0.001"])
+                   "block generate from-vrml filename 'dome.wrl' tolerance 1e-6"])
 def generate_from_vrml(session, call):
     from ..io.vrml import VrmlError, vrml_polys
     from ..errors import CommandError
@@ -149,13 +151,18 @@ def generate_from_vrml(session, call):
     except OSError as exc:
         raise CommandError(f"cannot read VRML file '{name}': {os_error_text(exc)}").with_location(where) from None
     text = raw.decode("utf-8", errors="replace")
-    tol = call.args["tolerance"] if call.args.get("tolerance") is not None else session.model.tolerance
+    from ..io.vrml import RELATIVE_TOLERANCE
+
+    given = call.args.get("tolerance")
     try:
-        polys = vrml_polys(text, path.name, float(tol))
+        if given is not None:
+            polys = vrml_polys(text, path.name, float(given))
+        else:
+            polys = vrml_polys(text, path.name, session.model.tolerance, RELATIVE_TOLERANCE)
     except VrmlError as exc:
         if "not convex" in exc.message or "not planar" in exc.message:
             exc.hint = exc.hint or (f"faces are counted after merging coplanar triangles; a shape folded by less "
                                     f"than a millimetre (a CAD export of curved masonry) reads with a larger "
-                                    f"`tolerance`, e.g. `block generate from-vrml filename '{name}' tolerance 0.001`")
+                                    f"`tolerance`, e.g. `block generate from-vrml filename '{name}' tolerance 0.002`")
         raise exc.with_location(where) from None
     _add(session, call, polys)

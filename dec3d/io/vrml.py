@@ -460,16 +460,28 @@ def shape_to_poly(shape: VrmlShape, tol: float, what: str) -> Poly:
     return polyhedron_from_faces(faces, tol, what)
 
 
-def vrml_polys(text: str, fname: str, tol: float) -> list[Poly]:
-    """Every IndexedFaceSet of the file as a checked convex polyhedron. Errors name the shape and line."""
+#: default planarity/convexity tolerance of a VRML shape, relative to its size (bounding-box diagonal):
+#: CAD exports of curved masonry fold brick faces by a fraction of a millimetre (dec3d's choice: 0.5 %)
+RELATIVE_TOLERANCE = 0.005
+
+
+def vrml_polys(text: str, fname: str, tol: float, relative: float = 0.0) -> list[Poly]:
+    """Every IndexedFaceSet of the file as a checked convex polyhedron. Errors name the shape and line.
+
+    Each shape is checked with the tolerance max(tol, relative × its bounding-box diagonal)."""
     shapes = read_vrml_shapes(text, fname)
     if not shapes:
         raise VrmlError(f"{fname}: the file holds no IndexedFaceSet: no block to make")
     polys = []
     for k, s in enumerate(shapes, start=1):
         what = f"{fname}:{s.line}: shape {k}"
+        t = tol
+        if relative > 0:
+            pts = np.concatenate(s.faces)
+            if np.all(np.isfinite(pts)):
+                t = max(tol, relative * float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))))
         try:
-            polys.append(shape_to_poly(s, tol, what))
+            polys.append(shape_to_poly(s, t, what))
         except GeometryError as exc:
             raise VrmlError(str(exc.args[0]) if exc.args else str(exc)) from None
     return polys

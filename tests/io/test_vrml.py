@@ -160,17 +160,27 @@ def test_read_vrml_shapes_keeps_file_order_and_lines():
     assert math.isclose(float(np.sum([f.shape[0] for f in shapes[1].faces])), 24.0)
 
 
-def test_a_concave_fold_below_the_tolerance_reads_with_a_larger_tolerance(tmp_path):
+def test_a_concave_fold_below_half_a_percent_is_read_as_one_face(tmp_path):
     # a unit cube whose bottom corner (1, 0, 0) is pulled 0.5 mm out of the block: the bottom's two triangles
     # meet in a concave fold along the diagonal 0-2 (as CAD exports of curved bricks do)
     pts = CUBE_PTS.replace("1 0 0,", "1 0 -0.0005,", 1)
     text = wrl(shape(pts, CUBE_TRI))
-    with pytest.raises(Dec3dError, match=r"fold\.wrl:\d+: shape 1: not convex") as ei:
-        run(tmp_path, {"fold.wrl": text}, "block generate from-vrml filename 'fold.wrl'\n")
-    assert "tolerance 0.001" in ei.value.hint
-    s = run(tmp_path, {"fold.wrl": text}, "block generate from-vrml filename 'fold.wrl' tolerance 0.001\n")
+    s = run(tmp_path, {"fold.wrl": text}, "block generate from-vrml filename 'fold.wrl'\n")
     b = s.model.blocks
     assert b["face_count"][0] == 6
     # the cube and the sliver under the folded bottom: 0.0005/6 m³ as the file's triangles have it, 0.0005/4
     # as dec3d's mass properties take the merged (non-planar) face, through its centroid
     assert b["volume"][0] == pytest.approx(1.0 + 0.0005 / 4, rel=1e-12)
+    # a strict tolerance refuses the fold, and the hint says how to read it
+    with pytest.raises(Dec3dError, match=r"fold\.wrl:\d+: shape 1: not convex") as ei:
+        run(tmp_path, {"fold.wrl": text}, "block generate from-vrml filename 'fold.wrl' tolerance 1e-6\n")
+    assert "tolerance 0.002" in ei.value.hint
+
+
+def test_the_relative_tolerance_still_refuses_a_clear_dent():
+    # corner (1, 0, 0) pulled 5 cm out: 2.9 % of the cube's diagonal, above the 0.5 % default
+    from dec3d.io.vrml import RELATIVE_TOLERANCE
+
+    text = wrl(shape(CUBE_PTS.replace("1 0 0,", "1 0 -0.05,", 1), CUBE_TRI))
+    with pytest.raises(VrmlError, match=r"shape 1: not convex"):
+        vrml_polys(text, "dent.wrl", 1e-6, RELATIVE_TOLERANCE)
