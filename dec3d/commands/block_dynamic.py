@@ -23,7 +23,8 @@ MODES_FILE = OutPath(suffix=".vtu")
                  "body's mass and full inertia tensor, and fixed velocity components are removed "
                  "(dec3d.physics.eigen). The generalised problem K φ = ω² M φ is solved with scipy (dense for up "
                  "to 600 free degrees of freedom, else sparse shift-invert). The frequencies f = ω/2π [Hz] and "
-                 "periods are listed and go into the results as `eigen.f<i>`; the VTK file holds the blocks "
+                 "periods are listed and go into the results as `eigen.f<i>` and `<file stem>.f<i>`; the VTK "
+                 "file holds the blocks "
                  "with point arrays `mode_<i>` (vertex displacement u + θ × r, largest 1) and field arrays "
                  "`frequency` and `omega2`. The model is not changed. Zoned blocks are refused.",
          examples=["block dynamic eigen modes 8", "block dynamic eigen modes 3 file 'arch_modes.vtu'"])
@@ -41,6 +42,7 @@ def eigen_modes(session, call):
         period = f"{1.0 / f:14.6g}" if f > 0 else "           inf"
         session.write(f"  {i:4d}  {f:14.6g}  {period}")
         session.results[f"eigen.f{i}"] = float(f)
+        session.results[f"{path.stem}.f{i}"] = float(f)
     shapes = {f"mode_{i + 1}": vertex_mode_displacement(session.model, modes, i) for i in range(n)}
     write_vtu(session.model, path, point_data=shapes,
               field_data={"frequency": modes.frequencies, "omega2": modes.omega2})
