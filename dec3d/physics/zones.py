@@ -78,10 +78,11 @@ class ZoneStepper:
         p = zs["prop"]
         miss = (p[el, ZP_BULK] <= 0) | (p[el, ZP_SHEAR] <= 0) | (p[el, ZP_DENSITY] <= 0)
         if miss.any():
-            what = [n for n, c in (("bulk", ZP_BULK), ("shear", ZP_SHEAR), ("density", ZP_DENSITY))
-                    if (p[el[miss], c] <= 0).any()]
-            raise error(f"{int(miss.sum())} elastic zones of blocks {_ids(model, zs['block'][el[miss]])} have no "
-                        f"{'/'.join(what)}: set them with `block zone property` before cycling")
+            what = "; ".join(f"{name} in blocks {_ids(model, zs['block'][el[p[el, c] <= 0]])}"
+                             for name, c in (("bulk", ZP_BULK), ("shear", ZP_SHEAR), ("density", ZP_DENSITY))
+                             if (p[el, c] <= 0).any())
+            raise error(f"{int(miss.sum())} elastic zones lack properties ({what}): set them with "
+                        "`block zone property` before cycling")
         nn = zs["nnode"][el]
         self.rows4 = np.ascontiguousarray(el[nn == 4])
         self.rows10 = np.ascontiguousarray(el[nn == 10])
