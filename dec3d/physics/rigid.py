@@ -21,8 +21,10 @@ from dec3d.errors import Dec3dError
 from dec3d.io.vtk import periodic_vtk
 from dec3d.kernels.balance import body_balance
 from dec3d.kernels.cycle import run_steps
+from dec3d.kernels.gpcontact import mixed_move_points, mixed_subcontact_forces, surface_weights
 from dec3d.kernels.jointlaw import P_KN, P_KS
-from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST, block_timestep
+from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST, block_timestep,
+                                  rigid_motion_groups)
 from dec3d.model.model import KIND_DEFORMABLE
 from dec3d.model.store import Store
 from dec3d.model.zones import has_zones
@@ -535,21 +537,48 @@ class RigidEngine(ContactDetection):
         return done
 
     # ------------------------------------------------------------ models with zoned blocks
-    def _zone_contacts_check(self) -> None:
-        """Contacts touching a zoned block are not wired to gridpoints yet: refuse them, except
-        between blocks of one joined set (linked gridpoints make those inert)."""
+    def _zone_contacts_check(self) -> bool:
+        """Contacts between two zoned blocks are not wired yet (issue "deformable blocks II"):
+        refuse them, except between blocks of one joined set (linked gridpoints make those
+        inert). Returns whether some contact joins a zoned block and a rigid one."""
         b, cs = self.model.blocks, self.contacts
         if not cs.n:
-            return
+            return False
         za = b["kind"][cs["a"]] == KIND_DEFORMABLE
         zb = b["kind"][cs["b"]] == KIND_DEFORMABLE
         lead = np.where(b["leader"] < 0, np.arange(b.n), b["leader"])
-        bad = (za | zb) & ~(za & zb & (lead[cs["a"]] == lead[cs["b"]]))
+        bad = za & zb & (lead[cs["a"]] != lead[cs["b"]])
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
-            raise RunError(f"{int(bad.sum())} contacts touch a zoned (deformable) block (the first between blocks "
-                           f"{int(cs['ida'][k])} and {int(cs['idb'][k])}): contacts of zoned blocks with other "
-                           "blocks do not cycle yet (issue 10, mixed models); nothing was cycled")
+            raise RunError(f"{int(bad.sum())} contacts join two zoned (deformable) blocks that are not joined (the "
+                           f"first between blocks {int(cs['ida'][k])} and {int(cs['idb'][k])}): contacts between "
+                           "deformable blocks do not cycle yet (issue 10, next part); nothing was cycled")
+        return bool((za ^ zb).any())
+
+    def _mixed_weights(self, zst) -> tuple:
+        """Gridpoint rows and interpolation weights of every sub-contact and contact point on a
+        zoned side (``gpcontact.surface_weights``), and the contact stiffness they give the
+        gridpoints (the joint term of Eq. 85: max(kn, ks) · area, shared by the weights)."""
+        m = self.model
+        b, f, v = m.blocks, m.faces, m.vertices
+        cs, ss = self.contacts, self.subcontacts
+        zoned = b["kind"] == KIND_DEFORMABLE
+        geo = (zoned, v["pos"], b["face_start"], b["face_count"], f["vstart"], f["nvert"],
+               m.face_vertices["vertex"])
+        out = []
+        for owner, pts in ((ss["contact"], ss["pos"]), (np.arange(cs.n, dtype=_I), cs["pos"])):
+            k = len(owner)
+            na, wa, nb, wb = np.empty((k, 3), _I), np.empty((k, 3)), np.empty((k, 3), _I), np.empty((k, 3))
+            surface_weights(np.ascontiguousarray(owner), pts, cs["a"], cs["b"], *geo, na, wa, nb, wb)
+            out.append((na, wa, nb, wb))
+        na, wa, nb, wb = out[0]
+        c = ss["contact"]
+        kk = np.maximum(cs["prop"][c, P_KN], cs["prop"][c, P_KS]) * ss["area"]
+        rows = np.concatenate((na.ravel(), nb.ravel()))
+        kw = np.concatenate(((wa * kk[:, None]).ravel(), (wb * kk[:, None]).ravel()))
+        on = rows >= 0
+        zst.set_contact_stiffness(rows[on], kw[on])
+        return out[0], out[1]
 
     def _cycle_zoned(self, nsteps: int, stop, max_time, warn=None) -> int:
         """``_cycle`` for a model with zoned blocks: per batch, the rigid bodies (if any) by
@@ -591,7 +620,9 @@ class RigidEngine(ContactDetection):
         progress = _Progress(nsteps, self)
         if self._signature != self._geometry_signature():
             self.detect()
-        self._zone_contacts_check()
+        mixed = self._zone_contacts_check()
+        if mixed:
+            wsub, wcon = self._mixed_weights(zst)
         if warn is not None:
             msg = self.stiffness_warning()
             if msg:
@@ -621,11 +652,14 @@ class RigidEngine(ContactDetection):
                 # with no rigid body and small strain nothing moves that could make a contact
                 if (m.step % interval == 0 or due) and (ng or large):
                     self.detect()
-                    self._zone_contacts_check()
+                    mixed = self._zone_contacts_check()
                     acc[:] = 0.0
                     due = False
                     if scaled and ng:
                         _, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt)
+                    if mixed:
+                        wsub, wcon = self._mixed_weights(zst)
+                        zst.set_masses(dt, scaled)
                     if loaded:
                         from dec3d.model.face_loads import recompute_fface
                         recompute_fface(m)
@@ -645,7 +679,12 @@ class RigidEngine(ContactDetection):
                 t0 = _time.perf_counter()
                 bad = -1
                 n_ok = k
-                if ng:
+                if mixed:
+                    n_ok = 0
+                    self._mixed_steps(k, zst, wsub, wcon, dt, g, mode, alpha, servo, full, gstart, gmember, gmass,
+                                      gimass, gisc, gprin, gaxes, gcen, fixity, large, vmax, out)
+                    n_ok = k
+                elif ng:
                     cs, ss = self.contacts, self.subcontacts
                     n_ok, bad = run_steps(k, dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass, gisc,
                                           gprin, gaxes, gcen, b["mass"], fixity, b["force"], b["moment"], b["fapp"],
@@ -657,10 +696,13 @@ class RigidEngine(ContactDetection):
                                           trigger, motion)
                     if bad >= 0:
                         raise self._blowup(bad, dt, motion[1] == 2.0)
-                for _ in range(n_ok):
+                for _ in range(0 if mixed else n_ok):
                     zbad = zst.step(dt, g, mode, alpha, large, vmax)
                     if zbad >= 0:
                         raise zst.unstable(zbad, dt)
+                zb = zst.blocks
+                b["force"][zb] = 0.0            # contact forces on zoned blocks went to their gridpoints
+                b["moment"][zb] = 0.0
                 self.timings["cycle"] += _time.perf_counter() - t0
                 due = motion[1] > 0.0
                 m.step += n_ok
@@ -692,6 +734,45 @@ class RigidEngine(ContactDetection):
             if mode == DAMP_ADAPTIVE:
                 s["servo"] = [float(x) for x in servo[:NSERVO]]
         return done
+
+    def _mixed_steps(self, k, zst, wsub, wcon, dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass,
+                     gisc, gprin, gaxes, gcen, fixity, large, vmax, out) -> None:
+        """``k`` steps of a model where zoned and rigid blocks touch (3DEC theory, "Deformable
+        blocks": a sub-contact on a deformable block moves with the gridpoints of the surface it
+        lies on, its force goes to them by the interpolation factors): sub-contact forces
+        (``gpcontact.mixed_subcontact_forces``), rigid motion, the zone step with the contact
+        forces on the gridpoints, then the contact points move (``mixed_move_points``)."""
+        m = self.model
+        b, v = m.blocks, m.vertices
+        cs, ss = self.contacts, self.subcontacts
+        gvel = v["velocity"]
+        gc = np.zeros((v.n, 3))
+        touched = np.unique(np.concatenate((wsub[0].ravel(), wsub[2].ravel())))
+        touched = touched[touched >= 0]
+        cown = np.arange(cs.n, dtype=_I)
+        for _ in range(k):
+            facc = zst.begin()
+            gc[touched] = 0.0
+            mixed_subcontact_forces(dt, b["centroid"], b["velocity"], b["spin"], b["force"], b["moment"], gvel, gc,
+                                    cs["a"], cs["b"], cs["normal"], cs["jmodel"], cs["prop"], ss["contact"], ss["pos"],
+                                    ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"],
+                                    *wsub)
+            facc[touched] += gc[touched]
+            zst.fmag[touched] += np.linalg.norm(gc[touched], axis=1)
+            if len(gmember):
+                gbad = rigid_motion_groups(dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass, gisc,
+                                           gprin, gaxes, gcen, b["mass"], fixity, b["force"], b["moment"], b["fapp"],
+                                           b["mapp"], b["velocity"], b["spin"], b["centroid"], b["disp"],
+                                           b["vert_start"], b["vert_count"], v["pos"], vmax, out)
+                if gbad >= 0 or not math.isfinite(out[0]):
+                    raise self._blowup(int(gmember[gstart[gbad]]) if gbad >= 0 else int(gmember[0]), dt, False)
+            zbad = zst.step(dt, g, mode, alpha, large, vmax, begun=True)
+            if zbad >= 0:
+                raise zst.unstable(zbad, dt)
+            mixed_move_points(dt, cs["a"], cs["b"], cown, cs["pos"], b["centroid"], b["velocity"], b["spin"], gvel,
+                              *wcon)
+            mixed_move_points(dt, cs["a"], cs["b"], ss["contact"], ss["pos"], b["centroid"], b["velocity"],
+                              b["spin"], gvel, *wsub)
 
     def timing_report(self) -> str:
         """The time spent per phase since the counters were last zeroed (seconds, share)."""

@@ -21,9 +21,9 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
    and the sum onto masters (``gp_externals``), damping and motion (``gp_motion``).
 
 Zoned blocks are not bodies of the rigid motion kernel (``RigidEngine._groups`` leaves them
-out). Contacts between a zoned block and another block are not wired yet (issue 10, "mixed
-models"): the engine refuses them, except contacts between blocks of one joined set, which a
-continuum of linked gridpoints makes inert.
+out). Contacts between a zoned and a rigid block add their forces to the gridpoints
+(``RigidEngine._mixed_steps``, kernels of ``gpcontact``); contacts between two zoned blocks are
+refused unless both are of one joined set (linked gridpoints make those inert).
 """
 from __future__ import annotations
 
@@ -128,6 +128,7 @@ class ZoneStepper:
         np.add.at(ktot, link[lk], stiff[lk])
         self.mtot = mtot
         self.ktot = ktot
+        self.kzone = ktot.copy()
         self.facc = np.zeros((n, 3))
         self.fmag = np.zeros(n)
         self.out = np.zeros(4)
@@ -149,14 +150,31 @@ class ZoneStepper:
         v["imass"][lk] = v["imass"][v["link"][lk]]
         self.dt = dt
 
+    def set_contact_stiffness(self, rows: np.ndarray, k: np.ndarray) -> None:
+        """The joint term of Eq. (85) (contact stiffness at boundary gridpoints, N/m, per vertex
+        row, summed onto masters): the density-scaled masses follow at the next ``set_masses``."""
+        link = self.model.vertices["link"]
+        rows = np.where(link[rows] >= 0, link[rows], rows)
+        kj = np.zeros(len(self.ktot))
+        np.add.at(kj, rows, k)
+        self.ktot = self.kzone + kj
+
     # ------------------------------------------------------------ one step
-    def step(self, dt: float, gravity: np.ndarray, mode: int, alpha: float, large: bool, vmax: float) -> int:
+    def begin(self) -> np.ndarray:
+        """Start a step: the gridpoint force accumulator zeroed and returned (contact forces
+        may be added to it before ``step(…, begun=True)``)."""
+        self.facc[self.rows] = 0.0
+        self.fmag[self.rows] = 0.0
+        return self.facc
+
+    def step(self, dt: float, gravity: np.ndarray, mode: int, alpha: float, large: bool, vmax: float,
+             begun: bool = False) -> int:
         """One step of every zoned block; returns the first unstable gridpoint row or −1."""
         m = self.model
         v, zs = m.vertices, m.store("zones")
         facc, fmag = self.facc, self.fmag
-        facc[self.rows] = 0.0
-        fmag[self.rows] = 0.0
+        if not begun:
+            self.begin()
         pos, vel = v["pos"], v["velocity"]
         zone_forces(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.bulk, self.shear, dt,
                     zs["stress"], facc, fmag)

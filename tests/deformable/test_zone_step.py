@@ -129,14 +129,43 @@ def test_zoned_block_without_a_model_is_refused(tmp_path):
         s.command("model cycle 5")
 
 
-def test_contact_with_a_zoned_block_is_refused_and_changes_nothing(tmp_path):
+def test_contact_between_two_zoned_blocks_is_refused_and_changes_nothing(tmp_path):
     s = _run(tmp_path, ["block create brick 0 1 0 1 0 1", "block create brick 0 1 0 1 -1 0",
-                        "block property density 2000", "block fix range position-z -1 0", "model gravity 9.81",
-                        "block zone generate edgelength 0.5 range position-z 0 1", *_ELASTIC])
+                        "model gravity 9.81", "block zone generate edgelength 0.5", *_ELASTIC,
+                        "block gridpoint apply velocity 0 0 0 range position-z -1"])
     before = s.model.vertices["pos"].copy()
-    with pytest.raises(Dec3dError, match="contacts touch a zoned .deformable. block.*do not cycle yet"):
+    with pytest.raises(Dec3dError, match="contacts join two zoned .deformable. blocks that are not joined.*"
+                                         "do not cycle yet"):
         s.command("model cycle 10")
     assert s.model.step == 0 and np.array_equal(s.model.vertices["pos"], before)
+
+
+@pytest.mark.parametrize("large", ["on", "off"])
+def test_rigid_block_resting_on_a_zoned_block(tmp_path, large):
+    """A rigid 1 m cube (ρ = 2000) on a zoned 1 m cube (E = 1 GPa, ν = 0.25, ρ = 2000) on rollers
+    at the base and the four sides (one-dimensional compression, M = E(1−ν)/((1+ν)(1−2ν))),
+    joint kn = ks = 10 GPa/m: the contact carries the weight W = 20 kN; the rigid block settles by
+    W/M·H + ρgH²/(2M) + W/(kn A) = 27.0 µm. The sub-contacts of the detection sit at the zoned
+    face's gridpoints and at the rigid face's corners with unequal areas (point-like loads on the
+    zoned surface), so the settlement is 3.3 % above the uniform-load answer: bar 5 %."""
+    s = _run(tmp_path, ["block create brick 0 1 0 1 0 1", "block create brick 0 1 0 1 1 2",
+                        "block property density 2000", "block zone generate edgelength 0.5 range position-z 0 1",
+                        "block zone cmodel assign elastic", "block zone property young 1e9 poisson 0.25 density 2000",
+                        "model gravity 0 0 -10", f"model large-strain {large}", "block contact jmodel assign elastic",
+                        "block contact material-table default property stiffness-normal 1e10 stiffness-shear 1e10",
+                        "block gridpoint apply velocity-z 0 range position-z 0",
+                        *[f"block gridpoint apply velocity-{a} 0 range position-{a} {c}" for a in "xy" for c in (0, 1)],
+                        "model solve ratio 1e-6"])
+    b, ss = s.model.blocks, s.model.store("subcontacts")
+    rigid = int(np.flatnonzero(b["kind"] == 0)[0])
+    W, M = 2e4, 1.2e9
+    assert ss["fn"].sum() == pytest.approx(W, rel=1e-4)
+    settle = W / M + 2000 * 10 / (2 * M) + W / 1e10
+    assert -b["disp"][rigid, 2] == pytest.approx(settle, rel=0.05)
+    # the zoned block carries it: mean σ_zz over its zones = −(W + its own weight / 2) / A
+    zs = s.model.store("zones")
+    mean = (zs["stress"][:, 2] * zs["volume"]).sum() / zs["volume"].sum()
+    assert mean == pytest.approx(-(W + 2000 * 10 / 2), rel=1e-3)
 
 
 def test_ten_node_zones_without_their_kernel_are_a_clear_error(tmp_path, monkeypatch):
