@@ -23,7 +23,9 @@ and "Mass (Density) Scaling".
     opposite node n, outward normal, area S); strain increment Δε = sym(∇v) Δt. In a mixed set
     (both overlays of one hexahedral zone, as the text does mixed discretization "over the
     combination of two overlays") the volumetric part is replaced by the volume-weighted mean of
-    the set (Eqs. 60-63). Incremental Hooke (Eq. 59, three-term Δε_v) updates the stress; the
+    the set (Eqs. 60-63). In large strain the stress is first turned with the material by the
+    spin increment ω Δt, ω = ½(∇v − ∇vᵀ) (the rotation rate of Eq. 58): σ += ωσ − σω (Jaumann,
+    dec3d's choice of objective rate). Incremental Hooke (Eq. 59, three-term Δε_v) updates the stress; the
     zone's nodal force is f^n = (1/3) σ·n^(n) S^(n) (Eq. 55 for a constant-stress tetrahedron),
     times the zone's weight (½ for an overlay zone: the nodal force is the average of the two).
     ``force[r]`` accumulates the force zones exert on gridpoint r; ``fmag[r]`` the sum of the
@@ -110,12 +112,27 @@ def zone_mass_stiffness(pos, gp, nnode, overlay, rows, bulk, shear, density, mas
 
 
 @njit(cache=True)
-def zone_forces(pos, vel, gp, rows, zset, weight, nset, bulk, shear, dt, stress, force, fmag):
+def _rotate(stress, z, w01, w02, w12):
+    """σ += W σ − σ W for the spin increment W (W01 = w01, W02 = w02, W12 = w12, antisymmetric)."""
+    s00 = stress[z, 0]; s11 = stress[z, 1]; s22 = stress[z, 2]
+    s01 = stress[z, 3]; s02 = stress[z, 4]; s12 = stress[z, 5]
+    stress[z, 0] = s00 + 2.0 * (w01 * s01 + w02 * s02)
+    stress[z, 1] = s11 + 2.0 * (-w01 * s01 + w12 * s12)
+    stress[z, 2] = s22 + 2.0 * (-w02 * s02 - w12 * s12)
+    stress[z, 3] = s01 + w01 * (s11 - s00) + w02 * s12 + w12 * s02
+    stress[z, 4] = s02 + w02 * (s22 - s00) + w01 * s12 - w12 * s01
+    stress[z, 5] = s12 + w12 * (s22 - s11) - w01 * s02 - w02 * s01
+
+
+@njit(cache=True)
+def zone_forces(pos, vel, gp, rows, zset, weight, nset, bulk, shear, dt, large, stress, force, fmag):
     """One step of 4-node elastic zones ``rows``: strain increment (mixed discretization over
-    the sets ``zset`` (per entry of rows: set index 0..nset-1, or -1)), stress update, nodal
-    forces times ``weight`` (per entry of rows) added to ``force``, their magnitudes to ``fmag``."""
+    the sets ``zset`` (per entry of rows: set index 0..nset-1, or -1)), stress update (in large
+    strain after rotating the stress by the spin increment), nodal forces times ``weight`` (per
+    entry of rows) added to ``force``, their magnitudes to ``fmag``."""
     nz = rows.shape[0]
     de = np.empty((nz, 6))
+    rot = np.zeros((nz, 3))
     vols = np.empty(nz)
     av = np.empty((nz, 4, 3))
     sv = np.zeros(nset)
@@ -138,6 +155,7 @@ def zone_forces(pos, vel, gp, rows, zset, weight, nset, bulk, shear, dt, stress,
         f = dt / (3.0 * vol)
         de[k, 0] = g00 * f; de[k, 1] = g11 * f; de[k, 2] = g22 * f
         de[k, 3] = 0.5 * (g01 + g10) * f; de[k, 4] = 0.5 * (g02 + g20) * f; de[k, 5] = 0.5 * (g12 + g21) * f
+        rot[k, 0] = 0.5 * (g01 - g10) * f; rot[k, 1] = 0.5 * (g02 - g20) * f; rot[k, 2] = 0.5 * (g12 - g21) * f
         h = zset[k]
         if h >= 0:
             sv[h] += (de[k, 0] + de[k, 1] + de[k, 2]) * vol
@@ -148,6 +166,8 @@ def zone_forces(pos, vel, gp, rows, zset, weight, nset, bulk, shear, dt, stress,
         if h >= 0 and ss[h] > 0.0:
             shift = (sv[h] / ss[h] - (de[k, 0] + de[k, 1] + de[k, 2])) / 3.0
             de[k, 0] += shift; de[k, 1] += shift; de[k, 2] += shift
+        if large:
+            _rotate(stress, z, rot[k, 0], rot[k, 1], rot[k, 2])
         ev = de[k, 0] + de[k, 1] + de[k, 2]
         lam = bulk[z] - 2.0 * shear[z] / 3.0
         g2 = 2.0 * shear[z]

@@ -177,7 +177,7 @@ class ZoneStepper:
             self.begin()
         pos, vel = v["pos"], v["velocity"]
         zone_forces(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.bulk, self.shear, dt,
-                    zs["stress"], facc, fmag)
+                    large, zs["stress"], facc, fmag)
         if self.ho is not None:
             self.ho(pos, vel, zs["gp"], self.rows10, self.bulk, self.shear, dt, zs["gstress"], zs["stress"], facc)
         gp_externals(self.rows, v["link"], v["mass"], gravity, v["fapp"], v["fface"], facc, fmag)

@@ -57,14 +57,15 @@ def _tensor(s):
     return np.array([[s[0], s[3], s[4]], [s[3], s[1], s[5]], [s[4], s[5], s[2]]])
 
 
-def twin_zone_forces(pos, vel, gp, rows, zset, weight, K, G, dt, stress, n):
+def twin_zone_forces(pos, vel, gp, rows, zset, weight, K, G, dt, stress, n, large=False):
     stress = stress.copy()
     force, fmag = np.zeros((n, 3)), np.zeros(n)
-    eps = {}
+    eps, spin = {}, {}
     for k, z in enumerate(rows):
         p = pos[gp[z, :4]]
         L = vel[gp[z, :4]].T @ _grad_n(p)               # L_ij = Σ v_i ∂N/∂x_j
         eps[k] = 0.5 * (L + L.T) * dt
+        spin[k] = 0.5 * (L - L.T) * dt
     # mixed discretization: volumetric part = volume-weighted mean over the set
     for h in set(int(x) for x in zset if x >= 0):
         ks = [k for k in range(len(rows)) if zset[k] == h]
@@ -74,7 +75,10 @@ def twin_zone_forces(pos, vel, gp, rows, zset, weight, K, G, dt, stress, n):
             eps[k] = eps[k] - np.trace(eps[k]) / 3 * np.eye(3) + mean / 3 * np.eye(3)
     for k, z in enumerate(rows):
         e = eps[k]
-        sig = _tensor(stress[z]) + (K[z] - 2 * G[z] / 3) * np.trace(e) * np.eye(3) + 2 * G[z] * e
+        sig = _tensor(stress[z])
+        if large:                                        # Jaumann: σ + Wσ − σW
+            sig = sig + spin[k] @ sig - sig @ spin[k]
+        sig = sig + (K[z] - 2 * G[z] / 3) * np.trace(e) * np.eye(3) + 2 * G[z] * e
         stress[z] = _voigt(sig)
         p = pos[gp[z, :4]]
         f = -_vol(p) * (sig @ _grad_n(p).T).T * weight[k]   # force of the zone on its nodes
@@ -119,7 +123,8 @@ def test_mass_and_stiffness_match_the_twin():
     assert mass.sum() == pytest.approx(sum(rho[z] * _vol(pos[gp[z, :4]]) * wi for z, wi in zip(rows, w)), rel=1e-12)
 
 
-def test_zone_forces_match_the_twin_with_mixed_sets():
+@pytest.mark.parametrize("large", [False, True])
+def test_zone_forces_match_the_twin_with_mixed_sets(large):
     rng = np.random.default_rng(7)
     pos, gp = _random_mesh(rng)
     nz = len(gp)
@@ -131,8 +136,8 @@ def test_zone_forces_match_the_twin_with_mixed_sets():
     weight = np.where(zset >= 0, 0.5, 1.0)
     stress = stress0.copy()
     force, fmag = np.zeros((20, 3)), np.zeros(20)
-    zone_forces(pos, vel, gp, rows, zset, weight, 3, K, G, 1e-3, stress, force, fmag)
-    ts, tf, tm = twin_zone_forces(pos, vel, gp, rows, zset, weight, K, G, 1e-3, stress0, 20)
+    zone_forces(pos, vel, gp, rows, zset, weight, 3, K, G, 1e-3, large, stress, force, fmag)
+    ts, tf, tm = twin_zone_forces(pos, vel, gp, rows, zset, weight, K, G, 1e-3, stress0, 20, large)
     assert np.allclose(stress, ts, rtol=1e-10, atol=1e-6)
     assert np.allclose(force, tf, rtol=1e-10, atol=1e-6)
     assert np.allclose(fmag, tm, rtol=1e-10, atol=1e-6)
@@ -149,7 +154,7 @@ def test_zone_forces_agree_with_the_first_kernel_slice_on_plain_tetrahedra():
     s1, s2 = np.zeros((nz, 6)), np.zeros((nz, 6))
     f1, f2 = np.zeros((20, 3)), np.zeros((20, 3))
     zone_forces(pos, vel, gp, np.arange(nz, dtype=np.int64), np.full(nz, -1, np.int64), np.ones(nz), 0, K, G, 1e-3,
-                s1, f1, np.zeros(20))
+                False, s1, f1, np.zeros(20))
     tet_elastic_step(pos, vel, gp, K, G, 1e-3, s2, f2)
     assert np.allclose(s1, s2, rtol=1e-12) and np.allclose(f1, f2, rtol=1e-12, atol=1e-9)
 
@@ -164,19 +169,35 @@ def test_mixed_set_keeps_uniform_strain_and_averages_the_volume_change():
     K, G = np.full(6, 2e9), np.full(6, 1e9)
     sa, sb = np.zeros((6, 6)), np.zeros((6, 6))
     rows = np.arange(6, dtype=np.int64)
-    zone_forces(pos, vel, gp, rows, np.zeros(6, np.int64), np.ones(6), 1, K, G, 1.0, sa, np.zeros((20, 3)),
+    zone_forces(pos, vel, gp, rows, np.zeros(6, np.int64), np.ones(6), 1, K, G, 1.0, False, sa, np.zeros((20, 3)),
                 np.zeros(20))
-    zone_forces(pos, vel, gp, rows, np.full(6, -1, np.int64), np.ones(6), 0, K, G, 1.0, sb, np.zeros((20, 3)),
+    zone_forces(pos, vel, gp, rows, np.full(6, -1, np.int64), np.ones(6), 0, K, G, 1.0, False, sb, np.zeros((20, 3)),
                 np.zeros(20))
     assert np.allclose(sa, sb, rtol=1e-10)
     e = 0.5 * (grad + grad.T)
     assert np.allclose(sa[0], _voigt((K[0] - 2 * G[0] / 3) * np.trace(e) * np.eye(3) + 2 * G[0] * e), rtol=1e-10)
     vel2 = rng.normal(size=(20, 3))
     s2 = np.zeros((6, 6))
-    zone_forces(pos, vel2, gp, rows, np.zeros(6, np.int64), np.ones(6), 1, K, G, 1.0, s2, np.zeros((20, 3)),
+    zone_forces(pos, vel2, gp, rows, np.zeros(6, np.int64), np.ones(6), 1, K, G, 1.0, False, s2, np.zeros((20, 3)),
                 np.zeros(20))
     mean = s2[:, :3].sum(axis=1) / 3                     # K Δε_v: the same in every zone of the set
     assert np.allclose(mean, mean[0], rtol=1e-10)
+
+
+def test_large_strain_turns_the_stress_with_a_rigid_rotation():
+    """A spin about z (v = Ω × x, no strain) turns a uniaxial σ_xx toward y by ΩΔt: to first
+    order σ_xy = σ_xx ΩΔt and the invariants stay; in small strain the stress does not change."""
+    rng = np.random.default_rng(9)
+    pos, gp = _random_mesh(rng, nz=3)
+    om = 0.01
+    vel = np.cross(np.array([0.0, 0.0, om]), pos)
+    K, G = np.full(3, 2e9), np.full(3, 1e9)
+    for large, want in ((True, np.array([1e6, 0, 0, 1e6 * om, 0, 0])), (False, np.array([1e6, 0, 0, 0, 0, 0]))):
+        st = np.zeros((3, 6))
+        st[:, 0] = 1e6
+        zone_forces(pos, vel, gp, np.arange(3, dtype=np.int64), np.full(3, -1, np.int64), np.ones(3), 0, K, G, 1.0,
+                    large, st, np.zeros((20, 3)), np.zeros(20))
+        assert np.allclose(st, want, rtol=0, atol=1e-6 * 1e6)
 
 
 def twin_externals(rows, link, mass, g, fapp, fface, force, fmag):
