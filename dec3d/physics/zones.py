@@ -113,7 +113,18 @@ class ZoneStepper:
         self.masters = np.ascontiguousarray(self.rows[link[self.rows] < 0])
         self.linked = np.ascontiguousarray(self.rows[link[self.rows] >= 0])
         held = v["apply_fix"] | ((v["fixity"] & 7) << 3) | ((b["fixity"][np.maximum(vb, 0)] & 7) << 3)
-        self.held = np.ascontiguousarray(held.astype(np.uint8))
+        held = held.astype(np.uint8)
+        # a condition set on a linked copy holds its master (the one gridpoint they both are)
+        lk = self.linked
+        self.vapp = v["vapp"].copy()
+        if len(lk):
+            for i in range(3):
+                bit = np.uint8(1 << i)
+                own = (held[lk] & bit) != 0
+                mst = link[lk[own]]
+                self.vapp[mst, i] = np.where((held[mst] & bit) != 0, self.vapp[mst, i], v["vapp"][lk[own], i])
+            np.bitwise_or.at(held, link[lk], held[lk])
+        self.held = np.ascontiguousarray(held)
         # masses and stiffness (reference: positions now)
         n = v.n
         mass = np.zeros(n)
@@ -182,7 +193,7 @@ class ZoneStepper:
             self.ho(pos, vel, zs["gp"], self.rows10, self.bulk, self.shear, dt, zs["gstress"], zs["stress"], facc)
         gp_externals(self.rows, v["link"], v["mass"], gravity, v["fapp"], v["fface"], facc, fmag)
         return gp_motion(self.masters, self.linked, v["link"], facc, v["force"], self.mtot, v["imass"], self.held,
-                         v["vapp"], vel, v["disp"], pos, dt, mode, alpha, large, vmax, self.out)
+                         self.vapp, vel, v["disp"], pos, dt, mode, alpha, large, vmax, self.out)
 
     @property
     def kinetic(self) -> float:

@@ -203,3 +203,48 @@ def test_dynamic_time_step_follows_eq_84(tmp_path):
     assert dt == pytest.approx(2 * np.sqrt(m / k).min(), rel=1e-12)
     uz = -s.model.vertices["disp"][:, 2].min()
     assert 0 < uz < 2.5 * 1e-4                        # bounded by twice the static answer (plus margin)
+
+
+@pytest.mark.parametrize("hold_copies", [False, True])
+def test_joined_blocks_with_linked_gridpoints_act_as_one_continuum(tmp_path, hold_copies):
+    """Two stacked bricks zoned as mixed hexahedra, joined, their coincident gridpoints linked
+    (the upper block's copy points to the lower block's row, as the contract says): under a
+    top load and rollers the pair deforms as one 2 m prism: ε_zz = σ/E everywhere, the top at
+    2 ε_zz, and the linked copies move exactly as their masters."""
+    s = Session(out_dir=tmp_path)
+    s.command("block create brick 0 1 0 1 0 1")
+    s.command("block create brick 0 1 0 1 1 2")
+    b = s.model.blocks
+    for r in range(2):
+        row = int(np.flatnonzero(b["id"] == r + 1)[0])
+        zone_brick(s.model, row, mixed=True)
+    v = s.model.vertices
+    lower, upper = (np.flatnonzero(v["block"] == int(np.flatnonzero(b["id"] == i)[0])) for i in (1, 2))
+    linked = 0
+    for r in upper:
+        hit = lower[np.all(np.abs(v["pos"][lower] - v["pos"][r]) < 1e-9, axis=1)]
+        if len(hit):
+            v["link"][r] = hit[0]
+            linked += 1
+    assert linked == 4
+    top = v["pos"][:, 2] > 1.5
+    if hold_copies:
+        # conditions set only on the linked copies (the upper block's rows at z = 1) hold the
+        # shared gridpoints: the lower block hangs from them, the upper one stands on them
+        cp = np.flatnonzero(v["link"] >= 0)
+        v["apply_fix"][cp] = 7
+        for line in ["block join", *_ELASTIC, "model gravity 0 0 -10", "model cycle 300"]:
+            s.command(line)
+        assert np.all(v["disp"][v["link"][cp]] == 0.0) and np.all(v["disp"][cp] == 0.0)
+        assert np.all(v["disp"][lower[v["pos"][lower, 2] < 0.5], 2] < -1e-8)
+        assert np.all(v["disp"][upper[v["pos"][upper, 2] > 1.5], 2] < -1e-8)
+        return
+    for line in ["block join", *_ELASTIC, *_ROLLERS, "block gridpoint apply force-z -250000 range position-z 2",
+                 "model solve ratio 1e-8"]:
+        s.command(line)
+    ez = -1e6 / E
+    assert np.allclose(v["disp"][:, 2], ez * v["pos"][:, 2], rtol=0, atol=1e-3 * abs(ez))
+    assert np.allclose(v["disp"][top, 2], 2 * ez, rtol=1e-3)
+    assert np.abs(s.model.store("zones")["stress"] - np.array([0, 0, -1e6, 0, 0, 0])).max() <= 1e-6 * 1e6
+    cp = np.flatnonzero(v["link"] >= 0)
+    assert np.array_equal(v["disp"][cp], v["disp"][v["link"][cp]])
