@@ -207,7 +207,8 @@ class ZoneStepper:
         h = self.held[r]
         free = (((h | (h >> 3)) & 7) != 7) & (v["imass"][r] > 0)
         r = r[free]
-        return np.linalg.norm(v["force"][r], axis=1), self.fmag[r]
+        f = v["force"][r]
+        return np.hypot(np.hypot(f[:, 0], f[:, 1]), f[:, 2]), self.fmag[r]     # (hypot: no overflow)
 
     def finish(self, large: bool) -> None:
         """After a run: zone volumes follow the geometry in large strain."""
@@ -224,7 +225,7 @@ class ZoneStepper:
     def unstable(self, row: int, dt: float) -> Dec3dError:
         m = self.model
         v = m.vertices
-        sp = float(np.linalg.norm(v["velocity"][row]))
+        sp = math.hypot(*v["velocity"][row])
         bid = int(m.blocks["id"][v["block"][row]])
         x, y, z = (float(c) for c in v["pos"][row])
         return self.error(f"the run became unstable at step {m.step}: a gridpoint of block {bid} at "
