@@ -235,3 +235,12 @@ def test_legacy_dec_geometry_is_refused_by_name(tmp_path, content, message):
     with pytest.raises(NotSupportedError, match=message) as ei:
         _call_dec(tmp_path, content)
     assert ei.value.location.line == 2        # the `call` line of the calling deck
+
+
+def test_material_table_entry_with_another_range_applies_to_existing_contacts_only(session):
+    session.command(STACK + "block contact material-table add prop stiffness-normal 5e9 stiffness-shear 2e9 "
+                    "range group 'top'\nblock create brick 0 1 0 1 3 4 group 'top'")
+    props = _props_by_pair(session)
+    assert props[(2, 3)][[P_KN, P_KS]].tolist() == [5e9, 2e9]      # existed when the entry was added
+    assert props[(3, 4)][[P_KN, P_KS]].tolist() == [1e9, 1e9]      # made later: the default
+    assert "mtables" not in session.model.settings.mechanical or not session.model.settings.mechanical["mtables"]

@@ -221,3 +221,15 @@ def test_sparse_shift_invert_path_agrees_with_the_dense_one(tmp_path, monkeypatc
     sparse.command("block dynamic eigen modes 5")
     got = [sparse.results[f"eigen.f{i}"] for i in range(1, 6)]
     assert got == pytest.approx([dense.results[f"eigen.f{i}"] for i in range(1, 6)], rel=1e-8)
+
+
+def test_open_sub_contacts_carry_no_spring(tmp_path):
+    # the block hangs 1 mm above its base: the contact exists (gap within the contact tolerance) but is
+    # open, so the block is free and all six frequencies are zero
+    s = _session(tmp_path)
+    s.command("block create brick -0.5 0.5 -0.5 0.5 -1 0\nblock create brick -0.5 0.5 -0.5 0.5 0.001 0.501\n"
+              f"block property density {RHO}\nblock contact jmodel assign elastic\n"
+              f"block contact property stiffness-normal {KN} stiffness-shear {KS}\nblock fix range id 1\n"
+              "block contact tolerance 0.01\nblock dynamic eigen modes 6")
+    assert engine(s.model).subcontacts.n > 0
+    assert [s.results[f"eigen.f{i}"] for i in range(1, 7)] == [0.0] * 6
