@@ -505,6 +505,23 @@ class Session:
                 exc.location = SourceLocation(loc.file, loc.line, loc.column, loc.text, loc.length, tuple(stack))
             raise exc.with_location(item.location)
 
+    def system_command(self, text: str, stack=(), refuse=None) -> None:
+        """FISH `system.command(s)`: bind ``s`` as deck lines now and run them (as a line of a
+        `command … endcommand` section would run). ``refuse(path)`` gives a reason a command may not
+        run here (a FISH callback), or None."""
+        deck = parse_deck(text, "<command>", tuple(stack))
+        binder = Binder(deck, self.bind_context, tuple(stack))
+        for raw in deck.lines:
+            item = binder.bind_line(raw)
+            if isinstance(item, ExprStatement):
+                self.run_statement(item)
+                continue
+            why = refuse(item.command.path) if refuse is not None else None
+            if why:
+                raise CommandError(why, item.location)
+            self._check_paths(item)
+            self.run_fish_command(item, stack)
+
     def new_model(self) -> None:
         """`model new`: a fresh model; FISH variables and functions are cleared too (as in 3DEC)."""
         self.model = Model()
