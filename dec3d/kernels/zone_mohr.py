@@ -206,6 +206,35 @@ def _try_planes(act, na, nn, dm, rr, lam, tol, mm, bb, x, sn):
     return True
 
 @njit(cache=True)
+def mohr_work():
+    """Scratch arrays of ``mohr_core`` (allocate once per batch, not per zone)."""
+    return (np.empty(3), np.empty((3, 3)), np.empty((9, 3)), np.empty((9, 3)), np.empty(9),
+            np.empty(3, np.int64), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3))
+
+
+@njit(cache=True)
+def _principal_values(s):
+    """Principal values (ascending) of the symmetric tensor s (6,) in closed form (the
+    trigonometric solution of the characteristic cubic); used only to skip clearly elastic zones."""
+    m = (s[0] + s[1] + s[2]) / 3.0
+    d0 = s[0] - m; d1 = s[1] - m; d2 = s[2] - m
+    j2 = 0.5 * (d0 * d0 + d1 * d1 + d2 * d2) + s[3] * s[3] + s[4] * s[4] + s[5] * s[5]
+    if j2 <= 0.0:
+        return m, m, m
+    j3 = d0 * (d1 * d2 - s[5] * s[5]) - s[3] * (s[3] * d2 - s[5] * s[4]) + s[4] * (s[3] * s[5] - d1 * s[4])
+    r = math.sqrt(j2 / 3.0)
+    cs = j3 / (2.0 * r * r * r)
+    if cs > 1.0:
+        cs = 1.0
+    elif cs < -1.0:
+        cs = -1.0
+    th = math.acos(cs) / 3.0
+    hi = m + 2.0 * r * math.cos(th)
+    lo = m + 2.0 * r * math.cos(th + 2.0 * math.pi / 3.0)
+    return lo, 3.0 * m - lo - hi, hi
+
+
+@njit(cache=True)
 def mohr_return(s, de, bulk, shear, coh, tanfric, ten, tandil):
     """Mohr-Coulomb update of one zone in place: s (6,) holds the stress at the start of the step
     and receives the new stress (elastic trial s + D:de, then Itasca's return; see the module
@@ -213,20 +242,37 @@ def mohr_return(s, de, bulk, shear, coh, tanfric, ten, tandil):
     components). Returns (bits, dsp): bits = 1 shear now | 2 tension now (0: elastic), dsp = mean
     trial stress - mean returned stress (the plastic correction K de^p of Eq. 73 of the 3DEC text,
     tension positive; 0 when elastic)."""
+    return mohr_core(s, de, bulk, shear, coh, tanfric, ten, tandil, mohr_work())
+
+
+@njit(cache=True)
+def mohr_core(s, de, bulk, shear, coh, tanfric, ten, tandil, work):
+    """``mohr_return`` with the scratch arrays ``work`` of ``mohr_work``."""
+    lam, vec, nn, dm, rr, act, mm, bb, x, sn = work
     hooke_increment(s, de, bulk, shear)
-    lam = np.empty(3)
-    vec = np.empty((3, 3))
-    sym_eig3(s, lam, vec)
-    s1 = lam[0]; s3 = lam[2]
     sphi = tanfric / math.sqrt(1.0 + tanfric * tanfric)
     npf = (1.0 + sphi) / (1.0 - sphi)
-    spsi = tandil / math.sqrt(1.0 + tandil * tandil)
-    nps = (1.0 + spsi) / (1.0 - spsi)
     rnp = math.sqrt(npf)
     ft = ten
     if tanfric > 0.0 and coh / tanfric < ft:
         ft = coh / tanfric
     csn = 2.0 * coh * rnp
+    # clearly elastic: first from the bounds m - 2r <= s1, s3 <= m + 2r (r = sqrt(J2 / 3)), then
+    # from the closed-form principal values (margin far above their round-off); no eigenvectors
+    m = (s[0] + s[1] + s[2]) / 3.0
+    d0 = s[0] - m; d1 = s[1] - m; d2 = s[2] - m
+    r2 = 2.0 * math.sqrt((0.5 * (d0 * d0 + d1 * d1 + d2 * d2) + s[3] * s[3] + s[4] * s[4] + s[5] * s[5]) / 3.0)
+    bscale = 3.0 * (abs(m) + r2) + coh + abs(ft)
+    if (m + r2) * npf - (m - r2) - csn < -1e-7 * bscale and m + r2 - ft < -1e-7 * bscale:
+        return 0, 0.0
+    q1, q2, q3 = _principal_values(s)
+    qscale = abs(q1) + abs(q2) + abs(q3) + coh + abs(ft)
+    if q3 * npf - q1 - csn < -1e-7 * qscale and q3 - ft < -1e-7 * qscale:
+        return 0, 0.0
+    sym_eig3(s, lam, vec)
+    s1 = lam[0]; s3 = lam[2]
+    spsi = tandil / math.sqrt(1.0 + tandil * tandil)
+    nps = (1.0 + spsi) / (1.0 - spsi)
     scale = abs(s1) + abs(s3) + abs(lam[1]) + coh + abs(ft)
     tol = 1e-10 * scale
     fs13 = s3 * npf - s1 - csn          # = -f_s (Itasca), > 0 violated
@@ -235,10 +281,31 @@ def mohr_return(s, de, bulk, shear, coh, tanfric, ten, tandil):
         return 0, 0.0
     a1 = bulk + 4.0 * shear / 3.0
     a2 = bulk - 2.0 * shear / 3.0
+    # Itasca's choice of the plane: h decides between shear and tension
+    sp = ft * npf - csn
+    ap = math.sqrt(1.0 + npf * npf) + npf
+    h = s3 - ft + ap * (s1 - sp)
+    first = 0 if (fs13 > tol and (h <= 0.0 or ft3 <= tol)) else 8
+    # fast path: Itasca's single-plane return in closed form, kept when it violates no plane
+    if first == 0:
+        ls = fs13 / (a1 * (1.0 + npf * nps) - a2 * (npf + nps))
+        n1 = s1 + ls * (a1 - a2 * nps)
+        n2 = lam[1] + ls * a2 * (1.0 - nps)
+        n3 = s3 + ls * (a2 - a1 * nps)
+        fast = SHEAR_NOW
+    else:
+        lt = ft3 / a1
+        n1 = s1 - lt * a2
+        n2 = lam[1] - lt * a2
+        n3 = ft
+        fast = TENSION_NOW
+    lo = min(n1, min(n2, n3))
+    hi = max(n1, max(n2, n3))
+    if hi * npf - lo - csn <= tol and hi - ft <= tol:
+        sn[0] = n1; sn[1] = n2; sn[2] = n3
+        return _rotate_back(s, lam, vec, sn, fast)
     # the nine planes: n (normal of F), dm (D times the flow direction), r
-    nn = np.zeros((9, 3))
-    dm = np.zeros((9, 3))
-    rr = np.empty(9)
+    nn[:, :] = 0.0
     for k in range(6):
         i = _SH_I[k]; j = _SH_J[k]
         nn[k, i] = -1.0; nn[k, j] = npf
@@ -255,16 +322,7 @@ def mohr_return(s, de, bulk, shear, coh, tanfric, ten, tandil):
         for t in range(3):
             dm[6 + i, t] = a2
         dm[6 + i, i] = a1
-    # Itasca's choice of the plane: h decides between shear and tension
-    sp = ft * npf - csn
-    ap = math.sqrt(1.0 + npf * npf) + npf
-    h = s3 - ft + ap * (s1 - sp)
-    first = 0 if (fs13 > tol and (h <= 0.0 or ft3 <= tol)) else 8
-    act = np.empty(3, np.int64)
-    mm = np.empty((3, 3))
-    bb = np.empty(3)
-    x = np.zeros(3)
-    sn = lam.copy()
+    sn[0] = lam[0]; sn[1] = lam[1]; sn[2] = lam[2]
     act[0] = first
     ok = _try_planes(act, 1, nn, dm, rr, lam, tol, mm, bb, x, sn)
     na = 1
@@ -301,21 +359,24 @@ def mohr_return(s, de, bulk, shear, coh, tanfric, ten, tandil):
                     if not ok:
                         act[0] = k; act[1] = k2; act[2] = k3
                         ok = _try_planes(act, 3, nn, dm, rr, lam, tol, mm, bb, x, sn)
-    xs = np.zeros(9)
+    bits = 0
     if ok:
         for a in range(na):
-            xs[act[a]] = x[a]
+            if x[a] > 0.0:
+                bits |= SHEAR_NOW if act[a] < 6 else TENSION_NOW
     else:
         # no consistent return found (not met in the tests): the isotropic admissible point
         piso = min((lam[0] + lam[1] + lam[2]) / 3.0, ft)
         sn[0] = piso; sn[1] = piso; sn[2] = piso
-        xs[0] = 1.0
+        bits = SHEAR_NOW
         if piso == ft:
-            xs[8] = 1.0
-    bits = 0
-    for k in range(9):
-        if xs[k] > 0.0:
-            bits |= SHEAR_NOW if k < 6 else TENSION_NOW
+            bits |= TENSION_NOW
+    return _rotate_back(s, lam, vec, sn, bits)
+
+
+@njit(cache=True)
+def _rotate_back(s, lam, vec, sn, bits):
+    """s (6,) += sum_k (sn_k - lam_k) v_k v_k^T (principal directions kept); returns (bits, dsp)."""
     d0 = sn[0] - lam[0]; d1 = sn[1] - lam[1]; d2 = sn[2] - lam[2]
     s[0] += d0 * vec[0, 0] * vec[0, 0] + d1 * vec[0, 1] * vec[0, 1] + d2 * vec[0, 2] * vec[0, 2]
     s[1] += d0 * vec[1, 0] * vec[1, 0] + d1 * vec[1, 1] * vec[1, 1] + d2 * vec[1, 2] * vec[1, 2]
@@ -347,11 +408,12 @@ def tet_mohr_step(pos, vel, gp, rows, prop, dt, stress, state, force):
     ``state`` updated (``merge_state``), nodal forces added to ``force``."""
     av = np.empty((4, 3))
     de = np.empty(6)
+    work = mohr_work()
     for k in range(rows.shape[0]):
         z = rows[k]
         tet_kinematics(pos, vel, gp, z, dt, av, de)
-        bits, _dsp = mohr_return(stress[z], de, prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
-                                 prop[z, ZP_TANFRIC], prop[z, ZP_TENSION], prop[z, ZP_TANDIL])
+        bits, _dsp = mohr_core(stress[z], de, prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
+                               prop[z, ZP_TANFRIC], prop[z, ZP_TENSION], prop[z, ZP_TANDIL], work)
         state[z] = merge_state(state[z], bits)
         tet_add_forces(gp, z, av, stress[z], 1.0, force)
 
@@ -429,6 +491,7 @@ def zone_constitutive(rows, cmodel, prop, de, stress, state, dsp):
     """Constitutive pass: entry k (zone z = rows[k]) gets de[k] applied by its model: elastic
     (Hooke) or Mohr-Coulomb (``mohr_return``, state merged, dsp[k] its plastic mean-stress
     correction); other codes (null) are left alone. dsp[k] = 0 unless Mohr-Coulomb yielded."""
+    work = mohr_work()
     for k in range(rows.shape[0]):
         z = rows[k]
         dsp[k] = 0.0
@@ -436,8 +499,8 @@ def zone_constitutive(rows, cmodel, prop, de, stress, state, dsp):
         if code == ZMODEL_ELASTIC:
             hooke_increment(stress[z], de[k], prop[z, ZP_BULK], prop[z, ZP_SHEAR])
         elif code == ZMODEL_MOHR:
-            bits, d = mohr_return(stress[z], de[k], prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
-                                  prop[z, ZP_TANFRIC], prop[z, ZP_TENSION], prop[z, ZP_TANDIL])
+            bits, d = mohr_core(stress[z], de[k], prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
+                                prop[z, ZP_TANFRIC], prop[z, ZP_TENSION], prop[z, ZP_TANDIL], work)
             state[z] = merge_state(state[z], bits)
             dsp[k] = d
 
