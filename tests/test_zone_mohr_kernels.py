@@ -581,3 +581,24 @@ def test_mohr_props_check_bad_friction_tangent():
     p[mz.ZP_TANFRIC] = -0.1
     with pytest.raises(Dec3dError, match="friction"):
         mohr_props_check(p[None, :])
+
+
+def test_md_stress_average_matches_twin():
+    rng = np.random.default_rng(21)
+    nz = 12
+    stress = rng.normal(size=(nz, 6)) * 1e6
+    rows = np.array([0, 1, 2, 3, 4, 5, 6, 7, 9, 11], np.int64)
+    zset = np.array([0, 0, 0, 1, 1, 1, 1, -1, 0, 1], np.int64)
+    vol = rng.uniform(0.1, 1.0, len(rows))
+    sk = stress.copy()
+    zm.md_stress_average(rows, zset, 2, vol, sk)
+    want = stress.copy()
+    for h in (0, 1):
+        members = [rows[k] for k in range(len(rows)) if zset[k] == h]
+        vols = [vol[k] for k in range(len(rows)) if zset[k] == h]
+        pbar = sum(np.trace(_tensor(stress[z])) / 3 * v for z, v in zip(members, vols)) / sum(vols)
+        for z in members:
+            want[z, :3] += pbar - stress[z, :3].mean()
+    assert np.allclose(sk, want, rtol=0, atol=1e-8)
+    assert np.array_equal(sk[[7, 8, 10]], stress[[7, 8, 10]])      # no set / not in rows: untouched
+    assert np.array_equal(sk[:, 3:], stress[:, 3:])

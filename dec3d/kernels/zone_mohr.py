@@ -530,3 +530,27 @@ def tet_zone_step(pos, vel, gp, rows, node, cmodel, prop, dt, nmd, stress, state
     if nmd:
         nmd_stress_correction(gp, rows, node, vol, dsp, stress)
     tet_force_pass(gp, rows, av, np.ones(nr), stress, force)
+
+
+@njit(cache=True)
+def md_stress_average(rows, zset, nset, vol, stress):
+    """Mixed discretization on stress for hexahedral zone sets (3DEC text Eqs. 64-67; the
+    ERRATA: s of Eq. 64 is the deviatoric *stress*): the mean stress of each tetrahedron of a set
+    (both overlays of one hexahedral zone) is replaced by the volume average over the set,
+    deviatoric parts kept. Entry k of rows belongs to set zset[k] (0..nset-1, -1: none, left
+    alone); vol[k] its volume. Needed after a Mohr-Coulomb return with dilation or tension
+    (the elastic mean-stress increments of a set are equal already)."""
+    sv = np.zeros(nset)
+    ss = np.zeros(nset)
+    for k in range(rows.shape[0]):
+        h = zset[k]
+        if h >= 0:
+            z = rows[k]
+            sv[h] += (stress[z, 0] + stress[z, 1] + stress[z, 2]) / 3.0 * vol[k]
+            ss[h] += vol[k]
+    for k in range(rows.shape[0]):
+        h = zset[k]
+        if h >= 0 and ss[h] > 0.0:
+            z = rows[k]
+            c = sv[h] / ss[h] - (stress[z, 0] + stress[z, 1] + stress[z, 2]) / 3.0
+            stress[z, 0] += c; stress[z, 1] += c; stress[z, 2] += c
