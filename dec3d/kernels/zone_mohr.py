@@ -68,8 +68,8 @@ SHEAR_PAST = 4
 TENSION_PAST = 8
 
 #: shear planes: (i, j) = (more compressive, less compressive) principal index; planes 6-8: tension
-_SH_I = (0, 0, 1, 1, 2, 2)
-_SH_J = (2, 1, 2, 0, 0, 1)
+_SH_I = np.array([0, 0, 1, 1, 2, 2], np.int64)
+_SH_J = np.array([2, 1, 2, 0, 0, 1], np.int64)
 
 
 @njit(cache=True)
@@ -323,10 +323,11 @@ def mohr_core(s, de, bulk, shear, coh, tanfric, ten, tandil, work):
             dm[6 + i, t] = a2
         dm[6 + i, i] = a1
     sn[0] = lam[0]; sn[1] = lam[1]; sn[2] = lam[2]
-    act[0] = first
-    ok = _try_planes(act, 1, nn, dm, rr, lam, tol, mm, bb, x, sn)
+    # Itasca's plane alone failed (the fast path above): with one other (corner / edge), then
+    # without it
+    ok = False
     na = 1
-    if not ok:          # corner / edge: first with Itasca's plane, then without it
+    if not ok:
         na = 2
         for k in range(9):
             if k != first:
