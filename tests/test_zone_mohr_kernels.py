@@ -590,18 +590,26 @@ def test_md_stress_average_matches_twin():
     rows = np.array([0, 1, 2, 3, 4, 5, 6, 7, 9, 11], np.int64)
     zset = np.array([0, 0, 0, 1, 1, 1, 1, -1, 0, 1], np.int64)
     vol = rng.uniform(0.1, 1.0, len(rows))
+    dsp = rng.normal(size=len(rows)) * 1e4
     sk = stress.copy()
-    zm.md_stress_average(rows, zset, 2, vol, sk)
+    zm.md_stress_average(rows, zset, 2, vol, dsp, sk)
     want = stress.copy()
     for h in (0, 1):
-        members = [rows[k] for k in range(len(rows)) if zset[k] == h]
-        vols = [vol[k] for k in range(len(rows)) if zset[k] == h]
-        pbar = sum(np.trace(_tensor(stress[z])) / 3 * v for z, v in zip(members, vols)) / sum(vols)
-        for z in members:
-            want[z, :3] += pbar - stress[z, :3].mean()
+        ks = [k for k in range(len(rows)) if zset[k] == h]
+        avg = sum(dsp[k] * vol[k] for k in ks) / sum(vol[k] for k in ks)
+        for k in ks:
+            want[rows[k], :3] += dsp[k] - avg
     assert np.allclose(sk, want, rtol=0, atol=1e-8)
     assert np.array_equal(sk[[7, 8, 10]], stress[[7, 8, 10]])      # no set / not in rows: untouched
     assert np.array_equal(sk[:, 3:], stress[:, 3:])
+    # Eq. 67: a set that started with one mean stress ends with the volume-averaged one
+    s2 = np.zeros((nz, 6)); s2[:, :3] = -1e6
+    s2[rows, :3] -= dsp[:, None]                                   # each zone's own return
+    zm.md_stress_average(rows, zset, 2, vol, dsp, s2)
+    for h in (0, 1):
+        ks = [k for k in range(len(rows)) if zset[k] == h]
+        pm = sum(s2[rows[k], :3].mean() * vol[k] for k in ks) / sum(vol[k] for k in ks)
+        assert np.allclose([s2[rows[k], :3].mean() for k in ks], pm, rtol=1e-12)
 
 
 # --------------------------------------------------------------------------------------------
@@ -663,3 +671,67 @@ def test_nmd_relieves_locking_under_a_strip_footing():
     assert p_nmd[-1] < 1.3 * prandtl
     assert p_cst[-1] > 1.12 * p_nmd[-1]                            # locking without NMD
     assert p_cst[-1] / p_cst[-2] - 1 > 1.5 * (p_nmd[-1] / p_nmd[-2] - 1)
+
+
+def test_zone_forces_plastic_matches_twin():
+    """The drop-in step (sets, weights, NMD, large strain, elastic and Mohr-Coulomb zones mixed)
+    against the twins composed by hand."""
+    rng = np.random.default_rng(17)
+    pos, gp = _two_cubes(rng)
+    nzn, nv = len(gp), len(pos)
+    vel = rng.normal(size=(nv, 3)) * 3e-3
+    rows = np.arange(nzn, dtype=np.int64)
+    zset = np.array([0, 0, 0, 0, 0, -1, -1, -1, -1, -1], np.int64)     # first cube: one "hexahedral" set
+    weight = np.where(zset >= 0, 0.5, 1.0)
+    node = np.arange(nv, dtype=np.int64)
+    prop = _props(nzn, rng)
+    cm = np.array([2, 1, 2, 2, 1, 2, 1, 2, 2, 2], np.int8)
+    s0 = rng.normal(size=(nzn, 6)) * 2e5 + np.array([-1e6, -1e6, -1e6, 0, 0, 0])
+    st0 = np.zeros(nzn, np.int32)
+    for large, nmd in ((False, False), (True, True), (False, True)):
+        sk, stk, fk, mk = s0.copy(), st0.copy(), np.zeros((nv, 3)), np.zeros(nv)
+        zm.zone_forces_plastic(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd, sk, stk, fk, mk)
+        # twin
+        kin = []
+        for z in rows:
+            x, v = pos[gp[z]], vel[gp[z]]
+            m = np.hstack([np.ones((4, 1)), x])
+            dn = np.linalg.inv(m)[1:, :].T
+            L = v.T @ dn
+            kin.append((_vec6(0.5 * (L + L.T)), abs(np.linalg.det(m)) / 6, dn, 0.5 * (L - L.T)))
+        de = np.array([k[0] for k in kin]); vol = np.array([k[1] for k in kin])
+        ev = de[:, :3].sum(1)
+        bar = ev.copy()
+        inset = zset >= 0
+        bar[inset] = (ev[inset] * vol[inset]).sum() / vol[inset].sum()
+        if nmd:
+            free = ~inset
+            bar[free] = twin_node_average(gp[free], ev[free], vol[free], node)
+        de[:, :3] += ((bar - ev) / 3)[:, None]
+        snew, dsp = np.zeros((nzn, 6)), np.zeros(nzn)
+        for z in rows:
+            S = _tensor(s0[z])
+            if large:
+                W = kin[z][3]
+                S = S + W @ S - S @ W
+            p = prop[z]
+            if cm[z] == 1:
+                e = _tensor(de[z])
+                snew[z] = _vec6(S + (K - 2 * G / 3) * np.trace(e) * np.eye(3) + 2 * G * e)
+            else:
+                snew[z], _, dsp[z], *_ = twin_mohr(_vec6(S), de[z], K, G, p[3], p[4], p[5], p[6])
+        avg = (dsp[inset] * vol[inset]).sum() / vol[inset].sum()
+        snew[inset, :3] += (dsp[inset] - avg)[:, None]
+        if nmd:
+            snew[free, :3] += (dsp[free] - twin_node_average(gp[free], dsp[free], vol[free], node))[:, None]
+        assert np.abs(sk - snew).max() < 1e-9 * np.abs(snew).max(), (large, nmd)
+        ft, mt = np.zeros((nv, 3)), np.zeros(nv)
+        for z in rows:
+            for n in range(4):
+                f = -weight[z] * vol[z] * _tensor(snew[z]) @ kin[z][2][n]
+                ft[gp[z, n]] += f
+                mt[gp[z, n]] += np.linalg.norm(f)
+        assert np.abs(fk - ft).max() < 1e-9 * np.abs(ft).max()
+        assert np.abs(mk - mt).max() < 1e-9 * mt.max()
+        assert (stk[cm == 2] > 0).sum() >= 2 and (stk[cm == 1] == 0).all()
+        assert np.abs(dsp).max() > 0

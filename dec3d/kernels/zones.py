@@ -66,10 +66,12 @@ def tet_elastic_step(pos, vel, gp, bulk, shear, dt, stress, force):
 # --- per-zone pieces shared by the constitutive kernels (kernels/zone_mohr.py) ---------------
 
 @njit(cache=True)
-def tet_kinematics(pos, vel, gp, z, dt, av, de):
+def tet_kinematics(pos, vel, gp, z, dt, av, de, w):
     """Strain increment of 4-node zone ``z`` (same formulas as ``tet_elastic_step``): fills
-    ``av`` (4, 3) with the area vectors n^(n) S^(n) of the faces opposite nodes 0-3 (outward)
-    and ``de`` (6,) with sym(grad v) dt in the order xx yy zz xy xz yz. Returns the volume."""
+    ``av`` (4, 3) with the area vectors n^(n) S^(n) of the faces opposite nodes 0-3 (outward),
+    ``de`` (6,) with sym(grad v) dt in the order xx yy zz xy xz yz and ``w`` (3,) with the spin
+    increment skw(grad v) dt, components 01 02 12 (Eq. 58's rotation rate times dt). Returns
+    the volume."""
     for n in range(4):
         i1 = gp[z, (n + 1) % 4]; i2 = gp[z, (n + 2) % 4]; i3 = gp[z, (n + 3) % 4]
         ax, ay, az = _face_vector(pos[i1], pos[i2], pos[i3], pos[gp[z, n]])
@@ -89,6 +91,7 @@ def tet_kinematics(pos, vel, gp, z, dt, av, de):
     f = dt / (3.0 * vol)
     de[0] = g00 * f; de[1] = g11 * f; de[2] = g22 * f
     de[3] = 0.5 * (g01 + g10) * f; de[4] = 0.5 * (g02 + g20) * f; de[5] = 0.5 * (g12 + g21) * f
+    w[0] = 0.5 * (g01 - g10) * f; w[1] = 0.5 * (g02 - g20) * f; w[2] = 0.5 * (g12 - g21) * f
     return vol
 
 
