@@ -3,8 +3,8 @@
 ``zones.prop`` keeps cohesion [Pa] (``ZP_COHESION``), tensile strength [Pa] (``ZP_TENSION``)
 and the *tangents* of the friction and dilation angles (``ZP_TANFRIC``, ``ZP_TANDIL``); users
 give the angles in degrees (3DEC/FLAC3D ``friction``, ``dilation``), converted with
-``angle_to_tangent``. The elastic columns (bulk, shear, density) are checked by the deformable
-step as for elastic zones.
+``angle_to_tangent``. The elastic columns (bulk, shear, density) must be set as for elastic
+zones; the check covers them too.
 
 Rules (Itasca, FLAC3D/3DEC "Mohr-Coulomb Model" page,
 https://docs.itascacg.com/itasca920/common/models/mohr/doc/modelmohr.html): cohesion >= 0,
@@ -20,7 +20,7 @@ import math
 import numpy as np
 
 from ..errors import Dec3dError
-from .zones import ZP_COHESION, ZP_TANDIL, ZP_TANFRIC, ZP_TENSION
+from .zones import ZP_BULK, ZP_COHESION, ZP_DENSITY, ZP_SHEAR, ZP_TANDIL, ZP_TANFRIC, ZP_TENSION
 
 
 def angle_to_tangent(deg) -> np.ndarray | float:
@@ -50,13 +50,17 @@ def mohr_props_check(prop_rows: np.ndarray, ids=None, error=Dec3dError) -> list[
     """Check the Mohr-Coulomb columns of ``prop_rows`` (n, NZPROP), one row per Mohr-Coulomb
     zone; ``ids`` (n,) the zone ids used in messages (default 1..n). Raises ``error`` (a
     Dec3dError subclass, e.g. the engine's RunError) naming the zones and the property for:
-    cohesion < 0, friction < 0 or >= 90 degrees (tangent negative, infinite or NaN), dilation < 0
+    bulk, shear or density not > 0 (the elastic part), cohesion < 0, friction < 0 or >= 90 degrees (tangent negative, infinite or NaN), dilation < 0
     or above friction, tension < 0, any value not finite. Returns warnings (strings) for
     tensions above c / tan(phi) (the model uses the apex value)."""
     p = np.atleast_2d(np.asarray(prop_rows, dtype=float))
     ids = np.arange(1, len(p) + 1) if ids is None else np.asarray(ids)
     c, tf, t, td = p[:, ZP_COHESION], p[:, ZP_TANFRIC], p[:, ZP_TENSION], p[:, ZP_TANDIL]
     problems = []
+    for name, col in (("bulk", ZP_BULK), ("shear", ZP_SHEAR), ("density", ZP_DENSITY)):
+        bad = ~np.isfinite(p[:, col]) | (p[:, col] <= 0.0)
+        if bad.any():
+            problems.append(f"{name} must be > 0: {_which(ids, bad)}")
     for name, col, rule in (("cohesion", c, "must be a finite value >= 0 Pa"),
                             ("tension", t, "must be a finite value >= 0 Pa"),
                             ("friction", tf, "must be at least 0 and less than 90 degrees"),
