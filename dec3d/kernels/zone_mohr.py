@@ -248,15 +248,30 @@ def mohr_return(s, de, bulk, shear, coh, tanfric, ten, tandil):
 @njit(cache=True)
 def mohr_core(s, de, bulk, shear, coh, tanfric, ten, tandil, work):
     """``mohr_return`` with the scratch arrays ``work`` of ``mohr_work``."""
-    lam, vec, nn, dm, rr, act, mm, bb, x, sn = work
-    hooke_increment(s, de, bulk, shear)
+    if mohr_trial(s, de, bulk, shear, coh, tanfric, ten):
+        return 0, 0.0
+    return mohr_plastic(s, bulk, shear, coh, tanfric, ten, tandil, work)
+
+
+@njit(cache=True)
+def _strength(coh, tanfric, ten):
+    """(N_phi, 2 c sqrt(N_phi), sigma_t capped at the apex c / tan phi)."""
     sphi = tanfric / math.sqrt(1.0 + tanfric * tanfric)
     npf = (1.0 + sphi) / (1.0 - sphi)
-    rnp = math.sqrt(npf)
     ft = ten
     if tanfric > 0.0 and coh / tanfric < ft:
         ft = coh / tanfric
-    csn = 2.0 * coh * rnp
+    return npf, 2.0 * coh * math.sqrt(npf), ft
+
+
+@njit(cache=True)
+def mohr_trial(s, de, bulk, shear, coh, tanfric, ten):
+    """First half of ``mohr_core``: s += D:de (the elastic trial); True when the trial is clearly
+    elastic (then s is the new stress), False when ``mohr_plastic`` must finish the update.
+    Kept apart so that hot loops pass the scratch arrays (whose reference counting costs more
+    than this test) only for the zones near or at yield."""
+    hooke_increment(s, de, bulk, shear)
+    npf, csn, ft = _strength(coh, tanfric, ten)
     # clearly elastic: first from the bounds m - 2r <= s1, s3 <= m + 2r (r = sqrt(J2 / 3)), then
     # from the closed-form principal values (margin far above their round-off); no eigenvectors
     m = (s[0] + s[1] + s[2]) / 3.0
@@ -264,11 +279,17 @@ def mohr_core(s, de, bulk, shear, coh, tanfric, ten, tandil, work):
     r2 = 2.0 * math.sqrt((0.5 * (d0 * d0 + d1 * d1 + d2 * d2) + s[3] * s[3] + s[4] * s[4] + s[5] * s[5]) / 3.0)
     bscale = 3.0 * (abs(m) + r2) + coh + abs(ft)
     if (m + r2) * npf - (m - r2) - csn < -1e-7 * bscale and m + r2 - ft < -1e-7 * bscale:
-        return 0, 0.0
+        return True
     q1, q2, q3 = _principal_values(s)
     qscale = abs(q1) + abs(q2) + abs(q3) + coh + abs(ft)
-    if q3 * npf - q1 - csn < -1e-7 * qscale and q3 - ft < -1e-7 * qscale:
-        return 0, 0.0
+    return q3 * npf - q1 - csn < -1e-7 * qscale and q3 - ft < -1e-7 * qscale
+
+
+@njit(cache=True)
+def mohr_plastic(s, bulk, shear, coh, tanfric, ten, tandil, work):
+    """Second half of ``mohr_core``: the return of the trial stress s (in place); (bits, dsp)."""
+    npf, csn, ft = _strength(coh, tanfric, ten)
+    lam, vec, nn, dm, rr, act, mm, bb, x, sn = work
     sym_eig3(s, lam, vec)
     s1 = lam[0]; s3 = lam[2]
     spsi = tandil / math.sqrt(1.0 + tandil * tandil)
@@ -414,8 +435,11 @@ def tet_mohr_step(pos, vel, gp, rows, prop, dt, stress, state, force):
     for k in range(rows.shape[0]):
         z = rows[k]
         tet_kinematics(pos, vel, gp, z, dt, av, de, w)
-        bits, _dsp = mohr_core(stress[z], de, prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
-                               prop[z, ZP_TANFRIC], prop[z, ZP_TENSION], prop[z, ZP_TANDIL], work)
+        bits = 0
+        if not mohr_trial(stress[z], de, prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
+                          prop[z, ZP_TANFRIC], prop[z, ZP_TENSION]):
+            bits, _dsp = mohr_plastic(stress[z], prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
+                                      prop[z, ZP_TANFRIC], prop[z, ZP_TENSION], prop[z, ZP_TANDIL], work)
         state[z] = merge_state(state[z], bits)
         tet_add_forces(gp, z, av, stress[z], 1.0, force)
 
@@ -504,10 +528,14 @@ def zone_constitutive(rows, cmodel, prop, de, stress, state, dsp):
         if code == ZMODEL_ELASTIC:
             hooke_increment(stress[z], de[k], prop[z, ZP_BULK], prop[z, ZP_SHEAR])
         elif code == ZMODEL_MOHR:
-            bits, d = mohr_core(stress[z], de[k], prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
-                                prop[z, ZP_TANFRIC], prop[z, ZP_TENSION], prop[z, ZP_TANDIL], work)
-            state[z] = merge_state(state[z], bits)
-            dsp[k] = d
+            if mohr_trial(stress[z], de[k], prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
+                          prop[z, ZP_TANFRIC], prop[z, ZP_TENSION]):
+                state[z] = state[z] & (SHEAR_PAST | TENSION_PAST)
+            else:
+                bits, d = mohr_plastic(stress[z], prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
+                                       prop[z, ZP_TANFRIC], prop[z, ZP_TENSION], prop[z, ZP_TANDIL], work)
+                state[z] = merge_state(state[z], bits)
+                dsp[k] = d
 
 
 @njit(cache=True)

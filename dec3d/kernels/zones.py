@@ -65,7 +65,7 @@ def tet_elastic_step(pos, vel, gp, bulk, shear, dt, stress, force):
 
 # --- per-zone pieces shared by the constitutive kernels (kernels/zone_mohr.py) ---------------
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def tet_kinematics(pos, vel, gp, z, dt, av, de, w):
     """Strain increment of 4-node zone ``z`` (same formulas as ``tet_elastic_step``): fills
     ``av`` (4, 3) with the area vectors n^(n) S^(n) of the faces opposite nodes 0-3 (outward),
@@ -95,7 +95,7 @@ def tet_kinematics(pos, vel, gp, z, dt, av, de, w):
     return vol
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def tet_add_forces(gp, z, av, s, w, force):
     """Add the nodal forces w (1/3) sigma . n^(n) S^(n) of zone ``z`` with stress ``s`` (6,)
     and face area vectors ``av`` (4, 3) (from ``tet_kinematics``) to ``force`` (sign as
@@ -108,7 +108,7 @@ def tet_add_forces(gp, z, av, s, w, force):
         force[r, 2] += (s[4] * av[n, 0] + s[5] * av[n, 1] + s[2] * av[n, 2]) * w3
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def hooke_increment(s, de, bulk, shear):
     """s (6,) += D : de for isotropic elasticity (Eq. 59 of the 3DEC text, three-term Δε_v)."""
     ev = de[0] + de[1] + de[2]
