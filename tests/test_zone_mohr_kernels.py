@@ -737,3 +737,24 @@ def test_zone_forces_plastic_matches_twin():
         assert np.abs(mk - mt).max() < 1e-9 * mt.max()
         assert (stk[cm == 2] > 0).sum() >= 2 and (stk[cm == 1] == 0).all()
         assert np.abs(dsp).max() > 0
+
+
+@pytest.mark.parametrize("c, phi, ten, psi", [(1e6, 0.0, 0.0, 0.0),        # Tresca, no tension
+                                              (1e6, 0.0, 1e12, 0.0),       # Tresca
+                                              (0.0, 35.0, 0.0, 0.0),       # cohesionless sand
+                                              (0.5e6, 30.0, 0.2e6, 30.0),  # associated flow
+                                              (2e6, 89.0, 1e6, 0.0)])      # friction near 90
+def test_limiting_properties_match_twin_and_stay_finite(c, phi, ten, psi):
+    rng = np.random.default_rng(int(phi * 10 + psi))
+    tf, td = math.tan(math.radians(phi)), math.tan(math.radians(psi))
+    for _ in range(300):
+        R = _rand_rotation(rng)
+        s0 = _vec6(R @ np.diag(rng.uniform(-6e6, 1e5, 3)) @ R.T)
+        de = rng.normal(size=6) * 10 ** rng.uniform(-5, -3)
+        s_k, bits, dsp = zm.mohr_update(s0, de, K, G, c, tf, ten, td)
+        s_t, active, dsp_t, *_ = twin_mohr(s0, de, K, G, c, tf, ten, td)
+        scale = np.abs(s0).max() + np.abs(s_t).max() + c
+        assert np.all(np.isfinite(s_k)) and math.isfinite(dsp)
+        assert np.abs(s_k - s_t).max() <= 1e-9 * scale
+        fs, ft = _yield_values(s_k, c, tf, ten)
+        assert fs >= -1e-8 * scale and ft <= 1e-8 * scale
