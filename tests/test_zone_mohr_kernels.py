@@ -758,3 +758,34 @@ def test_limiting_properties_match_twin_and_stay_finite(c, phi, ten, psi):
         assert np.abs(s_k - s_t).max() <= 1e-9 * scale
         fs, ft = _yield_values(s_k, c, tf, ten)
         assert fs >= -1e-8 * scale and ft <= 1e-8 * scale
+
+
+def test_parallel_step_is_bit_identical_to_serial():
+    import numba
+    rng = np.random.default_rng(23)
+    pos, gp = _two_cubes(rng)
+    nzn, nv = len(gp), len(pos)
+    vel = rng.normal(size=(nv, 3)) * 3e-3
+    rows = np.arange(nzn, dtype=np.int64)
+    zset = np.array([0, 0, 0, 0, 0, -1, -1, -1, -1, -1], np.int64)
+    weight = np.where(zset >= 0, 0.5, 1.0)
+    node = np.arange(nv, dtype=np.int64); node[8] = 1                # one linked gridpoint
+    prop = _props(nzn, rng)
+    cm = np.array([2, 1, 2, 2, 1, 2, 1, 2, 2, 2], np.int8)
+    s0 = rng.normal(size=(nzn, 6)) * 2e5 + np.array([-1e6, -1e6, -1e6, 0, 0, 0])
+    fstart, fent = zm.node_lists4(nv, np.arange(nv, dtype=np.int64), gp, rows)
+    nstart, nent = zm.node_lists4(nv, node, gp, rows)
+    assert np.array_equal(np.bincount(gp.ravel(), minlength=nv), np.diff(fstart))
+    for large, nmd in ((False, False), (True, True)):
+        ref = [s0.copy(), np.zeros(nzn, np.int32), rng.normal(size=(nv, 3)), np.zeros(nv)]
+        ref[3][:] = 1.0
+        par = [a.copy() for a in ref]
+        zm.zone_forces_plastic(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd, *ref)
+        for nt in (1, 2):
+            out = [a.copy() for a in par]
+            numba.set_num_threads(min(nt, numba.config.NUMBA_NUM_THREADS))
+            zm.zone_forces_plastic_parallel(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd,
+                                            *out, fstart, fent, nstart, nent)
+            for a, b in zip(ref, out):
+                assert np.array_equal(a, b), (large, nmd, nt)
+        assert (ref[1] > 0).sum() >= 2

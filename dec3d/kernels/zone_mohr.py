@@ -49,7 +49,7 @@ Kernels may not import dec3d.model: the property columns and model codes below m
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from .zones import hooke_increment, tet_add_forces, tet_kinematics
 
@@ -674,3 +674,141 @@ def zone_forces_plastic(pos, vel, gp, rows, zset, weight, nset, node, cmodel, pr
             fz = (s[4] * av[k, n, 0] + s[5] * av[k, n, 1] + s[2] * av[k, n, 2]) * w
             force[r, 0] += fx; force[r, 1] += fy; force[r, 2] += fz
             fmag[r] += math.sqrt(fx * fx + fy * fy + fz * fz)
+
+
+# --- the same step on threads --------------------------------------------------------------
+
+@njit(cache=True)
+def node_lists4(ntarget, target, gp, rows):
+    """Per target t, the (zone entry, node) pairs that add to it, in a fixed order (CSR): the
+    entries of t are nent[nstart[t]:nstart[t + 1]], each 4 k + a (node a of zone rows[k]),
+    ascending: the order of the serial scatter. ``target`` maps a gridpoint row to its target:
+    the row itself (nodal forces) or the averaging node (NMD). Made once per mesh."""
+    m = rows.shape[0]
+    nstart = np.zeros(ntarget + 1, dtype=np.int64)
+    for k in range(m):
+        for a in range(4):
+            nstart[target[gp[rows[k], a]] + 1] += 1
+    for t in range(ntarget):
+        nstart[t + 1] += nstart[t]
+    fill = nstart[:ntarget].copy()
+    nent = np.empty(4 * m, dtype=np.int64)
+    for k in range(m):
+        for a in range(4):
+            t = target[gp[rows[k], a]]
+            nent[fill[t]] = 4 * k + a
+            fill[t] += 1
+    return nstart, nent
+
+
+@njit(cache=True, parallel=True)
+def _node_average_par(gp, rows, sel, node, vol, val, nstart, nent, nodesum, nodevol, out):
+    """``_node_average`` with the sums gathered per node in the fixed order of ``node_lists4``
+    (same bits as the serial scatter, any thread count)."""
+    for t in prange(nstart.shape[0] - 1):
+        a = 0.0
+        b = 0.0
+        for e in range(nstart[t], nstart[t + 1]):
+            k = nent[e] // 4
+            if sel[k]:
+                a += val[k] * vol[k]
+                b += vol[k]
+        nodesum[t] = a
+        nodevol[t] = b
+    for k in prange(rows.shape[0]):
+        if sel[k]:
+            z = rows[k]
+            acc = 0.0
+            for n in range(4):
+                m = node[gp[z, n]]
+                acc += nodesum[m] / nodevol[m]
+            out[k] = 0.25 * acc
+
+
+@njit(cache=True, parallel=True)
+def zone_forces_plastic_parallel(pos, vel, gp, rows, zset, weight, nset, node, cmodel, prop, dt, large, nmd,
+                                 stress, state, force, fmag, fstart, fent, nstart, nent):
+    """``zone_forces_plastic`` on threads, bit for bit the same result for any thread count:
+    zone passes in parallel, gridpoint sums gathered in the serial order. fstart/fent:
+    ``node_lists4(nvert, arange(nvert), gp, rows)``; nstart/nent: ``node_lists4(nvert, node, gp,
+    rows)`` (only read when ``nmd``)."""
+    nr = rows.shape[0]
+    de = np.empty((nr, 6))
+    vol = np.empty(nr)
+    av = np.empty((nr, 4, 3))
+    spin = np.empty((nr, 3))
+    dsp = np.zeros(nr)
+    for k in prange(nr):
+        vol[k] = tet_kinematics(pos, vel, gp, rows[k], dt, av[k], de[k], spin[k])
+    sv = np.zeros(nset)
+    ss = np.zeros(nset)
+    free = np.empty(nr, np.bool_)
+    ev = np.empty(nr)
+    for k in range(nr):
+        ev[k] = de[k, 0] + de[k, 1] + de[k, 2]
+        h = zset[k]
+        free[k] = h < 0
+        if h >= 0:
+            sv[h] += ev[k] * vol[k]
+            ss[h] += vol[k]
+    bar = ev.copy()
+    for k in range(nr):
+        h = zset[k]
+        if h >= 0 and ss[h] > 0.0:
+            bar[k] = sv[h] / ss[h]
+    nsz = nstart.shape[0] - 1
+    nodesum = np.empty(max(nsz, 0))
+    nodevol = np.empty(max(nsz, 0))
+    if nmd:
+        _node_average_par(gp, rows, free, node, vol, ev, nstart, nent, nodesum, nodevol, bar)
+    for k in prange(nr):
+        shift = (bar[k] - ev[k]) / 3.0
+        de[k, 0] += shift; de[k, 1] += shift; de[k, 2] += shift
+        if large:
+            jaumann_rotate(stress[rows[k]], spin[k, 0], spin[k, 1], spin[k, 2])
+    # constitutive pass in chunks, one scratch set per chunk
+    nch = 64
+    for ch in prange(nch):
+        work = mohr_work()
+        for k in range(ch * nr // nch, (ch + 1) * nr // nch):
+            z = rows[k]
+            code = cmodel[z]
+            if code == ZMODEL_ELASTIC:
+                hooke_increment(stress[z], de[k], prop[z, ZP_BULK], prop[z, ZP_SHEAR])
+            elif code == ZMODEL_MOHR:
+                if mohr_trial(stress[z], de[k], prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
+                              prop[z, ZP_TANFRIC], prop[z, ZP_TENSION]):
+                    state[z] = state[z] & (SHEAR_PAST | TENSION_PAST)
+                else:
+                    bits, d = mohr_plastic(stress[z], prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
+                                           prop[z, ZP_TANFRIC], prop[z, ZP_TENSION], prop[z, ZP_TANDIL], work)
+                    state[z] = merge_state(state[z], bits)
+                    dsp[k] = d
+    md_stress_average(rows, zset, nset, vol, dsp, stress)
+    if nmd:
+        pb = dsp.copy()
+        _node_average_par(gp, rows, free, node, vol, dsp, nstart, nent, nodesum, nodevol, pb)
+        for k in prange(nr):
+            if free[k]:
+                z = rows[k]
+                c = dsp[k] - pb[k]
+                stress[z, 0] += c; stress[z, 1] += c; stress[z, 2] += c
+    zf = np.empty((nr, 4, 3))
+    zm_ = np.empty((nr, 4))
+    for k in prange(nr):
+        z = rows[k]
+        s = stress[z]
+        w = weight[k] / 3.0
+        for n in range(4):
+            fx = (s[0] * av[k, n, 0] + s[3] * av[k, n, 1] + s[4] * av[k, n, 2]) * w
+            fy = (s[3] * av[k, n, 0] + s[1] * av[k, n, 1] + s[5] * av[k, n, 2]) * w
+            fz = (s[4] * av[k, n, 0] + s[5] * av[k, n, 1] + s[2] * av[k, n, 2]) * w
+            zf[k, n, 0] = fx; zf[k, n, 1] = fy; zf[k, n, 2] = fz
+            zm_[k, n] = math.sqrt(fx * fx + fy * fy + fz * fz)
+    for r in prange(fstart.shape[0] - 1):
+        f0 = force[r, 0]; f1 = force[r, 1]; f2 = force[r, 2]; fm = fmag[r]
+        for e in range(fstart[r], fstart[r + 1]):
+            k = fent[e] // 4
+            n = fent[e] - 4 * k
+            f0 += zf[k, n, 0]; f1 += zf[k, n, 1]; f2 += zf[k, n, 2]; fm += zm_[k, n]
+        force[r, 0] = f0; force[r, 1] = f1; force[r, 2] = f2; fmag[r] = fm
