@@ -71,6 +71,14 @@ ZP_TENSION = 5
 ZP_TANDIL = 6
 NZPROP = 8
 
+#: plastic state bits of ``zones.state`` (Itasca's shear-n, tension-n, shear-p, tension-p):
+#: "now" bits are set by the step that yielded and cleared by the next step that does not,
+#: "past" bits stay once set
+ZSTATE_SHEAR_NOW = 1
+ZSTATE_TENSION_NOW = 2
+ZSTATE_SHEAR_PAST = 4
+ZSTATE_TENSION_PAST = 8
+
 #: stress components in store order
 STRESS_COMPONENTS = ("xx", "yy", "zz", "xy", "xz", "yz")
 
