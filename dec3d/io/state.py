@@ -393,6 +393,8 @@ def _settings_problem(d: dict) -> str | None:
               "timestep": lambda v: v is None or (_is_num(v) and v >= 0),
               "scale_timestep": lambda v: v is None or (_is_num(v) and v > 0),
               "servo": lambda v: isinstance(v, list) and len(v) <= 2**20 and all(_is_num(x) for x in v),
+              "dt_run": lambda v: isinstance(v, list) and (v == [] or (len(v) == 2 and _is_num(v[0]) and v[0] > 0
+                                                                        and _is_int(v[1]) and v[1] >= 0)),
               "props": lambda v: isinstance(v, dict) and all(isinstance(k, str) and _is_num(x) for k, x in v.items()),
               "signature": lambda v: isinstance(v, list) and all(_is_int(x) for x in v),
               "mtables": lambda v: isinstance(v, list) and all(_mtable_ok(t) for t in v),
