@@ -1,0 +1,218 @@
+"""Zoning blocks of the model (``block zone generate``): the mesher of ``dec3d.geometry.zoning``
+applied block by block, conformingly across joined blocks.
+
+Joined blocks (same ``blocks.leader``) are one continuum: when a block is zoned after a joined
+neighbour, the neighbour's gridpoints on the common boundary are taken over (tetrahedra: the
+regular triangulation then gives the same facet triangles; hexahedra: coinciding points snap to
+the neighbour's exact coordinates), and after each command ``relink`` points every duplicate
+gridpoint row of a joined set at its master, the lowest row at that position
+(``vertices.link``, the contract of ``dec3d.model.zones``). ``conformity`` checks the result:
+every surface triangle of a block lying on a joined neighbour must be a triangle of that
+neighbour too (same master gridpoints)."""
+from __future__ import annotations
+
+import numpy as np
+
+from dec3d.geometry.assemble import block_poly
+from dec3d.geometry.errors import GeometryError
+from dec3d.geometry.zoning import face_planes, inside, mesh_convex, mesh_hex, to_high_order
+from .store import Field
+from .zones import install_block_mesh, zone_stores
+
+
+def _ensure(model):
+    zs = zone_stores(model)
+    if "zlength" not in model.blocks:
+        # edge length a block was zoned with (its regular-triangulation weights scale with it)
+        model.blocks.add_field("zlength", Field((), np.float64, 0.0))
+    return zs
+
+
+def zoned_blocks(model) -> np.ndarray:
+    """Mask over blocks: blocks that have zones."""
+    out = np.zeros(model.blocks.n, bool)
+    if "zones" in model.stores:
+        zs = model.store("zones")
+        out[zs["block"][: zs.n]] = True
+    return out
+
+
+def _bid(model, row: int) -> str:
+    b = model.blocks
+    return f"block {int(b['id'][row])}" if "id" in b else f"block row {row}"
+
+
+def _hull(model, row: int):
+    """Face planes (unique) and gridpoints of a block."""
+    b = model.blocks
+    poly = block_poly(model, row)
+    N, D = face_planes(poly.vertices, poly.face_ptr, poly.face_idx)
+    key = np.round(np.c_[N, D] * 1e9)
+    _, first = np.unique(key, axis=0, return_index=True)
+    v0, nv = int(b["vert_start"][row]), int(b["vert_count"][row])
+    return N[first], D[first], model.vertices["pos"][v0:v0 + nv].copy()
+
+
+def _zoned_partners(model, row: int) -> list[int]:
+    b = model.blocks
+    lead = b["leader"][: b.n]
+    zoned = zoned_blocks(model)
+    cand = np.flatnonzero((lead == lead[row]) & zoned)
+    cand = cand[cand != row]
+    if not len(cand):
+        return []
+    vs = model.vertices["pos"]
+    v0, nv = int(b["vert_start"][row]), int(b["vert_count"][row])
+    lo, hi = vs[v0:v0 + nv].min(axis=0), vs[v0:v0 + nv].max(axis=0)
+    pad = 1e-6 * float(np.linalg.norm(hi - lo))
+    out = []
+    for r in cand:
+        a0, an = int(b["vert_start"][r]), int(b["vert_count"][r])
+        plo, phi = vs[a0:a0 + an].min(axis=0), vs[a0:a0 + an].max(axis=0)
+        if (plo <= hi + pad).all() and (phi >= lo - pad).all():
+            out.append(int(r))
+    return out
+
+
+def zone_tetra(model, rows, L: float) -> int:
+    """4-node tetrahedral zoning at edge length L of the unzoned blocks ``rows``; returns zones made."""
+    _ensure(model)
+    made = 0
+    for r in rows:
+        neigh = []
+        for p in _zoned_partners(model, r):
+            N, D, pts = _hull(model, p)
+            neigh.append((N, D, pts, float(model.blocks["zlength"][p]) or L))
+        poly = block_poly(model, r)
+        pts, tets, tris, src = mesh_convex(poly.vertices, poly.face_ptr, poly.face_idx, L, neighbours=neigh)
+        install_block_mesh(model, r, pts, tets, tris, src)
+        model.blocks["zlength"][r] = L
+        made += len(tets)
+    relink(model)
+    return made
+
+
+def zone_hexahedra(model, rows, divisions) -> int:
+    """Hexahedral mixed zoning (n1 n2 n3 cells) of the unzoned blocks ``rows``."""
+    _ensure(model)
+    polys = []
+    for r in rows:  # check every block before zoning any
+        poly = block_poly(model, r)
+        try:
+            from dec3d.geometry.zoning import hex_corners
+            hex_corners(poly.vertices, poly.face_ptr, poly.face_idx, _bid(model, r))
+        except GeometryError:
+            raise
+        polys.append(poly)
+    made = 0
+    for r in rows:
+        snap = [_hull(model, p)[2] for p in _zoned_partners(model, r)]
+        poly = block_poly(model, r)
+        pts, tets, hexid, overlay, tris, src = mesh_hex(poly.vertices, poly.face_ptr, poly.face_idx, divisions,
+                                                        _bid(model, r), np.concatenate(snap) if snap else None)
+        install_block_mesh(model, r, pts, tets, tris, src, hexid, overlay)
+        ext = poly.vertices.max(axis=0) - poly.vertices.min(axis=0)
+        model.blocks["zlength"][r] = float(np.mean(ext / np.asarray(divisions, float)))
+        made += len(tets)
+    relink(model)
+    return made
+
+
+def convert_high_order(model, rows) -> int:
+    """Make the 4-node tetrahedral zones of blocks ``rows`` 10-node ones (blocks already of
+    10-node zones are left as they are); returns the number of zones converted."""
+    zs = _ensure(model)
+    b, f = model.blocks, model.faces
+    done = 0
+    for r in rows:
+        zrow = np.flatnonzero(zs["block"][: zs.n] == r)
+        if not len(zrow) or (zs["nnode"][zrow] == 10).all():
+            continue
+        if (zs["hex"][zrow] >= 0).any():
+            raise GeometryError(f"{_bid(model, r)} has hexahedral zones: high-order-tetra converts "
+                                "4-node tetrahedral zones only")
+        v0, nv = int(b["vert_start"][r]), int(b["vert_count"][r])
+        pts = model.vertices["pos"][v0:v0 + nv].copy()
+        tets = zs["gp"][zrow, :4] - v0
+        f0, fc = int(b["face_start"][r]), int(b["face_count"][r])
+        tris = model.face_vertices["vertex"][f["vstart"][f0:f0 + fc][:, None] + np.arange(3)[None, :]] - v0
+        source = f["source"][f0:f0 + fc].copy()
+        keep_fields = {k: zs[k][zrow].copy() for k in ("cmodel", "prop", "stress", "state", "group")}
+        p10, t10, sub, parent = to_high_order(pts, tets, tris)
+        keep = np.ones(zs.n, bool)
+        keep[zrow] = False
+        zs.compact(keep)
+        sl = install_block_mesh(model, r, p10, t10, sub, source[parent], face_rows=f0 + parent)
+        for k, val in keep_fields.items():
+            zs[k][sl] = val
+        zs["gstress"][sl] = zs["stress"][sl][:, None, :]
+        done += len(zrow)
+    relink(model)
+    return done
+
+
+def relink(model) -> int:
+    """Point each duplicate gridpoint of a joined set (same coordinates, another zoned block of
+    the same leader) at its master, the lowest row; returns the number of links."""
+    if "zones" not in model.stores:
+        return 0
+    v, b = model.vertices, model.blocks
+    link = v["link"]
+    zoned = zoned_blocks(model)
+    link[v["zoned"]] = -1
+    lead = b["leader"][: b.n]
+    n = 0
+    for ld in np.unique(lead[zoned]):
+        rows = np.flatnonzero(zoned & (lead == ld))
+        if len(rows) < 2:
+            continue
+        gp = np.concatenate([np.arange(b["vert_start"][r], b["vert_start"][r] + b["vert_count"][r]) for r in rows])
+        pos = v["pos"][gp] + 0.0
+        _, inv = np.unique(pos, axis=0, return_inverse=True)
+        inv = inv.ravel()
+        master = np.full(inv.max() + 1, np.iinfo(np.int64).max)
+        np.minimum.at(master, inv, gp)
+        m = master[inv]
+        dup = m != gp
+        link[gp[dup]] = m[dup]
+        n += int(dup.sum())
+    return n
+
+
+def conformity(model) -> dict:
+    """Check joined zoned blocks: for every pair of joined zoned blocks, the surface triangles of
+    one lying on the other (centroid on its boundary) must be triangles of the other with the
+    same master gridpoints. Returns {"pairs": pairs in contact, "triangles": triangles checked,
+    "unmatched": [(block id, neighbour id, count)], "link_gap": largest distance between a
+    linked gridpoint and its master}."""
+    v, b, f = model.vertices, model.blocks, model.faces
+    out = {"pairs": 0, "triangles": 0, "unmatched": [], "link_gap": 0.0}
+    if "zones" not in model.stores:
+        return out
+    link = v["link"]
+    lk = np.flatnonzero(link >= 0)
+    if len(lk):
+        out["link_gap"] = float(np.linalg.norm(v["pos"][lk] - v["pos"][link[lk]], axis=1).max())
+    master = np.where(link >= 0, link, np.arange(v.n))
+    zoned = np.flatnonzero(zoned_blocks(model))
+    tri, keys = {}, {}
+    for r in zoned:
+        f0, fc = int(b["face_start"][r]), int(b["face_count"][r])
+        nodes = model.face_vertices["vertex"][f["vstart"][f0:f0 + fc][:, None] + np.arange(3)[None, :]]
+        tri[r] = nodes
+        keys[r] = set(map(tuple, np.sort(master[nodes], axis=1).tolist()))
+    for r in zoned:
+        for p in _zoned_partners(model, int(r)):
+            N, D, pts = _hull(model, p)
+            ext = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+            cen = v["pos"][tri[r]].mean(axis=1)
+            on = inside(cen, N, D, 1e-9 * ext)
+            if not on.any():
+                continue
+            out["pairs"] += 1
+            k = np.sort(master[tri[r][on]], axis=1)
+            out["triangles"] += int(on.sum())
+            miss = sum(1 for t in map(tuple, k.tolist()) if t not in keys[p])
+            if miss:
+                out["unmatched"].append((_bid(model, int(r)), _bid(model, p), miss))
+    return out
