@@ -33,6 +33,11 @@ import numpy as np
 
 from .errors import GeometryError
 
+#: tetrahedra with a smallest dihedral angle below this (degrees) are broken up by interior points
+SLIVER_DEG = 15.0
+#: at most this many rounds of adding points and triangulating again
+SLIVER_PASSES = 5
+
 #: weight of a point in the regular triangulation: this fraction of (its edge length)², times a
 #: hash of its position in [0, 1)
 WEIGHT_FRACTION = 1e-3
@@ -174,17 +179,85 @@ def mesh_convex(verts: np.ndarray, ptr: np.ndarray, loops: np.ndarray, L: float,
     _, first = np.unique(np.round(pts / (1e-9 * L)).astype(np.int64), axis=0, return_index=True)
     first = np.sort(first)
     pts, sc = pts[first], sc[first]
-    tets = regular_tets(pts, L, sc)
+    tets = _positive(pts, regular_tets(pts, L, sc), L)
+    best = (_quality(pts, tets), pts, tets)
+    for _ in range(SLIVER_PASSES):
+        extra = _sliver_points(pts, tets, N, D, L)
+        if not len(extra):
+            break
+        pts = np.concatenate([pts, extra])
+        sc = np.concatenate([sc, np.full(len(extra), L)])
+        tets = _positive(pts, regular_tets(pts, L, sc), L)
+        q = _quality(pts, tets)
+        if q > best[0]:
+            best = (q, pts, tets)
+    _, pts, tets = best                 # the best round (fewest slivers, then largest smallest angle)
+    tris = boundary_tris(tets)
+    cen = pts[tris].mean(axis=1)
+    src = np.argmin(np.abs(cen @ N.T - D), axis=1)
+    return pts, tets, tris, src
+
+
+def _positive(pts, tets, L):
+    """Drop flat tetrahedra (volume below 1e-10 L³) and orient the rest positive."""
     a, b, c, d = (pts[tets[:, k]] for k in range(4))
     vol = np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a) / 6.0
     keep = np.abs(vol) > 1e-10 * L ** 3
     tets, vol = tets[keep], vol[keep]
     neg = vol < 0
     tets[neg] = tets[neg][:, [0, 2, 1, 3]]
-    tris = boundary_tris(tets)
-    cen = pts[tris].mean(axis=1)
-    src = np.argmin(np.abs(cen @ N.T - D), axis=1)
-    return pts, tets, tris, src
+    return tets
+
+
+def tet_min_dihedral(pts: np.ndarray, tets: np.ndarray) -> np.ndarray:
+    """Smallest dihedral angle (radians) of each tetrahedron."""
+    p = pts[tets[:, :4]]
+    opp = [(1, 2, 3), (0, 3, 2), (0, 1, 3), (0, 2, 1)]
+    n = np.stack([np.cross(p[:, b] - p[:, a], p[:, c] - p[:, a]) for a, b, c in opp], axis=1)
+    n /= np.linalg.norm(n, axis=2, keepdims=True)
+    best = np.full(len(tets), np.pi)
+    for i in range(4):
+        for j in range(i + 1, 4):
+            cosang = np.clip(np.einsum("ij,ij->i", n[:, i], n[:, j]), -1, 1)
+            best = np.minimum(best, np.pi - np.arccos(cosang))
+    return best
+
+
+def _quality(pts, tets):
+    """Ordering of meshes for sliver removal: fewer tetrahedra below SLIVER_DEG first, then a
+    larger smallest angle."""
+    d = tet_min_dihedral(pts, tets)
+    return (-int((d < np.radians(SLIVER_DEG)).sum()), float(d.min(initial=np.pi)))
+
+
+def _sliver_points(pts, tets, N, D, L):
+    """Interior points that break up the tetrahedra whose smallest dihedral angle is below
+    SLIVER_DEG: each one's circumcentre, or its centroid when the circumcentre is not well inside
+    the block; kept only when at least 0.15 L inside the block and 0.3 L from every point. Added
+    points are interior, so the facet triangulations (and the conformity of joined blocks) stay."""
+    from scipy.spatial import cKDTree
+    bad = np.flatnonzero(tet_min_dihedral(pts, tets) < np.radians(SLIVER_DEG))
+    if not len(bad):
+        return np.zeros((0, 3))
+    p = pts[tets[bad]]
+    a = p[:, 0]
+    A = p[:, 1:] - a[:, None, :]
+    rhs = 0.5 * np.einsum("ijk,ijk->ij", A, A)
+    det = np.linalg.det(A)
+    ok = np.abs(det) > 1e-14 * L ** 3
+    cc = np.tile(p.mean(axis=1), (1, 1)).copy()
+    cc[ok] = a[ok] + np.linalg.solve(A[ok], rhs[ok][..., None])[..., 0]
+    cand = np.where(((cc @ N.T - D) < -0.15 * L).all(axis=1)[:, None], cc, p.mean(axis=1))
+    cand = cand[((cand @ N.T - D) < -0.15 * L).all(axis=1)]
+    if not len(cand):
+        return cand
+    far = cKDTree(pts).query(cand)[0] > 0.3 * L
+    cand = cand[far]
+    out = []
+    for q in cand[np.lexsort(cand.T[::-1])]:
+        if all(np.linalg.norm(q - r) > 0.3 * L for r in out):
+            out.append(q)
+    return np.array(out).reshape(-1, 3)
 
 
 def boundary_tris(tets: np.ndarray) -> np.ndarray:
