@@ -68,3 +68,40 @@ def test_sliver_removal_keeps_surface_and_volume(monkeypatch):
         assert (vol > 0).all() and abs(vol.sum() - V) < 1e-12 * V
     key = lambda p, s: {tuple(sorted(map(tuple, p[x].tolist()))) for x in s}
     assert len(p1) > len(p0) and key(p0, s0) == key(p1, s1)
+
+
+def _tet_keys(p, t):
+    return {tuple(sorted(map(tuple, np.round(p[x] / 1e-12).astype(np.int64).tolist()))) for x in t}
+
+
+def test_structured_interior_equals_one_hull(monkeypatch):
+    """The fast path (cells deep inside take the five-tetrahedron split, the hull only for the
+    rest) against its slow twin (one hull over all points): the same tetrahedra, for a brick and
+    a sheared block, before sliver removal (which then acts on the same mesh)."""
+    import dec3d.geometry.zoning as z
+    monkeypatch.setattr(z, "SLIVER_PASSES", 0)
+    cases = [(_brick(1.0, 0.7, 1.3), 0.09),
+             (_parallelepiped(np.array([1.3, 0, 0]), np.array([0.37, 1.1, 0.1]), np.array([0.15, 0.3, 0.9])), 0.07)]
+    for (v, ptr, loops), L in cases:
+        pf, tf, sf, _ = z.mesh_convex(v, ptr, loops, L, fast=True)
+        ps, ts, ss, _ = z.mesh_convex(v, ptr, loops, L, fast=False)
+        assert len(tf) > 3000
+        assert _tet_keys(pf, tf) == _tet_keys(ps, ts)
+        assert _tet_keys(pf, sf) == _tet_keys(ps, ss)
+
+
+def test_five_split_of_the_lattice():
+    """Deep inside a brick every lattice cell is split in five: the central tetrahedron on the
+    corners of odd parity (a regular tetrahedron of edge L*sqrt(2), volume L^3/3) and four corner
+    tetrahedra (volume L^3/6 each)."""
+    L = 0.1
+    v, ptr, loops = _brick(1.0, 1.0, 1.0)
+    pts, tets, _, _ = mesh_convex(v, ptr, loops, L)
+    p = pts[tets]
+    deep = (np.abs(p - 0.5) < 0.2).all(axis=(1, 2))
+    vol = np.einsum("ij,ij->i", np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), p[:, 3] - p[:, 0]) / 6
+    assert deep.sum() >= 5 * 27
+    v_deep = np.sort(vol[deep])
+    assert np.allclose(np.unique(np.round(v_deep / L ** 3, 12)), [1 / 6, 1 / 3])
+    assert abs((np.isclose(v_deep, L ** 3 / 3)).sum() * 4 - (np.isclose(v_deep, L ** 3 / 6)).sum()) <= 8
+    assert min_dihedral_deg(pts, tets[deep]) > 54.7   # arccos(1/sqrt 3) = 54.74 at the corner tetrahedra

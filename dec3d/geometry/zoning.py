@@ -128,19 +128,109 @@ def boundary_points(verts: np.ndarray, ptr: np.ndarray, loops: np.ndarray, L: fl
     return np.concatenate(pts)
 
 
-def regular_tets(pts: np.ndarray, L: float, scale: np.ndarray | float | None = None) -> np.ndarray:
+def regular_tets(pts: np.ndarray, L: float, scale: np.ndarray | float | None = None,
+                 weight: np.ndarray | None = None) -> np.ndarray:
     """The regular triangulation of ``pts`` as the lower hull of the lifted points
-    ``|p - c|² + W(p)`` (in units of L²), ``W = WEIGHT_FRACTION · scale² · position_hash(p)``:
-    lattice input is cospherical everywhere and the weights break the ties without moving any
-    point; coplanar points never form a tetrahedron (their lifted facet would be vertical)."""
+    ``|p - c|² + W(p)`` (in units of L²). ``W`` is ``weight`` [m²] when given, else
+    ``WEIGHT_FRACTION · scale² · position_hash(p)``: lattice input is cospherical everywhere
+    and the weights break the ties without moving any point; coplanar points never form a
+    tetrahedron (their lifted facet would be vertical)."""
     from scipy.spatial import ConvexHull
-    scale = L if scale is None else scale
+    if weight is None:
+        scale = L if scale is None else scale
+        weight = WEIGHT_FRACTION * np.asarray(scale, float) ** 2 * position_hash(pts)
     c = pts.mean(axis=0)
     q = (pts - c) / L
-    w = WEIGHT_FRACTION * (np.asarray(scale, float) / L) ** 2 * position_hash(pts)
-    lifted = np.c_[q, np.einsum("ij,ij->i", q, q) + w]
+    lifted = np.c_[q, np.einsum("ij,ij->i", q, q) + np.asarray(weight, float) / L ** 2]
     hull = ConvexHull(lifted, qhull_options="Qt Qbb")
     return hull.simplices[hull.equations[:, 3] < 0].astype(np.int64)
+
+
+#: weight of the even lattice points ((i + j + k) even), in L²: makes the regular triangulation of
+#: the lattice the five-tetrahedron split of every cell (the central tetrahedron on the odd corners)
+PARITY_WEIGHT = 0.05
+#: plus this much (in L²) times the position hash: equal parity weights leave exact ties (an even
+#: pair and three odd points in a plane along the pair lift onto one hyperplane) that become hull
+#: facets next to the boundary, where qhull would split them into flat tetrahedra; far below the
+#: 2·PARITY_WEIGHT margin of the five-tetrahedron split, so that split stays exact
+LATTICE_JITTER = 1e-4
+#: lattice points farther than this (in L) from every other point are triangulated by that
+#: split directly (no hull computation); the test compares with the full hull
+DEEP = 2.5
+
+
+def _five_split(cells: np.ndarray, lat_id: np.ndarray) -> np.ndarray:
+    """The five tetrahedra of each lattice cell (i, j, k) (m, 3): the central one on the corners of
+    odd parity, one at each even corner with its three edge neighbours. ``lat_id`` maps a lattice
+    index to a point row."""
+    out = []
+    for par_cell in (0, 1):
+        c = cells[cells.sum(axis=1) % 2 == par_cell]
+        # local corners (a, b, d) of odd global parity: (par_cell + a + b + d) odd
+        for tet in _five(1 - par_cell):
+            out.append(np.stack([lat_id[c[:, 0] + a, c[:, 1] + b, c[:, 2] + d] for a, b, d in tet], axis=1))
+    return np.concatenate(out) if out else np.zeros((0, 4), np.int64)
+
+
+def triangulate(pts: np.ndarray, W: np.ndarray, L: float, lat: tuple | None = None, fast: bool = True):
+    """Regular triangulation of ``pts`` with absolute weights ``W``. ``lat``: ``(start, index, shape)``
+    when rows ``start .. start + len(index)`` are lattice points with integer indices ``index`` in a
+    lattice of ``shape`` cells of size L (their weights the parity weights). With ``fast`` the cells
+    around lattice points far (``DEEP`` L) from every non-lattice point take the five-tetrahedron
+    split directly and only the rest goes through the hull: the same triangulation, faster."""
+    if lat is None or not fast:
+        return regular_tets(pts, L, weight=W)
+    from scipy.spatial import cKDTree
+    start, idx, shape = lat
+    ng = len(idx)
+    other = np.r_[np.arange(start), np.arange(start + ng, len(pts))]
+    if ng == 0 or len(other) == 0:
+        return regular_tets(pts, L, weight=W)
+    present = np.zeros(shape, bool)
+    present[idx[:, 0], idx[:, 1], idx[:, 2]] = True
+    lat_id = np.full(shape, -1, np.int64)
+    lat_id[idx[:, 0], idx[:, 1], idx[:, 2]] = start + np.arange(ng)
+    # complete cells: all eight corners present
+    sx, sy, sz = shape
+    cell = np.ones((sx - 1, sy - 1, sz - 1), bool) if min(shape) > 1 else np.zeros((0, 0, 0), bool)
+    if cell.size:
+        for a in (0, 1):
+            for b in (0, 1):
+                for d in (0, 1):
+                    cell &= present[a:sx - 1 + a, b:sy - 1 + b, d:sz - 1 + d]
+    far = cKDTree(pts[other]).query(pts[start:start + ng], distance_upper_bound=DEEP * L)[0] > DEEP * L
+    deep = np.zeros(shape, bool)
+    deep[idx[:, 0], idx[:, 1], idx[:, 2]] = far
+    # a deep point needs its eight cells complete
+    cp = np.zeros((sx + 1, sy + 1, sz + 1), bool)
+    if cell.size:
+        cp[1:sx, 1:sy, 1:sz] = cell
+    allc = np.ones(shape, bool)
+    for a in (0, 1):
+        for b in (0, 1):
+            for d in (0, 1):
+                allc &= cp[a:sx + a, b:sy + b, d:sz + d]
+    deep &= allc
+    if not deep.any():
+        return regular_tets(pts, L, weight=W)
+    # structured cells: complete cells with a deep corner
+    scell = np.zeros(cell.shape, bool)
+    for a in (0, 1):
+        for b in (0, 1):
+            for d in (0, 1):
+                scell |= deep[a:sx - 1 + a, b:sy - 1 + b, d:sz - 1 + d]
+    scell &= cell
+    keep_pt = np.ones(len(pts), bool)
+    keep_pt[lat_id[deep]] = False
+    rows = np.flatnonzero(keep_pt)
+    t = rows[regular_tets(pts[rows], L, weight=W[rows])]
+    # drop the hull's tetrahedra spanning the structured region (their centroid lies in it)
+    origin = pts[start] - idx[0] * L
+    ci = np.floor((pts[t].mean(axis=1) - origin) / L).astype(np.int64)
+    inr = ((ci >= 0) & (ci < np.array(scell.shape))).all(axis=1)
+    drop = np.zeros(len(t), bool)
+    drop[inr] = scell[ci[inr, 0], ci[inr, 1], ci[inr, 2]]
+    return np.concatenate([t[~drop], _five_split(np.argwhere(scell), lat_id)])
 
 
 def inside(pts: np.ndarray, N: np.ndarray, D: np.ndarray, tol: float) -> np.ndarray:
@@ -150,13 +240,14 @@ def inside(pts: np.ndarray, N: np.ndarray, D: np.ndarray, tol: float) -> np.ndar
     return (pts @ N.T - D <= tol).all(axis=1)
 
 
-def mesh_convex(verts: np.ndarray, ptr: np.ndarray, loops: np.ndarray, L: float, neighbours=()):
+def mesh_convex(verts: np.ndarray, ptr: np.ndarray, loops: np.ndarray, L: float, neighbours=(), fast: bool = True):
     """points (n,3), tets (m,4) positive, boundary tris (k,3), tri_source (k,) face index.
 
     ``neighbours``: already zoned joined blocks as ``(N, D, points, length)`` (face planes, all
     gridpoints, the edge length their weights were made with). Their points on this block's
     boundary are taken over (same coordinates, same weights), this block's own boundary points
-    inside them dropped, so the shared facets are triangulated alike."""
+    inside them dropped, so the shared facets are triangulated alike. ``fast``: see ``triangulate``
+    (False: one hull over all points, the slow twin of the tests)."""
     verts = np.asarray(verts, float)
     bp = boundary_points(verts, ptr, loops, L)
     N, D = face_planes(verts, ptr, loops)
@@ -172,26 +263,47 @@ def mesh_convex(verts: np.ndarray, ptr: np.ndarray, loops: np.ndarray, L: float,
             adopted.append((q, np.full(len(q), float(nlen))))
     lo, hi = verts.min(axis=0), verts.max(axis=0)
     axes = [np.arange(lo[d] + 0.5 * L, hi[d], L) for d in range(3)]
+    shape = tuple(len(a) for a in axes)
+    I = np.array(np.meshgrid(*[np.arange(n) for n in shape], indexing="ij")).reshape(3, -1).T
     G = np.array(np.meshgrid(*axes, indexing="ij")).reshape(3, -1).T
-    G = G[np.all(G @ N.T - D < -0.5 * L, axis=1)]
-    pts = np.concatenate([q for q, _ in adopted] + own + [G])
-    sc = np.concatenate([s for _, s in adopted] + scale + [np.full(len(G), L)])
-    _, first = np.unique(np.round(pts / (1e-9 * L)).astype(np.int64), axis=0, return_index=True)
+    inner = np.all(G @ N.T - D < -0.5 * L, axis=1)
+    G, I = G[inner], I[inner]
+    B = np.concatenate([q for q, _ in adopted] + own)
+    sc = np.concatenate([s for _, s in adopted] + scale)
+    _, first = np.unique(np.round(B / (1e-9 * L)).astype(np.int64), axis=0, return_index=True)
     first = np.sort(first)
-    pts, sc = pts[first], sc[first]
-    tets = _positive(pts, regular_tets(pts, L, sc), L)
-    best = (_quality(pts, tets), pts, tets)
+    B, sc = B[first], sc[first]
+    pts = np.concatenate([B, G])
+    W = np.concatenate([WEIGHT_FRACTION * sc ** 2 * position_hash(B),
+                        L ** 2 * (PARITY_WEIGHT * (I.sum(axis=1) % 2 == 0) + LATTICE_JITTER * position_hash(G))])
+    nb, ng = len(B), len(G)
+    alive = np.ones(len(pts), bool)
+
+    def run():
+        sel = np.flatnonzero(alive)
+        lat = (nb, I[alive[nb:nb + ng]], shape)
+        t = _positive(pts[sel], triangulate(pts[sel], W[sel], L, lat, fast), L)
+        return sel[t]
+
+    tets = run()
+    best = (_quality(pts, tets), alive.copy(), tets)
     for _ in range(SLIVER_PASSES):
-        extra = _sliver_points(pts, tets, N, D, L)
-        if not len(extra):
+        extra, drop = _sliver_fix(pts, tets, nb, N, D, L)
+        if not len(extra) and not len(drop):
             break
+        alive[drop] = False
         pts = np.concatenate([pts, extra])
-        sc = np.concatenate([sc, np.full(len(extra), L)])
-        tets = _positive(pts, regular_tets(pts, L, sc), L)
+        W = np.concatenate([W, WEIGHT_FRACTION * L ** 2 * position_hash(extra)])
+        alive = np.r_[alive, np.ones(len(extra), bool)]
+        tets = run()
         q = _quality(pts, tets)
         if q > best[0]:
-            best = (q, pts, tets)
-    _, pts, tets = best                 # the best round (fewest slivers, then largest smallest angle)
+            best = (q, alive.copy(), tets)
+    _, alive, tets = best               # the best round (fewest slivers, then largest smallest angle)
+    keep = np.flatnonzero(alive[:len(pts)] if len(alive) >= len(pts) else np.r_[alive, np.zeros(len(pts) - len(alive), bool)])
+    newrow = np.full(len(pts), -1, np.int64)
+    newrow[keep] = np.arange(len(keep))
+    pts, tets = pts[keep], newrow[tets]
     tris = boundary_tris(tets)
     cen = pts[tris].mean(axis=1)
     src = np.argmin(np.abs(cen @ N.T - D), axis=1)
@@ -227,46 +339,74 @@ def _quality(pts, tets):
     """Ordering of meshes for sliver removal: fewer tetrahedra below SLIVER_DEG first, then a
     larger smallest angle."""
     d = tet_min_dihedral(pts, tets)
-    return (-int((d < np.radians(SLIVER_DEG)).sum()), float(d.min(initial=np.pi)))
+    return (float(d.min(initial=np.pi)), -int((d < np.radians(SLIVER_DEG)).sum()))
 
 
-def _sliver_points(pts, tets, N, D, L):
-    """Interior points that break up the tetrahedra whose smallest dihedral angle is below
-    SLIVER_DEG: each one's circumcentre, or its centroid when the circumcentre is not well inside
-    the block; kept only when at least 0.15 L inside the block and 0.3 L from every point. Added
-    points are interior, so the facet triangulations (and the conformity of joined blocks) stay."""
+def _sliver_fix(pts, tets, nb, N, D, L):
+    """Changes that break up the tetrahedra whose smallest dihedral angle is below SLIVER_DEG,
+    touching interior points only (rows from ``nb`` on), so the facet triangulations (and the
+    conformity of joined blocks) stay: a sliver gets a point at its circumcentre, or its centroid
+    when the circumcentre is not well inside, kept only when at least 0.15 L inside the block and
+    0.3 L from every point; failing that, it loses its interior corner nearest the boundary when
+    that is within 1.5 L of it. Returns (new points, rows to drop)."""
     from scipy.spatial import cKDTree
     bad = np.flatnonzero(tet_min_dihedral(pts, tets) < np.radians(SLIVER_DEG))
     if not len(bad):
-        return np.zeros((0, 3))
-    p = pts[tets[bad]]
+        return np.zeros((0, 3)), np.zeros(0, np.int64)
+    tb = tets[bad]
+    p = pts[tb]
     a = p[:, 0]
     A = p[:, 1:] - a[:, None, :]
     rhs = 0.5 * np.einsum("ijk,ijk->ij", A, A)
-    det = np.linalg.det(A)
-    ok = np.abs(det) > 1e-14 * L ** 3
-    cc = np.tile(p.mean(axis=1), (1, 1)).copy()
+    ok = np.abs(np.linalg.det(A)) > 1e-14 * L ** 3
+    cc = p.mean(axis=1)
     cc[ok] = a[ok] + np.linalg.solve(A[ok], rhs[ok][..., None])[..., 0]
     cand = np.where(((cc @ N.T - D) < -0.15 * L).all(axis=1)[:, None], cc, p.mean(axis=1))
-    cand = cand[((cand @ N.T - D) < -0.15 * L).all(axis=1)]
-    if not len(cand):
-        return cand
-    far = cKDTree(pts).query(cand)[0] > 0.3 * L
-    cand = cand[far]
-    out = []
-    for q in cand[np.lexsort(cand.T[::-1])]:
-        if all(np.linalg.norm(q - r) > 0.3 * L for r in out):
-            out.append(q)
-    return np.array(out).reshape(-1, 3)
+    good = ((cand @ N.T - D) < -0.15 * L).all(axis=1)
+    good[good] = cKDTree(pts).query(cand[good])[0] > 0.3 * L
+    cand = cand[good]
+    # the rest lose their interior corner nearest the boundary, when it is within 1.5 L of it
+    depth = -(p[~good] @ N.T - D).max(axis=2)
+    depth = np.where(tb[~good] >= nb, depth, np.inf)
+    near = depth.min(axis=1) < 1.5 * L
+    drop = np.unique(tb[~good][near, np.argmin(depth[near], axis=1)])
+    if len(cand):
+        # one point per cluster: greedy in a fixed order, via neighbour lists
+        cand = cand[np.lexsort(cand.T[::-1])]
+        taken = np.ones(len(cand), bool)
+        for i, js in enumerate(cKDTree(cand).query_ball_point(cand, 0.3 * L)):
+            if taken[i]:
+                for j in js:
+                    if j > i:
+                        taken[j] = False
+        cand = cand[taken]
+    return cand.reshape(-1, 3), drop
+
+
+def _row_keys(rows: np.ndarray) -> np.ndarray:
+    """One int64 per row of small non-negative integers (sorted rows of 2 or 3), equal rows alike."""
+    n = int(rows.max(initial=0)) + 1
+    k = rows[:, 0].astype(np.int64)
+    if n ** rows.shape[1] >= 2 ** 62:
+        _, inv = np.unique(rows, axis=0, return_inverse=True)
+        return inv.ravel().astype(np.int64)
+    for j in range(1, rows.shape[1]):
+        k = k * n + rows[:, j]
+    return k
 
 
 def boundary_tris(tets: np.ndarray) -> np.ndarray:
     """Faces of positive tetrahedra that belong to one tetrahedron only, counter-clockwise seen
     from outside."""
     faces = np.concatenate([tets[:, [1, 2, 3]], tets[:, [0, 3, 2]], tets[:, [0, 1, 3]], tets[:, [0, 2, 1]]])
-    key = np.sort(faces, axis=1)
-    _, inv, cnt = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-    return faces[cnt[inv.ravel()] == 1]
+    key = _row_keys(np.sort(faces, axis=1))
+    order = np.argsort(key, kind="stable")
+    ks = key[order]
+    single = np.ones(len(ks), bool)
+    same = ks[1:] == ks[:-1]
+    single[1:] &= ~same
+    single[:-1] &= ~same
+    return faces[np.sort(order[single])]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -455,7 +595,8 @@ def to_high_order(pts: np.ndarray, tets: np.ndarray, tris: np.ndarray):
     tets = np.asarray(tets, np.int64)[:, :4]
     e = np.concatenate([tets[:, list(p)] for p in HO_EDGES])
     e = np.sort(e, axis=1)
-    uniq, inv = np.unique(e, axis=0, return_inverse=True)
+    _, first, inv = np.unique(_row_keys(e), return_index=True, return_inverse=True)
+    uniq = e[first]
     inv = inv.ravel()
     mid = 0.5 * (pts[uniq[:, 0]] + pts[uniq[:, 1]])
     n = len(pts)
