@@ -105,3 +105,29 @@ def test_five_split_of_the_lattice():
     assert np.allclose(np.unique(np.round(v_deep / L ** 3, 12)), [1 / 6, 1 / 3])
     assert abs((np.isclose(v_deep, L ** 3 / 3)).sum() * 4 - (np.isclose(v_deep, L ** 3 / 6)).sum()) <= 8
     assert min_dihedral_deg(pts, tets[deep]) > 54.7   # arccos(1/sqrt 3) = 54.74 at the corner tetrahedra
+
+
+def test_regular_tets_against_plain_lower_hull():
+    """regular_tets (with its far cap points) against a plain lower hull of the lifted points,
+    written here from the definition: the same tetrahedra once flat ones are dropped."""
+    from scipy.spatial import ConvexHull
+
+    from dec3d.geometry.zoning import boundary_points, position_hash, regular_tets
+    v, ptr, loops = _brick(1.0, 0.6, 0.8)
+    L = 0.15
+    pts = boundary_points(v, ptr, loops, L)
+    g = np.arange(0.1, 0.95, L)
+    inner = np.array([[x, y, z] for x in g for y in g if y < 0.5 for z in g if z < 0.7])
+    pts = np.unique(np.r_[pts, inner], axis=0)
+    W = 1e-3 * L ** 2 * position_hash(pts)
+    mine = regular_tets(pts, L, weight=W)
+    lift = np.c_[pts, (pts ** 2).sum(axis=1) + W]
+    h = ConvexHull(lift, qhull_options="Qt")
+    plain = h.simplices[h.equations[:, 3] < 0]
+
+    def solid(t):
+        p = pts[t]
+        vol = np.einsum("ij,ij->i", np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), p[:, 3] - p[:, 0])
+        return {tuple(sorted(x)) for x in t[np.abs(vol) > 1e-9].tolist()}
+    assert len(solid(mine)) > 500
+    assert solid(mine) == solid(plain)
