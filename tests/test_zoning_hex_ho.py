@@ -8,6 +8,7 @@ import pytest
 from dec3d.errors import Dec3dError
 from dec3d.geometry.errors import GeometryError
 from dec3d.geometry.zoning import mesh_hex
+from dec3d.model.zone_mesh import conformity
 
 
 def _tet_vol(p, t):
@@ -215,3 +216,46 @@ def test_high_order_with_edgelength_and_errors(session):
         session.command("block zone generate high-order-tetra")
     with pytest.raises(Dec3dError, match="cannot be combined"):
         session.command("block zone generate hexahedra divisions 1 1 1 high-order-tetra")
+
+
+def test_mesh_quality_of_a_hexahedral_cube(session):
+    """One unit-cube hexahedron: corner tetrahedra are trirectangular (edges 1 and sqrt 2, smallest
+    dihedral angle arccos(1/sqrt 3) = 54.7356 degrees, volume 1/6), the central one regular."""
+    from dec3d.model.zone_mesh import mesh_quality
+    session.command("block create brick 0 1 0 1 0 1\nblock zone generate hexahedra divisions 1 1 1")
+    q = mesh_quality(session.model)
+    assert q["zones"] == 1 and q["tetrahedra"] == 10 and q["gridpoints"] == 8
+    assert abs(q["edge_min"] - 1.0) < 1e-15 and abs(q["edge_max"] - np.sqrt(2)) < 1e-15
+    assert abs(q["dihedral_min"] - np.degrees(np.arccos(1 / np.sqrt(3)))) < 1e-9
+    assert abs(q["volume_min"] - 1 / 6) < 1e-15
+    assert mesh_quality(session.model, block_rows=[5])["zones"] == 0
+
+
+@pytest.mark.parametrize("line,msg", [
+    ("block zone generate divisions 2 2 2", "`divisions` goes with `hexahedra`"),
+    ("block zone generate", "needs edgelength"),
+    ("block zone generate hexahedra divisions 2 2 2 edgelength 0.5", "cannot be combined"),
+    ("block zone generate hexahedra divisions 400 400 400", r"would make about 6\.4e\+08 zones"),
+    ("block zone generate hexahedra divisions 2 2", "expected 3 numbers, got 2"),
+    ("block zone generate hexahedra divisions 2 0 2", "divisions"),
+])
+def test_generate_bad_input(session, line, msg):
+    session.command("block create brick 0 1 0 1 0 1")
+    with pytest.raises(Dec3dError, match=msg):
+        session.command(line)
+    assert "zones" not in session.model.stores or session.model.store("zones").n == 0
+
+
+def test_zoned_joined_model_save_restore(session, tmp_path):
+    session.command("block create brick 0 1 0 1 0 1\nblock create brick 1 2 0 1 0 1\nblock join on\n"
+                    "block zone generate edgelength 0.3 range pos-x 0 1\nblock zone generate edgelength 0.5\n"
+                    f"model save '{tmp_path / 'z.sav'}'")
+    m = session.model
+    before = (m.vertices["link"][: m.vertices.n].copy(), m.store("zones")["gp"][: m.store("zones").n].copy(),
+              m.blocks["zlength"][: m.blocks.n].copy())
+    session.command(f"model new\nmodel restore '{tmp_path / 'z.sav'}'")
+    m = session.model
+    assert np.array_equal(m.vertices["link"][: m.vertices.n], before[0])
+    assert np.array_equal(m.store("zones")["gp"][: m.store("zones").n], before[1])
+    assert np.array_equal(m.blocks["zlength"][: m.blocks.n], before[2])
+    assert conformity(m)["unmatched"] == [] and conformity(m)["pairs"] == 2
