@@ -116,7 +116,7 @@ def test_fine_then_coarse_joined_bricks(session):
                     "block zone generate edgelength 0.35")
     m = session.model
     assert check_joined_conforming(m) > 2 * 25         # at least the fine 5 x 5 face, two triangles a cell
-    assert conformity(m)["unmatched"] == []
+    assert conformity(m)["unmatched"] == [] and "warning" not in session.output.getvalue()
     # the coarse neighbour took the fine block's points on x = 1
     pos = m.vertices["pos"]
     b = m.blocks
@@ -172,3 +172,17 @@ def test_position_hash_depends_on_position_only():
     # spread: mean of many hashes near 1/2
     q = np.random.default_rng(1).uniform(-5, 5, (20000, 3))
     assert abs(position_hash(q).mean() - 0.5) < 0.01
+
+
+def test_mixed_styles_warn(session):
+    """A tetrahedral block joined to a hexahedral one: the quad diagonals and the regular
+    triangulation need not agree; the command says so with file:line."""
+    session.command("block create brick 0 1 0 1 0 1\nblock create brick 1 2 0 1 0 1\nblock join on\n"
+                    "block zone generate hexahedra divisions 3 3 3 range pos-x 0 1\n"
+                    "block zone generate edgelength 0.3")
+    rep = conformity(session.model)
+    out = session.output.getvalue()
+    assert rep["pairs"] == 2 and rep["unmatched"]                # this case does not conform (8 triangles)
+    assert "warning: " in out and ":5:" in out and "do not share all surface triangles" in out
+    # the gridpoints still coincide and are linked
+    assert rep["link_gap"] == 0.0 and (session.model.vertices["link"] >= 0).sum() == 16

@@ -40,7 +40,7 @@ _TETS_PER_CELL = 6.0
                    "block zone generate hexahedra divisions 2 5 12", "block zone generate high-order-tetra"])
 def block_zone_generate(session, call):
     from ..errors import Dec3dError
-    from ..model.zone_mesh import convert_high_order, zone_hexahedra, zone_tetra, zoned_blocks
+    from ..model.zone_mesh import conformity, convert_high_order, zone_hexahedra, zone_tetra, zoned_blocks
     a = call.args
     L = a["edgelength"] if a["edgelength"] is not None else a["edge_length"]
     hexa, divs, ho = a["hexahedra"], a["divisions"], a["high_order_tetra"]
@@ -82,3 +82,10 @@ def block_zone_generate(session, call):
             convert_high_order(model, [int(r) for r in inrange])
     except Dec3dError as exc:
         raise exc.with_location(call.location)
+    rep = conformity(model)
+    if rep["unmatched"]:
+        pairs = ", ".join(f"{a} / {b} ({n})" for a, b, n in rep["unmatched"][:4])
+        more = f" and {len(rep['unmatched']) - 4} more" if len(rep["unmatched"]) > 4 else ""
+        session.write(f"warning: {call.location}: joined blocks do not share all surface triangles on their "
+                      f"common faces (block / neighbour (triangles): {pairs}{more}); they will not act as one "
+                      "continuum there (zone them in one style, tetrahedra or hexahedra, with matching faces)")

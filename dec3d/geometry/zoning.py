@@ -523,7 +523,6 @@ def mesh_hex(verts: np.ndarray, ptr: np.ndarray, loops: np.ndarray, divisions, l
 
     tets, hexid, overlay = [], [], []
     patterns = {p: _five(p) for p in (0, 1)}
-    h = 0
     I, J, K = np.meshgrid(np.arange(n1), np.arange(n2), np.arange(n3), indexing="ij")
     I, J, K = I.ravel(), J.ravel(), K.ravel()
     cellpar = (I + J + K) % 2
@@ -556,7 +555,7 @@ def mesh_hex(verts: np.ndarray, ptr: np.ndarray, loops: np.ndarray, divisions, l
     neg = vol < 0
     tets[neg] = tets[neg][:, [0, 2, 1, 3]]
     # boundary quadrilaterals of the cell grid, two triangles each
-    tris, quads_src = _hex_surface(pts, n1, n2, n3, gid)
+    tris = _hex_surface(pts, n1, n2, n3, gid)
     N, D = face_planes(verts, ptr, loops)
     cen = pts[tris].mean(axis=1)
     src = np.argmin(np.abs(cen @ N.T - D), axis=1)
@@ -592,7 +591,7 @@ def _hex_surface(pts, n1, n2, n3, gid):
         q = np.roll(quads[r], -f)
         tris.append((q[0], q[1], q[2]))
         tris.append((q[0], q[2], q[3]))
-    return np.array(tris, np.int64), None
+    return np.array(tris, np.int64)
 
 
 # ---------------------------------------------------------------------------------------------

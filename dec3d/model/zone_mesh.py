@@ -15,7 +15,7 @@ import numpy as np
 
 from dec3d.geometry.assemble import block_poly
 from dec3d.geometry.errors import GeometryError
-from dec3d.geometry.zoning import face_planes, inside, mesh_convex, mesh_hex, to_high_order
+from dec3d.geometry.zoning import face_planes, hex_corners, inside, mesh_convex, mesh_hex, to_high_order
 from .store import Field
 from .zones import install_block_mesh, zone_stores
 
@@ -95,15 +95,9 @@ def zone_tetra(model, rows, L: float) -> int:
 def zone_hexahedra(model, rows, divisions) -> int:
     """Hexahedral mixed zoning (n1 n2 n3 cells) of the unzoned blocks ``rows``."""
     _ensure(model)
-    polys = []
     for r in rows:  # check every block before zoning any
         poly = block_poly(model, r)
-        try:
-            from dec3d.geometry.zoning import hex_corners
-            hex_corners(poly.vertices, poly.face_ptr, poly.face_idx, _bid(model, r))
-        except GeometryError:
-            raise
-        polys.append(poly)
+        hex_corners(poly.vertices, poly.face_ptr, poly.face_idx, _bid(model, r))
     made = 0
     for r in rows:
         snap = [_hull(model, p)[2] for p in _zoned_partners(model, r)]
