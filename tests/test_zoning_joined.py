@@ -186,3 +186,23 @@ def test_mixed_styles_warn(session):
     assert "warning: " in out and ":5:" in out and "do not share all surface triangles" in out
     # the gridpoints still coincide and are linked
     assert rep["link_gap"] == 0.0 and (session.model.vertices["link"] >= 0).sum() == 16
+
+
+@pytest.mark.parametrize("first", ["range pos-x 0 1", "range pos-x 1 2"])
+def test_t_junction_joined_faces(session, first):
+    """Block A's face x = 1 (y from 0 to 2) is shared half by B (y < 1) and half by C (y > 1).
+    Zoned A first, A puts points along y = 1 (where B's and C's faces end) so that no triangle
+    crosses it; zoned B and C first, A takes over both sets of points. Either way the faces
+    conform and every block keeps its volume (no corner lost)."""
+    session.command("block create brick 0 1 0 2 0 1\nblock create brick 1 2 0 1 0 1\nblock create brick 1 2 1 2 0 1\n"
+                    f"block join on\nblock zone generate edgelength 0.23 {first}\nblock zone generate edgelength 0.31")
+    m = session.model
+    assert check_joined_conforming(m) > 30
+    rep = conformity(m)
+    assert rep["unmatched"] == [] and rep["pairs"] == 6
+    zs, b = m.store("zones"), m.blocks
+    vol = zs["volume"][:zs.n]
+    assert (vol > 0).all()
+    for r, expect in ((0, 2.0), (1, 1.0), (2, 1.0)):
+        assert abs(vol[zs["block"][:zs.n] == r].sum() - expect) < 1e-12
+    assert "warning" not in session.output.getvalue()

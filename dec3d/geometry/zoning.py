@@ -255,27 +255,53 @@ def inside(pts: np.ndarray, N: np.ndarray, D: np.ndarray, tol: float) -> np.ndar
     return (pts @ N.T - D <= tol).all(axis=1)
 
 
-def mesh_convex(verts: np.ndarray, ptr: np.ndarray, loops: np.ndarray, L: float, neighbours=(), fast: bool = True):
+def mesh_convex(verts: np.ndarray, ptr: np.ndarray, loops: np.ndarray, L: float, neighbours=(), fast: bool = True,
+                imprint=()):
     """points (n,3), tets (m,4) positive, boundary tris (k,3), tri_source (k,) face index.
 
     ``neighbours``: already zoned joined blocks as ``(N, D, points, length)`` (face planes, all
     gridpoints, the edge length their weights were made with). Their points on this block's
     boundary are taken over (same coordinates, same weights), this block's own boundary points
-    inside them dropped, so the shared facets are triangulated alike. ``fast``: see ``triangulate``
-    (False: one hull over all points, the slow twin of the tests)."""
+    inside them dropped (but never a corner of the block the neighbour lacks), so the shared facets
+    are triangulated alike. ``imprint``: segments (k, 2, 3) on this block's faces where faces of
+    joined blocks still to be zoned end (see ``dec3d.model.zone_mesh``). ``fast``: see
+    ``triangulate`` (False: one hull over all points, the slow twin of the tests)."""
     verts = np.asarray(verts, float)
     bp = boundary_points(verts, ptr, loops, L)
     N, D = face_planes(verts, ptr, loops)
     tol = 1e-6 * L
+    corner = np.zeros(len(bp), bool)
+    corner[:len(verts)] = True
+    if len(imprint):
+        # lines where unzoned joined neighbours' faces end on this block's faces: points along them
+        # (so that the later neighbours find them and the triangles do not cross the lines), and
+        # this block's other boundary points kept 0.6 L away from them
+        segs = np.asarray(imprint, float).reshape(-1, 2, 3)
+        # ends that are this block's own corners add nothing
+        pointlike = np.linalg.norm(segs[:, 1] - segs[:, 0], axis=1) <= tol
+        at_corner = np.linalg.norm(segs[:, None, 0] - verts[None], axis=2).min(axis=1) <= tol
+        segs = segs[~(pointlike & at_corner)]
+    if len(imprint) and len(segs):
+        ip = [segs.reshape(-1, 3)] + [_edge_points(a, b, L) for a, b in segs]
+        ip = np.concatenate(ip)
+        near = _segment_distance(bp, segs) < 0.6 * L
+        keep = ~near | corner
+        bp, corner = np.concatenate([bp[keep], ip]), np.r_[corner[keep], np.zeros(len(ip), bool)]
     scale = [np.full(len(bp), L)]
     own = [bp]
     adopted = []
     for nN, nD, npts, nlen in neighbours:
-        keep = ~inside(own[0], nN, nD, tol)
-        own[0], scale[0] = own[0][keep], scale[0][keep]
         q = npts[inside(npts, N, D, tol)]
+        gone = inside(own[0], nN, nD, tol)
         if len(q):
             adopted.append((q, np.full(len(q), float(nlen))))
+            # a corner of this block inside the neighbour stays unless the neighbour has it
+            from scipy.spatial import cKDTree
+            has = cKDTree(q).query(own[0][corner], distance_upper_bound=tol)[0] <= tol
+            gone[np.flatnonzero(corner)[~has]] = False
+        else:
+            gone &= ~corner
+        own[0], scale[0], corner = own[0][~gone], scale[0][~gone], corner[~gone]
     lo, hi = verts.min(axis=0), verts.max(axis=0)
     axes = [np.arange(lo[d] + 0.5 * L, hi[d], L) for d in range(3)]
     shape = tuple(len(a) for a in axes)
@@ -323,6 +349,61 @@ def mesh_convex(verts: np.ndarray, ptr: np.ndarray, loops: np.ndarray, L: float,
     cen = pts[tris].mean(axis=1)
     src = np.argmin(np.abs(cen @ N.T - D), axis=1)
     return pts, tets, tris, src
+
+
+def _segment_distance(p: np.ndarray, segs: np.ndarray) -> np.ndarray:
+    """Distance of each point (n, 3) to the nearest of the segments (k, 2, 3)."""
+    best = np.full(len(p), np.inf)
+    for a, b in segs:
+        d = b - a
+        t = np.clip((p - a) @ d / max(float(d @ d), 1e-300), 0.0, 1.0)
+        best = np.minimum(best, np.linalg.norm(p - (a + t[:, None] * d), axis=1))
+    return best
+
+
+def imprint_segments(verts, ptr, loops, other_verts, other_ptr, other_loops, tol: float) -> np.ndarray:
+    """Segments (k, 2, 3) of the edges of another convex polyhedron's faces lying on this one's
+    faces (coplanar, opposite normals), clipped to the face, leaving out those along this face's own
+    edges; a clipped end on this face's boundary is kept as a zero-length segment (a point)."""
+    N, D = face_planes(verts, ptr, loops)
+    oN, oD = face_planes(other_verts, other_ptr, other_loops)
+    out = []
+    for f in range(len(ptr) - 1):
+        for g in range(len(other_ptr) - 1):
+            if N[f] @ oN[g] > -1 + 1e-9 or abs(D[f] + oD[g]) > tol:
+                continue
+            P = verts[loops[ptr[f]:ptr[f + 1]]]
+            m = len(P)
+            inward = [np.cross(N[f], P[(i + 1) % m] - P[i]) for i in range(m)]
+            inward = [w / np.linalg.norm(w) for w in inward]
+            Q = other_verts[other_loops[other_ptr[g]:other_ptr[g + 1]]]
+            for i in range(len(Q)):
+                a, b = Q[i], Q[(i + 1) % len(Q)]
+                t0, t1 = 0.0, 1.0
+                for k in range(m):
+                    da, db = inward[k] @ (a - P[k]), inward[k] @ (b - P[k])
+                    if da < -tol and db < -tol:
+                        t0, t1 = 1.0, 0.0
+                        break
+                    if (da < -tol) != (db < -tol):
+                        t = da / (da - db)
+                        if da < -tol:
+                            t0 = max(t0, t)
+                        else:
+                            t1 = min(t1, t)
+                if t1 < t0:
+                    continue
+                pa = a if t0 == 0.0 else a + t0 * (b - a)
+                pb = b if t1 == 1.0 else a + t1 * (b - a)
+                on_edge = any(abs(inward[k] @ (pa - P[k])) <= tol and abs(inward[k] @ (pb - P[k])) <= tol
+                              for k in range(m))
+                if on_edge:
+                    out += [(pa, pa), (pb, pb)]
+                else:
+                    out.append((pa, pb))
+    if not out:
+        return np.zeros((0, 2, 3))
+    return np.array(out, float)
 
 
 def _positive(pts, tets, L):

@@ -15,7 +15,8 @@ import numpy as np
 
 from dec3d.geometry.assemble import block_poly
 from dec3d.geometry.errors import GeometryError
-from dec3d.geometry.zoning import face_planes, hex_corners, inside, mesh_convex, mesh_hex, to_high_order
+from dec3d.geometry.zoning import (face_planes, hex_corners, imprint_segments, inside, mesh_convex, mesh_hex,
+                                   to_high_order)
 from .store import Field
 from .zones import install_block_mesh, zone_stores
 
@@ -54,10 +55,15 @@ def _hull(model, row: int):
 
 
 def _zoned_partners(model, row: int) -> list[int]:
+    zoned = zoned_blocks(model)
+    return [p for p in _joined_near(model, row) if zoned[p]]
+
+
+def _joined_near(model, row: int) -> list[int]:
+    """Blocks joined to ``row`` whose extents touch its own."""
     b = model.blocks
     lead = b["leader"][: b.n]
-    zoned = zoned_blocks(model)
-    cand = np.flatnonzero((lead == lead[row]) & zoned)
+    cand = np.flatnonzero(lead == lead[row])
     cand = cand[cand != row]
     if not len(cand):
         return []
@@ -84,7 +90,16 @@ def zone_tetra(model, rows, L: float) -> int:
             N, D, pts = _hull(model, p)
             neigh.append((N, D, pts, float(model.blocks["zlength"][p]) or L))
         poly = block_poly(model, r)
-        pts, tets, tris, src = mesh_convex(poly.vertices, poly.face_ptr, poly.face_idx, L, neighbours=neigh)
+        segs = []
+        zoned = zoned_blocks(model)
+        for p in _joined_near(model, r):
+            if not zoned[p]:
+                o = block_poly(model, p)
+                segs.append(imprint_segments(poly.vertices, poly.face_ptr, poly.face_idx, o.vertices, o.face_ptr,
+                                             o.face_idx, 1e-6 * L))
+        segs = np.concatenate(segs) if segs else np.zeros((0, 2, 3))
+        pts, tets, tris, src = mesh_convex(poly.vertices, poly.face_ptr, poly.face_idx, L, neighbours=neigh,
+                                           imprint=segs)
         install_block_mesh(model, r, pts, tets, tris, src)
         model.blocks["zlength"][r] = L
         made += len(tets)
