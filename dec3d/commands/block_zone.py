@@ -34,7 +34,9 @@ _TETS_PER_CELL = 6.0
                  "edge midpoint, each surface triangle split in four; with `edgelength L` the unzoned "
                  "blocks are zoned first. Joined blocks (`block join`) are zoned conformingly: a block zoned "
                  "after a joined neighbour takes over the neighbour's gridpoints on their common faces, "
-                 "and the copies are linked to one master gridpoint. A zoning that would make more than "
+                 "and the copies are linked to one master gridpoint; a warning names the blocks when "
+                 "shared faces do not end up with the same triangles (tetrahedra against hexahedra, "
+                 "different divisions). A zoning that would make more than "
                  "20 million zones is refused before anything is allocated.",
          examples=["block zone generate edgelength 0.5", "block zone generate edge-length 0.2 range pos-x 0 1",
                    "block zone generate hexahedra divisions 2 5 12", "block zone generate high-order-tetra"])
