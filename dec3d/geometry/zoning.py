@@ -71,14 +71,20 @@ def _face_frame(p: np.ndarray):
 
 
 def face_planes(verts: np.ndarray, ptr: np.ndarray, loops: np.ndarray):
-    """Outward unit normals (f, 3) and offsets (f,) of a polyhedron's faces."""
-    N, D = [], []
-    for f in range(len(ptr) - 1):
-        p = verts[loops[ptr[f]:ptr[f + 1]]]
-        n, _, _ = _face_frame(p)
-        N.append(n)
-        D.append(float((p @ n).mean()))
-    return np.array(N), np.array(D)
+    """Outward unit normals (f, 3) and offsets (f,) of a polyhedron's faces (Newell's normal of
+    each loop, offset the mean over its corners)."""
+    verts = np.asarray(verts, float)
+    ptr = np.asarray(ptr, np.int64)
+    loops = np.asarray(loops, np.int64)
+    cnt = np.diff(ptr)
+    pos = np.arange(len(loops))
+    face = np.repeat(np.arange(len(cnt)), cnt)
+    nxt = np.where(pos + 1 < ptr[face + 1], pos + 1, ptr[face])
+    a, b = verts[loops], verts[loops[nxt]]
+    n = np.add.reduceat(np.cross(a, b), ptr[:-1], axis=0)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    d = np.add.reduceat(np.einsum("ij,ij->i", a, n[face]), ptr[:-1]) / cnt
+    return n, d
 
 
 def _edge_points(pa: np.ndarray, pb: np.ndarray, L: float) -> np.ndarray:

@@ -54,45 +54,55 @@ def _hull(model, row: int):
     return N[first], D[first], model.vertices["pos"][v0:v0 + nv].copy()
 
 
-def _zoned_partners(model, row: int) -> list[int]:
-    zoned = zoned_blocks(model)
-    return [p for p in _joined_near(model, row) if zoned[p]]
+def _zoned_partners(model, row: int, boxes=None, zoned=None) -> list[int]:
+    zoned = zoned_blocks(model) if zoned is None else zoned
+    return [p for p in _joined_near(model, row, boxes) if zoned[p]]
 
 
-def _joined_near(model, row: int) -> list[int]:
-    """Blocks joined to ``row`` whose extents touch its own."""
+def _boxes(model):
+    """Lower and upper corners (n, 3) of every block's vertices."""
+    b, v = model.blocks, model.vertices
+    st, ct = b["vert_start"][: b.n], b["vert_count"][: b.n]
+    order = np.argsort(st)
+    pos = v["pos"]
+    lo = np.empty((b.n, 3))
+    hi = np.empty((b.n, 3))
+    idx = np.concatenate([np.arange(st[r], st[r] + ct[r]) for r in order]) if b.n else np.zeros(0, np.int64)
+    starts = np.concatenate(([0], np.cumsum(ct[order])[:-1])) if b.n else np.zeros(0, np.int64)
+    if b.n:
+        lo[order] = np.minimum.reduceat(pos[idx], starts, axis=0)
+        hi[order] = np.maximum.reduceat(pos[idx], starts, axis=0)
+    return lo, hi
+
+
+def _joined_near(model, row: int, boxes=None) -> list[int]:
+    """Blocks joined to ``row`` whose extents touch its own (``boxes``: ``_boxes`` when known)."""
     b = model.blocks
     lead = b["leader"][: b.n]
     cand = np.flatnonzero(lead == lead[row])
     cand = cand[cand != row]
     if not len(cand):
         return []
-    vs = model.vertices["pos"]
-    v0, nv = int(b["vert_start"][row]), int(b["vert_count"][row])
-    lo, hi = vs[v0:v0 + nv].min(axis=0), vs[v0:v0 + nv].max(axis=0)
-    pad = 1e-6 * float(np.linalg.norm(hi - lo))
-    out = []
-    for r in cand:
-        a0, an = int(b["vert_start"][r]), int(b["vert_count"][r])
-        plo, phi = vs[a0:a0 + an].min(axis=0), vs[a0:a0 + an].max(axis=0)
-        if (plo <= hi + pad).all() and (phi >= lo - pad).all():
-            out.append(int(r))
-    return out
+    lo, hi = boxes if boxes is not None else _boxes(model)
+    pad = 1e-6 * float(np.linalg.norm(hi[row] - lo[row]))
+    ok = (lo[cand] <= hi[row] + pad).all(axis=1) & (hi[cand] >= lo[row] - pad).all(axis=1)
+    return [int(r) for r in cand[ok]]
 
 
 def zone_tetra(model, rows, L: float) -> int:
     """4-node tetrahedral zoning at edge length L of the unzoned blocks ``rows``; returns zones made."""
     _ensure(model)
     made = 0
+    boxes = _boxes(model)
+    zoned = zoned_blocks(model)
     for r in rows:
         neigh = []
-        for p in _zoned_partners(model, r):
+        for p in _zoned_partners(model, r, boxes, zoned):
             N, D, pts = _hull(model, p)
             neigh.append((N, D, pts, float(model.blocks["zlength"][p]) or L))
         poly = block_poly(model, r)
         segs = []
-        zoned = zoned_blocks(model)
-        for p in _joined_near(model, r):
+        for p in _joined_near(model, r, boxes):
             if not zoned[p]:
                 o = block_poly(model, p)
                 segs.append(imprint_segments(poly.vertices, poly.face_ptr, poly.face_idx, o.vertices, o.face_ptr,
@@ -101,6 +111,7 @@ def zone_tetra(model, rows, L: float) -> int:
         pts, tets, tris, src = mesh_convex(poly.vertices, poly.face_ptr, poly.face_idx, L, neighbours=neigh,
                                            imprint=segs)
         install_block_mesh(model, r, pts, tets, tris, src)
+        zoned[r] = True
         model.blocks["zlength"][r] = L
         made += len(tets)
     relink(model)
@@ -114,12 +125,15 @@ def zone_hexahedra(model, rows, divisions) -> int:
         poly = block_poly(model, r)
         hex_corners(poly.vertices, poly.face_ptr, poly.face_idx, _bid(model, r))
     made = 0
+    boxes = _boxes(model)
+    zoned = zoned_blocks(model)
     for r in rows:
-        snap = [_hull(model, p)[2] for p in _zoned_partners(model, r)]
+        snap = [_hull(model, p)[2] for p in _zoned_partners(model, r, boxes, zoned)]
         poly = block_poly(model, r)
         pts, tets, hexid, overlay, tris, src = mesh_hex(poly.vertices, poly.face_ptr, poly.face_idx, divisions,
                                                         _bid(model, r), np.concatenate(snap) if snap else None)
         install_block_mesh(model, r, pts, tets, tris, src, hexid, overlay)
+        zoned[r] = True
         ext = poly.vertices.max(axis=0) - poly.vertices.min(axis=0)
         model.blocks["zlength"][r] = float(np.mean(ext / np.asarray(divisions, float)))
         made += len(tets)
@@ -210,9 +224,13 @@ def conformity(model) -> dict:
         nodes = model.face_vertices["vertex"][f["vstart"][f0:f0 + fc][:, None] + np.arange(3)[None, :]]
         tri[r] = nodes
         keys[r] = set(map(tuple, np.sort(master[nodes], axis=1).tolist()))
+    boxes, zmask = _boxes(model), zoned_blocks(model)
+    hulls = {}
     for r in zoned:
-        for p in _zoned_partners(model, int(r)):
-            N, D, pts = _hull(model, p)
+        for p in _zoned_partners(model, int(r), boxes, zmask):
+            if p not in hulls:
+                hulls[p] = _hull(model, p)
+            N, D, pts = hulls[p]
             ext = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
             cen = v["pos"][tri[r]].mean(axis=1)
             on = inside(cen, N, D, 1e-9 * ext)
