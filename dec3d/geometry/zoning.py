@@ -11,7 +11,15 @@ same facet triangles in both blocks: the restriction of a regular triangulation 
 the convex hull is the regular triangulation of the points on that facet, and positive
 scaling of the lifting or adding an affine function of position does not change it. Points of
 already zoned joined neighbours are taken over on the shared part of the boundary
-(``neighbours``), the block's own boundary points there dropped.
+(``neighbours``), the block's own boundary points there dropped; where faces of joined blocks
+still to be zoned end inside this block's faces, points are put along those lines
+(``imprint``). Interior lattice points carry parity weights instead, which make the regular
+triangulation the five-tetrahedron split of every lattice cell: cells deep inside are split
+directly and only the boundary band goes through qhull (``triangulate``; eight far "cap"
+points keep the block's coplanar face points off the 4-D hull, where qhull would merge them
+into huge facets). Slivers (smallest dihedral angle below SLIVER_DEG) get interior points at
+their circumcentres or lose an interior corner near the boundary, for a few rounds, the best
+round kept; interior changes leave every facet triangulation as it was.
 
 Hexahedra (``mesh_hex``): the trilinear map of the block's eight corners, n1 x n2 x n3 cells,
 each cell as two overlaid sets of five tetrahedra (3DEC theory text, "Mixed discretization":
@@ -33,7 +41,7 @@ import numpy as np
 
 from .errors import GeometryError
 
-#: tetrahedra with a smallest dihedral angle below this (degrees) are broken up by interior points
+#: tetrahedra with a smallest dihedral angle below this (degrees) are broken up (``_sliver_fix``)
 SLIVER_DEG = 15.0
 #: at most this many rounds of adding points and triangulating again
 SLIVER_PASSES = 5
