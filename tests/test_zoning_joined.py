@@ -200,9 +200,23 @@ def test_t_junction_joined_faces(session, first):
     assert check_joined_conforming(m) > 30
     rep = conformity(m)
     assert rep["unmatched"] == [] and rep["pairs"] == 6
-    zs, b = m.store("zones"), m.blocks
+    zs = m.store("zones")
     vol = zs["volume"][:zs.n]
     assert (vol > 0).all()
     for r, expect in ((0, 2.0), (1, 1.0), (2, 1.0)):
         assert abs(vol[zs["block"][:zs.n] == r].sum() - expect) < 1e-12
     assert "warning" not in session.output.getvalue()
+
+
+def test_edge_length_beyond_the_block(session):
+    """An edge length far beyond the block (1e300: L³ overflows a float) zones it with its
+    corners only (a cube: five or six tetrahedra), and a finer joined neighbour still conforms."""
+    session.command("block create brick 0 1 0 1 0 1\nblock create brick 1 2 0 1 0 1\nblock join on\n"
+                    "block zone generate edgelength 1e300 range pos-x 0 1\nblock zone generate edgelength 0.3")
+    m = session.model
+    zs = m.store("zones")
+    first = zs["block"][:zs.n] == 0
+    assert first.sum() in (5, 6) and abs(zs["volume"][:zs.n][first].sum() - 1.0) < 1e-12
+    assert abs(zs["volume"][:zs.n].sum() - 2.0) < 1e-12
+    assert np.isfinite(m.blocks["zlength"][: m.blocks.n]).all()
+    assert check_joined_conforming(m) == 4 and conformity(m)["unmatched"] == []

@@ -69,7 +69,7 @@ def block_zone_generate(session, call):
         est = 10.0 * float(np.prod([int(x) for x in divs])) * len(rows)
         what = f"hexahedra divisions {' '.join(str(int(x)) for x in divs)}"
     else:
-        est = _TETS_PER_CELL * float(model.blocks["volume"][rows].sum()) / L ** 3 if (rows and L) else 0.0
+        est = _TETS_PER_CELL * (float(model.blocks["volume"][rows].sum()) / L / L / L) if (rows and L) else 0.0
         what = f"edgelength {L:g}" if L else "high-order-tetra"
     if est > ZONE_BUDGET:
         raise ResourceError(f"`block zone generate {what}` would make about {est:.3g} zones, over "

@@ -99,20 +99,22 @@ def zone_tetra(model, rows, L: float) -> int:
         neigh = []
         for p in _zoned_partners(model, r, boxes, zoned):
             N, D, pts = _hull(model, p)
-            neigh.append((N, D, pts, float(model.blocks["zlength"][p]) or L))
+            neigh.append((N, D, pts, float(model.blocks["zlength"][p]) or float(np.ptp(pts, axis=0).max())))
         poly = block_poly(model, r)
+        # an edge length beyond the block's size zones it as if it were the size (same points)
+        Lr = min(L, float(np.linalg.norm(poly.vertices.max(axis=0) - poly.vertices.min(axis=0))))
         segs = []
         for p in _joined_near(model, r, boxes):
             if not zoned[p]:
                 o = block_poly(model, p)
                 segs.append(imprint_segments(poly.vertices, poly.face_ptr, poly.face_idx, o.vertices, o.face_ptr,
-                                             o.face_idx, 1e-6 * L))
+                                             o.face_idx, 1e-6 * Lr))
         segs = np.concatenate(segs) if segs else np.zeros((0, 2, 3))
-        pts, tets, tris, src = mesh_convex(poly.vertices, poly.face_ptr, poly.face_idx, L, neighbours=neigh,
+        pts, tets, tris, src = mesh_convex(poly.vertices, poly.face_ptr, poly.face_idx, Lr, neighbours=neigh,
                                            imprint=segs)
         install_block_mesh(model, r, pts, tets, tris, src)
         zoned[r] = True
-        model.blocks["zlength"][r] = L
+        model.blocks["zlength"][r] = Lr
         made += len(tets)
     relink(model)
     return made
