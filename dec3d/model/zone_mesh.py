@@ -112,10 +112,11 @@ def zone_tetra(model, rows, L: float) -> int:
         segs = np.concatenate(segs) if segs else np.zeros((0, 2, 3))
         pts, tets, tris, src = mesh_convex(poly.vertices, poly.face_ptr, poly.face_idx, Lr, neighbours=neigh,
                                            imprint=segs)
-        install_block_mesh(model, r, pts, tets, tris, src)
+        install_block_mesh(model, r, pts, tets, tris, src, compact=False)
         zoned[r] = True
         model.blocks["zlength"][r] = Lr
         made += len(tets)
+    _compact(model)
     relink(model)
     return made
 
@@ -134,11 +135,12 @@ def zone_hexahedra(model, rows, divisions) -> int:
         poly = block_poly(model, r)
         pts, tets, hexid, overlay, tris, src = mesh_hex(poly.vertices, poly.face_ptr, poly.face_idx, divisions,
                                                         _bid(model, r), np.concatenate(snap) if snap else None)
-        install_block_mesh(model, r, pts, tets, tris, src, hexid, overlay)
+        install_block_mesh(model, r, pts, tets, tris, src, hexid, overlay, compact=False)
         zoned[r] = True
         ext = poly.vertices.max(axis=0) - poly.vertices.min(axis=0)
         model.blocks["zlength"][r] = float(np.mean(ext / np.asarray(divisions, float)))
         made += len(tets)
+    _compact(model)
     relink(model)
     return made
 
@@ -149,6 +151,7 @@ def convert_high_order(model, rows) -> int:
     zs = _ensure(model)
     b, f = model.blocks, model.faces
     done = 0
+    old_rows = []
     for r in rows:
         zrow = np.flatnonzero(zs["block"][: zs.n] == r)
         if not len(zrow) or (zs["nnode"][zrow] == 10).all():
@@ -164,16 +167,26 @@ def convert_high_order(model, rows) -> int:
         source = f["source"][f0:f0 + fc].copy()
         keep_fields = {k: zs[k][zrow].copy() for k in ("cmodel", "prop", "stress", "state", "group")}
         p10, t10, sub, parent = to_high_order(pts, tets, tris)
-        keep = np.ones(zs.n, bool)
-        keep[zrow] = False
-        zs.compact(keep)
-        sl = install_block_mesh(model, r, p10, t10, sub, source[parent], face_rows=f0 + parent)
+        old_rows.append(zrow)
+        sl = install_block_mesh(model, r, p10, t10, sub, source[parent], face_rows=f0 + parent, compact=False)
         for k, val in keep_fields.items():
             zs[k][sl] = val
         zs["gstress"][sl] = zs["stress"][sl][:, None, :]
         done += len(zrow)
+    if old_rows:
+        keep = np.ones(zs.n, bool)
+        keep[np.concatenate(old_rows)] = False
+        zs.compact(keep)
+    _compact(model)
     relink(model)
     return done
+
+
+def _compact(model) -> None:
+    """Drop the vertex and face rows the zoned blocks no longer use (once per command)."""
+    from dec3d.geometry.assemble import compact_geometry
+    from .zones import follow_geometry
+    follow_geometry(model, compact_geometry(model))
 
 
 def relink(model) -> int:
