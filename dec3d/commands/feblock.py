@@ -1,0 +1,107 @@
+"""`feblock generate|list`: FE blocks of 20-node bricks (FE-block text, shared/seeds/003_*)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import CommandError, ResourceError
+from ..geometry.assemble import block_poly
+from ..geometry.febmesh import brick_corners, brick_mesh, divisions, side_faces
+from ..model.feblocks import element_volumes, feblock_store, install_feblock_mesh
+from ..model.model import KIND_DEFORMABLE, KIND_FE
+from .registry import command
+from .values import Num, Nums, P
+
+# Memory budget: about 3 kB per element (stress at 27 Gauss points, 20 node rows, nodes);
+# refuse beyond this many elements per command.
+FE_BUDGET = 2_000_000
+
+
+def _need_configured(session, call, what: str) -> None:
+    if "feblock" not in session.model.settings.configure:
+        raise CommandError(f"`{what}` needs `model configure feblock` first (FE blocks are off in this model)",
+                           call.location)
+
+
+@command("feblock generate",
+         positional=[P("size", Nums(3, 3, item=Num(lo=0, lo_open=True)),
+                       "target element sizes along the block's x, y and z axes", required=True, units="m")],
+         keywords=[P("integration", Num(integer=True, lo=2, hi=3),
+                     "Gauss points per direction: 2 (2 x 2 x 2, default) or 3 (3 x 3 x 3) (dec3d keyword)",
+                     default=2)],
+         range="block",
+         doc="Turn the visible 8-vertex hexahedral blocks in range into FE blocks meshed by 20-node bricks.",
+         details="Each block gets a regular mesh of n1 x n2 x n3 elements, n = the mean edge length along "
+                 "the block's axis divided by the size, rounded, at least 1 (the block's axes are those of "
+                 "its hexahedron nearest to x, y, z). Nodes are shared between elements and are gridpoints "
+                 "(`block gridpoint apply …` acts on them). The surface is approximated by eight triangles per "
+                 "element face around a mid-face slave node, as in the FE-block text. Needs `model configure "
+                 "feblock`. A block that is not an 8-vertex hexahedron, or a zoned block, is an error and "
+                 "nothing is changed; blocks already FE blocks are left as they are.",
+         examples=["feblock generate 1 1 1", "feblock generate 20 2.5 20 range group 'liner'",
+                   "feblock generate 0.5 0.5 0.5 integration 3"])
+def feblock_generate(session, call):
+    _need_configured(session, call, "feblock generate")
+    a = call.args
+    sizes = [float(x) for x in a["size"]]
+    nq = int(a["integration"])
+    model = session.model
+    b = model.blocks
+    sel = session.range_mask(call, "block") & ~b["hidden"]
+    rows = [int(r) for r in np.flatnonzero(sel) if int(b["kind"][r]) != KIND_FE]
+    plans = []
+    total = 0
+    for r in rows:
+        bid = int(b["id"][r])
+        if int(b["kind"][r]) == KIND_DEFORMABLE:
+            raise CommandError(f"block {bid} is zoned; `feblock generate` needs a rigid 8-vertex brick block",
+                               call.location)
+        poly = block_poly(model, r)
+        faces = poly.faces()
+        order = brick_corners(poly.vertices, faces)
+        if order is None:
+            raise CommandError(f"block {bid} is not an 8-vertex hexahedron ({len(poly.vertices)} vertices, "
+                               f"{len(faces)} faces); `feblock generate` meshes brick blocks only",
+                               call.location)
+        x8 = poly.vertices[order]
+        n = divisions(x8, sizes)
+        total += int(np.prod(n))
+        if total > FE_BUDGET:
+            raise ResourceError(f"`feblock generate` would make more than {FE_BUDGET} elements; use larger sizes",
+                                call.location)
+        points, elems, slaves, tris, sides, nmaster = brick_mesh(x8, n)
+        _, bad = element_volumes(points, elems)
+        if bad >= 0:
+            raise CommandError(f"block {bid}: element {bad + 1} of its mesh has a non-positive Jacobian "
+                               "(the block is too distorted for a regular mesh)", call.location)
+        src = side_faces(order, faces)[sides]
+        plans.append((bid, points, elems, slaves, tris, src, nmaster))
+    feblock_store(model)
+    for bid, points, elems, slaves, tris, src, nmaster in plans:
+        row = int(np.flatnonzero(b["id"][: b.n] == bid)[0])      # rows move as blocks are rewritten
+        install_feblock_mesh(model, row, points, elems, slaves, tris, src, nmaster, nq)
+
+
+@command("feblock list", range="block",
+         doc="List the FE blocks in range: elements, nodes (masters and slaves), volume, Gauss rule.",
+         examples=["feblock list", "feblock list range group 'liner'"])
+def feblock_list(session, call):
+    _need_configured(session, call, "feblock list")
+    model = session.model
+    es = feblock_store(model)
+    b, v = model.blocks, model.vertices
+    sel = session.range_mask(call, "block")
+    rows = [int(r) for r in np.flatnonzero(sel) if int(b["kind"][r]) == KIND_FE]
+    eb = es["block"][: es.n]
+    tot_e = int(np.isin(eb, rows).sum())
+    session.write(f"FE blocks {len(rows)}, elements {tot_e}")
+    if not rows:
+        return
+    session.write(f"{'block':>7} {'elements':>9} {'nodes':>7} {'slaves':>7} {'volume':>11} {'gauss':>6}")
+    for r in rows:
+        mine = eb == r
+        v0, nv = int(b["vert_start"][r]), int(b["vert_count"][r])
+        ns = int(v["feslave"][v0:v0 + nv].sum())
+        nq = sorted(set(int(q) for q in es["nq"][: es.n][mine]))
+        rule = "/".join(f"{q}x{q}x{q}" for q in nq)
+        session.write(f"{int(b['id'][r]):>7} {int(mine.sum()):>9} {nv - ns:>7} {ns:>7} "
+                      f"{es['volume'][: es.n][mine].sum():>11.6g} {rule:>6}")
