@@ -1,0 +1,202 @@
+"""`model configure feblock`, `feblock generate`, `feblock list`: the mesh installed in brick
+blocks (the FE-block text's fem_beam.dat geometry, the tunnel-liner prisms), a closed outward
+triangulated surface with mid-face slave nodes, gridpoint conditions on FE nodes, block deletion,
+save/restore, and the errors for bad input."""
+import hashlib
+import io
+import json
+import zipfile
+
+import numpy as np
+import pytest
+
+from dec3d.errors import Dec3dError
+from dec3d.kernels.feblock import YNODE, feb_slave_interp
+from dec3d.session import Session
+
+BEAM = """model new
+model configure feblock
+block create brick 0 10 0 1 0 1
+feblock generate 1 1 1
+"""
+
+
+def _surface(model, row):
+    b, f, fv = model.blocks, model.faces, model.face_vertices
+    f0, nf = int(b["face_start"][row]), int(b["face_count"][row])
+    assert (f["nvert"][f0:f0 + nf] == 3).all()
+    tri = np.array([fv["vertex"][f["vstart"][k]:f["vstart"][k] + 3] for k in range(f0, f0 + nf)])
+    return tri
+
+
+def _closed_and_outward(model, row, volume):
+    tri = _surface(model, row)
+    edges = {}
+    for t in tri:
+        for k in range(3):
+            e = (int(t[k]), int(t[(k + 1) % 3]))
+            edges[e] = edges.get(e, 0) + 1
+    assert all(c == 1 for c in edges.values())
+    assert all((b, a) in edges for a, b in edges)               # every edge used once each way: closed
+    p = model.vertices["pos"]
+    a, b_, c = p[tri[:, 0]], p[tri[:, 1]], p[tri[:, 2]]
+    vol = np.einsum("ij,ij->i", a, np.cross(b_, c)).sum() / 6.0   # divergence theorem: > 0 when outward
+    assert abs(vol - volume) < 1e-9 * volume
+
+
+def test_fem_beam_geometry(session):
+    session.command(BEAM + "feblock list")
+    m = session.model
+    es = m.store("feblocks")
+    assert es.n == 10
+    assert m.blocks["kind"][0] == 2                              # KIND_FE
+    assert abs(es["volume"][:10].sum() - 10.0) < 1e-12 and np.allclose(es["volume"][:10], 1.0)
+    v = m.vertices
+    masters = ~v["feslave"][: v.n]
+    # corners 11 x 4, mid-edges 10 x 4 along x and 11 x 4 across: 128 shared master nodes
+    assert masters.sum() == 128 and (~masters).sum() == 42
+    assert v["zoned"][: v.n].all()
+    # every element is the unit cube [e, e+1] x [0, 1] x [0, 1] with its nodes in Table 1 order
+    for e in range(10):
+        x = v["pos"][es["nodes"][e]]
+        assert np.allclose(x, (YNODE + 1) / 2 + [e, 0, 0], atol=1e-12)
+    # neighbours share their four corner and four mid-edge nodes of the common face
+    assert (es["nodes"][0][[1, 2, 5, 6]] == es["nodes"][1][[0, 3, 4, 7]]).all()
+    # slave nodes sit where the masters' interpolation puts them
+    pos = v["pos"].copy()
+    feb_slave_interp(es["nodes"], es["slaves"], np.arange(10, dtype=np.int64), pos)
+    assert np.allclose(pos, v["pos"], atol=1e-14)
+    assert (es["slaves"][:, 6] == -1).all()                      # no centre node
+    assert (es["slaves"][0, :6] >= 0).sum() == 5 and (es["slaves"][4, :6] >= 0).sum() == 4
+    _closed_and_outward(m, 0, 10.0)
+    assert abs(m.blocks["volume"][0] - 10.0) < 1e-9
+    out = session.output.getvalue()
+    assert "FE blocks 1, elements 10" in out and "128" in out and "42" in out and "2x2x2" in out
+
+
+def test_integration_and_divisions(session):
+    session.command("model configure feblock\nblock create brick 0 2 0 1 0 0.5\n"
+                    "feblock generate 0.5 0.4 1 integration 3")
+    es = session.model.store("feblocks")
+    # 2 / 0.5 = 4, 1 / 0.4 = 2.5 -> 3 (rounded half up), 0.5 / 1 -> 1
+    assert es.n == 12 and (es["nq"][:12] == 3).all()
+    assert abs(es["volume"][:12].sum() - 1.0) < 1e-12
+
+
+def test_liner_prism_blocks(session):
+    """The tunnel-liner deck's prisms (8-vertex hexahedra on an arc): `feblock generate 20 2.5 20`
+    gives one element through the thickness and across, eight along the tunnel."""
+    cmds = ["model configure feblock"]
+    th = np.radians([0.0, 180.0 / 7, 2 * 180.0 / 7])
+    for t1, t2 in zip(th[:-1], th[1:]):
+        p = [(4 * np.cos(t1), 4 * np.sin(t1)), (4 * np.cos(t2), 4 * np.sin(t2)),
+             (3.8 * np.cos(t2), 3.8 * np.sin(t2)), (3.8 * np.cos(t1), 3.8 * np.sin(t1))]
+        f1 = " ".join(f"{x:.12g} -10 {z:.12g}" for x, z in p)
+        f2 = " ".join(f"{x:.12g} 10 {z:.12g}" for x, z in p)
+        cmds.append(f"block create prism face-1 {f1} face-2 {f2} group 'liner'")
+    cmds.append("block create brick 10 11 0 1 0 1 group 'rock'")
+    cmds.append("block hide range group 'liner' not")
+    cmds.append("feblock generate 20 2.5 20")
+    session.command("\n".join(cmds))
+    m = session.model
+    es = m.store("feblocks")
+    assert es.n == 16
+    kinds = m.blocks["kind"][: m.blocks.n]
+    assert list(kinds) == [2, 2, 0]                              # the hidden rock block is untouched
+    for r in (0, 1):
+        mine = es["block"][: es.n] == r
+        assert mine.sum() == 8
+        _closed_and_outward(m, r, float(es["volume"][: es.n][mine].sum()))
+        assert abs(es["volume"][: es.n][mine].sum() - m.blocks["volume"][r]) < 1e-9
+
+
+def test_gridpoint_conditions_reach_fe_nodes(session):
+    session.command(BEAM + "block gridpoint apply velocity 0 0 0 range pos-x 0\n"
+                    "block gridpoint apply force-z [-100.0/3.0] range pos-x 10 pos-z 1")
+    v = session.model.vertices
+    held = np.flatnonzero(v["apply_fix"][: v.n] == 7)
+    assert np.allclose(v["pos"][held, 0], 0.0)
+    assert (~v["feslave"][held]).sum() == 8                      # 4 corners + 4 mid-edge nodes of the root face
+    loaded = np.flatnonzero(v["fapp"][: v.n, 2] != 0)
+    assert len(loaded) == 3 and np.allclose(v["fapp"][loaded, 2], -100.0 / 3)
+    assert not v["feslave"][loaded].any()
+
+
+def test_delete_block_drops_its_elements(session):
+    session.command("model configure feblock\nblock create brick 0 1 0 1 0 1\nblock create brick 2 3 0 1 0 1\n"
+                    "feblock generate 0.5 0.5 0.5\nblock delete range id 1")
+    m = session.model
+    es = m.store("feblocks")
+    assert es.n == 8 and (es["block"][:8] == 0).all()
+    v0, nv = int(m.blocks["vert_start"][0]), int(m.blocks["vert_count"][0])
+    nodes = es["nodes"][:8]
+    assert nodes.min() >= v0 and nodes.max() < v0 + nv
+    assert np.allclose(m.vertices["pos"][nodes].min(axis=(0, 1)), [2, 0, 0])
+
+
+def test_save_restore_round_trip_and_bad_file(tmp_path):
+    s = Session(out_dir=tmp_path, stdout=io.StringIO())
+    s.command(BEAM + "model save 'beam'")
+    t = Session(out_dir=tmp_path, stdout=io.StringIO())
+    t.command("model restore 'beam'")
+    a, b = s.model.store("feblocks"), t.model.store("feblocks")
+    assert b.n == 10
+    for key in ("nodes", "slaves", "nq", "volume", "block", "id"):
+        assert np.array_equal(a[key][:10], b[key][:10])
+    assert np.array_equal(s.model.vertices["feslave"][: s.model.vertices.n],
+                          t.model.vertices["feslave"][: t.model.vertices.n])
+    # a file whose element nodes point outside the vertices is refused, naming the problem
+    src = tmp_path / "beam.sav"
+    with zipfile.ZipFile(src) as z:
+        members = {n: z.read(n) for n in z.namelist()}
+    meta = json.loads(members["meta.json"])
+    arr = np.load(io.BytesIO(members["feblocks.nodes.npy"]))
+    arr[3, 5] = 10 ** 6
+    buf = io.BytesIO()
+    np.lib.format.write_array(buf, arr, version=(1, 0), allow_pickle=False)
+    members["feblocks.nodes.npy"] = buf.getvalue()
+    meta["sha256"]["feblocks.nodes"] = hashlib.sha256(buf.getvalue()).hexdigest()
+    members["meta.json"] = json.dumps(meta, sort_keys=True, indent=1).encode()
+    with zipfile.ZipFile(tmp_path / "bad.sav", "w") as z:
+        for n, data in members.items():
+            z.writestr(n, data)
+    u = Session(out_dir=tmp_path, stdout=io.StringIO())
+    with pytest.raises(Dec3dError, match="FE element node rows point outside the vertices"):
+        u.command("model restore 'bad'")
+
+
+def test_needs_configure(session):
+    session.command("block create brick 0 1 0 1 0 1")
+    for cmd in ("feblock generate 1 1 1", "feblock list"):
+        with pytest.raises(Dec3dError, match=r"needs `model configure feblock` first"):
+            session.command(cmd)
+    assert "feblocks" not in session.model.stores
+    assert session.model.blocks["kind"][0] == 0
+
+
+def test_non_brick_block_is_an_error_naming_it_and_nothing_changes(session):
+    session.command("model configure feblock\nblock create brick 0 1 0 1 0 1\n"
+                    "block create tetrahedron 2 0 0 3 0 0 2 1 0 2 0 1")
+    nv = session.model.vertices.n
+    with pytest.raises(Dec3dError, match=r"block 2 is not an 8-vertex hexahedron \(4 vertices, 4 faces\)"):
+        session.command("feblock generate 0.5 0.5 0.5")
+    assert session.model.vertices.n == nv
+    assert "feblocks" not in session.model.stores or session.model.store("feblocks").n == 0
+    assert (session.model.blocks["kind"][:2] == 0).all()
+    # in a range without the tetrahedron it works
+    session.command("feblock generate 0.5 0.5 0.5 range id 1")
+    assert session.model.store("feblocks").n == 8
+
+
+def test_zoned_block_and_bad_sizes_are_errors(session):
+    session.command("model configure feblock\nblock create brick 0 1 0 1 0 1\nblock zone generate edgelength 0.5")
+    with pytest.raises(Dec3dError, match=r"block 1 is zoned"):
+        session.command("feblock generate 1 1 1")
+    for bad in ("feblock generate 1 1", "feblock generate 1 0 1", "feblock generate 1 1 1 integration 4"):
+        with pytest.raises(Dec3dError):
+            session.command(bad)
+
+
+def test_generate_twice_leaves_fe_blocks_as_they_are(session):
+    session.command(BEAM + "feblock generate 0.5 0.5 0.5")
+    assert session.model.store("feblocks").n == 10
