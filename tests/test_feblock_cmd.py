@@ -258,3 +258,73 @@ def test_generated_fem_beam_relaxes_to_the_calculix_deflection(session):
     # the slave at the centre of the tip face moved with the beam end
     cen = np.flatnonzero(np.all(abs(v["pos"] - [10, 0.5, 0.5]) < 1e-9, axis=1))
     assert v["feslave"][cen[0]] and abs(-disp[cen[0], 2] - u) < 0.01 * u
+
+
+# ----------------------------------------------------------------------------- feblock read
+def _beam_file(tmp_path, corners_only=False, name="beam.fem"):
+    """The fem_beam mesh (10 unit cubes along x) as the text's ASCII format."""
+    grid, pts, elems = {}, [], []
+    for e in range(10):
+        ids = []
+        for y in (YNODE[:8] if corners_only else YNODE):
+            p = ((y + 1) / 2 + [e, 0, 0]).round(6)
+            k = tuple(p)
+            if k not in grid:
+                grid[k] = len(pts) + 1
+                pts.append(p)
+            ids.append(grid[k])
+        elems.append(ids)
+    lines = ["fem beam, 10 elements", f"{len(pts)} {len(elems)}"]
+    lines += [" ".join(f"{c:g}" for c in p) for p in pts]
+    lines += [" ".join(str(i) for i in ids) for ids in elems]
+    (tmp_path / name).write_text("\n".join(lines) + "\n")
+    return lines
+
+
+@pytest.mark.parametrize("corners_only", [False, True])
+def test_read_mesh_file(tmp_path, corners_only):
+    _beam_file(tmp_path, corners_only)
+    s = Session(out_dir=tmp_path, stdout=io.StringIO())
+    s.command("model configure feblock\nblock create brick 20 21 0 1 0 1\nfeblock read 'beam.fem' group 'beam'")
+    m = s.model
+    es = m.store("feblocks")
+    assert es.n == 10 and (es["block"][:10] == 1).all()
+    assert m.blocks["kind"][1] == 2 and m.blocks["kind"][0] == 0
+    v0, nv = int(m.blocks["vert_start"][1]), int(m.blocks["vert_count"][1])
+    assert (~m.vertices["feslave"][v0:v0 + nv]).sum() == 128 and m.vertices["feslave"][v0:v0 + nv].sum() == 42
+    for e in range(10):
+        assert np.allclose(m.vertices["pos"][es["nodes"][e]], (YNODE + 1) / 2 + [e, 0, 0], atol=1e-12)
+    _closed_and_outward(m, 1, 10.0)
+    assert abs(m.blocks["volume"][1] - 10.0) < 1e-9
+    assert m.groups.names[m.blocks["group"][1, 0]] == "beam"
+
+
+def test_read_mesh_file_errors(tmp_path):
+    lines = _beam_file(tmp_path)
+    nn = int(lines[1].split()[0])
+
+    def bad(name, text, match):
+        (tmp_path / name).write_text(text)
+        s = Session(out_dir=tmp_path, stdout=io.StringIO())
+        s.command("model configure feblock\nblock create brick 20 21 0 1 0 1")
+        nv = s.model.vertices.n
+        with pytest.raises(Dec3dError, match=match):
+            s.command(f"feblock read '{name}'")
+        assert s.model.blocks.n == 1 and s.model.vertices.n == nv
+        assert "feblocks" not in s.model.stores or s.model.store("feblocks").n == 0
+
+    body = "\n".join(lines)
+    bad("t1.fem", "\n".join(lines[:-3]), r"t1\.fem:\d+: the file ends after .* element lines")
+    bad("t2.fem", "title\n10 x\n", r"t2\.fem:2: the header line must be two integers")
+    bad("t3.fem", body.replace(lines[5], "1.0 abc 2"), r"t3\.fem:6: node 4: expected three coordinates")
+    e1 = 2 + nn
+    bad("t4.fem", body.replace(lines[e1], lines[e1] + " 7"), rf"t4\.fem:{e1 + 1}: element 1: 21 node numbers")
+    bad("t5.fem", body.replace(lines[e1], "999 " + " ".join(lines[e1].split()[1:])),
+        rf"t5\.fem:{e1 + 1}: element 1: node 999 is not between 1 and {nn}")
+    ids = lines[e1 + 2].split()
+    ids[:16] = ids[4:8] + ids[:4] + ids[12:16] + ids[8:12]         # mirrored top to bottom: inverted element
+    bad("t6.fem", body.replace(lines[e1 + 2], " ".join(ids)), rf"t6\.fem:{e1 + 3}: element 3 has a non-positive Jacobian")
+    bad("t7.fem", "only a title\n", r"t7\.fem:1: the file ends before the header")
+    s = Session(out_dir=tmp_path, stdout=io.StringIO())
+    with pytest.raises(Dec3dError, match=r"needs `model configure feblock` first"):
+        s.command("feblock read 'beam.fem'")

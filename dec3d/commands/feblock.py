@@ -5,11 +5,12 @@ import numpy as np
 
 from ..errors import CommandError, ResourceError
 from ..geometry.assemble import block_poly
-from ..geometry.febmesh import brick_corners, brick_mesh, divisions, side_faces
-from ..model.feblocks import element_volumes, feblock_store, install_feblock_mesh
+from ..geometry.febmesh import (MeshFileError, brick_corners, brick_mesh, complete_20, divisions, mesh_surface,
+                                parse_fe_mesh, side_faces)
+from ..model.feblocks import add_feblock, element_volumes, feblock_store, install_feblock_mesh
 from ..model.model import KIND_DEFORMABLE, KIND_FE
 from .registry import command
-from .values import Num, Nums, P
+from .values import InPath, Num, Nums, P, Text
 
 # Memory budget: about 3 kB per element (stress at 27 Gauss points, 20 node rows, nodes);
 # refuse beyond this many elements per command.
@@ -79,6 +80,53 @@ def feblock_generate(session, call):
     for bid, points, elems, slaves, tris, src, nmaster in plans:
         row = int(np.flatnonzero(b["id"][: b.n] == bid)[0])      # rows move as blocks are rewritten
         install_feblock_mesh(model, row, points, elems, slaves, tris, src, nmaster, nq)
+
+
+@command("feblock read", positional=[P("file", InPath(), "the mesh file", required=True)],
+         keywords=[P("integration", Num(integer=True, lo=2, hi=3),
+                     "Gauss points per direction: 2 (default) or 3 (dec3d keyword)", default=2),
+                   P("group", Text(), "group of the new block")],
+         doc="Read a mesh of 20-node (or 8-node) bricks from an ASCII file into one new FE block.",
+         details="The format of the FE-block text: a title line; `NN NE`; NN lines `x y z` (node n is the "
+                 "n-th); NE lines of 20 node numbers in the VTK quadratic-hexahedron / C3D20 order (corners "
+                 "counter-clockwise at the bottom then the top, then the mid-edge nodes of the bottom, top and "
+                 "vertical edges), or of 8 corner numbers (the mid-edge nodes are then inserted). Node "
+                 "numbering is free. The mesh surface (element faces met once) becomes the block's faces, eight "
+                 "triangles per face around a mid-face slave node. A malformed or truncated file, or an element "
+                 "with a non-positive Jacobian, is an error naming the file and line; nothing is changed.",
+         examples=["feblock read 'dam.fem'", "feblock read 'liner.txt' integration 3 group 'liner'"])
+def feblock_read(session, call):
+    _need_configured(session, call, "feblock read")
+    a = call.args
+    path = session.in_path(a["file"], call.locations.get("file", call.location))
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise CommandError(f"cannot read '{a['file']}': {exc.strerror or exc}", call.location) from None
+    try:
+        pts, elems, where = parse_fe_mesh(text)
+        if len(elems) > FE_BUDGET:
+            raise ResourceError(f"'{path.name}' has {len(elems)} elements, over the budget of {FE_BUDGET}",
+                                call.location)
+        if elems.shape[1] == 8:
+            pts, elems = complete_20(pts, elems)
+        _, bad = element_volumes(pts, elems)
+        if bad >= 0:
+            raise MeshFileError(int(where[bad]), f"element {bad + 1} has a non-positive Jacobian (inverted, "
+                                                 "badly distorted, or its nodes not in the Table 1 order)")
+        used = np.zeros(len(pts), bool)
+        used[elems.ravel()] = True
+        if not used.all():
+            raise MeshFileError(0, f"node {int(np.flatnonzero(~used)[0]) + 1} belongs to no element")
+        nmaster = len(pts)
+        allpts, slaves, tris = mesh_surface(pts, elems)
+    except MeshFileError as exc:
+        at = f"{path.name}:{exc.line}" if exc.line else path.name
+        raise CommandError(f"{at}: {exc}", call.location) from None
+    model = session.model
+    row = add_feblock(model, allpts, elems, slaves, tris, nmaster, int(a["integration"]))
+    if a["group"] is not None:
+        model.groups.assign(model.blocks, np.array([row]), a["group"], None)
 
 
 @command("feblock list", range="block",

@@ -177,3 +177,130 @@ def side_faces(corner_order: np.ndarray, faces: list[np.ndarray]) -> np.ndarray:
             vs = {int(corner_order[n]) for n, c in enumerate(_CUBE) if c[a] == s}
             out[2 * a + s] = fsets.index(vs)
     return out
+
+
+# ----------------------------------------------------------------------------- meshes read from files
+#: corner pairs of the mid-edge nodes 9-20 (0-based 8-19) of the corrected Table 1
+MID_EDGES = ((0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7))
+
+
+class MeshFileError(ValueError):
+    """A bad FE mesh file: ``line`` (1-based, 0 for the whole file) and the message."""
+
+    def __init__(self, line: int, message: str):
+        super().__init__(message)
+        self.line = line
+
+
+def parse_fe_mesh(text: str):
+    """The FE-block text's ASCII mesh ("Generation and Use of FE Blocks"): a title line; a
+    header line ``NN NE``; NN lines ``x y z`` (node n is the n-th, from 1); NE lines of 20 node
+    numbers (corrected Table 1 order) or of 8 (corners only: the mid-edge nodes are inserted at
+    the midpoints of the edges, shared between elements). Values are separated by blanks or
+    commas; blank lines are skipped. Returns (points (NN, 3), elems (NE, 8 or 20) 0-based, the
+    file line of each element) or raises MeshFileError naming the line."""
+    lines = [(k + 1, ln.replace(",", " ").split()) for k, ln in enumerate(text.splitlines())]
+    lines = [(k, t) for k, t in lines if t]
+    if len(lines) < 2:
+        raise MeshFileError(len(text.splitlines()), "the file ends before the header line `NN NE`")
+    k, head = lines[1]
+    try:
+        if len(head) != 2:
+            raise ValueError
+        nn, ne = int(head[0]), int(head[1])
+    except ValueError:
+        raise MeshFileError(k, "the header line must be two integers `NN NE` (numbers of nodes and "
+                               "elements)") from None
+    if nn < 8 or ne < 1:
+        raise MeshFileError(k, f"a mesh needs at least 8 nodes and one element (header says {nn} {ne})")
+    body = lines[2:]
+    if len(body) < nn + ne:
+        last = body[-1][0] if body else k
+        raise MeshFileError(last, f"the file ends after {len(body)} of the {nn} node and {ne} element lines "
+                                  "the header announces")
+    pts = np.empty((nn, 3))
+    for i in range(nn):
+        k, t = body[i]
+        try:
+            if len(t) != 3:
+                raise ValueError
+            pts[i] = [float(x) for x in t]
+        except ValueError:
+            raise MeshFileError(k, f"node {i + 1}: expected three coordinates `x y z`, got "
+                                   f"{' '.join(t)[:80]!r}") from None
+        if not np.isfinite(pts[i]).all():
+            raise MeshFileError(k, f"node {i + 1}: a coordinate is not finite")
+    elems, where = [], []
+    width = None
+    for j in range(ne):
+        k, t = body[nn + j]
+        try:
+            ids = [int(x) for x in t]
+        except ValueError:
+            raise MeshFileError(k, f"element {j + 1}: node numbers must be integers") from None
+        if len(ids) not in (8, 20):
+            raise MeshFileError(k, f"element {j + 1}: {len(ids)} node numbers; an element has 20 (or 8: corners "
+                                   "only)")
+        if width is not None and len(ids) != width:
+            raise MeshFileError(k, f"element {j + 1}: {len(ids)} nodes where the elements before have {width}")
+        width = len(ids)
+        bad = [n for n in ids if not 1 <= n <= nn]
+        if bad:
+            raise MeshFileError(k, f"element {j + 1}: node {bad[0]} is not between 1 and {nn}")
+        if len(set(ids)) != len(ids):
+            raise MeshFileError(k, f"element {j + 1}: a node appears twice")
+        elems.append(ids)
+        where.append(k)
+    if len(body) > nn + ne:
+        raise MeshFileError(body[nn + ne][0], "text after the last element line")
+    return pts, np.array(elems, np.int64) - 1, np.array(where, np.int64)
+
+
+def complete_20(points: np.ndarray, elems8: np.ndarray):
+    """Insert mid-edge nodes (shared by edge) into 8-node elements: returns (points, elems (ne, 20))."""
+    pts = [p for p in np.asarray(points, float)]
+    key: dict[tuple[int, int], int] = {}
+    out = np.empty((len(elems8), 20), np.int64)
+    for e, c in enumerate(np.asarray(elems8, np.int64)):
+        out[e, :8] = c
+        for q, (i, j) in enumerate(MID_EDGES):
+            k = (min(c[i], c[j]), max(c[i], c[j]))
+            if k not in key:
+                key[k] = len(pts)
+                pts.append((pts[c[i]] + pts[c[j]]) / 2)
+            out[e, 8 + q] = key[k]
+    return np.array(pts), out
+
+
+def mesh_surface(points: np.ndarray, elems: np.ndarray):
+    """The boundary of a 20-node mesh: element faces (by their corner nodes) met once. Returns
+    (points with a mid-face slave node appended per boundary face, slaves (ne, 7), tris (k, 3)
+    counter-clockwise from outside, eight per boundary face). Raises MeshFileError(0, …) when a
+    face is shared by more than two elements."""
+    from dec3d.kernels.feblock import shape20
+
+    count: dict[frozenset, int] = {}
+    for c in elems:
+        for s in range(6):
+            k = frozenset(int(c[v]) for v in FACES[s][:4])
+            count[k] = count.get(k, 0) + 1
+    if max(count.values()) > 2:
+        raise MeshFileError(0, "an element face is shared by more than two elements")
+    w = np.empty((6, 20))
+    dn = np.empty((20, 3))
+    for s in range(6):
+        shape20(YSLAVE[s, 0], YSLAVE[s, 1], YSLAVE[s, 2], w[s], dn)
+    pts = list(np.asarray(points, float))
+    slaves = np.full((len(elems), 7), -1, np.int64)
+    tris = []
+    for e, c in enumerate(elems):
+        for s in range(6):
+            f = FACES[s]
+            if count[frozenset(int(c[v]) for v in f[:4])] != 1:
+                continue
+            slaves[e, s] = len(pts)
+            pts.append(w[s] @ np.asarray(points)[c])
+            per = [c[f[0]], c[f[4]], c[f[1]], c[f[5]], c[f[2]], c[f[6]], c[f[3]], c[f[7]]]
+            for t in range(8):
+                tris.append((slaves[e, s], per[t], per[(t + 1) % 8]))
+    return np.array(pts), slaves, np.array(tris, np.int64)

@@ -114,10 +114,9 @@ def install_feblock_mesh(model, row: int, points: np.ndarray, elems: np.ndarray,
     Returns the slice of the new element rows."""
     from dec3d.geometry.assemble import compact_geometry, write_pieces
 
-    from .model import KIND_FE
     from .zones import follow_geometry
 
-    es = feblock_store(model)
+    feblock_store(model)
     b, fs = model.blocks, model.faces
     points = np.ascontiguousarray(points, dtype=_F)
     tris = np.asarray(tris, dtype=_I)
@@ -128,6 +127,15 @@ def install_feblock_mesh(model, row: int, points: np.ndarray, elems: np.ndarray,
     fst, fc = int(b["face_start"][row]), int(b["face_count"][row])
     fs["source"][fst:fst + fc] = tri_source
     follow_geometry(model, compact_geometry(model))
+    return _attach(model, row, points, elems, slaves, nmaster, nq)
+
+
+def _attach(model, row, points, elems, slaves, nmaster, nq) -> slice:
+    """Gridpoint fields of block ``row``'s (new) vertices and its element rows."""
+    from .model import KIND_FE
+
+    es = feblock_store(model)
+    b = model.blocks
     vs = model.vertices
     v0, nv = int(b["vert_start"][row]), int(b["vert_count"][row])
     vs["zoned"][v0:v0 + nv] = True
@@ -147,3 +155,20 @@ def install_feblock_mesh(model, row: int, points: np.ndarray, elems: np.ndarray,
     vol, _ = element_volumes(points, elems)
     es["volume"][sl] = vol
     return sl
+
+
+def add_feblock(model, points: np.ndarray, elems: np.ndarray, slaves: np.ndarray, tris: np.ndarray,
+                nmaster: int, nq: int = 2) -> int:
+    """A new FE block (``feblock read``) from a mesh and its surface (``geometry.febmesh.
+    mesh_surface``): every point is a vertex of the block, the triangles its faces. Returns its row."""
+    from dec3d.geometry.polyhedron import Poly
+
+    from .blocks import add_blocks
+    from .model import KIND_FE
+
+    feblock_store(model)
+    tris = np.asarray(tris, _I)
+    poly = Poly(np.ascontiguousarray(points, _F), np.arange(0, 3 * len(tris) + 1, 3, dtype=_I), tris.ravel())
+    row = int(add_blocks(model, [poly], kind=KIND_FE)[0])
+    _attach(model, row, points, elems, slaves, nmaster, nq)
+    return row
