@@ -562,7 +562,7 @@ def test_one_element_thick_2x2x2_has_a_free_end_zero_energy_mode_that_point_load
         assert z.shape[1] == nnull
         if nnull:
             assert np.abs(z.T @ point.ravel()[free]).max() > 10.0          # of a 100 N load
-            assert np.abs(z.T @ trac.ravel()[free]).max() < 1e-9
+            assert np.abs(z.T @ trac.ravel()[free]).max() < 1e-7         # round-off of the eigenvector
 
 
 def test_cantilever_2x2x2_within_one_percent_and_no_drift():

@@ -149,19 +149,20 @@ def ref_tables(nq):
 
 
 @njit(cache=True)
-def _grad_n(pos, nodes, dxi, dn):
+def _grad_n(x, dxi, dn):
     """Cartesian derivatives dn (20, 3) = dN_a/dx_j at one point from the master derivatives
-    dxi (20, 3) and the nodal positions (text: J_km = dN_I/dy_m x_Ik, Y = J^-1, Eq. 5
-    N_I,m = dN_I/dy_j Y_jm). Returns det J; dn is left as it was when det J is not positive."""
+    dxi (20, 3) and the element's node coordinates x (20, 3) (text: J_km = dN_I/dy_m x_Ik,
+    Y = J^-1, Eq. 5 N_I,m = dN_I/dy_j Y_jm). Returns det J; dn is left as it was when det J is
+    not positive. Scalars only (it runs at every Gauss point of every element every step)."""
     j00 = 0.0; j01 = 0.0; j02 = 0.0
     j10 = 0.0; j11 = 0.0; j12 = 0.0
     j20 = 0.0; j21 = 0.0; j22 = 0.0
     for a in range(20):
-        p = pos[nodes[a]]
+        x0 = x[a, 0]; x1 = x[a, 1]; x2 = x[a, 2]
         d0 = dxi[a, 0]; d1 = dxi[a, 1]; d2 = dxi[a, 2]
-        j00 += p[0] * d0; j01 += p[0] * d1; j02 += p[0] * d2
-        j10 += p[1] * d0; j11 += p[1] * d1; j12 += p[1] * d2
-        j20 += p[2] * d0; j21 += p[2] * d1; j22 += p[2] * d2
+        j00 += x0 * d0; j01 += x0 * d1; j02 += x0 * d2
+        j10 += x1 * d0; j11 += x1 * d1; j12 += x1 * d2
+        j20 += x2 * d0; j21 += x2 * d1; j22 += x2 * d2
     c00 = j11 * j22 - j12 * j21
     c01 = j12 * j20 - j10 * j22
     c02 = j10 * j21 - j11 * j20
@@ -187,11 +188,22 @@ def _grad_n(pos, nodes, dxi, dn):
 
 
 @njit(cache=True)
-def _elem_grads(pos, nodes, dref, wts, dng, wd):
+def _gather(arr, nodes, e, nd, out):
+    """nd[a] = nodes[e, a] and out[a] = arr[nd[a]] (20 rows) for one element."""
+    for a in range(20):
+        r = nodes[e, a]
+        nd[a] = r
+        out[a, 0] = arr[r, 0]
+        out[a, 1] = arr[r, 1]
+        out[a, 2] = arr[r, 2]
+
+
+@njit(cache=True)
+def _elem_grads(x, dref, wts, dng, wd):
     """Cartesian derivatives dng (ng, 20, 3) and w_g det J_g (ng,) at every Gauss point of one
-    element. False when det J is not positive at some point."""
+    element with node coordinates x (20, 3). False when det J is not positive at some point."""
     for g in range(wts.shape[0]):
-        det = _grad_n(pos, nodes, dref[g], dng[g])
+        det = _grad_n(x, dref[g], dng[g])
         if not det > 0.0:
             return False
         wd[g] = wts[g] * det
@@ -216,6 +228,118 @@ def _elem_force(dng, wd, sg, fe):
 
 
 @njit(cache=True)
+def _jac_inv(x, dxi, jinv):
+    """Inverse Jacobian jinv (3, 3) (jinv[k, j] = dy_k/dx_j) at one point; returns det J (jinv
+    untouched when not positive)."""
+    j00 = 0.0; j01 = 0.0; j02 = 0.0
+    j10 = 0.0; j11 = 0.0; j12 = 0.0
+    j20 = 0.0; j21 = 0.0; j22 = 0.0
+    for a in range(20):
+        x0 = x[a, 0]; x1 = x[a, 1]; x2 = x[a, 2]
+        d0 = dxi[a, 0]; d1 = dxi[a, 1]; d2 = dxi[a, 2]
+        j00 += x0 * d0; j01 += x0 * d1; j02 += x0 * d2
+        j10 += x1 * d0; j11 += x1 * d1; j12 += x1 * d2
+        j20 += x2 * d0; j21 += x2 * d1; j22 += x2 * d2
+    c00 = j11 * j22 - j12 * j21
+    c01 = j12 * j20 - j10 * j22
+    c02 = j10 * j21 - j11 * j20
+    det = j00 * c00 + j01 * c01 + j02 * c02
+    if not det > 0.0:
+        return det
+    r = 1.0 / det
+    jinv[0, 0] = c00 * r
+    jinv[1, 0] = c01 * r
+    jinv[2, 0] = c02 * r
+    jinv[0, 1] = (j02 * j21 - j01 * j22) * r
+    jinv[1, 1] = (j00 * j22 - j02 * j20) * r
+    jinv[2, 1] = (j01 * j20 - j00 * j21) * r
+    jinv[0, 2] = (j01 * j12 - j02 * j11) * r
+    jinv[1, 2] = (j02 * j10 - j00 * j12) * r
+    jinv[2, 2] = (j00 * j11 - j01 * j10) * r
+    return det
+
+
+@njit(cache=True)
+def _elem_step(xe, ve, dref, wts, lam, g2, dt, sg, se, fe, jinv, wd):
+    """Stress update and nodal forces of one element (node coordinates xe, velocities ve
+    (20, 3)): Gauss-point stresses sg (>= ng, 6) and mean se (6,) updated, fe (20, 3) filled
+    with the element's force on each node. False, changing nothing, when det J is not positive
+    at a Gauss point. Works in master coordinates: grad v = (sum_a v_a (x) dN_a/dy) J^-1 and
+    f_a = -(w det J sigma J^-T) dN_a/dy, the same sums as B^T sigma without forming grad N."""
+    ng = wts.shape[0]
+    vol = 0.0
+    for g in range(ng):
+        det = _jac_inv(xe, dref[g], jinv[g])
+        if not det > 0.0:
+            return False
+        wd[g] = wts[g] * det
+        vol += wd[g]
+    for a in range(20):
+        fe[a, 0] = 0.0
+        fe[a, 1] = 0.0
+        fe[a, 2] = 0.0
+    for c in range(6):
+        se[c] = 0.0
+    for g in range(ng):
+        d = dref[g]
+        # master velocity gradient m[i, k] = sum_a v_ai dN_a/dy_k
+        m00 = 0.0; m01 = 0.0; m02 = 0.0
+        m10 = 0.0; m11 = 0.0; m12 = 0.0
+        m20 = 0.0; m21 = 0.0; m22 = 0.0
+        for a in range(20):
+            v0 = ve[a, 0]; v1 = ve[a, 1]; v2 = ve[a, 2]
+            n0 = d[a, 0]; n1 = d[a, 1]; n2 = d[a, 2]
+            m00 += v0 * n0; m01 += v0 * n1; m02 += v0 * n2
+            m10 += v1 * n0; m11 += v1 * n1; m12 += v1 * n2
+            m20 += v2 * n0; m21 += v2 * n1; m22 += v2 * n2
+        ji = jinv[g]
+        # L = m J^-1
+        l00 = m00 * ji[0, 0] + m01 * ji[1, 0] + m02 * ji[2, 0]
+        l01 = m00 * ji[0, 1] + m01 * ji[1, 1] + m02 * ji[2, 1]
+        l02 = m00 * ji[0, 2] + m01 * ji[1, 2] + m02 * ji[2, 2]
+        l10 = m10 * ji[0, 0] + m11 * ji[1, 0] + m12 * ji[2, 0]
+        l11 = m10 * ji[0, 1] + m11 * ji[1, 1] + m12 * ji[2, 1]
+        l12 = m10 * ji[0, 2] + m11 * ji[1, 2] + m12 * ji[2, 2]
+        l20 = m20 * ji[0, 0] + m21 * ji[1, 0] + m22 * ji[2, 0]
+        l21 = m20 * ji[0, 1] + m21 * ji[1, 1] + m22 * ji[2, 1]
+        l22 = m20 * ji[0, 2] + m21 * ji[1, 2] + m22 * ji[2, 2]
+        exx = l00 * dt; eyy = l11 * dt; ezz = l22 * dt
+        exy = 0.5 * (l01 + l10) * dt
+        exz = 0.5 * (l02 + l20) * dt
+        eyz = 0.5 * (l12 + l21) * dt
+        ev = exx + eyy + ezz
+        s = sg[g]
+        s[0] += lam * ev + g2 * exx
+        s[1] += lam * ev + g2 * eyy
+        s[2] += lam * ev + g2 * ezz
+        s[3] += g2 * exy
+        s[4] += g2 * exz
+        s[5] += g2 * eyz
+        w = wd[g]
+        fv = w / vol
+        for c in range(6):
+            se[c] += fv * s[c]
+        sxx = s[0] * w; syy = s[1] * w; szz = s[2] * w
+        sxy = s[3] * w; sxz = s[4] * w; syz = s[5] * w
+        # P[i, k] = w det J sum_j sigma_ij J^-1[k, j]
+        p00 = sxx * ji[0, 0] + sxy * ji[0, 1] + sxz * ji[0, 2]
+        p01 = sxx * ji[1, 0] + sxy * ji[1, 1] + sxz * ji[1, 2]
+        p02 = sxx * ji[2, 0] + sxy * ji[2, 1] + sxz * ji[2, 2]
+        p10 = sxy * ji[0, 0] + syy * ji[0, 1] + syz * ji[0, 2]
+        p11 = sxy * ji[1, 0] + syy * ji[1, 1] + syz * ji[1, 2]
+        p12 = sxy * ji[2, 0] + syy * ji[2, 1] + syz * ji[2, 2]
+        p20 = sxz * ji[0, 0] + syz * ji[0, 1] + szz * ji[0, 2]
+        p21 = sxz * ji[1, 0] + syz * ji[1, 1] + szz * ji[1, 2]
+        p22 = sxz * ji[2, 0] + syz * ji[2, 1] + szz * ji[2, 2]
+        for a in range(20):
+            n0 = d[a, 0]; n1 = d[a, 1]; n2 = d[a, 2]
+            fe[a, 0] -= p00 * n0 + p01 * n1 + p02 * n2
+            fe[a, 1] -= p10 * n0 + p11 * n1 + p12 * n2
+            fe[a, 2] -= p20 * n0 + p21 * n1 + p22 * n2
+    return True
+
+
+@njit(cache=True)
 def feb_step(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, force, nq):
     """One elastic step of the 20-node elements in ``rows`` with the nq x nq x nq rule.
 
@@ -230,52 +354,22 @@ def feb_step(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, force, nq)
     """
     shp, dref, wts = ref_tables(nq)
     ng = wts.shape[0]
-    dng = np.empty((ng, 20, 3))
+    jinv = np.empty((ng, 3, 3))
     wd = np.empty(ng)
     nd = np.empty(20, np.int64)
+    xe = np.empty((20, 3))
+    ve = np.empty((20, 3))
     fe = np.empty((20, 3))
     bad = -1
     for kk in range(rows.shape[0]):
         e = rows[kk]
-        for a in range(20):
-            nd[a] = nodes[e, a]
-        if not _elem_grads(pos, nd, dref, wts, dng, wd):
+        _gather(pos, nodes, e, nd, xe)
+        _gather(vel, nodes, e, nd, ve)
+        if not _elem_step(xe, ve, dref, wts, bulk[e] - 2.0 * shear[e] / 3.0, 2.0 * shear[e], dt,
+                          gstress[e], stress[e], fe, jinv, wd):
             if bad < 0:
                 bad = e
             continue
-        lam = bulk[e] - 2.0 * shear[e] / 3.0
-        g2 = 2.0 * shear[e]
-        vol = 0.0
-        for g in range(ng):
-            vol += wd[g]
-        for c in range(6):
-            stress[e, c] = 0.0
-        for g in range(ng):
-            dn = dng[g]
-            l00 = 0.0; l01 = 0.0; l02 = 0.0
-            l10 = 0.0; l11 = 0.0; l12 = 0.0
-            l20 = 0.0; l21 = 0.0; l22 = 0.0
-            for a in range(20):
-                v = vel[nd[a]]
-                l00 += v[0] * dn[a, 0]; l01 += v[0] * dn[a, 1]; l02 += v[0] * dn[a, 2]
-                l10 += v[1] * dn[a, 0]; l11 += v[1] * dn[a, 1]; l12 += v[1] * dn[a, 2]
-                l20 += v[2] * dn[a, 0]; l21 += v[2] * dn[a, 1]; l22 += v[2] * dn[a, 2]
-            exx = l00 * dt; eyy = l11 * dt; ezz = l22 * dt
-            exy = 0.5 * (l01 + l10) * dt
-            exz = 0.5 * (l02 + l20) * dt
-            eyz = 0.5 * (l12 + l21) * dt
-            ev = exx + eyy + ezz
-            s = gstress[e, g]
-            s[0] += lam * ev + g2 * exx
-            s[1] += lam * ev + g2 * eyy
-            s[2] += lam * ev + g2 * ezz
-            s[3] += g2 * exy
-            s[4] += g2 * exz
-            s[5] += g2 * eyz
-            f = wd[g] / vol
-            for c in range(6):
-                stress[e, c] += f * s[c]
-        _elem_force(dng, wd, gstress[e], fe)
         for a in range(20):
             r = nd[a]
             force[r, 0] += fe[a, 0]
@@ -294,13 +388,13 @@ def feb_forces(pos, nodes, rows, gstress, force, nq):
     dng = np.empty((ng, 20, 3))
     wd = np.empty(ng)
     nd = np.empty(20, np.int64)
+    xe = np.empty((20, 3))
     fe = np.empty((20, 3))
     bad = -1
     for kk in range(rows.shape[0]):
         e = rows[kk]
-        for a in range(20):
-            nd[a] = nodes[e, a]
-        if not _elem_grads(pos, nd, dref, wts, dng, wd):
+        _gather(pos, nodes, e, nd, xe)
+        if not _elem_grads(xe, dref, wts, dng, wd):
             if bad < 0:
                 bad = e
             continue
@@ -321,12 +415,12 @@ def feb_volume(pos, nodes, rows, volume):
     dng = np.empty((27, 20, 3))
     wd = np.empty(27)
     nd = np.empty(20, np.int64)
+    xe = np.empty((20, 3))
     bad = -1
     for kk in range(rows.shape[0]):
         e = rows[kk]
-        for a in range(20):
-            nd[a] = nodes[e, a]
-        if not _elem_grads(pos, nd, dref, wts, dng, wd):
+        _gather(pos, nodes, e, nd, xe)
+        if not _elem_grads(xe, dref, wts, dng, wd):
             volume[e] = 0.0
             if bad < 0:
                 bad = e
@@ -353,13 +447,13 @@ def feb_lumped_mass(pos, nodes, rows, density, mass):
     dng = np.empty((27, 20, 3))
     wd = np.empty(27)
     nd = np.empty(20, np.int64)
+    xe = np.empty((20, 3))
     dd = np.empty(20)
     bad = -1
     for kk in range(rows.shape[0]):
         e = rows[kk]
-        for a in range(20):
-            nd[a] = nodes[e, a]
-        if not _elem_grads(pos, nd, dref, wts, dng, wd):
+        _gather(pos, nodes, e, nd, xe)
+        if not _elem_grads(xe, dref, wts, dng, wd):
             if bad < 0:
                 bad = e
             continue
@@ -395,13 +489,13 @@ def feb_stiffness(pos, nodes, rows, bulk, shear, kdiag, nq):
     dng = np.empty((ng, 20, 3))
     wd = np.empty(ng)
     nd = np.empty(20, np.int64)
+    xe = np.empty((20, 3))
     K = np.empty((60, 60))
     bad = -1
     for kk in range(rows.shape[0]):
         e = rows[kk]
-        for a in range(20):
-            nd[a] = nodes[e, a]
-        if not _elem_grads(pos, nd, dref, wts, dng, wd):
+        _gather(pos, nodes, e, nd, xe)
+        if not _elem_grads(xe, dref, wts, dng, wd):
             if bad < 0:
                 bad = e
             continue
@@ -443,12 +537,12 @@ def feb_body_force(pos, nodes, rows, density, gvec, force):
     dng = np.empty((27, 20, 3))
     wd = np.empty(27)
     nd = np.empty(20, np.int64)
+    xe = np.empty((20, 3))
     bad = -1
     for kk in range(rows.shape[0]):
         e = rows[kk]
-        for a in range(20):
-            nd[a] = nodes[e, a]
-        if not _elem_grads(pos, nd, dref, wts, dng, wd):
+        _gather(pos, nodes, e, nd, xe)
+        if not _elem_grads(xe, dref, wts, dng, wd):
             if bad < 0:
                 bad = e
             continue
