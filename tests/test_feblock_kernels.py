@@ -584,3 +584,52 @@ def test_cantilever_2x2x2_within_one_percent_and_no_drift():
         u.append(-disp[p, 2])
     assert abs(u[0] - 0.4) < 0.01 * 0.4, u
     assert abs(u[1] - u[0]) < 1e-3 * u[0] and abs(u[2] - u[0]) < 1e-3 * u[0], u
+
+
+@pytest.mark.parametrize("nq", [2, 3])
+def test_parallel_step_is_bit_identical_to_serial_for_any_thread_count(nq):
+    import numba
+
+    from dec3d.kernels.feblock import feb_node_lists, feb_step_parallel
+
+    pos, nodes = beam_mesh(6, 3, 2, 6.0, 3.0, 2.0)
+    rng = np.random.default_rng(21)
+    pos = pos + rng.uniform(-0.05, 0.05, pos.shape)
+    ne = len(nodes)
+    rows = np.arange(ne, dtype=np.int64)[::-1].copy()             # any order
+    vel = rng.normal(size=pos.shape)
+    K, G = np.full(ne, 3e9), np.full(ne, 2e9)
+    gs0 = rng.normal(scale=1e5, size=(ne, 27, 6))
+    ref_gs, ref_s, ref_f = gs0.copy(), np.zeros((ne, 6)), np.ones_like(pos)
+    assert feb_step(pos, vel, nodes, rows, K, G, 1e-4, ref_gs, ref_s, ref_f, nq) == -1
+    nstart, nent = feb_node_lists(len(pos), nodes, rows)
+    old = numba.get_num_threads()
+    try:
+        for th in sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)}):
+            numba.set_num_threads(th)
+            gs, s, f = gs0.copy(), np.zeros((ne, 6)), np.ones_like(pos)
+            fe, ok = np.empty((ne, 20, 3)), np.empty(ne, np.bool_)
+            assert feb_step_parallel(pos, vel, nodes, rows, K, G, 1e-4, gs, s, f, nq, fe, ok, nstart, nent) == -1
+            assert np.array_equal(gs, ref_gs) and np.array_equal(s, ref_s) and np.array_equal(f, ref_f)
+    finally:
+        numba.set_num_threads(old)
+
+
+def test_fe_bench_runs_and_prints_its_figures():
+    """bench/fe_bench.py on a tiny mesh (no timing asserted)."""
+    import os
+    import subprocess
+    import sys
+
+    from conftest import ROOT
+
+    out = subprocess.run([sys.executable, str(ROOT / "bench" / "fe_bench.py"), "--n", "8", "--steps", "1",
+                          "--threads", "1"], capture_output=True, text=True, timeout=300, cwd=ROOT,
+                         env={**os.environ, "PYTHONPATH": os.pathsep.join(
+                             [str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])})
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert lines[0].startswith("machine: ") and "elem-cyc/s" in lines[1]
+    rows = [ln.split() for ln in lines[2:]]
+    assert [r[0] for r in rows] == ["8", "8"] and [r[2] for r in rows] == ["2x2x2", "3x3x3"]
+    assert all(float(r[5]) > 0 and float(r[6]) > 1000 for r in rows)

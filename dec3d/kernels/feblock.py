@@ -42,7 +42,7 @@ integrates skips an element whose det J is not positive at one of its points (no
 the stores) and returns the first such element row (-1 if none) for the host to report.
 """
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 #: master coordinates of the 20 nodes (corrected Table 1), 0-based rows
 YNODE = np.array([
@@ -63,6 +63,9 @@ FACES = np.array([[1, 0, 3, 2, 8, 11, 10, 9], [4, 5, 6, 7, 12, 13, 14, 15],
                   [3, 0, 4, 7, 11, 16, 15, 19], [1, 2, 6, 5, 9, 18, 13, 17]], dtype=np.int64)
 
 NGMAX = 27
+
+#: elements per work unit of the parallel element pass
+CHUNK = 256
 
 
 @njit(cache=True)
@@ -376,6 +379,83 @@ def feb_step(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, force, nq)
             force[r, 1] += fe[a, 1]
             force[r, 2] += fe[a, 2]
     return bad
+
+
+@njit(cache=True, parallel=True)
+def feb_element_pass(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq):
+    """The element half of ``feb_step_parallel``, in parallel over chunks of rows (each element
+    writes only its own rows): stress update, and fe[k] (20, 3) = the force of element rows[k]
+    on each of its nodes; ok[k] = False for an element with det J not positive (untouched)."""
+    n = rows.shape[0]
+    nchunk = (n + CHUNK - 1) // CHUNK
+    for c in prange(nchunk):
+        shp, dref, wts = ref_tables(nq)
+        ng = wts.shape[0]
+        jinv = np.empty((ng, 3, 3))
+        wd = np.empty(ng)
+        nd = np.empty(20, np.int64)
+        xe = np.empty((20, 3))
+        ve = np.empty((20, 3))
+        for kk in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
+            e = rows[kk]
+            _gather(pos, nodes, e, nd, xe)
+            _gather(vel, nodes, e, nd, ve)
+            ok[kk] = _elem_step(xe, ve, dref, wts, bulk[e] - 2.0 * shear[e] / 3.0, 2.0 * shear[e], dt,
+                                gstress[e], stress[e], fe[kk], jinv, wd)
+
+
+@njit(cache=True)
+def feb_node_lists(nv, nodes, rows):
+    """Per node, the (element, local node) entries that add to it, in a fixed order (CSR): the
+    entries of node r are nent[nstart[r]:nstart[r + 1]], each 20 k + a (node a of element
+    rows[k]), ascending: the order of the serial scatter of ``feb_step``. Made once per mesh.
+    Returns (nstart (nv + 1,), nent (20 k,)) int64."""
+    m = rows.shape[0]
+    nstart = np.zeros(nv + 1, dtype=np.int64)
+    for kk in range(m):
+        for a in range(20):
+            nstart[nodes[rows[kk], a] + 1] += 1
+    for r in range(nv):
+        nstart[r + 1] += nstart[r]
+    fill = nstart[:nv].copy()
+    nent = np.empty(20 * m, dtype=np.int64)
+    for kk in range(m):
+        for a in range(20):
+            r = nodes[rows[kk], a]
+            nent[fill[r]] = 20 * kk + a
+            fill[r] += 1
+    return nstart, nent
+
+
+@njit(cache=True, parallel=True)
+def feb_node_sums(force, fe, ok, nstart, nent):
+    """force[r] += the element forces fe of node r's entries (``feb_node_lists``) in their fixed
+    order, in parallel over nodes: the sums do not depend on the thread count and equal the
+    serial scatter. Entries of elements with ok False are skipped."""
+    for r in prange(nstart.shape[0] - 1):
+        f0 = force[r, 0]; f1 = force[r, 1]; f2 = force[r, 2]
+        for q in range(nstart[r], nstart[r + 1]):
+            kk = nent[q] // 20
+            if ok[kk]:
+                a = nent[q] - 20 * kk
+                f0 += fe[kk, a, 0]; f1 += fe[kk, a, 1]; f2 += fe[kk, a, 2]
+        force[r, 0] = f0; force[r, 1] = f1; force[r, 2] = f2
+
+
+@njit(cache=True)
+def feb_step_parallel(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, force, nq,
+                      fe, ok, nstart, nent):
+    """``feb_step`` on several threads, bit for bit the same result whatever the thread count
+    (and the same as ``feb_step``): a parallel element pass into the scratch fe (len(rows), 20,
+    3) [N] and ok (len(rows),) bool, then fixed-order sums per node over the lists of
+    ``feb_node_lists(len(force), nodes, rows)``. Returns the first element row skipped in the
+    order of rows (-1 none)."""
+    feb_element_pass(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq)
+    feb_node_sums(force, fe, ok, nstart, nent)
+    for kk in range(rows.shape[0]):
+        if not ok[kk]:
+            return rows[kk]
+    return -1
 
 
 @njit(cache=True)
