@@ -328,3 +328,40 @@ def test_read_mesh_file_errors(tmp_path):
     s = Session(out_dir=tmp_path, stdout=io.StringIO())
     with pytest.raises(Dec3dError, match=r"needs `model configure feblock` first"):
         s.command("feblock read 'beam.fem'")
+
+
+def test_vtk_of_fe_elements_reads_back(tmp_path, session):
+    """Quadratic hexahedra (VTK 25): meshio sees ten hexahedron20 cells with the element nodes,
+    displacements and stresses; VTK's own cell volume (pyvista) is the element volume, so the
+    node order is VTK's."""
+    import meshio
+
+    from dec3d.io.fevtk import write_feblocks_vtu
+
+    session.command(BEAM)
+    m = session.model
+    es, v = m.store("feblocks"), m.vertices
+    v["pos"][:, 2] += 0.01 * v["pos"][:, 0] ** 2                 # a bent beam: displacement = pos - origin
+    es["stress"][:10] = np.arange(60, dtype=float).reshape(10, 6)
+    es["gstress"][:10, :8] = 1.0
+    path = write_feblocks_vtu(m, tmp_path / "fe.vtu")
+    mesh = meshio.read(path)
+    assert [c.type for c in mesh.cells] == ["hexahedron20"] and mesh.cells[0].data.shape == (10, 20)
+    rows = mesh.point_data["vertex_row"]
+    assert len(rows) == 128 and not v["feslave"][rows].any()
+    assert np.allclose(mesh.points, v["pos"][rows])
+    conn = mesh.cells[0].data
+    assert np.array_equal(rows[conn], es["nodes"][:10])
+    assert np.allclose(mesh.point_data["displacement"][:, 2], 0.01 * v["origin"][rows, 0] ** 2)
+    assert np.allclose(mesh.cell_data["stress"][0], es["stress"][:10])
+    assert np.allclose(mesh.cell_data["stress_gauss_mean"][0], 1.0)
+    assert np.array_equal(mesh.cell_data["element_id"][0], np.arange(1, 11))
+    pv = pytest.importorskip("pyvista")
+    grid = pv.read(path)
+    assert (np.asarray(grid.celltypes) == 25).all()
+    vol = grid.compute_cell_sizes(length=False, area=False)["Volume"]
+    feb_vol = np.zeros(10)
+    from dec3d.kernels.feblock import feb_volume
+    feb_volume(np.ascontiguousarray(v["pos"]), np.ascontiguousarray(es["nodes"]), np.arange(10, dtype=np.int64),
+               feb_vol)
+    assert np.allclose(vol, feb_vol, rtol=1e-6)
