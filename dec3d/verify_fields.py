@@ -13,6 +13,9 @@ measures are the ones that verification defines (its FISH file ``ElasticHole.fis
 - displacement: Σ over every gridpoint of ||u_xz| − u_exact| / (N · u_edge), in %, where
   u_edge is the exact radial displacement at the hole wall on the x axis and N the number of
   gridpoints (shared gridpoints of joined blocks counted once per block, as 3DEC lists them).
+
+``uniaxial`` and ``self_weight``: the patch test and the self-weight column of the deformable
+blocks (shared/verification/PROBLEMS.md D1, D2), measures in their functions' docstrings.
 """
 from __future__ import annotations
 
@@ -61,5 +64,47 @@ def kirsch_errors(model, p1: float, p2: float, a: float, bulk: float, shear: flo
     return {"sigr": err_sr, "sigt": err_st, "disp": err_d}
 
 
+def _slope(x: np.ndarray, y: np.ndarray) -> float:
+    """Least-squares slope dy/dx."""
+    xm = x - x.mean()
+    return float((xm * (y - y.mean())).sum() / (xm * xm).sum())
+
+
+def uniaxial_measures(model, sigma: float) -> dict[str, float]:
+    """A prism of zones under a uniform axial stress ``sigma`` along z (tension positive) on
+    rollers (verification D1): the strains as least-squares slopes of the gridpoint
+    displacements, ``ezz`` = du_z/dz and ``exx`` = du_x/dx (closed form σ/E and −ν σ/E), and
+    ``spread``: the largest deviation of any zone's stress tensor from (0, 0, σ, 0, 0, 0),
+    relative to |σ| (closed form 0)."""
+    zs, vs = model.store("zones"), model.vertices
+    if zs.n == 0:
+        raise ValueError("uniaxial: the model has no zones")
+    gp = np.flatnonzero(vs["zoned"])
+    p, u = vs["pos"][gp], vs["disp"][gp]
+    want = np.array([0.0, 0.0, sigma, 0.0, 0.0, 0.0])
+    spread = float(np.abs(zs["stress"] - want).max()) / abs(sigma)
+    return {"ezz": _slope(p[:, 2], u[:, 2]), "exx": _slope(p[:, 0], u[:, 0]), "spread": spread}
+
+
+def self_weight_measures(model, density: float, g: float, height: float) -> dict[str, float]:
+    """A column of zones standing on z = 0 under its own weight (verification D2): ``settle``
+    the mean downward displacement of the gridpoints at the top (z = height) [m]; ``stress``
+    the mean over the zones of |σ_zz − σ_exact| / (ρ g H) in %, σ_exact = −ρ g (H − z) at the
+    zone centroid; ``stress_max`` the largest of those deviations, in %."""
+    zs, vs = model.store("zones"), model.vertices
+    if zs.n == 0:
+        raise ValueError("self-weight: the model has no zones")
+    gp = np.flatnonzero(vs["zoned"])
+    top = gp[np.abs(vs["pos"][gp, 2] - height) <= 1e-6 * height]
+    if not len(top):
+        raise ValueError(f"self-weight: no gridpoint at the top z = {height:g}")
+    zc = vs["pos"][zs["gp"][:, :4]].mean(axis=1)[:, 2]
+    dev = np.abs(zs["stress"][:, 2] + density * g * (height - zc)) / (density * g * height)
+    return {"settle": -float(vs["disp"][top, 2].mean()), "stress": 100.0 * float(dev.mean()),
+            "stress_max": 100.0 * float(dev.max())}
+
+
 #: derive kinds that read the model: name -> (function, its parameter names)
-FIELDS = {"kirsch": (kirsch_errors, ("p1", "p2", "a", "bulk", "shear"))}
+FIELDS = {"kirsch": (kirsch_errors, ("p1", "p2", "a", "bulk", "shear")),
+          "uniaxial": (uniaxial_measures, ("sigma",)),
+          "self_weight": (self_weight_measures, ("density", "g", "height"))}

@@ -77,9 +77,10 @@ def test_completion_marks_what_does_not_run():
     top = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document(""), None)}
     assert top["plot"] == "display only: skipped" and top["model"] == ""
     kws = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document("block history velocity "), None)}
-    assert kws["gridpointid"] == "not supported yet" and kws["block-id"] == ""
+    assert kws["zone-id"] == "not supported yet" and kws["gridpointid"] == "" and kws["block-id"] == ""
     fish = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document("fish "), None)}
-    assert fish["define"] == "FISH function definition" and fish["list"] == "" and fish["callback"] == "not supported yet"
+    assert fish["define"] == "FISH function definition" and fish["list"] == "" and fish["callback"] == ""
+    assert fish["debug"] == "not supported yet"
 
 
 def test_completion_of_words_and_keywords():

@@ -499,7 +499,9 @@ def _fish_inline(text: str):
 
 
 def _fish_knows(name: str, ctx: BindContext) -> bool:
-    """A name dec3d's FISH runs: a FISH function of the deck or an implemented intrinsic."""
+    """A name dec3d's FISH runs: a FISH function of the deck, an implemented intrinsic, or a variable
+    (`v(i)` indexes a list, map or vector held by a variable)."""
     from ..fish import intrinsics
 
-    return name in ctx.fish_functions or intrinsics.resolve(name) is not None
+    return (name in ctx.fish_functions or intrinsics.resolve(name) is not None or name in ctx.assigned
+            or name in ctx.session_variables or name in ctx.fish_variables)

@@ -115,3 +115,42 @@ def block_gridpoint_initialize(session, call):
         for i, ax in enumerate(_AX):
             if a[f"{base}_{ax}"] is not None:
                 v[field][rows, i] = a[f"{base}_{ax}"]
+
+
+def _conditions(v, r) -> str:
+    """Applied conditions of gridpoint row ``r`` in words: held velocity components and applied forces."""
+    out = []
+    bits = int(v["apply_fix"][r])
+    for i, ax in enumerate(_AX):
+        if bits & (1 << i):
+            out.append(f"v{ax}={v['vapp'][r, i]:.4g}")
+    for i, ax in enumerate(_AX):
+        if v["fapp"][r, i] != 0.0:
+            out.append(f"f{ax}={v['fapp'][r, i]:.4g}")
+    if np.any(v["fface"][r] != 0.0):
+        out.append("face-stress")
+    if v["link"][r] >= 0:
+        out.append(f"linked-to={int(v['link'][r]) + 1}")
+    return " ".join(out)
+
+
+@command("block gridpoint list", range="gridpoint",
+         doc="List the gridpoints of zoned blocks in range: id, block, position, displacement, velocity, conditions.",
+         details="The id of a gridpoint is its vertex row + 1 (what `block.zone.gp` gives). Conditions: held "
+                 "velocity components (`vz=0`), applied forces (`fx=…`), `face-stress` when an applied face "
+                 "stress loads it, and `linked-to=<id>` for a gridpoint shared with a joined block (a copy of "
+                 "that one).",
+         examples=["block gridpoint list", "block gridpoint list range position-z 0"])
+def block_gridpoint_list(session, call):
+    m = session.model
+    rows = _gridpoints(session, call, "block gridpoint list")
+    if not len(rows):
+        return
+    v, b = m.vertices, m.blocks
+    owner = v["block"][rows]
+    session.write(f"{'id':>7} {'block':>6} {'x':>11} {'y':>11} {'z':>11} {'disp-x':>11} {'disp-y':>11} "
+                  f"{'disp-z':>11} {'vel-x':>11} {'vel-y':>11} {'vel-z':>11}  conditions")
+    for k, r in enumerate(rows):
+        p, d, u = v["pos"][r], v["disp"][r], v["velocity"][r]
+        nums = " ".join(f"{x:>11.5g}" for x in (*p, *d, *u))
+        session.write(f"{r + 1:>7} {b['id'][owner[k]]:>6} {nums}  {_conditions(v, r)}")

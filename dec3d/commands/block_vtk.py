@@ -22,7 +22,13 @@ STEM = OutPath(stem=True)
                  "rotation_angle (θ). Point data: displacement (of each vertex since its block was made) and "
                  "velocity (v + ω × r of its block). The files open in ParaView, PyVista and meshio (meshio "
                  "reads no grid without cells). Relative names are written in the output folder. "
-                 "With `interval n` a snapshot is also written every n steps while the model cycles.",
+                 "With `interval n` a snapshot is also written every n steps while the model cycles. "
+                 "Zoned blocks are written as their zones (tetra cells; quadratic tetra for 10-node zones) with "
+                 "cell data zone_id, overlay (0/1: the two overlaid 5-tetrahedron sets of a hexahedral zone, -1 otherwise; "
+                 "threshold on it to see one set), stress (XX YY ZZ XY YZ XZ, ParaView's tensor order), mean_stress, "
+                 "principal_stress and von_mises, and gridpoint displacement and velocity as point data. When the "
+                 "model has rigid blocks too, the zones go to `<file>_zones_<nnnn>.vtu` (part 1 of the same "
+                 "time in the .pvd), since meshio reads no file mixing polyhedra with other cells.",
          examples=["block vtk", "block vtk 'jointed' interval 100", "block vtk filename 'out/blocks'",
                    "block vtk off"])
 def block_vtk(session, call):

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import BindError, ResourceError
+from ..errors import BindError, CommandError, ResourceError
 from ..geometry.assemble import block_poly
 from ..geometry.zoning import mesh_convex
 from ..model.zones import install_block_mesh, zone_stores
 from .registry import command
-from .values import FLAG, Num, Nums, P
+from .values import FLAG, Choice, Num, Nums, P
 
 # Memory budget: about 1 kB per zone (issue 10); refuse beyond this many zones per command.
 ZONE_BUDGET = 20_000_000
@@ -50,3 +50,257 @@ def block_zone_generate(session, call):
         poly = block_poly(model, row)
         pts, tets, tris, src = mesh_convex(poly.vertices, poly.face_ptr, poly.face_idx, L)
         install_block_mesh(model, row, pts, tets, tris, src)
+
+
+# ----------------------------------------------------------------------------- zone stresses
+_COMPS = ("xx", "yy", "zz", "xy", "xz", "yz")
+#: Gauss points of a 10-node zone (4-point rule): barycentric weight A on one corner, B on the others
+_GA, _GB = 0.5854101966249685, 0.1381966011250105
+
+
+def _zone_rows(session, call, what: str) -> np.ndarray:
+    """Rows of the zones in range; a warning naming file:line when there are none."""
+    m = session.model
+    zone_stores(m)
+    rows = np.flatnonzero(session.range_mask(call, "zone"))
+    if not len(rows):
+        session.write(f"warning: {call.location}: `{what}` selected no zone"
+                      + (" (there are no zones: `block zone generate` makes them)" if m.store("zones").n == 0
+                         else ""))
+    return rows
+
+
+def _gauss_points(model, rows) -> np.ndarray:
+    """(m, 4, 3) Gauss points of the zones ``rows`` (used for 10-node zones)."""
+    from ..model.zone_quality import corners
+    p = corners(model, rows)
+    w = np.full((4, 4), _GB)
+    np.fill_diagonal(w, _GA)
+    return np.einsum("gk,mkd->mgd", w, p)
+
+
+def stress_updates(model, rows, comp: int, value, how: str = "set") -> list:
+    """New values of stress component ``comp`` of the zones ``rows``: set (how='set'), added
+    ('add') or multiplied ('multiply'); ``value(points (..., 3)) -> (...)`` gives the value at zone
+    centroids and Gauss points. A 10-node zone takes the value at each Gauss point, its stress
+    being their mean. Returns [(field, index, values)] for ``write_updates`` (nothing written yet,
+    so a command can check every value first)."""
+    zs = model.store("zones")
+    rows = np.asarray(rows, dtype=np.int64)
+    ho = rows[zs["nnode"][rows] == 10]
+    lo = rows[zs["nnode"][rows] != 10]
+
+    def combine(old, new):
+        return new if how == "set" else old + new if how == "add" else old * new
+
+    with np.errstate(over="ignore", invalid="ignore"):     # checked by write_updates
+        return _stress_updates(model, zs, lo, ho, comp, value, combine)
+
+
+def _stress_updates(model, zs, lo, ho, comp, value, combine) -> list:
+    from ..model.zone_quality import centroids
+    out = []
+    if lo.size:
+        out.append(("stress", (lo, comp), combine(zs["stress"][lo, comp], value(centroids(model, lo)))))
+    if ho.size:
+        g = combine(zs["gstress"][ho, :, comp], value(_gauss_points(model, ho)))
+        out.append(("gstress", (ho, slice(None), comp), g))
+        out.append(("stress", (ho, comp), g.mean(axis=1)))
+    return out
+
+
+def write_updates(model, updates: list, where) -> None:
+    """Write ``stress_updates`` results after checking they are all finite (else nothing is written)."""
+    for _, _, vals in updates:
+        if not np.isfinite(vals).all():
+            raise CommandError("the stress would not be finite (a gradient too large for the model's "
+                               "coordinates?); nothing was changed", where)
+    zs = model.store("zones")
+    for key, idx, vals in updates:
+        zs[key][idx] = vals
+
+
+def _check_initialize(call):
+    a = call.args
+    comps = [c for c in _COMPS if a[f"stress_{c}"] is not None]
+    if a["stress"] is None and not comps:
+        raise BindError("`block zone initialize` needs stress <sxx syy szz sxy sxz syz> or stress-xx … <f>",
+                        call.location)
+    if a["stress"] is not None and comps:
+        raise BindError("give either stress <6 values> or stress-xx … components, not both", call.location)
+    if a["add"] and a["multiply"]:
+        raise BindError("give `add` or `multiply`, not both", call.location)
+    if a["gradient"] is not None:
+        if a["stress"] is not None or len(comps) != 1:
+            raise BindError("`gradient` goes with exactly one stress component (stress-xx … <f> gradient <gx gy gz>)",
+                            call.locations.get("gradient", call.location))
+        if a["multiply"]:
+            raise BindError("`gradient` cannot be combined with `multiply`", call.location)
+    elif a["origin"] is not None:
+        raise BindError("`origin` is the point where a `gradient` starts: give `gradient` too",
+                        call.locations.get("origin", call.location))
+
+
+@command("block zone initialize",
+         keywords=[P("stress", Nums(6, 6), "sxx syy szz sxy sxz syz (tension positive)", units="Pa"),
+                   *[P(f"stress-{c}", Num(), f"the {c} component", units="Pa") for c in _COMPS],
+                   P("gradient", Nums(3, 3), "gx gy gz: the component varies as f + g·(x − origin)", units="Pa/m"),
+                   P("origin", Nums(3, 3), "where the gradient starts (default 0 0 0)", units="m"),
+                   P("add", FLAG, "add to the present value instead of replacing it", bare=True),
+                   P("multiply", FLAG, "multiply the present value instead of replacing it", bare=True),
+                   P("vary", Nums(3, 3), "random variation", supported=False)],
+         range="zone", check=_check_initialize,
+         doc="Set the stress of the zones in range (located by centroid), all six components or some.",
+         details="Stresses are tension positive (3DEC sign convention). With `gradient gx gy gz` one component "
+                 "varies linearly: f + gx (x − x0) + gy (y − y0) + gz (z − z0), (x0 y0 z0) the `origin` "
+                 "(default 0 0 0), taken at the zone centroid; a 10-node zone takes it at each of its four "
+                 "Gauss points and its stress is their mean. `add` adds to and `multiply` multiplies the "
+                 "stress there. Gridpoint forces follow from the stresses at the next step.",
+         examples=["block zone initialize stress -1e6 -1e6 -2e6 0 0 0",
+                   "block zone initialize stress-zz -1e6 gradient 0 0 2.6e4 range group 'rock'",
+                   "block zone initialize stress-xx 1e5 add range position-z 0 5"])
+def block_zone_initialize(session, call):
+    a = call.args
+    rows = _zone_rows(session, call, "block zone initialize")
+    how = "add" if a["add"] else "multiply" if a["multiply"] else "set"
+    if a["stress"] is not None:
+        vals = [(i, float(v)) for i, v in enumerate(a["stress"])]
+    else:
+        vals = [(i, float(a[f"stress_{c}"])) for i, c in enumerate(_COMPS) if a[f"stress_{c}"] is not None]
+    grad = np.zeros(3) if a["gradient"] is None else np.asarray(a["gradient"], float)
+    origin = np.zeros(3) if a["origin"] is None else np.asarray(a["origin"], float)
+    if not len(rows):
+        return
+    updates = []
+    for i, f in vals:
+        updates += stress_updates(session.model, rows, i, lambda x, f=f: f + (x - origin) @ grad, how)
+    write_updates(session.model, updates, call.location)
+
+
+# ----------------------------------------------------------------------------- in-situ stress
+def insitu_contact_forces(model, cmask, stress_at) -> tuple | None:
+    """Sub-contact forces of the contacts ``cmask`` under the stress field ``stress_at(points) -> (k, 6)``.
+
+    On a plane of unit normal n (A → B) the material on B's side pulls A by the traction σ·n
+    (Cauchy), so the force on B is F = −A σ·n, A the sub-contact area. Its normal part is the
+    normal force (compression positive), its tangential part the shear force on B:
+        fn = −A n·σ·n,   fs = −A (σ·n − (n·σ·n) n).
+    The joint law works from the total normal displacement (Fn = −kn A (un − u_dil),
+    dec3d.kernels.jointlaw), so un is set to u_dil − fn / (kn A) for the force to persist.
+    Returns (sub-contact rows, fn, fs, un) or None when there are no contacts."""
+    from ..kernels.jointlaw import P_KN
+    from ..model.zone_quality import tensor
+    if "contacts" not in model.stores:
+        return None
+    cs, ss = model.store("contacts"), model.store("subcontacts")
+    if cs.n == 0 or ss.n == 0:
+        return None
+    sub = np.flatnonzero(np.asarray(cmask, bool)[ss["contact"]])
+    c = ss["contact"][sub]
+    n = cs["normal"][c]
+    area = ss["area"][sub]
+    t = np.einsum("kij,kj->ki", tensor(stress_at(ss["pos"][sub])), n)      # σ·n
+    tn = np.einsum("ki,ki->k", t, n)
+    fn = -area * tn
+    fs = -area[:, None] * (t - tn[:, None] * n)
+    kna = cs["prop"][c, P_KN] * area
+    un = np.where(kna > 0.0, ss["udil"][sub] - fn / np.where(kna > 0.0, kna, 1.0), ss["un"][sub])
+    return sub, fn, fs, un
+
+
+@command("block insitu",
+         keywords=[P("stress", Nums(6, 6), "sxx syy szz sxy sxz syz at the origin (tension positive)", units="Pa"),
+                   *[P(f"gradient-{ax}", Nums(6, 6), f"the change of the six components per metre of {ax}",
+                       units="Pa/m") for ax in ("x", "y", "z")],
+                   P("nodisplacements", FLAG, "keep displacements", bare=True, supported=False),
+                   P("total", FLAG, "total stresses with pore pressure", bare=True, supported=False),
+                   P("pore-pressure", Num(), "pore pressure", supported=False),
+                   P("fluid-temperature", Num(), "fluid temperature", supported=False)],
+         range="zone",
+         doc="Set an in-situ stress: the stress of the zones in range and the forces of the existing "
+             "sub-contacts in range, consistently.",
+         details="σ(x) = σ0 + x·gx + y·gy + z·gz, each g a six-component `gradient-x|y|z` (default zero), tension "
+                 "positive. Zones (located by centroid) take σ at their centroid (10-node zones at each Gauss "
+                 "point). Each sub-contact of a contact in range (located by the contact's point; groups of the "
+                 "contact or of its blocks) takes the force of the traction on its plane: normal force "
+                 "−A n·σ·n (compression positive), shear force −A (σ·n − (n·σ·n) n) on the second block, A its "
+                 "area, n the contact normal; its normal displacement is set so the joint law keeps that force. "
+                 "Contacts made later start from their own gap. Displacements are not changed.",
+         examples=["block insitu stress -30e6 -30e6 -15e6 0 0 0",
+                   "block insitu stress -1e6 -1e6 -2e6 0 0 0 gradient-z 1e4 1e4 2e4 0 0 0 range group 'rock'"])
+def block_insitu(session, call):
+    a = call.args
+    if a["stress"] is None:
+        raise BindError("`block insitu` needs stress <sxx syy szz sxy sxz syz>", call.location)
+    m = session.model
+    s0 = np.asarray(a["stress"], float)
+    grad = np.array([np.zeros(6) if a[f"gradient_{ax}"] is None else np.asarray(a[f"gradient_{ax}"], float)
+                     for ax in ("x", "y", "z")])                     # (3, 6): row d = d σ / d x_d
+
+    def stress_at(x):
+        return s0 + x @ grad
+
+    zone_stores(m)
+    zrows = np.flatnonzero(session.range_mask(call, "zone"))
+    updates = []
+    for i in range(6):
+        updates += stress_updates(m, zrows, i, lambda x, i=i: stress_at(x)[..., i])
+    contact = None
+    if "contacts" in m.stores and m.store("contacts").n:
+        try:
+            cmask = session.range_mask(call, "contact")
+        except CommandError as exc:              # an element contacts lack (`id`): the zones only
+            cmask = None
+            session.write(f"warning: {call.location}: `block insitu`: the range does not select contacts "
+                          f"({exc.message}); their forces are left as they are")
+        if cmask is not None:
+            with np.errstate(over="ignore", invalid="ignore"):      # checked below
+                contact = insitu_contact_forces(m, cmask, stress_at)
+    if contact is not None and not all(np.isfinite(v).all() for v in contact[1:]):
+        raise CommandError("a sub-contact force would not be finite; nothing was changed", call.location)
+    write_updates(m, updates, call.location)
+    nsub = 0
+    if contact is not None:
+        sub, fn, fs, un = contact
+        ss = m.store("subcontacts")
+        ss["fn"][sub], ss["fs"][sub], ss["un"][sub] = fn, fs, un
+        nsub = len(sub)
+    if not len(zrows) and not nsub:
+        session.write(f"warning: {call.location}: `block insitu` selected no zone and no sub-contact")
+
+
+# ----------------------------------------------------------------------------- listing
+@command("block zone list", positional=[P("what", Choice(("information",)), "mesh summary instead of a zone table")],
+         range="zone",
+         doc="List the zones in range (id, block, centroid, volume, stress), or a mesh summary with `information`.",
+         details="`information`: number of zones and of gridpoints (a gridpoint shared by joined blocks counted "
+                 "once), smallest and largest edge, smallest dihedral angle (70.53° for a regular tetrahedron, "
+                 "near 0 for a sliver), smallest and total volume. These go into the session results as "
+                 "`zones`, `gridpoints`, `zone_edge_min`, `zone_edge_max`, `zone_dihedral_min` (degrees), "
+                 "`zone_volume_min` and `zone_volume`.",
+         examples=["block zone list", "block zone list information", "block zone list range position-z 0 1"])
+def block_zone_list(session, call):
+    from ..model.zone_quality import centroids, mesh_information
+    m = session.model
+    zs = zone_stores(m)
+    rows = np.flatnonzero(session.range_mask(call, "zone"))
+    if call.args["what"] == "information":
+        info = mesh_information(m, rows)
+        session.write(f"zones {info['zones']} (of {zs.n}), gridpoints {info['gridpoints']}")
+        session.results.update({"zones": float(info["zones"]), "gridpoints": float(info["gridpoints"])})
+        if info["zones"]:
+            session.write(f"edge length: smallest {info['edge_min']:.6g} m, largest {info['edge_max']:.6g} m")
+            session.write(f"smallest dihedral angle {info['dihedral_min']:.4g} degrees")
+            session.write(f"volume: smallest {info['volume_min']:.6g} m^3, total {info['volume_total']:.6g} m^3")
+            session.results.update({"zone_edge_min": info["edge_min"], "zone_edge_max": info["edge_max"],
+                                    "zone_dihedral_min": info["dihedral_min"],
+                                    "zone_volume_min": info["volume_min"], "zone_volume": info["volume_total"]})
+        return
+    c = centroids(m, rows)
+    bid = m.blocks["id"][zs["block"][rows]]
+    head = " ".join(f"{'s' + k:>11}" for k in _COMPS)
+    session.write(f"{'id':>7} {'block':>6} {'x':>11} {'y':>11} {'z':>11} {'volume':>11} {head}")
+    for k, r in enumerate(rows):
+        s = " ".join(f"{v:>11.5g}" for v in zs["stress"][r])
+        session.write(f"{zs['id'][r]:>7} {bid[k]:>6} {c[k, 0]:>11.5g} {c[k, 1]:>11.5g} {c[k, 2]:>11.5g} "
+                      f"{zs['volume'][r]:>11.5g} {s}")

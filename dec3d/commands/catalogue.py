@@ -60,7 +60,7 @@ def install(registry=REGISTRY) -> None:
                                               "some generators (`r=0`): accepted and ignored; use group")])
     registry.node_keywords("model history", [P("name", Text(), "history name")])
     registry.node_keywords("block history", [P("name", Text(), "history name")])
-    registry.node_keywords("fish history", [P("name", Text(), "history name")])
+    # `fish history [name '<s>'] <var>` takes its name itself (commands.fish_cmds): a FISH variable may be called `name`
     # bare top-level forms seen in decks (3DEC accepts them as program commands)
     registry.alias("call", "program call")
     registry.alias("return", "program return")

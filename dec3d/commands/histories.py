@@ -6,10 +6,14 @@ Histories are sampled by the rigid engine every `history interval` steps (dec3d.
 """
 from __future__ import annotations
 
+import numpy as np
+
 from ..errors import BindError, CommandError
 from ..io.history import write_csv, write_png
-from ..physics.history import (BLOCK_QUANTITIES, CONTACT_QUANTITIES, MODEL_QUANTITIES, POINT_QUANTITIES,
-                               RIGID_QUANTITIES, ROTATION_QUANTITIES, figures, histories, nearest_block_id)
+from ..physics.history import (BLOCK_QUANTITIES, CONTACT_QUANTITIES, GRIDPOINT_QUANTITIES, MODEL_QUANTITIES,
+                               POINT_QUANTITIES, RIGID_QUANTITIES, ROTATION_QUANTITIES, ZONE_QUANTITIES, figures,
+                               histories, nearest_block_id, nearest_gridpoint, zone_at)
+from ..model.model import KIND_DEFORMABLE
 from .registry import REGISTRY, command
 from .values import NUMBERISH, VEC3, Choice, Num, OutPath, P, Text, ValueType, _number_literal
 
@@ -42,9 +46,15 @@ class HistoryRefs(ValueType):
 
 def _check_block(call):
     point = call.args.get("material_point")
+    given = [k for k in ("position", "block_id", "gridpointid") if call.args.get(k) is not None]
     if call.args["position"] is not None and call.args["block_id"] is not None:
         raise BindError("give either `position <x y z>` or `block-id <i>`, not both", call.location)
-    if call.args["position"] is None and call.args["block_id"] is None and point is None:
+    if len(given) > 1:
+        raise BindError("`gridpointid <i>` names the gridpoint alone: give no `position` or `block-id` with it",
+                        call.location)
+    if given == ["gridpointid"] and point is not None:
+        raise BindError("`material-point` follows a point of a block, not a gridpoint", call.location)
+    if not given and point is None:
         raise BindError("give either `position <x y z>` or `block-id <i>`"
                         + (" (or `material-point <x y z>`)" if "material_point" in call.args else ""), call.location)
 
@@ -61,6 +71,9 @@ def _block_history(quantity, kind="block"):
         m = session.model
         name = _name(session, call)
         point = call.args.get("material_point")
+        if call.args.get("gridpointid") is not None:
+            _gridpoint_history(session, call, quantity, name)
+            return
         if call.args["block_id"] is not None:
             bid = int(call.args["block_id"])
             if not (m.blocks["id"] == bid).any():
@@ -70,7 +83,13 @@ def _block_history(quantity, kind="block"):
                 bid = nearest_block_id(m, call.args["position"] if call.args["position"] is not None else point)
             except ValueError as exc:
                 raise CommandError(str(exc), call.location)
-        if point is not None:
+        row = int(np.flatnonzero(m.blocks["id"] == bid)[0])
+        if (point is None and call.args["position"] is not None and quantity in GRIDPOINT_QUANTITIES
+                and m.blocks["kind"][row] == KIND_DEFORMABLE):
+            # a zoned block: the gridpoint of the nearest block nearest the point
+            local = nearest_gridpoint(m, row, call.args["position"])
+            histories(m).add_gridpoint(quantity, bid, local, name)
+        elif point is not None:
             histories(m).add_point(quantity, bid, point, name)
         elif kind == "rigid":
             histories(m).add_rigid(quantity, bid, name)
@@ -83,9 +102,25 @@ def _block_history(quantity, kind="block"):
     return handler
 
 
+def _gridpoint_history(session, call, quantity, name):
+    """`block history <q> gridpointid <i>`: the gridpoint with id i (its vertex row + 1)."""
+    m = session.model
+    gid = int(call.args["gridpointid"])
+    where = call.locations.get("gridpointid", call.location)
+    if quantity not in GRIDPOINT_QUANTITIES:
+        raise CommandError(f"`{quantity}` is not a gridpoint quantity (displacement, velocity or position)", where)
+    v = m.vertices
+    row = gid - 1
+    if not (0 <= row < v.n) or "zoned" not in v or not v["zoned"][row]:
+        raise CommandError(f"there is no gridpoint {gid} (gridpoints are the vertices of zoned blocks)", where)
+    brow = int(v["block"][row])
+    histories(m).add_gridpoint(quantity, int(m.blocks["id"][brow]), row - int(m.blocks["vert_start"][brow]), name)
+
+
 _BLOCK_KW = [P("position", VEC3, "the block whose centroid is nearest this point", units="m"),
              P("block-id", Num(integer=True, lo=1), "the block with this id"),
-             P("gridpointid", Num(integer=True), "a gridpoint of a deformable block", supported=False),
+             P("gridpointid", Num(integer=True), "a gridpoint of a zoned block by id (displacement, velocity, "
+               "position)"),
              P("zone-id", Num(integer=True), "a zone of a deformable block", supported=False)]
 _POINT_KW = [P("material-point", VEC3, "follow the point fixed to the block that is here when the command runs "
                             "(a corner: its vertex)", units="m")]
@@ -93,6 +128,8 @@ _WHAT = {"displacement": "displacement", "velocity": "velocity", "rvelocity": "a
          "position": "centroid position"}
 _WHICH = ("The block is the one whose centroid is nearest `position` when the command runs, or the "
           "block `block-id`. A leading `name '<s>'` names the history (default: its number).")
+_GP = (" When that block is zoned (deformable), `position` records the gridpoint of it nearest the point "
+       "instead; `gridpointid <i>` names a gridpoint directly (its id is its vertex row + 1).")
 _POINT = (" With `material-point x y z` (dec3d) the value is that of the point fixed to the block that is at "
           "(x, y, z) when the command runs, instead of the centroid: its position now, its displacement "
           "since the block was made, its velocity v + ω × (p − c). Give a corner's coordinates to follow "
@@ -107,7 +144,8 @@ for _q in BLOCK_QUANTITIES:
     _pt = _q in POINT_QUANTITIES
     command(f"block history {_q}", keywords=_BLOCK_KW + (_POINT_KW if _pt else []), check=_check_block,
             doc=f"Record the {_comp} {_what} of one block every `history interval` steps.",
-            details=_WHICH + ("" if _q.split("-")[0] in ("displacement", "velocity") else
+            details=_WHICH + (_GP if _q in GRIDPOINT_QUANTITIES else "")
+            + ("" if _q.split("-")[0] in ("displacement", "velocity") else
                               " (dec3d: `rvelocity` and `position` are not 3DEC history variables.)")
             + (_POINT if _pt else ""),
             examples=[f"block history {_q} position 0.5 0.5 0.5", f"block history name 'h{_q[0]}' {_q} block-id 2"]
@@ -140,6 +178,46 @@ for _q in RIGID_QUANTITIES:
             examples=[f"block history {_q} position 0.5 0.5 0.5"])(_block_history(_q, kind="rigid"))
 
 REGISTRY.node_keywords("block contact history", [P("name", Text(), "history name")])
+REGISTRY.node_keywords("block zone history", [P("name", Text(), "history name")])
+
+
+def _check_zone(call):
+    if (call.args["position"] is None) == (call.args["zone_id"] is None):
+        raise BindError("give either `position <x y z>` or `zone-id <i>`", call.location)
+
+
+def _zone_history(quantity):
+    def handler(session, call):
+        m = session.model
+        name = _name(session, call)
+        if call.args["zone_id"] is not None:
+            zid = int(call.args["zone_id"])
+            if "zones" not in m.stores or not (m.store("zones")["id"] == zid).any():
+                raise CommandError(f"there is no zone {zid}", call.locations.get("zone_id", call.location))
+        else:
+            try:
+                zid = zone_at(m, call.args["position"])
+            except ValueError as exc:
+                raise CommandError(str(exc), call.location)
+        histories(m).add_zone(quantity, zid, name)
+
+    handler.__name__ = "zone_history_" + quantity.replace("-", "_")
+    return handler
+
+
+for _q in ZONE_QUANTITIES:
+    command(f"block zone history {_q}",
+            keywords=[P("position", VEC3, "the zone containing this point (else the one whose centroid is nearest)",
+                        units="m"),
+                      P("zone-id", Num(integer=True, lo=1), "the zone with this id")],
+            check=_check_zone,
+            doc=f"Record the {_q[-2:]} stress [Pa, tension positive] of one zone every `history interval` steps.",
+            details="The zone is the one containing `position` when the command runs (the first by number when "
+                    "the point is on a face shared by several), or, when no zone contains it, the zone whose "
+                    "centroid is nearest; or the zone `zone-id`. A leading `name '<s>'` names the history. The "
+                    "value is NaN once the zone is gone.",
+            examples=[f"block zone history {_q} position 0.5 0.5 0.5",
+                      f"block zone history name 's' {_q} zone-id 12"])(_zone_history(_q))
 
 
 def _contact_history(quantity):
@@ -230,3 +308,56 @@ def history_export(session, call):
 def _file_part(name: str) -> str:
     """A history name as part of a file name: path separators and control characters become '_'."""
     return "".join("_" if (ch in "/\\" or not ch.isprintable()) else ch for ch in str(name)) or "_"
+
+
+@command("history rename", positional=[P("old", HistoryRefs(1), "the history's number or name", required=True)],
+         keywords=[P("name", Text(), "its new name", required=True)],
+         doc="Give a history a new name (what `history export` and result figures use).",
+         details="The history is found by name, else by number; a name another history has is refused.",
+         examples=["history rename 'shearforce' name '5'", "history rename 1 name 'settle'"])
+def history_rename(session, call):
+    hs = histories(session.model)
+    h = _find(hs, call.args["old"], call, "old")
+    new = str(call.args["name"])
+    if not new.strip():
+        raise CommandError("a history name cannot be empty", call.locations.get("name", call.location))
+    other = hs.find(new)
+    if other is not None and other is not h:
+        raise CommandError(f"a history named '{new}' exists already", call.locations.get("name", call.location))
+    h.name = new
+
+
+@command("history list", doc="Print every history: number, name, what it records and its number of samples.",
+         examples=["history list"])
+def history_list(session, call):
+    hs = histories(session.model)
+    if not hs.items:
+        session.write("no histories")
+    for h in hs.items:
+        last = f", last {h.values[-1]:.6g} at step {h.steps[-1]}" if h.values else ""
+        session.write(f"{h.id:4d}  '{h.name}'  {h.label}  ({len(h.values)} samples{last})")
+
+
+@command("history name", positional=[P("history", HistoryRefs(1), "the history's name or number", required=True)],
+         keywords=[P("label", Text(), "its new label (the CSV header and plot title)", required=True)],
+         doc="Set the label of a history (what `history export` writes as its column header and plot title).",
+         details="The history is found by name, else by number (a history's name is its number unless it was "
+                 "given one).",
+         examples=["history name '1' label 'Unbalanced Force'", "history name 3 label 'C2_MiddleSail'"])
+def history_name(session, call):
+    h = _find(histories(session.model), call.args["history"], call, "history")
+    h.label = str(call.args["label"])
+
+
+@command("history delete", positional=[P("ids", HistoryRefs(), "history numbers or names; omitted: every history")],
+         doc="Delete histories (all of them when none is named) with their samples.",
+         details="Histories made afterwards are numbered on from the last one left (from 1 when none is left).",
+         examples=["history delete", "history delete 2 'settle'"])
+def history_delete(session, call):
+    hs = histories(session.model)
+    ids = call.args["ids"]
+    if not ids:
+        hs.items.clear()
+        return
+    gone = {id(_find(hs, key, call, "ids")) for key in ids}
+    hs.items[:] = [h for h in hs.items if id(h) not in gone]

@@ -7,7 +7,7 @@ block.disp, block.mass, block.vol, block.group, block.fix).
 """
 from __future__ import annotations
 
-from .intrinsics import intrinsic
+from .intrinsics import intrinsic, setter
 from .values import FishValueError, Vec, type_name
 
 
@@ -102,3 +102,38 @@ def _block_fix(rt, b):
     """True when the block is fixed (`block fix`)."""
     m, r = _row(rt, b, "block.fix")
     return bool(m.blocks["fixity"][r])
+
+
+@intrinsic("block.head")
+def _block_head(rt):
+    """The first block (0 when there is none); walk on with block.next."""
+    ids = rt.session.model.blocks["id"]
+    return int(ids[0]) if len(ids) else 0
+
+
+@intrinsic("block.next", 1)
+def _block_next(rt, b):
+    """The block after `b` in block.list order, 0 after the last."""
+    m, r = _row(rt, b, "block.next")
+    return int(m.blocks["id"][r + 1]) if r + 1 < m.blocks.n else 0
+
+
+def _set_vector(name, field, what):
+    """`name(b) = v` and `name.x(b) = x`: write a block's vector field (finite numbers only)."""
+    def whole(rt, b, v):
+        m, r = _row(rt, b, name)
+        if type(v) is not Vec or any(type(c) not in (int, float) or c - c for c in v):
+            raise FishValueError(f"`{name}` is set to a vector of finite numbers, not a {type_name(v)}")
+        m.blocks[field][r] = (float(v.x), float(v.y), float(v.z))
+    setter(name, f"set the block's {what}")(whole)
+    for k, c in (("x", 0), ("y", 1), ("z", 2)):
+        def comp(rt, b, x, c=c, full=f"{name}.{k}"):
+            m, r = _row(rt, b, full)
+            if type(x) not in (int, float) or x - x:
+                raise FishValueError(f"`{full}` is set to a finite number, not {x!r}")
+            m.blocks[field][r, c] = float(x)
+        setter(f"{name}.{k}", f"set one component of the block's {what}")(comp)
+
+
+_set_vector("block.vel", "velocity", "velocity [m/s]")
+_set_vector("block.force.app", "fapp", "applied force [N] (as `block apply force`)")

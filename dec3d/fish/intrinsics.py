@@ -263,6 +263,21 @@ def _system_error(rt, message):
     raise SystemErrorRaised(to_string(message))
 
 
+@intrinsic("system.directory.create", 1)
+def _directory_create(rt, name):
+    """Make a folder (and its parents) under the output folder; 0 when it exists afterwards. A name that
+    leaves the output folder is refused as every file a deck writes (dec3d.io.paths)."""
+    if type(name) is not str:
+        raise FishValueError(f"`system.directory.create` takes a folder name (a string), not a {type_name(name)}")
+    # checked as a file inside the folder: the folder itself may exist already
+    path = rt.session.out_path((name.rstrip("/\\") or name) + "/.dec3d-folder").parent
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise FishValueError(f"`system.directory.create`: cannot make '{name}': {exc.strerror or exc}") from None
+    return 0
+
+
 @intrinsic("time.kernel")
 def _time_kernel(rt):
     """Milliseconds of processor time spent by dec3d (Itasca: time in calculations, ms)."""
@@ -284,7 +299,8 @@ _START = _time.perf_counter()
 def _type(rt, v):
     """Itasca's type codes: 1 integer, 2 float, 3 string, 4 pointer/index, 5 vector (2-D), 6 vector (3-D),
     7 boolean, ... 10 list, 11 map; dec3d returns the ones it has."""
-    return {int: 1, float: 2, str: 3, Vec: 6, bool: 7, list: 10, dict: 11}.get(type(v), 0)
+    code = {int: 1, float: 2, str: 3, Vec: 6, bool: 7, list: 10, dict: 11}.get(type(v))
+    return code if code is not None else (4 if hasattr(v, "kind") and hasattr(v, "key") else 0)
 
 
 @intrinsic("list", 0, None)
@@ -436,10 +452,44 @@ def _mech_time_total(rt):
     return float(rt.session.model.time)
 
 
+#: ``ENGINE[0](model)`` -> the model's rigid engine (registered by dec3d.commands.fish_cmds; FISH imports
+#: no physics). mech.timestep and mech.solve read it.
+ENGINE: list = [None]
+
+
+def _engine(rt, name):
+    if ENGINE[0] is None:                     # pragma: no cover - the commands layer registers it at import
+        raise FishValueError(f"`{name}`: no cycling engine is attached")
+    return ENGINE[0](rt.session.model)
+
+
+@intrinsic("mech.timestep")
+def _mech_timestep(rt):
+    """The time step [s] of the last cycle (0 before the model has cycled)."""
+    return float(_engine(rt, "mech.timestep").dt)
+
+
+_SOLVE = ("ratio", "ratio-average", "ratio-local", "ratio-maximum", "unbalanced-maximum")
+
+
+@intrinsic("mech.solve", 1)
+def _mech_solve(rt, what):
+    """An equilibrium measure of the last step, as `model solve` uses it: 'ratio', 'ratio-average',
+    'ratio-local', 'ratio-maximum' or 'unbalanced-maximum' (abbreviations as for the command)."""
+    if type(what) is not str:
+        raise FishValueError(f"`mech.solve` takes the name of a measure (a string), not a {type_name(what)}")
+    key = what.lower()
+    hits = [k for k in _SOLVE if k == key] or [k for k in _SOLVE if k.startswith(key)]
+    if len(hits) != 1:
+        raise FishValueError(f"`mech.solve`: '{what}' is {'ambiguous' if hits else 'not'} one of {', '.join(_SOLVE)}")
+    return float(_engine(rt, "mech.solve").criteria()[hits[0]])
+
+
 @intrinsic("global.title")
 def _title(rt):
     return rt.session.model.settings.title
 
 from . import block_intrinsics  # noqa: E402,F401  (registers block.*)
+from . import contact_intrinsics  # noqa: E402,F401  (registers block.contact.*, block.subcontact.*)
 from . import table_intrinsics  # noqa: E402,F401  (registers table.*)
 from . import zone_intrinsics  # noqa: E402,F401  (registers block.zone.*)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import sys
 
 from ..errors import Dec3dError, ExpressionError, NotSupportedError, SourceLocation
-from .values import FishValueError
+from .values import FishValueError, type_name
 
 MAX_DEPTH = 200            # nested FISH calls
 STOP_CHECK = 1023          # loops look at the stop flag every STOP_CHECK + 1 iterations
@@ -92,6 +92,11 @@ class FishRuntime:
         self.inline_cache: dict = {}
         self.command_scope: list = []        # (closures by id(deferred), frame) while a command section runs
         self.tables: dict = {}               # FISH tables by id (table_intrinsics)
+        #: `fish callback add`: (position, name, interval, site), kept sorted by position (then order added)
+        self.callbacks: list = []
+        #: `fish history`: FISH name -> where the command was (errors of a sample point there)
+        self.history_sites: dict = {}
+        self.in_callback = 0                 # > 0 while a callback runs (sections refuse cycling commands)
 
     @property
     def globals(self) -> dict:
@@ -159,7 +164,48 @@ class FishRuntime:
         self.functions.clear()
         self.inline_cache.clear()
         self.tables.clear()
+        self.callbacks.clear()
+        self.history_sites.clear()
         self.auto_create = True
+
+    # ------------------------------------------------------------ sampling (fish history)
+    def probe(self, name: str) -> float:
+        """The value `fish history <name>` records: a FISH function is called (no arguments) and its
+        value taken; a global variable is read. Numbers and booleans (1/0) only."""
+        site = self.history_sites.get(name)
+        fn = self.functions.get(name)
+        if fn is not None:
+            self.in_callback += 1            # sampled while the cycle goes on, as a callback is
+            try:
+                v = fn.invoke([], site)
+            finally:
+                self.in_callback -= 1
+        elif name in self.globals:
+            v = self.globals[name]
+        else:
+            raise self.error_at(site, f"`fish history {name}`: there is no FISH variable or function `{name}` "
+                                      "any more")
+        t = type(v)
+        if t is bool:
+            return 1.0 if v else 0.0
+        if t is int or t is float:
+            return float(v)
+        raise self.error_at(site, f"`fish history {name}`: the value is a {type_name(v)}, not a number")
+
+    # ------------------------------------------------------------ callbacks
+    def run_callbacks(self, step: int) -> None:
+        """Call every `fish callback` function whose interval divides `step` (in position order)."""
+        for _pos, name, interval, site in list(self.callbacks):
+            if step % interval:
+                continue
+            fn = self.functions.get(name)
+            if fn is None:
+                raise self.error_at(site, f"FISH callback `{name}` is not a FISH function any more")
+            self.in_callback += 1
+            try:
+                fn.invoke([], site)
+            finally:
+                self.in_callback -= 1
 
 
 def not_supported(name: str) -> NotSupportedError:

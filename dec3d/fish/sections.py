@@ -40,6 +40,10 @@ class CommandSections:
                         except Exception as e:
                             raise rt.locate(e, src, (item.location.line, item.location.column)) from None
                     else:
+                        if rt.in_callback and _cycle_bound(item.command.path):
+                            raise rt.error_at(item.location, f"`{' '.join(item.command.path)}` cannot run in a FISH "
+                                              "callback: the cycle that calls it is still going on (cycling again, "
+                                              "replacing the model or changing its blocks is refused there)")
                         session.run_fish_command(item, rt.stack())
             finally:
                 rt.command_scope.pop()
@@ -115,3 +119,17 @@ def _deferreds(item):
             for rc in item.range.elements:
                 walk(rc.args)
     return out
+
+
+#: commands a FISH callback may not run: they cycle, replace the model or change its blocks while the
+#: engine's step loop holds the block set it started with
+_NOT_IN_CALLBACK = (("model", "cycle"), ("model", "solve"), ("model", "step"), ("model", "new"),
+                    ("model", "restore"), ("model", "factor-of-safety"), ("model", "fos"), ("program", "call"),
+                    ("block", "create"), ("block", "delete"), ("block", "cut"), ("block", "join"),
+                    ("block", "merge-start"), ("block", "merge-finish"), ("block", "generate"),
+                    ("block", "excavate"), ("block", "fill"), ("block", "densify"), ("block", "fragment"),
+                    ("block", "copy"), ("block", "zone", "generate"), ("block", "import"))
+
+
+def _cycle_bound(path) -> bool:
+    return any(tuple(path[:len(p)]) == p for p in _NOT_IN_CALLBACK)

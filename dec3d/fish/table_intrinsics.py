@@ -4,7 +4,8 @@ A table is a list of (x, y) points kept sorted by x, named by an integer or stri
 (Itasca FISH: `table.get(id)` returns the table, creating it when absent; assigning
 `table(t, x) = y` adds the point, replacing one at the same x; reading `table(t, x)`
 interpolates linearly between the neighbouring points, holding the end values outside).
-Tables live on the FISH run time of the session (the `table` commands are not implemented yet).
+Tables live on the FISH run time of the session; the `table` command (dec3d.commands.fish_cmds)
+adds, imports, lists and deletes them. `table.x(t, i)` / `table.y(t, i)` read point i (from 1).
 """
 from __future__ import annotations
 
@@ -22,6 +23,27 @@ class Table:
 
     def __repr__(self):
         return f"table {to_string(self.id)}"
+
+
+def table_key(t):
+    """The key a table id is kept under: names are case-insensitive."""
+    return t.lower() if type(t) is str else t
+
+
+def add_points(tab: Table, points) -> None:
+    """Add (x, y) points, keeping x increasing; a point at an x already there replaces its y."""
+    for x, y in points:
+        x, y = _num(x, "a table x"), _num(y, "a table y")
+        if x - x or y - y:
+            raise FishValueError("a table point must be finite")
+        k = bisect_left(tab.xs, x)
+        if k < len(tab.xs) and tab.xs[k] == x:
+            tab.ys[k] = y
+            continue
+        if len(tab.xs) >= MAX_LIST:
+            raise FishValueError(f"a table with more than {MAX_LIST} points")
+        tab.xs.insert(k, x)
+        tab.ys.insert(k, y)
 
 
 def _tables(rt) -> dict:
@@ -80,15 +102,28 @@ def _table_size(rt, t):
 @setter("table")
 def _set_point(rt, t, x, y):
     tab = t if isinstance(t, Table) else _table_get(rt, t)
-    x, y = _num(x, "a table x"), _num(y, "a table y")
-    k = bisect_left(tab.xs, x)
-    if k < len(tab.xs) and tab.xs[k] == x:
-        tab.ys[k] = y
-        return
-    if len(tab.xs) >= MAX_LIST:
-        raise FishValueError(f"a table with more than {MAX_LIST} points")
-    tab.xs.insert(k, x)
-    tab.ys.insert(k, y)
+    add_points(tab, [(x, y)])
+
+
+def _point(rt, t, i, name):
+    tab = _table(rt, t, name)
+    if type(i) is not int:
+        raise FishValueError(f"`{name}`: the point index must be an integer, not a {type_name(i)}")
+    if not 1 <= i <= len(tab.xs):
+        raise FishValueError(f"`{name}`: point {i} is out of range 1..{len(tab.xs)}")
+    return tab, i - 1
+
+
+@intrinsic("table.x", 2)
+def _table_x(rt, t, i):
+    tab, k = _point(rt, t, i, "table.x")
+    return tab.xs[k]
+
+
+@intrinsic("table.y", 2)
+def _table_y(rt, t, i):
+    tab, k = _point(rt, t, i, "table.y")
+    return tab.ys[k]
 
 
 @intrinsic("table", 2)

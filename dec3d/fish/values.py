@@ -56,7 +56,11 @@ _TYPE_NAMES = {int: "integer", float: "float", bool: "boolean", str: "string", V
 
 
 def type_name(v) -> str:
-    return _TYPE_NAMES.get(type(v), type(v).__name__)
+    name = _TYPE_NAMES.get(type(v))
+    if name is None:
+        kind = getattr(v, "kind", None)          # pointers of the model intrinsics (contact, sub-contact)
+        return kind if isinstance(kind, str) else type(v).__name__
+    return name
 
 
 def to_string(v) -> str:

@@ -15,6 +15,18 @@ since the block was made, radians) and ``rotation_angle`` (its length), as defin
 ``velocity`` (v + ω × r of its block). Field data: one ``group_code:<name>`` array per group
 name holding its code. Scalar arrays carry no ``NumberOfComponents`` (VTK's default 1) and
 every array is a numeric ``DataArray``, so VTK/ParaView, PyVista and meshio all read the files.
+
+Zoned (deformable) blocks are written as their zones instead: VTK_TETRA cells (type 10), or
+VTK_QUADRATIC_TETRA (24) for 10-node zones, whose node order (corners, then mid-edge nodes of
+edges 01 12 20 03 13 23) is the zones store's. Zone cells follow the polyhedra, 4-node ones first,
+each by zone row; they carry their block's cell data and ``zone_id`` (0 on polyhedra), ``overlay``
+(0 or 1: which 5-tetrahedron set of a mixed-discretization hexahedron; -1 otherwise), ``stress``
+(six components in VTK's symmetric-tensor order XX YY ZZ XY YZ XZ, tension positive),
+``mean_stress``, ``principal_stress`` (ascending: most compressive first) and ``von_mises`` (zero on
+polyhedra). Gridpoints' point data are their own displacement and velocity. meshio reads no file
+mixing polyhedra with other cells, so a series snapshot of a model with both rigid blocks and zones
+is two files: ``<stem>_<nnnn>.vtu`` (rigid blocks) and ``<stem>_zones_<nnnn>.vtu`` (zones), parts 0
+and 1 of the same time in the .pvd.
 """
 from __future__ import annotations
 
@@ -29,6 +41,11 @@ from dec3d.io.finite import require_finite
 from dec3d.model.kinematics import block_rotation, vertex_displacement, vertex_velocity
 
 VTK_POLYHEDRON = 42
+VTK_TETRA = 10
+VTK_QUADRATIC_TETRA = 24          # corners, then mid-edge nodes of edges 01 12 20 03 13 23 (the zones' order)
+#: VTK's order of a symmetric tensor's six components (XX YY ZZ XY YZ XZ) as columns of ``zones.stress``
+#: (xx yy zz xy xz yz)
+VTK_TENSOR_ORDER = np.array([0, 1, 2, 3, 5, 4])
 _TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.float32): "Float32",
           np.dtype(np.int64): "Int64", np.dtype(np.int32): "Int32",
           np.dtype(np.uint8): "UInt8", np.dtype(np.int8): "Int8"}
@@ -90,13 +107,78 @@ def block_cells(model, rows=None):
     return connectivity, offsets, stream, faceoffsets.astype(np.int64)
 
 
-def write_vtu(model, path: str | os.PathLike) -> str:
-    """Write one snapshot of every live block; returns the path written."""
+def mixed(model) -> bool:
+    """True when the model has both zones and rigid (unzoned) blocks: meshio reads no file mixing
+    polyhedron cells with others, so a snapshot of such a model is two files (``VtkSeries``)."""
+    from dec3d.model.zones import has_zones
+    if not has_zones(model):
+        return False
+    return bool(np.setdiff1d(np.arange(model.blocks.n), model.store("zones")["block"]).size)
+
+
+def _zone_cells(model, cells: str):
+    """Cells of a model with zones (``dec3d.model.zones``): the block rows written as polyhedra (the
+    rigid ones, by ``cell_order``; none when ``cells`` is "zones"), the zone rows written (4-node
+    zones, then 10-node ones, each by row; none when ``cells`` is "blocks"), their connectivity and
+    VTK cell types."""
+    b = model.blocks
+    zs = model.store("zones")
+    zoned = np.zeros(b.n, dtype=bool)
+    zoned[zs["block"]] = True
+    rigid = np.flatnonzero(~zoned) if cells != "zones" else np.zeros(0, np.int64)
+    poly = rigid[np.argsort(b["vert_count"][rigid], kind="stable")]
+    nn = zs["nnode"].astype(np.int64)
+    zrows = (np.concatenate([np.flatnonzero(nn == 4), np.flatnonzero(nn == 10)]) if cells != "blocks"
+             else np.zeros(0, np.int64))
+    nz = nn[zrows]
+    conn = zs["gp"][zrows][np.arange(10)[None, :] < nz[:, None]]      # row by row, the first nnode of each
+    types = np.where(nz == 10, VTK_QUADRATIC_TETRA, VTK_TETRA).astype(np.uint8)
+    return poly, zrows, conn, np.cumsum(nz), types
+
+
+def _zone_cell_data(model, zrows, npoly: int) -> dict:
+    """Cell arrays of the zones (zero on the polyhedron cells of rigid blocks): zone_id, overlay, the stress
+    tensor in VTK's symmetric-tensor order, mean stress, principal stresses and von Mises stress."""
+    from dec3d.model.zone_quality import mean_stress, principal_stresses, von_mises
+    zs = model.store("zones")
+    st = zs["stress"][zrows]
+
+    def pad(a):
+        out = np.zeros((npoly + len(zrows),) + a.shape[1:], dtype=a.dtype)
+        out[npoly:] = a
+        return out
+
+    overlay = np.full(npoly + len(zrows), -1, dtype=np.int8)
+    overlay[npoly:] = zs["overlay"][zrows]
+    return {"zone_id": pad(zs["id"][zrows]), "overlay": overlay, "stress": pad(st[:, VTK_TENSOR_ORDER]),
+            "mean_stress": pad(mean_stress(st)), "principal_stress": pad(principal_stresses(st)),
+            "von_mises": pad(von_mises(st))}
+
+
+def write_vtu(model, path: str | os.PathLike, cells: str = "all") -> str:
+    """Write one snapshot of every live block; returns the path written.
+
+    In a model with zones, ``cells`` picks what is written: "all" (rigid blocks as polyhedra and
+    zones), "blocks" (the rigid blocks only) or "zones" (the zones only)."""
+    from dec3d.model.zones import has_zones
     path = os.fspath(path)
     b, v = model.blocks, model.vertices
     require_finite("Points", v["pos"])      # the fields below derive from it: name the source
-    order = cell_order(model)
+    zoned = has_zones(model)
+    if zoned:
+        order, zrows, zconn, zoffs, ztypes = _zone_cells(model, cells)
+        cell_rows = np.concatenate([order, model.store("zones")["block"][zrows]])
+    else:
+        order = cell_order(model)
+        cell_rows = order
     conn, offs, faces, faceoffs = block_cells(model, order)
+    types = np.full(len(order), VTK_POLYHEDRON, dtype=np.uint8)
+    if zoned:
+        conn = np.concatenate([conn, zconn])
+        offs = np.concatenate([offs, (offs[-1] if len(offs) else 0) + zoffs])
+        types = np.concatenate([types, ztypes])
+        faceoffs = np.concatenate([faceoffs, np.full(len(zrows), -1, dtype=np.int64)])
+    ncell = len(cell_rows)
     ind = "      "
     parts = ['<?xml version="1.0"?>\n',
              '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" '
@@ -110,10 +192,15 @@ def write_vtu(model, path: str | os.PathLike) -> str:
             parts.append(_data_array(f"group_code:{gname}", np.array([code], dtype=np.int32), ind,
                                      tuples=True))
         parts.append("    </FieldData>\n")
-    parts.append(f'    <Piece NumberOfPoints="{v.n}" NumberOfCells="{b.n}">\n')
+    parts.append(f'    <Piece NumberOfPoints="{v.n}" NumberOfCells="{ncell}">\n')
     parts.append('      <PointData Vectors="displacement">\n')
-    parts.append(_data_array("displacement", vertex_displacement(model), ind + "  "))
-    parts.append(_data_array("velocity", vertex_velocity(model), ind + "  "))
+    disp, vel = vertex_displacement(model), vertex_velocity(model)
+    if zoned:
+        # gridpoints move on their own: their displacement and velocity are the vertex store's
+        gp = v["zoned"]
+        disp[gp], vel[gp] = v["disp"][gp], v["velocity"][gp]
+    parts.append(_data_array("displacement", disp, ind + "  "))
+    parts.append(_data_array("velocity", vel, ind + "  "))
     parts.append("      </PointData>\n")
     parts.append('      <CellData Scalars="block_id">\n')
     leader = b["leader"]
@@ -124,28 +211,33 @@ def write_vtu(model, path: str | os.PathLike) -> str:
             "displacement": b["disp"], "velocity": b["velocity"], "spin": b["spin"],
             "rotation": rot, "rotation_angle": np.linalg.norm(rot, axis=1)}
     for key, arr in cell.items():
-        parts.append(_data_array(key, arr[order], ind + "  "))
+        parts.append(_data_array(key, arr[cell_rows], ind + "  "))
     slots = model.groups.slot_names("blocks")
-    g = b["group"][order]
+    g = b["group"][cell_rows]
     for col, slot in enumerate(slots):
         parts.append(_data_array(f"group:{slot}", g[:, col], ind + "  "))
+    if zoned and len(zrows):
+        for key, arr in _zone_cell_data(model, zrows, len(order)).items():
+            parts.append(_data_array(key, arr, ind + "  "))
     parts.append("      </CellData>\n")
     parts.append("      <Points>\n")
     parts.append(_data_array("Points", v["pos"], ind + "  "))
     parts.append("      </Points>\n      <Cells>\n")
     parts.append(_data_array("connectivity", conn, ind + "  "))
     parts.append(_data_array("offsets", offs, ind + "  "))
-    parts.append(_data_array("types", np.full(b.n, VTK_POLYHEDRON, dtype=np.uint8), ind + "  "))
-    parts.append(_data_array("faces", faces, ind + "  "))
-    parts.append(_data_array("faceoffsets", faceoffs, ind + "  "))
+    parts.append(_data_array("types", types, ind + "  "))
+    if len(order):
+        parts.append(_data_array("faces", faces, ind + "  "))
+        parts.append(_data_array("faceoffsets", faceoffs, ind + "  "))
     parts.append("      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n")
     with open(path, "w", encoding="utf-8", newline="\n") as fh:
         fh.write("".join(parts))
     return path
 
 
-def write_pvd(path: str | os.PathLike, entries: list[tuple[float, str]]) -> str:
-    """Write a ParaView collection: ``entries`` of (time [s], .vtu file) in order.
+def write_pvd(path: str | os.PathLike, entries: list[tuple]) -> str:
+    """Write a ParaView collection: ``entries`` of (time [s], .vtu file[, part]) in order (part 0 by
+    default; the zones of a mixed model are part 1 of the same time).
 
     File names are written relative to the .pvd's folder when they lie under it.
     """
@@ -154,9 +246,10 @@ def write_pvd(path: str | os.PathLike, entries: list[tuple[float, str]]) -> str:
     lines = ['<?xml version="1.0"?>\n',
              '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n',
              "  <Collection>\n"]
-    for t, f in entries:
+    for t, f, *part in entries:
         rel = os.path.relpath(os.path.abspath(f), base)
-        lines.append(f'    <DataSet timestep="{float(t)!r}" group="" part="0" file={quoteattr(rel)}/>\n')
+        lines.append(f'    <DataSet timestep="{float(t)!r}" group="" part="{int(part[0]) if part else 0}" '
+                     f'file={quoteattr(rel)}/>\n')
     lines.append("  </Collection>\n</VTKFile>\n")
     with open(path, "w", encoding="utf-8", newline="\n") as fh:
         fh.write("".join(lines))
@@ -172,7 +265,8 @@ class VtkSeries:
 
     def __init__(self, stem: str | os.PathLike, guard=None):
         self.stem = os.fspath(stem)
-        self.entries: list[tuple[float, str]] = []
+        self.entries: list[tuple] = []
+        self.count = 0                  # snapshots written
         #: guard(file) -> file: checks each file before it is written (``Session.out_path``)
         self.guard = guard or (lambda f: f)
 
@@ -184,9 +278,18 @@ class VtkSeries:
         folder = os.path.dirname(self.stem)
         if folder:
             os.makedirs(folder, exist_ok=True)
-        vtu = self.guard(f"{self.stem}_{len(self.entries):04d}.vtu")
-        write_vtu(model, vtu)
-        self.entries.append((float(time), vtu))
+        k = self.count
+        vtu = self.guard(f"{self.stem}_{k:04d}.vtu")
+        if mixed(model):
+            # meshio reads no file mixing polyhedra with other cells: the zones go beside, as part 1
+            zvtu = self.guard(f"{self.stem}_zones_{k:04d}.vtu")
+            write_vtu(model, vtu, cells="blocks")
+            write_vtu(model, zvtu, cells="zones")
+            self.entries += [(float(time), vtu, 0), (float(time), zvtu, 1)]
+        else:
+            write_vtu(model, vtu)
+            self.entries.append((float(time), vtu))
+        self.count += 1
         write_pvd(self.guard(self.pvd_path), self.entries)
         return vtu
 

@@ -112,7 +112,8 @@ def _face_fields() -> dict[str, Field]:
 
 #: other names by which commands and ranges refer to stores
 STORE_ALIASES = {"block": "blocks", "vertex": "vertices", "gridpoint": "vertices",
-                 "face": "faces", "contact": "contacts", "subcontact": "subcontacts"}
+                 "face": "faces", "contact": "contacts", "subcontact": "subcontacts",
+                 "zone": "zones"}
 
 
 class Model:

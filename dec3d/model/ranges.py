@@ -26,6 +26,9 @@ _POSITION_FIELD = {"blocks": "centroid", "faces": "centroid", "vertices": "pos"}
 def positions(model, store_name: str) -> np.ndarray:
     """The (n, 3) point by which rows of a store are selected geometrically."""
     store = model.store(store_name)
+    if store.name == "zones":                 # a zone is located by its centroid
+        from .zone_quality import centroids
+        return centroids(model)
     key = _POSITION_FIELD.get(store.name)
     for k in (key, "centroid", "pos"):
         if k is not None and k in store:
@@ -145,6 +148,9 @@ def mask_group(model, store_name: str, names: str | Sequence[str],
         own = _in_groups(model, store, names, None)
         blocks = _in_groups(model, model.blocks, names, None)
         return own | blocks[store["a"]] | blocks[store["b"]]
+    if store.name == "zones":
+        # a zone is in a group when it is, or when its block is (block groups select zones)
+        return _in_groups(model, store, names, slot) | _in_groups(model, model.blocks, names, slot)[store["block"]]
     return _in_groups(model, store, names, slot)
 
 

@@ -7,6 +7,7 @@ keeps the step and the total time of each sample beside the value.
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -34,6 +35,13 @@ RIGID_QUANTITIES = tuple(f"angular-momentum{s}" for s, _ in _XYZ) + ("shape-erro
 CONTACT_QUANTITIES = {"force-normal": ("fn", "sum"), "force-shear": ("fs", "norm"),
                       "force-shear-x": ("fs", 0), "force-shear-y": ("fs", 1), "force-shear-z": ("fs", 2),
                       "displacement-normal": ("un", "mean"), "displacement-shear": ("us", "norm-mean")}
+#: gridpoint quantity -> (vertex field, component or None for the magnitude); ``block history`` on a zoned block
+GRIDPOINT_QUANTITIES = {q: ({"centroid": "pos"}.get(fld, fld), comp) for q, (fld, comp) in BLOCK_QUANTITIES.items()
+                        if fld in ("disp", "velocity", "centroid")}
+#: zone quantity -> column of ``zones.stress``; ``block zone history``
+ZONE_QUANTITIES = {f"stress-{c}": i for i, c in enumerate(("xx", "yy", "zz", "xy", "xz", "yz"))}
+#: a FISH name a `fish history` records (``HistorySet.add_fish``)
+FISH_NAME = re.compile(r"[a-z_][a-z0-9_]{0,127}")
 MODEL_QUANTITIES = ("unbalanced-maximum", "ratio", "ratio-average", "ratio-local", "ratio-maximum", "time-total",
                     "kinetic-energy")
 
@@ -65,8 +73,13 @@ class HistorySet:
     def __call__(self, eng) -> None:
         """Step hook: sample every history when the step count is a multiple of the interval."""
         if self.items and eng.step % self.interval == 0:
-            for h in self.items:
-                h.sample(eng)
+            # every value first: one that fails (a FISH history's function) leaves no history a sample ahead
+            values = [float(h.value(eng)) for h in self.items]
+            step, time = int(eng.step), float(eng.time)
+            for h, v in zip(self.items, values):
+                h.steps.append(step)
+                h.times.append(time)
+                h.values.append(v)
 
     def add(self, label: str, value: Callable, name: str | None = None, spec: dict | None = None) -> History:
         hid = (self.items[-1].id + 1) if self.items else 1
@@ -178,6 +191,23 @@ class HistorySet:
             h = self.add_point(q, block_id(), num_list("point", 3), name, p_origin=num_list("origin", 3))
         elif kind == "model" and q in MODEL_QUANTITIES:
             h = self.add_model(q, name)
+        elif kind == "gridpoint" and q in GRIDPOINT_QUANTITIES:
+            local = spec.get("local")
+            if not isinstance(local, int) or isinstance(local, bool) or local < 0:
+                raise ValueError(f"history {hid}: gridpoint index {local!r} is not a whole number ≥ 0")
+            bid = block_id()
+            b = self.model.blocks
+            rows = np.flatnonzero(b["id"] == bid)
+            if rows.size == 0 or local >= int(b["vert_count"][rows[0]]):
+                raise ValueError(f"history {hid}: block {bid} has no gridpoint {local + 1}")
+            h = self.add_gridpoint(q, bid, local, name)
+        elif kind == "zone" and q in ZONE_QUANTITIES:
+            zid = spec.get("zone_id")
+            if not isinstance(zid, int) or isinstance(zid, bool) or zid < 1:
+                raise ValueError(f"history {hid}: zone id {zid!r} is not a whole number ≥ 1")
+            h = self.add_zone(q, zid, name)
+        elif kind == "fish" and isinstance(q, str) and FISH_NAME.fullmatch(q):
+            h = self.add_fish(q, name)
         else:
             raise ValueError(f"history {hid}: unknown kind {kind!r} or quantity {q!r}")
         self.items.pop()
@@ -343,6 +373,46 @@ class HistorySet:
         h.follow = pair           # the two block ids followed (set at the first sample), for save files
         return h
 
+    def add_gridpoint(self, quantity: str, block_id: int, local: int, name: str | None = None) -> History:
+        """Displacement, velocity or position of one gridpoint of a zoned block: the ``local``-th row of
+        the block's vertex range (kept by block id and index, so the history survives other blocks
+        being zoned or deleted, which moves vertex rows). A gridpoint shared by joined blocks reads its
+        master's motion."""
+        fld, comp = GRIDPOINT_QUANTITIES[quantity]
+        model = self.model
+        cache: dict = {}
+
+        def value(eng) -> float:
+            r = self._row(block_id, cache)
+            v = model.vertices
+            row = int(model.blocks["vert_start"][r]) + local
+            if v["link"][row] >= 0:
+                row = int(v["link"][row])
+            x = v[fld][row]
+            return float(np.linalg.norm(x)) if comp is None else float(x[comp])
+
+        return self.add(f"block {block_id} gridpoint {local + 1} {quantity}", value, name,
+                        {"kind": "gridpoint", "quantity": quantity, "block_id": int(block_id), "local": int(local)})
+
+    def add_zone(self, quantity: str, zone_id: int, name: str | None = None) -> History:
+        """A stress component [Pa, tension positive] of the zone with id ``zone_id``."""
+        col = ZONE_QUANTITIES[quantity]
+        model = self.model
+        cache = {"row": -1}
+
+        def value(eng) -> float:
+            zs = model.store("zones")
+            r = cache["row"]
+            if not (0 <= r < zs.n and zs["id"][r] == zone_id):
+                hit = np.flatnonzero(zs["id"] == zone_id)
+                if hit.size == 0:
+                    return float("nan")          # the zone has gone (its block deleted)
+                r = cache["row"] = int(hit[0])
+            return float(zs["stress"][r, col])
+
+        return self.add(f"zone {zone_id} {quantity}", value, name,
+                        {"kind": "zone", "quantity": quantity, "zone_id": int(zone_id)})
+
     def add_model(self, quantity: str, name: str | None = None) -> History:
         if quantity.startswith(("ratio", "unbalanced")):   # the measures of `model solve` (RigidEngine.criteria)
             value = lambda eng: float(eng.criteria()[quantity])   # noqa: E731
@@ -350,6 +420,21 @@ class HistorySet:
             attr = {"time-total": "time", "kinetic-energy": "kinetic"}[quantity]
             value = lambda eng: float(getattr(eng, attr))          # noqa: E731
         return self.add(f"mechanical {quantity}", value, name, {"kind": "model", "quantity": quantity})
+
+
+    def add_fish(self, var: str, name: str | None = None) -> History:
+        """`fish history`: the value of a FISH global variable, or of a FISH function called at each
+        sample. The FISH run time reaches the model as ``model.fish_probe(var)`` (set by the session's
+        FISH commands; physics knows nothing of FISH)."""
+        model = self.model
+
+        def value(eng) -> float:
+            probe = getattr(model, "fish_probe", None)
+            if probe is None:
+                raise ValueError(f"FISH history `{var}`: no FISH run time is attached to the model")
+            return probe(var)
+
+        return self.add(f"fish {var}", value, name, {"kind": "fish", "quantity": var})
 
 
 def _contact_view(model, eng):
@@ -375,6 +460,36 @@ def nearest_block_id(model, position) -> int:
         raise ValueError("there are no blocks")
     d = np.linalg.norm(b["centroid"][rows] - np.asarray(position, dtype=float), axis=1)
     return int(b["id"][rows[int(np.argmin(d))]])
+
+
+def nearest_gridpoint(model, block_row: int, position) -> int:
+    """Index, within block ``block_row``'s vertex range, of its gridpoint nearest ``position``."""
+    b = model.blocks
+    s, c = int(b["vert_start"][block_row]), int(b["vert_count"][block_row])
+    d = np.linalg.norm(model.vertices["pos"][s:s + c] - np.asarray(position, dtype=float), axis=1)
+    return int(np.argmin(d))
+
+
+def zone_at(model, position) -> int:
+    """Id of the zone containing ``position`` (the first one, by row, when it lies on shared faces), or
+    of the zone whose centroid is nearest when no zone contains it. ValueError when there are no zones."""
+    from dec3d.model.zone_quality import corners
+    if "zones" not in model.stores or model.store("zones").n == 0:
+        raise ValueError("there are no zones (`block zone generate` makes them)")
+    zs = model.store("zones")
+    x = np.asarray(position, dtype=float)
+    p = corners(model)
+    # barycentric coordinates: solve [p1-p0 p2-p0 p3-p0] l = x - p0
+    m = np.transpose(p[:, 1:] - p[:, :1], (0, 2, 1))
+    ok = np.abs(np.linalg.det(m)) > 0.0
+    lam = np.full((zs.n, 3), -1.0)
+    if ok.any():
+        lam[ok] = np.linalg.solve(m[ok], (x - p[ok, 0])[..., None])[..., 0]
+    bary = np.column_stack([1.0 - lam.sum(axis=1), lam])
+    inside = np.flatnonzero((bary >= -1e-9).all(axis=1))
+    if inside.size:
+        return int(zs["id"][inside[0]])
+    return int(zs["id"][int(np.argmin(np.linalg.norm(p.mean(axis=1) - x, axis=1)))])
 
 
 def histories(model) -> HistorySet:

@@ -21,8 +21,11 @@ from dec3d.errors import Dec3dError
 from dec3d.io.vtk import periodic_vtk
 from dec3d.kernels.balance import body_balance
 from dec3d.kernels.cycle import run_steps
+from dec3d.kernels.gpcontact import mixed_move_points, mixed_subcontact_forces, surface_weights
 from dec3d.kernels.jointlaw import P_KN, P_KS
-from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST, block_timestep
+from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST, block_timestep,
+                                  rigid_motion_groups)
+from dec3d.model.model import KIND_DEFORMABLE
 from dec3d.model.store import Store
 from dec3d.model.zones import has_zones
 
@@ -55,6 +58,9 @@ class RunError(Dec3dError):
     to its state before the ``cycle`` call that failed."""
 
 
+#: vertex fields the deformable step changes (saved before a run, put back if it fails)
+_GP_STATE = ("velocity", "disp", "force", "mass", "imass")
+
 #: target wall time of one kernel call [s]: Ctrl-C and progress are seen at least this often
 CHUNK_SECONDS = 0.2
 #: local/maximum ratios are scaled by this so that they mean about the same as the average
@@ -86,6 +92,8 @@ class RigidEngine(ContactDetection):
         #: seconds per phase; "hooks" covers histories and periodic VTK snapshots
         self.timings = {"detect": 0.0, "search": 0.0, "subcontacts": 0.0, "cycle": 0.0, "hooks": 0.0}
         self._cand = None             # candidate pairs (rows A, rows B) of the last cell map
+        #: the deformable step of the last run on a model with zones (``physics.zones``), or None
+        self._zstep = None
         contact_stores(model)
 
     # ------------------------------------------------------------ model-backed state
@@ -156,9 +164,10 @@ class RigidEngine(ContactDetection):
 
     # ------------------------------------------------------------ cycling
     def _groups(self):
-        """CSR of the moving bodies: joined blocks by leader (leader first), lone blocks alone."""
+        """CSR of the moving bodies: joined blocks by leader (leader first), lone blocks alone.
+        Zoned (deformable) blocks are not rigid bodies: they move by their gridpoints."""
         b = self.model.blocks
-        rows = np.flatnonzero(~b["hidden"]).astype(_I)
+        rows = np.flatnonzero(~b["hidden"] & (b["kind"] != KIND_DEFORMABLE)).astype(_I)
         lead = b["leader"][rows]
         lead = np.where(lead < 0, rows, lead)
         order = np.lexsort((rows != lead, rows, lead))
@@ -245,21 +254,28 @@ class RigidEngine(ContactDetection):
         out = {"ratio": 0.0, "ratio-average": 0.0, "ratio-local": 0.0, "ratio-maximum": 0.0,
                "unbalanced-maximum": 0.0}
         gstart, gmember = self._group_cache if self._group_cache is not None else self._groups()
-        if b.n == 0 or len(gmember) == 0:
+        zst = self._zstep if has_zones(m) else None
+        if b.n == 0 or (len(gmember) == 0 and zst is None):
             return out
         ng = len(gstart) - 1
         cs, ss = self.contacts, self.subcontacts
         held = (b["fixity"] | b["apply_fix"])[gmember[gstart[:-1]]].astype(np.uint8)
         un = np.empty(ng)
         A = np.empty(ng)
-        body_balance(np.asarray(m.settings.gravity, dtype=_F), gstart, gmember, b["mass"], b["fapp"], held,
-                     cs["a"], cs["b"], cs["normal"], ss["contact"], ss["fn"], ss["fs"], np.empty((b.n, 3)),
-                     np.empty(b.n), un, A)
+        if ng:
+            body_balance(np.asarray(m.settings.gravity, dtype=_F), gstart, gmember, b["mass"], b["fapp"], held,
+                         cs["a"], cs["b"], cs["normal"], ss["contact"], ss["fn"], ss["fs"], np.empty((b.n, 3)),
+                         np.empty(b.n), un, A)
         free = (held & 7) != 7
-        if not free.any():
-            return out
         un = un[free]
         A = A[free]
+        if zst is not None:
+            # gridpoints of zoned blocks count as bodies (Itasca's own definitions are for gridpoints)
+            gu, ga = zst.balance()
+            un = np.concatenate((un, gu))
+            A = np.concatenate((A, ga))
+        if not len(un):
+            return out
         umax = float(un.max())
         out["unbalanced-maximum"] = umax
         if A.sum() > 0.0:
@@ -334,7 +350,10 @@ class RigidEngine(ContactDetection):
         b, v = m.blocks, m.vertices
         hs = getattr(m, "history_set", None)
         return {"blocks": {k: b[k].copy() for k in b.fields},
-                "vertices": {k: v[k].copy() for k in ("pos", "map_pos", "look_pos") if k in v},
+                "vertices": {k: v[k].copy() for k in ("pos", "map_pos", "look_pos")
+                             + (_GP_STATE if has_zones(m) else ()) if k in v},
+                "zones": ({k: m.store("zones")[k].copy() for k in ("stress", "gstress", "volume")}
+                          if has_zones(m) else {}),
                 # (to_arrays gives views where it can: copy them)
                 "contacts": {k: a.copy() for k, a in self.contacts.to_arrays().items()},
                 "subcontacts": {k: a.copy() for k, a in self.subcontacts.to_arrays().items()},
@@ -349,6 +368,8 @@ class RigidEngine(ContactDetection):
             b.full(k)[: len(a)] = a
         for k, a in snap["vertices"].items():
             v.full(k)[: len(a)] = a
+        for k, a in snap["zones"].items():
+            m.store("zones").full(k)[: len(a)] = a
         self.contacts.load_arrays(snap["contacts"])
         self.subcontacts.load_arrays(snap["subcontacts"])
         mechanical = m.settings.mechanical
@@ -387,8 +408,7 @@ class RigidEngine(ContactDetection):
         b = m.blocks
         live = ~b["hidden"]
         if has_zones(m):
-            raise RunError("zoned (deformable) blocks do not cycle yet: `block zone generate` has made zones, "
-                           "but the zone mechanics are not in this version (issue 10); nothing was cycled")
+            return self._cycle_zoned(nsteps, stop, max_time, warn)
         if (b["mass"][live] <= 0).any():
             raise RunError("a block has no mass: set `block property density` before cycling")
         s = self.settings()
@@ -515,6 +535,244 @@ class RigidEngine(ContactDetection):
             if mode == DAMP_ADAPTIVE:
                 s["servo"] = [float(x) for x in servo[:NSERVO]]
         return done
+
+    # ------------------------------------------------------------ models with zoned blocks
+    def _zone_contacts_check(self) -> bool:
+        """Contacts between two zoned blocks are not wired yet (issue "deformable blocks II"):
+        refuse them, except between blocks of one joined set (linked gridpoints make those
+        inert). Returns whether some contact joins a zoned block and a rigid one."""
+        b, cs = self.model.blocks, self.contacts
+        if not cs.n:
+            return False
+        za = b["kind"][cs["a"]] == KIND_DEFORMABLE
+        zb = b["kind"][cs["b"]] == KIND_DEFORMABLE
+        lead = np.where(b["leader"] < 0, np.arange(b.n), b["leader"])
+        bad = za & zb & (lead[cs["a"]] != lead[cs["b"]])
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            raise RunError(f"{int(bad.sum())} contacts join two zoned (deformable) blocks that are not joined (the "
+                           f"first between blocks {int(cs['ida'][k])} and {int(cs['idb'][k])}): contacts between "
+                           "deformable blocks do not cycle yet (issue 10, next part); nothing was cycled")
+        return bool((za ^ zb).any())
+
+    def _mixed_weights(self, zst) -> tuple:
+        """Gridpoint rows and interpolation weights of every sub-contact and contact point on a
+        zoned side (``gpcontact.surface_weights``), and the contact stiffness they give the
+        gridpoints (the joint term of Eq. 85: max(kn, ks) · area, shared by the weights)."""
+        m = self.model
+        b, f, v = m.blocks, m.faces, m.vertices
+        cs, ss = self.contacts, self.subcontacts
+        zoned = b["kind"] == KIND_DEFORMABLE
+        geo = (zoned, v["pos"], b["face_start"], b["face_count"], f["vstart"], f["nvert"],
+               m.face_vertices["vertex"])
+        out = []
+        for owner, pts in ((ss["contact"], ss["pos"]), (np.arange(cs.n, dtype=_I), cs["pos"])):
+            k = len(owner)
+            na, wa, nb, wb = np.empty((k, 3), _I), np.empty((k, 3)), np.empty((k, 3), _I), np.empty((k, 3))
+            surface_weights(np.ascontiguousarray(owner), pts, cs["a"], cs["b"], *geo, na, wa, nb, wb)
+            out.append((na, wa, nb, wb))
+        na, wa, nb, wb = out[0]
+        c = ss["contact"]
+        kk = np.maximum(cs["prop"][c, P_KN], cs["prop"][c, P_KS]) * ss["area"]
+        rows = np.concatenate((na.ravel(), nb.ravel()))
+        kw = np.concatenate(((wa * kk[:, None]).ravel(), (wb * kk[:, None]).ravel()))
+        on = rows >= 0
+        zst.set_contact_stiffness(rows[on], kw[on])
+        return out[0], out[1]
+
+    def _cycle_zoned(self, nsteps: int, stop, max_time, warn=None) -> int:
+        """``_cycle`` for a model with zoned blocks: per batch, the rigid bodies (if any) by
+        ``run_steps`` and the zoned blocks step by step (``physics.zones.ZoneStepper``) with the
+        same Δt. The two parts share no contact (``_zone_contacts_check``), so running the rigid
+        steps of a batch before the zone steps of that batch is the same as interleaving them."""
+        from .zones import ZoneStepper
+
+        m = self.model
+        b = m.blocks
+        rigid = ~b["hidden"] & (b["kind"] != KIND_DEFORMABLE)
+        if (b["mass"][rigid] <= 0).any():
+            raise RunError("a block has no mass: set `block property density` before cycling")
+        zst = ZoneStepper(m, RunError)
+        self._zstep = zst
+        s = self.settings()
+        g = np.asarray(m.settings.gravity, dtype=_F)
+        mode, alpha = self.damping()
+        full = self.full_inertia()
+        large = bool(m.settings.large_strain)
+        gstart, gmember = self._groups()
+        self._group_cache = (gstart, gmember)
+        ng = len(gstart) - 1
+        inertia = np.einsum("bij,bj,bkj->bik", b["principal_axes"], b["principal_moment"], b["principal_axes"])
+        gmass, gcen, _, gprin, gaxes, giscalar = group_properties(gstart, gmember, b["mass"], b["centroid"],
+                                                                  inertia, b["inertia_approx"],
+                                                                  b["principal_moment"], b["principal_axes"])
+        axes0 = gaxes.copy()
+        servo = new_servo(ng, ratio=float(s["servo_ratio"]))
+        if mode == DAMP_ADAPTIVE and len(s["servo"]) == NSERVO:
+            servo[:NSERVO] = s["servo"]
+        servo[S_HIST] = 0.0
+        fixity = (b["fixity"] | b["apply_fix"]).astype(np.uint8)
+        dt_fixed = float(s["timestep"]) if s["timestep"] else None
+        out = np.zeros(4)
+        vmax = 1e6
+        interval = max(1, int(m.settings.update_interval))
+        done = 0
+        progress = _Progress(nsteps, self)
+        if self._signature != self._geometry_signature():
+            self.detect()
+        mixed = self._zone_contacts_check()
+        if mixed:
+            wsub, wcon = self._mixed_weights(zst)
+        if warn is not None:
+            msg = self.stiffness_warning()
+            if msg:
+                warn(msg)
+        scaled = self.mass_scaling()
+        dt_r = self._masses(gstart, gmember, gmass, giscalar, dt_fixed)[0] if ng else math.inf
+        if dt_fixed is not None:
+            dt = dt_fixed
+        elif scaled:
+            dt = dt_r if ng else float(s["scale_timestep"] or 1.0)
+        else:
+            dt = min(dt_r, zst.natural_timestep())
+        if not math.isfinite(dt) or dt <= 0:
+            dt = 1.0
+        zst.set_masses(dt, scaled)
+        if ng:
+            _, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt)
+        self.dt = dt
+        radius = self._radii()
+        acc = np.zeros(b.n)
+        motion = np.zeros(2)
+        trigger = 0.5 * self.tolerance()
+        due = False
+        loaded = large and "fstress" in m.faces and bool(np.any(m.faces["fstress"] != 0.0))
+        try:
+            while done < nsteps and not _StopFlag.requested:
+                # with no rigid body and small strain nothing moves that could make a contact
+                if (m.step % interval == 0 or due) and (ng or large):
+                    self.detect()
+                    mixed = self._zone_contacts_check()
+                    acc[:] = 0.0
+                    due = False
+                    if scaled and ng:
+                        _, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt)
+                    if mixed:
+                        wsub, wcon = self._mixed_weights(zst)
+                        zst.set_masses(dt, scaled)
+                    if loaded:
+                        from dec3d.model.face_loads import recompute_fface
+                        recompute_fface(m)
+                k = min(nsteps - done, interval - m.step % interval)
+                for h in self.step_hooks:
+                    hi = int(getattr(h, "interval", 0) or 0)
+                    if hi > 0:
+                        k = min(k, hi - m.step % hi)
+                vtk = m.outputs.get("vtk")
+                if vtk and vtk["interval"] > 0:
+                    k = max(1, min(k, vtk["last_step"] + vtk["interval"] - m.step))
+                if max_time is not None:
+                    left = int(math.ceil((max_time - m.time) / dt - 1e-9))
+                    if left <= 0:
+                        break
+                    k = min(k, left)
+                t0 = _time.perf_counter()
+                bad = -1
+                n_ok = k
+                if mixed:
+                    n_ok = 0
+                    self._mixed_steps(k, zst, wsub, wcon, dt, g, mode, alpha, servo, full, gstart, gmember, gmass,
+                                      gimass, gisc, gprin, gaxes, gcen, fixity, large, vmax, out)
+                    n_ok = k
+                elif ng:
+                    cs, ss = self.contacts, self.subcontacts
+                    n_ok, bad = run_steps(k, dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass, gisc,
+                                          gprin, gaxes, gcen, b["mass"], fixity, b["force"], b["moment"], b["fapp"],
+                                          b["mapp"], b["velocity"], b["spin"], b["centroid"], b["disp"],
+                                          b["vert_start"], b["vert_count"], m.vertices["pos"], cs["a"], cs["b"],
+                                          cs["normal"], cs["pos"], np.arange(cs.n, dtype=_I), cs["jmodel"],
+                                          cs["prop"], ss["contact"], ss["pos"], ss["area"], ss["fn"], ss["fs"],
+                                          ss["un"], ss["udil"], ss["us"], ss["state"], vmax, out, radius, acc,
+                                          trigger, motion)
+                    if bad >= 0:
+                        raise self._blowup(bad, dt, motion[1] == 2.0)
+                for _ in range(0 if mixed else n_ok):
+                    zbad = zst.step(dt, g, mode, alpha, large, vmax)
+                    if zbad >= 0:
+                        raise zst.unstable(zbad, dt)
+                zb = zst.blocks
+                b["force"][zb] = 0.0            # contact forces on zoned blocks went to their gridpoints
+                b["moment"][zb] = 0.0
+                self.timings["cycle"] += _time.perf_counter() - t0
+                due = motion[1] > 0.0
+                m.step += n_ok
+                m.time += n_ok * dt
+                done += n_ok
+                self._criteria = None
+                self.kinetic = (float(out[2]) if ng else 0.0) + zst.kinetic
+                t0 = _time.perf_counter()
+                for hook in self.step_hooks:
+                    hook(self)
+                periodic_vtk(m)
+                self.timings["hooks"] += _time.perf_counter() - t0
+                progress.update(done)
+                if stop is not None and stop(self):
+                    break
+        finally:
+            self._group_cache = None
+            progress.close()
+            zst.finish(large)
+            if ng:
+                turn = np.einsum("gij,gkj->gik", gaxes, axes0)
+                gid = np.repeat(np.arange(ng), np.diff(gstart))
+                pa = b["principal_axes"]
+                pa[gmember] = _orthonormal(np.einsum("bij,bjk->bik", turn[gid], pa[gmember]))
+                lone = np.diff(gstart) == 1
+                pa[gmember[gstart[:-1][lone]]] = gaxes[lone]
+                b["inertia"][gmember] = np.einsum("bij,bj,bkj->bik", pa[gmember], b["principal_moment"][gmember],
+                                                  pa[gmember])
+            if mode == DAMP_ADAPTIVE:
+                s["servo"] = [float(x) for x in servo[:NSERVO]]
+        return done
+
+    def _mixed_steps(self, k, zst, wsub, wcon, dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass,
+                     gisc, gprin, gaxes, gcen, fixity, large, vmax, out) -> None:
+        """``k`` steps of a model where zoned and rigid blocks touch (3DEC theory, "Deformable
+        blocks": a sub-contact on a deformable block moves with the gridpoints of the surface it
+        lies on, its force goes to them by the interpolation factors): sub-contact forces
+        (``gpcontact.mixed_subcontact_forces``), rigid motion, the zone step with the contact
+        forces on the gridpoints, then the contact points move (``mixed_move_points``)."""
+        m = self.model
+        b, v = m.blocks, m.vertices
+        cs, ss = self.contacts, self.subcontacts
+        gvel = v["velocity"]
+        gc = np.zeros((v.n, 3))
+        touched = np.unique(np.concatenate((wsub[0].ravel(), wsub[2].ravel())))
+        touched = touched[touched >= 0]
+        cown = np.arange(cs.n, dtype=_I)
+        for _ in range(k):
+            facc = zst.begin()
+            gc[touched] = 0.0
+            mixed_subcontact_forces(dt, b["centroid"], b["velocity"], b["spin"], b["force"], b["moment"], gvel, gc,
+                                    cs["a"], cs["b"], cs["normal"], cs["jmodel"], cs["prop"], ss["contact"], ss["pos"],
+                                    ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"],
+                                    *wsub)
+            facc[touched] += gc[touched]
+            zst.fmag[touched] += np.linalg.norm(gc[touched], axis=1)
+            if len(gmember):
+                gbad = rigid_motion_groups(dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass, gisc,
+                                           gprin, gaxes, gcen, b["mass"], fixity, b["force"], b["moment"], b["fapp"],
+                                           b["mapp"], b["velocity"], b["spin"], b["centroid"], b["disp"],
+                                           b["vert_start"], b["vert_count"], v["pos"], vmax, out)
+                if gbad >= 0 or not math.isfinite(out[0]):
+                    raise self._blowup(int(gmember[gstart[gbad]]) if gbad >= 0 else int(gmember[0]), dt, False)
+            zbad = zst.step(dt, g, mode, alpha, large, vmax, begun=True)
+            if zbad >= 0:
+                raise zst.unstable(zbad, dt)
+            mixed_move_points(dt, cs["a"], cs["b"], cown, cs["pos"], b["centroid"], b["velocity"], b["spin"], gvel,
+                              *wcon)
+            mixed_move_points(dt, cs["a"], cs["b"], ss["contact"], ss["pos"], b["centroid"], b["velocity"],
+                              b["spin"], gvel, *wsub)
 
     def timing_report(self) -> str:
         """The time spent per phase since the counters were last zeroed (seconds, share)."""

@@ -30,3 +30,44 @@ def test_missing_block_is_a_clear_error(session):
     with pytest.raises(ExpressionError) as e:
         session.command("[m = block.mass(7)]")
     assert "`block.mass`: there is no block with id 7" in e.value.message and e.value.location.column == 6
+
+
+def test_block_walk_and_velocity_writes(session):
+    """A lone block with no gravity keeps the velocity FISH gives it: after n steps it has moved v n dt."""
+    session.command("block create brick 0 1 0 1 0 1\nblock create brick 5 6 0 1 0 1\nblock create brick 9 10 0 1 0 1\n"
+                    "block property density 1000\nblock delete range id 2\n"
+                    "fish define walk\n  local b = block.head\n  local out = list.sequence(0)\n"
+                    "  loop while b # 0\n    out = list.append(out, b)\n    b = block.next(b)\n  endloop\n"
+                    "  walk = out\nend\n[w = walk]\n"
+                    "[block.vel(1) = vector(0.1, 0.0, 0.0)]\n[block.vel.z(3) = -0.2]\n"
+                    "[block.force.app.y(3) = 0.0]\nmodel cycle 10\n"
+                    "[dt = mech.timestep]\n[dx = block.disp.x(1)]\n[dz = block.disp.z(3)]\n[vx = block.vel.x(1)]")
+    v = session.variables
+    assert v["w"] == [1, 3]
+    assert v["dt"] > 0 and v["vx"] == 0.1
+    assert v["dx"] == pytest.approx(0.1 * 10 * v["dt"], rel=1e-9)
+    assert v["dz"] == pytest.approx(-0.2 * 10 * v["dt"], rel=1e-9)
+
+
+def test_block_writes_refuse_bad_values(session):
+    session.command("block create brick 0 1 0 1 0 1")
+    for text, msg in [("[block.vel(1) = 3]", "`block.vel` is set to a vector of finite numbers, not a integer"),
+                      ("[block.vel.x(1) = 'a']", "`block.vel.x` is set to a finite number"),
+                      ("[block.vel.x(4) = 1.0]", "there is no block with id 4"),
+                      ("[q = mech.solve('bogus')]", "'bogus' is not one of ratio"),
+                      ("[q = mech.solve('ratio-')]", "'ratio-' is ambiguous")]:
+        with pytest.raises(ExpressionError) as e:
+            session.command(text)
+        assert msg in e.value.message, text
+    assert tuple(session.model.blocks["velocity"][0]) == (0.0, 0.0, 0.0)
+
+
+def test_mech_solve_is_the_measure_model_solve_uses(session):
+    session.command("block create brick 0 1 0 1 0 1\nblock create brick 0 1 0 1 1 2\nblock property density 1000\n"
+                    "block contact jmodel assign elastic\nblock contact property stiffness-normal 1e9 stiffness-shear 1e9\n"
+                    "model gravity 0 0 -10\nblock fix range position-z 0 1\nhistory interval 1\n"
+                    "model history name 'r' mechanical ratio-local\nmodel history name 'u' mechanical unbalanced-max\n"
+                    "model cycle 50\n[r = mech.solve('ratio-local')]\n[u = mech.solve('unbal')]")
+    hs = session.model.history_set
+    assert session.variables["r"] == hs.find("r").values[-1] > 0
+    assert session.variables["u"] == hs.find("u").values[-1] > 0

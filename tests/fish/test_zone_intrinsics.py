@@ -34,3 +34,14 @@ def test_missing_zone_is_a_clear_error(session):
     with pytest.raises(ExpressionError) as e:
         session.command("[s = block.zone.vol(7)]")
     assert "`block.zone.vol`: there is no zone with id 7" in e.value.message
+
+
+def test_zone_ids_out_of_row_order_still_find_their_zone(session):
+    session.command("block create brick 0 2 0 1 0 1")
+    m = session.model
+    zone_brick(m, 0)
+    zs = m.store("zones")
+    zs["id"][:] = zs["id"][::-1].copy()            # row 0 now holds zone n, row n-1 zone 1
+    zs["volume"][:] = np.arange(1, zs.n + 1)      # the row number + 1, to see which row is read
+    session.command("[v1 = block.zone.vol(1)]\n[vn = block.zone.vol(5)]")
+    assert session.variables["v1"] == 5.0 and session.variables["vn"] == 1.0

@@ -1,0 +1,106 @@
+"""`block zone cmodel assign` and `block zone property`: the constitutive model and the
+properties of the zones of deformable blocks.
+
+Zones are selected by their centroid (range elements), or by their group or the group of
+their block. Elastic moduli are stored as bulk and shear modulus (``zones.prop`` columns
+``ZP_BULK``, ``ZP_SHEAR``); Young's modulus and Poisson's ratio are converted with the
+isotropic relations K = E / (3 (1 − 2ν)), G = E / (2 (1 + ν)). Giving only one of young or
+poisson keeps the other as it follows from the zone's present bulk and shear modulus
+(E = 9KG / (3K + G), ν = (3K − 2G) / (2 (3K + G))), as 3DEC keeps the last given pair.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import BindError
+from ..model.zones import ZMODEL_ELASTIC, ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
+from .registry import command
+from .values import Choice, Num, P
+
+_MODELS = {"elastic": ZMODEL_ELASTIC, "null": ZMODEL_NULL}
+
+
+def _zones(session, call, what: str) -> np.ndarray:
+    """Rows of the zones in range; a warning naming file:line when there are none."""
+    zs = zone_stores(session.model)
+    rows = np.flatnonzero(session.range_mask(call, "zone")) if zs.n else np.zeros(0, np.int64)
+    if not len(rows):
+        why = "" if zs.n else " (no block is zoned: use `block zone generate` first)"
+        session.write(f"warning: {call.location}: `{what}` selected no zone{why}")
+    return rows
+
+
+@command("block zone cmodel assign",
+         positional=[P("model", Choice(tuple(_MODELS)), "elastic, or null (the zone carries no stress or mass)",
+                       required=True)],
+         range="zone",
+         doc="Assign the constitutive model of the zones in range.",
+         details="`elastic`: isotropic linear elasticity (set bulk and shear, or young and poisson, and density "
+                 "with `block zone property`). `null`: the zone takes no part in the mechanics (no stress, no "
+                 "force, no mass); its stress is set to zero.",
+         examples=["block zone cmodel assign elastic", "block zone cmodel assign null range position-z 0 1"])
+def block_zone_cmodel_assign(session, call):
+    rows = _zones(session, call, "block zone cmodel assign")
+    zs = session.model.store("zones")
+    code = _MODELS[call.args["model"]]
+    zs["cmodel"][rows] = code
+    if code == ZMODEL_NULL:
+        zs["stress"][rows] = 0.0
+        zs["gstress"][rows] = 0.0
+
+
+_POS = Num(lo=0, lo_open=True)
+
+
+@command("block zone property",
+         keywords=[P("bulk", _POS, "bulk modulus K", units="Pa"),
+                   P("shear", _POS, "shear modulus G", units="Pa"),
+                   P("young", _POS, "Young's modulus E (with poisson)", units="Pa"),
+                   P("poisson", Num(lo=-1, hi=0.5, lo_open=True, hi_open=True), "Poisson's ratio ν, -1 < ν < 0.5"),
+                   P("density", _POS, "mass density", units="kg/m³")],
+         range="zone",
+         doc="Set the elastic moduli and density of the zones in range.",
+         details="Give either bulk and/or shear, or young and/or poisson (not both kinds in one command); they are "
+                 "kept as bulk and shear modulus. Young or poisson alone changes that one and keeps the other as "
+                 "the zone's present moduli give it; a zone with no moduli yet needs both. Zone properties are "
+                 "checked when cycling starts: an elastic zone without bulk, shear or density stops the run, "
+                 "naming its blocks.",
+         examples=["block zone property bulk 3.9e9 shear 2.8e9 density 2600",
+                   "block zone property young 1e9 poisson 0.25 density 2000 range position-z 0 1",
+                   "block zone property density 2500"])
+def block_zone_property(session, call):
+    a = call.args
+    keys = [k for k in ("bulk", "shear", "young", "poisson", "density") if a[k] is not None]
+    if not keys:
+        raise BindError("`block zone property` needs bulk, shear, young, poisson or density", call.location)
+    kg = a["bulk"] is not None or a["shear"] is not None
+    ev = a["young"] is not None or a["poisson"] is not None
+    if kg and ev:
+        where = call.locations.get("young" if a["young"] is not None else "poisson", call.location)
+        raise BindError("`block zone property`: give bulk/shear or young/poisson, not both pairs in one command",
+                        where)
+    rows = _zones(session, call, "block zone property")
+    zs = session.model.store("zones")
+    prop = zs["prop"]
+    if ev and len(rows):
+        K, G = prop[rows, ZP_BULK], prop[rows, ZP_SHEAR]
+        have = (K > 0) & (G > 0)
+        if (a["young"] is None or a["poisson"] is None) and not have.all():
+            given, other = ("young", "poisson") if a["young"] is not None else ("poisson", "young")
+            z = int(zs["id"][rows[~have][0]])
+            raise BindError(f"`block zone property {given}` needs {other} too: {int((~have).sum())} zone(s) in "
+                            f"range have no elastic moduli yet (the first is zone {z})",
+                            call.locations.get(given, call.location))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            E = a["young"] if a["young"] is not None else 9.0 * K * G / (3.0 * K + G)
+            nu = a["poisson"] if a["poisson"] is not None else (3.0 * K - 2.0 * G) / (2.0 * (3.0 * K + G))
+        E = np.broadcast_to(np.asarray(E, float), rows.shape)
+        nu = np.broadcast_to(np.asarray(nu, float), rows.shape)
+        prop[rows, ZP_BULK] = E / (3.0 * (1.0 - 2.0 * nu))
+        prop[rows, ZP_SHEAR] = E / (2.0 * (1.0 + nu))
+    if a["bulk"] is not None:
+        prop[rows, ZP_BULK] = a["bulk"]
+    if a["shear"] is not None:
+        prop[rows, ZP_SHEAR] = a["shear"]
+    if a["density"] is not None:
+        prop[rows, ZP_DENSITY] = a["density"]

@@ -1,0 +1,284 @@
+"""The deformable-block step: gridpoint masses and stiffness, zone forces with mixed
+discretization, and the gridpoint equations of motion with damping.
+
+Sources: the 3DEC theory text (/work/shared/seeds/000_b8ba745952e0c537.txt), sections
+"Deformable Block Motion" (Eqs. 53-59, ERRATA: Δε_v has three terms), "Accurate Modeling of
+Plastic Collapse" (mixed discretization, Eqs. 60-63 and the two overlays), "Mechanical
+Damping" (local damping Eqs. 78-79, combined damping Eq. 83), "Numerical Stability" (Eqs. 84-86)
+and "Mass (Density) Scaling".
+
+``zone_mass_stiffness``
+    Lumped mass of a 4-node tetrahedron: ρV/4 to each corner (its centroid rule; the text's
+    "one-third" in Eq. 56 is the triangle rule of the 2-D code). A 10-node tetrahedron lumps by
+    diagonal scaling of its consistent mass (corners ∫N² = V/70, mid-edge nodes 8V/105, scaled to
+    sum to ρV: 1/36 and 4/27 of the zone mass). A zone of a mixed (hexahedral) set counts half:
+    its two overlays cover the same volume. Node stiffness of Eq. (86),
+    k = (8/3)(K + 4G/3) b_max² / h_min, b_max the longest edge and h_min the smallest height
+    (3V / largest face area), added to each node of the zone (halved for an overlay zone; for a
+    10-node zone four times the corner-tetrahedron value, dec3d's conservative choice, since its
+    nodes are twice as close).
+
+``zone_forces`` (4-node zones)
+    Velocity gradient from Gauss's theorem, ∂v_i/∂x_j = −(1/3V) Σ_n v_i^n n_j^(n) S^(n) (face (n)
+    opposite node n, outward normal, area S); strain increment Δε = sym(∇v) Δt. In a mixed set
+    (both overlays of one hexahedral zone, as the text does mixed discretization "over the
+    combination of two overlays") the volumetric part is replaced by the volume-weighted mean of
+    the set (Eqs. 60-63). In large strain the stress is first turned with the material by the
+    spin increment ω Δt, ω = ½(∇v − ∇vᵀ) (the rotation rate of Eq. 58): σ += ωσ − σω (Jaumann,
+    dec3d's choice of objective rate). Incremental Hooke (Eq. 59, three-term Δε_v) updates the stress; the
+    zone's nodal force is f^n = (1/3) σ·n^(n) S^(n) (Eq. 55 for a constant-stress tetrahedron),
+    times the zone's weight (½ for an overlay zone: the nodal force is the average of the two).
+    ``force[r]`` accumulates the force zones exert on gridpoint r; ``fmag[r]`` the sum of the
+    magnitudes of those contributions (Itasca's "applied force magnitude" of the ratio).
+
+``gp_externals``  gravity (real mass), applied and face forces per row, then linked rows summed
+    onto their master.
+
+``gp_motion``  for each master gridpoint: Eq. (78) with the damping force of Eq. (79) (local)
+    or Eq. (83) (combined, sign as ``motion._ldamp``), velocity components held at ``vapp``
+    (``apply_fix`` bits) or at their value (``fixity`` bits), displacement += v Δt, position +=
+    v Δt in large strain; then the motion of each master is copied to its linked rows.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def _area_vec(pos, i1, i2, i3, iopp):
+    """Area vector of triangle (i1 i2 i3), pointing away from point iopp."""
+    ux = pos[i2, 0] - pos[i1, 0]; uy = pos[i2, 1] - pos[i1, 1]; uz = pos[i2, 2] - pos[i1, 2]
+    wx = pos[i3, 0] - pos[i1, 0]; wy = pos[i3, 1] - pos[i1, 1]; wz = pos[i3, 2] - pos[i1, 2]
+    nx = 0.5 * (uy * wz - uz * wy)
+    ny = 0.5 * (uz * wx - ux * wz)
+    nz = 0.5 * (ux * wy - uy * wx)
+    d = (pos[iopp, 0] - pos[i1, 0]) * nx + (pos[iopp, 1] - pos[i1, 1]) * ny + (pos[iopp, 2] - pos[i1, 2]) * nz
+    if d > 0.0:
+        return -nx, -ny, -nz
+    return nx, ny, nz
+
+
+@njit(cache=True)
+def _tet_volume(pos, a, b, c, d):
+    x1 = pos[b, 0] - pos[a, 0]; y1 = pos[b, 1] - pos[a, 1]; z1 = pos[b, 2] - pos[a, 2]
+    x2 = pos[c, 0] - pos[a, 0]; y2 = pos[c, 1] - pos[a, 1]; z2 = pos[c, 2] - pos[a, 2]
+    x3 = pos[d, 0] - pos[a, 0]; y3 = pos[d, 1] - pos[a, 1]; z3 = pos[d, 2] - pos[a, 2]
+    return abs(x1 * (y2 * z3 - z2 * y3) - y1 * (x2 * z3 - z2 * x3) + z1 * (x2 * y3 - y2 * x3)) / 6.0
+
+
+@njit(cache=True)
+def zone_mass_stiffness(pos, gp, nnode, overlay, rows, bulk, shear, density, mass, stiff):
+    """Add the lumped mass and Eq. (86) stiffness of each zone in ``rows`` to its nodes
+    (``mass``, ``stiff`` indexed by vertex row; bulk/shear/density indexed by zone row)."""
+    for k in range(rows.shape[0]):
+        z = rows[k]
+        a = gp[z, 0]; b = gp[z, 1]; c = gp[z, 2]; d = gp[z, 3]
+        vol = _tet_volume(pos, a, b, c, d)
+        if vol <= 0.0:
+            continue
+        w = 0.5 if overlay[z] >= 0 else 1.0
+        # longest edge and largest face
+        bmax2 = 0.0
+        for i in range(4):
+            for j in range(i + 1, 4):
+                p = gp[z, i]; q = gp[z, j]
+                e2 = ((pos[p, 0] - pos[q, 0]) ** 2 + (pos[p, 1] - pos[q, 1]) ** 2
+                      + (pos[p, 2] - pos[q, 2]) ** 2)
+                if e2 > bmax2:
+                    bmax2 = e2
+        amax = 0.0
+        for n in range(4):
+            ax, ay, az = _area_vec(pos, gp[z, (n + 1) % 4], gp[z, (n + 2) % 4], gp[z, (n + 3) % 4], gp[z, n])
+            ar = math.sqrt(ax * ax + ay * ay + az * az)
+            if ar > amax:
+                amax = ar
+        hmin = 3.0 * vol / amax
+        kz = 8.0 / 3.0 * (bulk[z] + 4.0 * shear[z] / 3.0) * bmax2 / hmin * w
+        mz = density[z] * vol * w
+        if nnode[z] == 10:
+            for n in range(4):
+                mass[gp[z, n]] += mz / 36.0
+                stiff[gp[z, n]] += 4.0 * kz
+            for n in range(4, 10):
+                mass[gp[z, n]] += mz * 4.0 / 27.0
+                stiff[gp[z, n]] += 4.0 * kz
+        else:
+            for n in range(4):
+                mass[gp[z, n]] += 0.25 * mz
+                stiff[gp[z, n]] += kz
+
+
+@njit(cache=True)
+def _rotate(stress, z, w01, w02, w12):
+    """σ += W σ − σ W for the spin increment W (W01 = w01, W02 = w02, W12 = w12, antisymmetric)."""
+    s00 = stress[z, 0]; s11 = stress[z, 1]; s22 = stress[z, 2]
+    s01 = stress[z, 3]; s02 = stress[z, 4]; s12 = stress[z, 5]
+    stress[z, 0] = s00 + 2.0 * (w01 * s01 + w02 * s02)
+    stress[z, 1] = s11 + 2.0 * (-w01 * s01 + w12 * s12)
+    stress[z, 2] = s22 + 2.0 * (-w02 * s02 - w12 * s12)
+    stress[z, 3] = s01 + w01 * (s11 - s00) + w02 * s12 + w12 * s02
+    stress[z, 4] = s02 + w02 * (s22 - s00) + w01 * s12 - w12 * s01
+    stress[z, 5] = s12 + w12 * (s22 - s11) - w01 * s02 - w02 * s01
+
+
+@njit(cache=True)
+def zone_forces(pos, vel, gp, rows, zset, weight, nset, bulk, shear, dt, large, stress, force, fmag):
+    """One step of 4-node elastic zones ``rows``: strain increment (mixed discretization over
+    the sets ``zset`` (per entry of rows: set index 0..nset-1, or -1)), stress update (in large
+    strain after rotating the stress by the spin increment), nodal forces times ``weight`` (per
+    entry of rows) added to ``force``, their magnitudes to ``fmag``."""
+    nz = rows.shape[0]
+    de = np.empty((nz, 6))
+    rot = np.zeros((nz, 3))
+    vols = np.empty(nz)
+    av = np.empty((nz, 4, 3))
+    sv = np.zeros(nset)
+    ss = np.zeros(nset)
+    for k in range(nz):
+        z = rows[k]
+        for n in range(4):
+            ax, ay, az = _area_vec(pos, gp[z, (n + 1) % 4], gp[z, (n + 2) % 4], gp[z, (n + 3) % 4], gp[z, n])
+            av[k, n, 0] = ax; av[k, n, 1] = ay; av[k, n, 2] = az
+        vol = _tet_volume(pos, gp[z, 0], gp[z, 1], gp[z, 2], gp[z, 3])
+        vols[k] = vol
+        g00 = 0.0; g01 = 0.0; g02 = 0.0; g10 = 0.0; g11 = 0.0; g12 = 0.0; g20 = 0.0; g21 = 0.0; g22 = 0.0
+        for n in range(4):
+            r = gp[z, n]
+            v0 = vel[r, 0]; v1 = vel[r, 1]; v2 = vel[r, 2]
+            s0 = av[k, n, 0]; s1 = av[k, n, 1]; s2 = av[k, n, 2]
+            g00 -= v0 * s0; g01 -= v0 * s1; g02 -= v0 * s2
+            g10 -= v1 * s0; g11 -= v1 * s1; g12 -= v1 * s2
+            g20 -= v2 * s0; g21 -= v2 * s1; g22 -= v2 * s2
+        f = dt / (3.0 * vol)
+        de[k, 0] = g00 * f; de[k, 1] = g11 * f; de[k, 2] = g22 * f
+        de[k, 3] = 0.5 * (g01 + g10) * f; de[k, 4] = 0.5 * (g02 + g20) * f; de[k, 5] = 0.5 * (g12 + g21) * f
+        rot[k, 0] = 0.5 * (g01 - g10) * f; rot[k, 1] = 0.5 * (g02 - g20) * f; rot[k, 2] = 0.5 * (g12 - g21) * f
+        h = zset[k]
+        if h >= 0:
+            sv[h] += (de[k, 0] + de[k, 1] + de[k, 2]) * vol
+            ss[h] += vol
+    for k in range(nz):
+        z = rows[k]
+        h = zset[k]
+        if h >= 0 and ss[h] > 0.0:
+            shift = (sv[h] / ss[h] - (de[k, 0] + de[k, 1] + de[k, 2])) / 3.0
+            de[k, 0] += shift; de[k, 1] += shift; de[k, 2] += shift
+        if large:
+            _rotate(stress, z, rot[k, 0], rot[k, 1], rot[k, 2])
+        ev = de[k, 0] + de[k, 1] + de[k, 2]
+        lam = bulk[z] - 2.0 * shear[z] / 3.0
+        g2 = 2.0 * shear[z]
+        for i in range(3):
+            stress[z, i] += lam * ev + g2 * de[k, i]
+        for i in range(3, 6):
+            stress[z, i] += g2 * de[k, i]
+        sxx = stress[z, 0]; syy = stress[z, 1]; szz = stress[z, 2]
+        sxy = stress[z, 3]; sxz = stress[z, 4]; syz = stress[z, 5]
+        w = weight[k] / 3.0
+        for n in range(4):
+            r = gp[z, n]
+            s0 = av[k, n, 0]; s1 = av[k, n, 1]; s2 = av[k, n, 2]
+            fx = (sxx * s0 + sxy * s1 + sxz * s2) * w
+            fy = (sxy * s0 + syy * s1 + syz * s2) * w
+            fz = (sxz * s0 + syz * s1 + szz * s2) * w
+            force[r, 0] += fx; force[r, 1] += fy; force[r, 2] += fz
+            fmag[r] += math.sqrt(fx * fx + fy * fy + fz * fz)
+
+
+@njit(cache=True)
+def gp_externals(rows, link, mass, gravity, fapp, fface, force, fmag):
+    """Add gravity m g (real mass), applied and face forces to each gridpoint row of ``rows``
+    (their magnitudes to ``fmag``), then sum each linked row's force and fmag onto its master."""
+    for k in range(rows.shape[0]):
+        r = rows[k]
+        tot = 0.0
+        for i in range(3):
+            fg = mass[r] * gravity[i]
+            force[r, i] += fg + fapp[r, i] + fface[r, i]
+        tot = (math.sqrt((mass[r] * gravity[0]) ** 2 + (mass[r] * gravity[1]) ** 2 + (mass[r] * gravity[2]) ** 2)
+               + math.sqrt(fapp[r, 0] ** 2 + fapp[r, 1] ** 2 + fapp[r, 2] ** 2)
+               + math.sqrt(fface[r, 0] ** 2 + fface[r, 1] ** 2 + fface[r, 2] ** 2))
+        fmag[r] += tot
+    for k in range(rows.shape[0]):
+        r = rows[k]
+        m = link[r]
+        if m >= 0:
+            for i in range(3):
+                force[m, i] += force[r, i]
+            fmag[m] += fmag[r]
+
+
+@njit(cache=True)
+def _sgn(x):
+    if x > 0.0:
+        return 1.0
+    if x < 0.0:
+        return -1.0
+    return 0.0
+
+
+@njit(cache=True)
+def gp_motion(masters, linked, link, force, fprev, mass, imass, held, vapp, vel, disp, pos, dt, mode, alpha,
+              large, vmax, out):
+    """Move the master gridpoints ``masters`` one step (see the module text), then copy the
+    motion to the ``linked`` rows. ``force`` (total force per master) is left as the unbalanced
+    force (held components zeroed) and copied to ``fprev`` (the previous step's unbalanced force
+    for combined damping, read before). ``held`` (uint8): bits 0-2 held at vapp, bits 3-5 held
+    at the present velocity. out: [0] largest unbalanced force, [1] Σ unbalanced force,
+    [2] kinetic energy (real masses), [3] first row that became unstable (−1: none).
+    Returns the number of master rows whose velocity exceeded ``vmax`` or is not finite."""
+    umax = 0.0
+    usum = 0.0
+    ke = 0.0
+    bad = -1
+    for k in range(masters.shape[0]):
+        r = masters[k]
+        m = imass[r]
+        u2 = 0.0
+        for i in range(3):
+            f = force[r, i]
+            if held[r] & (1 << i):
+                vel[r, i] = vapp[r, i]
+                f = 0.0
+            elif held[r] & (8 << i) or m <= 0.0:
+                f = 0.0
+            else:
+                fd = 0.0
+                if mode == 1 or mode == 3:
+                    fd = alpha * abs(f) * _sgn(vel[r, i])
+                elif mode == 2:
+                    fd = alpha * abs(f) * (_sgn(vel[r, i]) - _sgn(f - fprev[r, i])) * 0.5
+                vel[r, i] += (f - fd) * dt / m
+            force[r, i] = f
+            fprev[r, i] = f
+            u2 += f * f
+            d = vel[r, i] * dt
+            disp[r, i] += d
+            if large:
+                pos[r, i] += d
+            ke += 0.5 * mass[r] * vel[r, i] * vel[r, i]
+        u = math.sqrt(u2)
+        usum += u
+        if u > umax:
+            umax = u
+        sp = vel[r, 0] * vel[r, 0] + vel[r, 1] * vel[r, 1] + vel[r, 2] * vel[r, 2]
+        if bad < 0 and not (sp <= vmax * vmax):
+            bad = r
+    for k in range(linked.shape[0]):
+        r = linked[k]
+        mr = link[r]
+        for i in range(3):
+            vel[r, i] = vel[mr, i]
+            disp[r, i] = disp[mr, i]
+            force[r, i] = force[mr, i]
+            fprev[r, i] = fprev[mr, i]
+            if large:
+                pos[r, i] = pos[mr, i]
+    out[0] = umax
+    out[1] = usum
+    out[2] = ke
+    out[3] = bad
+    return bad

@@ -1,0 +1,234 @@
+"""The deformable step of the cycle: zoned blocks move by their gridpoints.
+
+``ZoneStepper`` is made by ``RigidEngine`` at the start of every ``model cycle`` / ``solve`` on a
+model with zones (state is the model's: ``zones`` store and the gridpoint fields of
+``vertices``, see ``dec3d.model.zones``; the stepper holds only what it can rebuild):
+
+1. checks: every zoned block has zones with a model, every elastic zone its bulk, shear and
+   density (``RunError`` naming the blocks otherwise); 10-node zones need
+   ``dec3d.kernels.zones_ho``;
+2. lumped masses and the node stiffness of Eq. (86) (kernel ``zonestep.zone_mass_stiffness``),
+   summed onto link masters (joined blocks share gridpoints by linking);
+3. time step and inertial masses. Static runs (the engine's mass scaling on): density scaling
+   (3DEC theory, "Mass (Density) Scaling"): the inertial mass of each gridpoint is set so that
+   the step of Eq. (84), Δt = 2 (m/k)^½, is the run's Δt: m = k Δt² / 4, with Δt = 1 (FLAC3D's
+   and 3DEC's choice for static runs with deformable zones) unless rigid blocks cycle too (then
+   the rigid Δt) or a time step was fixed (``block mechanical timestep`` / ``mass-scale
+   timestep``). Dynamic runs: real masses and Δt = min over gridpoints of Eq. (84), and of the
+   rigid Δt when rigid blocks cycle;
+4. each step (``step``): zone forces (``zonestep.zone_forces``, mixed discretization in
+   hexahedral sets; 10-node zones by ``zones_ho.tet10_step``), gravity, applied and face forces
+   and the sum onto masters (``gp_externals``), damping and motion (``gp_motion``).
+
+Zoned blocks are not bodies of the rigid motion kernel (``RigidEngine._groups`` leaves them
+out). Contacts between a zoned and a rigid block add their forces to the gridpoints
+(``RigidEngine._mixed_steps``, kernels of ``gpcontact``); contacts between two zoned blocks are
+refused unless both are of one joined set (linked gridpoints make those inert).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from dec3d.errors import Dec3dError
+from dec3d.kernels.zonestep import gp_externals, gp_motion, zone_forces, zone_mass_stiffness
+from dec3d.model.model import KIND_DEFORMABLE
+from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
+
+_F = np.float64
+_I = np.int64
+
+
+def _ids(model, rows) -> str:
+    ids = sorted(set(int(i) for i in model.blocks["id"][np.asarray(rows, _I)]))
+    head = ", ".join(str(i) for i in ids[:10])
+    return head + (f" … ({len(ids)} blocks)" if len(ids) > 10 else "")
+
+
+def zoned_blocks(model) -> np.ndarray:
+    """Rows of the live zoned (deformable) blocks."""
+    b = model.blocks
+    return np.flatnonzero((b["kind"] == KIND_DEFORMABLE) & ~b["hidden"]).astype(_I)
+
+
+class ZoneStepper:
+    def __init__(self, model, error):
+        """``error``: the exception class to raise (the engine's ``RunError``)."""
+        self.model = model
+        self.error = error
+        zs = zone_stores(model)
+        b, v = model.blocks, model.vertices
+        self.blocks = zoned_blocks(model)
+        on = np.zeros(b.n, bool)
+        on[self.blocks] = True
+        zrow = np.flatnonzero(on[zs["block"]]).astype(_I)
+        cm = zs["cmodel"][zrow]
+        bad = ~np.isin(cm, (ZMODEL_NULL, ZMODEL_ELASTIC))
+        if bad.any():
+            raise error(f"zones of blocks {_ids(model, zs['block'][zrow[bad]])} have a constitutive model that "
+                        "does not cycle yet (only elastic and null)")
+        live = np.zeros(b.n, bool)
+        live[zs["block"][zrow[cm == ZMODEL_ELASTIC]]] = True
+        none = self.blocks[~live[self.blocks]]
+        if len(none):
+            raise error(f"zoned blocks {_ids(model, none)} have no zone with a constitutive model: use "
+                        "`block zone cmodel assign elastic` (and `block zone property`) before cycling")
+        el = zrow[cm == ZMODEL_ELASTIC]
+        p = zs["prop"]
+        miss = (p[el, ZP_BULK] <= 0) | (p[el, ZP_SHEAR] <= 0) | (p[el, ZP_DENSITY] <= 0)
+        if miss.any():
+            what = "; ".join(f"{name} in blocks {_ids(model, zs['block'][el[p[el, c] <= 0]])}"
+                             for name, c in (("bulk", ZP_BULK), ("shear", ZP_SHEAR), ("density", ZP_DENSITY))
+                             if (p[el, c] <= 0).any())
+            raise error(f"{int(miss.sum())} elastic zones lack properties ({what}): set them with "
+                        "`block zone property` before cycling")
+        nn = zs["nnode"][el]
+        self.rows4 = np.ascontiguousarray(el[nn == 4])
+        self.rows10 = np.ascontiguousarray(el[nn == 10])
+        self.ho = None
+        if len(self.rows10):
+            try:
+                from dec3d.kernels import zones_ho
+                self.ho = zones_ho.tet10_step
+            except ImportError:
+                raise error("10-node zones not available: this version cannot cycle high-order "
+                            "tetrahedra (`block zone generate high-order-tetra`)") from None
+        # mixed-discretization sets of the 4-node zones: compact set numbers
+        hx = zs["hex"][self.rows4]
+        self.weight = np.where(zs["overlay"][self.rows4] >= 0, 0.5, 1.0)
+        self.zset = np.full(len(self.rows4), -1, _I)
+        if (hx >= 0).any():
+            _, inv = np.unique(hx[hx >= 0], return_inverse=True)
+            self.zset[hx >= 0] = inv.ravel()
+        self.nset = int(self.zset.max()) + 1 if len(self.zset) else 0
+        self.bulk = np.ascontiguousarray(p[:, ZP_BULK])
+        self.shear = np.ascontiguousarray(p[:, ZP_SHEAR])
+        self.density = np.ascontiguousarray(p[:, ZP_DENSITY])
+        # gridpoints: rows of the zoned blocks, masters and linked copies
+        vb = v["block"]
+        gpmask = v["zoned"] & on[np.maximum(vb, 0)] & (vb >= 0)
+        self.rows = np.flatnonzero(gpmask).astype(_I)
+        link = v["link"]
+        self.masters = np.ascontiguousarray(self.rows[link[self.rows] < 0])
+        self.linked = np.ascontiguousarray(self.rows[link[self.rows] >= 0])
+        held = v["apply_fix"] | ((v["fixity"] & 7) << 3) | ((b["fixity"][np.maximum(vb, 0)] & 7) << 3)
+        held = held.astype(np.uint8)
+        # a condition set on a linked copy holds its master (the one gridpoint they both are)
+        lk = self.linked
+        self.vapp = v["vapp"].copy()
+        if len(lk):
+            for i in range(3):
+                bit = np.uint8(1 << i)
+                own = (held[lk] & bit) != 0
+                mst = link[lk[own]]
+                self.vapp[mst, i] = np.where((held[mst] & bit) != 0, self.vapp[mst, i], v["vapp"][lk[own], i])
+            np.bitwise_or.at(held, link[lk], held[lk])
+        self.held = np.ascontiguousarray(held)
+        # masses and stiffness (reference: positions now)
+        n = v.n
+        mass = np.zeros(n)
+        stiff = np.zeros(n)
+        zone_mass_stiffness(v["pos"], zs["gp"], zs["nnode"], zs["overlay"], el, self.bulk, self.shear,
+                            self.density, mass, stiff)
+        v["mass"][self.rows] = mass[self.rows]
+        mtot = mass.copy()
+        ktot = stiff.copy()
+        lk = self.linked
+        np.add.at(mtot, link[lk], mass[lk])
+        np.add.at(ktot, link[lk], stiff[lk])
+        self.mtot = mtot
+        self.ktot = ktot
+        self.kzone = ktot.copy()
+        self.facc = np.zeros((n, 3))
+        self.fmag = np.zeros(n)
+        self.out = np.zeros(4)
+
+    # ------------------------------------------------------------ time step and masses
+    def natural_timestep(self) -> float:
+        """Eq. (84): 2 min (m/k)^½ over the master gridpoints that have stiffness [s]."""
+        m, k = self.mtot[self.masters], self.ktot[self.masters]
+        on = (k > 0) & (m > 0)
+        return float(2.0 * np.sqrt(m[on] / k[on]).min()) if on.any() else math.inf
+
+    def set_masses(self, dt: float, scaled: bool) -> None:
+        """Inertial masses: density-scaled to Δt (m = k Δt²/4, Eq. 84) or the real ones."""
+        v = self.model.vertices
+        im = self.ktot * dt * dt / 4.0 if scaled else self.mtot.copy()
+        im[self.ktot <= 0] = 0.0
+        v["imass"][self.masters] = im[self.masters]
+        lk = self.linked
+        v["imass"][lk] = v["imass"][v["link"][lk]]
+        self.dt = dt
+
+    def set_contact_stiffness(self, rows: np.ndarray, k: np.ndarray) -> None:
+        """The joint term of Eq. (85) (contact stiffness at boundary gridpoints, N/m, per vertex
+        row, summed onto masters): the density-scaled masses follow at the next ``set_masses``."""
+        link = self.model.vertices["link"]
+        rows = np.where(link[rows] >= 0, link[rows], rows)
+        kj = np.zeros(len(self.ktot))
+        np.add.at(kj, rows, k)
+        self.ktot = self.kzone + kj
+
+    # ------------------------------------------------------------ one step
+    def begin(self) -> np.ndarray:
+        """Start a step: the gridpoint force accumulator zeroed and returned (contact forces
+        may be added to it before ``step(…, begun=True)``)."""
+        self.facc[self.rows] = 0.0
+        self.fmag[self.rows] = 0.0
+        return self.facc
+
+    def step(self, dt: float, gravity: np.ndarray, mode: int, alpha: float, large: bool, vmax: float,
+             begun: bool = False) -> int:
+        """One step of every zoned block; returns the first unstable gridpoint row or −1."""
+        m = self.model
+        v, zs = m.vertices, m.store("zones")
+        facc, fmag = self.facc, self.fmag
+        if not begun:
+            self.begin()
+        pos, vel = v["pos"], v["velocity"]
+        zone_forces(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.bulk, self.shear, dt,
+                    large, zs["stress"], facc, fmag)
+        if self.ho is not None:
+            self.ho(pos, vel, zs["gp"], self.rows10, self.bulk, self.shear, dt, zs["gstress"], zs["stress"], facc)
+        gp_externals(self.rows, v["link"], v["mass"], gravity, v["fapp"], v["fface"], facc, fmag)
+        return gp_motion(self.masters, self.linked, v["link"], facc, v["force"], self.mtot, v["imass"], self.held,
+                         self.vapp, vel, v["disp"], pos, dt, mode, alpha, large, vmax, self.out)
+
+    @property
+    def kinetic(self) -> float:
+        return float(self.out[2])
+
+    def balance(self) -> tuple[np.ndarray, np.ndarray]:
+        """(unbalanced force, applied force magnitude) of the free master gridpoints at the last
+        step: a gridpoint takes part unless all three components are held or it has no mass."""
+        v = self.model.vertices
+        r = self.masters
+        h = self.held[r]
+        free = (((h | (h >> 3)) & 7) != 7) & (v["imass"][r] > 0)
+        r = r[free]
+        f = v["force"][r]
+        return np.hypot(np.hypot(f[:, 0], f[:, 1]), f[:, 2]), self.fmag[r]     # (hypot: no overflow)
+
+    def finish(self, large: bool) -> None:
+        """After a run: zone volumes follow the geometry in large strain."""
+        if not large:
+            return
+        m = self.model
+        zs, p = m.store("zones"), m.vertices["pos"]
+        g = zs["gp"][: zs.n, :4]
+        if not zs.n:
+            return
+        a, b, c, d = (p[g[:, i]] for i in range(4))
+        zs["volume"][:] = np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a) / 6.0
+
+    def unstable(self, row: int, dt: float) -> Dec3dError:
+        m = self.model
+        v = m.vertices
+        sp = math.hypot(*v["velocity"][row])
+        bid = int(m.blocks["id"][v["block"][row]])
+        x, y, z = (float(c) for c in v["pos"][row])
+        return self.error(f"the run became unstable at step {m.step}: a gridpoint of block {bid} at "
+                          f"({x:.4g}, {y:.4g}, {z:.4g}) reached velocity {sp:.3g} m/s (time step {dt:.3g} s); "
+                          "the model is back at its state before this command")
+
