@@ -365,3 +365,12 @@ def test_vtk_of_fe_elements_reads_back(tmp_path, session):
     feb_volume(np.ascontiguousarray(v["pos"]), np.ascontiguousarray(es["nodes"]), np.arange(10, dtype=np.int64),
                feb_vol)
     assert np.allclose(vol, feb_vol, rtol=1e-6)
+
+
+def test_cycling_fe_blocks_is_refused_until_the_step_is_wired(session):
+    session.command(BEAM)
+    pos = session.model.vertices["pos"].copy()
+    for cmd in ("model cycle 10", "model solve"):
+        with pytest.raises(Dec3dError, match=r"FE blocks .* do not cycle yet"):
+            session.command(cmd)
+    assert np.array_equal(session.model.vertices["pos"], pos)

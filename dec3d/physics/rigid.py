@@ -25,7 +25,7 @@ from dec3d.kernels.gpcontact import mixed_move_points, mixed_subcontact_forces, 
 from dec3d.kernels.jointlaw import P_KN, P_KS
 from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST, block_timestep,
                                   rigid_motion_groups)
-from dec3d.model.model import KIND_DEFORMABLE
+from dec3d.model.model import KIND_DEFORMABLE, KIND_FE
 from dec3d.model.store import Store
 from dec3d.model.zones import has_zones
 
@@ -407,6 +407,9 @@ class RigidEngine(ContactDetection):
         m = self.model
         b = m.blocks
         live = ~b["hidden"]
+        if (b["kind"][live] == KIND_FE).any():      # issue 12: the FE step is not in the engine yet
+            raise RunError("FE blocks (`feblock generate|read`) do not cycle yet: the 20-node element step is "
+                           "not in the engine; nothing was cycled")
         if has_zones(m):
             return self._cycle_zoned(nsteps, stop, max_time, warn)
         if (b["mass"][live] <= 0).any():
