@@ -374,3 +374,42 @@ def test_cycling_fe_blocks_is_refused_until_the_step_is_wired(session):
         with pytest.raises(Dec3dError, match=r"FE blocks .* do not cycle yet"):
             session.command(cmd)
     assert np.array_equal(session.model.vertices["pos"], pos)
+
+
+def test_feblock_change_sets_material_per_element_range(session):
+    from dec3d.model.zones import ZMODEL_ELASTIC, ZP_BULK, ZP_DENSITY, ZP_SHEAR
+
+    session.command(BEAM + "feblock change cmodel elastic young 1e6 poisson 0.2 density 2000\n"
+                    "feblock change density 2500 range position-x 5 10\nfeblock change poisson 0.25 range id 1")
+    es = session.model.store("feblocks")
+    assert (es["cmodel"][:10] == ZMODEL_ELASTIC).all()
+    K, G = es["prop"][:10, ZP_BULK], es["prop"][:10, ZP_SHEAR]
+    assert np.allclose(K[1:], 1e6 / (3 * 0.6)) and np.allclose(G[1:], 1e6 / 2.4)
+    E = 9 * K[0] * G[0] / (3 * K[0] + G[0])
+    nu = (3 * K[0] - 2 * G[0]) / (2 * (3 * K[0] + G[0]))
+    assert abs(E - 1e6) < 1e-6 and abs(nu - 0.25) < 1e-12               # young kept, poisson changed
+    dens = es["prop"][:10, ZP_DENSITY]
+    assert np.allclose(dens[:5], 2000) and np.allclose(dens[5:], 2500)     # centroids 5.5 ... 9.5 in range
+    with pytest.raises(Dec3dError, match="not both pairs"):
+        session.command("feblock change bulk 1e6 young 1e6")
+    with pytest.raises(Dec3dError, match="needs cmodel, young"):
+        session.command("feblock change")
+
+
+def test_feblock_change_young_alone_needs_poisson_and_changes_nothing(session):
+    session.command(BEAM)
+    with pytest.raises(Dec3dError, match="young and poisson are both needed: element 1 has no elastic moduli"):
+        session.command("feblock change cmodel elastic young 1e6")
+    assert (session.model.store("feblocks")["cmodel"][:10] == 0).all()
+
+
+def test_block_zone_cmodel_and_property_reach_fe_elements_as_the_seed_deck_uses_them(session):
+    """fem_beam.dat: `block zone cmodel assign el` and `block zone prop dens 2000 young [E] poiss 0.2`."""
+    from dec3d.model.zones import ZMODEL_ELASTIC, ZP_BULK, ZP_DENSITY, ZP_SHEAR
+
+    session.command(BEAM + "block zone cmodel assign el\nblock zone prop dens 2000 young 1e6 poiss 0.2")
+    es = session.model.store("feblocks")
+    assert (es["cmodel"][:10] == ZMODEL_ELASTIC).all()
+    assert np.allclose(es["prop"][:10, ZP_BULK], 1e6 / 1.8) and np.allclose(es["prop"][:10, ZP_SHEAR], 1e6 / 2.4)
+    assert np.allclose(es["prop"][:10, ZP_DENSITY], 2000)
+    assert "selected no zone" not in session.output.getvalue()

@@ -3,14 +3,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import CommandError, ResourceError
+from ..errors import BindError, CommandError, ResourceError
 from ..geometry.assemble import block_poly
 from ..geometry.febmesh import (MeshFileError, brick_corners, brick_mesh, complete_20, divisions, mesh_surface,
                                 parse_fe_mesh, side_faces)
-from ..model.feblocks import add_feblock, element_volumes, feblock_store, install_feblock_mesh
+from ..model.feblocks import add_feblock, element_volumes, feblock_store, install_feblock_mesh, set_material
 from ..model.model import KIND_DEFORMABLE, KIND_FE
+from ..model.zones import ZMODEL_ELASTIC, ZMODEL_NULL
 from .registry import command
-from .values import InPath, Num, Nums, P, Text
+from .values import Choice, InPath, Num, Nums, P, Text
 
 # Memory budget: about 3 kB per element (stress at 27 Gauss points, 20 node rows, nodes);
 # refuse beyond this many elements per command.
@@ -127,6 +128,47 @@ def feblock_read(session, call):
     row = add_feblock(model, allpts, elems, slaves, tris, nmaster, int(a["integration"]))
     if a["group"] is not None:
         model.groups.assign(model.blocks, np.array([row]), a["group"], None)
+
+
+_POS = Num(lo=0, lo_open=True)
+_CMODELS = {"elastic": ZMODEL_ELASTIC, "null": ZMODEL_NULL}
+
+
+@command("feblock change",
+         keywords=[P("cmodel", Choice(tuple(_CMODELS)), "constitutive model: elastic, or null (no stress)"),
+                   P("young", _POS, "Young's modulus E", units="Pa"),
+                   P("poisson", Num(lo=-1, hi=0.5, lo_open=True, hi_open=True), "Poisson's ratio, -1 < nu < 0.5"),
+                   P("bulk", _POS, "bulk modulus K", units="Pa"),
+                   P("shear", _POS, "shear modulus G", units="Pa"),
+                   P("density", _POS, "mass density", units="kg/m³")],
+         range="block",
+         doc="Set the constitutive model and properties of the FE elements in range.",
+         details="The FE-block text assigns material per element with `feblock change`; the range selects "
+                 "elements by their centroid (the mean of their corners), id or group. Moduli are kept as bulk "
+                 "and shear (give bulk/shear or young/poisson, not both pairs); young or poisson alone keeps "
+                 "the other as the element's present moduli give it.",
+         examples=["feblock change cmodel elastic young 30e9 poisson 0.2 density 2400",
+                   "feblock change density 2500 range position-x 0 5"])
+def feblock_change(session, call):
+    _need_configured(session, call, "feblock change")
+    a = call.args
+    keys = [k for k in ("cmodel", "young", "poisson", "bulk", "shear", "density") if a[k] is not None]
+    if not keys:
+        raise BindError("`feblock change` needs cmodel, young, poisson, bulk, shear or density", call.location)
+    if (a["bulk"] is not None or a["shear"] is not None) and (a["young"] is not None or a["poisson"] is not None):
+        raise BindError("`feblock change`: give bulk/shear or young/poisson, not both pairs in one command",
+                        call.location)
+    model = session.model
+    feblock_store(model)
+    rows = np.flatnonzero(session.range_mask(call, "feblocks"))
+    if not len(rows):
+        session.write(f"warning: {call.location}: `feblock change` selected no FE element")
+        return
+    try:
+        set_material(model, rows, _CMODELS[a["cmodel"]] if a["cmodel"] is not None else None, a["young"],
+                     a["poisson"], a["bulk"], a["shear"], a["density"])
+    except ValueError as exc:
+        raise BindError(f"`feblock change`: young and poisson are both needed: {exc}", call.location) from None
 
 
 @command("feblock list", range="block",

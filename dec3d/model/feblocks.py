@@ -19,6 +19,7 @@ The deformable step (``dec3d.physics.zones``) is to move masters only and call t
                             centre); -1 where not made (inner faces; the centre is never made)
     nq ()            int8   Gauss rule: 2 (2 x 2 x 2, the text's default) or 3 (3 x 3 x 3)
     volume ()        m³     volume (reference configuration)
+    centroid (3,)    m      mean of the 8 corners (reference configuration): the point range elements test
     stress (6,)      Pa     xx yy zz xy xz yz, tension positive: volume-weighted mean of gstress
     gstress (27, 6)  Pa     Gauss-point stresses (the first nq³ rows used), y1 fastest
     cmodel ()        int8   constitutive model code (``zones.ZMODEL_*``); 0: none assigned
@@ -53,6 +54,7 @@ def _fields() -> dict[str, Field]:
         "slaves": Field((7,), _I, -1),
         "nq": Field((), np.int8, 2),
         "volume": Field((), _F, 0.0),
+        "centroid": Field((3,), _F, 0.0),
         "stress": Field((6,), _F, 0.0),
         "gstress": Field((NGAUSS_MAX, 6), _F, 0.0),
         "cmodel": Field((), np.int8, ZMODEL_NULL),
@@ -71,6 +73,42 @@ def feblock_store(model) -> Store:
     if "feslave" not in model.vertices:
         model.vertices.add_field("feslave", Field((), np.bool_, False))
     return model.add_store(Store("feblocks", _fields(), capacity=64))
+
+
+def set_material(model, rows: np.ndarray, cmodel: int | None = None, young=None, poisson=None, bulk=None,
+                 shear=None, density=None) -> None:
+    """Constitutive model and properties of FE elements ``rows`` (``zones.ZP_*`` columns; moduli
+    kept as bulk and shear, young/poisson converted by K = E / (3 (1 - 2 nu)), G = E / (2 (1 + nu));
+    one of young/poisson alone keeps the other as the element's present K, G give it). The caller
+    has checked the values; raises ValueError when young or poisson alone meets an element
+    without moduli."""
+    from .zones import ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR
+
+    es = model.store("feblocks")
+    rows = np.asarray(rows, _I)
+    if (young is None) != (poisson is None) and len(rows):
+        have = (es["prop"][rows, ZP_BULK] > 0) & (es["prop"][rows, ZP_SHEAR] > 0)
+        if not have.all():
+            raise ValueError(f"element {int(es['id'][rows[~have][0]])} has no elastic moduli yet")
+    if cmodel is not None:
+        es["cmodel"][rows] = cmodel
+        if cmodel == ZMODEL_NULL:
+            es["stress"][rows] = 0.0
+            es["gstress"][rows] = 0.0
+    prop = es["prop"]
+    if (young is not None or poisson is not None) and len(rows):
+        K, G = prop[rows, ZP_BULK], prop[rows, ZP_SHEAR]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            E = young if young is not None else 9.0 * K * G / (3.0 * K + G)
+            nu = poisson if poisson is not None else (3.0 * K - 2.0 * G) / (2.0 * (3.0 * K + G))
+        prop[rows, ZP_BULK] = E / (3.0 * (1.0 - 2.0 * np.asarray(nu)))
+        prop[rows, ZP_SHEAR] = E / (2.0 * (1.0 + np.asarray(nu)))
+    if bulk is not None:
+        prop[rows, ZP_BULK] = bulk
+    if shear is not None:
+        prop[rows, ZP_SHEAR] = shear
+    if density is not None:
+        prop[rows, ZP_DENSITY] = density
 
 
 def has_feblocks(model) -> bool:
@@ -154,6 +192,7 @@ def _attach(model, row, points, elems, slaves, nmaster, nq) -> slice:
     es["id"][sl] = np.arange(start_id, start_id + m)
     vol, _ = element_volumes(points, elems)
     es["volume"][sl] = vol
+    es["centroid"][sl] = np.asarray(points)[np.asarray(elems)[:, :8]].mean(axis=1)
     return sl
 
 
