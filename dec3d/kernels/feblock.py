@@ -381,6 +381,24 @@ def feb_step(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, force, nq)
     return bad
 
 
+@njit(cache=True)
+def _element_chunk(lo, hi, pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq):
+    """Elements rows[lo:hi] of the element pass (see ``feb_element_pass``)."""
+    shp, dref, wts = ref_tables(nq)
+    ng = wts.shape[0]
+    jinv = np.empty((ng, 3, 3))
+    wd = np.empty(ng)
+    nd = np.empty(20, np.int64)
+    xe = np.empty((20, 3))
+    ve = np.empty((20, 3))
+    for kk in range(lo, hi):
+        e = rows[kk]
+        _gather(pos, nodes, e, nd, xe)
+        _gather(vel, nodes, e, nd, ve)
+        ok[kk] = _elem_step(xe, ve, dref, wts, bulk[e] - 2.0 * shear[e] / 3.0, 2.0 * shear[e], dt,
+                            gstress[e], stress[e], fe[kk], jinv, wd)
+
+
 @njit(cache=True, parallel=True)
 def feb_element_pass(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq):
     """The element half of ``feb_step_parallel``, in parallel over chunks of rows (each element
@@ -389,19 +407,14 @@ def feb_element_pass(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe
     n = rows.shape[0]
     nchunk = (n + CHUNK - 1) // CHUNK
     for c in prange(nchunk):
-        shp, dref, wts = ref_tables(nq)
-        ng = wts.shape[0]
-        jinv = np.empty((ng, 3, 3))
-        wd = np.empty(ng)
-        nd = np.empty(20, np.int64)
-        xe = np.empty((20, 3))
-        ve = np.empty((20, 3))
-        for kk in range(c * CHUNK, min(n, (c + 1) * CHUNK)):
-            e = rows[kk]
-            _gather(pos, nodes, e, nd, xe)
-            _gather(vel, nodes, e, nd, ve)
-            ok[kk] = _elem_step(xe, ve, dref, wts, bulk[e] - 2.0 * shear[e] / 3.0, 2.0 * shear[e], dt,
-                                gstress[e], stress[e], fe[kk], jinv, wd)
+        _element_chunk(c * CHUNK, min(n, (c + 1) * CHUNK), pos, vel, nodes, rows, bulk, shear, dt, gstress,
+                       stress, fe, ok, nq)
+
+
+@njit(cache=True)
+def feb_element_pass_serial(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq):
+    """``feb_element_pass`` on the calling thread (small meshes: no thread start-up), same results."""
+    _element_chunk(0, rows.shape[0], pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq)
 
 
 @njit(cache=True)
@@ -440,6 +453,39 @@ def feb_node_sums(force, fe, ok, nstart, nent):
                 a = nent[q] - 20 * kk
                 f0 += fe[kk, a, 0]; f1 += fe[kk, a, 1]; f2 += fe[kk, a, 2]
         force[r, 0] = f0; force[r, 1] = f1; force[r, 2] = f2
+
+
+@njit(cache=True)
+def _node_range_mag(lo, hi, force, fmag, fe, ok, nstart, nent):
+    for r in range(lo, hi):
+        f0 = force[r, 0]; f1 = force[r, 1]; f2 = force[r, 2]
+        mg = fmag[r]
+        for q in range(nstart[r], nstart[r + 1]):
+            kk = nent[q] // 20
+            if ok[kk]:
+                a = nent[q] - 20 * kk
+                x = fe[kk, a, 0]; y = fe[kk, a, 1]; z = fe[kk, a, 2]
+                f0 += x; f1 += y; f2 += z
+                mg += np.sqrt(x * x + y * y + z * z)
+        force[r, 0] = f0; force[r, 1] = f1; force[r, 2] = f2
+        fmag[r] = mg
+
+
+@njit(cache=True, parallel=True)
+def feb_node_sums_mag(force, fmag, fe, ok, nstart, nent):
+    """``feb_node_sums`` that also adds to fmag[r] the magnitude of every element force on node
+    r (sum over its entries of |fe|: the scale of the forces meeting at the node, for
+    equilibrium ratios). Parallel over chunks of nodes; the same sums for any thread count."""
+    nv = nstart.shape[0] - 1
+    nchunk = (nv + 4 * CHUNK - 1) // (4 * CHUNK)
+    for c in prange(nchunk):
+        _node_range_mag(c * 4 * CHUNK, min(nv, (c + 1) * 4 * CHUNK), force, fmag, fe, ok, nstart, nent)
+
+
+@njit(cache=True)
+def feb_node_sums_mag_serial(force, fmag, fe, ok, nstart, nent):
+    """``feb_node_sums_mag`` on the calling thread, same results."""
+    _node_range_mag(0, nstart.shape[0] - 1, force, fmag, fe, ok, nstart, nent)
 
 
 @njit(cache=True)

@@ -28,14 +28,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from dec3d.kernels.feblock import (feb_body_force, feb_lumped_mass, feb_slave_forces, feb_slave_interp,
-                                   feb_step, feb_stiffness)
+from dec3d.kernels.feblock import (_slave_weights, feb_body_force, feb_element_pass, feb_element_pass_serial,
+                                   feb_lumped_mass, feb_node_lists, feb_node_sums_mag, feb_node_sums_mag_serial,
+                                   feb_slave_forces, feb_slave_interp, feb_stiffness)
 from dec3d.model.feblocks import feblock_store
 from dec3d.model.model import KIND_FE
 from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR
 
 _F = np.float64
 _I = np.int64
+
+#: elements of one Gauss rule above which the element pass runs on threads (same results either way)
+PARALLEL_MIN = 2048
 
 #: the Gershgorin bound times this is the node stiffness used for time step and density scaling
 DAMPING_MARGIN = 2.0
@@ -86,6 +90,9 @@ class FeStepper:
         self.slaves = np.ascontiguousarray(es["slaves"])
         nq = es["nq"][el]
         self.groups = [(np.int64(q), np.ascontiguousarray(el[nq == q])) for q in (2, 3) if (nq == q).any()]
+        # per Gauss rule: scratch of the parallel element pass and the fixed-order node lists
+        self.scratch = [(np.empty((len(r), 20, 3)), np.empty(len(r), np.bool_), *feb_node_lists(v.n, self.nodes, r))
+                        for _, r in self.groups]
         self.erows = np.ascontiguousarray(erow)
         n = v.n
         pos = np.ascontiguousarray(v["pos"])
@@ -109,19 +116,41 @@ class FeStepper:
         self.masters = np.ascontiguousarray(self.rows[~v["feslave"][self.rows]])
         self.slave_rows = np.ascontiguousarray(self.rows[v["feslave"][self.rows]])
 
-    def forces(self, pos, vel, dt: float, gravity, facc) -> int:
-        """Add the element forces F^S (stresses updated) and the consistent gravity F^G to facc.
-        Returns the first element row skipped (det J not positive), −1 if none."""
+    def forces(self, pos, vel, dt: float, gravity, facc, fmag=None) -> int:
+        """Add the element forces F^S (stresses updated; elements on the threads, node sums in a
+        fixed order) and the consistent gravity F^G to facc, and the magnitudes of both to fmag
+        (if given). Returns the first element row skipped (det J not positive), −1 if none."""
+        es = self.model.store("feblocks")
+        gs, st = es["gstress"], es["stress"]
+        mag = fmag if fmag is not None else np.zeros(len(facc))
         first = -1
-        for q, rows in self.groups:
-            bad = feb_step(pos, vel, self.nodes, rows, self.bulk, self.shear, dt, self.model.store("feblocks")
-                           ["gstress"], self.model.store("feblocks")["stress"], facc, q)
-            if bad >= 0 and first < 0:
-                first = bad
+        for (q, rows), (fe, ok, nstart, nent) in zip(self.groups, self.scratch):
+            # small meshes on the calling thread: starting the threads costs more than the work
+            par = len(rows) > PARALLEL_MIN
+            (feb_element_pass if par else feb_element_pass_serial)(pos, vel, self.nodes, rows, self.bulk,
+                                                                  self.shear, dt, gs, st, fe, ok, q)
+            (feb_node_sums_mag if par else feb_node_sums_mag_serial)(facc, mag, fe, ok, nstart, nent)
+            if first < 0 and not ok.all():
+                first = int(rows[np.flatnonzero(~ok)[0]])
         g = np.asarray(gravity, _F)
         if g.any():
-            facc[self.masters] += self.gweight[self.masters, None] * g
+            w = self.gweight[self.masters]
+            facc[self.masters] += w[:, None] * g
+            mag[self.masters] += np.abs(w) * float(np.sqrt(g @ g))
         return first
+
+    def slave_stiffness(self, k: np.ndarray) -> None:
+        """Move stiffness put on slave rows (contacts, Eq. 85) to the masters, weighted by
+        |N_a| at the slave (a bound of what Eq. 9 carries to each)."""
+        w = np.abs(_slave_weights())
+        for s in range(7):
+            r = self.slaves[self.erows, s]
+            on = r >= 0
+            if not on.any():
+                continue
+            ks = k[r[on]]
+            np.add.at(k, self.nodes[self.erows[on]], ks[:, None] * w[s][None, :])
+            k[r[on]] = 0.0
 
     def slave_forces(self, facc) -> None:
         """Forces on slave nodes (contacts, face loads) to the masters by Eq. (9)."""
