@@ -413,3 +413,10 @@ def test_block_zone_cmodel_and_property_reach_fe_elements_as_the_seed_deck_uses_
     assert np.allclose(es["prop"][:10, ZP_BULK], 1e6 / 1.8) and np.allclose(es["prop"][:10, ZP_SHEAR], 1e6 / 2.4)
     assert np.allclose(es["prop"][:10, ZP_DENSITY], 2000)
     assert "selected no zone" not in session.output.getvalue()
+
+
+def test_one_element_thick_mesh_with_reduced_integration_warns(session):
+    session.command(BEAM)
+    assert "one element thick" in session.output.getvalue() and "integration 3" in session.output.getvalue()
+    session.command("block create brick 0 1 5 6 0 1\nfeblock generate 1 1 1 integration 3 range id 2")
+    assert session.output.getvalue().count("one element thick") == 1

@@ -76,11 +76,18 @@ def feblock_generate(session, call):
             raise CommandError(f"block {bid}: element {bad + 1} of its mesh has a non-positive Jacobian "
                                "(the block is too distorted for a regular mesh)", call.location)
         src = side_faces(order, faces)[sides]
-        plans.append((bid, points, elems, slaves, tris, src, nmaster))
+        plans.append((bid, points, elems, slaves, tris, src, nmaster, n))
     feblock_store(model)
-    for bid, points, elems, slaves, tris, src, nmaster in plans:
+    thin = []
+    for bid, points, elems, slaves, tris, src, nmaster, n in plans:
         row = int(np.flatnonzero(b["id"][: b.n] == bid)[0])      # rows move as blocks are rewritten
         install_feblock_mesh(model, row, points, elems, slaves, tris, src, nmaster, nq)
+        if nq == 2 and min(n) == 1:
+            thin.append(bid)
+    if thin:
+        session.write(f"warning: {call.location}: blocks {', '.join(str(i) for i in thin[:10])} are one element "
+                      "thick: with 2x2x2 integration their free faces have a zero-energy mode that point loads can "
+                      "drive without bound; use `integration 3` or distributed loads")
 
 
 @command("feblock read", positional=[P("file", InPath(), "the mesh file", required=True)],
