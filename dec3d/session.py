@@ -202,8 +202,30 @@ class Session:
             raise CommandError(f"cannot read deck `{shown}`: {paths.os_error_text(exc)}", where) from None
         if raw.startswith(b"\xef\xbb\xbf"):
             raw = raw[3:]                   # a UTF-8 byte-order mark
+        if path.suffix.lower() == ".dec":
+            return self._load_dec(raw, path, shown, where, stack)
         text = raw.decode("utf-8", errors="replace")
         return self.load_text(text, str(path), path.parent, stack)
+
+    def _load_dec(self, raw: bytes, path: Path, shown: str, where, stack) -> list:
+        """A `.dec` file: read as a deck when it holds 3DEC commands; 3DEC's legacy binary/tabular
+        block-geometry format (not documented) is refused by name."""
+        from .errors import NotSupportedError
+
+        why = ("3DEC's legacy .dec block-geometry files are not supported (their format is not documented); "
+               "a .dec file that holds 3DEC commands is read as a deck")
+        if b"\x00" in raw[:4096]:
+            raise NotSupportedError(f"`{shown}` is a binary file, not a deck: {why}", where)
+        try:
+            return self.load_text(raw.decode("utf-8", errors="replace"), str(path), path.parent, stack)
+        except NotSupportedError:
+            raise
+        except Dec3dError as exc:
+            loc = exc.location
+            if loc is not None and loc.file == str(path):
+                raise NotSupportedError(f"`{shown}` is not a deck of commands (line {loc.line}: {exc.message}): "
+                                        f"{why}", where) from None
+            raise
 
     def _bind_deck(self, deck: ParsedDeck, base_dir: Path, stack) -> list[Item]:
         binder = Binder(deck, self.bind_context, stack)
@@ -482,6 +504,23 @@ class Session:
                 loc = item.location
                 exc.location = SourceLocation(loc.file, loc.line, loc.column, loc.text, loc.length, tuple(stack))
             raise exc.with_location(item.location)
+
+    def system_command(self, text: str, stack=(), refuse=None) -> None:
+        """FISH `system.command(s)`: bind ``s`` as deck lines now and run them (as a line of a
+        `command … endcommand` section would run). ``refuse(path)`` gives a reason a command may not
+        run here (a FISH callback), or None."""
+        deck = parse_deck(text, "<command>", tuple(stack))
+        binder = Binder(deck, self.bind_context, tuple(stack))
+        for raw in deck.lines:
+            item = binder.bind_line(raw)
+            if isinstance(item, ExprStatement):
+                self.run_statement(item)
+                continue
+            why = refuse(item.command.path) if refuse is not None else None
+            if why:
+                raise CommandError(why, item.location)
+            self._check_paths(item)
+            self.run_fish_command(item, stack)
 
     def new_model(self) -> None:
         """`model new`: a fresh model; FISH variables and functions are cleared too (as in 3DEC)."""

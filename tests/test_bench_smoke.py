@@ -38,7 +38,7 @@ def test_rigid_bench_equilibrium_check_on_one_cube():
         import rigid_bench as rb
     finally:
         sys.path.pop(0)
-    r = rb.equilibrium(1, chunk=10, cap=5000)
+    r = rb.equilibrium(1, cap=5000)
     assert r["reached"] and r["steps"] < 5000
     assert r["reaction_error"] <= 1e-3 and r["max_speed"] < 1e-5
     import io

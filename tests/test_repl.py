@@ -77,7 +77,10 @@ def test_completion_marks_what_does_not_run():
     top = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document(""), None)}
     assert top["plot"] == "display only: skipped" and top["model"] == ""
     kws = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document("block history velocity "), None)}
-    assert kws["zone-id"] == "not supported yet" and kws["gridpointid"] == "" and kws["block-id"] == ""
+    assert kws["zone-id"] == "" and kws["gridpointid"] == "" and kws["block-id"] == ""
+    ckws = {c.text: c.display_meta_text
+            for c in RegistryCompleter().get_completions(Document("block contact history force-normal "), None)}
+    assert ckws["contact-id"] == "not supported yet" and ckws["position"] == ""
     fish = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document("fish "), None)}
     assert fish["define"] == "FISH function definition" and fish["list"] == "" and fish["callback"] == ""
     assert fish["debug"] == "not supported yet"

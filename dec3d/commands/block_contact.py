@@ -152,6 +152,60 @@ def material_default(session, call):
     s["props"].update(props)
 
 
+def _table_rule(call):
+    """The group pair [a, b] and slot of a range that is one `group-intersection` (kept for contacts
+    made later), or None for any other range."""
+    r = call.range
+    if r is None or len(r.elements) != 1:
+        return None
+    rc = r.elements[0]
+    if rc.element.name != "group-intersection" or rc.negate:
+        return None
+    a, b, slot = rc.args.get("first"), rc.args.get("second"), rc.args.get("slot")
+    if not all(isinstance(x, str) for x in (a, b)) or not (slot is None or isinstance(slot, str)):
+        return None
+    return [a, b], slot
+
+
+@command("block contact material-table add",
+         keywords=[P("jmodel", Text(), "joint model of the entry (default: the current default model)"),
+                   P("property", FLAG, "3DEC's word before the properties", bare=True), *_KW],
+         open_keywords=True, range="contact", check=_check_default,
+         doc="Add a material-table entry: a joint model and properties for the contacts in range, now and "
+             "(for a `group-intersection` range) for contacts made later between those groups.",
+         details="Entries are numbered from 1 in the order they are added. The contacts in range take the "
+                 "entry's model and properties (properties not given take the model's own defaults, not "
+                 "those of `material-table default`), and keep them through re-detection until `block contact "
+                 "property` or `jmodel assign` changes them. When the range is one `group-intersection 'a' 'b' "
+                 "[slot 's']`, a contact made later between a block of a and a block of b takes the entry too "
+                 "(the last entry added wins where several match); any other range applies to the contacts "
+                 "that exist when the command runs.",
+         examples=["block contact material-table add jmodel mohr prop stiffness-normal 1e10 stiffness-shear 1e9 "
+                   "friction 35 range group-intersection 'brickUp' 'brickDown' slot 'components'"])
+def material_add(session, call):
+    s = mech(session.model)
+    name = _model_arg(call, "jmodel")
+    _check_model_name(name, call.locations.get("jmodel", call.location))
+    name = name or s["jmodel"]
+    props = _given(call)
+    props.pop("property", None)
+    _check(call, name, props)
+    jm = JOINT_MODELS[name]
+    tables = s.setdefault("mtables", [])
+    entry = {"id": len(tables) + 1, "jmodel": name, "props": dict(props), "groups": None, "slot": None}
+    rule = _table_rule(call)
+    if rule is not None:
+        entry["groups"], entry["slot"] = rule
+    e, sel = _contacts_in_range(session, call)
+    c = e.contacts
+    c["jmodel"][sel] = jm.code
+    c["prop"][sel] = jm.row(props)
+    c["own_props"][sel] = 1
+    if rule is not None or call.range is None:
+        tables.append(entry)
+    session.results["material-table.count"] = float(len(tables))
+
+
 @command("block contact tolerance", positional=[P("ctol", Num(lo=0, lo_open=True), "contact tolerance CTOL",
                                                   required=True, units="m")],
          doc="Set CTOL: contacts are made when the gap is at most CTOL and deleted beyond it.",

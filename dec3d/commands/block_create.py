@@ -13,19 +13,22 @@ from ..geometry.tunnel import tunnel, tunnel_block_count
 from ..model.blocks import add_blocks
 from .budget import check_blocks
 from .registry import command
-from .values import ANGLE, COORD, LENGTH, POINT, Nums, Num, P, Text
+from .values import ANGLE, COORD, LENGTH, POINT, InPath, Nums, Num, P, Text
 
 GROUP_KW = [P("group", Text(), "group of the new blocks"),
             P("slot", Text(), "group slot (default 'Default')"),
             P("face-group", Text(), "group of the new blocks' faces"),
-            P("region", Num(integer=True), "3DEC 5 region number (`r=0` in old generators): accepted, ignored")]
+            P("region", Num(integer=True), "3DEC 5 region number (`r=0` in old generators; default 0), "
+                                                     "selected by `range region`")]
 
 
 def _add(session, call, polys) -> None:
     m = session.model
     check_blocks(session, len(polys), f"`{call.name}`", call.location)
     rows = add_blocks(m, polys, group=call.args["group"], slot=call.args["slot"])
-    if call.args["face_group"] is not None:
+    if call.args.get("region") is not None:
+        m.blocks["region"][rows] = call.args["region"]
+    if call.args.get("face_group") is not None:
         fs = m.blocks["face_start"][rows]
         fc = m.blocks["face_count"][rows]
         faces = np.concatenate([np.arange(s, s + c) for s, c in zip(fs, fc)])
@@ -111,4 +114,55 @@ def create_tunnel(session, call):
     polys = tunnel(a["dip"], a["dip_direction"], a["radius"], a["length"], a["blocks_axial"],
                    a["blocks_radial"], a["blocks_tangential"], a["boundary"], a["radius_ratio"],
                    origin=a["origin"], tol=session.model.tolerance)
+    _add(session, call, polys)
+
+
+@command("block generate from-vrml",
+         keywords=[P("filename", InPath(exts=(".wrl",)), "the VRML 2.0 file: beside the calling deck, else in the "
+                     "output folder (.wrl tried when there is no extension)", required=True),
+                   P("group", Text(), "group of the new blocks"), P("slot", Text(), "group slot (default 'Default')"),
+                   P("tolerance", Num(lo=0, lo_open=True), "planarity and convexity tolerance for this file "
+                     "(dec3d; default 0.5 % of each shape's size, at least `block tolerance`)", units="m")],
+         doc="Create one convex block per IndexedFaceSet of a VRML 2.0 (.wrl) file.",
+         details="The file's node tree is read with DEF/USE; Transform nodes (translation, rotation, scale, "
+                 "scaleOrientation, center) place their children; Group, Anchor, Collision and Switch hold "
+                 "shapes; appearance, normals, lights and viewpoints are skipped. Faces that a CAD exporter "
+                 "split into triangles are merged back where neighbours lie in one plane (within the model "
+                 "tolerance). Every shape must be closed and convex: a refused shape is named by its number and "
+                 "the file's line, and no block of the file is added. Other geometry nodes (Box, Sphere, ...), "
+                 "PROTO and Inline are refused by name. CAD exports of curved masonry fold a brick's faces by a "
+                 "fraction of a millimetre (the public scaffree dome bricks: 0.7 mm, a concave fold), so each "
+                 "shape is checked with a tolerance of 0.5 % of its size (its bounding-box diagonal; at least the "
+                 "model tolerance): a face folded by less is read as one face, its corners within that distance "
+                 "of its plane. `tolerance <f>` gives the tolerance in metres instead (`tolerance 1e-6`: strict).",
+         examples=["block generate from-vrml filename 'dome_herringbone_5_1_65_8_1_1_0_0.wrl'",
+                   "block generate from-vrml filename 'course_1' group 'C1'",
+                   "block generate from-vrml filename 'dome.wrl' tolerance 1e-6"])
+def generate_from_vrml(session, call):
+    from ..io.vrml import VrmlError, vrml_polys
+    from ..errors import CommandError
+    from ..io.paths import os_error_text
+
+    where = call.locations.get("filename", call.location)
+    name = call.args["filename"]
+    path = session.in_path(name, where, (".wrl",), "VRML file")
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise CommandError(f"cannot read VRML file '{name}': {os_error_text(exc)}").with_location(where) from None
+    text = raw.decode("utf-8", errors="replace")
+    from ..io.vrml import RELATIVE_TOLERANCE
+
+    given = call.args.get("tolerance")
+    try:
+        if given is not None:
+            polys = vrml_polys(text, path.name, float(given))
+        else:
+            polys = vrml_polys(text, path.name, session.model.tolerance, RELATIVE_TOLERANCE)
+    except VrmlError as exc:
+        if "not convex" in exc.message or "not planar" in exc.message:
+            exc.hint = exc.hint or (f"faces are counted after merging coplanar triangles; a shape folded by less "
+                                    f"than a millimetre (a CAD export of curved masonry) reads with a larger "
+                                    f"`tolerance`, e.g. `block generate from-vrml filename '{name}' tolerance 0.002`")
+        raise exc.with_location(where) from None
     _add(session, call, polys)

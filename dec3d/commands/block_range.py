@@ -95,9 +95,10 @@ def group(session, store, args):
 
 @range_element("group-intersection", positional=[P("first", Text(), "group name", required=True),
                                                  P("second", Text(), "group name", required=True)],
+               keywords=[P("slot", Text(), "only groups of this slot (default: any slot)")],
                doc="in both groups (contacts: between a block of one and a block of the other)")
 def group_intersection(session, store, args):
-    return _run(R.mask_group_intersection, session, store, a=args["first"], b=args["second"])
+    return _run(R.mask_group_intersection, session, store, a=args["first"], b=args["second"], slot=args["slot"])
 
 
 @range_element("id", positional=[P("id", Num(integer=True), "id", required=True)],
@@ -110,3 +111,10 @@ def id_(session, store, args):
                doc="the entities with these ids")
 def id_list(session, store, args):
     return _run(R.mask_id_list, session, store, ids=args["ids"])
+
+
+@range_element("region", positional=[P("region", Num(integer=True), "3DEC 5 region number", required=True)],
+               doc="blocks created with this region number (`r=<i>`; 0 when none was given), and their "
+                   "faces, vertices and gridpoints")
+def region(session, store, args):
+    return _run(R.mask_region, session, store, region=args["region"])

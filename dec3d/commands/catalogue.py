@@ -43,7 +43,7 @@ _GROUPS = {
 }
 
 #: range elements of 3DEC that dec3d does not implement yet (implemented ones are registered elsewhere)
-_RANGE_UNSUPPORTED = ("annulus", "polygon", "rectangle", "ellipse", "named-range", "extra", "fish", "region",
+_RANGE_UNSUPPORTED = ("annulus", "polygon", "rectangle", "ellipse", "named-range", "extra", "fish",
                       "jmodel", "cmodel-name", "by", "extent", "state", "direction", "distance")
 
 
@@ -57,7 +57,7 @@ def install(registry=REGISTRY) -> None:
                                             P("slot", Text(), "group slot"),
                                             P("face-group", Text(), "group of the new faces"),
                                             P("region", Num(integer=True), "3DEC 5 region number, still written by "
-                                              "some generators (`r=0`): accepted and ignored; use group")])
+                                              "some generators (`r=0`); selected by `range region`")])
     registry.node_keywords("model history", [P("name", Text(), "history name")])
     registry.node_keywords("block history", [P("name", Text(), "history name")])
     # `fish history [name '<s>'] <var>` takes its name itself (commands.fish_cmds): a FISH variable may be called `name`

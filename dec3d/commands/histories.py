@@ -46,14 +46,18 @@ class HistoryRefs(ValueType):
 
 def _check_block(call):
     point = call.args.get("material_point")
-    given = [k for k in ("position", "block_id", "gridpointid") if call.args.get(k) is not None]
+    given = [k for k in ("position", "block_id", "gridpointid", "zone_id") if call.args.get(k) is not None]
     if call.args["position"] is not None and call.args["block_id"] is not None:
         raise BindError("give either `position <x y z>` or `block-id <i>`, not both", call.location)
     if len(given) > 1:
-        raise BindError("`gridpointid <i>` names the gridpoint alone: give no `position` or `block-id` with it",
+        word = "gridpointid" if "gridpointid" in given else "zone-id"
+        what = "gridpoint" if word == "gridpointid" else "zone"
+        if given == ["gridpointid", "zone_id"]:
+            raise BindError("give `gridpointid <i>` or `zone-id <i>`, not both", call.location)
+        raise BindError(f"`{word} <i>` names the {what} alone: give no `position` or `block-id` with it",
                         call.location)
-    if given == ["gridpointid"] and point is not None:
-        raise BindError("`material-point` follows a point of a block, not a gridpoint", call.location)
+    if given in (["gridpointid"], ["zone_id"]) and point is not None:
+        raise BindError("`material-point` follows a point of a block, not a gridpoint or zone", call.location)
     if not given and point is None:
         raise BindError("give either `position <x y z>` or `block-id <i>`"
                         + (" (or `material-point <x y z>`)" if "material_point" in call.args else ""), call.location)
@@ -73,6 +77,9 @@ def _block_history(quantity, kind="block"):
         point = call.args.get("material_point")
         if call.args.get("gridpointid") is not None:
             _gridpoint_history(session, call, quantity, name)
+            return
+        if call.args.get("zone_id") is not None:
+            _zone_centroid_history(session, call, quantity, name)
             return
         if call.args["block_id"] is not None:
             bid = int(call.args["block_id"])
@@ -117,11 +124,26 @@ def _gridpoint_history(session, call, quantity, name):
     histories(m).add_gridpoint(quantity, int(m.blocks["id"][brow]), row - int(m.blocks["vert_start"][brow]), name)
 
 
+def _zone_centroid_history(session, call, quantity, name):
+    """`block history <q> zone-id <i>`: the value at the centroid of zone i, from its nodes."""
+    m = session.model
+    zid = int(call.args["zone_id"])
+    where = call.locations.get("zone_id", call.location)
+    if quantity not in GRIDPOINT_QUANTITIES:
+        raise CommandError(f"`{quantity}` is not a zone quantity (displacement, velocity or position)", where)
+    z = m.stores.get("zones")
+    if z is None or not z.n or not (z["id"] == zid).any():
+        raise CommandError(f"there is no zone {zid}" + ("" if z is not None and z.n else
+                                                           ": no block is zoned (`block zone generate`)"), where)
+    histories(m).add_zone_centroid(quantity, zid, name)
+
+
 _BLOCK_KW = [P("position", VEC3, "the block whose centroid is nearest this point", units="m"),
              P("block-id", Num(integer=True, lo=1), "the block with this id"),
              P("gridpointid", Num(integer=True), "a gridpoint of a zoned block by id (displacement, velocity, "
                "position)"),
-             P("zone-id", Num(integer=True), "a zone of a deformable block", supported=False)]
+             P("zone-id", Num(integer=True, lo=1), "a zone: the value at its centroid (displacement, velocity, "
+               "position)")]
 _POINT_KW = [P("material-point", VEC3, "follow the point fixed to the block that is here when the command runs "
                             "(a corner: its vertex)", units="m")]
 _WHAT = {"displacement": "displacement", "velocity": "velocity", "rvelocity": "angular velocity",
@@ -129,7 +151,9 @@ _WHAT = {"displacement": "displacement", "velocity": "velocity", "rvelocity": "a
 _WHICH = ("The block is the one whose centroid is nearest `position` when the command runs, or the "
           "block `block-id`. A leading `name '<s>'` names the history (default: its number).")
 _GP = (" When that block is zoned (deformable), `position` records the gridpoint of it nearest the point "
-       "instead; `gridpointid <i>` names a gridpoint directly (its id is its vertex row + 1).")
+       "instead; `gridpointid <i>` names a gridpoint directly (its id is its vertex row + 1); `zone-id <i>` "
+       "records the value at the centroid of zone i (its nodes weighted by the element's shape functions "
+       "there: 1/4 each for a 4-node zone, -1/8 per corner and 1/4 per mid-edge node for a 10-node one).")
 _POINT = (" With `material-point x y z` (dec3d) the value is that of the point fixed to the block that is at "
           "(x, y, z) when the command runs, instead of the centroid: its position now, its displacement "
           "since the block was made, its velocity v + ω × (p − c). Give a corner's coordinates to follow "

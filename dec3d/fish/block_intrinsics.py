@@ -7,6 +7,8 @@ block.disp, block.mass, block.vol, block.group, block.fix).
 """
 from __future__ import annotations
 
+import numpy as np
+
 from .intrinsics import intrinsic, setter
 from .values import FishValueError, Vec, type_name
 
@@ -67,10 +69,85 @@ _vector_family("block.rvel", "spin")
 _vector_family("block.force.app", "fapp")
 
 
+def _contact_loads(model):
+    """(force (n, 3) N, moment about the centroid (n, 3) N·m) on every block from its sub-contacts as
+    they stand (normal force fn along the contact normal A → B on B, shear force fs on B; the opposite
+    on A)."""
+    b = model.blocks
+    f = np.zeros((b.n, 3))
+    mo = np.zeros((b.n, 3))
+    st = model.stores
+    cs, ss = st.get("contacts"), st.get("subcontacts")
+    if cs is None or ss is None or ss.n == 0:
+        return f, mo
+    c = ss["contact"]
+    fb = ss["fn"][:, None] * cs["normal"][c] + ss["fs"]
+    for rows, sign in ((cs["b"][c], 1.0), (cs["a"][c], -1.0)):
+        np.add.at(f, rows, sign * fb)
+        np.add.at(mo, rows, sign * np.cross(ss["pos"] - b["centroid"][rows], fb))
+    return f, mo
+
+
+def _unbalanced(model, r):
+    f, mo = _contact_loads(model)
+    b = model.blocks
+    g = np.asarray(model.settings.gravity, dtype=float)
+    return f[r] + b["fapp"][r] + b["mass"][r] * g, mo[r] + b["mapp"][r]
+
+
+def _load_family(name, which):
+    def whole(rt, b):
+        m, r = _row(rt, b, name)
+        v = _unbalanced(m, r)[which]
+        return Vec(float(v[0]), float(v[1]), float(v[2]))
+    intrinsic(name, 1)(whole)
+    for k, c in (("x", 0), ("y", 1), ("z", 2)):
+        def comp(rt, b, c=c, full=f"{name}.{k}"):
+            m, r = _row(rt, b, full)
+            return float(_unbalanced(m, r)[which][c])
+        intrinsic(f"{name}.{k}", 1)(comp)
+
+
+# the out-of-balance force (contacts, applied force, weight) and moment about the centroid (contacts,
+# applied moment) on a block as its sub-contact forces stand (a fixed block: the reaction it needs)
+_load_family("block.force.unbal", 0)
+_load_family("block.moment", 1)
+
+
+def _face_row(rt, f, name):
+    if type(f) is not int:
+        raise FishValueError(f"`{name}` takes a face (from block.subcontact.face), not a {type_name(f)}")
+    faces = rt.session.model.faces
+    if not 1 <= f <= faces.n:
+        raise FishValueError(f"`{name}`: there is no face {f}")
+    return faces, f - 1
+
+
+@intrinsic("block.face.pos", 1)
+def _face_pos(rt, f):
+    """Area centroid of a block face."""
+    faces, r = _face_row(rt, f, "block.face.pos")
+    return _vec(faces["centroid"], r)
+
+
+@intrinsic("block.face.bface", 1)
+def _face_bface(rt, f):
+    """The block face a face belongs to: for a rigid block's face, the face itself; for a triangle of a
+    zoned block's surface, the polygon face it lies on is not kept as a face of its own, so the triangle."""
+    _face_row(rt, f, "block.face.bface")
+    return f
+
+
 @intrinsic("block.mass", 1)
 def _block_mass(rt, b):
     m, r = _row(rt, b, "block.mass")
     return float(m.blocks["mass"][r])
+
+
+@intrinsic("block.region", 1)
+def _block_region(rt, b):
+    m, r = _row(rt, b, "block.region")
+    return int(m.blocks["region"][r])
 
 
 @intrinsic("block.vol", 1)

@@ -230,6 +230,16 @@ def _sub_scalar(name, field):
     intrinsic(name, 1)(fn)
 
 
+@intrinsic("block.subcontact.face", 1)
+def _sub_face(rt, s):
+    """The block face under a vertex-face sub-contact, as block.face.* take it (its face row + 1, valid
+    until the blocks change); 0 (null) for edge crossings and point sub-contacts."""
+    ss, k = _sub_row(rt, s, "block.subcontact.face")
+    if int(ss["kind"][k]) in (0, 1) and int(ss["key1"][k]) >= 0:
+        return int(ss["key1"][k]) + 1
+    return 0
+
+
 _sub_scalar("block.subcontact.area", "area")
 _sub_scalar("block.subcontact.force.norm", "fn")
 _sub_scalar("block.subcontact.disp.norm", "un")

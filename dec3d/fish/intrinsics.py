@@ -263,6 +263,23 @@ def _system_error(rt, message):
     raise SystemErrorRaised(to_string(message))
 
 
+@intrinsic("system.command", 1)
+def _system_command(rt, text):
+    """Run a command given as a string (`system.command('exit')`), bound and run at once, as a line of a
+    `command … endcommand` section: in a FISH callback, commands that cycle or change the blocks are refused."""
+    if type(text) is not str:
+        raise FishValueError(f"`system.command` takes a command (a string), not a {type_name(text)}")
+    from .sections import _cycle_bound
+
+    def refuse(path):
+        if rt.in_callback and _cycle_bound(path):
+            return (f"`{' '.join(path)}` cannot run in a FISH callback: the cycle that calls it is still going "
+                    "on (cycling again, replacing the model or changing its blocks is refused there)")
+        return None
+    rt.session.system_command(text, rt.stack(), refuse)
+    return 0
+
+
 @intrinsic("system.directory.create", 1)
 def _directory_create(rt, name):
     """Make a folder (and its parents) under the output folder; 0 when it exists afterwards. A name that

@@ -393,8 +393,11 @@ def _settings_problem(d: dict) -> str | None:
               "timestep": lambda v: v is None or (_is_num(v) and v >= 0),
               "scale_timestep": lambda v: v is None or (_is_num(v) and v > 0),
               "servo": lambda v: isinstance(v, list) and len(v) <= 2**20 and all(_is_num(x) for x in v),
+              "dt_run": lambda v: isinstance(v, list) and (v == [] or (len(v) == 2 and _is_num(v[0]) and v[0] > 0
+                                                                        and _is_int(v[1]) and v[1] >= 0)),
               "props": lambda v: isinstance(v, dict) and all(isinstance(k, str) and _is_num(x) for k, x in v.items()),
               "signature": lambda v: isinstance(v, list) and all(_is_int(x) for x in v),
+              "mtables": lambda v: isinstance(v, list) and all(_mtable_ok(t) for t in v),
               "grid": lambda v: (isinstance(v, list) and len(v) == 3 and isinstance(v[0], list) and len(v[0]) == 3
                                  and all(_is_num(x) for x in v[0]) and _is_num(v[1]) and v[1] > 0
                                  and isinstance(v[2], list) and len(v[2]) == 3
@@ -403,6 +406,16 @@ def _settings_problem(d: dict) -> str | None:
         if k in m and not ok(m[k]):
             return f"mechanical setting `{k}` has the value {_short(m[k])}, which is not allowed"
     return None
+
+
+def _mtable_ok(t) -> bool:
+    """One `block contact material-table add` entry of the mechanical settings."""
+    return (isinstance(t, dict) and _is_int(t.get("id")) and t.get("jmodel") in _known()["joint_models"]
+            and isinstance(t.get("props"), dict)
+            and all(isinstance(k, str) and _is_num(x) for k, x in t["props"].items())
+            and (t.get("groups") is None or (isinstance(t["groups"], list) and len(t["groups"]) == 2
+                                             and all(isinstance(g, str) for g in t["groups"])))
+            and (t.get("slot") is None or isinstance(t["slot"], str)))
 
 
 def _short(v) -> str:

@@ -155,8 +155,10 @@ def _zone_cell_data(model, zrows, npoly: int) -> dict:
             "von_mises": pad(von_mises(st))}
 
 
-def write_vtu(model, path: str | os.PathLike, cells: str = "all") -> str:
-    """Write one snapshot of every live block; returns the path written.
+def write_vtu(model, path: str | os.PathLike, cells: str = "all", point_data: dict | None = None,
+              field_data: dict | None = None) -> str:
+    """Write one snapshot of every live block; returns the path written. ``point_data`` and
+    ``field_data`` (name -> array) are extra arrays after the standard ones (eigenmode shapes).
 
     In a model with zones, ``cells`` picks what is written: "all" (rigid blocks as polyhedra and
     zones), "blocks" (the rigid blocks only) or "zones" (the zones only)."""
@@ -185,12 +187,14 @@ def write_vtu(model, path: str | os.PathLike, cells: str = "all") -> str:
              'header_type="UInt64">\n',
              '  <UnstructuredGrid>\n']
     names = list(model.groups.names)
-    if names:
+    if names or field_data:
         # a numeric array per name (code = its index): meshio reads no String arrays
         parts.append("    <FieldData>\n")
         for code, gname in enumerate(names):
             parts.append(_data_array(f"group_code:{gname}", np.array([code], dtype=np.int32), ind,
                                      tuples=True))
+        for key, arr in (field_data or {}).items():
+            parts.append(_data_array(key, np.atleast_1d(np.asarray(arr)), ind, tuples=True))
         parts.append("    </FieldData>\n")
     parts.append(f'    <Piece NumberOfPoints="{v.n}" NumberOfCells="{ncell}">\n')
     parts.append('      <PointData Vectors="displacement">\n')
@@ -201,6 +205,8 @@ def write_vtu(model, path: str | os.PathLike, cells: str = "all") -> str:
         disp[gp], vel[gp] = v["disp"][gp], v["velocity"][gp]
     parts.append(_data_array("displacement", disp, ind + "  "))
     parts.append(_data_array("velocity", vel, ind + "  "))
+    for key, arr in (point_data or {}).items():
+        parts.append(_data_array(key, np.asarray(arr), ind + "  "))
     parts.append("      </PointData>\n")
     parts.append('      <CellData Scalars="block_id">\n')
     leader = b["leader"]

@@ -77,6 +77,7 @@ def _block_fields() -> dict[str, Field]:
         "kind": Field((), np.int8, KIND_RIGID),
         "hidden": Field((), np.bool_, False),
         "leader": Field((), _I, -1),
+        "region": Field((), _I, 0),          # 3DEC 5 region number (`r=<i>` of generators, `range region`)
         "group": group_field(),
         "vert_start": Field((), _I, 0),
         "vert_count": Field((), _I, 0),

@@ -168,18 +168,22 @@ def _in_groups(model, store, names, slot) -> np.ndarray:
     return np.isin(g, codes).any(axis=1)
 
 
-def mask_group_intersection(model, store_name: str, a: str, b: str) -> np.ndarray:
-    """``group-intersection '<a>' '<b>'``: rows in both groups (any slots). Contacts select
-    the contacts between a block of one group and a block of the other, or contacts that are
-    themselves in both groups."""
+def mask_group_intersection(model, store_name: str, a: str, b: str, slot: str | None = None) -> np.ndarray:
+    """``group-intersection '<a>' '<b>' [slot '<s>']``: rows in both groups (any slot, or the slot
+    given). Contacts select the contacts between a block of one group and a block of the other,
+    or contacts that are themselves in both groups."""
     store = model.store(store_name)
     if store.name == "contacts":
-        own = _in_groups(model, store, [a], None) & _in_groups(model, store, [b], None)
-        ga = _in_groups(model, model.blocks, [a], None)
-        gb = _in_groups(model, model.blocks, [b], None)
-        ia, ib = store["a"], store["b"]
-        return own | (ga[ia] & gb[ib]) | (gb[ia] & ga[ib])
-    return mask_group(model, store_name, a) & mask_group(model, store_name, b)
+        own = _in_groups(model, store, [a], slot) & _in_groups(model, store, [b], slot)
+        return own | pairs_in_groups(model, store["a"], store["b"], a, b, slot)
+    return _in_groups(model, store, [a], slot) & _in_groups(model, store, [b], slot)
+
+
+def pairs_in_groups(model, ra, rb, a: str, b: str, slot: str | None = None) -> np.ndarray:
+    """Block pairs (rows ``ra[i]``, ``rb[i]``) with one block in group ``a`` and the other in ``b``."""
+    ga = _in_groups(model, model.blocks, [a], slot)
+    gb = _in_groups(model, model.blocks, [b], slot)
+    return (ga[ra] & gb[rb]) | (gb[ra] & ga[rb])
 
 
 def mask_id(model, store_name: str, id: int) -> np.ndarray:  # noqa: A002 (3DEC's keyword)
@@ -193,6 +197,25 @@ def mask_id_list(model, store_name: str, ids: Sequence[int]) -> np.ndarray:
     if "id" not in store:
         raise KeyError(f"{store_name}s have no id")
     return np.isin(store["id"], np.asarray(list(ids), dtype=np.int64))
+
+
+def mask_region(model, store_name: str, region: int) -> np.ndarray:
+    """``region <i>``: blocks with that 3DEC 5 region number (``r=<i>`` when created, 0 when not
+    given); entities of other stores by the region of the block they belong to."""
+    store = model.store(store_name)
+    regions = model.blocks["region"]
+    if store is model.blocks:
+        return regions == int(region)
+    if store.name == "contacts":          # a contact is in the region when one of its blocks is
+        a, b = store["a"], store["b"]
+        return (regions[a] == int(region)) | (regions[b] == int(region))
+    if "block" not in store:
+        raise KeyError(f"{store_name}s belong to no block: `region` selects blocks and their parts")
+    owner = store["block"]
+    ok = (owner >= 0) & (owner < len(regions))
+    out = np.zeros(store.n, dtype=bool)
+    out[ok] = regions[owner[ok]] == int(region)
+    return out
 
 
 # ------------------------------------------------------------------ modifiers
@@ -226,4 +249,5 @@ RANGE_ELEMENTS = {
     "group-intersection": mask_group_intersection,
     "id": mask_id,
     "id-list": mask_id_list,
+    "region": mask_region,
 }

@@ -33,6 +33,7 @@ from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelo
 from dec3d.kernels.jointlaw import NPROP
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.groups import group_field
+from dec3d.model.ranges import pairs_in_groups
 from dec3d.model.store import Field, Store
 
 from .jmodels import JOINT_MODELS, MODEL_BY_CODE
@@ -114,6 +115,20 @@ def default_row(s: dict, code: int) -> np.ndarray:
     (the default properties this model has)."""
     jm = MODEL_BY_CODE[code]
     return jm.row({k: v for k, v in s["props"].items() if k in jm.props})
+
+
+def apply_material_tables(model, tables, new, ra, rb, jcode, prop, own) -> None:
+    """Give new contacts (mask ``new``; block rows ``ra``, ``rb``) the model and properties of the
+    last `material-table add` entry whose group pair they join (an entry without groups: any pair)."""
+    for t in tables:
+        jm = JOINT_MODELS[t["jmodel"]]
+        hit = new.copy()
+        if t.get("groups"):
+            hit &= pairs_in_groups(model, ra, rb, t["groups"][0], t["groups"][1], t.get("slot"))
+        if hit.any():
+            jcode[hit] = jm.code
+            prop[hit] = jm.row(t["props"])
+            own[hit] = 1
 
 
 class ContactDetection:
@@ -277,6 +292,8 @@ class ContactDetection:
             sel = old & (own == 0) & (jcode == code)
             prop[sel] = default_row(s, int(code))
         group[old] = cs["group"][prev_c[old]]
+        if s.get("mtables") and not old.all():      # `block contact material-table add` entries
+            apply_material_tables(m, s["mtables"], ~old, ra_c, rb_c, jcode, prop, own)
         # sub-contacts of the recomputed contacts (zero-area ones carry nothing and are dropped)
         t1 = _time.perf_counter()
         f_ra, f_rb, f_prev = ra[fresh], rb[fresh], prev[fresh]

@@ -201,6 +201,11 @@ class HistorySet:
             if rows.size == 0 or local >= int(b["vert_count"][rows[0]]):
                 raise ValueError(f"history {hid}: block {bid} has no gridpoint {local + 1}")
             h = self.add_gridpoint(q, bid, local, name)
+        elif kind == "zone-centroid" and q in GRIDPOINT_QUANTITIES:
+            zid = spec.get("zone_id")
+            if not isinstance(zid, int) or isinstance(zid, bool) or zid < 1:
+                raise ValueError(f"history {hid}: zone id {zid!r} is not a whole number ≥ 1")
+            h = self.add_zone_centroid(q, zid, name)
         elif kind == "zone" and q in ZONE_QUANTITIES:
             zid = spec.get("zone_id")
             if not isinstance(zid, int) or isinstance(zid, bool) or zid < 1:
@@ -412,6 +417,31 @@ class HistorySet:
 
         return self.add(f"zone {zone_id} {quantity}", value, name,
                         {"kind": "zone", "quantity": quantity, "zone_id": int(zone_id)})
+
+    def add_zone_centroid(self, quantity: str, zone_id: int, name: str | None = None) -> History:
+        """Displacement, velocity or position at the centroid of the zone ``zone_id``, interpolated from
+        its nodes with the element's shape functions there (4-node tetrahedron: each corner 1/4; 10-node:
+        corners -1/8, mid-edge nodes 1/4). NaN once the zone is gone."""
+        fld, comp = GRIDPOINT_QUANTITIES[quantity]
+        model = self.model
+        cache = {"row": -1}
+
+        def value(eng) -> float:
+            zs = model.store("zones")
+            r = cache["row"]
+            if not (0 <= r < zs.n and zs["id"][r] == zone_id):
+                hit = np.flatnonzero(zs["id"] == zone_id)
+                if hit.size == 0:
+                    return float("nan")
+                r = cache["row"] = int(hit[0])
+            nn = int(zs["nnode"][r])
+            gp = zs["gp"][r, :nn]
+            w = np.full(nn, 0.25) if nn == 4 else np.concatenate([np.full(4, -0.125), np.full(6, 0.25)])
+            x = w @ model.vertices[fld][gp]
+            return float(np.linalg.norm(x)) if comp is None else float(x[comp])
+
+        return self.add(f"zone {zone_id} centroid {quantity}", value, name,
+                        {"kind": "zone-centroid", "quantity": quantity, "zone_id": int(zone_id)})
 
     def add_model(self, quantity: str, name: str | None = None) -> History:
         if quantity.startswith(("ratio", "unbalanced")):   # the measures of `model solve` (RigidEngine.criteria)

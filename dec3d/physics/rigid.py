@@ -51,6 +51,7 @@ MECH_DEFAULTS = {
     "servo": [],               # adaptive global damping state (kernels.motion, first NSERVO entries)
     "servo_ratio": 0.5,        # its target ratio
     "scale_timestep": None,    # Δt wanted with density scaling [s] (None: Eq. 87, median body)
+    "dt_run": [],              # [Δt, step]: the step the last rigid run ended on and the Δt it was using
 }
 
 
@@ -449,13 +450,23 @@ class RigidEngine(ContactDetection):
         interval = max(1, int(m.settings.update_interval))
         done = 0
         progress = _Progress(nsteps, self)
-        if self._signature != self._geometry_signature():
+        fresh = self._signature != self._geometry_signature()
+        if fresh:
             self.detect()
         if warn is not None:
             msg = self.stiffness_warning()
             if msg:
                 warn(msg)
-        dt, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt_fixed)
+        # Δt follows the contact stiffnesses: worked out again at every detection (below). A run
+        # that starts between two detections, on the step where the last run ended and with the
+        # geometry as it left it, goes on with that run's Δt, so that a run split into several
+        # commands (or saved and restored in between) takes exactly the steps of one run
+        last = s["dt_run"]
+        if (dt_fixed is None and not fresh and len(last) == 2 and int(last[1]) == m.step
+                and m.step % interval != 0):
+            dt, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, float(last[0]))
+        else:
+            dt, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt_fixed)
         self.dt = dt
         # detection also runs as soon as a block has moved CTOL/2 since the last one, so
         # that two blocks approaching each other cannot close more than CTOL unseen
@@ -471,7 +482,11 @@ class RigidEngine(ContactDetection):
                     self.detect()
                     acc[:] = 0.0
                     due = False
-                    if self.mass_scaling():
+                    if dt_fixed is None:
+                        # the contacts made or lost change the stiffness each body feels
+                        dt, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, None)
+                        self.dt = dt
+                    elif self.mass_scaling():
                         _, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt)
                 k = min(nsteps - done, interval - m.step % interval)
                 for h in self.step_hooks:
@@ -546,6 +561,7 @@ class RigidEngine(ContactDetection):
             pa[gmember[gstart[:-1][lone]]] = gaxes[lone]
             b["inertia"][gmember] = np.einsum("bij,bj,bkj->bik", pa[gmember], b["principal_moment"][gmember],
                                               pa[gmember])
+            s["dt_run"] = [float(self.dt), int(m.step)]
             if mode == DAMP_ADAPTIVE:
                 s["servo"] = [float(x) for x in servo[:NSERVO]]
         return done

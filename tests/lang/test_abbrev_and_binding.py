@@ -49,8 +49,8 @@ def test_unknown_keyword_suggests(session):
 
 def test_known_but_unimplemented_command(session):
     with pytest.raises(NotSupportedError) as e:
-        session.command("block dynamic eigen modes 8")
-    assert e.value.message == "`block dynamic` is not supported yet"
+        session.command("block copy id 1 translate 1 0 0")
+    assert e.value.message == "`block copy` is not supported yet"
 
 
 def test_legacy_syntax_is_named(session):

@@ -115,4 +115,4 @@ def test_not_and_union(grid):
 
 def test_registry_lists_every_element():
     assert set(R.RANGE_ELEMENTS) == {"position", "position-x", "position-y", "position-z", "plane",
-                                     "cylinder", "sphere", "group", "group-intersection", "id", "id-list"}
+                                     "cylinder", "sphere", "group", "group-intersection", "id", "id-list", "region"}

@@ -1,0 +1,791 @@
+"""Mohr-Coulomb zones and nodal mixed discretization: kernels against slow twins, and the D4
+one-zone triaxial test driven by hand.
+
+The twins are written from the formulas (Itasca's "Mohr-Coulomb Model" page; the 3DEC theory
+text, Eqs. 68-76) in plain python/numpy: numpy's eigh for the principal stresses, Itasca's
+closed forms for the single-plane returns, numpy.linalg.solve for the corner/edge returns,
+dictionaries for the nodal averages. They do not call the kernels or use their helpers.
+"""
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+from dec3d.errors import Dec3dError
+from dec3d.kernels import zone_mohr as zm
+from dec3d.kernels.zones import tet_elastic_step
+from dec3d.model import zones as mz
+from dec3d.model.zone_mohr import angle_to_tangent, mohr_props_check, tangent_to_angle
+
+K, G = 2e9, 1e9
+A1, A2 = K + 4 * G / 3, K - 2 * G / 3
+
+
+# --------------------------------------------------------------------------------------------
+# twin of the Mohr-Coulomb return
+
+def _tensor(s):
+    return np.array([[s[0], s[3], s[4]], [s[3], s[1], s[5]], [s[4], s[5], s[2]]])
+
+
+def _vec6(t):
+    return np.array([t[0, 0], t[1, 1], t[2, 2], t[0, 1], t[0, 2], t[1, 2]])
+
+
+def _nfac(tan_angle):
+    sn = math.sin(math.atan(tan_angle))
+    return (1 + sn) / (1 - sn)
+
+
+def twin_mohr(s0, de, bulk, shear, c, tanphi, ten, tanpsi):
+    """Returns (new stress 6, set of active planes, dsp, principal trial, principal new, axes)."""
+    eps = _tensor(de)
+    lam_ = bulk - 2 * shear / 3
+    trial = _tensor(s0) + lam_ * np.trace(eps) * np.eye(3) + 2 * shear * eps
+    w, v = np.linalg.eigh(trial)                  # ascending: s1 <= s2 <= s3
+    nphi, npsi = _nfac(tanphi), _nfac(tanpsi)
+    st = min(ten, c / tanphi) if tanphi > 0 else ten
+    a1, a2 = bulk + 4 * shear / 3, bulk - 2 * shear / 3
+    dmat = np.full((3, 3), a2) + (a1 - a2) * np.eye(3)
+    planes = {}
+    for (i, j) in [(0, 2), (0, 1), (1, 2), (1, 0), (2, 0), (2, 1)]:
+        n = np.zeros(3); n[i] = -1; n[j] = nphi
+        m = np.zeros(3); m[i] = -1; m[j] = npsi
+        planes[("s", i, j)] = (n, 2 * c * math.sqrt(nphi), m)
+    for i in range(3):
+        e = np.zeros(3); e[i] = 1
+        planes[("t", i)] = (e, st, e)
+    order = [("s", 0, 2), ("s", 0, 1), ("s", 1, 2), ("s", 1, 0), ("s", 2, 0), ("s", 2, 1),
+             ("t", 0), ("t", 1), ("t", 2)]
+    F = lambda key, sv: planes[key][0] @ sv - planes[key][1]      # noqa: E731
+    tol = 1e-10 * (abs(w).sum() + c + abs(st))
+    s1, s2, s3 = w
+    fs = s1 - s3 * nphi + 2 * c * math.sqrt(nphi)       # Itasca's f_s (< 0 yield)
+    ft = st - s3                                         # Itasca's f^t (< 0 yield)
+    if fs >= -tol and ft >= -tol:
+        return trial.copy()[[0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]], set(), 0.0, w, w.copy(), v
+    sig_p = st * nphi - 2 * c * math.sqrt(nphi)
+    alpha_p = math.sqrt(1 + nphi ** 2) + nphi
+    h = s3 - st + alpha_p * (s1 - sig_p)
+    # Itasca's single-plane returns, closed form
+    if fs < -tol and (h <= 0 or ft >= -tol):
+        lam_s = fs / ((a1 - a2 * npsi) - (-a1 * npsi + a2) * nphi)
+        new = np.array([s1 - lam_s * (a1 - a2 * npsi), s2 - lam_s * a2 * (1 - npsi),
+                        s3 - lam_s * (a2 - a1 * npsi)])
+        active = [("s", 0, 2)]
+        mult = {("s", 0, 2): -lam_s}
+    else:
+        new = np.array([s1 - (s3 - st) * a2 / a1, s2 - (s3 - st) * a2 / a1, st])
+        active = [("t", 2)]
+        mult = {("t", 2): (s3 - st) / a1}
+
+    def admissible(sv):
+        return all(F(key, sv) <= tol for key in order)
+
+    def solve(keys):
+        M = np.array([[planes[a][0] @ dmat @ planes[b][2] for b in keys] for a in keys])
+        if np.linalg.cond(M) > 1e11:
+            return None
+        lam = np.linalg.solve(M, np.array([F(a, w) for a in keys]))
+        if lam.min() < -1e-12 * np.abs(lam).max():
+            return None
+        sv = w - sum(l_ * (dmat @ planes[a][2]) for l_, a in zip(lam, keys))
+        return (sv, dict(zip(keys, lam))) if admissible(sv) else None
+
+    if not admissible(new):
+        first = active[0]
+        others = [k for k in order if k != first]
+        cands = ([[first, k] for k in others] + [[k] for k in others]
+                 + [list(p) for p in itertools.combinations(others, 2)]
+                 + [list(p) for p in itertools.combinations(order, 3)])
+        for keys in cands:
+            got = solve(keys)
+            if got is not None:
+                new, mult = got
+                break
+        else:
+            raise AssertionError("twin: no consistent return")
+    out = trial + v @ np.diag(new - w) @ v.T
+    return _vec6(out), {k for k in mult if mult[k] > 0}, -(new - w).sum() / 3, w, new, v
+
+
+def _rand_rotation(rng):
+    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
+    return q * np.sign(np.diag(r))
+
+
+def _random_case(rng):
+    c = rng.uniform(0.2e6, 2e6)
+    phi = rng.uniform(0, 45)
+    psi = rng.uniform(0, phi)
+    tanphi, tanpsi = math.tan(math.radians(phi)), math.tan(math.radians(psi))
+    apex = c / tanphi if tanphi > 0 else np.inf
+    ten = rng.uniform(0, 1.3) * min(apex, 3e6)
+    p = rng.uniform(-8e6, 1e6)
+    s_principal = p + rng.normal(size=3) * rng.uniform(0, 3e6)
+    R = _rand_rotation(rng)
+    s0 = _vec6(R @ np.diag(s_principal) @ R.T)
+    de = rng.normal(size=6) * 10 ** rng.uniform(-5, -2.7)
+    return s0, de, c, tanphi, ten, tanpsi
+
+
+def _region(active):
+    sh = any(k[0] == "s" for k in active)
+    te = any(k[0] == "t" for k in active)
+    return {(False, False): "elastic", (True, False): "shear", (False, True): "tension",
+            (True, True): "corner"}[(sh, te)]
+
+
+def _yield_values(s, c, tanphi, ten):
+    w = np.linalg.eigvalsh(_tensor(s))
+    nphi = _nfac(tanphi)
+    st = min(ten, c / tanphi) if tanphi > 0 else ten
+    return w[0] - w[2] * nphi + 2 * c * math.sqrt(nphi), w[2] - st
+
+
+def test_constants_mirror_the_model():
+    assert (zm.ZP_BULK, zm.ZP_SHEAR, zm.ZP_COHESION, zm.ZP_TANFRIC, zm.ZP_TENSION, zm.ZP_TANDIL) == \
+        (mz.ZP_BULK, mz.ZP_SHEAR, mz.ZP_COHESION, mz.ZP_TANFRIC, mz.ZP_TENSION, mz.ZP_TANDIL)
+    assert (zm.ZMODEL_ELASTIC, zm.ZMODEL_MOHR) == (mz.ZMODEL_ELASTIC, mz.ZMODEL_MOHR)
+    assert (zm.SHEAR_NOW, zm.TENSION_NOW, zm.SHEAR_PAST, zm.TENSION_PAST) == \
+        (mz.ZSTATE_SHEAR_NOW, mz.ZSTATE_TENSION_NOW, mz.ZSTATE_SHEAR_PAST, mz.ZSTATE_TENSION_PAST)
+
+
+@pytest.mark.parametrize("s", [np.array([3., -1, 2, 0.5, -0.7, 0.2]), np.array([1., 1, 1, 0, 0, 0]),
+                               np.array([2., 2, 5, 0, 0, 0]), np.array([0., 0, 0, 0, 0, 0]),
+                               np.array([1e7, -3e6, 2e6, 4e6, 0, 0]), np.array([1., 1, 1, 1e-9, 0, 0])])
+def test_jacobi_eigen_matches_numpy(s):
+    lam, vec = np.empty(3), np.empty((3, 3))
+    zm.sym_eig3(s, lam, vec)
+    t = _tensor(s)
+    scale = max(np.abs(s).max(), 1e-300)
+    assert np.allclose(lam, np.linalg.eigvalsh(t), atol=1e-14 * scale)
+    assert np.abs(t @ vec - vec * lam).max() <= 1e-14 * scale + 1e-300
+    assert np.allclose(vec.T @ vec, np.eye(3), atol=1e-14)
+    assert np.all(np.diff(lam) >= 0)
+
+
+def test_mohr_return_matches_twin_on_random_states():
+    rng = np.random.default_rng(11)
+    seen = {"elastic": 0, "shear": 0, "tension": 0, "corner": 0}
+    edge = 0
+    for _ in range(3000):
+        s0, de, c, tf, ten, td = _random_case(rng)
+        s_k, bits, dsp_k = zm.mohr_update(s0, de, K, G, c, tf, ten, td)
+        s_t, active, dsp_t, *_ = twin_mohr(s0, de, K, G, c, tf, ten, td)
+        scale = np.abs(s0).max() + np.abs(s_t).max() + c
+        assert np.abs(s_k - s_t).max() <= 1e-9 * scale, (s0, de, c, tf, ten, td)
+        assert abs(dsp_k - dsp_t) <= 1e-9 * scale
+        region = _region(active)
+        seen[region] += 1
+        edge += len([k for k in active if k[0] == "s"]) > 1
+        assert bits == (1 if region in ("shear", "corner") else 0) | (2 if region in ("tension", "corner") else 0)
+        # after the return the stress is admissible
+        fs, ft = _yield_values(s_k, c, tf, ten)
+        assert fs >= -1e-8 * scale and ft <= 1e-8 * scale
+        if region == "elastic":
+            assert dsp_k == 0.0
+    assert min(seen.values()) >= 50, seen
+    assert edge >= 20, edge
+
+
+def test_single_plane_shear_return_is_itascas_and_flows_per_dilation():
+    """Trial in the shear region: new principal stresses by Itasca's closed form, on the yield
+    line; plastic strain increment along (-1, 0, N_psi) in the trial's principal axes."""
+    c, ten = 1e6, 0.5e6
+    for psi in (0.0, 10.0, 30.0):
+        tf, td = math.tan(math.radians(30)), math.tan(math.radians(psi))
+        nphi, npsi = 3.0, _nfac(td)
+        s0 = np.array([-2e6, -3e6, -9e6, 0.4e6, 0.3e6, -0.2e6])
+        de = np.array([8e-4, 6e-4, -4e-3, 0.2e-4, 0, 0])
+        s_k, bits, dsp = zm.mohr_update(s0, de, K, G, c, tf, ten, td)
+        assert bits == 1
+        w = np.linalg.eigh(_tensor(s0) + (K - 2 * G / 3) * de[:3].sum() * np.eye(3) + 2 * G * _tensor(de))
+        s1, s2, s3 = w[0]
+        fs = s1 - s3 * nphi + 2 * c * math.sqrt(nphi)
+        assert fs < 0 and s3 < ten
+        lam_s = fs / ((A1 - A2 * npsi) - (-A1 * npsi + A2) * nphi)
+        want = np.array([s1 - lam_s * (A1 - A2 * npsi), s2 - lam_s * A2 * (1 - npsi), s3 - lam_s * (A2 - A1 * npsi)])
+        got = np.diag(w[1].T @ _tensor(s_k) @ w[1])
+        assert np.allclose(got, want, rtol=1e-12, atol=1e-6)
+        assert abs(want[0] - want[2] * nphi + 2 * c * math.sqrt(nphi)) < 1e-6
+        # plastic strain = total - elastic, in the principal axes of the trial
+        ds = _tensor(s_k) - _tensor(s0)
+        de_el = (ds - (K - 2 * G / 3) / (3 * K) * np.trace(ds) * np.eye(3)) / (2 * G)
+        ep = w[1].T @ (_tensor(de) - de_el) @ w[1]
+        assert np.abs(ep - np.diag(np.diag(ep))).max() < 1e-12
+        assert abs(ep[1, 1]) < 1e-12
+        assert ep[0, 0] < 0 and abs(ep[2, 2] / ep[0, 0] + npsi) < 1e-8
+        # plastic volume change: zero with psi = 0, (N_psi - 1) |de1_p| otherwise; dsp = K de_v^p
+        assert abs(np.trace(ep) - (npsi - 1) * -ep[0, 0]) < 1e-12
+        assert abs(dsp - K * np.trace(ep)) <= 1e-6 * abs(K * ep[0, 0])
+
+
+def test_tension_return_is_associated_and_hits_the_cut_off():
+    c, tf, ten = 2e6, math.tan(math.radians(35)), 0.3e6
+    s0 = np.array([0.1e6, -0.2e6, 0.2e6, 0, 0, 0])
+    de = np.array([0.0, 0.0, 4e-4, 0, 0, 0])
+    s_k, bits, dsp = zm.mohr_update(s0, de, K, G, c, tf, ten, 0.0)
+    assert bits == 2
+    assert abs(s_k[2] - ten) < 1e-6
+    trial_zz = 0.2e6 + A1 * 4e-4
+    assert np.allclose(s_k[:2], [0.1e6 + A2 * 4e-4 - (trial_zz - ten) * A2 / A1,
+                                 -0.2e6 + A2 * 4e-4 - (trial_zz - ten) * A2 / A1], rtol=1e-12)
+    assert abs(dsp - (trial_zz - ten) * (A1 + 2 * A2) / (3 * A1)) < 1e-6
+
+
+def test_state_bits_now_and_past():
+    assert zm.merge_state(0, 1) == 1 | 4
+    assert zm.merge_state(1 | 4, 0) == 4
+    assert zm.merge_state(4, 2) == 4 | 2 | 8
+    assert zm.merge_state(2 | 8 | 4, 0) == 12
+
+
+# --------------------------------------------------------------------------------------------
+# batched 4-node step and NMD against twins
+
+CUBE = np.array([[x, y, z] for z in (0., 1.) for y in (0., 1.) for x in (0., 1.)])
+CUBE5 = np.array([[0, 1, 2, 4], [1, 3, 2, 7], [1, 4, 5, 7], [2, 4, 6, 7], [1, 2, 4, 7]])
+
+
+def _two_cubes(rng):
+    """Two 5-tet cubes side by side sharing the face x = 1 (the right cube split as the mirror
+    image of the left, so the shared face's triangles agree), gridpoints jittered."""
+    pos = np.vstack([CUBE, (CUBE + [1.0, 0, 0])[[1, 3, 5, 7]]])   # rows 8..11: right cube's x = 2 corners
+    ids = [1, 8, 3, 9, 5, 10, 7, 11]                               # right cube local corner -> row
+    # the right cube uses the mirrored split so the shared face triangles agree: reflect x
+    mirror = [1, 0, 3, 2, 5, 4, 7, 6]
+    tets_r = np.array([[ids[mirror[a]] for a in t] for t in CUBE5])
+    gp = np.vstack([CUBE5, tets_r])
+    pos = pos + rng.normal(size=pos.shape) * 0.05
+    return pos, gp
+
+
+def twin_kinematics(x, v, dt):
+    m = np.hstack([np.ones((4, 1)), x])
+    dn = np.linalg.inv(m)[1:, :].T
+    L = v.T @ dn
+    return _vec6(0.5 * (L + L.T) * dt), abs(np.linalg.det(m)) / 6.0, dn
+
+
+def twin_forces(x, s, vol, dn):
+    return [-vol * _tensor(s) @ dn[n] for n in range(4)]
+
+
+def twin_node_average(gp, vals, vols, node):
+    acc, wt = {}, {}
+    for t, (val, vol) in enumerate(zip(vals, vols)):
+        for g in gp[t, :4]:
+            m = node[g]
+            acc[m] = acc.get(m, 0.0) + val * vol
+            wt[m] = wt.get(m, 0.0) + vol
+    return np.array([sum(acc[node[g]] / wt[node[g]] for g in gp[t, :4]) / 4 for t in range(len(gp))])
+
+
+def _props(n, rng):
+    prop = np.zeros((n, mz.NZPROP))
+    prop[:, mz.ZP_BULK] = K; prop[:, mz.ZP_SHEAR] = G
+    prop[:, mz.ZP_COHESION] = rng.uniform(0.1e6, 0.5e6, n)
+    prop[:, mz.ZP_TANFRIC] = np.tan(np.radians(rng.uniform(10, 40, n)))
+    prop[:, mz.ZP_TANDIL] = prop[:, mz.ZP_TANFRIC] * rng.uniform(0, 1, n)
+    prop[:, mz.ZP_TENSION] = rng.uniform(0, 0.3e6, n)
+    return prop
+
+
+def test_tet_mohr_step_matches_twin():
+    rng = np.random.default_rng(3)
+    pos, gp = _two_cubes(rng)
+    nz = len(gp)
+    vel = rng.normal(size=(len(pos), 3)) * 1e-3
+    prop = _props(nz, rng)
+    s0 = np.array([_vec6(np.diag([-1e6, -1.5e6, -2e6]))] * nz) + rng.normal(size=(nz, 6)) * 2e5
+    rows = np.arange(nz, dtype=np.int64)
+    sk, fk, stk = s0.copy(), np.zeros((len(pos), 3)), np.array([0, 4, 8, 12] * 2 + [0, 0], np.int32)
+    st0 = stk.copy()
+    zm.tet_mohr_step(pos, vel, gp, rows, prop, 1.0, sk, stk, fk)
+    ft = np.zeros_like(fk)
+    nyield = 0
+    for z in range(nz):
+        de, vol, dn = twin_kinematics(pos[gp[z]], vel[gp[z]], 1.0)
+        p = prop[z]
+        s_new, active, *_ = twin_mohr(s0[z], de, K, G, p[mz.ZP_COHESION], p[mz.ZP_TANFRIC], p[mz.ZP_TENSION],
+                                      p[mz.ZP_TANDIL])
+        assert np.abs(sk[z] - s_new).max() < 1e-9 * np.abs(s_new).max()
+        now = (1 if any(a[0] == "s" for a in active) else 0) | (2 if any(a[0] == "t" for a in active) else 0)
+        assert stk[z] == (st0[z] & 12) | now | (now << 2)
+        nyield += now > 0
+        for n, f in enumerate(twin_forces(pos[gp[z]], s_new, vol, dn)):
+            ft[gp[z, n]] += f
+    assert nyield >= 3
+    assert np.abs(fk - ft).max() < 1e-9 * np.abs(ft).max()
+    assert np.abs(fk.sum(axis=0)).max() < 1e-9 * np.abs(fk).max()
+
+
+def test_nmd_kernels_match_twin_and_pass_the_patch_test():
+    rng = np.random.default_rng(5)
+    pos, gp = _two_cubes(rng)
+    nz = len(gp)
+    # link two gridpoints to masters (a shared gridpoint copied in another block's range)
+    node = np.arange(len(pos), dtype=np.int64)
+    rows = np.array([0, 2, 3, 4, 5, 6, 8, 9], np.int64)        # a subset: zones 1 and 7 left out
+    vol = rng.uniform(0.1, 0.3, len(rows))
+    de = rng.normal(size=(len(rows), 6)) * 1e-4
+    dk = de.copy()
+    zm.nmd_strain_average(gp, rows, node, vol, dk)
+    ev = de[:, :3].sum(axis=1)
+    bar = twin_node_average(gp[rows], ev, vol, node)
+    want = de.copy()
+    want[:, :3] += ((bar - ev) / 3)[:, None]
+    assert np.allclose(dk, want, rtol=0, atol=1e-16)
+    assert np.allclose(dk[:, 3:], de[:, 3:], rtol=0, atol=0)            # deviatoric parts kept
+    assert np.allclose(dk[:, :3] - dk[:, :3].sum(1, keepdims=True) / 3,
+                       de[:, :3] - ev[:, None] / 3, atol=1e-18)
+    # linked gridpoints average at their master
+    node2 = node.copy(); node2[8] = 1; node2[10] = 5
+    dk2 = de.copy()
+    zm.nmd_strain_average(gp, rows, node2, vol, dk2)
+    bar2 = twin_node_average(gp[rows], ev, vol, node2)
+    assert np.allclose(dk2[:, :3].sum(1), bar2, atol=1e-16)
+    # stress correction
+    dsp = rng.normal(size=len(rows)) * 1e4
+    dsp[::3] = 0.0
+    s = rng.normal(size=(nz, 6)) * 1e6
+    sk = s.copy()
+    zm.nmd_stress_correction(gp, rows, node, vol, dsp, sk)
+    barp = twin_node_average(gp[rows], dsp, vol, node)
+    want = s.copy()
+    want[rows, :3] += (dsp - barp)[:, None]
+    assert np.allclose(sk, want, rtol=0, atol=1e-8)
+    # patch test: uniform values are left as they are
+    du = np.tile(rng.normal(size=6) * 1e-4, (len(rows), 1))
+    dku = du.copy()
+    zm.nmd_strain_average(gp, rows, node, vol, dku)
+    assert np.allclose(dku, du, rtol=1e-13, atol=0)
+    su = s.copy()
+    zm.nmd_stress_correction(gp, rows, node, vol, np.full(len(rows), 3e4), su)
+    assert np.allclose(su, s, rtol=0, atol=1e-9)
+
+
+def test_tet_zone_step_elastic_and_mohr_paths():
+    rng = np.random.default_rng(9)
+    pos, gp = _two_cubes(rng)
+    nz = len(gp)
+    vel = rng.normal(size=(len(pos), 3)) * 1e-4
+    rows = np.arange(nz, dtype=np.int64)
+    node = np.arange(len(pos), dtype=np.int64)
+    prop = _props(nz, rng)
+    s0 = rng.normal(size=(nz, 6)) * 1e5
+    # all elastic, no NMD: the same as tet_elastic_step
+    cm = np.full(nz, mz.ZMODEL_ELASTIC, np.int8)
+    sa, fa, st = s0.copy(), np.zeros((len(pos), 3)), np.zeros(nz, np.int32)
+    zm.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 0.5, False, sa, st, fa)
+    sb, fb = s0.copy(), np.zeros_like(fa)
+    tet_elastic_step(pos, vel, gp, prop[:, 0].copy(), prop[:, 1].copy(), 0.5, sb, fb)
+    assert np.allclose(sa, sb, rtol=1e-12, atol=1e-6) and np.allclose(fa, fb, rtol=1e-12, atol=1e-6)
+    # all Mohr-Coulomb, no NMD: the same as tet_mohr_step
+    cm[:] = mz.ZMODEL_MOHR
+    vel *= 30
+    sa, fa, sta = s0.copy(), np.zeros_like(fa), np.zeros(nz, np.int32)
+    zm.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 1.0, False, sa, sta, fa)
+    sb, fb, stb = s0.copy(), np.zeros_like(fa), np.zeros(nz, np.int32)
+    zm.tet_mohr_step(pos, vel, gp, rows, prop, 1.0, sb, stb, fb)
+    assert np.array_equal(sa, sb) and np.array_equal(fa, fb) and np.array_equal(sta, stb)
+    assert (sta > 0).sum() >= 3
+    # with NMD: twin of the whole sequence (strain average, return, stress correction, forces)
+    sa, fa, sta = s0.copy(), np.zeros_like(fa), np.zeros(nz, np.int32)
+    zm.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 1.0, True, sa, sta, fa)
+    kin = [twin_kinematics(pos[gp[z]], vel[gp[z]], 1.0) for z in rows]
+    de = np.array([k[0] for k in kin]); vol = np.array([k[1] for k in kin])
+    ev = de[:, :3].sum(1)
+    de[:, :3] += ((twin_node_average(gp, ev, vol, node) - ev) / 3)[:, None]
+    snew, dsp = [], []
+    for z in rows:
+        p = prop[z]
+        s_, _, d_, *_ = twin_mohr(s0[z], de[z], K, G, p[3], p[4], p[5], p[6])
+        snew.append(s_); dsp.append(d_)
+    snew, dsp = np.array(snew), np.array(dsp)
+    snew[:, :3] += (dsp - twin_node_average(gp, dsp, vol, node))[:, None]
+    assert np.abs(sa - snew).max() < 1e-9 * np.abs(snew).max()
+    ft = np.zeros_like(fa)
+    for z in rows:
+        for n, f in enumerate(twin_forces(None, snew[z], vol[z], kin[z][2])):
+            ft[gp[z, n]] += f
+    assert np.abs(fa - ft).max() < 1e-9 * np.abs(ft).max()
+    assert np.abs(dsp).max() > 0      # some zones dilated, so the stress averaging was exercised
+
+
+# --------------------------------------------------------------------------------------------
+# D4: one-zone triaxial test (a cube of 5 tetrahedra, homogeneous strain), driven by hand
+
+def _cube_step(stress, state, prop, rate, nmd):
+    """One step of the 5-tet cube with velocity (ax x, ay y, az z), dt = 1; returns new arrays."""
+    s, st, f = stress.copy(), state.copy(), np.zeros((8, 3))
+    vel = CUBE * np.asarray(rate)
+    rows = np.arange(5, dtype=np.int64)
+    if nmd:
+        zm.tet_zone_step(CUBE, vel, CUBE5, rows, np.arange(8, dtype=np.int64),
+                         np.full(5, mz.ZMODEL_MOHR, np.int8), prop, 1.0, True, s, st, f)
+    else:
+        zm.tet_mohr_step(CUBE, vel, CUBE5, rows, prop, 1.0, s, st, f)
+    return s, st
+
+
+def _triaxial(conf, axial_rate, nsteps, c, phi, ten, psi, lateral_servo=True, nmd=False):
+    """Axial strain increments on z; x and y held at stress ``conf`` by a Newton servo on the
+    lateral strain increment (the same on x and y). Returns the axial stress, the mean lateral stress, plastic
+    volumetric strain, state and axial strain, per step."""
+    prop = np.zeros((5, mz.NZPROP))
+    prop[:, mz.ZP_BULK], prop[:, mz.ZP_SHEAR] = K, G
+    prop[:, mz.ZP_COHESION] = c
+    prop[:, mz.ZP_TANFRIC] = math.tan(math.radians(phi))
+    prop[:, mz.ZP_TENSION] = ten
+    prop[:, mz.ZP_TANDIL] = math.tan(math.radians(psi))
+    stress = np.tile(np.array([conf, conf, conf, 0, 0, 0], float), (5, 1))
+    state = np.zeros(5, np.int32)
+    out = []
+    ev_total = 0.0
+    p0 = conf
+    for _ in range(nsteps):
+        a = -axial_rate * A2 / (A1 + A2)          # elastic guess: lateral stress unchanged
+        for _it in range(12):
+            s, st = _cube_step(stress, state, prop, (a, a, axial_rate), nmd)
+            r = s[0, :2].mean() - conf
+            if abs(r) < 1e-10 * max(abs(conf), 1e5):
+                break
+            s2, _ = _cube_step(stress, state, prop, (a + 1e-7, a + 1e-7, axial_rate), nmd)
+            a -= r / ((s2[0, :2].mean() - s[0, :2].mean()) / 1e-7)
+        assert np.abs(s - s[0]).max() <= 1e-9 * np.abs(s).max()     # homogeneous
+        stress, state = s, st
+        ev_total += 2 * a + axial_rate
+        p = stress[0, :3].mean()
+        out.append((stress[0, 2], stress[0, :2].mean(), ev_total - (p - p0) / K, state[0]))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("conf", [-1e6, -5e6, -10e6])
+def test_d4_triaxial_peak_axial_stress(conf):
+    c, phi = 1e6, 30.0
+    nphi = _nfac(math.tan(math.radians(phi)))
+    peak = conf * nphi - 2 * c * math.sqrt(nphi)       # compression negative: sigma1 = sigma3 N + ... 
+    strain_to_peak = (conf - peak) / (9 * K * G / (3 * K + G))
+    n = 80
+    res = _triaxial(conf, -1.5 * strain_to_peak / n, n, c, phi, ten=0.5e6, psi=0.0)
+    axial, lateral, evp, state = res.T
+    err = abs(axial[-1] - peak) / abs(peak)
+    assert err < 0.005, (axial[-1], peak)
+    assert abs(axial.min() - peak) / abs(peak) < 0.005           # no overshoot past the peak
+    assert np.abs(lateral - conf).max() < 1e-6 * abs(conf)
+    assert int(state[-1]) & 1 and int(state[-1]) & 4              # shear now and past
+    assert not int(state[-1]) & 2
+    # dilation 0: no plastic volume change
+    assert np.abs(evp).max() < 1e-12
+    # still elastic before the peak: the first steps follow Young's modulus
+    assert state[0] == 0
+
+
+def test_d4_dilation_gives_plastic_volume_increase():
+    c, phi, psi, conf = 1e6, 30.0, 10.0, -5e6
+    nphi, npsi = 3.0, _nfac(math.tan(math.radians(psi)))
+    peak = conf * nphi - 2 * c * math.sqrt(nphi)
+    E = 9 * K * G / (3 * K + G)
+    n, rate = 100, -1.6 * (conf - peak) / E / 100
+    res = _triaxial(conf, rate, n, c, phi, ten=0.5e6, psi=psi)
+    axial, lateral, evp, state = res.T
+    assert abs(axial[-1] - peak) / abs(peak) < 0.005
+    # in steady plastic flow (stress constant) the plastic strain rate is the total rate:
+    # axial de1 = rate, volumetric = (1 - N_psi) * rate  (flow rule g = s1 - s3 N_psi)
+    d_evp = np.diff(evp)[-10:]
+    assert np.allclose(d_evp, (1 - npsi) * rate, rtol=1e-6)
+    assert d_evp[-1] > 0
+
+
+def test_d4_nmd_path_gives_the_same_homogeneous_answer():
+    conf, c, phi = -5e6, 1e6, 30.0
+    peak = conf * 3 - 2 * c * math.sqrt(3)
+    res = _triaxial(conf, -2e-4, 40, c, phi, ten=0.5e6, psi=15.0, nmd=True)
+    assert abs(res[-1, 0] - peak) / abs(peak) < 0.005
+
+
+def _uniaxial_tension(c, phi, ten, rate=2e-5, n=60, lateral=0.0):
+    return _triaxial(lateral, rate, n, c, phi, ten=ten, psi=0.0)
+
+
+def test_d4_tension_cut_off_in_pure_tension():
+    c, phi, ten = 1e6, 30.0, 0.4e6           # 2c/sqrt(N_phi) = 1.15 MPa: tension governs
+    res = _uniaxial_tension(c, phi, ten)
+    axial, lateral, _, state = res.T
+    assert abs(axial[-1] - ten) < 1e-6 * ten
+    assert axial.max() <= ten * (1 + 1e-9)
+    assert int(state[-1]) & 2 and int(state[-1]) & 8 and not int(state[-1]) & 1
+    assert np.abs(lateral).max() < 1e-3
+
+
+def test_tension_above_the_apex_is_capped():
+    """Isotropic extension: all principal stresses stop at min(sigma_t, c / tan phi)."""
+    c, tf = 1e6, math.tan(math.radians(30))
+    s = np.zeros(6)
+    for ten, want in ((5e6, c / tf), (0.5e6, 0.5e6)):
+        s = np.zeros(6)
+        for _ in range(30):
+            s, bits, _ = zm.mohr_update(s, np.array([1e-4, 1e-4, 1e-4, 0, 0, 0]), K, G, c, tf, ten, 0.0)
+        assert np.allclose(s[:3], want, rtol=1e-9) and np.abs(s[3:]).max() < 1e-6
+        assert bits & 2
+
+
+# --------------------------------------------------------------------------------------------
+# property check and conversions
+
+def _prow(c=1e6, fric=30.0, ten=0.5e6, dil=0.0):
+    p = np.zeros(mz.NZPROP)
+    p[mz.ZP_BULK], p[mz.ZP_SHEAR], p[mz.ZP_DENSITY] = K, G, 2500
+    p[mz.ZP_COHESION], p[mz.ZP_TENSION] = c, ten
+    p[mz.ZP_TANFRIC] = math.tan(math.radians(fric))
+    p[mz.ZP_TANDIL] = math.tan(math.radians(dil))
+    return p
+
+
+def test_angle_conversions():
+    assert angle_to_tangent(45.0) == pytest.approx(1.0, rel=1e-15)
+    assert np.allclose(tangent_to_angle(angle_to_tangent(np.array([0., 12.5, 89.0]))), [0, 12.5, 89.0])
+    for bad in (-1.0, 90.0, float("nan"), 120.0):
+        with pytest.raises(ValueError, match="less than 90 degrees"):
+            angle_to_tangent(bad)
+
+
+def test_mohr_props_check_accepts_good_rows_and_warns_at_the_apex():
+    assert mohr_props_check(np.array([_prow(), _prow(c=0, fric=0, ten=0), _prow(dil=30.0)])) == []
+    w = mohr_props_check(np.array([_prow(), _prow(c=1e6, fric=45.0, ten=2e6)]), ids=[7, 9])
+    assert len(w) == 1 and "1 zone(s) (9)" in w[0] and "apex" in w[0]
+
+
+@pytest.mark.parametrize("row, words", [
+    (_prow(c=-1.0), "cohesion must be a finite value >= 0 Pa: 1 zone(s) (4)"),
+    (_prow(ten=-5.0), "tension must be a finite value >= 0 Pa"),
+    (_prow(dil=35.0), "dilation must not exceed friction: 1 zone(s) (4)"),
+    (_prow(c=float("nan")), "cohesion must be a finite value"),
+    (np.where(np.arange(mz.NZPROP) == mz.ZP_SHEAR, 0.0, _prow()), "shear must be > 0: 1 zone(s) (4)"),
+    (np.where(np.arange(mz.NZPROP) == mz.ZP_DENSITY, -1.0, _prow()), "density must be > 0"),
+])
+def test_mohr_props_check_errors(row, words):
+    class RunError(Dec3dError):
+        pass
+    rows = np.array([_prow(), row])
+    with pytest.raises(RunError, match="Mohr-Coulomb zone properties") as e:
+        mohr_props_check(rows, ids=[3, 4], error=RunError)
+    assert words in str(e.value)
+
+
+def test_mohr_props_check_bad_friction_tangent():
+    p = _prow(); p[mz.ZP_TANFRIC] = np.inf
+    with pytest.raises(Dec3dError, match="friction must be at least 0 and less than 90 degrees"):
+        mohr_props_check(p[None, :])
+    p[mz.ZP_TANFRIC] = -0.1
+    with pytest.raises(Dec3dError, match="friction"):
+        mohr_props_check(p[None, :])
+
+
+def test_md_stress_average_matches_twin():
+    rng = np.random.default_rng(21)
+    nz = 12
+    stress = rng.normal(size=(nz, 6)) * 1e6
+    rows = np.array([0, 1, 2, 3, 4, 5, 6, 7, 9, 11], np.int64)
+    zset = np.array([0, 0, 0, 1, 1, 1, 1, -1, 0, 1], np.int64)
+    vol = rng.uniform(0.1, 1.0, len(rows))
+    dsp = rng.normal(size=len(rows)) * 1e4
+    sk = stress.copy()
+    zm.md_stress_average(rows, zset, 2, vol, dsp, sk)
+    want = stress.copy()
+    for h in (0, 1):
+        ks = [k for k in range(len(rows)) if zset[k] == h]
+        avg = sum(dsp[k] * vol[k] for k in ks) / sum(vol[k] for k in ks)
+        for k in ks:
+            want[rows[k], :3] += dsp[k] - avg
+    assert np.allclose(sk, want, rtol=0, atol=1e-8)
+    assert np.array_equal(sk[[7, 8, 10]], stress[[7, 8, 10]])      # no set / not in rows: untouched
+    assert np.array_equal(sk[:, 3:], stress[:, 3:])
+    # Eq. 67: a set that started with one mean stress ends with the volume-averaged one
+    s2 = np.zeros((nz, 6)); s2[:, :3] = -1e6
+    s2[rows, :3] -= dsp[:, None]                                   # each zone's own return
+    zm.md_stress_average(rows, zset, 2, vol, dsp, s2)
+    for h in (0, 1):
+        ks = [k for k in range(len(rows)) if zset[k] == h]
+        pm = sum(s2[rows[k], :3].mean() * vol[k] for k in ks) / sum(vol[k] for k in ks)
+        assert np.allclose([s2[rows[k], :3].mean() for k in ks], pm, rtol=1e-12)
+
+
+# --------------------------------------------------------------------------------------------
+# locking of constant-strain tetrahedra in plastic flow, and NMD relieving it: a smooth strip
+# footing on an undrained (phi = 0, psi = 0) layer, driven by a small explicit loop here
+# (dynamic relaxation with local damping 0.8, mass from the zone stiffness, dt = 1)
+
+def _footing_mesh(nx, nz, h):
+    xs, zs = np.arange(nx + 1) * h, -np.arange(nz + 1)[::-1] * h
+    X, Y, Z = np.meshgrid(xs, np.array([0.0, h]), zs, indexing="ij")
+    pos = np.stack([X, Y, Z], -1).reshape(-1, 3)
+    kuhn = [(0, 1, 3, 7), (0, 3, 2, 7), (0, 2, 6, 7), (0, 6, 4, 7), (0, 4, 5, 7), (0, 5, 1, 7)]
+    tets = []
+    for i in range(nx):
+        for k in range(nz):
+            c = [((i + (b & 1)) * 2 + ((b >> 1) & 1)) * (nz + 1) + k + ((b >> 2) & 1) for b in range(8)]
+            tets += [[c[a] for a in t] for t in kuhn]
+    return pos, np.array(tets, np.int64)
+
+
+def _footing_pressure(nmd, nx=16, nz=8, h=0.5, half_width=1.0, steps=10000, v0=2e-6):
+    pos, gp = _footing_mesh(nx, nz, h)
+    nzn, nv = len(gp), len(pos)
+    Kf, Gf, c = 2e8, 1e8, 1e5
+    prop = np.zeros((nzn, mz.NZPROP))
+    prop[:, mz.ZP_BULK], prop[:, mz.ZP_SHEAR], prop[:, mz.ZP_COHESION], prop[:, mz.ZP_TENSION] = Kf, Gf, c, 1e12
+    cm = np.full(nzn, mz.ZMODEL_MOHR, np.int8)
+    rows, node = np.arange(nzn, dtype=np.int64), np.arange(nv, dtype=np.int64)
+    stress, state = np.zeros((nzn, 6)), np.zeros(nzn, np.int32)
+    mass = np.zeros(nv)
+    np.add.at(mass, gp.ravel(), (8 / 3) * (Kf + 4 * Gf / 3) * 2 * h * h / (h / math.sqrt(3)) / 4)
+    x, z = pos[:, 0], pos[:, 2]
+    fix = np.zeros((nv, 3), bool)
+    fix[np.isclose(x, 0) | np.isclose(x, nx * h), 0] = True      # symmetry plane and far side
+    fix[:, 1] = True                                               # plane strain
+    fix[np.isclose(z, -nz * h), :] = True                          # rough base
+    foot = np.isclose(z, 0) & (x <= half_width + 1e-9)
+    fix[foot, 2] = True
+    vel = np.zeros((nv, 3))
+    vel[foot, 2] = -v0
+    p = []
+    for it in range(steps):
+        f = np.zeros((nv, 3))
+        zm.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 1.0, nmd, stress, state, f)
+        if (it + 1) % (steps // 10) == 0:
+            p.append(f[foot, 2].sum() / (half_width * h) / c)
+        vel += np.where(fix, 0.0, (f - 0.8 * np.abs(f) * np.sign(vel)) / mass[:, None])
+    return np.array(p)
+
+
+def test_nmd_relieves_locking_under_a_strip_footing():
+    """Prandtl: limit pressure (pi + 2) c. On this coarse mesh (two zones under the half-footing)
+    NMD levels off 24 % above it (measured on 32 x 16 zones: 14 %), the plain constant-strain
+    tetrahedra are 15 % stiffer still and keep climbing."""
+    p_nmd = _footing_pressure(True)
+    p_cst = _footing_pressure(False)
+    prandtl = math.pi + 2
+    assert abs(p_nmd[-1] / p_nmd[-2] - 1) < 0.01                   # a limit load
+    assert p_nmd[-1] < 1.3 * prandtl
+    assert p_cst[-1] > 1.12 * p_nmd[-1]                            # locking without NMD
+    assert p_cst[-1] / p_cst[-2] - 1 > 1.5 * (p_nmd[-1] / p_nmd[-2] - 1)
+
+
+def test_zone_forces_plastic_matches_twin():
+    """The drop-in step (sets, weights, NMD, large strain, elastic and Mohr-Coulomb zones mixed)
+    against the twins composed by hand."""
+    rng = np.random.default_rng(17)
+    pos, gp = _two_cubes(rng)
+    nzn, nv = len(gp), len(pos)
+    vel = rng.normal(size=(nv, 3)) * 3e-3
+    rows = np.arange(nzn, dtype=np.int64)
+    zset = np.array([0, 0, 0, 0, 0, -1, -1, -1, -1, -1], np.int64)     # first cube: one "hexahedral" set
+    weight = np.where(zset >= 0, 0.5, 1.0)
+    node = np.arange(nv, dtype=np.int64)
+    prop = _props(nzn, rng)
+    cm = np.array([2, 1, 2, 2, 1, 2, 1, 2, 2, 2], np.int8)
+    s0 = rng.normal(size=(nzn, 6)) * 2e5 + np.array([-1e6, -1e6, -1e6, 0, 0, 0])
+    st0 = np.zeros(nzn, np.int32)
+    for large, nmd in ((False, False), (True, True), (False, True)):
+        sk, stk, fk, mk = s0.copy(), st0.copy(), np.zeros((nv, 3)), np.zeros(nv)
+        zm.zone_forces_plastic(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd, sk, stk, fk, mk)
+        # twin
+        kin = []
+        for z in rows:
+            x, v = pos[gp[z]], vel[gp[z]]
+            m = np.hstack([np.ones((4, 1)), x])
+            dn = np.linalg.inv(m)[1:, :].T
+            L = v.T @ dn
+            kin.append((_vec6(0.5 * (L + L.T)), abs(np.linalg.det(m)) / 6, dn, 0.5 * (L - L.T)))
+        de = np.array([k[0] for k in kin]); vol = np.array([k[1] for k in kin])
+        ev = de[:, :3].sum(1)
+        bar = ev.copy()
+        inset = zset >= 0
+        bar[inset] = (ev[inset] * vol[inset]).sum() / vol[inset].sum()
+        if nmd:
+            free = ~inset
+            bar[free] = twin_node_average(gp[free], ev[free], vol[free], node)
+        de[:, :3] += ((bar - ev) / 3)[:, None]
+        snew, dsp = np.zeros((nzn, 6)), np.zeros(nzn)
+        for z in rows:
+            S = _tensor(s0[z])
+            if large:
+                W = kin[z][3]
+                S = S + W @ S - S @ W
+            p = prop[z]
+            if cm[z] == 1:
+                e = _tensor(de[z])
+                snew[z] = _vec6(S + (K - 2 * G / 3) * np.trace(e) * np.eye(3) + 2 * G * e)
+            else:
+                snew[z], _, dsp[z], *_ = twin_mohr(_vec6(S), de[z], K, G, p[3], p[4], p[5], p[6])
+        avg = (dsp[inset] * vol[inset]).sum() / vol[inset].sum()
+        snew[inset, :3] += (dsp[inset] - avg)[:, None]
+        if nmd:
+            snew[free, :3] += (dsp[free] - twin_node_average(gp[free], dsp[free], vol[free], node))[:, None]
+        assert np.abs(sk - snew).max() < 1e-9 * np.abs(snew).max(), (large, nmd)
+        ft, mt = np.zeros((nv, 3)), np.zeros(nv)
+        for z in rows:
+            for n in range(4):
+                f = -weight[z] * vol[z] * _tensor(snew[z]) @ kin[z][2][n]
+                ft[gp[z, n]] += f
+                mt[gp[z, n]] += np.linalg.norm(f)
+        assert np.abs(fk - ft).max() < 1e-9 * np.abs(ft).max()
+        assert np.abs(mk - mt).max() < 1e-9 * mt.max()
+        assert (stk[cm == 2] > 0).sum() >= 2 and (stk[cm == 1] == 0).all()
+        assert np.abs(dsp).max() > 0
+
+
+@pytest.mark.parametrize("c, phi, ten, psi", [(1e6, 0.0, 0.0, 0.0),        # Tresca, no tension
+                                              (1e6, 0.0, 1e12, 0.0),       # Tresca
+                                              (0.0, 35.0, 0.0, 0.0),       # cohesionless sand
+                                              (0.5e6, 30.0, 0.2e6, 30.0),  # associated flow
+                                              (2e6, 89.0, 1e6, 0.0)])      # friction near 90
+def test_limiting_properties_match_twin_and_stay_finite(c, phi, ten, psi):
+    rng = np.random.default_rng(int(phi * 10 + psi))
+    tf, td = math.tan(math.radians(phi)), math.tan(math.radians(psi))
+    for _ in range(300):
+        R = _rand_rotation(rng)
+        s0 = _vec6(R @ np.diag(rng.uniform(-6e6, 1e5, 3)) @ R.T)
+        de = rng.normal(size=6) * 10 ** rng.uniform(-5, -3)
+        s_k, bits, dsp = zm.mohr_update(s0, de, K, G, c, tf, ten, td)
+        s_t, active, dsp_t, *_ = twin_mohr(s0, de, K, G, c, tf, ten, td)
+        scale = np.abs(s0).max() + np.abs(s_t).max() + c
+        assert np.all(np.isfinite(s_k)) and math.isfinite(dsp)
+        assert np.abs(s_k - s_t).max() <= 1e-9 * scale
+        fs, ft = _yield_values(s_k, c, tf, ten)
+        assert fs >= -1e-8 * scale and ft <= 1e-8 * scale
+
+
+def test_parallel_step_is_bit_identical_to_serial():
+    import numba
+    rng = np.random.default_rng(23)
+    pos, gp = _two_cubes(rng)
+    nzn, nv = len(gp), len(pos)
+    vel = rng.normal(size=(nv, 3)) * 3e-3
+    rows = np.arange(nzn, dtype=np.int64)
+    zset = np.array([0, 0, 0, 0, 0, -1, -1, -1, -1, -1], np.int64)
+    weight = np.where(zset >= 0, 0.5, 1.0)
+    node = np.arange(nv, dtype=np.int64); node[8] = 1                # one linked gridpoint
+    prop = _props(nzn, rng)
+    cm = np.array([2, 1, 2, 2, 1, 2, 1, 2, 2, 2], np.int8)
+    s0 = rng.normal(size=(nzn, 6)) * 2e5 + np.array([-1e6, -1e6, -1e6, 0, 0, 0])
+    fstart, fent = zm.node_lists4(nv, np.arange(nv, dtype=np.int64), gp, rows)
+    nstart, nent = zm.node_lists4(nv, node, gp, rows)
+    assert np.array_equal(np.bincount(gp.ravel(), minlength=nv), np.diff(fstart))
+    for large, nmd in ((False, False), (True, True)):
+        ref = [s0.copy(), np.zeros(nzn, np.int32), rng.normal(size=(nv, 3)), np.zeros(nv)]
+        ref[3][:] = 1.0
+        par = [a.copy() for a in ref]
+        zm.zone_forces_plastic(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd, *ref)
+        for nt in (1, 2):
+            out = [a.copy() for a in par]
+            numba.set_num_threads(min(nt, numba.config.NUMBA_NUM_THREADS))
+            zm.zone_forces_plastic_parallel(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd,
+                                            *out, fstart, fent, nstart, nent)
+            for a, b in zip(ref, out):
+                assert np.array_equal(a, b), (large, nmd, nt)
+        assert (ref[1] > 0).sum() >= 2
