@@ -648,7 +648,8 @@ class RigidEngine(ContactDetection):
         interval = max(1, int(m.settings.update_interval))
         done = 0
         progress = _Progress(nsteps, self)
-        if self._signature != self._geometry_signature():
+        fresh = self._signature != self._geometry_signature()
+        if fresh:
             self.detect()
         mixed = self._zone_contacts_check()
         if mixed:
@@ -658,15 +659,23 @@ class RigidEngine(ContactDetection):
             if msg:
                 warn(msg)
         scaled = self.mass_scaling()
-        dt_r = self._masses(gstart, gmember, gmass, giscalar, dt_fixed)[0] if ng else math.inf
-        if dt_fixed is not None:
-            dt = dt_fixed
-        elif scaled:
-            dt = dt_r if ng else float(s["scale_timestep"] or 1.0)
+
+        def pick_dt() -> float:
+            """Δt for the contacts as they are now (worked out again at every detection)."""
+            if dt_fixed is not None:
+                return dt_fixed
+            dt_r = self._masses(gstart, gmember, gmass, giscalar, None)[0] if ng else math.inf
+            d = (dt_r if ng else float(s["scale_timestep"] or 1.0)) if scaled else min(dt_r, zst.natural_timestep())
+            return d if math.isfinite(d) and d > 0 else 1.0
+
+        # as in `_cycle`: a run starting between detections where the last one ended goes on
+        # with its Δt, so that split runs and save/restore change no number
+        last = s["dt_run"]
+        if (dt_fixed is None and not fresh and len(last) == 2 and int(last[1]) == m.step
+                and m.step % interval != 0):
+            dt = float(last[0])
         else:
-            dt = min(dt_r, zst.natural_timestep())
-        if not math.isfinite(dt) or dt <= 0:
-            dt = 1.0
+            dt = pick_dt()
         zst.set_masses(dt, scaled)
         if ng:
             _, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt)
@@ -685,10 +694,13 @@ class RigidEngine(ContactDetection):
                     mixed = self._zone_contacts_check()
                     acc[:] = 0.0
                     due = False
-                    if scaled and ng:
-                        _, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt)
                     if mixed:
                         wsub, wcon = self._mixed_weights(zst)
+                    old_dt, dt = dt, pick_dt()
+                    self.dt = dt
+                    if scaled and ng:
+                        _, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt)
+                    if mixed or dt != old_dt:
                         zst.set_masses(dt, scaled)
                     if loaded:
                         from dec3d.model.face_loads import recompute_fface
@@ -752,6 +764,7 @@ class RigidEngine(ContactDetection):
             self._group_cache = None
             progress.close()
             zst.finish(large)
+            s["dt_run"] = [float(self.dt), int(m.step)]
             if ng:
                 turn = np.einsum("gij,gkj->gik", gaxes, axes0)
                 gid = np.repeat(np.arange(ng), np.diff(gstart))
