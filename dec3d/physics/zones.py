@@ -5,8 +5,9 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
 ``vertices``, see ``dec3d.model.zones``; the stepper holds only what it can rebuild):
 
 1. checks: every zoned block has zones with a model, every elastic zone its bulk, shear and
-   density (``RunError`` naming the blocks otherwise); 10-node zones need
-   ``dec3d.kernels.zones_ho``;
+   density (``RunError`` naming the blocks otherwise); Mohr-Coulomb zones by
+   ``model.zone_mohr.mohr_props_check`` (errors stop the run, warnings go to the engine's
+   ``warn``); Mohr-Coulomb on 10-node zones is refused;
 2. lumped masses and the node stiffness of Eq. (86) (kernel ``zonestep.zone_mass_stiffness``),
    summed onto link masters (joined blocks share gridpoints by linking);
 3. time step and inertial masses. Static runs (the engine's mass scaling on): density scaling
@@ -16,8 +17,12 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
    the rigid Δt) or a time step was fixed (``block mechanical timestep`` / ``mass-scale
    timestep``). Dynamic runs: real masses and Δt = min over gridpoints of Eq. (84), and of the
    rigid Δt when rigid blocks cycle;
-4. each step (``step``): zone forces (``zonestep.zone_forces``, mixed discretization in
-   hexahedral sets; 10-node zones by ``zones_ho.tet10_step``), gravity, applied and face forces
+4. each step (``step``): zone forces of the 4-node zones (``zone_mohr.zone_forces_plastic``
+   with elastic and Mohr-Coulomb zones mixed, mixed discretization in hexahedral sets and nodal
+   mixed discretization, NMD, for the other tetrahedra when ``settings.mechanical["nmd"]`` is on,
+   the default, ``block zone nodal-mixed-discretization``; with NMD off and only elastic zones
+   the elastic ``zonestep.zone_forces``; 10-node zones by ``zones_ho.tet10_step``), gravity,
+   applied and face forces
    and the sum onto masters (``gp_externals``), damping and motion (``gp_motion``).
 
 Zoned blocks are not bodies of the rigid motion kernel (``RigidEngine._groups`` leaves them
@@ -32,9 +37,11 @@ import math
 import numpy as np
 
 from dec3d.errors import Dec3dError
+from dec3d.kernels.zone_mohr import zone_forces_plastic
 from dec3d.kernels.zonestep import gp_externals, gp_motion, zone_forces, zone_mass_stiffness
 from dec3d.model.model import KIND_DEFORMABLE
-from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
+from dec3d.model.zone_mohr import mohr_props_check
+from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_MOHR, ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
 
 _F = np.float64
 _I = np.int64
@@ -53,8 +60,9 @@ def zoned_blocks(model) -> np.ndarray:
 
 
 class ZoneStepper:
-    def __init__(self, model, error):
-        """``error``: the exception class to raise (the engine's ``RunError``)."""
+    def __init__(self, model, error, warn=None):
+        """``error``: the exception class to raise (the engine's ``RunError``); ``warn``: where the
+        warnings of the property checks go (the engine's warn callback), or None."""
         self.model = model
         self.error = error
         zs = zone_stores(model)
@@ -64,36 +72,51 @@ class ZoneStepper:
         on[self.blocks] = True
         zrow = np.flatnonzero(on[zs["block"]]).astype(_I)
         cm = zs["cmodel"][zrow]
-        bad = ~np.isin(cm, (ZMODEL_NULL, ZMODEL_ELASTIC))
+        bad = ~np.isin(cm, (ZMODEL_NULL, ZMODEL_ELASTIC, ZMODEL_MOHR))
         if bad.any():
             raise error(f"zones of blocks {_ids(model, zs['block'][zrow[bad]])} have a constitutive model that "
-                        "does not cycle yet (only elastic and null)")
+                        "does not cycle (only elastic, mohr-coulomb and null)")
+        act = (cm == ZMODEL_ELASTIC) | (cm == ZMODEL_MOHR)
         live = np.zeros(b.n, bool)
-        live[zs["block"][zrow[cm == ZMODEL_ELASTIC]]] = True
+        live[zs["block"][zrow[act]]] = True
         none = self.blocks[~live[self.blocks]]
         if len(none):
             raise error(f"zoned blocks {_ids(model, none)} have no zone with a constitutive model: use "
                         "`block zone cmodel assign elastic` (and `block zone property`) before cycling")
-        el = zrow[cm == ZMODEL_ELASTIC]
+        el = zrow[act]
         p = zs["prop"]
-        miss = (p[el, ZP_BULK] <= 0) | (p[el, ZP_SHEAR] <= 0) | (p[el, ZP_DENSITY] <= 0)
+        ela = zrow[cm == ZMODEL_ELASTIC]
+        miss = (p[ela, ZP_BULK] <= 0) | (p[ela, ZP_SHEAR] <= 0) | (p[ela, ZP_DENSITY] <= 0)
         if miss.any():
-            what = "; ".join(f"{name} in blocks {_ids(model, zs['block'][el[p[el, c] <= 0]])}"
+            what = "; ".join(f"{name} in blocks {_ids(model, zs['block'][ela[p[ela, c] <= 0]])}"
                              for name, c in (("bulk", ZP_BULK), ("shear", ZP_SHEAR), ("density", ZP_DENSITY))
-                             if (p[el, c] <= 0).any())
+                             if (p[ela, c] <= 0).any())
             raise error(f"{int(miss.sum())} elastic zones lack properties ({what}): set them with "
                         "`block zone property` before cycling")
+        mo = zrow[cm == ZMODEL_MOHR]
+        #: warnings of the property check (also given to ``warn`` when there is one)
+        self.warnings = mohr_props_check(p[mo], ids=zs["id"][mo], error=error) if len(mo) else []
+        if warn is not None:
+            for w in self.warnings:
+                warn(w)
         nn = zs["nnode"][el]
+        if len(mo) and (zs["nnode"][mo] == 10).any():
+            ho = mo[zs["nnode"][mo] == 10]
+            raise error(f"{len(ho)} Mohr-Coulomb zones of blocks {_ids(model, zs['block'][ho])} are 10-node "
+                        "tetrahedra: Mohr-Coulomb cycles on 4-node zones only (use `block zone generate "
+                        "edgelength` or `hexahedra` for these blocks, or an elastic model)")
         self.rows4 = np.ascontiguousarray(el[nn == 4])
         self.rows10 = np.ascontiguousarray(el[nn == 10])
+        #: the plastic-capable zone step: with Mohr-Coulomb zones or nodal mixed discretization
+        self.nmd = bool(model.settings.mechanical.get("nmd", True))
+        self.plastic = bool(len(mo)) or (self.nmd and bool(len(self.rows4)))
+        link0 = v["link"]
+        #: NMD averaging node of each vertex row: its link master (one gridpoint of a joined set) or itself
+        self.node = np.ascontiguousarray(np.where(link0 >= 0, link0, np.arange(v.n, dtype=_I)))
         self.ho = None
         if len(self.rows10):
-            try:
-                from dec3d.kernels import zones_ho
-                self.ho = zones_ho.tet10_step
-            except ImportError:
-                raise error("10-node zones not available: this version cannot cycle high-order "
-                            "tetrahedra (`block zone generate high-order-tetra`)") from None
+            from dec3d.kernels import zones_ho
+            self.ho = zones_ho.tet10_step
         # mixed-discretization sets of the 4-node zones: compact set numbers
         hx = zs["hex"][self.rows4]
         self.weight = np.where(zs["overlay"][self.rows4] >= 0, 0.5, 1.0)
@@ -187,8 +210,12 @@ class ZoneStepper:
         if not begun:
             self.begin()
         pos, vel = v["pos"], v["velocity"]
-        zone_forces(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.bulk, self.shear, dt,
-                    large, zs["stress"], facc, fmag)
+        if self.plastic:
+            zone_forces_plastic(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.node,
+                                zs["cmodel"], zs["prop"], dt, large, self.nmd, zs["stress"], zs["state"], facc, fmag)
+        else:
+            zone_forces(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.bulk, self.shear,
+                        dt, large, zs["stress"], facc, fmag)
         if self.ho is not None:
             self.ho(pos, vel, zs["gp"], self.rows10, self.bulk, self.shear, dt, zs["gstress"], zs["stress"], facc)
         gp_externals(self.rows, v["link"], v["mass"], gravity, v["fapp"], v["fface"], facc, fmag)
