@@ -8,8 +8,10 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
    density (``RunError`` naming the blocks otherwise); Mohr-Coulomb zones by
    ``model.zone_mohr.mohr_props_check`` (errors stop the run, warnings go to the engine's
    ``warn``); Mohr-Coulomb on 10-node zones is refused;
-2. lumped masses and the node stiffness of Eq. (86) (kernel ``zonestep.zone_mass_stiffness``),
-   summed onto link masters (joined blocks share gridpoints by linking);
+2. lumped masses and the node stiffness of Eq. (86) (kernel ``zonestep.zone_mass_stiffness``)
+   of the 4-node zones; for 10-node zones HRZ lumped masses (``zones_ho.tet10_lumped_mass``) and
+   the Gershgorin row-sum stiffness (``zones_ho.tet10_stiffness``); summed onto link masters
+   (joined blocks share gridpoints by linking);
 3. time step and inertial masses. Static runs (the engine's mass scaling on): density scaling
    (3DEC theory, "Mass (Density) Scaling"): the inertial mass of each gridpoint is set so that
    the step of Eq. (84), Δt = 2 (m/k)^½, is the run's Δt: m = k Δt² / 4, with Δt = 1 (FLAC3D's
@@ -21,9 +23,12 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
    with elastic and Mohr-Coulomb zones mixed, mixed discretization in hexahedral sets and nodal
    mixed discretization, NMD, for the other tetrahedra when ``settings.mechanical["nmd"]`` is on,
    the default, ``block zone nodal-mixed-discretization``; with NMD off and only elastic zones
-   the elastic ``zonestep.zone_forces``; 10-node zones by ``zones_ho.tet10_step``), gravity,
-   applied and face forces
-   and the sum onto masters (``gp_externals``), damping and motion (``gp_motion``).
+   the elastic ``zonestep.zone_forces``; 10-node zones by ``zones_ho.tet10_step``), gravity (m g
+   on the gridpoints of 4-node zones, the consistent loads of ``zones_ho.tet10_body_force`` on
+   those of 10-node zones, both counted in the applied-force magnitudes of the equilibrium
+   ratio), applied and face forces (``model.face_loads``: 6-node faces of 10-node zones by
+   ``zones_ho.tri6_traction_loads``) and the sum onto masters (``gp_externals``), damping and
+   motion (``gp_motion``).
 
 Zoned blocks are not bodies of the rigid motion kernel (``RigidEngine._groups`` leaves them
 out). Contacts between a zoned and a rigid block add their forces to the gridpoints
@@ -152,8 +157,22 @@ class ZoneStepper:
         n = v.n
         mass = np.zeros(n)
         stiff = np.zeros(n)
-        zone_mass_stiffness(v["pos"], zs["gp"], zs["nnode"], zs["overlay"], el, self.bulk, self.shear,
+        zone_mass_stiffness(v["pos"], zs["gp"], zs["nnode"], zs["overlay"], self.rows4, self.bulk, self.shear,
                             self.density, mass, stiff)
+        #: mass whose weight is lumped (m g per gridpoint): that of the 4-node zones; 10-node zones
+        #: load their gridpoints with the consistent body force instead (``tet10_body_force``)
+        self.gmass = mass.copy()
+        self.r10 = np.zeros(0, _I)
+        self._g10 = None
+        if len(self.rows10):
+            from dec3d.kernels import zones_ho
+            bad = max(zones_ho.tet10_lumped_mass(v["pos"], zs["gp"], self.rows10, self.density, mass),
+                      zones_ho.tet10_stiffness(v["pos"], zs["gp"], self.rows10, self.bulk, self.shear, stiff))
+            if bad >= 0:
+                raise error(f"10-node zone {int(zs['id'][bad])} of block {int(b['id'][zs['block'][bad]])} is "
+                            "inverted or flat (its Jacobian is not positive at a Gauss point)")
+            g10 = zs["gp"][self.rows10]
+            self.r10 = np.unique(g10[g10 >= 0]).astype(_I)
         v["mass"][self.rows] = mass[self.rows]
         mtot = mass.copy()
         ktot = stiff.copy()
@@ -218,9 +237,28 @@ class ZoneStepper:
                         dt, large, zs["stress"], facc, fmag)
         if self.ho is not None:
             self.ho(pos, vel, zs["gp"], self.rows10, self.bulk, self.shear, dt, zs["gstress"], zs["stress"], facc)
-        gp_externals(self.rows, v["link"], v["mass"], gravity, v["fapp"], v["fface"], facc, fmag)
+        if len(self.r10):
+            self._body_force10(gravity)
+            facc[self.r10] += self.fb10
+            fmag[self.r10] += self.fb10mag
+        gp_externals(self.rows, v["link"], self.gmass, gravity, v["fapp"], v["fface"], facc, fmag)
         return gp_motion(self.masters, self.linked, v["link"], facc, v["force"], self.mtot, v["imass"], self.held,
                          self.vapp, vel, v["disp"], pos, dt, mode, alpha, large, vmax, self.out)
+
+    def _body_force10(self, gravity) -> None:
+        """The consistent gravity loads of the 10-node zones (FE-block text 003_*, "Gravity
+        Forces": F_a = ρ g ∫ N_a dV), on the geometry at the start of the run, made again when the
+        gravity changes: ``fb10`` (per row of ``r10``) and their magnitudes ``fb10mag``."""
+        g = tuple(float(x) for x in gravity)
+        if g == self._g10:
+            return
+        from dec3d.kernels.zones_ho import tet10_body_force
+        m = self.model
+        f = np.zeros((m.vertices.n, 3))
+        tet10_body_force(m.vertices["pos"], m.store("zones")["gp"], self.rows10, self.density, np.asarray(g, _F), f)
+        self.fb10 = f[self.r10]
+        self.fb10mag = np.sqrt((self.fb10 ** 2).sum(axis=1))
+        self._g10 = g
 
     @property
     def kinetic(self) -> float:

@@ -239,3 +239,58 @@ def test_joined_blocks_with_linked_gridpoints_act_as_one_continuum(tmp_path, hol
     assert np.abs(s.model.store("zones")["stress"] - np.array([0, 0, -1e6, 0, 0, 0])).max() <= 1e-6 * 1e6
     cp = np.flatnonzero(v["link"] >= 0)
     assert np.array_equal(v["disp"][cp], v["disp"][v["link"][cp]])
+
+
+def test_d1_uniaxial_cube_of_ten_node_tetrahedra(tmp_path):
+    """10-node zones through the engine (HRZ masses, Gershgorin stiffness, Gauss-point stresses)
+    with the top load as consistent 6-node face loads: ε = σ/E, lateral −ν σ/E and every Gauss
+    point at the uniaxial stress."""
+    from zone_fixtures import zone_convex_tet10
+    s = Session(out_dir=tmp_path)
+    s.command("block create brick 0 1 0 1 0 1")
+    zone_convex_tet10(s.model, 0, 0.5)
+    zs = s.model.store("zones")
+    assert (zs["nnode"] == 10).all()
+    for line in [*_ELASTIC, *_ROLLERS, "block face apply stress-zz -1e6 range position-z 1", "model solve ratio 1e-8"]:
+        s.command(line)
+    _uniaxial_checks(s, -1e6)
+    want = np.array([0, 0, -1e6, 0, 0, 0])
+    assert np.abs(zs["gstress"] - want).max() <= 1e-6 * 1e6
+    # the top load is the consistent one: no force on the top corners of the 6-node faces,
+    # and the whole load σ A on the top
+    v = s.model.vertices
+    top = np.abs(v["pos"][:, 2] - 1) < 1e-9
+    assert abs(v["fface"][top, 2].sum() + 1e6) < 1e-6
+    corner = np.zeros(v.n, bool)
+    corner[zs["gp"][:, :4].ravel()] = True
+    mids = top & ~corner
+    assert np.abs(v["fface"][top & corner, 2]).max() < 1e-6 and (v["fface"][mids, 2] < 0).all()
+
+
+def test_ten_node_self_weight_uses_the_consistent_body_force(tmp_path):
+    """Gravity on 10-node zones: the loads of zones_ho.tet10_body_force (−W/20 at each corner,
+    W/5 at each mid-edge node of a zone of weight W), summing to the block's weight; a column
+    under its own weight reaches σ_zz = ρ g (H − z) at the Gauss points (linear stress, which
+    quadratic zones represent exactly) and the balanced state counts its weight in the ratio."""
+    from zone_fixtures import zone_convex_tet10
+    s = Session(out_dir=tmp_path)
+    s.command("block create brick 0 1 0 1 0 2")
+    zone_convex_tet10(s.model, 0, 1.0)
+    for line in [*_ELASTIC, "model gravity 0 0 -10", *_ROLLERS,
+                 "block gridpoint apply velocity-x 0 range position-x 1",
+                 "block gridpoint apply velocity-y 0 range position-y 1",
+                 "model solve ratio 1e-9"]:
+        s.command(line)
+    zst = s.model.rigid_engine._zstep
+    assert abs(zst.fb10[:, 2].sum() + 2500 * 10 * 2.0) < 1e-6 * 5e4
+    assert (zst.gmass == 0).all()
+    from dec3d.kernels.zones_ho import tet10_gauss_positions
+    zs = s.model.store("zones")
+    gpos = np.zeros((zs.n, 4, 3))
+    tet10_gauss_positions(s.model.vertices["pos"], zs["gp"], np.arange(zs.n), gpos)
+    exact = -2500 * 10 * (2.0 - gpos[:, :, 2])
+    assert np.abs(zs["gstress"][:, :, 2] - exact).max() < 1e-5 * 2500 * 10 * 2
+    # top settlement: u = ρ g H² / (2 M), M the constrained modulus K + 4G/3 (laterally held)
+    top = np.abs(s.model.vertices["pos"][:, 2] - 2.0) < 1e-9
+    M = K + 4 * G / 3
+    np.testing.assert_allclose(s.model.vertices["disp"][top, 2], -2500 * 10 * 4 / (2 * M), rtol=1e-4)
