@@ -294,3 +294,25 @@ def test_ten_node_self_weight_uses_the_consistent_body_force(tmp_path):
     top = np.abs(s.model.vertices["pos"][:, 2] - 2.0) < 1e-9
     M = K + 4 * G / 3
     np.testing.assert_allclose(s.model.vertices["disp"][top, 2], -2500 * 10 * 4 / (2 * M), rtol=1e-4)
+
+
+def test_ten_node_face_loaded_in_part_falls_back_to_thirds(tmp_path):
+    """A stress on only some of the four triangles of a 6-node face (a range through the face)
+    cannot be a uniform traction on that face: those triangles share their load by thirds, and
+    the total is still σ times the loaded area."""
+    from zone_fixtures import zone_convex_tet10
+    s = Session(out_dir=tmp_path)
+    s.command("block create brick 0 1 0 1 0 1")
+    zone_convex_tet10(s.model, 0, 1.0)
+    s.command("block face apply stress-zz -1e6 range position-z 1 position-x 0 0.3")
+    m = s.model
+    f, fv, v = m.faces, m.face_vertices, m.vertices
+    loaded = np.flatnonzero(f["fstress"][:, 2] != 0)
+    nodes = fv["vertex"][f["vstart"][loaded][:, None] + np.arange(3)]
+    p = v["pos"][nodes]
+    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    assert 0 < len(loaded) and area.sum() < 1.0
+    want = np.zeros(v.n)
+    for k in range(3):
+        np.add.at(want, nodes[:, k], -1e6 * area / 3)
+    np.testing.assert_allclose(v["fface"][:, 2], want, rtol=0, atol=1e-6)
