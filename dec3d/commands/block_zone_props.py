@@ -139,7 +139,7 @@ def block_zone_property(session, call):
          details="NMD (3DEC theory text, \"Nodal Mixed Discretization for a Tetrahedral Grid\"): the volumetric "
                  "strain increment of each tetrahedron is replaced by the average over the zones around its "
                  "gridpoints, and so is the plastic mean-stress correction, the constitutive model untouched; it "
-                 "removes the locking of constant-strain tetrahedra in plastic flow. On by default; zones of "
+                 "reduces the locking of constant-strain tetrahedra in plastic flow. On by default; zones of "
                  "hexahedral mixed-discretization sets use their own averaging either way. The command name is "
                  "dec3d's (no 3DEC command for this switch was found); the setting is saved with the model.",
          examples=["block zone nodal-mixed-discretization off", "block zone nodal-mixed-discretization on"])
