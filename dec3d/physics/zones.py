@@ -39,10 +39,11 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
 from dec3d.errors import Dec3dError
-from dec3d.kernels.zone_mohr import zone_forces_plastic
+from dec3d.kernels.zone_mohr import node_lists4, zone_forces_plastic, zone_forces_plastic_parallel
 from dec3d.kernels.zonestep import gp_externals, gp_motion, zone_forces, zone_mass_stiffness
 from dec3d.model.model import KIND_DEFORMABLE
 from dec3d.model.zone_mohr import mohr_props_check
@@ -50,6 +51,10 @@ from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_MOHR, ZMODEL_NULL, ZP_BULK,
 
 _F = np.float64
 _I = np.int64
+
+#: 4-node zones from which the plastic step runs on threads (``zone_forces_plastic_parallel``,
+#: bit-identical to the serial kernel, so the choice never changes a result)
+PARALLEL_MIN_ZONES = 20000
 
 
 def _ids(model, rows) -> str:
@@ -122,6 +127,13 @@ class ZoneStepper:
         if len(self.rows10):
             from dec3d.kernels import zones_ho
             self.ho = zones_ho.tet10_step
+        #: gather lists of the threaded plastic step (same bits as the serial one), big models only
+        self.par = None
+        if self.plastic and len(self.rows4) >= PARALLEL_MIN_ZONES and numba.get_num_threads() > 1:
+            nv = v.n
+            fstart, fent = node_lists4(nv, np.arange(nv, dtype=_I), zs["gp"], self.rows4)
+            nstart, nent = node_lists4(nv, self.node, zs["gp"], self.rows4)
+            self.par = (fstart, fent, nstart, nent)
         # mixed-discretization sets of the 4-node zones: compact set numbers
         hx = zs["hex"][self.rows4]
         self.weight = np.where(zs["overlay"][self.rows4] >= 0, 0.5, 1.0)
@@ -229,7 +241,11 @@ class ZoneStepper:
         if not begun:
             self.begin()
         pos, vel = v["pos"], v["velocity"]
-        if self.plastic:
+        if self.par is not None:
+            zone_forces_plastic_parallel(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.node,
+                                         zs["cmodel"], zs["prop"], dt, large, self.nmd, zs["stress"], zs["state"],
+                                         facc, fmag, *self.par)
+        elif self.plastic:
             zone_forces_plastic(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.node,
                                 zs["cmodel"], zs["prop"], dt, large, self.nmd, zs["stress"], zs["state"], facc, fmag)
         else:

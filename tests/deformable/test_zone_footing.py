@@ -73,3 +73,21 @@ def test_footing_pressure_of_a_uniform_stress(tmp_path):
     assert 0.25 * 1.0 < trib < 0.25 * 1.5
     np.testing.assert_allclose(q["q"], 3e5 * trib / 0.25, rtol=1e-12)
     np.testing.assert_allclose(q["q_c"], q["q"] / C, rtol=1e-15)
+
+
+def test_threaded_plastic_step_gives_the_serial_bits(tmp_path, monkeypatch):
+    """Big models take the threaded plastic step (``zone_forces_plastic_parallel``); forced on
+    for this small one it gives the serial run's stresses, states and displacements bit for bit."""
+    import numba
+
+    import dec3d.physics.zones as pz
+    runs = []
+    for threshold in (10**12, 0):
+        monkeypatch.setattr(pz, "PARALLEL_MIN_ZONES", threshold)
+        s, _ = _footing(tmp_path, "on", steps=1500)
+        assert (s.model.rigid_engine._zstep.par is not None) == (threshold == 0 and numba.get_num_threads() > 1)
+        zs = s.model.store("zones")
+        runs.append((zs["stress"].copy(), zs["state"].copy(), s.model.vertices["disp"].copy()))
+    assert ((runs[0][1] & 1) != 0).any()
+    for a, b in zip(*runs):
+        np.testing.assert_array_equal(a, b)
