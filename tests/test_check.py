@@ -69,18 +69,18 @@ def test_missing_called_file_and_undefined_names_stop_the_run(tmp_path, capsys):
 
 
 def test_blockers_in_called_decks_are_reported_with_their_file(tmp_path, capsys):
-    deck = _deck(tmp_path, geo="block create brick 0 1 0 1 1 3\nblock zone generate hexahedra divisions 1 1 1\n")
+    deck = _deck(tmp_path, geo="block create brick 0 1 0 1 1 3\nblock cut joint-set persistence 0.5\n")
     geo = tmp_path / "sub" / "geo.dat"
     reports = check_file(deck)
     bad = [r for r in reports if r.status not in (RUNNABLE, DOES_NOTHING)]
     assert [(r.file, r.line, r.status) for r in bad] == [(str(geo), 2, NOT_SUPPORTED)]
     assert main(["check", str(deck)]) == 1
     out = capsys.readouterr().out
-    assert f"{geo}:2:21: not supported yet: keyword `hexahedra` is not supported yet" in out
+    assert f"{geo}:2:21: not supported yet: keyword `persistence` is not supported yet" in out
     assert "(in 2 files)" in out
     # the run stops at the same line
     assert main(["run", str(deck), "--out", str(tmp_path / "out"), "-q"]) != 0
-    assert f"{geo}:2:21: error: keyword `hexahedra` is not supported yet" in capsys.readouterr().err
+    assert f"{geo}:2:21: error: keyword `persistence` is not supported yet" in capsys.readouterr().err
 
 
 def test_a_file_that_calls_itself(tmp_path):
@@ -114,7 +114,7 @@ def test_elastic_hole_master_reports_the_called_decks(tmp_path):
     files = {r.file.rsplit("/", 1)[-1] for r in reports}
     assert {"master.dat", "ElasticHole-Hex.dat", "ElasticHole-tet.dat", "ElasticHole-HO.dat", "check.fis"} <= files
     blocked = {r.file.rsplit("/", 1)[-1] for r in reports if r.status in (ERROR, NOT_SUPPORTED)}
-    assert "ElasticHole-Hex.dat" in blocked                 # deformable zones are not supported yet
+    assert blocked == set()        # zoning (tet, hexahedra, high-order), zone properties, insitu: all bind
     plots = [r for r in reports if r.file.endswith("master.dat") and r.what.startswith("plot")]
     assert len(plots) == 9 and {r.status for r in plots} == {DOES_NOTHING}
     # `[checkError(...)]` binds (the function is defined); the FISH functions that read zones and

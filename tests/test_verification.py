@@ -21,7 +21,8 @@ def test_every_verification_problem_is_there():
     assert {f.name for f in FOLDERS} >= {"R1_inclined_plane", "R2_wedge", "R3_block_on_spring", "R4_bounce",
                                          "R5_stack", "R6_joint_shear", "R7_spinning_block",
                                          "S1_fredlund_krahn_slope", "S1_ru025", "S2_kim_dam",
-                                         "D1_uniaxial_tet", "D2_self_weight", "D4_triaxial"}
+                                         "D1_uniaxial_tet", "D2_self_weight", "D3_elastic_hole_tet",
+                                         "D3_elastic_hole_hex", "D3_elastic_hole_ho", "D4_triaxial"}
 
 
 def _demo(tmp_path, expects: str):
@@ -142,3 +143,21 @@ def test_kirsch_errors_vanish_on_the_exact_field_and_measure_a_known_offset():
     zs["stress"][:, 2] -= 0.01 * p1          # and in z: σ_r and σ_θ both 1 % of p1 off everywhere
     e = kirsch_errors(m, p1, p2, a, K, G)
     assert e["sigr"] == pytest.approx(1.0, rel=1e-9) and e["sigt"] == pytest.approx(1.0, rel=1e-9)
+
+
+@pytest.mark.parametrize("folder,deck", [("D3_elastic_hole_tet", "tet"), ("D3_elastic_hole_hex", "Hex"),
+                                         ("D3_elastic_hole_ho", "HO")])
+def test_elastic_hole_folders_run_itascas_command_lines_as_written(folder, deck):
+    """Issue 10: the D3 folders' model lines are exactly the command lines of Itasca's decks —
+    comments and blank lines left out, and the three lines that call the FISH check, save the
+    model and return (the errors are computed from the model state by the `kirsch` derive)."""
+    from conftest import DECKS, NO_DECKS
+
+    src = DECKS / f"peterzhu6667__pinn-cp-3dec__Elastic_Hole__ElasticHole-{deck}.dat"
+    if not src.exists():
+        pytest.skip(NO_DECKS)
+    keep = [ln for ln in src.read_text().splitlines()
+            if ln.strip() and not ln.lstrip().startswith(";")
+            and not ln.split()[0:2] in (["program", "call"], ["model", "save"], ["program", "return"])]
+    ours = (ROOT / "verification" / folder / "deck.dat").read_text().splitlines()
+    assert ours == keep

@@ -153,7 +153,8 @@ def follow_geometry(model, vmap: np.ndarray | None, block_map: np.ndarray | None
 
 def install_block_mesh(model, row: int, points: np.ndarray, tets: np.ndarray, tris: np.ndarray,
                        tri_source: np.ndarray, hexid: np.ndarray | None = None,
-                       overlay: np.ndarray | None = None) -> slice:
+                       overlay: np.ndarray | None = None, face_rows: np.ndarray | None = None,
+                       compact: bool = True) -> slice:
     """Make block ``row`` a zoned (deformable) block with this mesh.
 
     points (n, 3): its gridpoints (any order); tets (m, 4) or (m, 10): zone node lists, local
@@ -161,7 +162,11 @@ def install_block_mesh(model, row: int, points: np.ndarray, tets: np.ndarray, tr
     of edges 01 12 20 03 13 23); tris (k, 3): the boundary triangles, counter-clockwise seen
     from outside; tri_source (k,): index (within the block, before zoning) of the polygon face
     each triangle lies on (its groups carry over); hexid/overlay (m,): mixed-discretization
-    sets of hexahedral zoning (local hexahedron number and 0/1), or None.
+    sets of hexahedral zoning (local hexahedron number and 0/1), or None; face_rows (k,): the
+    face rows each triangle takes its groups from (default: the polygon faces ``tri_source``;
+    re-zoning an already zoned block passes its old triangles); compact=False leaves the block's
+    old vertex and face rows in place (unreferenced) for the caller to drop once, with
+    ``compact_geometry`` and ``follow_geometry``, after installing many blocks.
 
     The block's vertices and faces are replaced (old rows compacted away, other stores
     follow), its kind becomes deformable, its gridpoints get lumped masses later (the
@@ -177,14 +182,14 @@ def install_block_mesh(model, row: int, points: np.ndarray, tets: np.ndarray, tr
     tets = np.asarray(tets, dtype=_I)
     tris = np.asarray(tris, dtype=_I)
     f0 = int(b["face_start"][row])
-    fsrc = f0 + np.asarray(tri_source, dtype=_I)
+    fsrc = f0 + np.asarray(tri_source, dtype=_I) if face_rows is None else np.asarray(face_rows, dtype=_I)
     write_pieces(model, np.array([row], _I), points, np.full(len(points), -1, _I),
                  np.array([len(points)], _I), np.full(len(tris), 3, _I), fsrc,
                  np.array([len(tris)], _I), tris.ravel())
     fst, fc = int(b["face_start"][row]), int(b["face_count"][row])
     fs["source"][fst:fst + fc] = tri_source
-    vmap = compact_geometry(model)
-    follow_geometry(model, vmap)
+    if compact:
+        follow_geometry(model, compact_geometry(model))
     vs = model.vertices
     v0, nv = int(b["vert_start"][row]), int(b["vert_count"][row])
     vs["zoned"][v0:v0 + nv] = True
