@@ -355,6 +355,7 @@ def block_zone_list(session, call):
             session.results.update({"zone_edge_min": info["edge_min"], "zone_edge_max": info["edge_max"],
                                     "zone_dihedral_min": info["dihedral_min"],
                                     "zone_volume_min": info["volume_min"], "zone_volume": info["volume_total"]})
+        _plastic_counts(session, zs, rows)
         return
     _plastic_counts(session, zs, rows)
     c = centroids(m, rows)

@@ -10,7 +10,7 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
    ``warn``); Mohr-Coulomb on 10-node zones is refused;
 2. lumped masses and the node stiffness of Eq. (86) (kernel ``zonestep.zone_mass_stiffness``)
    of the 4-node zones; for 10-node zones HRZ lumped masses (``zones_ho.tet10_lumped_mass``) and
-   the Gershgorin row-sum stiffness (``zones_ho.tet10_stiffness``); summed onto link masters
+   twice the Gershgorin row-sum stiffness (``zones_ho.tet10_stiffness``); summed onto link masters
    (joined blocks share gridpoints by linking);
 3. time step and inertial masses. Static runs (the engine's mass scaling on): density scaling
    (3DEC theory, "Mass (Density) Scaling"): the inertial mass of each gridpoint is set so that
@@ -51,6 +51,11 @@ from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_MOHR, ZMODEL_NULL, ZP_BULK,
 
 _F = np.float64
 _I = np.int64
+
+#: factor on the Gershgorin stiffness of 10-node zones (``zones_ho.tet10_stiffness``): the bound
+#: itself puts density-scaled masses (m = k Δt²/4) at the very limit of stability, with nothing to
+#: spare; the D3 10-node hole deck went unstable at step 130 with it and runs with twice it
+TET10_STIFFNESS_MARGIN = 2.0
 
 #: 4-node zones from which the plastic step runs on threads (``zone_forces_plastic_parallel``,
 #: bit-identical to the serial kernel, so the choice never changes a result)
@@ -178,8 +183,10 @@ class ZoneStepper:
         self._g10 = None
         if len(self.rows10):
             from dec3d.kernels import zones_ho
+            k10 = np.zeros(n)
             bad = max(zones_ho.tet10_lumped_mass(v["pos"], zs["gp"], self.rows10, self.density, mass),
-                      zones_ho.tet10_stiffness(v["pos"], zs["gp"], self.rows10, self.bulk, self.shear, stiff))
+                      zones_ho.tet10_stiffness(v["pos"], zs["gp"], self.rows10, self.bulk, self.shear, k10))
+            stiff += TET10_STIFFNESS_MARGIN * k10
             if bad >= 0:
                 raise error(f"10-node zone {int(zs['id'][bad])} of block {int(b['id'][zs['block'][bad]])} is "
                             "inverted or flat (its Jacobian is not positive at a Gauss point)")

@@ -128,6 +128,9 @@ def test_triaxial_peak_is_the_mohr_coulomb_strength(tmp_path, s3):
     assert (r["zones_shear_now"], r["zones_shear_past"], r["zones_tension_now"]) == (6.0, 6.0, 0.0)
     assert "plastic state: shear-now 6, tension-now 0, shear-past 6, tension-past 0, never yielded 0" \
         in s.out.getvalue()
+    s.results.clear()
+    s.command("block zone list information")
+    assert s.results["zones_shear_past"] == 6.0 and s.results["zones"] == 6.0
 
 
 def test_pure_tension_reaches_the_cut_off(tmp_path):

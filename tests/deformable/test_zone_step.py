@@ -1,6 +1,8 @@
 """Zoned blocks cycle: analytical answers (verification/PROBLEMS.md D1, D2), the engine's
 handling of mixed rigid/zoned models, bad input at cycle time and the rollback of a failed run."""
 
+import math
+
 import numpy as np
 import pytest
 
@@ -316,3 +318,34 @@ def test_ten_node_face_loaded_in_part_falls_back_to_thirds(tmp_path):
     for k in range(3):
         np.add.at(want, nodes[:, k], -1e6 * area / 3)
     np.testing.assert_allclose(v["fface"][:, 2], want, rtol=0, atol=1e-6)
+
+
+def test_ten_node_time_step_is_below_the_stability_limit(tmp_path):
+    """Eq. (84) with the 10-node stiffness (twice the Gershgorin row sums of tet10_stiffness) and
+    HRZ masses gives a Δt below the explicit limit 2/ω_max of the zone, ω_max² the largest
+    eigenvalue of M⁻¹K with K probed column by column from the zone's nodal forces."""
+    from dec3d.kernels.zones_ho import tet10_step
+    from dec3d.physics.rigid import RunError
+    from dec3d.physics.zones import ZoneStepper
+    from zone_fixtures import zone_tet10
+    s = Session(out_dir=tmp_path)
+    s.command("block create tetrahedron 0 0 0 1 0 0 0.2 1.3 0 0.4 0.3 0.9")
+    zone_tet10(s.model, 0)
+    for line in _ELASTIC:
+        s.command(line)
+    zst = ZoneStepper(s.model, RunError)
+    dt = zst.natural_timestep()
+    v, zs = s.model.vertices, s.model.store("zones")
+    gp = zs["gp"][0]
+    Kmat = np.zeros((30, 30))
+    for d in range(30):
+        vel = np.zeros((v.n, 3))
+        vel[gp[d // 3], d % 3] = 1.0
+        f = np.zeros((v.n, 3))
+        tet10_step(v["pos"], vel, zs["gp"], np.array([0]), zs["prop"][:, 0].copy(), zs["prop"][:, 1].copy(), 1.0,
+                   np.zeros((1, 4, 6)), np.zeros((1, 6)), f)
+        Kmat[:, d] = -f[gp].ravel()
+    m = np.repeat(zst.mtot[gp], 3)
+    w2 = np.linalg.eigvalsh(Kmat / np.sqrt(np.outer(m, m))).max()
+    limit = 2 / math.sqrt(w2)
+    assert dt < limit and dt > 0.2 * limit
