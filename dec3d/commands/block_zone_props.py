@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import BindError
+from ..model.feblocks import set_material
 from ..model.zone_mohr import angle_to_tangent
 from ..model.zones import (ZMODEL_ELASTIC, ZMODEL_MOHR, ZMODEL_NULL, ZP_BULK, ZP_COHESION, ZP_DENSITY, ZP_SHEAR,
                            ZP_TANDIL, ZP_TANFRIC, ZP_TENSION, zone_stores)
@@ -22,11 +23,19 @@ from .values import ONOFF, Choice, Num, P
 _MODELS = {"elastic": ZMODEL_ELASTIC, "null": ZMODEL_NULL, "mohr-coulomb": ZMODEL_MOHR}
 
 
-def _zones(session, call, what: str) -> np.ndarray:
-    """Rows of the zones in range; a warning naming file:line when there are none."""
+def _fe_rows(session, call) -> np.ndarray:
+    """FE-block elements in range (``dec3d.model.feblocks``): these commands set them too."""
+    m = session.model
+    if "feblocks" not in m.stores or not m.store("feblocks").n:
+        return np.zeros(0, np.int64)
+    return np.flatnonzero(session.range_mask(call, "feblocks"))
+
+
+def _zones(session, call, what: str, fe_rows=()) -> np.ndarray:
+    """Rows of the zones in range; a warning naming file:line when there are none (nor FE elements)."""
     zs = zone_stores(session.model)
     rows = np.flatnonzero(session.range_mask(call, "zone")) if zs.n else np.zeros(0, np.int64)
-    if not len(rows):
+    if not len(rows) and not len(fe_rows):
         why = "" if zs.n else " (no block is zoned: use `block zone generate` first)"
         session.write(f"warning: {call.location}: `{what}` selected no zone{why}")
     return rows
@@ -45,9 +54,15 @@ def _zones(session, call, what: str) -> np.ndarray:
          examples=["block zone cmodel assign elastic", "block zone cmodel assign mohr-c range position-z 0 1",
                    "block zone cmodel assign null range position-z 0 1"])
 def block_zone_cmodel_assign(session, call):
-    rows = _zones(session, call, "block zone cmodel assign")
+    fe = _fe_rows(session, call)
+    rows = _zones(session, call, "block zone cmodel assign", fe)
     zs = session.model.store("zones")
     code = _MODELS[call.args["model"]]
+    if len(fe) and code == ZMODEL_MOHR:
+        raise BindError(f"`block zone cmodel assign mohr-coulomb`: {len(fe)} FE-block element(s) in range; FE "
+                        "blocks take elastic or null only (narrow the range to zoned blocks)", call.location)
+    if len(fe):
+        set_material(session.model, fe, code)
     zs["cmodel"][rows] = code
     zs["state"][rows] = 0
     if code == ZMODEL_NULL:
@@ -95,7 +110,15 @@ def block_zone_property(session, call):
         where = call.locations.get("young" if a["young"] is not None else "poisson", call.location)
         raise BindError("`block zone property`: give bulk/shear or young/poisson, not both pairs in one command",
                         where)
-    rows = _zones(session, call, "block zone property")
+    fe = _fe_rows(session, call)
+    if len(fe):
+        try:
+            set_material(session.model, fe, None, a["young"], a["poisson"], a["bulk"], a["shear"], a["density"])
+        except ValueError as exc:
+            given = "young" if a["young"] is not None else "poisson"
+            raise BindError(f"`block zone property {given}` needs the other too: {exc}",
+                            call.locations.get(given, call.location)) from None
+    rows = _zones(session, call, "block zone property", fe)
     zs = session.model.store("zones")
     prop = zs["prop"]
     if ev and len(rows):

@@ -459,6 +459,7 @@ def _build(path: str, meta: dict, blobs: dict[str, bytes]) -> Model:
     _check_geometry(path, model)
     _check_contacts(path, model)
     _check_zones(path, model)
+    _check_feblocks(path, model)
     h = meta.get("histories")
     if h is not None:
         harrays = {}
@@ -547,6 +548,30 @@ def _check_zones(path: str, model: Model) -> None:
     need((gp[~used] == -1).all(), "a zone has gridpoint rows past its node count")
     need(np.isin(zs["cmodel"], (ZMODEL_NULL, ZMODEL_ELASTIC, ZMODEL_MOHR)).all(),
          "a zone has an unknown constitutive model code")
+
+
+def _check_feblocks(path: str, model: Model) -> None:
+    """The ``feblocks`` store (dec3d.model.feblocks): node and slave rows within the vertices,
+    block rows within the blocks, Gauss rule 2 or 3, known constitutive codes."""
+    from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_MOHR, ZMODEL_NULL
+
+    if "feblocks" not in model.stores or not model.store("feblocks").n:
+        return
+    es, nv = model.store("feblocks"), model.vertices.n
+
+    def need(ok, what):
+        if not ok:
+            raise StateFileError(f"'{path}': {what}")
+
+    for key in ("block", "nodes", "slaves", "nq", "cmodel"):
+        need(key in es, f"the feblocks store lacks its '{key}' field")
+    need(es["block"].min() >= 0 and es["block"].max() < model.blocks.n, "FE element block rows point outside the blocks")
+    need(es["nodes"].min() >= 0 and es["nodes"].max() < nv, "FE element node rows point outside the vertices")
+    s = es["slaves"]
+    need(((s == -1) | ((s >= 0) & (s < nv))).all(), "FE element slave rows point outside the vertices")
+    need(np.isin(es["nq"], (2, 3)).all(), "an FE element has a Gauss rule other than 2 or 3")
+    need(np.isin(es["cmodel"], (ZMODEL_NULL, ZMODEL_ELASTIC, ZMODEL_MOHR)).all(),
+         "an FE element has an unknown constitutive model code")
 
 
 def _check_contacts(path: str, model: Model) -> None:

@@ -133,6 +133,9 @@ def follow_geometry(model, vmap: np.ndarray | None, block_map: np.ndarray | None
     """Keep zones and gridpoint links consistent after vertex rows moved (``vmap``: old -> new
     row, -1 dropped, from ``compact_geometry``) and/or block rows moved (``block_map``, from
     ``Store.compact``). Zones of dropped blocks go away; links to dropped rows are cleared."""
+    if "feblocks" in model.stores:                 # FE-block elements (dec3d.model.feblocks)
+        from .feblocks import follow_feblocks
+        follow_feblocks(model, vmap, block_map)
     if "zones" not in model.stores:
         return
     zs = model.store("zones")

@@ -25,8 +25,9 @@ from dec3d.kernels.gpcontact import mixed_move_points, mixed_subcontact_forces, 
 from dec3d.kernels.jointlaw import P_KN, P_KS
 from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST, block_timestep,
                                   rigid_motion_groups)
-from dec3d.model.model import KIND_DEFORMABLE
+from dec3d.model.model import KIND_DEFORMABLE, KIND_FE
 from dec3d.model.store import Store
+from dec3d.model.feblocks import has_feblocks
 from dec3d.model.zones import has_zones
 
 from .bodies import group_properties, inertial_masses, new_servo
@@ -61,6 +62,15 @@ class RunError(Dec3dError):
 
 #: vertex fields the deformable step changes (saved before a run, put back if it fails)
 _GP_STATE = ("velocity", "disp", "force", "mass", "imass")
+
+
+def _deformable(kind):
+    """Zoned and FE blocks: they move by their gridpoints (nodes), not as rigid bodies."""
+    return (kind == KIND_DEFORMABLE) | (kind == KIND_FE)
+
+
+def _has_gridpoints(m) -> bool:
+    return has_zones(m) or has_feblocks(m)
 
 #: target wall time of one kernel call [s]: Ctrl-C and progress are seen at least this often
 CHUNK_SECONDS = 0.2
@@ -168,7 +178,7 @@ class RigidEngine(ContactDetection):
         """CSR of the moving bodies: joined blocks by leader (leader first), lone blocks alone.
         Zoned (deformable) blocks are not rigid bodies: they move by their gridpoints."""
         b = self.model.blocks
-        rows = np.flatnonzero(~b["hidden"] & (b["kind"] != KIND_DEFORMABLE)).astype(_I)
+        rows = np.flatnonzero(~b["hidden"] & ~_deformable(b["kind"])).astype(_I)
         lead = b["leader"][rows]
         lead = np.where(lead < 0, rows, lead)
         order = np.lexsort((rows != lead, rows, lead))
@@ -255,7 +265,7 @@ class RigidEngine(ContactDetection):
         out = {"ratio": 0.0, "ratio-average": 0.0, "ratio-local": 0.0, "ratio-maximum": 0.0,
                "unbalanced-maximum": 0.0}
         gstart, gmember = self._group_cache if self._group_cache is not None else self._groups()
-        zst = self._zstep if has_zones(m) else None
+        zst = self._zstep if _has_gridpoints(m) else None
         if b.n == 0 or (len(gmember) == 0 and zst is None):
             return out
         ng = len(gstart) - 1
@@ -352,9 +362,11 @@ class RigidEngine(ContactDetection):
         hs = getattr(m, "history_set", None)
         return {"blocks": {k: b[k].copy() for k in b.fields},
                 "vertices": {k: v[k].copy() for k in ("pos", "map_pos", "look_pos")
-                             + (_GP_STATE if has_zones(m) else ()) if k in v},
+                             + (_GP_STATE if _has_gridpoints(m) else ()) if k in v},
                 "zones": ({k: m.store("zones")[k].copy() for k in ("stress", "gstress", "volume", "state")}
                           if has_zones(m) else {}),
+                "feblocks": ({k: m.store("feblocks")[k].copy() for k in ("stress", "gstress")}
+                             if has_feblocks(m) else {}),
                 # (to_arrays gives views where it can: copy them)
                 "contacts": {k: a.copy() for k, a in self.contacts.to_arrays().items()},
                 "subcontacts": {k: a.copy() for k, a in self.subcontacts.to_arrays().items()},
@@ -371,6 +383,8 @@ class RigidEngine(ContactDetection):
             v.full(k)[: len(a)] = a
         for k, a in snap["zones"].items():
             m.store("zones").full(k)[: len(a)] = a
+        for k, a in snap.get("feblocks", {}).items():
+            m.store("feblocks").full(k)[: len(a)] = a
         self.contacts.load_arrays(snap["contacts"])
         self.subcontacts.load_arrays(snap["subcontacts"])
         mechanical = m.settings.mechanical
@@ -408,7 +422,7 @@ class RigidEngine(ContactDetection):
         m = self.model
         b = m.blocks
         live = ~b["hidden"]
-        if has_zones(m):
+        if _has_gridpoints(m):
             return self._cycle_zoned(nsteps, stop, max_time, warn)
         if (b["mass"][live] <= 0).any():
             raise RunError("a block has no mass: set `block property density` before cycling")
@@ -560,8 +574,8 @@ class RigidEngine(ContactDetection):
         b, cs = self.model.blocks, self.contacts
         if not cs.n:
             return False
-        za = b["kind"][cs["a"]] == KIND_DEFORMABLE
-        zb = b["kind"][cs["b"]] == KIND_DEFORMABLE
+        za = _deformable(b["kind"][cs["a"]])
+        zb = _deformable(b["kind"][cs["b"]])
         lead = np.where(b["leader"] < 0, np.arange(b.n), b["leader"])
         bad = za & zb & (lead[cs["a"]] != lead[cs["b"]])
         if bad.any():
@@ -578,7 +592,7 @@ class RigidEngine(ContactDetection):
         m = self.model
         b, f, v = m.blocks, m.faces, m.vertices
         cs, ss = self.contacts, self.subcontacts
-        zoned = b["kind"] == KIND_DEFORMABLE
+        zoned = _deformable(b["kind"])
         geo = (zoned, v["pos"], b["face_start"], b["face_count"], f["vstart"], f["nvert"],
                m.face_vertices["vertex"])
         out = []
@@ -605,7 +619,7 @@ class RigidEngine(ContactDetection):
 
         m = self.model
         b = m.blocks
-        rigid = ~b["hidden"] & (b["kind"] != KIND_DEFORMABLE)
+        rigid = ~b["hidden"] & ~_deformable(b["kind"])
         if (b["mass"][rigid] <= 0).any():
             raise RunError("a block has no mass: set `block property density` before cycling")
         zst = ZoneStepper(m, RunError, warn)

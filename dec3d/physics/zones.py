@@ -45,6 +45,7 @@ import numpy as np
 from dec3d.errors import Dec3dError
 from dec3d.kernels.zone_mohr import node_lists4, zone_forces_plastic, zone_forces_plastic_parallel
 from dec3d.kernels.zonestep import gp_externals, gp_motion, zone_forces, zone_mass_stiffness
+from dec3d.model.feblocks import has_feblocks
 from dec3d.model.model import KIND_DEFORMABLE
 from dec3d.model.zone_mohr import mohr_props_check
 from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_MOHR, ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
@@ -150,12 +151,20 @@ class ZoneStepper:
         self.bulk = np.ascontiguousarray(p[:, ZP_BULK])
         self.shear = np.ascontiguousarray(p[:, ZP_SHEAR])
         self.density = np.ascontiguousarray(p[:, ZP_DENSITY])
-        # gridpoints: rows of the zoned blocks, masters and linked copies
+        # FE blocks (issue 12): their nodes move with the gridpoints; forces, masses and slave
+        # nodes come from dec3d.physics.feblocks.FeStepper
+        self.fe = None
+        if has_feblocks(model):
+            from .feblocks import FeStepper
+            self.fe = FeStepper(model, error)
+            on[self.fe.blocks] = True
+        # gridpoints: rows of the zoned blocks, masters and linked copies (FE slave nodes are neither)
         vb = v["block"]
         gpmask = v["zoned"] & on[np.maximum(vb, 0)] & (vb >= 0)
         self.rows = np.flatnonzero(gpmask).astype(_I)
         link = v["link"]
-        self.masters = np.ascontiguousarray(self.rows[link[self.rows] < 0])
+        slave = v["feslave"][self.rows] if "feslave" in v else np.zeros(len(self.rows), bool)
+        self.masters = np.ascontiguousarray(self.rows[(link[self.rows] < 0) & ~slave])
         self.linked = np.ascontiguousarray(self.rows[link[self.rows] >= 0])
         held = v["apply_fix"] | ((v["fixity"] & 7) << 3) | ((b["fixity"][np.maximum(vb, 0)] & 7) << 3)
         held = held.astype(np.uint8)
@@ -192,7 +201,12 @@ class ZoneStepper:
                             "inverted or flat (its Jacobian is not positive at a Gauss point)")
             g10 = zs["gp"][self.rows10]
             self.r10 = np.unique(g10[g10 >= 0]).astype(_I)
+        if self.fe is not None:
+            mass += self.fe.mass
+            stiff += self.fe.stiff
         v["mass"][self.rows] = mass[self.rows]
+        if self.fe is not None:
+            self.blocks = np.concatenate((self.blocks, self.fe.blocks))
         mtot = mass.copy()
         ktot = stiff.copy()
         lk = self.linked
@@ -229,6 +243,8 @@ class ZoneStepper:
         rows = np.where(link[rows] >= 0, link[rows], rows)
         kj = np.zeros(len(self.ktot))
         np.add.at(kj, rows, k)
+        if self.fe is not None:
+            self.fe.slave_stiffness(kj)
         self.ktot = self.kzone + kj
 
     # ------------------------------------------------------------ one step
@@ -260,13 +276,26 @@ class ZoneStepper:
                         dt, large, zs["stress"], facc, fmag)
         if self.ho is not None:
             self.ho(pos, vel, zs["gp"], self.rows10, self.bulk, self.shear, dt, zs["gstress"], zs["stress"], facc)
+        fe = self.fe
+        if fe is not None:
+            e = fe.forces(pos, vel, dt, gravity, facc, fmag)
+            if e >= 0:
+                es = m.store("feblocks")
+                raise self.error(f"at step {m.step} FE element {int(es['id'][e])} (block "
+                                 f"{int(m.blocks['id'][es['block'][e]])}) turned inside out (det J not positive); "
+                                 "the model is back at its state before this command")
         if len(self.r10):
             self._body_force10(gravity)
             facc[self.r10] += self.fb10
             fmag[self.r10] += self.fb10mag
         gp_externals(self.rows, v["link"], self.gmass, gravity, v["fapp"], v["fface"], facc, fmag)
-        return gp_motion(self.masters, self.linked, v["link"], facc, v["force"], self.mtot, v["imass"], self.held,
-                         self.vapp, vel, v["disp"], pos, dt, mode, alpha, large, vmax, self.out)
+        if fe is not None:
+            fe.slave_forces(facc)
+        bad = gp_motion(self.masters, self.linked, v["link"], facc, v["force"], self.mtot, v["imass"], self.held,
+                        self.vapp, vel, v["disp"], pos, dt, mode, alpha, large, vmax, self.out)
+        if fe is not None:
+            fe.follow(vel, v["disp"], *((pos,) if large else ()))
+        return bad
 
     def _body_force10(self, gravity) -> None:
         """The consistent gravity loads of the 10-node zones (FE-block text 003_*, "Gravity
