@@ -16,6 +16,9 @@ measures are the ones that verification defines (its FISH file ``ElasticHole.fis
 
 ``uniaxial`` and ``self_weight``: the patch test and the self-weight column of the deformable
 blocks (shared/verification/PROBLEMS.md D1, D2), measures in their functions' docstrings.
+
+``zone_block``: the mean zone stress and the yielding fractions of one block (the triaxial
+specimens of D4). ``footing``: the mean pressure under a strip footing (D5).
 """
 from __future__ import annotations
 
@@ -104,7 +107,60 @@ def self_weight_measures(model, density: float, g: float, height: float) -> dict
             "stress_max": 100.0 * float(dev.max())}
 
 
+def zone_block_measures(model, block: float) -> dict[str, float]:
+    """Volume-weighted mean stress components of the zones of one block (by id), and the
+    fractions of its zones yielding in shear and in tension at the last step (plastic state
+    bits of ``zones.state``): the stress a laboratory specimen of one block shows."""
+    from dec3d.model.zones import STRESS_COMPONENTS, ZSTATE_SHEAR_NOW, ZSTATE_TENSION_NOW
+    zs = model.store("zones")
+    rows = np.flatnonzero(model.blocks["id"][zs["block"]] == int(block))
+    if not len(rows):
+        raise ValueError(f"zone-block: block {int(block)} has no zones")
+    w = zs["volume"][rows]
+    mean = (zs["stress"][rows] * w[:, None]).sum(axis=0) / w.sum()
+    out = {f"s{c}": float(mean[k]) for k, c in enumerate(STRESS_COMPONENTS)}
+    st = zs["state"][rows]
+    out["shear_now"] = float(np.mean((st & ZSTATE_SHEAR_NOW) != 0))
+    out["tension_now"] = float(np.mean((st & ZSTATE_TENSION_NOW) != 0))
+    return out
+
+
+def footing_measures(model, half_width: float, surface: float, length: float, cohesion: float) -> dict[str, float]:
+    """Mean pressure under a strip footing pushed in by gridpoint velocities: the gridpoints on
+    the surface z = ``surface`` with 0 <= x <= ``half_width`` (a half model, symmetric about
+    x = 0, ``length`` thick in y). The force the zones exert on each of those gridpoints is worked
+    out from the zone stresses (a tetrahedron's stress σ pushes its node n with σ·(S n)/3, S n
+    the outward area vector of the face opposite n; 3DEC theory text, nodal forces of a
+    constant-strain tetrahedron); q = Σ f_z / (half_width · length), and q / c."""
+    zs, vs = model.store("zones"), model.vertices
+    p = vs["pos"]
+    tol = 1e-6 * max(half_width, length)
+    link = vs["link"]
+    node = np.where(link >= 0, link, np.arange(vs.n))
+    on = np.zeros(vs.n, bool)
+    on[node[(np.abs(p[:, 2] - surface) <= tol) & (p[:, 0] <= half_width + tol) & (p[:, 0] >= -tol)]] = True
+    fz = 0.0
+    rows = np.flatnonzero(zs["cmodel"] > 0)
+    g = zs["gp"][rows, :4]
+    st = zs["stress"][rows]
+    for n in range(4):
+        sel = on[node[g[:, n]]]
+        if not sel.any():
+            continue
+        a, b, c = (p[g[sel, (n + k) % 4]] for k in (1, 2, 3))
+        d = p[g[sel, n]]
+        area = 0.5 * np.cross(b - a, c - a)                   # normal of the face opposite n
+        away = np.einsum("ij,ij->i", area, a - d) < 0          # make it point away from node n
+        area[away] *= -1.0
+        s = st[sel]
+        fz += float(np.sum((s[:, 4] * area[:, 0] + s[:, 5] * area[:, 1] + s[:, 2] * area[:, 2]) / 3.0))
+    q = fz / (half_width * length)
+    return {"q": q, "q_c": q / cohesion}
+
+
 #: derive kinds that read the model: name -> (function, its parameter names)
 FIELDS = {"kirsch": (kirsch_errors, ("p1", "p2", "a", "bulk", "shear")),
           "uniaxial": (uniaxial_measures, ("sigma",)),
-          "self_weight": (self_weight_measures, ("density", "g", "height"))}
+          "self_weight": (self_weight_measures, ("density", "g", "height")),
+          "zone_block": (zone_block_measures, ("block",)),
+          "footing": (footing_measures, ("half_width", "surface", "length", "cohesion"))}

@@ -311,6 +311,23 @@ def block_insitu(session, call):
 
 
 # ----------------------------------------------------------------------------- listing
+def _plastic_counts(session, zs, rows) -> None:
+    """Zones of the rows in each plastic state (``zones.state`` bits), when some are Mohr-Coulomb:
+    a line of output and the session results ``zones_shear_now`` … ``zones_tension_past``."""
+    from ..model.zones import (ZMODEL_MOHR, ZSTATE_SHEAR_NOW, ZSTATE_SHEAR_PAST, ZSTATE_TENSION_NOW,
+                               ZSTATE_TENSION_PAST)
+    if not (zs["cmodel"][rows] == ZMODEL_MOHR).any():
+        return
+    st = zs["state"][rows]
+    counts = {name: int(((st & bit) != 0).sum()) for name, bit in
+              (("shear-now", ZSTATE_SHEAR_NOW), ("tension-now", ZSTATE_TENSION_NOW),
+               ("shear-past", ZSTATE_SHEAR_PAST), ("tension-past", ZSTATE_TENSION_PAST))}
+    elastic = int(((st & (ZSTATE_SHEAR_PAST | ZSTATE_TENSION_PAST)) == 0).sum())
+    session.write("plastic state: " + ", ".join(f"{k} {n}" for k, n in counts.items())
+                  + f", never yielded {elastic}")
+    session.results.update({"zones_" + k.replace("-", "_"): float(n) for k, n in counts.items()})
+
+
 @command("block zone list", positional=[P("what", Choice(("information",)), "mesh summary instead of a zone table")],
          range="zone",
          doc="List the zones in range (id, block, centroid, volume, stress), or a mesh summary with `information`.",
@@ -318,7 +335,9 @@ def block_insitu(session, call):
                  "once), smallest and largest edge, smallest dihedral angle (70.53° for a regular tetrahedron, "
                  "near 0 for a sliver), smallest and total volume. These go into the session results as "
                  "`zones`, `gridpoints`, `zone_edge_min`, `zone_edge_max`, `zone_dihedral_min` (degrees), "
-                 "`zone_volume_min` and `zone_volume`.",
+                 "`zone_volume_min` and `zone_volume`. With Mohr-Coulomb zones in range, both forms also count the "
+                 "zones by plastic state (shear-now, tension-now, shear-past, tension-past, never yielded), "
+                 "kept as results `zones_shear_now` … `zones_tension_past`.",
          examples=["block zone list", "block zone list information", "block zone list range position-z 0 1"])
 def block_zone_list(session, call):
     from ..model.zone_quality import centroids, mesh_information
@@ -336,7 +355,9 @@ def block_zone_list(session, call):
             session.results.update({"zone_edge_min": info["edge_min"], "zone_edge_max": info["edge_max"],
                                     "zone_dihedral_min": info["dihedral_min"],
                                     "zone_volume_min": info["volume_min"], "zone_volume": info["volume_total"]})
+        _plastic_counts(session, zs, rows)
         return
+    _plastic_counts(session, zs, rows)
     c = centroids(m, rows)
     bid = m.blocks["id"][zs["block"][rows]]
     head = " ".join(f"{'s' + k:>11}" for k in _COMPS)

@@ -138,7 +138,8 @@ def _zone_cells(model, cells: str):
 
 def _zone_cell_data(model, zrows, npoly: int) -> dict:
     """Cell arrays of the zones (zero on the polyhedron cells of rigid blocks): zone_id, overlay, the stress
-    tensor in VTK's symmetric-tensor order, mean stress, principal stresses and von Mises stress."""
+    tensor in VTK's symmetric-tensor order, mean stress, principal stresses, von Mises stress and the
+    plastic state bits (``zones.state``: 1 shear now, 2 tension now, 4 shear past, 8 tension past)."""
     from dec3d.model.zone_quality import mean_stress, principal_stresses, von_mises
     zs = model.store("zones")
     st = zs["stress"][zrows]
@@ -152,7 +153,7 @@ def _zone_cell_data(model, zrows, npoly: int) -> dict:
     overlay[npoly:] = zs["overlay"][zrows]
     return {"zone_id": pad(zs["id"][zrows]), "overlay": overlay, "stress": pad(st[:, VTK_TENSOR_ORDER]),
             "mean_stress": pad(mean_stress(st)), "principal_stress": pad(principal_stresses(st)),
-            "von_mises": pad(von_mises(st))}
+            "von_mises": pad(von_mises(st)), "plastic_state": pad(zs["state"][zrows])}
 
 
 def write_vtu(model, path: str | os.PathLike, cells: str = "all", point_data: dict | None = None,

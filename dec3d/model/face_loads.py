@@ -4,6 +4,11 @@ Each loaded triangle keeps the stress applied to it (``faces.fstress``, 6 compon
 xz yz, tension positive); ``vertices.fface`` is recomputed from all of them: traction t = σ·n on
 the triangle, force t·A shared equally (A/3) by its three gridpoints. Loads add (as 3DEC does);
 ``apply-remove`` clears the record of the faces in range and recomputes, so removal is exact.
+A face of a 10-node zone is on the surface as four triangles (corner, corner, corner and the
+middle one of its mid-edge nodes); when all four carry the same stress the face is loaded as
+one 6-node triangle with the consistent loads of ``kernels.zones_ho.tri6_traction_loads`` (0 at
+the corners, A/3 at the mid-edge nodes for a flat face), which a 10-node mesh needs to carry a
+uniform stress exactly; thirds of the four triangles (A/12 and A/4) would not.
 Only triangles on the outside of a joined continuum take loads: a triangle whose gridpoints
 (resolved to their link masters) are also a triangle of another block is interior.
 """
@@ -63,9 +68,55 @@ def recompute_fface(model) -> None:
     sig[:, 0, 1] = sig[:, 1, 0] = s[:, 3]
     sig[:, 0, 2] = sig[:, 2, 0] = s[:, 4]
     sig[:, 1, 2] = sig[:, 2, 1] = s[:, 5]
-    force = np.einsum("kij,kj->ki", sig, an) / 3.0
+    tri6, members = _tri6_faces(model, nodes, s)
+    thirds = np.ones(len(rows), bool)
+    if len(tri6):
+        from dec3d.kernels.zones_ho import tri6_traction_loads
+        thirds[members.ravel()] = False
+        a6 = an[members].sum(axis=1)                                # the 6-node face's area vector
+        unit = a6 / np.linalg.norm(a6, axis=1)[:, None]
+        trac = np.ascontiguousarray(np.einsum("kij,kj->ki", sig[members[:, 0]], unit))
+        tri6_traction_loads(v["pos"], np.ascontiguousarray(tri6), trac, v["fface"])
+    force = np.einsum("kij,kj->ki", sig[thirds], an[thirds]) / 3.0
     for k in range(3):
-        np.add.at(v["fface"], nodes[:, k], force)
+        np.add.at(v["fface"], nodes[thirds, k], force)
+
+
+#: the faces of a 10-node zone as 6-node triangles (zone node columns: corners 0-3, then the
+#: mid-edge nodes of edges 01 12 20 03 13 23): corners a b c, then the mid-points of ab bc ca
+_TRI6 = ((0, 1, 2, 4, 5, 6), (1, 2, 3, 5, 9, 8), (0, 2, 3, 6, 9, 7), (0, 1, 3, 4, 8, 7))
+
+
+def _lookup(table: np.ndarray, queries: np.ndarray) -> np.ndarray:
+    """Row of ``table`` (k, 3 sorted, rows distinct) equal to each query row, −1 for none."""
+    if not len(table) or not len(queries):
+        return np.full(len(queries), -1, np.int64)
+    _, inv = np.unique(np.vstack([table, queries]), axis=0, return_inverse=True)
+    inv = inv.ravel()
+    at = np.full(int(inv.max()) + 1, -1, np.int64)
+    at[inv[: len(table)]] = np.arange(len(table))
+    return at[inv[len(table):]]
+
+
+def _tri6_faces(model, nodes: np.ndarray, fstress: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The 6-node faces of 10-node zones whose four surface triangles are all among the loaded
+    ones (``nodes`` (k, 3), their stresses ``fstress``) with one stress: (g, 6) node rows and
+    (g, 4) indices into ``nodes`` of their triangles."""
+    zs = model.store("zones")
+    ten = np.flatnonzero(zs["nnode"] == 10)
+    empty = (np.zeros((0, 6), np.int64), np.zeros((0, 4), np.int64))
+    if not len(ten):
+        return empty
+    g = zs["gp"][ten]
+    faces = np.concatenate([g[:, list(c)] for c in _TRI6])                     # (4 m, 6)
+    c0, c1, c2, m01, m12, m20 = faces.T
+    subs = [np.column_stack(t) for t in ((c0, m01, m20), (m01, c1, m12), (m20, m12, c2), (m01, m12, m20))]
+    table = np.sort(nodes, axis=1)
+    idx = np.column_stack([_lookup(table, np.sort(t, axis=1)) for t in subs])  # (4 m, 4)
+    ok = (idx >= 0).all(axis=1)
+    idx, faces = idx[ok], faces[ok]
+    same = np.all(fstress[idx] == fstress[idx[:, :1]], axis=(1, 2))
+    return faces[same], idx[same]
 
 
 def apply_face_stress(model, mask: np.ndarray, stress6: np.ndarray) -> int:

@@ -363,7 +363,7 @@ class RigidEngine(ContactDetection):
         return {"blocks": {k: b[k].copy() for k in b.fields},
                 "vertices": {k: v[k].copy() for k in ("pos", "map_pos", "look_pos")
                              + (_GP_STATE if _has_gridpoints(m) else ()) if k in v},
-                "zones": ({k: m.store("zones")[k].copy() for k in ("stress", "gstress", "volume")}
+                "zones": ({k: m.store("zones")[k].copy() for k in ("stress", "gstress", "volume", "state")}
                           if has_zones(m) else {}),
                 "feblocks": ({k: m.store("feblocks")[k].copy() for k in ("stress", "gstress")}
                              if has_feblocks(m) else {}),
@@ -622,7 +622,7 @@ class RigidEngine(ContactDetection):
         rigid = ~b["hidden"] & ~_deformable(b["kind"])
         if (b["mass"][rigid] <= 0).any():
             raise RunError("a block has no mass: set `block property density` before cycling")
-        zst = ZoneStepper(m, RunError)
+        zst = ZoneStepper(m, RunError, warn)
         self._zstep = zst
         s = self.settings()
         g = np.asarray(m.settings.gravity, dtype=_F)

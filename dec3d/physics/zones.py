@@ -5,10 +5,13 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
 ``vertices``, see ``dec3d.model.zones``; the stepper holds only what it can rebuild):
 
 1. checks: every zoned block has zones with a model, every elastic zone its bulk, shear and
-   density (``RunError`` naming the blocks otherwise); 10-node zones need
-   ``dec3d.kernels.zones_ho``;
-2. lumped masses and the node stiffness of Eq. (86) (kernel ``zonestep.zone_mass_stiffness``),
-   summed onto link masters (joined blocks share gridpoints by linking);
+   density (``RunError`` naming the blocks otherwise); Mohr-Coulomb zones by
+   ``model.zone_mohr.mohr_props_check`` (errors stop the run, warnings go to the engine's
+   ``warn``); Mohr-Coulomb on 10-node zones is refused;
+2. lumped masses and the node stiffness of Eq. (86) (kernel ``zonestep.zone_mass_stiffness``)
+   of the 4-node zones; for 10-node zones HRZ lumped masses (``zones_ho.tet10_lumped_mass``) and
+   twice the Gershgorin row-sum stiffness (``zones_ho.tet10_stiffness``); summed onto link masters
+   (joined blocks share gridpoints by linking);
 3. time step and inertial masses. Static runs (the engine's mass scaling on): density scaling
    (3DEC theory, "Mass (Density) Scaling"): the inertial mass of each gridpoint is set so that
    the step of Eq. (84), Δt = 2 (m/k)^½, is the run's Δt: m = k Δt² / 4, with Δt = 1 (FLAC3D's
@@ -16,9 +19,16 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
    the rigid Δt) or a time step was fixed (``block mechanical timestep`` / ``mass-scale
    timestep``). Dynamic runs: real masses and Δt = min over gridpoints of Eq. (84), and of the
    rigid Δt when rigid blocks cycle;
-4. each step (``step``): zone forces (``zonestep.zone_forces``, mixed discretization in
-   hexahedral sets; 10-node zones by ``zones_ho.tet10_step``), gravity, applied and face forces
-   and the sum onto masters (``gp_externals``), damping and motion (``gp_motion``).
+4. each step (``step``): zone forces of the 4-node zones (``zone_mohr.zone_forces_plastic``
+   with elastic and Mohr-Coulomb zones mixed, mixed discretization in hexahedral sets and nodal
+   mixed discretization, NMD, for the other tetrahedra when ``settings.mechanical["nmd"]`` is on,
+   the default, ``block zone nodal-mixed-discretization``; with NMD off and only elastic zones
+   the elastic ``zonestep.zone_forces``; 10-node zones by ``zones_ho.tet10_step``), gravity (m g
+   on the gridpoints of 4-node zones, the consistent loads of ``zones_ho.tet10_body_force`` on
+   those of 10-node zones, both counted in the applied-force magnitudes of the equilibrium
+   ratio), applied and face forces (``model.face_loads``: 6-node faces of 10-node zones by
+   ``zones_ho.tri6_traction_loads``) and the sum onto masters (``gp_externals``), damping and
+   motion (``gp_motion``).
 
 Zoned blocks are not bodies of the rigid motion kernel (``RigidEngine._groups`` leaves them
 out). Contacts between a zoned and a rigid block add their forces to the gridpoints
@@ -29,16 +39,28 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
 from dec3d.errors import Dec3dError
+from dec3d.kernels.zone_mohr import node_lists4, zone_forces_plastic, zone_forces_plastic_parallel
 from dec3d.kernels.zonestep import gp_externals, gp_motion, zone_forces, zone_mass_stiffness
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.model import KIND_DEFORMABLE
-from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
+from dec3d.model.zone_mohr import mohr_props_check
+from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_MOHR, ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
 
 _F = np.float64
 _I = np.int64
+
+#: factor on the Gershgorin stiffness of 10-node zones (``zones_ho.tet10_stiffness``): the bound
+#: itself puts density-scaled masses (m = k Δt²/4) at the very limit of stability, with nothing to
+#: spare; the D3 10-node hole deck went unstable at step 130 with it and runs with twice it
+TET10_STIFFNESS_MARGIN = 2.0
+
+#: 4-node zones from which the plastic step runs on threads (``zone_forces_plastic_parallel``,
+#: bit-identical to the serial kernel, so the choice never changes a result)
+PARALLEL_MIN_ZONES = 20000
 
 
 def _ids(model, rows) -> str:
@@ -54,8 +76,9 @@ def zoned_blocks(model) -> np.ndarray:
 
 
 class ZoneStepper:
-    def __init__(self, model, error):
-        """``error``: the exception class to raise (the engine's ``RunError``)."""
+    def __init__(self, model, error, warn=None):
+        """``error``: the exception class to raise (the engine's ``RunError``); ``warn``: where the
+        warnings of the property checks go (the engine's warn callback), or None."""
         self.model = model
         self.error = error
         zs = zone_stores(model)
@@ -65,36 +88,58 @@ class ZoneStepper:
         on[self.blocks] = True
         zrow = np.flatnonzero(on[zs["block"]]).astype(_I)
         cm = zs["cmodel"][zrow]
-        bad = ~np.isin(cm, (ZMODEL_NULL, ZMODEL_ELASTIC))
+        bad = ~np.isin(cm, (ZMODEL_NULL, ZMODEL_ELASTIC, ZMODEL_MOHR))
         if bad.any():
             raise error(f"zones of blocks {_ids(model, zs['block'][zrow[bad]])} have a constitutive model that "
-                        "does not cycle yet (only elastic and null)")
+                        "does not cycle (only elastic, mohr-coulomb and null)")
+        act = (cm == ZMODEL_ELASTIC) | (cm == ZMODEL_MOHR)
         live = np.zeros(b.n, bool)
-        live[zs["block"][zrow[cm == ZMODEL_ELASTIC]]] = True
+        live[zs["block"][zrow[act]]] = True
         none = self.blocks[~live[self.blocks]]
         if len(none):
             raise error(f"zoned blocks {_ids(model, none)} have no zone with a constitutive model: use "
                         "`block zone cmodel assign elastic` (and `block zone property`) before cycling")
-        el = zrow[cm == ZMODEL_ELASTIC]
+        el = zrow[act]
         p = zs["prop"]
-        miss = (p[el, ZP_BULK] <= 0) | (p[el, ZP_SHEAR] <= 0) | (p[el, ZP_DENSITY] <= 0)
+        ela = zrow[cm == ZMODEL_ELASTIC]
+        miss = (p[ela, ZP_BULK] <= 0) | (p[ela, ZP_SHEAR] <= 0) | (p[ela, ZP_DENSITY] <= 0)
         if miss.any():
-            what = "; ".join(f"{name} in blocks {_ids(model, zs['block'][el[p[el, c] <= 0]])}"
+            what = "; ".join(f"{name} in blocks {_ids(model, zs['block'][ela[p[ela, c] <= 0]])}"
                              for name, c in (("bulk", ZP_BULK), ("shear", ZP_SHEAR), ("density", ZP_DENSITY))
-                             if (p[el, c] <= 0).any())
+                             if (p[ela, c] <= 0).any())
             raise error(f"{int(miss.sum())} elastic zones lack properties ({what}): set them with "
                         "`block zone property` before cycling")
+        mo = zrow[cm == ZMODEL_MOHR]
+        #: warnings of the property check (also given to ``warn`` when there is one)
+        self.warnings = mohr_props_check(p[mo], ids=zs["id"][mo], error=error) if len(mo) else []
+        if warn is not None:
+            for w in self.warnings:
+                warn(w)
         nn = zs["nnode"][el]
+        if len(mo) and (zs["nnode"][mo] == 10).any():
+            ho = mo[zs["nnode"][mo] == 10]
+            raise error(f"{len(ho)} Mohr-Coulomb zones of blocks {_ids(model, zs['block'][ho])} are 10-node "
+                        "tetrahedra: Mohr-Coulomb cycles on 4-node zones only (use `block zone generate "
+                        "edgelength` or `hexahedra` for these blocks, or an elastic model)")
         self.rows4 = np.ascontiguousarray(el[nn == 4])
         self.rows10 = np.ascontiguousarray(el[nn == 10])
+        #: the plastic-capable zone step: with Mohr-Coulomb zones or nodal mixed discretization
+        self.nmd = bool(model.settings.mechanical.get("nmd", True))
+        self.plastic = bool(len(mo)) or (self.nmd and bool(len(self.rows4)))
+        link0 = v["link"]
+        #: NMD averaging node of each vertex row: its link master (one gridpoint of a joined set) or itself
+        self.node = np.ascontiguousarray(np.where(link0 >= 0, link0, np.arange(v.n, dtype=_I)))
         self.ho = None
         if len(self.rows10):
-            try:
-                from dec3d.kernels import zones_ho
-                self.ho = zones_ho.tet10_step
-            except ImportError:
-                raise error("10-node zones not available: this version cannot cycle high-order "
-                            "tetrahedra (`block zone generate high-order-tetra`)") from None
+            from dec3d.kernels import zones_ho
+            self.ho = zones_ho.tet10_step
+        #: gather lists of the threaded plastic step (same bits as the serial one), big models only
+        self.par = None
+        if self.plastic and len(self.rows4) >= PARALLEL_MIN_ZONES and numba.get_num_threads() > 1:
+            nv = v.n
+            fstart, fent = node_lists4(nv, np.arange(nv, dtype=_I), zs["gp"], self.rows4)
+            nstart, nent = node_lists4(nv, self.node, zs["gp"], self.rows4)
+            self.par = (fstart, fent, nstart, nent)
         # mixed-discretization sets of the 4-node zones: compact set numbers
         hx = zs["hex"][self.rows4]
         self.weight = np.where(zs["overlay"][self.rows4] >= 0, 0.5, 1.0)
@@ -138,16 +183,29 @@ class ZoneStepper:
         n = v.n
         mass = np.zeros(n)
         stiff = np.zeros(n)
-        zone_mass_stiffness(v["pos"], zs["gp"], zs["nnode"], zs["overlay"], el, self.bulk, self.shear,
+        zone_mass_stiffness(v["pos"], zs["gp"], zs["nnode"], zs["overlay"], self.rows4, self.bulk, self.shear,
                             self.density, mass, stiff)
-        self.gmass = v["mass"]                  # gravity as m g (FE nodes: consistent loads instead)
+        #: mass whose weight is lumped (m g per gridpoint): that of the 4-node zones; 10-node zones
+        #: load their gridpoints with the consistent body force instead (``tet10_body_force``)
+        self.gmass = mass.copy()
+        self.r10 = np.zeros(0, _I)
+        self._g10 = None
+        if len(self.rows10):
+            from dec3d.kernels import zones_ho
+            k10 = np.zeros(n)
+            bad = max(zones_ho.tet10_lumped_mass(v["pos"], zs["gp"], self.rows10, self.density, mass),
+                      zones_ho.tet10_stiffness(v["pos"], zs["gp"], self.rows10, self.bulk, self.shear, k10))
+            stiff += TET10_STIFFNESS_MARGIN * k10
+            if bad >= 0:
+                raise error(f"10-node zone {int(zs['id'][bad])} of block {int(b['id'][zs['block'][bad]])} is "
+                            "inverted or flat (its Jacobian is not positive at a Gauss point)")
+            g10 = zs["gp"][self.rows10]
+            self.r10 = np.unique(g10[g10 >= 0]).astype(_I)
         if self.fe is not None:
             mass += self.fe.mass
             stiff += self.fe.stiff
         v["mass"][self.rows] = mass[self.rows]
         if self.fe is not None:
-            self.gmass = v["mass"].copy()
-            self.gmass[self.fe.rows] = 0.0
             self.blocks = np.concatenate((self.blocks, self.fe.blocks))
         mtot = mass.copy()
         ktot = stiff.copy()
@@ -206,8 +264,16 @@ class ZoneStepper:
         if not begun:
             self.begin()
         pos, vel = v["pos"], v["velocity"]
-        zone_forces(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.bulk, self.shear, dt,
-                    large, zs["stress"], facc, fmag)
+        if self.par is not None:
+            zone_forces_plastic_parallel(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.node,
+                                         zs["cmodel"], zs["prop"], dt, large, self.nmd, zs["stress"], zs["state"],
+                                         facc, fmag, *self.par)
+        elif self.plastic:
+            zone_forces_plastic(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.node,
+                                zs["cmodel"], zs["prop"], dt, large, self.nmd, zs["stress"], zs["state"], facc, fmag)
+        else:
+            zone_forces(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.bulk, self.shear,
+                        dt, large, zs["stress"], facc, fmag)
         if self.ho is not None:
             self.ho(pos, vel, zs["gp"], self.rows10, self.bulk, self.shear, dt, zs["gstress"], zs["stress"], facc)
         fe = self.fe
@@ -218,6 +284,10 @@ class ZoneStepper:
                 raise self.error(f"at step {m.step} FE element {int(es['id'][e])} (block "
                                  f"{int(m.blocks['id'][es['block'][e]])}) turned inside out (det J not positive); "
                                  "the model is back at its state before this command")
+        if len(self.r10):
+            self._body_force10(gravity)
+            facc[self.r10] += self.fb10
+            fmag[self.r10] += self.fb10mag
         gp_externals(self.rows, v["link"], self.gmass, gravity, v["fapp"], v["fface"], facc, fmag)
         if fe is not None:
             fe.slave_forces(facc)
@@ -226,6 +296,21 @@ class ZoneStepper:
         if fe is not None:
             fe.follow(vel, v["disp"], *((pos,) if large else ()))
         return bad
+
+    def _body_force10(self, gravity) -> None:
+        """The consistent gravity loads of the 10-node zones (FE-block text 003_*, "Gravity
+        Forces": F_a = ρ g ∫ N_a dV), on the geometry at the start of the run, made again when the
+        gravity changes: ``fb10`` (per row of ``r10``) and their magnitudes ``fb10mag``."""
+        g = tuple(float(x) for x in gravity)
+        if g == self._g10:
+            return
+        from dec3d.kernels.zones_ho import tet10_body_force
+        m = self.model
+        f = np.zeros((m.vertices.n, 3))
+        tet10_body_force(m.vertices["pos"], m.store("zones")["gp"], self.rows10, self.density, np.asarray(g, _F), f)
+        self.fb10 = f[self.r10]
+        self.fb10mag = np.sqrt((self.fb10 ** 2).sum(axis=1))
+        self._g10 = g
 
     @property
     def kinetic(self) -> float:

@@ -1,6 +1,7 @@
 """Zoned blocks cycle: analytical answers (verification/PROBLEMS.md D1, D2), the engine's
 handling of mixed rigid/zoned models, bad input at cycle time and the rollback of a failed run."""
-import sys
+
+import math
 
 import numpy as np
 import pytest
@@ -168,14 +169,6 @@ def test_rigid_block_resting_on_a_zoned_block(tmp_path, large):
     assert mean == pytest.approx(-(W + 2000 * 10 / 2), rel=1e-3)
 
 
-def test_ten_node_zones_without_their_kernel_are_a_clear_error(tmp_path, monkeypatch):
-    s = _run(tmp_path, ["block create brick 0 1 0 1 0 1", "block zone generate edgelength 0.5", *_ELASTIC])
-    s.model.store("zones")["nnode"][0] = 10
-    monkeypatch.setitem(sys.modules, "dec3d.kernels.zones_ho", None)     # import fails
-    with pytest.raises(Dec3dError, match="10-node zones not available"):
-        s.command("model cycle 1")
-
-
 def test_unstable_run_is_rolled_back(tmp_path):
     """Real masses (no damping, no density scaling) and a time step far above Eq. (84): the
     run blows up, says where, and the model is back as it was (zone stresses included)."""
@@ -248,3 +241,111 @@ def test_joined_blocks_with_linked_gridpoints_act_as_one_continuum(tmp_path, hol
     assert np.abs(s.model.store("zones")["stress"] - np.array([0, 0, -1e6, 0, 0, 0])).max() <= 1e-6 * 1e6
     cp = np.flatnonzero(v["link"] >= 0)
     assert np.array_equal(v["disp"][cp], v["disp"][v["link"][cp]])
+
+
+def test_d1_uniaxial_cube_of_ten_node_tetrahedra(tmp_path):
+    """10-node zones through the engine (HRZ masses, Gershgorin stiffness, Gauss-point stresses)
+    with the top load as consistent 6-node face loads: ε = σ/E, lateral −ν σ/E and every Gauss
+    point at the uniaxial stress."""
+    from zone_fixtures import zone_convex_tet10
+    s = Session(out_dir=tmp_path)
+    s.command("block create brick 0 1 0 1 0 1")
+    zone_convex_tet10(s.model, 0, 0.5)
+    zs = s.model.store("zones")
+    assert (zs["nnode"] == 10).all()
+    for line in [*_ELASTIC, *_ROLLERS, "block face apply stress-zz -1e6 range position-z 1", "model solve ratio 1e-8"]:
+        s.command(line)
+    _uniaxial_checks(s, -1e6)
+    want = np.array([0, 0, -1e6, 0, 0, 0])
+    assert np.abs(zs["gstress"] - want).max() <= 1e-6 * 1e6
+    # the top load is the consistent one: no force on the top corners of the 6-node faces,
+    # and the whole load σ A on the top
+    v = s.model.vertices
+    top = np.abs(v["pos"][:, 2] - 1) < 1e-9
+    assert abs(v["fface"][top, 2].sum() + 1e6) < 1e-6
+    corner = np.zeros(v.n, bool)
+    corner[zs["gp"][:, :4].ravel()] = True
+    mids = top & ~corner
+    assert np.abs(v["fface"][top & corner, 2]).max() < 1e-6 and (v["fface"][mids, 2] < 0).all()
+
+
+def test_ten_node_self_weight_uses_the_consistent_body_force(tmp_path):
+    """Gravity on 10-node zones: the loads of zones_ho.tet10_body_force (−W/20 at each corner,
+    W/5 at each mid-edge node of a zone of weight W), summing to the block's weight; a column
+    under its own weight reaches σ_zz = ρ g (H − z) at the Gauss points (linear stress, which
+    quadratic zones represent exactly) and the balanced state counts its weight in the ratio."""
+    from zone_fixtures import zone_convex_tet10
+    s = Session(out_dir=tmp_path)
+    s.command("block create brick 0 1 0 1 0 2")
+    zone_convex_tet10(s.model, 0, 1.0)
+    for line in [*_ELASTIC, "model gravity 0 0 -10", *_ROLLERS,
+                 "block gridpoint apply velocity-x 0 range position-x 1",
+                 "block gridpoint apply velocity-y 0 range position-y 1",
+                 "model solve ratio 1e-9"]:
+        s.command(line)
+    zst = s.model.rigid_engine._zstep
+    assert abs(zst.fb10[:, 2].sum() + 2500 * 10 * 2.0) < 1e-6 * 5e4
+    assert (zst.gmass == 0).all()
+    from dec3d.kernels.zones_ho import tet10_gauss_positions
+    zs = s.model.store("zones")
+    gpos = np.zeros((zs.n, 4, 3))
+    tet10_gauss_positions(s.model.vertices["pos"], zs["gp"], np.arange(zs.n), gpos)
+    exact = -2500 * 10 * (2.0 - gpos[:, :, 2])
+    assert np.abs(zs["gstress"][:, :, 2] - exact).max() < 1e-5 * 2500 * 10 * 2
+    # top settlement: u = ρ g H² / (2 M), M the constrained modulus K + 4G/3 (laterally held)
+    top = np.abs(s.model.vertices["pos"][:, 2] - 2.0) < 1e-9
+    M = K + 4 * G / 3
+    np.testing.assert_allclose(s.model.vertices["disp"][top, 2], -2500 * 10 * 4 / (2 * M), rtol=1e-4)
+
+
+def test_ten_node_face_loaded_in_part_falls_back_to_thirds(tmp_path):
+    """A stress on only some of the four triangles of a 6-node face (a range through the face)
+    cannot be a uniform traction on that face: those triangles share their load by thirds, and
+    the total is still σ times the loaded area."""
+    from zone_fixtures import zone_convex_tet10
+    s = Session(out_dir=tmp_path)
+    s.command("block create brick 0 1 0 1 0 1")
+    zone_convex_tet10(s.model, 0, 1.0)
+    s.command("block face apply stress-zz -1e6 range position-z 1 position-x 0 0.3")
+    m = s.model
+    f, fv, v = m.faces, m.face_vertices, m.vertices
+    loaded = np.flatnonzero(f["fstress"][:, 2] != 0)
+    nodes = fv["vertex"][f["vstart"][loaded][:, None] + np.arange(3)]
+    p = v["pos"][nodes]
+    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    assert 0 < len(loaded) and area.sum() < 1.0
+    want = np.zeros(v.n)
+    for k in range(3):
+        np.add.at(want, nodes[:, k], -1e6 * area / 3)
+    np.testing.assert_allclose(v["fface"][:, 2], want, rtol=0, atol=1e-6)
+
+
+def test_ten_node_time_step_is_below_the_stability_limit(tmp_path):
+    """Eq. (84) with the 10-node stiffness (twice the Gershgorin row sums of tet10_stiffness) and
+    HRZ masses gives a Δt below the explicit limit 2/ω_max of the zone, ω_max² the largest
+    eigenvalue of M⁻¹K with K probed column by column from the zone's nodal forces."""
+    from dec3d.kernels.zones_ho import tet10_step
+    from dec3d.physics.rigid import RunError
+    from dec3d.physics.zones import ZoneStepper
+    from zone_fixtures import zone_tet10
+    s = Session(out_dir=tmp_path)
+    s.command("block create tetrahedron 0 0 0 1 0 0 0.2 1.3 0 0.4 0.3 0.9")
+    zone_tet10(s.model, 0)
+    for line in _ELASTIC:
+        s.command(line)
+    zst = ZoneStepper(s.model, RunError)
+    dt = zst.natural_timestep()
+    v, zs = s.model.vertices, s.model.store("zones")
+    gp = zs["gp"][0]
+    Kmat = np.zeros((30, 30))
+    for d in range(30):
+        vel = np.zeros((v.n, 3))
+        vel[gp[d // 3], d % 3] = 1.0
+        f = np.zeros((v.n, 3))
+        tet10_step(v["pos"], vel, zs["gp"], np.array([0]), zs["prop"][:, 0].copy(), zs["prop"][:, 1].copy(), 1.0,
+                   np.zeros((1, 4, 6)), np.zeros((1, 6)), f)
+        Kmat[:, d] = -f[gp].ravel()
+    m = np.repeat(zst.mtot[gp], 3)
+    w2 = np.linalg.eigvalsh(Kmat / np.sqrt(np.outer(m, m))).max()
+    limit = 2 / math.sqrt(w2)
+    assert dt < limit and dt > 0.2 * limit

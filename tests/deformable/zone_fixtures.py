@@ -36,3 +36,29 @@ def zone_tet10(model, row: int):
             tris.append(t)
             src.append(f)
     return install_block_mesh(model, row, pts, tet, np.array(tris), np.array(src))
+
+
+def zone_convex_tet10(model, row: int, edge: float):
+    """Zone a convex block into 10-node tetrahedra: the mesher's 4-node tetrahedra of about
+    ``edge`` with a node added at the middle of every edge, each surface triangle split in four
+    at its mid-edge nodes (what `block zone generate high-order-tetra` is to make)."""
+    from dec3d.geometry.zoning import mesh_convex
+    poly = block_poly(model, row)
+    pts, tets, tris, src = mesh_convex(poly.vertices, poly.face_ptr, poly.face_idx, edge)
+    pts = [np.asarray(p, float) for p in pts]
+    mid = {}
+
+    def m(i, j):
+        key = (min(i, j), max(i, j))
+        if key not in mid:
+            mid[key] = len(pts)
+            pts.append((pts[i] + pts[j]) / 2)
+        return mid[key]
+
+    t10 = [list(t) + [m(t[i], t[j]) for i, j in _EDGES] for t in np.asarray(tets).tolist()]
+    tri4, src4 = [], []
+    for (a, b, c), s in zip(np.asarray(tris).tolist(), np.asarray(src).tolist()):
+        ab, bc, ca = m(a, b), m(b, c), m(c, a)
+        tri4 += [(a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca)]      # counter-clockwise as (a, b, c)
+        src4 += [s] * 4
+    return install_block_mesh(model, row, np.array(pts), np.array(t10), np.array(tri4), np.array(src4))
