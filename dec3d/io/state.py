@@ -606,3 +606,12 @@ def _check_contacts(path: str, model: Model) -> None:
                  "sub-contact owners point outside the contacts")
         if "kind" in sc:
             need(sc["kind"].min() >= 0 and sc["kind"].max() <= 3, "a sub-contact has an unknown kind")
+    nv = model.vertices.n
+    for st, what in ((c, "contact"), (sc, "sub-contact")):
+        if st is None or not st.n:
+            continue
+        for key in ("gp_a", "gp_b"):
+            if key in st:
+                g = st[key]
+                need(((g == -1) | ((g >= 0) & (g < nv))).all(),
+                     f"{what} surface gridpoints ({key}) point outside the vertices")

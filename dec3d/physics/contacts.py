@@ -55,6 +55,12 @@ CONTACT_FIELDS = {
     "own_props": Field((), np.uint8, 0), # 1: set by `block contact property`; 0: follows the defaults
     "sub_start": Field((), _I, 0),       # CSR into subcontacts
     "sub_count": Field((), _I, 0),
+    # on a zoned (deformable) side: the gridpoints of the surface triangle the point moves with
+    # and its interpolation weights (set at detection by gpcontact.surface_weights; -1: rigid side)
+    "gp_a": Field((3,), _I, -1),
+    "gw_a": Field((3,), _F, 0.0),
+    "gp_b": Field((3,), _I, -1),
+    "gw_b": Field((3,), _F, 0.0),
     "group": group_field(),
 }
 
@@ -71,6 +77,12 @@ SUBCONTACT_FIELDS = {
     "udil": Field((), _F, 0.0),          # dilation [m]
     "us": Field((3,), _F, 0.0),          # accumulated shear displacement [m]
     "state": Field((), _I, 0),           # ST_* bits (kernels.jointlaw)
+    # on a zoned (deformable) side: the gridpoints of the surface triangle the point moves with
+    # and its interpolation weights (set at detection by gpcontact.surface_weights; -1: rigid side)
+    "gp_a": Field((3,), _I, -1),
+    "gw_a": Field((3,), _F, 0.0),
+    "gp_b": Field((3,), _I, -1),
+    "gw_b": Field((3,), _F, 0.0),
 }
 
 #: engine settings (``model.settings.mechanical``) and their defaults

@@ -585,22 +585,38 @@ class RigidEngine(ContactDetection):
                            "deformable blocks do not cycle yet (issue 10, next part); nothing was cycled")
         return bool((za ^ zb).any())
 
-    def _mixed_weights(self, zst) -> tuple:
+    def _mixed_weights(self, zst, recompute: bool = True) -> tuple:
         """Gridpoint rows and interpolation weights of every sub-contact and contact point on a
         zoned side (``gpcontact.surface_weights``), and the contact stiffness they give the
-        gridpoints (the joint term of Eq. 85: max(kn, ks) · area, shared by the weights)."""
+        gridpoints (the joint term of Eq. 85: max(kn, ks) · area, shared by the weights).
+
+        They are kept in the contact stores (``gp_a gw_a gp_b gw_b``): made at a detection and
+        used until the next one, so a run that starts between two detections (a split run, a
+        restored model) takes them as the last run left them (``recompute=False``) instead of
+        working them out from points that have moved since."""
         m = self.model
         b, f, v = m.blocks, m.faces, m.vertices
         cs, ss = self.contacts, self.subcontacts
         zoned = _deformable(b["kind"])
-        geo = (zoned, v["pos"], b["face_start"], b["face_count"], f["vstart"], f["nvert"],
-               m.face_vertices["vertex"])
-        out = []
-        for owner, pts in ((ss["contact"], ss["pos"]), (np.arange(cs.n, dtype=_I), cs["pos"])):
-            k = len(owner)
-            na, wa, nb, wb = np.empty((k, 3), _I), np.empty((k, 3)), np.empty((k, 3), _I), np.empty((k, 3))
-            surface_weights(np.ascontiguousarray(owner), pts, cs["a"], cs["b"], *geo, na, wa, nb, wb)
-            out.append((na, wa, nb, wb))
+        stores = ((ss, ss["contact"]), (cs, np.arange(cs.n, dtype=_I)))
+        if not recompute:
+            # kept weights are usable only if every point on a zoned side has its triangle
+            for st, owner in stores:
+                for side, key in (("a", "gp_a"), ("b", "gp_b")):
+                    if (st[key][zoned[cs[side][owner]], 0] < 0).any():
+                        recompute = True
+        if recompute:
+            geo = (zoned, v["pos"], b["face_start"], b["face_count"], f["vstart"], f["nvert"],
+                   m.face_vertices["vertex"])
+            for st, owner in stores:
+                k = len(owner)
+                na, wa, nb, wb = np.empty((k, 3), _I), np.empty((k, 3)), np.empty((k, 3), _I), np.empty((k, 3))
+                surface_weights(np.ascontiguousarray(owner), st["pos"], cs["a"], cs["b"], *geo, na, wa, nb, wb)
+                st["gp_a"][:] = na
+                st["gw_a"][:] = wa
+                st["gp_b"][:] = nb
+                st["gw_b"][:] = wb
+        out = [tuple(st[key] for key in ("gp_a", "gw_a", "gp_b", "gw_b")) for st, _ in stores]
         na, wa, nb, wb = out[0]
         c = ss["contact"]
         kk = np.maximum(cs["prop"][c, P_KN], cs["prop"][c, P_KS]) * ss["area"]
@@ -652,8 +668,11 @@ class RigidEngine(ContactDetection):
         if fresh:
             self.detect()
         mixed = self._zone_contacts_check()
+        last = s["dt_run"]
+        # between two detections, where the last run ended: go on as that run would have
+        between = not fresh and len(last) == 2 and int(last[1]) == m.step and m.step % interval != 0
         if mixed:
-            wsub, wcon = self._mixed_weights(zst)
+            wsub, wcon = self._mixed_weights(zst, recompute=not between)
         if warn is not None:
             msg = self.stiffness_warning()
             if msg:
@@ -670,9 +689,7 @@ class RigidEngine(ContactDetection):
 
         # as in `_cycle`: a run starting between detections where the last one ended goes on
         # with its Δt, so that split runs and save/restore change no number
-        last = s["dt_run"]
-        if (dt_fixed is None and not fresh and len(last) == 2 and int(last[1]) == m.step
-                and m.step % interval != 0):
+        if dt_fixed is None and between:
             dt = float(last[0])
         else:
             dt = pick_dt()
