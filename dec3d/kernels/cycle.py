@@ -1,29 +1,38 @@
 """Many mechanical steps in one call (3DEC theory, Fig. 13: the calculation cycle).
 
 Per step, with the contacts and sub-contacts fixed between two detection passes:
-  1. sub-contact relative velocities → displacement increments → joint law → forces and
-     moments on the blocks (``jointlaw.subcontact_forces``);
+  1. sub-contact relative velocities → displacement increments → joint law → forces
+     (``jointlaw.subcontact_update``, in parallel over sub-contacts), then the forces and
+     moments on every block summed in a fixed order (``jointlaw.block_sums``, in parallel
+     over blocks);
   2. motion of every group of joined blocks (a lone block is a group of one), Eqs. (44)-(52)
-     with damping and Euler's equations as chosen (``motion.rigid_motion_groups``);
+     with damping and Euler's equations as chosen (``motion.rigid_motion_groups``, in parallel
+     over groups);
   3. the contact reference points and the sub-contact points move with the mean
      displacement of the two blocks at that point, Eq. (11) (rotation included).
 The host (``dec3d.physics.rigid``) calls this between detection passes, histories and
 solve checks, so Python runs once per batch, not once per step.
+
+Threads: every parallel loop writes only its own items' rows and every sum is taken in a fixed
+order (never an atomic or a shared accumulator), so the results are bit-identical whatever the
+number of threads (``dec3d.config.set_threads``), and equal to those of one serial loop.
 """
 from __future__ import annotations
 
 import math
 
-from numba import njit
+import numpy as np
+from numba import njit, prange
 
-from .jointlaw import subcontact_forces
+from .jointlaw import block_lists, block_sums, subcontact_update
 from .motion import rigid_motion_groups
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def _move_points(dt, ca, cb, owner, pts, centroid, vel, spin):
-    """Eq. (11) for points pts (k, 3) of contacts owner (k,), in place, without scratch."""
-    for i in range(pts.shape[0]):
+    """Eq. (11) for points pts (k, 3) of contacts owner (k,), in place, without scratch
+    (in parallel: each point is its own)."""
+    for i in prange(pts.shape[0]):
         c = owner[i]
         d0 = 0.0
         d1 = 0.0
@@ -67,9 +76,13 @@ def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
     done = 0
     bad = -1
     motion[1] = 0.0
+    # the sub-contacts of every block in a fixed order, for the forces' fixed-order sums
+    bstart, bent = block_lists(centroid.shape[0], ca, cb, sc_contact)
+    sg = np.empty((sc_contact.shape[0], 3))
     for _ in range(nsteps):
-        subcontact_forces(dt, centroid, vel, spin, force, moment, ca, cb, cn, cmodel, cprop,
-                          sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state)
+        subcontact_update(dt, centroid, vel, spin, ca, cb, cn, cmodel, cprop,
+                          sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg)
+        block_sums(centroid, force, moment, sc_pos, sg, bstart, bent)
         g = rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
                                 gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
                                 mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp,
