@@ -109,7 +109,7 @@ def coulomb_one(kn, ks, tanf, coh, ten, tandil, zdil, tanf_r, coh_r, ten_r, mode
     return fn, fs0, fs1, fs2, un, udil, us0, us1, us2, state
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")   # (a call with this many arrays costs more than the work)
 def _one_subcontact(s, dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
                     sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg):
     """Force update of sub-contact s; its force on B (Fⁿ n + Fˢ) goes to sg[s] (3,)."""
@@ -208,7 +208,7 @@ def block_lists(nb, ca, cb, sc_contact):
     return bstart, bent
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")   # (a call with this many arrays costs more than the work)
 def _block_sum(x, bpos, bforce, bmoment, sc_pos, sg, bstart, bent):
     """``block_sums`` for block x."""
     e0 = bstart[x]
