@@ -221,7 +221,8 @@ def main() -> int:
             out = subprocess.run([sys.executable, os.path.abspath(__file__), "--child", str(n),
                                   "--steps", str(args.steps), "--jmodel", args.jmodel]
                                  + (["--full-detection"] if args.full_detection else [])
-                                 + (["--threads", str(args.threads, args.dynamic)] if args.threads else []),
+                                 + (["--threads", str(args.threads)] if args.threads else [])
+                                 + (["--dynamic"] if args.dynamic else []),
                                  capture_output=True, text=True)
             if out.returncode != 0:
                 sys.stderr.write(out.stderr)
