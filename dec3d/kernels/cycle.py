@@ -22,10 +22,17 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import numba
 from numba import njit, prange
 
 from .jointlaw import block_lists, block_sums, subcontact_update
 from .motion import rigid_motion_groups
+
+
+#: a model with less work per step than this (sub-contacts + 4 × bodies) runs on one thread:
+#: each parallel loop costs a wake-up of the other threads (microseconds on a quiet machine,
+#: up to a scheduler time slice on a busy one), more than a small model's whole step
+SERIAL_BELOW = 4000
 
 
 @njit(cache=True, parallel=True)
@@ -54,7 +61,7 @@ def _move_points(dt, ca, cb, owner, pts, centroid, vel, spin):
 
 
 @njit(cache=True)
-def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
+def _run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
               gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
               mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
               ca, cb, cn, cc, cown, cmodel, cprop,
@@ -112,3 +119,30 @@ def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
             motion[1] = 1.0
             break
     return done, bad
+
+
+def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
+              gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
+              mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
+              ca, cb, cn, cc, cown, cmodel, cprop,
+              sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
+              vmax, out, radius, acc, trigger, motion):
+    """``_run_steps`` (the kernel, documented there), on one thread when the model is small
+    (``SERIAL_BELOW``). The thread count is switched here, in Python: a kernel that switches it
+    itself cannot be cached by numba."""
+    args = (nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
+            gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
+            mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
+            ca, cb, cn, cc, cown, cmodel, cprop,
+            sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
+            vmax, out, radius, acc, trigger, motion)
+    if sc_contact.shape[0] + 4 * gmember.shape[0] >= SERIAL_BELOW:
+        return _run_steps(*args)
+    n = numba.get_num_threads()
+    if n == 1:
+        return _run_steps(*args)
+    numba.set_num_threads(1)           # (the same numbers: every sum has a fixed order)
+    try:
+        return _run_steps(*args)
+    finally:
+        numba.set_num_threads(n)
