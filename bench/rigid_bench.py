@@ -75,9 +75,10 @@ def one(n: int, steps: int, jmodel: str, full: bool = False, threads: int | None
         sys.path.insert(0, root)       # the checkout's dec3d (also when it is not installed)
     import numba
 
+    import dec3d                       # (first: it chooses numba's threading layer)
+
     if threads:
         numba.set_num_threads(threads)
-    import dec3d
 
     if full:
         import dec3d.physics.contacts as contacts

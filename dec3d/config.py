@@ -22,11 +22,13 @@ SAVE_FORMAT_VERSION = 1
 
 #: environment variable with the number of threads of the parallel kernels (read at import)
 THREADS_ENV = "DEC3D_THREADS"
-#: numba threading layers in the order dec3d wants them: TBB, else numba's own workqueue, never
-#: GNU OpenMP first — it is not fork-safe on Linux (a process forked after a parallel kernel ran,
-#: as the factor-of-safety pool does, aborts), while TBB and workqueue are (numba documentation,
-#: "The Threading Layers")
-LAYER_PRIORITY = ("tbb", "workqueue", "omp")
+#: numba threading layers in the order dec3d wants them: numba's own workqueue first. GNU OpenMP
+#: is not fork-safe on Linux (a process forked after a parallel kernel ran, as the
+#: factor-of-safety pool does, aborts; numba documentation, "The Threading Layers"), and TBB hung
+#: here in numba's before-fork handler (``tbb::finalize`` spinning on ``sched_yield``, numba issue
+#: #5983) when a later test forked; its idle workers also spin on a busy machine. The workqueue is
+#: fork-safe; it is not thread-safe (dec3d runs kernels from one thread only)
+LAYER_PRIORITY = ("workqueue", "tbb", "omp")
 
 
 def max_threads() -> int:
