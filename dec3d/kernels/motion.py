@@ -98,7 +98,9 @@ Damping (``damp_mode``), with α = ``alpha`` for modes 1 and 2:
 ``out`` (4,): [0] max |F_u| over groups (fixed components left out) [N]; [1] Σ over members of
 |m g_i| + |F_i| (contact force) [N]; [2] kinetic energy with the real masses and inertia
 (½ m V² + ½ ωᵀ J ω, J from unscaled ``gprin``) [J]; [3] the viscous coefficient α_v used [1/s].
-After the step every member has vel = V + ω × (c_b − C) (new arms) and spin = ω; member centroids
+The groups move in parallel (numba ``prange``; each writes only its own rows) and the sums over
+groups (out[1], out[2], the servo's works) are taken afterwards in group order, so the numbers do
+not depend on the thread count. After the step every member has vel = V + ω × (c_b − C) (new arms) and spin = ω; member centroids
 and vertices turn about C with the Cayley rotation and move by V Δt; disp accumulates each
 member's centroid displacement; forces and moments of the members are reset to zero. A group
 whose speed |V_x|+|V_y|+|V_z| reaches ``vmax`` or whose ω is not finite does not move; the first
