@@ -20,18 +20,19 @@ number of threads (``dec3d.config.set_threads``), and equal to those of one seri
 from __future__ import annotations
 
 import math
+import types
 
 import numpy as np
-import numba
 from numba import njit, prange
 
 from .jointlaw import block_lists, block_sums, subcontact_update
 from .motion import rigid_motion_groups
 
 
-#: a model with less work per step than this (sub-contacts + 4 × bodies) runs on one thread:
-#: each parallel loop costs a wake-up of the other threads (microseconds on a quiet machine,
-#: up to a scheduler time slice on a busy one), more than a small model's whole step
+#: a model with less work per step than this (sub-contacts + 4 × bodies) runs the serial twin of
+#: the kernel (``_run_steps_1``): each parallel loop costs a wake-up of the other threads
+#: (microseconds on a quiet machine, up to a scheduler time slice on a busy one), more than a
+#: small model's whole step
 SERIAL_BELOW = 4000
 
 
@@ -127,9 +128,8 @@ def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
               ca, cb, cn, cc, cown, cmodel, cprop,
               sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
               vmax, out, radius, acc, trigger, motion):
-    """``_run_steps`` (the kernel, documented there), on one thread when the model is small
-    (``SERIAL_BELOW``). The thread count is switched here, in Python: a kernel that switches it
-    itself cannot be cached by numba."""
+    """``_run_steps`` (the kernel, documented there); a small model (``SERIAL_BELOW``) runs its
+    serial twin ``_run_steps_1`` (the same numbers: every sum has a fixed order)."""
     args = (nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
             gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
             mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
@@ -138,11 +138,27 @@ def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
             vmax, out, radius, acc, trigger, motion)
     if sc_contact.shape[0] + 4 * gmember.shape[0] >= SERIAL_BELOW:
         return _run_steps(*args)
-    n = numba.get_num_threads()
-    if n == 1:
-        return _run_steps(*args)
-    numba.set_num_threads(1)           # (the same numbers: every sum has a fixed order)
-    try:
-        return _run_steps(*args)
-    finally:
-        numba.set_num_threads(n)
+    return _run_steps_1(*args)
+
+
+def _serial_twin(kernel, name, **swap):
+    """The same kernel compiled without ``parallel`` (its ``prange`` loops run as ``range``), under
+    its own name (so numba caches it in its own file); ``swap`` replaces globals it calls."""
+    f = getattr(kernel, "py_func", kernel)         # (a plain function when the JIT is disabled)
+    glb = dict(f.__globals__, **swap) if swap else f.__globals__
+    g = types.FunctionType(f.__code__, glb, name, f.__defaults__, f.__closure__)
+    g.__qualname__ = name
+    g.__module__ = f.__module__
+    g.__doc__ = f"``{f.__name__}`` on one thread, without parallel loops."
+    return njit(cache=True)(g)
+
+
+# a small model's steps: no parallel loop at all. Waking the other threads costs more than such a
+# step (on a busy machine up to a scheduler time slice per loop; even a one-thread parallel loop
+# hands its work to a worker thread of numba's workqueue)
+_run_steps_1 = _serial_twin(
+    _run_steps, "_run_steps_1",
+    subcontact_update=_serial_twin(subcontact_update, "_subcontact_update_1"),
+    block_sums=_serial_twin(block_sums, "_block_sums_1"),
+    rigid_motion_groups=_serial_twin(rigid_motion_groups, "_rigid_motion_groups_1"),
+    _move_points=_serial_twin(_move_points, "_move_points_1"))

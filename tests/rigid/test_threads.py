@@ -14,6 +14,7 @@ import pytest
 from conftest import ROOT
 from dec3d import config
 from dec3d.errors import BindError, CommandError
+from dec3d.kernels import cycle
 from dec3d.kernels.jointlaw import block_lists, block_sums
 
 TWO = pytest.mark.skipif(config.max_threads() < 2, reason="numba may use only one thread here")
@@ -64,15 +65,20 @@ def _state(scene: str, threads: int, tmp_path) -> dict:
 
 @TWO
 @pytest.mark.parametrize("scene", sorted(SCENES))
-def test_one_and_two_threads_give_the_same_bits(scene, tmp_path, restore_threads):
+def test_one_and_two_threads_give_the_same_bits(scene, tmp_path, restore_threads, monkeypatch):
+    # these scenes are small: the parallel kernels run only when the size switch is lowered
+    monkeypatch.setattr(cycle, "SERIAL_BELOW", 0)
     one = _state(scene, 1, tmp_path)
     two = _state(scene, 2, tmp_path)
-    assert one.keys() == two.keys()
+    # and the serial twin a small model runs gives the same bits
+    monkeypatch.setattr(cycle, "SERIAL_BELOW", 10**9)
+    ser = _state(scene, 2, tmp_path)
+    assert one.keys() == two.keys() == ser.keys()
     assert one["time"][1] == 200 and len(one["subcontacts/fn"]) > 0
     # the blocks did move (a scene at rest would compare nothing)
     assert np.abs(one["blocks/disp"]).max() > 1e-6
-    differ = [k for k in one if not np.array_equal(one[k], two[k], equal_nan=True)]
-    assert differ == []
+    assert [k for k in one if not np.array_equal(one[k], two[k], equal_nan=True)] == []
+    assert [k for k in one if not np.array_equal(one[k], ser[k], equal_nan=True)] == []
 
 
 def _scatter_twin(nb, ca, cb, owner, pos, centroid, g):
@@ -210,9 +216,10 @@ def _child_run(scene: str, out: str) -> dict:
 
 
 @TWO
-def test_a_forked_process_runs_the_kernels_after_the_parent_did(tmp_path, restore_threads):
+def test_a_forked_process_runs_the_kernels_after_the_parent_did(tmp_path, restore_threads, monkeypatch):
     """The factor-of-safety pool forks the process after parallel kernels ran in it: with GNU
     OpenMP the child aborted. The child's run gives the parent's numbers."""
+    monkeypatch.setattr(cycle, "SERIAL_BELOW", 0)          # the parallel kernels (the child inherits it)
     mine = _state("sliding", 2, tmp_path)
     with ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork")) as pool:
         theirs = pool.submit(_child_run, "sliding", str(tmp_path)).result(timeout=600)
