@@ -20,7 +20,6 @@ number of threads (``dec3d.config.set_threads``), and equal to those of one seri
 from __future__ import annotations
 
 import math
-import types
 
 import numpy as np
 from numba import njit, prange
@@ -146,7 +145,7 @@ def _serial_twin(kernel, name, **swap):
     its own name (so numba caches it in its own file); ``swap`` replaces globals it calls."""
     f = getattr(kernel, "py_func", kernel)         # (a plain function when the JIT is disabled)
     glb = dict(f.__globals__, **swap) if swap else f.__globals__
-    g = types.FunctionType(f.__code__, glb, name, f.__defaults__, f.__closure__)
+    g = type(f)(f.__code__, glb, name, f.__defaults__, f.__closure__)      # (a FunctionType)
     g.__qualname__ = name
     g.__module__ = f.__module__
     g.__doc__ = f"``{f.__name__}`` on one thread, without parallel loops."
