@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import get_num_threads, njit, prange
 
 from .jointlaw import block_lists, block_sums, subcontact_update
 from .motion import rigid_motion_groups
@@ -127,15 +127,16 @@ def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
               ca, cb, cn, cc, cown, cmodel, cprop,
               sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
               vmax, out, radius, acc, trigger, motion):
-    """``_run_steps`` (the kernel, documented there); a small model (``SERIAL_BELOW``) runs its
-    serial twin ``_run_steps_1`` (the same numbers: every sum has a fixed order)."""
+    """``_run_steps`` (the kernel, documented there); a small model (``SERIAL_BELOW``), or any
+    model on one thread, runs its serial twin ``_run_steps_1`` (the same numbers: every sum has a
+    fixed order)."""
     args = (nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
             gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
             mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
             ca, cb, cn, cc, cown, cmodel, cprop,
             sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
             vmax, out, radius, acc, trigger, motion)
-    if sc_contact.shape[0] + 4 * gmember.shape[0] >= SERIAL_BELOW:
+    if sc_contact.shape[0] + 4 * gmember.shape[0] >= SERIAL_BELOW and get_num_threads() > 1:
         return _run_steps(*args)
     return _run_steps_1(*args)
 

@@ -66,19 +66,16 @@ def _state(scene: str, threads: int, tmp_path) -> dict:
 @TWO
 @pytest.mark.parametrize("scene", sorted(SCENES))
 def test_one_and_two_threads_give_the_same_bits(scene, tmp_path, restore_threads, monkeypatch):
-    # these scenes are small: the parallel kernels run only when the size switch is lowered
+    # one thread runs the serial twins of the kernels; these scenes are small, so the parallel
+    # kernels run on two threads only when the size switch is lowered
     monkeypatch.setattr(cycle, "SERIAL_BELOW", 0)
     one = _state(scene, 1, tmp_path)
     two = _state(scene, 2, tmp_path)
-    # and the serial twin a small model runs gives the same bits
-    monkeypatch.setattr(cycle, "SERIAL_BELOW", 10**9)
-    ser = _state(scene, 2, tmp_path)
-    assert one.keys() == two.keys() == ser.keys()
+    assert one.keys() == two.keys()
     assert one["time"][1] == 200 and len(one["subcontacts/fn"]) > 0
     # the blocks did move (a scene at rest would compare nothing)
     assert np.abs(one["blocks/disp"]).max() > 1e-6
     assert [k for k in one if not np.array_equal(one[k], two[k], equal_nan=True)] == []
-    assert [k for k in one if not np.array_equal(one[k], ser[k], equal_nan=True)] == []
 
 
 def _scatter_twin(nb, ca, cb, owner, pos, centroid, g):
@@ -212,7 +209,7 @@ def test_init_threads_reads_the_variable_and_keeps_a_chosen_layer(restore_thread
 def _child_run(scene: str, out: str) -> dict:
     from pathlib import Path
 
-    return _state(scene, 1, Path(out))
+    return _state(scene, 2, Path(out))
 
 
 @TWO
