@@ -109,76 +109,68 @@ def coulomb_one(kn, ks, tanf, coh, ten, tandil, zdil, tanf_r, coh_r, ten_r, mode
     return fn, fs0, fs1, fs2, un, udil, us0, us1, us2, state
 
 
-@njit(cache=True, inline="always")   # (a call with this many arrays costs more than the work)
-def _one_subcontact(s, dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
-                    sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg):
-    """Force update of sub-contact s; its force on B (Fⁿ n + Fˢ) goes to sg[s] (3,)."""
-    c = sc_contact[s]
-    a = ca[c]
-    b = cb[c]
-    n0 = cn[c, 0]
-    n1 = cn[c, 1]
-    n2 = cn[c, 2]
-    x0 = sc_pos[s, 0]
-    x1 = sc_pos[s, 1]
-    x2 = sc_pos[s, 2]
-    ra0 = x0 - bpos[a, 0]
-    ra1 = x1 - bpos[a, 1]
-    ra2 = x2 - bpos[a, 2]
-    rb0 = x0 - bpos[b, 0]
-    rb1 = x1 - bpos[b, 1]
-    rb2 = x2 - bpos[b, 2]
-    wa0 = bspin[a, 0]
-    wa1 = bspin[a, 1]
-    wa2 = bspin[a, 2]
-    wb0 = bspin[b, 0]
-    wb1 = bspin[b, 1]
-    wb2 = bspin[b, 2]
-    # Eq. (15)
-    v0 = bvel[b, 0] + wb1 * rb2 - wb2 * rb1 - bvel[a, 0] - (wa1 * ra2 - wa2 * ra1)
-    v1 = bvel[b, 1] + wb2 * rb0 - wb0 * rb2 - bvel[a, 1] - (wa2 * ra0 - wa0 * ra2)
-    v2 = bvel[b, 2] + wb0 * rb1 - wb1 * rb0 - bvel[a, 2] - (wa0 * ra1 - wa1 * ra0)
-    du0 = v0 * dt
-    du1 = v1 * dt
-    du2 = v2 * dt
-    dun = du0 * n0 + du1 * n1 + du2 * n2
-    st0 = sc_state[s]
-    if st0 & ST_NEW:
-        du0 = 0.0
-        du1 = 0.0
-        du2 = 0.0
-        dun = 0.0
-        st0 &= ~ST_NEW
-    fn, f0, f1, f2, un, ud, u0, u1, u2, st = coulomb_one(
-        cprop[c, P_KN], cprop[c, P_KS], cprop[c, P_TANF], cprop[c, P_COH], cprop[c, P_TEN],
-        cprop[c, P_TANDIL], cprop[c, P_ZDIL], cprop[c, P_TANF_RES], cprop[c, P_COH_RES],
-        cprop[c, P_TEN_RES], cmodel[c], sc_area[s],
-        dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s], sc_udil[s],
-        sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
-    sc_fn[s] = fn
-    sc_fs[s, 0] = f0
-    sc_fs[s, 1] = f1
-    sc_fs[s, 2] = f2
-    sc_un[s] = un
-    sc_udil[s] = ud
-    sc_us[s, 0] = u0
-    sc_us[s, 1] = u1
-    sc_us[s, 2] = u2
-    sc_state[s] = st
-    # force on B (ERRATA Eqs. 28-32)
-    sg[s, 0] = fn * n0 + f0
-    sg[s, 1] = fn * n1 + f1
-    sg[s, 2] = fn * n2 + f2
-
-
 @njit(cache=True, parallel=True)
 def subcontact_update(dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
                       sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg):
     """The joint law of every sub-contact, in parallel (each writes only its own rows); the
     force on B of sub-contact s goes to sg (ns, 3) [N] for ``block_sums``."""
     for s in prange(sc_contact.shape[0]):
-        _one_subcontact(s, dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
-                        sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg)
+        c = sc_contact[s]
+        a = ca[c]
+        b = cb[c]
+        n0 = cn[c, 0]
+        n1 = cn[c, 1]
+        n2 = cn[c, 2]
+        x0 = sc_pos[s, 0]
+        x1 = sc_pos[s, 1]
+        x2 = sc_pos[s, 2]
+        ra0 = x0 - bpos[a, 0]
+        ra1 = x1 - bpos[a, 1]
+        ra2 = x2 - bpos[a, 2]
+        rb0 = x0 - bpos[b, 0]
+        rb1 = x1 - bpos[b, 1]
+        rb2 = x2 - bpos[b, 2]
+        wa0 = bspin[a, 0]
+        wa1 = bspin[a, 1]
+        wa2 = bspin[a, 2]
+        wb0 = bspin[b, 0]
+        wb1 = bspin[b, 1]
+        wb2 = bspin[b, 2]
+        # Eq. (15)
+        v0 = bvel[b, 0] + wb1 * rb2 - wb2 * rb1 - bvel[a, 0] - (wa1 * ra2 - wa2 * ra1)
+        v1 = bvel[b, 1] + wb2 * rb0 - wb0 * rb2 - bvel[a, 1] - (wa2 * ra0 - wa0 * ra2)
+        v2 = bvel[b, 2] + wb0 * rb1 - wb1 * rb0 - bvel[a, 2] - (wa0 * ra1 - wa1 * ra0)
+        du0 = v0 * dt
+        du1 = v1 * dt
+        du2 = v2 * dt
+        dun = du0 * n0 + du1 * n1 + du2 * n2
+        st0 = sc_state[s]
+        if st0 & ST_NEW:
+            du0 = 0.0
+            du1 = 0.0
+            du2 = 0.0
+            dun = 0.0
+            st0 &= ~ST_NEW
+        fn, f0, f1, f2, un, ud, u0, u1, u2, st = coulomb_one(
+            cprop[c, P_KN], cprop[c, P_KS], cprop[c, P_TANF], cprop[c, P_COH], cprop[c, P_TEN],
+            cprop[c, P_TANDIL], cprop[c, P_ZDIL], cprop[c, P_TANF_RES], cprop[c, P_COH_RES],
+            cprop[c, P_TEN_RES], cmodel[c], sc_area[s],
+            dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s], sc_udil[s],
+            sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
+        sc_fn[s] = fn
+        sc_fs[s, 0] = f0
+        sc_fs[s, 1] = f1
+        sc_fs[s, 2] = f2
+        sc_un[s] = un
+        sc_udil[s] = ud
+        sc_us[s, 0] = u0
+        sc_us[s, 1] = u1
+        sc_us[s, 2] = u2
+        sc_state[s] = st
+        # force on B (ERRATA Eqs. 28-32)
+        sg[s, 0] = fn * n0 + f0
+        sg[s, 1] = fn * n1 + f1
+        sg[s, 2] = fn * n2 + f2
 
 
 @njit(cache=True)
