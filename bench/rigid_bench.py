@@ -75,9 +75,10 @@ def one(n: int, steps: int, jmodel: str, full: bool = False, threads: int | None
         sys.path.insert(0, root)       # the checkout's dec3d (also when it is not installed)
     import numba
 
+    import dec3d                       # (first: it chooses numba's threading layer)
+
     if threads:
         numba.set_num_threads(threads)
-    import dec3d
 
     if full:
         import dec3d.physics.contacts as contacts
@@ -222,7 +223,8 @@ def main() -> int:
             out = subprocess.run([sys.executable, os.path.abspath(__file__), "--child", str(n),
                                   "--steps", str(args.steps), "--jmodel", args.jmodel]
                                  + (["--full-detection"] if args.full_detection else [])
-                                 + (["--threads", str(args.threads, args.dynamic)] if args.threads else []),
+                                 + (["--threads", str(args.threads)] if args.threads else [])
+                                 + (["--dynamic"] if args.dynamic else []),
                                  capture_output=True, text=True)
             if out.returncode != 0:
                 sys.stderr.write(out.stderr)

@@ -6,6 +6,19 @@ from .kcache import guard as _guard
 _guard()      # before any kernel is imported: stale cached kernels cleared, cold-start notice
 
 
+def _init_threads():
+    import sys
+
+    from .config import init_threads
+
+    msg = init_threads()     # fork-safe threading layer; DEC3D_THREADS
+    if msg:
+        sys.stderr.write(msg + "\n")
+
+
+_init_threads()
+
+
 def __getattr__(name):
     # Session and run_deck import the language layer; loaded on first use so that
     # `import dec3d.kernels...` stays light.

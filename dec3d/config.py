@@ -13,3 +13,95 @@ INT = np.int64
 NUMBA_CACHE = True
 #: version written into save files; a file with a newer version is refused
 SAVE_FORMAT_VERSION = 1
+
+
+# ----------------------------------------------------------------------------------------------
+# threads of the parallel kernels (numba prange); every kernel gives bit-identical results
+# whatever the count (fixed-order sums, see dec3d/kernels/cycle.py)
+# ----------------------------------------------------------------------------------------------
+
+#: environment variable with the number of threads of the parallel kernels (read at import)
+THREADS_ENV = "DEC3D_THREADS"
+#: numba threading layers in the order dec3d wants them: numba's own workqueue first. GNU OpenMP
+#: is not fork-safe on Linux (a process forked after a parallel kernel ran, as the
+#: factor-of-safety pool does, aborts; numba documentation, "The Threading Layers"), and TBB hung
+#: here in numba's before-fork handler (``tbb::finalize`` spinning on ``sched_yield``, numba issue
+#: #5983) when a later test forked; its idle workers also spin on a busy machine. The workqueue is
+#: fork-safe; it is not thread-safe (dec3d runs kernels from one thread only)
+LAYER_PRIORITY = ("workqueue", "tbb", "omp")
+
+
+def max_threads() -> int:
+    """The most threads the kernels may use in this process (numba's NUMBA_NUM_THREADS: by
+    default the number of cores)."""
+    from numba.core import config
+
+    return int(config.NUMBA_NUM_THREADS)
+
+
+def threads() -> int:
+    """Threads the parallel kernels use now (in this thread of the program)."""
+    import numba
+
+    return int(numba.get_num_threads())
+
+
+def set_threads(n) -> int:
+    """Use ``n`` threads in the parallel kernels (1 ≤ n ≤ ``max_threads()``); ValueError
+    otherwise. Returns n. (numba keeps the count per calling thread: a program that runs decks
+    in another thread sets it there.)"""
+    import numba
+
+    top = max_threads()
+    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= top:
+        raise ValueError(f"the number of threads must be a whole number from 1 to {top} "
+                         f"(the cores numba may use here, NUMBA_NUM_THREADS), got {n!r}")
+    numba.set_num_threads(n)
+    return n
+
+
+def threading_layer() -> str:
+    """The numba threading layer in use ("not started yet" before the first parallel kernel)."""
+    import numba
+
+    try:
+        return str(numba.threading_layer())
+    except ValueError:
+        return "not started yet"
+
+
+def thread_report() -> str:
+    """One line: threads used, of how many, and the threading layer."""
+    return f"threads {threads()} of {max_threads()} (numba threading layer: {threading_layer()})"
+
+
+def init_threads(environ=None) -> str | None:
+    """Run once at ``import dec3d``: prefer the fork-safe threading layers (``LAYER_PRIORITY``)
+    unless the user chose one (NUMBA_THREADING_LAYER or NUMBA_THREADING_LAYER_PRIORITY), and take
+    the thread count from ``DEC3D_THREADS`` when set. Returns a warning for a value of
+    ``DEC3D_THREADS`` that cannot be used (the count is then left as it was), else None."""
+    import os
+
+    env = os.environ if environ is None else environ
+    if "NUMBA_THREADING_LAYER" not in env and "NUMBA_THREADING_LAYER_PRIORITY" not in env:
+        from numba.core import config
+
+        # the environment too: numba re-reads it when it changes, and child processes inherit it
+        env["NUMBA_THREADING_LAYER_PRIORITY"] = " ".join(LAYER_PRIORITY)
+        config.THREADING_LAYER_PRIORITY = list(LAYER_PRIORITY)
+    raw = env.get(THREADS_ENV, "").strip()
+    if not raw:
+        return None
+    try:
+        n = int(raw)
+    except ValueError:
+        n = None
+    top = max_threads()
+    if n is None or n < 1:
+        return (f"dec3d: {THREADS_ENV}={raw!r} is not a whole number ≥ 1; "
+                f"the kernels use {threads()} thread(s)")
+    if n > top:
+        set_threads(top)
+        return f"dec3d: {THREADS_ENV}={n} is more than the {top} cores numba may use here; using {top}"
+    set_threads(n)
+    return None

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from .registry import command
-from .values import FLAG, ONOFF, Choice, Nums, P, Text
+from .values import FLAG, ONOFF, Choice, Num, Nums, P, Text
 
 
 @command("model new", keywords=[P("force", FLAG, "accepted for 3DEC compatibility (no prompt is ever shown)")],
@@ -22,13 +22,44 @@ def model_title(session, call):
 CONFIGURE_OPTIONS = ("dynamic", "fluid", "thermal", "highorder", "feblock", "creep")
 
 
-@command("model configure", positional=[P("option", Choice(CONFIGURE_OPTIONS), "process to enable", required=True)],
-         doc="Enable an optional process or element type for the rest of the model's life.",
+def _check_configure(call):
+    from ..errors import BindError
+
+    if call.args["option"] != "threads" and call.args["n"] is not None:
+        raise BindError(f"`model configure {call.args['option']}` takes no value",
+                        call.locations.get("n", call.location))
+
+
+@command("model configure",
+         positional=[P("option", Choice(CONFIGURE_OPTIONS + ("threads",)), "process to enable, or `threads`",
+                       required=True),
+                     P("n", Num(integer=True, lo=1), "with `threads`: the number of threads of the parallel kernels")],
+         check=_check_configure,
+         doc="Enable an optional process or element type for the rest of the model's life; or set the number "
+             "of threads the calculation uses.",
          details="Options: " + ", ".join(CONFIGURE_OPTIONS) + ". Each is recorded once, in the order given; "
                  "the engine reads them (dynamic: damping defaults for dynamic runs; highorder: 10-node "
-                 "tetrahedra; feblock: 20-node brick FE blocks).",
-         examples=["model configure dynamic", "model config dyn", "model configure highorder"])
+                 "tetrahedra; feblock: 20-node brick FE blocks). `threads n` sets how many threads the parallel "
+                 "kernels (contact forces, motion, point updates) use from now on, at most the number of cores "
+                 "(numba's NUMBA_NUM_THREADS); `threads` alone prints the count. The environment variable "
+                 "DEC3D_THREADS sets it when dec3d starts. It is a setting of the program, not of the model "
+                 "(`model new` keeps it, save files do not hold it), and the results are bit-identical whatever "
+                 "the count: every sum is taken in a fixed order.",
+         examples=["model configure dynamic", "model config dyn", "model configure highorder",
+                   "model configure threads 2", "model configure threads"])
 def model_configure(session, call):
+    if call.args["option"] == "threads":
+        from ..config import set_threads, thread_report
+        from ..errors import CommandError
+
+        n = call.args["n"]
+        if n is not None:
+            try:
+                set_threads(int(n))
+            except ValueError as exc:
+                raise CommandError(str(exc), call.locations.get("n", call.location)) from None
+        session.write(thread_report() + "\n")
+        return
     opts = session.model.settings.configure
     if call.args["option"] not in opts:
         opts.append(call.args["option"])

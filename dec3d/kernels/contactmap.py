@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from .commonplane import common_plane, contact_type
 from .jointlaw import ST_NEW
@@ -47,7 +47,7 @@ def match_sorted(old0, old1, new0, new1):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def cp_batch(ra, rb, prev, vpos, bvstart, bvcount, centroid, old_n, old_c, reach,
              out_n, out_c, out_gap, out_type):
     """Common plane of every candidate pair (rows ra[i], rb[i]; A → B).
@@ -59,10 +59,10 @@ def cp_batch(ra, rb, prev, vpos, bvstart, bvcount, centroid, old_n, old_c, reach
     a contact when its gap is at most this (CTOL, plus the blocks' step motion when fast).
     Writes out_n/out_c (k, 3), out_gap (k,) m, out_type (k,) contact type (CT_*, 0 if apart).
     """
-    n0 = np.empty(3)
-    nn = np.empty(3)
-    cc = np.empty(3)
-    for i in range(ra.shape[0]):
+    for i in prange(ra.shape[0]):          # pairs in parallel: each writes only its own row
+        n0 = np.empty(3)
+        nn = np.empty(3)
+        cc = np.empty(3)
         a = ra[i]
         b = rb[i]
         va = vpos[bvstart[a]:bvstart[a] + bvcount[a]]
@@ -102,7 +102,7 @@ def newell(vpos, fverts, start, m):
     return nx, ny, nz
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def subcontact_gaps(sc_contact, pos, ca, cb, cn, cgap, centroid, vpos, bfstart, bfcount, fvstart,
                     fnvert, fverts, out):
     """Gap [m] of each sub-contact: along the contact normal n (A → B) through its point x,
@@ -117,7 +117,7 @@ def subcontact_gaps(sc_contact, pos, ca, cb, cn, cgap, centroid, vpos, bfstart, 
     such face (degenerate). sc_contact (ns,), pos (ns, 3) [m]; ca, cb (nc,) block rows;
     cn (nc, 3); centroid (nb, 3); faces as in ``subgeom.subcontacts_batch``; writes out (ns,).
     """
-    for s in range(sc_contact.shape[0]):
+    for s in prange(sc_contact.shape[0]):      # in parallel: each writes only out[s]
         c = sc_contact[s]
         n0 = cn[c, 0]
         n1 = cn[c, 1]

@@ -1,29 +1,45 @@
 """Many mechanical steps in one call (3DEC theory, Fig. 13: the calculation cycle).
 
 Per step, with the contacts and sub-contacts fixed between two detection passes:
-  1. sub-contact relative velocities → displacement increments → joint law → forces and
-     moments on the blocks (``jointlaw.subcontact_forces``);
+  1. sub-contact relative velocities → displacement increments → joint law → forces
+     (``jointlaw.subcontact_update``, in parallel over sub-contacts), then the forces and
+     moments on every block summed in a fixed order (``jointlaw.block_sums``, in parallel
+     over blocks);
   2. motion of every group of joined blocks (a lone block is a group of one), Eqs. (44)-(52)
-     with damping and Euler's equations as chosen (``motion.rigid_motion_groups``);
+     with damping and Euler's equations as chosen (``motion.rigid_motion_groups``, in parallel
+     over groups);
   3. the contact reference points and the sub-contact points move with the mean
      displacement of the two blocks at that point, Eq. (11) (rotation included).
 The host (``dec3d.physics.rigid``) calls this between detection passes, histories and
 solve checks, so Python runs once per batch, not once per step.
+
+Threads: every parallel loop writes only its own items' rows and every sum is taken in a fixed
+order (never an atomic or a shared accumulator), so the results are bit-identical whatever the
+number of threads (``dec3d.config.set_threads``), and equal to those of one serial loop.
 """
 from __future__ import annotations
 
 import math
 
-from numba import njit
+import numpy as np
+from numba import get_num_threads, njit, prange
 
-from .jointlaw import subcontact_forces
+from .jointlaw import block_lists, block_sums, subcontact_update
 from .motion import rigid_motion_groups
 
 
-@njit(cache=True)
+#: a model with less work per step than this (sub-contacts + 4 × bodies) runs the serial twin of
+#: the kernel (``_run_steps_1``): each parallel loop costs a wake-up of the other threads
+#: (microseconds on a quiet machine, up to a scheduler time slice on a busy one), more than a
+#: small model's whole step
+SERIAL_BELOW = 4000
+
+
+@njit(cache=True, parallel=True)
 def _move_points(dt, ca, cb, owner, pts, centroid, vel, spin):
-    """Eq. (11) for points pts (k, 3) of contacts owner (k,), in place, without scratch."""
-    for i in range(pts.shape[0]):
+    """Eq. (11) for points pts (k, 3) of contacts owner (k,), in place, without scratch
+    (in parallel: each point is its own)."""
+    for i in prange(pts.shape[0]):
         c = owner[i]
         d0 = 0.0
         d1 = 0.0
@@ -45,7 +61,7 @@ def _move_points(dt, ca, cb, owner, pts, centroid, vel, spin):
 
 
 @njit(cache=True)
-def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
+def _run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
               gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
               mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
               ca, cb, cn, cc, cown, cmodel, cprop,
@@ -67,9 +83,13 @@ def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
     done = 0
     bad = -1
     motion[1] = 0.0
+    # the sub-contacts of every block in a fixed order, for the forces' fixed-order sums
+    bstart, bent = block_lists(centroid.shape[0], ca, cb, sc_contact)
+    sg = np.empty((sc_contact.shape[0], 3))
     for _ in range(nsteps):
-        subcontact_forces(dt, centroid, vel, spin, force, moment, ca, cb, cn, cmodel, cprop,
-                          sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state)
+        subcontact_update(dt, centroid, vel, spin, ca, cb, cn, cmodel, cprop,
+                          sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg)
+        block_sums(centroid, force, moment, sc_pos, sg, bstart, bent)
         g = rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
                                 gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
                                 mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp,
@@ -99,3 +119,46 @@ def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
             motion[1] = 1.0
             break
     return done, bad
+
+
+def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
+              gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
+              mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
+              ca, cb, cn, cc, cown, cmodel, cprop,
+              sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
+              vmax, out, radius, acc, trigger, motion):
+    """``_run_steps`` (the kernel, documented there); a small model (``SERIAL_BELOW``), or any
+    model on one thread, runs its serial twin ``_run_steps_1`` (the same numbers: every sum has a
+    fixed order)."""
+    args = (nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
+            gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
+            mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
+            ca, cb, cn, cc, cown, cmodel, cprop,
+            sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
+            vmax, out, radius, acc, trigger, motion)
+    if sc_contact.shape[0] + 4 * gmember.shape[0] >= SERIAL_BELOW and get_num_threads() > 1:
+        return _run_steps(*args)
+    return _run_steps_1(*args)
+
+
+def _serial_twin(kernel, name, **swap):
+    """The same kernel compiled without ``parallel`` (its ``prange`` loops run as ``range``), under
+    its own name (so numba caches it in its own file); ``swap`` replaces globals it calls."""
+    f = getattr(kernel, "py_func", kernel)         # (a plain function when the JIT is disabled)
+    glb = dict(f.__globals__, **swap) if swap else f.__globals__
+    g = type(f)(f.__code__, glb, name, f.__defaults__, f.__closure__)      # (a FunctionType)
+    g.__qualname__ = name
+    g.__module__ = f.__module__
+    g.__doc__ = f"``{f.__name__}`` on one thread, without parallel loops."
+    return njit(cache=True)(g)
+
+
+# a small model's steps: no parallel loop at all. Waking the other threads costs more than such a
+# step (on a busy machine up to a scheduler time slice per loop; even a one-thread parallel loop
+# hands its work to a worker thread of numba's workqueue)
+_run_steps_1 = _serial_twin(
+    _run_steps, "_run_steps_1",
+    subcontact_update=_serial_twin(subcontact_update, "_subcontact_update_1"),
+    block_sums=_serial_twin(block_sums, "_block_sums_1"),
+    rigid_motion_groups=_serial_twin(rigid_motion_groups, "_rigid_motion_groups_1"),
+    _move_points=_serial_twin(_move_points, "_move_points_1"))

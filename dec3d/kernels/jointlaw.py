@@ -26,7 +26,8 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+import numpy as np
+from numba import njit, prange
 
 P_KN = 0
 P_KS = 1
@@ -108,19 +109,12 @@ def coulomb_one(kn, ks, tanf, coh, ten, tandil, zdil, tanf_r, coh_r, ten_r, mode
     return fn, fs0, fs1, fs2, un, udil, us0, us1, us2, state
 
 
-@njit(cache=True)
-def subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment,
-                      ca, cb, cn, cmodel, cprop,
-                      sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state):
-    """One force update of every sub-contact; adds the forces and moments to the blocks.
-
-    bpos/bvel/bspin (nb, 3): centroid [m], velocity [m/s], spin [rad/s] at t − Δt/2.
-    bforce/bmoment (nb, 3): accumulated in place [N], [N·m].
-    ca, cb (nc,) block rows; cn (nc, 3) unit normal A → B; cmodel (nc,); cprop (nc, NPROP).
-    sc_* (ns, ...): contact row, position on the c-p (3), area, Fn, Fs (3), uⁿ, u_dil, uˢ (3), state.
-    Serial loop: the scatter order is the sub-contact order (deterministic).
-    """
-    for s in range(sc_contact.shape[0]):
+@njit(cache=True, parallel=True)
+def subcontact_update(dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
+                      sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg):
+    """The joint law of every sub-contact, in parallel (each writes only its own rows); the
+    force on B of sub-contact s goes to sg (ns, 3) [N] for ``block_sums``."""
+    for s in prange(sc_contact.shape[0]):
         c = sc_contact[s]
         a = ca[c]
         b = cb[c]
@@ -136,12 +130,16 @@ def subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment,
         rb0 = x0 - bpos[b, 0]
         rb1 = x1 - bpos[b, 1]
         rb2 = x2 - bpos[b, 2]
-        wa = bspin[a]
-        wb = bspin[b]
+        wa0 = bspin[a, 0]
+        wa1 = bspin[a, 1]
+        wa2 = bspin[a, 2]
+        wb0 = bspin[b, 0]
+        wb1 = bspin[b, 1]
+        wb2 = bspin[b, 2]
         # Eq. (15)
-        v0 = bvel[b, 0] + wb[1] * rb2 - wb[2] * rb1 - bvel[a, 0] - (wa[1] * ra2 - wa[2] * ra1)
-        v1 = bvel[b, 1] + wb[2] * rb0 - wb[0] * rb2 - bvel[a, 1] - (wa[2] * ra0 - wa[0] * ra2)
-        v2 = bvel[b, 2] + wb[0] * rb1 - wb[1] * rb0 - bvel[a, 2] - (wa[0] * ra1 - wa[1] * ra0)
+        v0 = bvel[b, 0] + wb1 * rb2 - wb2 * rb1 - bvel[a, 0] - (wa1 * ra2 - wa2 * ra1)
+        v1 = bvel[b, 1] + wb2 * rb0 - wb0 * rb2 - bvel[a, 1] - (wa2 * ra0 - wa0 * ra2)
+        v2 = bvel[b, 2] + wb0 * rb1 - wb1 * rb0 - bvel[a, 2] - (wa0 * ra1 - wa1 * ra0)
         du0 = v0 * dt
         du1 = v1 * dt
         du2 = v2 * dt
@@ -153,10 +151,10 @@ def subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment,
             du2 = 0.0
             dun = 0.0
             st0 &= ~ST_NEW
-        p = cprop[c]
         fn, f0, f1, f2, un, ud, u0, u1, u2, st = coulomb_one(
-            p[P_KN], p[P_KS], p[P_TANF], p[P_COH], p[P_TEN], p[P_TANDIL], p[P_ZDIL],
-            p[P_TANF_RES], p[P_COH_RES], p[P_TEN_RES], cmodel[c], sc_area[s],
+            cprop[c, P_KN], cprop[c, P_KS], cprop[c, P_TANF], cprop[c, P_COH], cprop[c, P_TEN],
+            cprop[c, P_TANDIL], cprop[c, P_ZDIL], cprop[c, P_TANF_RES], cprop[c, P_COH_RES],
+            cprop[c, P_TEN_RES], cmodel[c], sc_area[s],
             dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s], sc_udil[s],
             sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
         sc_fn[s] = fn
@@ -170,18 +168,111 @@ def subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment,
         sc_us[s, 2] = u2
         sc_state[s] = st
         # force on B (ERRATA Eqs. 28-32)
-        g0 = fn * n0 + f0
-        g1 = fn * n1 + f1
-        g2 = fn * n2 + f2
-        bforce[b, 0] += g0
-        bforce[b, 1] += g1
-        bforce[b, 2] += g2
-        bforce[a, 0] -= g0
-        bforce[a, 1] -= g1
-        bforce[a, 2] -= g2
-        bmoment[b, 0] += rb1 * g2 - rb2 * g1
-        bmoment[b, 1] += rb2 * g0 - rb0 * g2
-        bmoment[b, 2] += rb0 * g1 - rb1 * g0
-        bmoment[a, 0] -= ra1 * g2 - ra2 * g1
-        bmoment[a, 1] -= ra2 * g0 - ra0 * g2
-        bmoment[a, 2] -= ra0 * g1 - ra1 * g0
+        sg[s, 0] = fn * n0 + f0
+        sg[s, 1] = fn * n1 + f1
+        sg[s, 2] = fn * n2 + f2
+
+
+@njit(cache=True)
+def block_lists(nb, ca, cb, sc_contact):
+    """Per block, the sub-contacts acting on it in a fixed order (CSR): the entries of block x
+    are bent[bstart[x]:bstart[x + 1]], each 2 s (x is B of sub-contact s) or 2 s + 1 (x is A),
+    ascending — the order in which a serial scatter over s, B before A, would add them.
+    Returns (bstart (nb + 1,), bent (2 ns,)) int64."""
+    ns = sc_contact.shape[0]
+    bstart = np.zeros(nb + 1, dtype=np.int64)
+    for s in range(ns):
+        c = sc_contact[s]
+        bstart[cb[c] + 1] += 1
+        bstart[ca[c] + 1] += 1
+    for x in range(nb):
+        bstart[x + 1] += bstart[x]
+    fill = bstart[:nb].copy()
+    bent = np.empty(2 * ns, dtype=np.int64)
+    for s in range(ns):
+        c = sc_contact[s]
+        b = cb[c]
+        bent[fill[b]] = 2 * s
+        fill[b] += 1
+        a = ca[c]
+        bent[fill[a]] = 2 * s + 1
+        fill[a] += 1
+    return bstart, bent
+
+
+@njit(cache=True, inline="always")   # (a call with this many arrays costs more than the work)
+def _block_sum(x, bpos, bforce, bmoment, sc_pos, sg, bstart, bent):
+    """``block_sums`` for block x."""
+    e0 = bstart[x]
+    e1 = bstart[x + 1]
+    if e1 == e0:
+        return
+    p0 = bpos[x, 0]
+    p1 = bpos[x, 1]
+    p2 = bpos[x, 2]
+    f0 = bforce[x, 0]
+    f1 = bforce[x, 1]
+    f2 = bforce[x, 2]
+    m0 = bmoment[x, 0]
+    m1 = bmoment[x, 1]
+    m2 = bmoment[x, 2]
+    for e in range(e0, e1):
+        code = bent[e]
+        s = code >> 1
+        g0 = sg[s, 0]
+        g1 = sg[s, 1]
+        g2 = sg[s, 2]
+        r0 = sc_pos[s, 0] - p0
+        r1 = sc_pos[s, 1] - p1
+        r2 = sc_pos[s, 2] - p2
+        if code & 1:
+            f0 -= g0
+            f1 -= g1
+            f2 -= g2
+            m0 -= r1 * g2 - r2 * g1
+            m1 -= r2 * g0 - r0 * g2
+            m2 -= r0 * g1 - r1 * g0
+        else:
+            f0 += g0
+            f1 += g1
+            f2 += g2
+            m0 += r1 * g2 - r2 * g1
+            m1 += r2 * g0 - r0 * g2
+            m2 += r0 * g1 - r1 * g0
+    bforce[x, 0] = f0
+    bforce[x, 1] = f1
+    bforce[x, 2] = f2
+    bmoment[x, 0] = m0
+    bmoment[x, 1] = m1
+    bmoment[x, 2] = m2
+
+
+@njit(cache=True, parallel=True)
+def block_sums(bpos, bforce, bmoment, sc_pos, sg, bstart, bent):
+    """Add the sub-contact forces sg (ns, 3) (on B; −sg on A) and their moments about each
+    centroid, (x − centroid) × force, to bforce/bmoment (nb, 3), in parallel over blocks: each
+    block sums its own list (``block_lists``) in its fixed order, so the sums do not depend on
+    the number of threads (and equal a serial scatter over s)."""
+    for x in prange(bstart.shape[0] - 1):
+        _block_sum(x, bpos, bforce, bmoment, sc_pos, sg, bstart, bent)
+
+
+@njit(cache=True)
+def subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment,
+                      ca, cb, cn, cmodel, cprop,
+                      sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state):
+    """One force update of every sub-contact; adds the forces and moments to the blocks.
+
+    bpos/bvel/bspin (nb, 3): centroid [m], velocity [m/s], spin [rad/s] at t − Δt/2.
+    bforce/bmoment (nb, 3): accumulated in place [N], [N·m].
+    ca, cb (nc,) block rows; cn (nc, 3) unit normal A → B; cmodel (nc,); cprop (nc, NPROP).
+    sc_* (ns, ...): contact row, position on the c-p (3), area, Fn, Fs (3), uⁿ, u_dil, uˢ (3), state.
+    Two parallel passes with fixed-order sums (``subcontact_update``, ``block_sums``): the result
+    is that of a serial loop over s adding the force on B, then on A, whatever the thread count.
+    (``cycle.run_steps`` calls the passes itself, making ``block_lists`` once per call.)
+    """
+    sg = np.empty((sc_contact.shape[0], 3))
+    subcontact_update(dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
+                      sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg)
+    bstart, bent = block_lists(bpos.shape[0], ca, cb, sc_contact)
+    block_sums(bpos, bforce, bmoment, sc_pos, sg, bstart, bent)

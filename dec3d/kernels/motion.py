@@ -98,7 +98,9 @@ Damping (``damp_mode``), with α = ``alpha`` for modes 1 and 2:
 ``out`` (4,): [0] max |F_u| over groups (fixed components left out) [N]; [1] Σ over members of
 |m g_i| + |F_i| (contact force) [N]; [2] kinetic energy with the real masses and inertia
 (½ m V² + ½ ωᵀ J ω, J from unscaled ``gprin``) [J]; [3] the viscous coefficient α_v used [1/s].
-After the step every member has vel = V + ω × (c_b − C) (new arms) and spin = ω; member centroids
+The groups move in parallel (numba ``prange``; each writes only its own rows) and the sums over
+groups (out[1], out[2], the servo's works) are taken afterwards in group order, so the numbers do
+not depend on the thread count. After the step every member has vel = V + ω × (c_b − C) (new arms) and spin = ω; member centroids
 and vertices turn about C with the Cayley rotation and move by V Δt; disp accumulates each
 member's centroid displacement; forces and moments of the members are reset to zero. A group
 whose speed |V_x|+|V_y|+|V_z| reaches ``vmax`` or whose ω is not finite does not move; the first
@@ -114,7 +116,8 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+import numpy as np
+from numba import njit, prange
 
 
 @njit(cache=True)
@@ -271,7 +274,7 @@ def _jmul(ax, p0, p1, p2, x0, x1, x2):
             ax[2, 0] * y0 + ax[2, 1] * y1 + ax[2, 2] * y2)
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
                         gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
                         mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp,
@@ -304,6 +307,236 @@ def rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
     al = alpha if (damp_mode == 1 or damp_mode == 2) else 0.0
     d1 = 1.0 - av * dt * 0.5
     d2 = 1.0 / (1.0 + av * dt * 0.5)
+    # every group in parallel (each writes only its own rows: its members, its servo tail,
+    # gaxes[g], gcentroid[g], and its terms below), then the sums in group order: the same
+    # numbers whatever the thread count, and those of one serial loop over the groups
+    fterm = np.zeros((gmember.shape[0], 3))
+    gun = np.empty(ng)
+    gke = np.empty(ng)
+    gwork = np.empty(ng)
+    gdek = np.empty(ng)
+    gok = np.empty(ng, dtype=np.bool_)
+    gon = np.empty(ng, dtype=np.bool_)
+    for g in prange(ng):
+        j0 = gstart[g]
+        j1 = gstart[g + 1]
+        gon[g] = j1 > j0
+        gok[g] = True
+        if j1 > j0:
+            lead = gmember[j0]
+            fx = fixity[lead]
+            C0 = gcentroid[g, 0]
+            C1 = gcentroid[g, 1]
+            C2 = gcentroid[g, 2]
+            F0 = 0.0
+            F1 = 0.0
+            F2 = 0.0
+            M0 = 0.0
+            M1 = 0.0
+            M2 = 0.0
+            for j in range(j0, j1):
+                b = gmember[j]
+                f0 = force[b, 0] + fapp[b, 0] + mass[b] * gravity[0]
+                f1 = force[b, 1] + fapp[b, 1] + mass[b] * gravity[1]
+                f2 = force[b, 2] + fapp[b, 2] + mass[b] * gravity[2]
+                e0 = centroid[b, 0] - C0
+                e1 = centroid[b, 1] - C1
+                e2 = centroid[b, 2] - C2
+                M0 += (moment[b, 0] + mapp[b, 0]) + (e1 * f2 - e2 * f1)
+                M1 += (moment[b, 1] + mapp[b, 1]) + (e2 * f0 - e0 * f2)
+                M2 += (moment[b, 2] + mapp[b, 2]) + (e0 * f1 - e1 * f0)
+                F0 += f0
+                F1 += f1
+                F2 += f2
+                for i in range(3):
+                    fterm[j, i] = abs(mass[b] * gravity[i]) + abs(force[b, i])
+            # state at t − Δt/2: ω shared, V at C from the leader
+            w0 = spin[lead, 0]
+            w1 = spin[lead, 1]
+            w2 = spin[lead, 2]
+            e0 = centroid[lead, 0] - C0
+            e1 = centroid[lead, 1] - C1
+            e2 = centroid[lead, 2] - C2
+            v0 = vel[lead, 0] - (w1 * e2 - w2 * e1)
+            v1 = vel[lead, 1] - (w2 * e0 - w0 * e2)
+            v2 = vel[lead, 2] - (w0 * e1 - w1 * e0)
+            mi = gimass[g]
+            ek0 = 0.5 * mi * (v0 * v0 + v1 * v1 + v2 * v2)
+            # translation (Eq. 49)
+            base = NSERVO + 6 * g
+            un2 = 0.0
+            nv0 = v0
+            nv1 = v1
+            nv2 = v2
+            for i in range(3):
+                fu = F0 if i == 0 else (F1 if i == 1 else F2)
+                v = v0 if i == 0 else (v1 if i == 1 else v2)
+                fp = 0.0
+                if damp_mode == 2:
+                    fp = servo[base + i]
+                    servo[base + i] = fu
+                if (fx >> i) & 1:
+                    fu = 0.0
+                else:
+                    fd = _ldamp(damp_mode, al, fu, v, fp, hist)
+                    nv = (d1 * v + (fu - fd) / mi * dt) * d2
+                    if i == 0:
+                        nv0 = nv
+                    elif i == 1:
+                        nv1 = nv
+                    else:
+                        nv2 = nv
+                un2 += fu * fu
+            un = math.sqrt(un2)
+            ek1 = 0.5 * mi * (nv0 * nv0 + nv1 * nv1 + nv2 * nv2)
+            # rotation
+            nw0 = w0
+            nw1 = w1
+            nw2 = w2
+            if not full_inertia:
+                isc = giscalar[g]
+                ek0 += 0.5 * isc * (w0 * w0 + w1 * w1 + w2 * w2)
+                for i in range(3):
+                    mu = M0 if i == 0 else (M1 if i == 1 else M2)
+                    w = w0 if i == 0 else (w1 if i == 1 else w2)
+                    mp = 0.0
+                    if damp_mode == 2:
+                        mp = servo[base + 3 + i]
+                        servo[base + 3 + i] = mu
+                    if not (fx >> (3 + i)) & 1:
+                        md = _ldamp(damp_mode, al, mu, w, mp, hist)
+                        nw = (d1 * w + (mu - md) / isc * dt) * d2
+                        if i == 0:
+                            nw0 = nw
+                        elif i == 1:
+                            nw1 = nw
+                        else:
+                            nw2 = nw
+                ek1 += 0.5 * isc * (nw0 * nw0 + nw1 * nw1 + nw2 * nw2)
+            else:
+                rs = gimass[g] / gmass[g]
+                p0 = gprin[g, 0] * rs
+                p1 = gprin[g, 1] * rs
+                p2 = gprin[g, 2] * rs
+                ax = gaxes[g]
+                # L(t − Δt/2) = Pᵀ J(t) ω, P the half of the last rotation
+                b0, b1, b2 = _half(0.5 * dt * w0, 0.5 * dt * w1, 0.5 * dt * w2)
+                y0, y1, y2 = _jmul(ax, p0, p1, p2, w0, w1, w2)
+                L0, L1, L2 = _cay(-b0, -b1, -b2, y0, y1, y2)
+                ek0 += 0.5 * (w0 * L0 + w1 * L1 + w2 * L2)
+                for i in range(3):
+                    mu = M0 if i == 0 else (M1 if i == 1 else M2)
+                    w = w0 if i == 0 else (w1 if i == 1 else w2)
+                    mp = 0.0
+                    if damp_mode == 2:
+                        mp = servo[base + 3 + i]
+                        servo[base + 3 + i] = mu
+                    if not (fx >> (3 + i)) & 1:
+                        md = _ldamp(damp_mode, al, mu, w, mp, hist)
+                        if i == 0:
+                            L0 = (d1 * L0 + (mu - md) * dt) * d2
+                        elif i == 1:
+                            L1 = (d1 * L1 + (mu - md) * dt) * d2
+                        else:
+                            L2 = (d1 * L2 + (mu - md) * dt) * d2
+                # ω(t + Δt/2): J(t) ω = Pᵀ(ω) L by fixed-point iteration
+                q0 = 1.0 / p0
+                q1 = 1.0 / p1
+                q2 = 1.0 / p2
+                nw0, nw1, nw2 = _jmul(ax, q0, q1, q2, L0, L1, L2)
+                for it in range(60):
+                    b0, b1, b2 = _half(0.5 * dt * nw0, 0.5 * dt * nw1, 0.5 * dt * nw2)
+                    x0, x1, x2 = _cay(-b0, -b1, -b2, L0, L1, L2)
+                    u0, u1, u2 = _jmul(ax, q0, q1, q2, x0, x1, x2)
+                    dw = abs(u0 - nw0) + abs(u1 - nw1) + abs(u2 - nw2)
+                    nw0 = u0
+                    nw1 = u1
+                    nw2 = u2
+                    if not dw > 1e-15 * (abs(u0) + abs(u1) + abs(u2)):
+                        break
+                if (fx >> 3) & 1:
+                    nw0 = w0
+                if (fx >> 4) & 1:
+                    nw1 = w1
+                if (fx >> 5) & 1:
+                    nw2 = w2
+                ek1 += 0.5 * (nw0 * L0 + nw1 * L1 + nw2 * L2)
+            wterm = 0.0
+            dterm = 0.0
+            if damp_mode == 3:
+                wterm = av * dt * (ek0 + ek1)
+                dterm = abs(ek1 - ek0)
+            # real kinetic energy at t + Δt/2
+            y0, y1, y2 = _jmul(gaxes[g], gprin[g, 0], gprin[g, 1], gprin[g, 2], nw0, nw1, nw2)
+            kterm = 0.5 * gmass[g] * (nv0 * nv0 + nv1 * nv1 + nv2 * nv2) + 0.5 * (nw0 * y0 + nw1 * y1 + nw2 * y2)
+            sp = abs(nv0) + abs(nv1) + abs(nv2)
+            ok = sp < vmax and math.isfinite(nw0 + nw1 + nw2)
+            gun[g] = un
+            gke[g] = kterm
+            gwork[g] = wterm
+            gdek[g] = dterm
+            gok[g] = ok
+            if not ok:
+                for j in range(j0, j1):
+                    b = gmember[j]
+                    vel[b, 0] = nv0
+                    vel[b, 1] = nv1
+                    vel[b, 2] = nv2
+                    spin[b, 0] = nw0
+                    spin[b, 1] = nw1
+                    spin[b, 2] = nw2
+            else:
+                dx0 = nv0 * dt
+                dx1 = nv1 * dt
+                dx2 = nv2 * dt
+                a0 = 0.5 * nw0 * dt
+                a1 = 0.5 * nw1 * dt
+                a2 = 0.5 * nw2 * dt
+                h = 2.0 / (1.0 + a0 * a0 + a1 * a1 + a2 * a2)
+                for j in range(j0, j1):
+                    b = gmember[j]
+                    for v in range(vstart[b], vstart[b] + vcount[b]):
+                        r0 = vpos[v, 0] - C0
+                        r1 = vpos[v, 1] - C1
+                        r2 = vpos[v, 2] - C2
+                        s0 = r0 + (a1 * r2 - a2 * r1)
+                        s1 = r1 + (a2 * r0 - a0 * r2)
+                        s2 = r2 + (a0 * r1 - a1 * r0)
+                        vpos[v, 0] = C0 + dx0 + r0 + h * (a1 * s2 - a2 * s1)
+                        vpos[v, 1] = C1 + dx1 + r1 + h * (a2 * s0 - a0 * s2)
+                        vpos[v, 2] = C2 + dx2 + r2 + h * (a0 * s1 - a1 * s0)
+                    r0 = centroid[b, 0] - C0
+                    r1 = centroid[b, 1] - C1
+                    r2 = centroid[b, 2] - C2
+                    s0 = r0 + (a1 * r2 - a2 * r1)
+                    s1 = r1 + (a2 * r0 - a0 * r2)
+                    s2 = r2 + (a0 * r1 - a1 * r0)
+                    t0 = h * (a1 * s2 - a2 * s1)
+                    t1 = h * (a2 * s0 - a0 * s2)
+                    t2 = h * (a0 * s1 - a1 * s0)
+                    centroid[b, 0] = C0 + dx0 + r0 + t0
+                    centroid[b, 1] = C1 + dx1 + r1 + t1
+                    centroid[b, 2] = C2 + dx2 + r2 + t2
+                    disp[b, 0] += dx0 + t0
+                    disp[b, 1] += dx1 + t1
+                    disp[b, 2] += dx2 + t2
+                    e0 = r0 + t0
+                    e1 = r1 + t1
+                    e2 = r2 + t2
+                    vel[b, 0] = nv0 + (nw1 * e2 - nw2 * e1)
+                    vel[b, 1] = nv1 + (nw2 * e0 - nw0 * e2)
+                    vel[b, 2] = nv2 + (nw0 * e1 - nw1 * e0)
+                    spin[b, 0] = nw0
+                    spin[b, 1] = nw1
+                    spin[b, 2] = nw2
+                for k in range(3):
+                    x0, x1, x2 = _cay(a0, a1, a2, gaxes[g, 0, k], gaxes[g, 1, k], gaxes[g, 2, k])
+                    gaxes[g, 0, k] = x0
+                    gaxes[g, 1, k] = x1
+                    gaxes[g, 2, k] = x2
+                gcentroid[g, 0] = C0 + dx0
+                gcentroid[g, 1] = C1 + dx1
+                gcentroid[g, 2] = C2 + dx2
     fmax = 0.0
     fsum = 0.0
     ke = 0.0
@@ -311,222 +544,20 @@ def rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
     dek = 0.0
     bad = -1
     for g in range(ng):
-        j0 = gstart[g]
-        j1 = gstart[g + 1]
-        if j1 <= j0:
+        if not gon[g]:
             continue
-        lead = gmember[j0]
-        fx = fixity[lead]
-        C0 = gcentroid[g, 0]
-        C1 = gcentroid[g, 1]
-        C2 = gcentroid[g, 2]
-        F0 = 0.0
-        F1 = 0.0
-        F2 = 0.0
-        M0 = 0.0
-        M1 = 0.0
-        M2 = 0.0
-        for j in range(j0, j1):
-            b = gmember[j]
-            f0 = force[b, 0] + fapp[b, 0] + mass[b] * gravity[0]
-            f1 = force[b, 1] + fapp[b, 1] + mass[b] * gravity[1]
-            f2 = force[b, 2] + fapp[b, 2] + mass[b] * gravity[2]
-            e0 = centroid[b, 0] - C0
-            e1 = centroid[b, 1] - C1
-            e2 = centroid[b, 2] - C2
-            M0 += (moment[b, 0] + mapp[b, 0]) + (e1 * f2 - e2 * f1)
-            M1 += (moment[b, 1] + mapp[b, 1]) + (e2 * f0 - e0 * f2)
-            M2 += (moment[b, 2] + mapp[b, 2]) + (e0 * f1 - e1 * f0)
-            F0 += f0
-            F1 += f1
-            F2 += f2
+        if gun[g] > fmax:
+            fmax = gun[g]
+        for j in range(gstart[g], gstart[g + 1]):
             for i in range(3):
-                fsum += abs(mass[b] * gravity[i]) + abs(force[b, i])
-        # state at t − Δt/2: ω shared, V at C from the leader
-        w0 = spin[lead, 0]
-        w1 = spin[lead, 1]
-        w2 = spin[lead, 2]
-        e0 = centroid[lead, 0] - C0
-        e1 = centroid[lead, 1] - C1
-        e2 = centroid[lead, 2] - C2
-        v0 = vel[lead, 0] - (w1 * e2 - w2 * e1)
-        v1 = vel[lead, 1] - (w2 * e0 - w0 * e2)
-        v2 = vel[lead, 2] - (w0 * e1 - w1 * e0)
-        mi = gimass[g]
-        ek0 = 0.5 * mi * (v0 * v0 + v1 * v1 + v2 * v2)
-        # translation (Eq. 49)
-        base = NSERVO + 6 * g
-        un2 = 0.0
-        nv0 = v0
-        nv1 = v1
-        nv2 = v2
-        for i in range(3):
-            fu = F0 if i == 0 else (F1 if i == 1 else F2)
-            v = v0 if i == 0 else (v1 if i == 1 else v2)
-            fp = 0.0
-            if damp_mode == 2:
-                fp = servo[base + i]
-                servo[base + i] = fu
-            if (fx >> i) & 1:
-                fu = 0.0
-            else:
-                fd = _ldamp(damp_mode, al, fu, v, fp, hist)
-                nv = (d1 * v + (fu - fd) / mi * dt) * d2
-                if i == 0:
-                    nv0 = nv
-                elif i == 1:
-                    nv1 = nv
-                else:
-                    nv2 = nv
-            un2 += fu * fu
-        un = math.sqrt(un2)
-        if un > fmax:
-            fmax = un
-        ek1 = 0.5 * mi * (nv0 * nv0 + nv1 * nv1 + nv2 * nv2)
-        # rotation
-        nw0 = w0
-        nw1 = w1
-        nw2 = w2
-        if not full_inertia:
-            isc = giscalar[g]
-            ek0 += 0.5 * isc * (w0 * w0 + w1 * w1 + w2 * w2)
-            for i in range(3):
-                mu = M0 if i == 0 else (M1 if i == 1 else M2)
-                w = w0 if i == 0 else (w1 if i == 1 else w2)
-                mp = 0.0
-                if damp_mode == 2:
-                    mp = servo[base + 3 + i]
-                    servo[base + 3 + i] = mu
-                if not (fx >> (3 + i)) & 1:
-                    md = _ldamp(damp_mode, al, mu, w, mp, hist)
-                    nw = (d1 * w + (mu - md) / isc * dt) * d2
-                    if i == 0:
-                        nw0 = nw
-                    elif i == 1:
-                        nw1 = nw
-                    else:
-                        nw2 = nw
-            ek1 += 0.5 * isc * (nw0 * nw0 + nw1 * nw1 + nw2 * nw2)
-        else:
-            rs = gimass[g] / gmass[g]
-            p0 = gprin[g, 0] * rs
-            p1 = gprin[g, 1] * rs
-            p2 = gprin[g, 2] * rs
-            ax = gaxes[g]
-            # L(t − Δt/2) = Pᵀ J(t) ω, P the half of the last rotation
-            b0, b1, b2 = _half(0.5 * dt * w0, 0.5 * dt * w1, 0.5 * dt * w2)
-            y0, y1, y2 = _jmul(ax, p0, p1, p2, w0, w1, w2)
-            L0, L1, L2 = _cay(-b0, -b1, -b2, y0, y1, y2)
-            ek0 += 0.5 * (w0 * L0 + w1 * L1 + w2 * L2)
-            for i in range(3):
-                mu = M0 if i == 0 else (M1 if i == 1 else M2)
-                w = w0 if i == 0 else (w1 if i == 1 else w2)
-                mp = 0.0
-                if damp_mode == 2:
-                    mp = servo[base + 3 + i]
-                    servo[base + 3 + i] = mu
-                if not (fx >> (3 + i)) & 1:
-                    md = _ldamp(damp_mode, al, mu, w, mp, hist)
-                    if i == 0:
-                        L0 = (d1 * L0 + (mu - md) * dt) * d2
-                    elif i == 1:
-                        L1 = (d1 * L1 + (mu - md) * dt) * d2
-                    else:
-                        L2 = (d1 * L2 + (mu - md) * dt) * d2
-            # ω(t + Δt/2): J(t) ω = Pᵀ(ω) L by fixed-point iteration
-            q0 = 1.0 / p0
-            q1 = 1.0 / p1
-            q2 = 1.0 / p2
-            nw0, nw1, nw2 = _jmul(ax, q0, q1, q2, L0, L1, L2)
-            for it in range(60):
-                b0, b1, b2 = _half(0.5 * dt * nw0, 0.5 * dt * nw1, 0.5 * dt * nw2)
-                x0, x1, x2 = _cay(-b0, -b1, -b2, L0, L1, L2)
-                u0, u1, u2 = _jmul(ax, q0, q1, q2, x0, x1, x2)
-                dw = abs(u0 - nw0) + abs(u1 - nw1) + abs(u2 - nw2)
-                nw0 = u0
-                nw1 = u1
-                nw2 = u2
-                if not dw > 1e-15 * (abs(u0) + abs(u1) + abs(u2)):
-                    break
-            if (fx >> 3) & 1:
-                nw0 = w0
-            if (fx >> 4) & 1:
-                nw1 = w1
-            if (fx >> 5) & 1:
-                nw2 = w2
-            ek1 += 0.5 * (nw0 * L0 + nw1 * L1 + nw2 * L2)
+                fsum += fterm[j, i]
         if damp_mode == 3:
-            work += av * dt * (ek0 + ek1)
-            dek += abs(ek1 - ek0)
-        # real kinetic energy at t + Δt/2
-        y0, y1, y2 = _jmul(gaxes[g], gprin[g, 0], gprin[g, 1], gprin[g, 2], nw0, nw1, nw2)
-        ke += 0.5 * gmass[g] * (nv0 * nv0 + nv1 * nv1 + nv2 * nv2) + 0.5 * (nw0 * y0 + nw1 * y1 + nw2 * y2)
-        sp = abs(nv0) + abs(nv1) + abs(nv2)
-        ok = sp < vmax and math.isfinite(nw0 + nw1 + nw2)
-        if not ok:
-            if bad < 0:
-                bad = g
-            for j in range(j0, j1):
-                b = gmember[j]
-                vel[b, 0] = nv0
-                vel[b, 1] = nv1
-                vel[b, 2] = nv2
-                spin[b, 0] = nw0
-                spin[b, 1] = nw1
-                spin[b, 2] = nw2
-            continue
-        dx0 = nv0 * dt
-        dx1 = nv1 * dt
-        dx2 = nv2 * dt
-        a0 = 0.5 * nw0 * dt
-        a1 = 0.5 * nw1 * dt
-        a2 = 0.5 * nw2 * dt
-        h = 2.0 / (1.0 + a0 * a0 + a1 * a1 + a2 * a2)
-        for j in range(j0, j1):
-            b = gmember[j]
-            for v in range(vstart[b], vstart[b] + vcount[b]):
-                r0 = vpos[v, 0] - C0
-                r1 = vpos[v, 1] - C1
-                r2 = vpos[v, 2] - C2
-                s0 = r0 + (a1 * r2 - a2 * r1)
-                s1 = r1 + (a2 * r0 - a0 * r2)
-                s2 = r2 + (a0 * r1 - a1 * r0)
-                vpos[v, 0] = C0 + dx0 + r0 + h * (a1 * s2 - a2 * s1)
-                vpos[v, 1] = C1 + dx1 + r1 + h * (a2 * s0 - a0 * s2)
-                vpos[v, 2] = C2 + dx2 + r2 + h * (a0 * s1 - a1 * s0)
-            r0 = centroid[b, 0] - C0
-            r1 = centroid[b, 1] - C1
-            r2 = centroid[b, 2] - C2
-            s0 = r0 + (a1 * r2 - a2 * r1)
-            s1 = r1 + (a2 * r0 - a0 * r2)
-            s2 = r2 + (a0 * r1 - a1 * r0)
-            t0 = h * (a1 * s2 - a2 * s1)
-            t1 = h * (a2 * s0 - a0 * s2)
-            t2 = h * (a0 * s1 - a1 * s0)
-            centroid[b, 0] = C0 + dx0 + r0 + t0
-            centroid[b, 1] = C1 + dx1 + r1 + t1
-            centroid[b, 2] = C2 + dx2 + r2 + t2
-            disp[b, 0] += dx0 + t0
-            disp[b, 1] += dx1 + t1
-            disp[b, 2] += dx2 + t2
-            e0 = r0 + t0
-            e1 = r1 + t1
-            e2 = r2 + t2
-            vel[b, 0] = nv0 + (nw1 * e2 - nw2 * e1)
-            vel[b, 1] = nv1 + (nw2 * e0 - nw0 * e2)
-            vel[b, 2] = nv2 + (nw0 * e1 - nw1 * e0)
-            spin[b, 0] = nw0
-            spin[b, 1] = nw1
-            spin[b, 2] = nw2
-        for k in range(3):
-            x0, x1, x2 = _cay(a0, a1, a2, gaxes[g, 0, k], gaxes[g, 1, k], gaxes[g, 2, k])
-            gaxes[g, 0, k] = x0
-            gaxes[g, 1, k] = x1
-            gaxes[g, 2, k] = x2
-        gcentroid[g, 0] = C0 + dx0
-        gcentroid[g, 1] = C1 + dx1
-        gcentroid[g, 2] = C2 + dx2
-    for j in range(gstart[0], gstart[ng]):
+            work += gwork[g]
+            dek += gdek[g]
+        ke += gke[g]
+        if not gok[g] and bad < 0:
+            bad = g
+    for j in prange(gstart[0], gstart[ng]):
         b = gmember[j]
         for i in range(3):
             force[b, i] = 0.0

@@ -343,13 +343,18 @@ class ContactDetection:
         counts[~kept_c], base[~kept_c] = f_count[fi[~kept_c]], ss.n + f_start[fi[~kept_c]]
         starts = (np.cumsum(counts) - counts).astype(_I)
         total = int(counts.sum())
-        src = np.repeat(base - starts, counts) + np.arange(total, dtype=_I)
         owner = np.repeat(np.arange(nc, dtype=_I), counts)
-        pool = {"kind": (ss["kind"], kind), "key0": (ss["key0"], key0), "key1": (ss["key1"], key1),
-                "pos": (ss["pos"], pos), "area": (ss["area"], area), "fn": (ss["fn"], np.zeros(ns)),
-                "fs": (ss["fs"], fs), "un": (ss["un"], un), "udil": (ss["udil"], udil), "us": (ss["us"], us),
-                "state": (ss["state"], state)}
-        sub = {key: np.concatenate(pair)[src] for key, pair in pool.items()}
+        # nothing recomputed and every old sub-contact kept in place (a quiet model): the rows
+        # stay as they are (the gather below would copy each of them onto itself)
+        same = nf == 0 and total == ss.n and np.array_equal(base, starts)
+        sub = {}
+        if not same:
+            src = np.repeat(base - starts, counts) + np.arange(total, dtype=_I)
+            pool = {"kind": (ss["kind"], kind), "key0": (ss["key0"], key0), "key1": (ss["key1"], key1),
+                    "pos": (ss["pos"], pos), "area": (ss["area"], area), "fn": (ss["fn"], np.zeros(ns)),
+                    "fs": (ss["fs"], fs), "un": (ss["un"], un), "udil": (ss["udil"], udil), "us": (ss["us"], us),
+                    "state": (ss["state"], state)}
+            sub = {key: np.concatenate(pair)[src] for key, pair in pool.items()}
         self.timings["subcontacts"] += _time.perf_counter() - t1
         # install
         cs.clear()
@@ -358,8 +363,9 @@ class ContactDetection:
                          ("normal", normal), ("gap", cgap), ("type", ctyp), ("jmodel", jcode), ("prop", prop),
                          ("own_props", own), ("sub_start", starts), ("sub_count", counts), ("group", group)):
             cs[key][...] = val
-        ss.clear()
-        ss.append(total)
+        if not same:
+            ss.clear()
+            ss.append(total)
         ss["contact"][...] = owner
         for key, val in sub.items():
             ss[key][...] = val

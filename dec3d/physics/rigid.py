@@ -840,8 +840,10 @@ class RigidEngine(ContactDetection):
         tot = (t["detect"] + t["cycle"] + t["hooks"]) or 1e-30
         rows = [("detection", t["detect"]), ("  neighbour search", t["search"]),
                 ("  sub-contacts", t["subcontacts"]), ("cycle kernel", t["cycle"]), ("histories, VTK", t["hooks"])]
+        from dec3d.config import thread_report
+
         return "\n".join([f"{'phase':<20}{'seconds':>9}{'share':>8}"] +
-                         [f"{k:<20}{v:9.3f}{100 * v / tot:7.1f}%" for k, v in rows])
+                         [f"{k:<20}{v:9.3f}{100 * v / tot:7.1f}%" for k, v in rows] + [thread_report()])
 
 
 def _orthonormal(a: np.ndarray) -> np.ndarray:
