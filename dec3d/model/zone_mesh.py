@@ -261,16 +261,24 @@ def conformity(model) -> dict:
 
 
 def mesh_quality(model, block_rows=None) -> dict:
-    """Figures of the zoning (for ``block zone list information``): zones (a hexahedral zone
-    counts once), tetrahedra (zone rows), gridpoints (linked copies counted once), smallest and
-    largest zone edge [m], smallest dihedral angle [degrees] and smallest zone volume [m³] (of the
-    4-node tetrahedra or the corner tetrahedra of 10-node ones), over the blocks ``block_rows``
-    (all zoned blocks when None)."""
-    from dec3d.geometry.zoning import tet_min_dihedral
+    """Figures of the zoning over the blocks ``block_rows`` (all zoned blocks when None): those of
+    ``zone_quality.mesh_information`` (the one implementation, used by ``block zone list
+    information``), with ``zones`` counting a hexahedral zone once and ``tetrahedra`` the zone rows."""
+    from .zone_quality import mesh_information
     out = {"zones": 0, "tetrahedra": 0, "gridpoints": 0, "edge_min": None, "edge_max": None,
            "dihedral_min": None, "volume_min": None}
     if "zones" not in model.stores or model.store("zones").n == 0:
         return out
+    zs = model.store("zones")
+    sel = np.ones(zs.n, bool) if block_rows is None else np.isin(zs["block"][: zs.n], block_rows)
+    rows = np.flatnonzero(sel)
+    if rows.size == 0:
+        return out
+    out.update(mesh_information(model, rows))
+    hexid = zs["hex"][rows]
+    out["tetrahedra"] = int(rows.size)
+    out["zones"] = int((hexid < 0).sum() + len(np.unique(hexid[hexid >= 0])))
+    return out
     zs, v = model.store("zones"), model.vertices
     sel = np.ones(zs.n, bool) if block_rows is None else np.isin(zs["block"][: zs.n], block_rows)
     if not sel.any():
