@@ -22,7 +22,8 @@ def test_every_verification_problem_is_there():
                                          "R5_stack", "R6_joint_shear", "R7_spinning_block",
                                          "S1_fredlund_krahn_slope", "S1_ru025", "S2_kim_dam",
                                          "D1_uniaxial_tet", "D1_uniaxial_hex", "D2_self_weight", "D3_elastic_hole_tet",
-                                         "D3_elastic_hole_hex", "D3_elastic_hole_ho"}
+                                         "D3_elastic_hole_hex", "D3_elastic_hole_ho",
+                                         "D7_rigid_on_deformable"}
 
 
 def _demo(tmp_path, expects: str):
