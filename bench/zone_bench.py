@@ -29,7 +29,6 @@ import argparse
 import json
 import os
 import statistics
-import subprocess
 import sys
 import time
 
@@ -140,7 +139,7 @@ def main(argv=None) -> int:
         print(json.dumps(one(args.child, args.steps, args.child_threads or None)))
         return 0
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    from rigid_bench import machine
+    from rigid_bench import machine, run_children
 
     print(f"machine: {machine()}")
     print(f"loadavg before: {loadavg()}")
@@ -150,15 +149,9 @@ def main(argv=None) -> int:
           f"{'zone-cyc/s':>11} {'zones B/z':>9} {'gp B/z':>7} {'step B/z':>8} {'total B/z':>9} {'RSS B/z':>8}")
     for th in args.threads:
         for n in args.zones:
-            runs = []
-            for _ in range(args.repeat):
-                out = subprocess.run([sys.executable, os.path.abspath(__file__), "--child", str(n),
-                                      "--steps", str(args.steps), "--child-threads", str(th)],
-                                     capture_output=True, text=True)
-                if out.returncode != 0:
-                    sys.stderr.write(out.stderr)
-                    raise SystemExit(f"zones = {n:g}: the run failed (exit {out.returncode})")
-                runs.append(json.loads(out.stdout.strip().splitlines()[-1]))
+            runs = run_children([sys.executable, os.path.abspath(__file__), "--child", str(n),
+                                 "--steps", str(args.steps), "--child-threads", str(th)],
+                                args.repeat, f"zones = {n:g}")
             sec = [r["seconds"] for r in runs]
             t = statistics.median(sec)
             r0 = runs[0]

@@ -279,22 +279,3 @@ def mesh_quality(model, block_rows=None) -> dict:
     out["tetrahedra"] = int(rows.size)
     out["zones"] = int((hexid < 0).sum() + len(np.unique(hexid[hexid >= 0])))
     return out
-    zs, v = model.store("zones"), model.vertices
-    sel = np.ones(zs.n, bool) if block_rows is None else np.isin(zs["block"][: zs.n], block_rows)
-    if not sel.any():
-        return out
-    gp = zs["gp"][: zs.n][sel]
-    hexid = zs["hex"][: zs.n][sel]
-    out["tetrahedra"] = int(sel.sum())
-    out["zones"] = int((hexid < 0).sum() + len(np.unique(hexid[hexid >= 0])))
-    used = np.unique(gp[gp >= 0])
-    link = v["link"][used]
-    out["gridpoints"] = int(len(np.unique(np.where(link >= 0, link, used))))
-    pos = v["pos"]
-    c = gp[:, :4]
-    e = np.concatenate([np.linalg.norm(pos[c[:, i]] - pos[c[:, j]], axis=1)
-                        for i, j in ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))])
-    out["edge_min"], out["edge_max"] = float(e.min()), float(e.max())
-    out["dihedral_min"] = float(np.degrees(tet_min_dihedral(pos, c).min()))
-    out["volume_min"] = float(zs["volume"][: zs.n][sel].min())
-    return out
