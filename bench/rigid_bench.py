@@ -175,6 +175,20 @@ def machine() -> str:
     return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, {platform.system()} {platform.release()}"
 
 
+def run_children(cmd: list, repeat: int, what: str) -> list:
+    """Run ``cmd`` (a bench script in ``--child`` mode) ``repeat`` times, each a fresh process,
+    and return the JSON dicts each printed on its last line; stop with the child's stderr when a
+    run fails (``what`` names the size in the message)."""
+    runs = []
+    for _ in range(repeat):
+        out = subprocess.run(cmd, capture_output=True, text=True)
+        if out.returncode != 0:
+            sys.stderr.write(out.stderr)
+            raise SystemExit(f"{what}: the run failed (exit {out.returncode})")
+        runs.append(json.loads(out.stdout.strip().splitlines()[-1]))
+    return runs
+
+
 def _fmt(x) -> str:
     return "n/a" if x is None else str(x)
 
@@ -218,18 +232,12 @@ def main() -> int:
     print(f"{'n':>3} {'blocks':>7} {'contacts':>8} {'subcont':>8} {'build s':>8} {'warmup s':>8} "
           f"{'seconds':>8} {'min..max':>15} {'blk-cyc/s':>10} {'subc-upd/s':>11} {'peak MiB':>9}")
     for n in args.n:
-        runs = []
-        for _ in range(args.repeat):
-            out = subprocess.run([sys.executable, os.path.abspath(__file__), "--child", str(n),
-                                  "--steps", str(args.steps), "--jmodel", args.jmodel]
-                                 + (["--full-detection"] if args.full_detection else [])
-                                 + (["--threads", str(args.threads)] if args.threads else [])
-                                 + (["--dynamic"] if args.dynamic else []),
-                                 capture_output=True, text=True)
-            if out.returncode != 0:
-                sys.stderr.write(out.stderr)
-                raise SystemExit(f"n = {n}: the run failed (exit {out.returncode})")
-            runs.append(json.loads(out.stdout.strip().splitlines()[-1]))
+        runs = run_children([sys.executable, os.path.abspath(__file__), "--child", str(n),
+                             "--steps", str(args.steps), "--jmodel", args.jmodel]
+                            + (["--full-detection"] if args.full_detection else [])
+                            + (["--threads", str(args.threads)] if args.threads else [])
+                            + (["--dynamic"] if args.dynamic else []),
+                            args.repeat, f"n = {n}")
         sec = [r["seconds"] for r in runs]
         t = statistics.median(sec)
         r0 = runs[0]

@@ -51,3 +51,46 @@ def test_rigid_bench_equilibrium_check_on_one_cube():
         assert not rb.at_equilibrium(s)[0]          # no contact yet: reaction 0
         s.command(f"model cycle {r['steps']}")
         assert abs(rb.base_reaction(s) - 2600 * 9.81) <= 1e-3 * 2600 * 9.81
+
+
+def test_zone_bench_runs_and_prints_its_figures():
+    """bench/zone_bench.py on two tiny cubes, one thread: the header and one row per size with a
+    positive zone-cycle rate and memory per zone (no timing asserted)."""
+    out = subprocess.run([sys.executable, str(ROOT / "bench" / "zone_bench.py"), "--zones", "150", "1500",
+                          "--steps", "3", "--repeat", "1", "--threads", "1"], capture_output=True, text=True,
+                         timeout=300, cwd=ROOT,
+                         env={**os.environ, "PYTHONPATH": os.pathsep.join(
+                             [str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])})
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert lines[0].startswith("machine: ") and lines[1].startswith("loadavg before: ")
+    assert lines[-1].startswith("loadavg after: ")
+    head = next(i for i, ln in enumerate(lines) if ln.split()[:2] == ["threads", "zones"])
+    for word in ("zone-cyc/s", "zones B/z", "total B/z", "RSS B/z"):
+        assert word in lines[head]
+    rows = [ln.split() for ln in lines[head + 1:-1]]
+    assert len(rows) == 2 and [r[0] for r in rows] == ["1", "1"]
+    small, large = int(rows[0][1]), int(rows[1][1])
+    assert 0 < small < large                      # more zones asked, more zones made
+    for r in rows:
+        assert float(r[6]) > 0                    # zone-cycles/s
+        # the zones store alone is more than the 4 gridpoint indices and the stress tensor
+        assert float(r[7]) >= 4 * 8 + 6 * 8
+        # total = zones store + gridpoints + stepper, within the rounding of the printed columns
+        assert abs(float(r[10]) - float(r[7]) - float(r[8]) - float(r[9])) <= 1.5
+
+
+def test_zone_bench_edge_length_gives_about_the_zones_asked():
+    """The edge length formula against the mesher itself: within 25 % of the asked count."""
+    sys.path.insert(0, str(ROOT / "bench"))
+    try:
+        import zone_bench as zb
+    finally:
+        sys.path.pop(0)
+    import numpy as np
+
+    from dec3d.geometry.zoning import mesh_convex
+    v = np.array([[x, y, z] for z in (0, 1) for y in (0, 1) for x in (0, 1)], float)
+    loops = np.array([[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]]).ravel()
+    _pts, tets, _tris, _src = mesh_convex(v, np.arange(0, 25, 4), loops, zb.edge_length(2e4))
+    assert abs(len(tets) / 2e4 - 1) < 0.25

@@ -99,12 +99,14 @@ def _emit(k, out_contact, out_kind, out_key0, out_key1, out_pos, out_area,
 def make_scratch(maxv, maxf, maxfv):
     """Scratch buffers of ``subcontacts_one`` for blocks of at most maxv vertices, maxf
     faces and maxfv face-loop entries (plain numpy; also called inside the batch kernel)."""
-    return _scratch(maxv, maxf, maxfv)
+    return _scratch(maxv, maxf, maxfv, maxfv * maxfv)
 
 
 @njit(cache=True)
-def _scratch(maxv, maxf, maxfv):
-    ncr = max(maxfv * maxfv, 1)
+def _scratch(maxv, maxf, maxfv, ncr):
+    """ncr: room for edge-edge crossings, at most the product of the two blocks' face-loop
+    entries of a contact (each side has at most that many distinct edges)."""
+    ncr = max(ncr, 1)
     nbuf = 2 * max(maxv, maxfv) + 8
     return (np.zeros((2, maxv, 2)),            # 0 sxy: 2-D coords of each block vertex
             np.zeros((2, maxv), np.int64),     # 1 tv: touching vertices (local index)
@@ -460,17 +462,26 @@ def subcontacts_batch(vpos, bvstart, bvcount, bfstart, bfcount, fvstart, fnvert,
     the c-p), out_area (cap,) m², ordered by contact row then kind then loop order, and
     nothing beyond cap = len(out_contact). Returns the number of sub-contacts needed.
     """
+    # scratch sized by the blocks of the contacts only, the crossings by the largest product of
+    # the two sides' face-loop entries: sizing them by the largest block of the model squared
+    # asked for 10^10 crossing rows once a block was zoned into 10^5 tetrahedra
     maxv = np.int64(1)
     maxf = np.int64(1)
     maxfv = np.int64(1)
+    ncr = np.int64(1)
+    nfv = np.zeros(bvstart.shape[0], np.int64)
     for b in range(bvstart.shape[0]):
-        maxv = max(maxv, bvcount[b])
-        maxf = max(maxf, bfcount[b])
         m = 0
         for f in range(bfstart[b], bfstart[b] + bfcount[b]):
             m += fnvert[f]
-        maxfv = max(maxfv, m)
-    scratch = _scratch(maxv, maxf, maxfv)
+        nfv[b] = m
+    for i in range(ca.shape[0]):
+        for b in (ca[i], cb[i]):
+            maxv = max(maxv, bvcount[b])
+            maxf = max(maxf, bfcount[b])
+            maxfv = max(maxfv, nfv[b])
+        ncr = max(ncr, nfv[ca[i]] * nfv[cb[i]])
+    scratch = _scratch(maxv, maxf, maxfv, ncr)
     k = np.int64(0)
     for i in range(ca.shape[0]):
         k = subcontacts_one(i, ca[i], cb[i], cn[i], cc[i], ctol, point_area, vpos, bvstart,

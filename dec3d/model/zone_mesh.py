@@ -261,32 +261,21 @@ def conformity(model) -> dict:
 
 
 def mesh_quality(model, block_rows=None) -> dict:
-    """Figures of the zoning (for ``block zone list information``): zones (a hexahedral zone
-    counts once), tetrahedra (zone rows), gridpoints (linked copies counted once), smallest and
-    largest zone edge [m], smallest dihedral angle [degrees] and smallest zone volume [m³] (of the
-    4-node tetrahedra or the corner tetrahedra of 10-node ones), over the blocks ``block_rows``
-    (all zoned blocks when None)."""
-    from dec3d.geometry.zoning import tet_min_dihedral
+    """Figures of the zoning over the blocks ``block_rows`` (all zoned blocks when None): those of
+    ``zone_quality.mesh_information`` (the one implementation, used by ``block zone list
+    information``), with ``zones`` counting a hexahedral zone once and ``tetrahedra`` the zone rows."""
+    from .zone_quality import mesh_information
     out = {"zones": 0, "tetrahedra": 0, "gridpoints": 0, "edge_min": None, "edge_max": None,
            "dihedral_min": None, "volume_min": None}
     if "zones" not in model.stores or model.store("zones").n == 0:
         return out
-    zs, v = model.store("zones"), model.vertices
+    zs = model.store("zones")
     sel = np.ones(zs.n, bool) if block_rows is None else np.isin(zs["block"][: zs.n], block_rows)
-    if not sel.any():
+    rows = np.flatnonzero(sel)
+    if rows.size == 0:
         return out
-    gp = zs["gp"][: zs.n][sel]
-    hexid = zs["hex"][: zs.n][sel]
-    out["tetrahedra"] = int(sel.sum())
+    out.update(mesh_information(model, rows))
+    hexid = zs["hex"][rows]
+    out["tetrahedra"] = int(rows.size)
     out["zones"] = int((hexid < 0).sum() + len(np.unique(hexid[hexid >= 0])))
-    used = np.unique(gp[gp >= 0])
-    link = v["link"][used]
-    out["gridpoints"] = int(len(np.unique(np.where(link >= 0, link, used))))
-    pos = v["pos"]
-    c = gp[:, :4]
-    e = np.concatenate([np.linalg.norm(pos[c[:, i]] - pos[c[:, j]], axis=1)
-                        for i, j in ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))])
-    out["edge_min"], out["edge_max"] = float(e.min()), float(e.max())
-    out["dihedral_min"] = float(np.degrees(tet_min_dihedral(pos, c).min()))
-    out["volume_min"] = float(zs["volume"][: zs.n][sel].min())
     return out

@@ -33,6 +33,7 @@ from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelo
 from dec3d.kernels.jointlaw import NPROP
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.groups import group_field
+from dec3d.model.model import KIND_DEFORMABLE
 from dec3d.model.ranges import pairs_in_groups
 from dec3d.model.store import Field, Store
 
@@ -120,6 +121,43 @@ def _subcontacts(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea):
         if k <= cap:
             return tuple(a[:k] for a in out)
         cap = int(k)
+
+
+def zoned_side_carries(sc_contact, kind, area, za, zb) -> None:
+    """Face-face sub-contacts of a contact between a zoned block and a rigid one: the zoned
+    side's gridpoints (and the edge crossings) carry the whole area, the rigid face's vertices
+    none (their ``area`` set to 0, dropped by the caller), in place.
+
+    The face-face rule (``kernels.subgeom``) gives both sides' vertices half the overlap each,
+    a vertex's share being a third of each fan triangle of its face. A zoned face is the zone
+    surface triangles, so its gridpoint shares are the consistent load of a uniform pressure on
+    linear triangles (area/3 per corner). A rigid face's shares follow the fan of its loop (a
+    square's corners 1/3, 1/6, 1/3, 1/6 of its area) and its corner forces reach the zoned
+    face's gridpoints by the interpolation weights as point loads at the rigid corners: a rigid
+    block on a laterally confined zoned column then settled 3.3 % more than under the uniform
+    load its rigid face imposes. The rigid side is dropped only where the zoned side holds at
+    least a quarter of the overlap, half of its own half (a rigid face inside one zone triangle
+    keeps its corners, else it would have no spring at all); the kept areas are scaled back to
+    the overlap's total.
+
+    sc_contact (ns,) contact index of each sub-contact; kind (ns,) 0 A-vertex, 1 B-vertex,
+    2 edge-edge, 3 point; area (ns,) [m²] changed; za, zb (nc,) whether A, B are zoned."""
+    one = np.asarray(za, bool) != np.asarray(zb, bool)
+    if not one.any() or len(sc_contact) == 0:
+        return
+    c = sc_contact
+    face = one[c] & (kind <= 2)
+    rigid_kind = np.where(za, 1, 0)[c]          # A zoned: B's vertices (kind 1) are the rigid face's
+    drop = face & (kind == rigid_kind)
+    keep = face & ~drop
+    nc = len(one)
+    tot = np.bincount(c[face], weights=area[face], minlength=nc)
+    kept = np.bincount(c[keep], weights=area[keep], minlength=nc)
+    ok = one & (tot > 0.0) & (kept >= 0.25 * tot)
+    scale = np.where(ok, tot / np.where(kept > 0.0, kept, 1.0), 1.0)
+    area[drop & ok[c]] = 0.0
+    sel = keep & ok[c]
+    area[sel] *= scale[c[sel]]
 
 
 def default_row(s: dict, code: int) -> np.ndarray:
@@ -315,6 +353,9 @@ class ContactDetection:
         vertex_point_areas(sc_c, kind, key0, ctype[local[fresh]], f_n, vpos, m.vertices["block"],
                            b["face_start"], b["face_count"], f["vstart"], f["nvert"], fv["vertex"],
                            self.point_area(), area)
+        zoned = b["kind"] == KIND_DEFORMABLE
+        if zoned.any():
+            zoned_side_carries(sc_c, kind, area, zoned[f_ra], zoned[f_rb])
         live = area > 0.0
         if not live.all():
             sc_c, kind, key0, key1, pos, area = (x[live] for x in (sc_c, kind, key0, key1, pos, area))

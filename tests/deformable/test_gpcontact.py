@@ -109,3 +109,28 @@ def test_mixed_move_points_average_the_two_sides():
     va = 0.5 * gvel[0] + 0.3 * gvel[1] + 0.2 * gvel[2]
     vb = bvel[1] + np.cross(bspin[1], x - bpos[1])
     assert np.allclose(pts[0], x + 0.5 * dt * (va + vb), rtol=0, atol=1e-15)
+
+
+def test_zoned_side_carries_the_face_face_area():
+    """Contact 0: A zoned, B rigid, both faces' vertices with half the overlap 1 m² each -> A's
+    vertices and the crossing keep it all, scaled back to 1 m², B's vertices get 0. Contact 1:
+    B zoned but its gridpoints hold only 0.1 of 1 m² (a rigid face inside one zone triangle):
+    unchanged. Contact 2: both rigid: unchanged; point sub-contacts (kind 3) never change."""
+    from dec3d.physics.contacts import zoned_side_carries
+    sc = np.array([0, 0, 0, 0, 0, 0, 1, 1, 1, 2, 2, 2])
+    kind = np.array([0, 0, 1, 1, 2, 3, 0, 0, 1, 0, 1, 3])
+    area = np.array([0.2, 0.25, 0.3, 0.2, 0.05, 0.01, 0.45, 0.45, 0.1, 0.5, 0.5, 0.01])
+    before = area.copy()
+    zoned_side_carries(sc, kind, area, np.array([True, False, False]), np.array([False, True, False]))
+    # contact 0: kept 0.2 + 0.25 + 0.05 = 0.5 of 1.0 -> scale 2
+    assert np.allclose(area[:6], [0.4, 0.5, 0.0, 0.0, 0.1, 0.01], rtol=1e-15)
+    assert area[:5].sum() == pytest.approx(before[:5].sum(), rel=1e-15)
+    assert np.array_equal(area[6:], before[6:])
+
+
+def test_zoned_side_carries_nothing_to_do():
+    from dec3d.physics.contacts import zoned_side_carries
+    area = np.array([0.5, 0.5])
+    zoned_side_carries(np.array([0, 0]), np.array([0, 1]), area, np.array([True]), np.array([True]))
+    assert np.array_equal(area, [0.5, 0.5])
+    zoned_side_carries(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.array([True]), np.array([False]))

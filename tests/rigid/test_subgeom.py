@@ -330,3 +330,29 @@ def test_one_contact_entry_matches_the_batch():
     assert k == sel.sum()
     for got, want in zip(o, out):
         np.testing.assert_array_equal(got[:k], want[sel])
+
+
+def test_scratch_is_sized_by_the_blocks_in_contact():
+    """A block of 40 000 triangles (a zoned block's surface) beside a stack of 8 unit cubes in
+    contact: the scratch is sized by the cubes of the contacts, so the batch gives the same
+    sub-contacts as without the big block; sizing the crossings by the largest block squared
+    (1.2e5² rows) ran out of memory."""
+    arrays, contacts = _stack(2)
+    vpos, bvstart, bvcount, bfstart, bfcount, fvstart, fnvert, fverts = arrays
+    nt = 40000
+    big = (np.vstack([vpos, np.zeros((3, 3)) + 50.0]), np.append(bvstart, len(vpos)), np.append(bvcount, 3),
+           np.append(bfstart, len(fnvert)), np.append(bfcount, nt),
+           np.append(fvstart, len(fverts) + 3 * np.arange(nt)), np.append(fnvert, np.full(nt, 3)),
+           np.append(fverts, np.tile(len(vpos) + np.arange(3), nt)))
+    ca = np.array([x[0] for x in contacts], np.int64)
+    cb = np.array([x[1] for x in contacts], np.int64)
+    cn = np.array([x[2] for x in contacts])
+    cc = np.array([x[3] for x in contacts])
+    want = run(arrays, contacts)
+    cap = 256
+    out = (np.zeros(cap, np.int64), np.zeros(cap, np.int64), np.zeros(cap, np.int64),
+           np.zeros(cap, np.int64), np.zeros((cap, 3)), np.zeros(cap))
+    k = subcontacts_batch(*big, ca, cb, cn, cc, 1e-6, 0.01, *out)
+    assert k == len(want[0])
+    for a, b in zip(out, want):
+        np.testing.assert_array_equal(a[:k], b)

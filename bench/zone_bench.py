@@ -1,0 +1,171 @@
+"""Benchmark of the elastic zone cycle: a unit cube zoned into about N 4-node tetrahedra under
+gravity, base held, elastic zones (E = 10 GPa, nu = 0.25, rho = 2500), density scaling.
+
+Figures per N (issue 10 targets on this machine: >= 2e7 zone-cycles/s with 2 threads at 1e6
+zones; <= 1 kB per zone; zoning 1e6 zones <= 30 s):
+
+- zone-cycles/s: zones x timed steps / wall time of `model cycle S` (after warm-up steps that
+  also compile the kernels and build the engine's zone stepper);
+- memory per zone: bytes of the live rows of the ``zones`` store, of the gridpoint store
+  (``model.vertices``: positions, velocities, forces, masses of every gridpoint) and of the
+  numpy arrays the engine's zone stepper holds, each divided by the zone count; and the growth
+  of the process's resident set (VmRSS) from before the zoning to after the timed steps, per
+  zone (this one also counts the mesher's temporaries that Python did not give back).
+
+The scene is built through the public command API (``dec3d.Session().command``).  Each run is
+a fresh process (``--child``); the median of ``--repeat`` runs is printed, with the machine and
+/proc/loadavg before and after (the machine is shared: read the figures with the load).
+
+    python bench/zone_bench.py [--zones 1e4 1e5 1e6] [--steps 50] [--repeat 3] [--threads 1 2]
+
+``--threads N`` calls numba.set_num_threads(N) in each run (dec3d has no `model configure
+threads` command; numba's own count is the default).  The edge length for N zones is
+(5.08 / N)^(1/3) m, from the mesher's measured density (bench/zone_mesh_bench.py: 0.037 m gives
+about 1e5 zones, 0.0172 m about 1e6).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import sys
+import time
+
+WARMUP = 3
+#: zones per m³ of a unit cube at edge length L is about ZONE_DENSITY / L³ (measured)
+ZONE_DENSITY = 5.08
+
+
+def edge_length(zones: float) -> float:
+    """Edge length [m] giving about ``zones`` tetrahedra in a unit cube."""
+    return (ZONE_DENSITY / zones) ** (1.0 / 3.0)
+
+
+def deck(length: float) -> str:
+    return "\n".join([
+        "model new",
+        "block create brick 0 1 0 1 0 1",
+        f"block zone generate edgelength {length:.6g}",
+        "block zone cmodel assign elastic",
+        "block zone property young 10e9 poisson 0.25 density 2500",
+        "model gravity 0 0 -10",
+        "block gridpoint apply velocity 0 0 0 range position-z 0",
+    ]) + "\n"
+
+
+def _rss_bytes() -> int:
+    with open("/proc/self/status", encoding="utf-8") as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) * 1024
+    return 0
+
+
+def _store_bytes(store) -> int:
+    """Bytes of the live rows of every field of a ``dec3d.model.store.Store``."""
+    return int(sum(store.live(k).nbytes for k in store.fields))
+
+
+def _stepper_bytes(model) -> int:
+    """Bytes of the numpy arrays held by the engine's zone stepper (0 when there is none)."""
+    import numpy as np
+
+    eng = getattr(model, "rigid_engine", None)
+    zst = getattr(eng, "_zstep", None) if eng is not None else None
+    if zst is None:
+        return 0
+    return int(sum(v.nbytes for v in vars(zst).values() if isinstance(v, np.ndarray)))
+
+
+def one(zones: float, steps: int, threads: int | None = None) -> dict:
+    """Build, warm up and time in this process."""
+    import io
+    import tempfile
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    if os.path.isdir(os.path.join(root, "dec3d")) and root not in sys.path:
+        sys.path.insert(0, root)       # the checkout's dec3d (also when it is not installed)
+    import numba
+
+    if threads:
+        numba.set_num_threads(threads)
+    import dec3d
+
+    with tempfile.TemporaryDirectory() as d:
+        # compile the kernels on a tiny cube first, so the RSS growth is the model's
+        w = dec3d.Session(out_dir=d, stdout=io.StringIO())
+        w.command(deck(0.5))
+        w.command(f"model cycle {WARMUP}")
+        del w
+        s = dec3d.Session(out_dir=d, stdout=io.StringIO())
+        rss0 = _rss_bytes()
+        t0 = time.perf_counter()
+        s.command(deck(edge_length(zones)))
+        t1 = time.perf_counter()
+        s.command(f"model cycle {WARMUP}")
+        t2 = time.perf_counter()
+        s.command(f"model cycle {steps}")
+        t3 = time.perf_counter()
+        rss1 = _rss_bytes()
+        m = s.model
+        nz = m.store("zones").n
+        out = dict(threads=numba.get_num_threads(), zones=nz, gridpoints=m.vertices.n,
+                   zoning_s=t1 - t0, warmup_s=t2 - t1, seconds=t3 - t2,
+                   zones_b=_store_bytes(m.store("zones")), gp_b=_store_bytes(m.vertices),
+                   stepper_b=_stepper_bytes(m), rss_growth_b=rss1 - rss0)
+    return out
+
+
+def loadavg() -> str:
+    try:
+        with open("/proc/loadavg", encoding="utf-8") as f:
+            return f.read().strip()
+    except OSError:
+        return "n/a"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--zones", type=float, nargs="+", default=[1e4, 1e5, 1e6], help="zone counts (about)")
+    ap.add_argument("--steps", type=int, default=50, help="timed steps S")
+    ap.add_argument("--repeat", type=int, default=3, help="runs per size (median printed)")
+    ap.add_argument("--threads", type=int, nargs="+", default=[0],
+                    help="numba thread counts to run (numba.set_num_threads); 0: numba's own")
+    ap.add_argument("--child", type=float, help=argparse.SUPPRESS)
+    ap.add_argument("--child-threads", type=int, default=0, help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.child:
+        print(json.dumps(one(args.child, args.steps, args.child_threads or None)))
+        return 0
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from rigid_bench import machine, run_children
+
+    print(f"machine: {machine()}")
+    print(f"loadavg before: {loadavg()}")
+    print(f"scene: unit cube of 4-node tetrahedra under gravity, elastic, base held; {WARMUP} warm-up + "
+          f"{args.steps} timed steps, median of {args.repeat}")
+    print(f"{'threads':>7} {'zones':>8} {'gridpts':>8} {'zoning s':>8} {'seconds':>8} {'min..max':>15} "
+          f"{'zone-cyc/s':>11} {'zones B/z':>9} {'gp B/z':>7} {'step B/z':>8} {'total B/z':>9} {'RSS B/z':>8}")
+    for th in args.threads:
+        for n in args.zones:
+            runs = run_children([sys.executable, os.path.abspath(__file__), "--child", str(n),
+                                 "--steps", str(args.steps), "--child-threads", str(th)],
+                                args.repeat, f"zones = {n:g}")
+            sec = [r["seconds"] for r in runs]
+            t = statistics.median(sec)
+            r0 = runs[0]
+            nz = r0["zones"]
+            rate = nz * args.steps / t if t > 0 else float("inf")
+            zb, gb, sb = r0["zones_b"] / nz, r0["gp_b"] / nz, r0["stepper_b"] / nz
+            rss = statistics.median(r["rss_growth_b"] for r in runs) / nz
+            print(f"{r0['threads']:>7} {nz:>8} {r0['gridpoints']:>8} "
+                  f"{statistics.median(r['zoning_s'] for r in runs):>8.2f} {t:>8.3f} "
+                  f"{min(sec):>7.3f}..{max(sec):<7.3f} {rate:>11.4g} {zb:>9.0f} {gb:>7.0f} {sb:>8.0f} "
+                  f"{zb + gb + sb:>9.0f} {rss:>8.0f}", flush=True)
+    print(f"loadavg after: {loadavg()}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
