@@ -44,6 +44,8 @@ the stores) and returns the first such element row (-1 if none) for the host to 
 import numpy as np
 from numba import njit, prange
 
+from .gather import node_lists, node_sums
+
 #: master coordinates of the 20 nodes (corrected Table 1), 0-based rows
 YNODE = np.array([
     [-1.0, -1.0, -1.0], [1.0, -1.0, -1.0], [1.0, 1.0, -1.0], [-1.0, 1.0, -1.0],
@@ -421,38 +423,10 @@ def feb_element_pass_serial(pos, vel, nodes, rows, bulk, shear, dt, gstress, str
 def feb_node_lists(nv, nodes, rows):
     """Per node, the (element, local node) entries that add to it, in a fixed order (CSR): the
     entries of node r are nent[nstart[r]:nstart[r + 1]], each 20 k + a (node a of element
-    rows[k]), ascending: the order of the serial scatter of ``feb_step``. Made once per mesh.
-    Returns (nstart (nv + 1,), nent (20 k,)) int64."""
-    m = rows.shape[0]
-    nstart = np.zeros(nv + 1, dtype=np.int64)
-    for kk in range(m):
-        for a in range(20):
-            nstart[nodes[rows[kk], a] + 1] += 1
-    for r in range(nv):
-        nstart[r + 1] += nstart[r]
-    fill = nstart[:nv].copy()
-    nent = np.empty(20 * m, dtype=np.int64)
-    for kk in range(m):
-        for a in range(20):
-            r = nodes[rows[kk], a]
-            nent[fill[r]] = 20 * kk + a
-            fill[r] += 1
-    return nstart, nent
-
-
-@njit(cache=True, parallel=True)
-def feb_node_sums(force, fe, ok, nstart, nent):
-    """force[r] += the element forces fe of node r's entries (``feb_node_lists``) in their fixed
-    order, in parallel over nodes: the sums do not depend on the thread count and equal the
-    serial scatter. Entries of elements with ok False are skipped."""
-    for r in prange(nstart.shape[0] - 1):
-        f0 = force[r, 0]; f1 = force[r, 1]; f2 = force[r, 2]
-        for q in range(nstart[r], nstart[r + 1]):
-            kk = nent[q] // 20
-            if ok[kk]:
-                a = nent[q] - 20 * kk
-                f0 += fe[kk, a, 0]; f1 += fe[kk, a, 1]; f2 += fe[kk, a, 2]
-        force[r, 0] = f0; force[r, 1] = f1; force[r, 2] = f2
+    rows[k]), ascending: the order of the serial scatter of ``feb_step``
+    (``kernels/gather.node_lists``). Made once per mesh. Returns (nstart (nv + 1,), nent
+    (20 k,)) int64."""
+    return node_lists(nv, np.arange(nv), nodes, rows, 20)
 
 
 @njit(cache=True)
@@ -473,7 +447,7 @@ def _node_range_mag(lo, hi, force, fmag, fe, ok, nstart, nent):
 
 @njit(cache=True, parallel=True)
 def feb_node_sums_mag(force, fmag, fe, ok, nstart, nent):
-    """``feb_node_sums`` that also adds to fmag[r] the magnitude of every element force on node
+    """``kernels/gather.node_sums`` that also adds to fmag[r] the magnitude of every element force on node
     r (sum over its entries of |fe|: the scale of the forces meeting at the node, for
     equilibrium ratios). Parallel over chunks of nodes; the same sums for any thread count."""
     nv = nstart.shape[0] - 1
@@ -497,7 +471,7 @@ def feb_step_parallel(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, f
     ``feb_node_lists(len(force), nodes, rows)``. Returns the first element row skipped in the
     order of rows (-1 none)."""
     feb_element_pass(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq)
-    feb_node_sums(force, fe, ok, nstart, nent)
+    node_sums(force, fe, ok, nstart, nent)
     for kk in range(rows.shape[0]):
         if not ok[kk]:
             return rows[kk]

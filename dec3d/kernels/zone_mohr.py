@@ -51,6 +51,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from .gather import node_lists
 from .zones import hooke_increment, tet_add_forces, tet_kinematics
 
 # mirrors of dec3d.model.zones
@@ -683,22 +684,9 @@ def node_lists4(ntarget, target, gp, rows):
     """Per target t, the (zone entry, node) pairs that add to it, in a fixed order (CSR): the
     entries of t are nent[nstart[t]:nstart[t + 1]], each 4 k + a (node a of zone rows[k]),
     ascending: the order of the serial scatter. ``target`` maps a gridpoint row to its target:
-    the row itself (nodal forces) or the averaging node (NMD). Made once per mesh."""
-    m = rows.shape[0]
-    nstart = np.zeros(ntarget + 1, dtype=np.int64)
-    for k in range(m):
-        for a in range(4):
-            nstart[target[gp[rows[k], a]] + 1] += 1
-    for t in range(ntarget):
-        nstart[t + 1] += nstart[t]
-    fill = nstart[:ntarget].copy()
-    nent = np.empty(4 * m, dtype=np.int64)
-    for k in range(m):
-        for a in range(4):
-            t = target[gp[rows[k], a]]
-            nent[fill[t]] = 4 * k + a
-            fill[t] += 1
-    return nstart, nent
+    the row itself (nodal forces) or the averaging node (NMD) (``kernels/gather.node_lists``).
+    Made once per mesh."""
+    return node_lists(ntarget, target, gp, rows, 4)
 
 
 @njit(cache=True, parallel=True)

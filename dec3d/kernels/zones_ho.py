@@ -33,6 +33,9 @@ to report as an error naming the zone.
 import numpy as np
 from numba import njit, prange
 
+from .gather import node_lists as gather_lists
+from .gather import node_sums
+
 GA = 0.5854101966249685     # (5 + 3 sqrt 5) / 20
 GB = 0.1381966011250105     # (5 - sqrt 5) / 20
 GW = 1.0 / 24.0             # weight of each point (reference tetrahedron volume 1/6)
@@ -264,38 +267,10 @@ def tet10_zone_pass(pos, vel, gp, rows, bulk, shear, dt, gstress, stress, zf, ok
 def node_lists(nv, gp, rows):
     """Per gridpoint, the (zone, node) entries that add to it, in a fixed order (CSR): the
     entries of gridpoint r are nent[nstart[r]:nstart[r + 1]], each 10 k + a (node a of zone
-    rows[k]), ascending: the order of the serial scatter of ``tet10_step``. Made once per mesh.
-    Returns (nstart (nv + 1,), nent (10 k,)) int64."""
-    m = rows.shape[0]
-    nstart = np.zeros(nv + 1, dtype=np.int64)
-    for kk in range(m):
-        for a in range(10):
-            nstart[gp[rows[kk], a] + 1] += 1
-    for r in range(nv):
-        nstart[r + 1] += nstart[r]
-    fill = nstart[:nv].copy()
-    nent = np.empty(10 * m, dtype=np.int64)
-    for kk in range(m):
-        for a in range(10):
-            r = gp[rows[kk], a]
-            nent[fill[r]] = 10 * kk + a
-            fill[r] += 1
-    return nstart, nent
-
-
-@njit(cache=True, parallel=True)
-def node_sums(force, zf, ok, nstart, nent):
-    """force[r] += the zone forces zf of gridpoint r's entries (``node_lists``) in their fixed
-    order, in parallel over gridpoints: the sums do not depend on the thread count and equal the
-    serial scatter. Entries of zones with ok False are skipped."""
-    for r in prange(nstart.shape[0] - 1):
-        f0 = force[r, 0]; f1 = force[r, 1]; f2 = force[r, 2]
-        for e in range(nstart[r], nstart[r + 1]):
-            kk = nent[e] // 10
-            if ok[kk]:
-                a = nent[e] - 10 * kk
-                f0 += zf[kk, a, 0]; f1 += zf[kk, a, 1]; f2 += zf[kk, a, 2]
-        force[r, 0] = f0; force[r, 1] = f1; force[r, 2] = f2
+    rows[k]), ascending: the order of the serial scatter of ``tet10_step``
+    (``kernels/gather.node_lists``). Made once per mesh. Returns (nstart (nv + 1,), nent
+    (10 k,)) int64."""
+    return gather_lists(nv, np.arange(nv), gp, rows, 10)
 
 
 @njit(cache=True)
