@@ -45,6 +45,7 @@ import numpy as np
 from numba import njit, prange
 
 from .gather import node_lists, node_sums
+from .zones_ho import add_stiffness_bound
 
 #: master coordinates of the 20 nodes (corrected Table 1), 0-based rows
 YNODE = np.array([
@@ -584,30 +585,7 @@ def feb_stiffness(pos, nodes, rows, bulk, shear, kdiag, nq):
             if bad < 0:
                 bad = e
             continue
-        lam = bulk[e] - 2.0 * shear[e] / 3.0
-        G = shear[e]
-        K[:, :] = 0.0
-        for g in range(ng):
-            dn = dng[g]
-            w = wd[g]
-            for a in range(20):
-                for b in range(20):
-                    dot = dn[a, 0] * dn[b, 0] + dn[a, 1] * dn[b, 1] + dn[a, 2] * dn[b, 2]
-                    for i in range(3):
-                        for j in range(3):
-                            kij = lam * dn[a, i] * dn[b, j] + G * dn[b, i] * dn[a, j]
-                            if i == j:
-                                kij += G * dot
-                            K[3 * a + i, 3 * b + j] += w * kij
-        for a in range(20):
-            best = 0.0
-            for i in range(3):
-                rs = 0.0
-                for col in range(60):
-                    rs += abs(K[3 * a + i, col])
-                if rs > best:
-                    best = rs
-            kdiag[nd[a]] += best
+        add_stiffness_bound(dng, wd, bulk[e] - 2.0 * shear[e] / 3.0, shear[e], nd, K, kdiag)
     return bad
 
 

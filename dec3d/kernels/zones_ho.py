@@ -348,6 +348,38 @@ def tet10_lumped_mass(pos, gp, rows, density, mass):
 
 
 @njit(cache=True)
+def add_stiffness_bound(dng, wd, lam, G, nd, K, kdiag):
+    """kdiag[nd[a]] += the largest absolute row sum of node a's three rows of the element
+    stiffness K = sum_g wd[g] B_g^T D B_g (isotropic elastic, Lame lam and G), from the Cartesian
+    shape-function gradients dng (ng, n, 3); K (3 n, 3 n) is scratch. Shared by the 10-node
+    zones and the 20-node FE blocks (``tet10_stiffness``, ``feblock.feb_stiffness``)."""
+    n = dng.shape[1]
+    K[:, :] = 0.0
+    for g in range(wd.shape[0]):
+        dn = dng[g]
+        w = wd[g]
+        # block ab of B^T D B: lambda g_a g_b^T + G g_b g_a^T + G (g_a . g_b) I, g = grad N
+        for a in range(n):
+            for b in range(n):
+                dot = dn[a, 0] * dn[b, 0] + dn[a, 1] * dn[b, 1] + dn[a, 2] * dn[b, 2]
+                for i in range(3):
+                    for j in range(3):
+                        kij = lam * dn[a, i] * dn[b, j] + G * dn[b, i] * dn[a, j]
+                        if i == j:
+                            kij += G * dot
+                        K[3 * a + i, 3 * b + j] += w * kij
+    for a in range(n):
+        best = 0.0
+        for i in range(3):
+            rs = 0.0
+            for col in range(3 * n):
+                rs += abs(K[3 * a + i, col])
+            if rs > best:
+                best = rs
+        kdiag[nd[a]] += best
+
+
+@njit(cache=True)
 def tet10_stiffness(pos, gp, rows, bulk, shear, kdiag):
     """Nodal stiffness measure k_i of the text's Eq. (84)-(85) (dt_n = 2 min sqrt(m_i / k_i))
     for 10-node zones, added to kdiag[gp].
@@ -374,31 +406,7 @@ def tet10_stiffness(pos, gp, rows, bulk, shear, kdiag):
             if bad < 0:
                 bad = z
             continue
-        lam = bulk[z] - 2.0 * shear[z] / 3.0
-        G = shear[z]
-        K[:, :] = 0.0
-        for g in range(4):
-            dn = dn4[g]
-            wd = wd4[g]
-            # block ab of B^T D B: lambda g_a g_b^T + G g_b g_a^T + G (g_a . g_b) I, g = grad N
-            for a in range(10):
-                for b in range(10):
-                    dot = dn[a, 0] * dn[b, 0] + dn[a, 1] * dn[b, 1] + dn[a, 2] * dn[b, 2]
-                    for i in range(3):
-                        for j in range(3):
-                            kij = lam * dn[a, i] * dn[b, j] + G * dn[b, i] * dn[a, j]
-                            if i == j:
-                                kij += G * dot
-                            K[3 * a + i, 3 * b + j] += wd * kij
-        for a in range(10):
-            best = 0.0
-            for i in range(3):
-                rs = 0.0
-                for col in range(30):
-                    rs += abs(K[3 * a + i, col])
-                if rs > best:
-                    best = rs
-            kdiag[nodes[a]] += best
+        add_stiffness_bound(dn4, wd4, bulk[z] - 2.0 * shear[z] / 3.0, shear[z], nodes, K, kdiag)
     return bad
 
 
