@@ -45,7 +45,7 @@ import numpy as np
 from numba import njit, prange
 
 from .gather import node_lists, node_sums
-from .zones_ho import add_stiffness_bound
+from .zones_ho import add_body_force, add_stiffness_bound
 
 #: master coordinates of the 20 nodes (corrected Table 1), 0-based rows
 YNODE = np.array([
@@ -609,15 +609,7 @@ def feb_body_force(pos, nodes, rows, density, gvec, force):
             if bad < 0:
                 bad = e
             continue
-        for a in range(20):
-            w = 0.0
-            for g in range(27):
-                w += wd[g] * shp[g, a]
-            w *= density[e]
-            r = nd[a]
-            force[r, 0] += w * gvec[0]
-            force[r, 1] += w * gvec[1]
-            force[r, 2] += w * gvec[2]
+        add_body_force(wd, shp, density[e], gvec, nd, force)
     return bad
 
 

@@ -411,6 +411,22 @@ def tet10_stiffness(pos, gp, rows, bulk, shear, kdiag):
 
 
 @njit(cache=True)
+def add_body_force(wd, shp, rho, gvec, nd, force):
+    """force[nd[a]] += rho gvec sum_g wd[g] shp[g, a]: the consistent gravity load int rho N_a g dV
+    of one element from the weights w det J wd (ng,) and shape values shp (ng, n) at its
+    integration points. Shared by ``tet10_body_force`` and ``feblock.feb_body_force``."""
+    for a in range(shp.shape[1]):
+        w = 0.0
+        for g in range(wd.shape[0]):
+            w += wd[g] * shp[g, a]
+        w *= rho
+        r = nd[a]
+        force[r, 0] += w * gvec[0]
+        force[r, 1] += w * gvec[1]
+        force[r, 2] += w * gvec[2]
+
+
+@njit(cache=True)
 def tet10_body_force(pos, gp, rows, density, gvec, force):
     """Consistent nodal forces of gravity on 10-node zones, added to force[gp]:
     F_a = rho g int N_a dV, by the 4-point rule (exact for straight edges).
@@ -448,15 +464,7 @@ def tet10_body_force(pos, gp, rows, density, gvec, force):
             if bad < 0:
                 bad = z
             continue
-        for a in range(10):
-            w = 0.0
-            for g in range(4):
-                w += wd4[g] * shp[g, a]
-            w *= density[z]
-            r = nodes[a]
-            force[r, 0] += w * gvec[0]
-            force[r, 1] += w * gvec[1]
-            force[r, 2] += w * gvec[2]
+        add_body_force(wd4, shp, density[z], gvec, nodes, force)
     return bad
 
 
