@@ -606,6 +606,31 @@ def jaumann_rotate(s, w01, w02, w12):
 
 
 @njit(cache=True)
+def _set_strain_mean(de, vol, zset, nset):
+    """Volumetric strain increments ev (nr,) of the entries, free (nr,) True for an entry
+    outside every hexahedral set, and bar (nr,): the volume-weighted mean ev of the entry's set
+    (Eqs. 60-63), ev itself for a free entry. Shared by the serial and threaded steps."""
+    nr = de.shape[0]
+    sv = np.zeros(nset)
+    ss = np.zeros(nset)
+    free = np.empty(nr, np.bool_)
+    ev = np.empty(nr)
+    for k in range(nr):
+        ev[k] = de[k, 0] + de[k, 1] + de[k, 2]
+        h = zset[k]
+        free[k] = h < 0
+        if h >= 0:
+            sv[h] += ev[k] * vol[k]
+            ss[h] += vol[k]
+    bar = ev.copy()
+    for k in range(nr):
+        h = zset[k]
+        if h >= 0 and ss[h] > 0.0:
+            bar[k] = sv[h] / ss[h]
+    return ev, free, bar
+
+
+@njit(cache=True)
 def zone_forces_plastic(pos, vel, gp, rows, zset, weight, nset, node, cmodel, prop, dt, large, nmd,
                         stress, state, force, fmag):
     """One step of the 4-node zones ``rows`` with elastic and Mohr-Coulomb zones mixed, laid out
@@ -626,22 +651,7 @@ def zone_forces_plastic(pos, vel, gp, rows, zset, weight, nset, node, cmodel, pr
     dsp = np.empty(nr)
     tet_strain_pass(pos, vel, gp, rows, dt, de, vol, av, spin)
     # strain: hexahedral sets
-    sv = np.zeros(nset)
-    ss = np.zeros(nset)
-    free = np.empty(nr, np.bool_)
-    ev = np.empty(nr)
-    for k in range(nr):
-        ev[k] = de[k, 0] + de[k, 1] + de[k, 2]
-        h = zset[k]
-        free[k] = h < 0
-        if h >= 0:
-            sv[h] += ev[k] * vol[k]
-            ss[h] += vol[k]
-    bar = ev.copy()
-    for k in range(nr):
-        h = zset[k]
-        if h >= 0 and ss[h] > 0.0:
-            bar[k] = sv[h] / ss[h]
+    ev, free, bar = _set_strain_mean(de, vol, zset, nset)
     nsz = node.shape[0]
     nodesum = np.empty(nsz)
     nodevol = np.empty(nsz)
@@ -728,22 +738,7 @@ def zone_forces_plastic_parallel(pos, vel, gp, rows, zset, weight, nset, node, c
     dsp = np.zeros(nr)
     for k in prange(nr):
         vol[k] = tet_kinematics(pos, vel, gp, rows[k], dt, av[k], de[k], spin[k])
-    sv = np.zeros(nset)
-    ss = np.zeros(nset)
-    free = np.empty(nr, np.bool_)
-    ev = np.empty(nr)
-    for k in range(nr):
-        ev[k] = de[k, 0] + de[k, 1] + de[k, 2]
-        h = zset[k]
-        free[k] = h < 0
-        if h >= 0:
-            sv[h] += ev[k] * vol[k]
-            ss[h] += vol[k]
-    bar = ev.copy()
-    for k in range(nr):
-        h = zset[k]
-        if h >= 0 and ss[h] > 0.0:
-            bar[k] = sv[h] / ss[h]
+    ev, free, bar = _set_strain_mean(de, vol, zset, nset)
     nsz = nstart.shape[0] - 1
     nodesum = np.empty(max(nsz, 0))
     nodevol = np.empty(max(nsz, 0))
