@@ -3,7 +3,7 @@ serial element-by-element scatter, and the gathered sums are that scatter bit fo
 import numpy as np
 import pytest
 
-from dec3d.kernels.gather import node_lists, node_sums
+from dec3d.kernels.gather import node_lists, node_sums, scatter
 
 
 def scatter_twin(nv, conn, rows, fe, ok, force0):
@@ -37,6 +37,12 @@ def test_node_lists_and_sums_match_the_serial_scatter(nper):
     want = scatter_twin(nv, conn, rows, fe, ok, force0)
     got = force0.copy()
     node_sums(got, fe, ok, nstart, nent)
+    assert np.array_equal(got, want)
+    # the serial scatter, element by element
+    got = force0.copy()
+    for k, e in enumerate(rows):
+        if ok[k]:
+            scatter(got, conn[e], fe[k])
     assert np.array_equal(got, want)
 
 

@@ -44,7 +44,7 @@ the stores) and returns the first such element row (-1 if none) for the host to 
 import numpy as np
 from numba import njit, prange
 
-from .gather import node_lists, node_sums
+from .gather import node_lists, node_sums, scatter
 from .zones_ho import add_body_force, add_stiffness_bound
 
 #: master coordinates of the 20 nodes (corrected Table 1), 0-based rows
@@ -361,11 +361,7 @@ def feb_step(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, force, nq)
             if bad < 0:
                 bad = e
             continue
-        for a in range(20):
-            r = nd[a]
-            force[r, 0] += fe[a, 0]
-            force[r, 1] += fe[a, 1]
-            force[r, 2] += fe[a, 2]
+        scatter(force, nd, fe)
     return bad
 
 
@@ -485,11 +481,7 @@ def feb_forces(pos, nodes, rows, gstress, force, nq):
                 bad = e
             continue
         _elem_force(dng, wd, gstress[e], fe)
-        for a in range(20):
-            r = nd[a]
-            force[r, 0] += fe[a, 0]
-            force[r, 1] += fe[a, 1]
-            force[r, 2] += fe[a, 2]
+        scatter(force, nd, fe)
     return bad
 
 

@@ -49,3 +49,13 @@ def node_sums(force, fe, ok, nstart, nent):
                 a = nent[q] - nper * kk
                 f0 += fe[kk, a, 0]; f1 += fe[kk, a, 1]; f2 += fe[kk, a, 2]
         force[r, 0] = f0; force[r, 1] = f1; force[r, 2] = f2
+
+
+@njit(cache=True, inline='always')
+def scatter(force, nd, fe):
+    """force[nd[a]] += fe[a] for the nodes of one element (the serial scatter), fe (n, 3)."""
+    for a in range(nd.shape[0]):
+        r = nd[a]
+        force[r, 0] += fe[a, 0]
+        force[r, 1] += fe[a, 1]
+        force[r, 2] += fe[a, 2]

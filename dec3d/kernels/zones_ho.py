@@ -34,7 +34,7 @@ import numpy as np
 from numba import njit, prange
 
 from .gather import node_lists as gather_lists
-from .gather import node_sums
+from .gather import node_sums, scatter
 
 GA = 0.5854101966249685     # (5 + 3 sqrt 5) / 20
 GB = 0.1381966011250105     # (5 - sqrt 5) / 20
@@ -206,11 +206,7 @@ def tet10_step(pos, vel, gp, rows, bulk, shear, dt, gstress, stress, force):
             if bad < 0:
                 bad = z
             continue
-        for a in range(10):
-            r = nodes[a]
-            force[r, 0] += fz[a, 0]
-            force[r, 1] += fz[a, 1]
-            force[r, 2] += fz[a, 2]
+        scatter(force, nodes, fz)
     return bad
 
 
@@ -234,11 +230,7 @@ def tet10_forces(pos, gp, rows, gstress, force):
                 bad = z
             continue
         _zone_force(dn4, wd4, gstress[z], fz)
-        for a in range(10):
-            r = nodes[a]
-            force[r, 0] += fz[a, 0]
-            force[r, 1] += fz[a, 1]
-            force[r, 2] += fz[a, 2]
+        scatter(force, nodes, fz)
     return bad
 
 
