@@ -109,13 +109,19 @@ def _block_history(quantity, kind="block"):
     return handler
 
 
+def _motion_target(call, key: str, quantity: str, what: str):
+    """(id, location) of the `key <i>` keyword of a gridpoint-quantity history, after checking
+    that ``quantity`` is one (displacement, velocity or position) of a ``what``."""
+    where = call.locations.get(key, call.location)
+    if quantity not in GRIDPOINT_QUANTITIES:
+        raise CommandError(f"`{quantity}` is not a {what} quantity (displacement, velocity or position)", where)
+    return int(call.args[key]), where
+
+
 def _gridpoint_history(session, call, quantity, name):
     """`block history <q> gridpointid <i>`: the gridpoint with id i (its vertex row + 1)."""
     m = session.model
-    gid = int(call.args["gridpointid"])
-    where = call.locations.get("gridpointid", call.location)
-    if quantity not in GRIDPOINT_QUANTITIES:
-        raise CommandError(f"`{quantity}` is not a gridpoint quantity (displacement, velocity or position)", where)
+    gid, where = _motion_target(call, "gridpointid", quantity, "gridpoint")
     v = m.vertices
     row = gid - 1
     if not (0 <= row < v.n) or "zoned" not in v or not v["zoned"][row]:
@@ -127,10 +133,7 @@ def _gridpoint_history(session, call, quantity, name):
 def _zone_centroid_history(session, call, quantity, name):
     """`block history <q> zone-id <i>`: the value at the centroid of zone i, from its nodes."""
     m = session.model
-    zid = int(call.args["zone_id"])
-    where = call.locations.get("zone_id", call.location)
-    if quantity not in GRIDPOINT_QUANTITIES:
-        raise CommandError(f"`{quantity}` is not a zone quantity (displacement, velocity or position)", where)
+    zid, where = _motion_target(call, "zone_id", quantity, "zone")
     z = m.stores.get("zones")
     if z is None or not z.n or not (z["id"] == zid).any():
         raise CommandError(f"there is no zone {zid}" + ("" if z is not None and z.n else

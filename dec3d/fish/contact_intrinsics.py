@@ -117,16 +117,19 @@ def _find(rt, b1, b2):
     return _ptr(cs, int(hit[0])) if len(hit) else 0
 
 
-@intrinsic("block.contact.b1", 1)
-def _b1(rt, c):
-    cs, r = _contact_row(rt, c, "block.contact.b1")
-    return int(cs["ida"][r])
+def _scalar(name, get, contact=True):
+    """Registers the one-argument intrinsic ``name``: get(store, row) of its contact (or, with
+    contact False, sub-contact) pointer's row."""
+    row = _contact_row if contact else _sub_row
+
+    def fn(rt, p):
+        st, r = row(rt, p, name)
+        return get(st, r)
+    intrinsic(name, 1)(fn)
 
 
-@intrinsic("block.contact.b2", 1)
-def _b2(rt, c):
-    cs, r = _contact_row(rt, c, "block.contact.b2")
-    return int(cs["idb"][r])
+_scalar("block.contact.b1", lambda cs, r: int(cs["ida"][r]))
+_scalar("block.contact.b2", lambda cs, r: int(cs["idb"][r]))
 
 
 def _family(prefix, get, contact=True):
@@ -223,13 +226,6 @@ def _sub_contact(rt, s):
     return ContactPtr("contact", s.key[:2], s.hint)
 
 
-def _sub_scalar(name, field):
-    def fn(rt, s):
-        ss, k = _sub_row(rt, s, name)
-        return float(ss[field][k])
-    intrinsic(name, 1)(fn)
-
-
 @intrinsic("block.subcontact.face", 1)
 def _sub_face(rt, s):
     """The block face under a vertex-face sub-contact, as block.face.* take it (its face row + 1, valid
@@ -240,9 +236,9 @@ def _sub_face(rt, s):
     return 0
 
 
-_sub_scalar("block.subcontact.area", "area")
-_sub_scalar("block.subcontact.force.norm", "fn")
-_sub_scalar("block.subcontact.disp.norm", "un")
+_scalar("block.subcontact.area", lambda ss, k: float(ss["area"][k]), contact=False)
+_scalar("block.subcontact.force.norm", lambda ss, k: float(ss["fn"][k]), contact=False)
+_scalar("block.subcontact.disp.norm", lambda ss, k: float(ss["un"][k]), contact=False)
 _family("block.subcontact.pos", lambda ss, k: ss["pos"][k], contact=False)
 _family("block.subcontact.force.shear", lambda ss, k: ss["fs"][k], contact=False)
 _family("block.subcontact.disp.shear", lambda ss, k: ss["us"][k], contact=False)
@@ -255,16 +251,8 @@ def _sub_state(rt, s):
     return int(ss["state"][k])
 
 
-@intrinsic("block.subcontact.force.shear.mag", 1)
-def _sub_fs_mag(rt, s):
-    ss, k = _sub_row(rt, s, "block.subcontact.force.shear.mag")
-    return float(np.linalg.norm(ss["fs"][k]))
-
-
-@intrinsic("block.subcontact.disp.shear.mag", 1)
-def _sub_us_mag(rt, s):
-    ss, k = _sub_row(rt, s, "block.subcontact.disp.shear.mag")
-    return float(np.linalg.norm(ss["us"][k]))
+_scalar("block.subcontact.force.shear.mag", lambda ss, k: float(np.linalg.norm(ss["fs"][k])), contact=False)
+_scalar("block.subcontact.disp.shear.mag", lambda ss, k: float(np.linalg.norm(ss["us"][k])), contact=False)
 
 
 @intrinsic("block.contact.type", 1)

@@ -44,6 +44,9 @@ the stores) and returns the first such element row (-1 if none) for the host to 
 import numpy as np
 from numba import njit, prange
 
+from .gather import node_lists, node_sums, scatter
+from .zones_ho import add_body_force, add_stiffness_bound
+
 #: master coordinates of the 20 nodes (corrected Table 1), 0-based rows
 YNODE = np.array([
     [-1.0, -1.0, -1.0], [1.0, -1.0, -1.0], [1.0, 1.0, -1.0], [-1.0, 1.0, -1.0],
@@ -151,12 +154,12 @@ def ref_tables(nq):
     return shp, dref, wts
 
 
-@njit(cache=True)
-def _grad_n(x, dxi, dn):
-    """Cartesian derivatives dn (20, 3) = dN_a/dx_j at one point from the master derivatives
+@njit(cache=True, inline='always')
+def _jacobian(x, dxi):
+    """det J and the entries i_kj = dy_k/dx_j of J^-1 at one point, from the master derivatives
     dxi (20, 3) and the element's node coordinates x (20, 3) (text: J_km = dN_I/dy_m x_Ik,
-    Y = J^-1, Eq. 5 N_I,m = dN_I/dy_j Y_jm). Returns det J; dn is left as it was when det J is
-    not positive. Scalars only (it runs at every Gauss point of every element every step)."""
+    Y = J^-1). Returns (det, i00, i01, i02, i10, i11, i12, i20, i21, i22), the inverse all
+    zeros when det J is not positive. Scalars only (every Gauss point of every element)."""
     j00 = 0.0; j01 = 0.0; j02 = 0.0
     j10 = 0.0; j11 = 0.0; j12 = 0.0
     j20 = 0.0; j21 = 0.0; j22 = 0.0
@@ -171,17 +174,21 @@ def _grad_n(x, dxi, dn):
     c02 = j10 * j21 - j11 * j20
     det = j00 * c00 + j01 * c01 + j02 * c02
     if not det > 0.0:
-        return det
+        return det, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     r = 1.0 / det
-    i00 = c00 * r
-    i10 = c01 * r
-    i20 = c02 * r
-    i01 = (j02 * j21 - j01 * j22) * r
-    i11 = (j00 * j22 - j02 * j20) * r
-    i21 = (j01 * j20 - j00 * j21) * r
-    i02 = (j01 * j12 - j02 * j11) * r
-    i12 = (j02 * j10 - j00 * j12) * r
-    i22 = (j00 * j11 - j01 * j10) * r
+    return (det, c00 * r, (j02 * j21 - j01 * j22) * r, (j01 * j12 - j02 * j11) * r,
+            c01 * r, (j00 * j22 - j02 * j20) * r, (j02 * j10 - j00 * j12) * r,
+            c02 * r, (j01 * j20 - j00 * j21) * r, (j00 * j11 - j01 * j10) * r)
+
+
+@njit(cache=True)
+def _grad_n(x, dxi, dn):
+    """Cartesian derivatives dn (20, 3) = dN_a/dx_j at one point from the master derivatives
+    dxi (20, 3) and the element's node coordinates x (20, 3) (text, Eq. 5: N_I,m = dN_I/dy_j
+    Y_jm). Returns det J; dn is left as it was when det J is not positive."""
+    det, i00, i01, i02, i10, i11, i12, i20, i21, i22 = _jacobian(x, dxi)
+    if not det > 0.0:
+        return det
     for a in range(20):
         d0 = dxi[a, 0]; d1 = dxi[a, 1]; d2 = dxi[a, 2]
         dn[a, 0] = d0 * i00 + d1 * i10 + d2 * i20
@@ -234,31 +241,12 @@ def _elem_force(dng, wd, sg, fe):
 def _jac_inv(x, dxi, jinv):
     """Inverse Jacobian jinv (3, 3) (jinv[k, j] = dy_k/dx_j) at one point; returns det J (jinv
     untouched when not positive)."""
-    j00 = 0.0; j01 = 0.0; j02 = 0.0
-    j10 = 0.0; j11 = 0.0; j12 = 0.0
-    j20 = 0.0; j21 = 0.0; j22 = 0.0
-    for a in range(20):
-        x0 = x[a, 0]; x1 = x[a, 1]; x2 = x[a, 2]
-        d0 = dxi[a, 0]; d1 = dxi[a, 1]; d2 = dxi[a, 2]
-        j00 += x0 * d0; j01 += x0 * d1; j02 += x0 * d2
-        j10 += x1 * d0; j11 += x1 * d1; j12 += x1 * d2
-        j20 += x2 * d0; j21 += x2 * d1; j22 += x2 * d2
-    c00 = j11 * j22 - j12 * j21
-    c01 = j12 * j20 - j10 * j22
-    c02 = j10 * j21 - j11 * j20
-    det = j00 * c00 + j01 * c01 + j02 * c02
+    det, i00, i01, i02, i10, i11, i12, i20, i21, i22 = _jacobian(x, dxi)
     if not det > 0.0:
         return det
-    r = 1.0 / det
-    jinv[0, 0] = c00 * r
-    jinv[1, 0] = c01 * r
-    jinv[2, 0] = c02 * r
-    jinv[0, 1] = (j02 * j21 - j01 * j22) * r
-    jinv[1, 1] = (j00 * j22 - j02 * j20) * r
-    jinv[2, 1] = (j01 * j20 - j00 * j21) * r
-    jinv[0, 2] = (j01 * j12 - j02 * j11) * r
-    jinv[1, 2] = (j02 * j10 - j00 * j12) * r
-    jinv[2, 2] = (j00 * j11 - j01 * j10) * r
+    jinv[0, 0] = i00; jinv[0, 1] = i01; jinv[0, 2] = i02
+    jinv[1, 0] = i10; jinv[1, 1] = i11; jinv[1, 2] = i12
+    jinv[2, 0] = i20; jinv[2, 1] = i21; jinv[2, 2] = i22
     return det
 
 
@@ -373,11 +361,7 @@ def feb_step(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, force, nq)
             if bad < 0:
                 bad = e
             continue
-        for a in range(20):
-            r = nd[a]
-            force[r, 0] += fe[a, 0]
-            force[r, 1] += fe[a, 1]
-            force[r, 2] += fe[a, 2]
+        scatter(force, nd, fe)
     return bad
 
 
@@ -421,38 +405,10 @@ def feb_element_pass_serial(pos, vel, nodes, rows, bulk, shear, dt, gstress, str
 def feb_node_lists(nv, nodes, rows):
     """Per node, the (element, local node) entries that add to it, in a fixed order (CSR): the
     entries of node r are nent[nstart[r]:nstart[r + 1]], each 20 k + a (node a of element
-    rows[k]), ascending: the order of the serial scatter of ``feb_step``. Made once per mesh.
-    Returns (nstart (nv + 1,), nent (20 k,)) int64."""
-    m = rows.shape[0]
-    nstart = np.zeros(nv + 1, dtype=np.int64)
-    for kk in range(m):
-        for a in range(20):
-            nstart[nodes[rows[kk], a] + 1] += 1
-    for r in range(nv):
-        nstart[r + 1] += nstart[r]
-    fill = nstart[:nv].copy()
-    nent = np.empty(20 * m, dtype=np.int64)
-    for kk in range(m):
-        for a in range(20):
-            r = nodes[rows[kk], a]
-            nent[fill[r]] = 20 * kk + a
-            fill[r] += 1
-    return nstart, nent
-
-
-@njit(cache=True, parallel=True)
-def feb_node_sums(force, fe, ok, nstart, nent):
-    """force[r] += the element forces fe of node r's entries (``feb_node_lists``) in their fixed
-    order, in parallel over nodes: the sums do not depend on the thread count and equal the
-    serial scatter. Entries of elements with ok False are skipped."""
-    for r in prange(nstart.shape[0] - 1):
-        f0 = force[r, 0]; f1 = force[r, 1]; f2 = force[r, 2]
-        for q in range(nstart[r], nstart[r + 1]):
-            kk = nent[q] // 20
-            if ok[kk]:
-                a = nent[q] - 20 * kk
-                f0 += fe[kk, a, 0]; f1 += fe[kk, a, 1]; f2 += fe[kk, a, 2]
-        force[r, 0] = f0; force[r, 1] = f1; force[r, 2] = f2
+    rows[k]), ascending: the order of the serial scatter of ``feb_step``
+    (``kernels/gather.node_lists``). Made once per mesh. Returns (nstart (nv + 1,), nent
+    (20 k,)) int64."""
+    return node_lists(nv, np.arange(nv), nodes, rows, 20)
 
 
 @njit(cache=True)
@@ -473,7 +429,7 @@ def _node_range_mag(lo, hi, force, fmag, fe, ok, nstart, nent):
 
 @njit(cache=True, parallel=True)
 def feb_node_sums_mag(force, fmag, fe, ok, nstart, nent):
-    """``feb_node_sums`` that also adds to fmag[r] the magnitude of every element force on node
+    """``kernels/gather.node_sums`` that also adds to fmag[r] the magnitude of every element force on node
     r (sum over its entries of |fe|: the scale of the forces meeting at the node, for
     equilibrium ratios). Parallel over chunks of nodes; the same sums for any thread count."""
     nv = nstart.shape[0] - 1
@@ -497,7 +453,7 @@ def feb_step_parallel(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, f
     ``feb_node_lists(len(force), nodes, rows)``. Returns the first element row skipped in the
     order of rows (-1 none)."""
     feb_element_pass(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq)
-    feb_node_sums(force, fe, ok, nstart, nent)
+    node_sums(force, fe, ok, nstart, nent)
     for kk in range(rows.shape[0]):
         if not ok[kk]:
             return rows[kk]
@@ -525,11 +481,7 @@ def feb_forces(pos, nodes, rows, gstress, force, nq):
                 bad = e
             continue
         _elem_force(dng, wd, gstress[e], fe)
-        for a in range(20):
-            r = nd[a]
-            force[r, 0] += fe[a, 0]
-            force[r, 1] += fe[a, 1]
-            force[r, 2] += fe[a, 2]
+        scatter(force, nd, fe)
     return bad
 
 
@@ -625,30 +577,7 @@ def feb_stiffness(pos, nodes, rows, bulk, shear, kdiag, nq):
             if bad < 0:
                 bad = e
             continue
-        lam = bulk[e] - 2.0 * shear[e] / 3.0
-        G = shear[e]
-        K[:, :] = 0.0
-        for g in range(ng):
-            dn = dng[g]
-            w = wd[g]
-            for a in range(20):
-                for b in range(20):
-                    dot = dn[a, 0] * dn[b, 0] + dn[a, 1] * dn[b, 1] + dn[a, 2] * dn[b, 2]
-                    for i in range(3):
-                        for j in range(3):
-                            kij = lam * dn[a, i] * dn[b, j] + G * dn[b, i] * dn[a, j]
-                            if i == j:
-                                kij += G * dot
-                            K[3 * a + i, 3 * b + j] += w * kij
-        for a in range(20):
-            best = 0.0
-            for i in range(3):
-                rs = 0.0
-                for col in range(60):
-                    rs += abs(K[3 * a + i, col])
-                if rs > best:
-                    best = rs
-            kdiag[nd[a]] += best
+        add_stiffness_bound(dng, wd, bulk[e] - 2.0 * shear[e] / 3.0, shear[e], nd, K, kdiag)
     return bad
 
 
@@ -672,15 +601,7 @@ def feb_body_force(pos, nodes, rows, density, gvec, force):
             if bad < 0:
                 bad = e
             continue
-        for a in range(20):
-            w = 0.0
-            for g in range(27):
-                w += wd[g] * shp[g, a]
-            w *= density[e]
-            r = nd[a]
-            force[r, 0] += w * gvec[0]
-            force[r, 1] += w * gvec[1]
-            force[r, 2] += w * gvec[2]
+        add_body_force(wd, shp, density[e], gvec, nd, force)
     return bad
 
 

@@ -51,6 +51,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from .gather import node_lists
 from .zones import hooke_increment, tet_add_forces, tet_kinematics
 
 # mirrors of dec3d.model.zones
@@ -605,6 +606,31 @@ def jaumann_rotate(s, w01, w02, w12):
 
 
 @njit(cache=True)
+def _set_strain_mean(de, vol, zset, nset):
+    """Volumetric strain increments ev (nr,) of the entries, free (nr,) True for an entry
+    outside every hexahedral set, and bar (nr,): the volume-weighted mean ev of the entry's set
+    (Eqs. 60-63), ev itself for a free entry. Shared by the serial and threaded steps."""
+    nr = de.shape[0]
+    sv = np.zeros(nset)
+    ss = np.zeros(nset)
+    free = np.empty(nr, np.bool_)
+    ev = np.empty(nr)
+    for k in range(nr):
+        ev[k] = de[k, 0] + de[k, 1] + de[k, 2]
+        h = zset[k]
+        free[k] = h < 0
+        if h >= 0:
+            sv[h] += ev[k] * vol[k]
+            ss[h] += vol[k]
+    bar = ev.copy()
+    for k in range(nr):
+        h = zset[k]
+        if h >= 0 and ss[h] > 0.0:
+            bar[k] = sv[h] / ss[h]
+    return ev, free, bar
+
+
+@njit(cache=True)
 def zone_forces_plastic(pos, vel, gp, rows, zset, weight, nset, node, cmodel, prop, dt, large, nmd,
                         stress, state, force, fmag):
     """One step of the 4-node zones ``rows`` with elastic and Mohr-Coulomb zones mixed, laid out
@@ -625,22 +651,7 @@ def zone_forces_plastic(pos, vel, gp, rows, zset, weight, nset, node, cmodel, pr
     dsp = np.empty(nr)
     tet_strain_pass(pos, vel, gp, rows, dt, de, vol, av, spin)
     # strain: hexahedral sets
-    sv = np.zeros(nset)
-    ss = np.zeros(nset)
-    free = np.empty(nr, np.bool_)
-    ev = np.empty(nr)
-    for k in range(nr):
-        ev[k] = de[k, 0] + de[k, 1] + de[k, 2]
-        h = zset[k]
-        free[k] = h < 0
-        if h >= 0:
-            sv[h] += ev[k] * vol[k]
-            ss[h] += vol[k]
-    bar = ev.copy()
-    for k in range(nr):
-        h = zset[k]
-        if h >= 0 and ss[h] > 0.0:
-            bar[k] = sv[h] / ss[h]
+    ev, free, bar = _set_strain_mean(de, vol, zset, nset)
     nsz = node.shape[0]
     nodesum = np.empty(nsz)
     nodevol = np.empty(nsz)
@@ -683,22 +694,9 @@ def node_lists4(ntarget, target, gp, rows):
     """Per target t, the (zone entry, node) pairs that add to it, in a fixed order (CSR): the
     entries of t are nent[nstart[t]:nstart[t + 1]], each 4 k + a (node a of zone rows[k]),
     ascending: the order of the serial scatter. ``target`` maps a gridpoint row to its target:
-    the row itself (nodal forces) or the averaging node (NMD). Made once per mesh."""
-    m = rows.shape[0]
-    nstart = np.zeros(ntarget + 1, dtype=np.int64)
-    for k in range(m):
-        for a in range(4):
-            nstart[target[gp[rows[k], a]] + 1] += 1
-    for t in range(ntarget):
-        nstart[t + 1] += nstart[t]
-    fill = nstart[:ntarget].copy()
-    nent = np.empty(4 * m, dtype=np.int64)
-    for k in range(m):
-        for a in range(4):
-            t = target[gp[rows[k], a]]
-            nent[fill[t]] = 4 * k + a
-            fill[t] += 1
-    return nstart, nent
+    the row itself (nodal forces) or the averaging node (NMD) (``kernels/gather.node_lists``).
+    Made once per mesh."""
+    return node_lists(ntarget, target, gp, rows, 4)
 
 
 @njit(cache=True, parallel=True)
@@ -740,22 +738,7 @@ def zone_forces_plastic_parallel(pos, vel, gp, rows, zset, weight, nset, node, c
     dsp = np.zeros(nr)
     for k in prange(nr):
         vol[k] = tet_kinematics(pos, vel, gp, rows[k], dt, av[k], de[k], spin[k])
-    sv = np.zeros(nset)
-    ss = np.zeros(nset)
-    free = np.empty(nr, np.bool_)
-    ev = np.empty(nr)
-    for k in range(nr):
-        ev[k] = de[k, 0] + de[k, 1] + de[k, 2]
-        h = zset[k]
-        free[k] = h < 0
-        if h >= 0:
-            sv[h] += ev[k] * vol[k]
-            ss[h] += vol[k]
-    bar = ev.copy()
-    for k in range(nr):
-        h = zset[k]
-        if h >= 0 and ss[h] > 0.0:
-            bar[k] = sv[h] / ss[h]
+    ev, free, bar = _set_strain_mean(de, vol, zset, nset)
     nsz = nstart.shape[0] - 1
     nodesum = np.empty(max(nsz, 0))
     nodevol = np.empty(max(nsz, 0))

@@ -33,6 +33,9 @@ to report as an error naming the zone.
 import numpy as np
 from numba import njit, prange
 
+from .gather import node_lists as gather_lists
+from .gather import node_sums, scatter
+
 GA = 0.5854101966249685     # (5 + 3 sqrt 5) / 20
 GB = 0.1381966011250105     # (5 - sqrt 5) / 20
 GW = 1.0 / 24.0             # weight of each point (reference tetrahedron volume 1/6)
@@ -203,11 +206,7 @@ def tet10_step(pos, vel, gp, rows, bulk, shear, dt, gstress, stress, force):
             if bad < 0:
                 bad = z
             continue
-        for a in range(10):
-            r = nodes[a]
-            force[r, 0] += fz[a, 0]
-            force[r, 1] += fz[a, 1]
-            force[r, 2] += fz[a, 2]
+        scatter(force, nodes, fz)
     return bad
 
 
@@ -231,11 +230,7 @@ def tet10_forces(pos, gp, rows, gstress, force):
                 bad = z
             continue
         _zone_force(dn4, wd4, gstress[z], fz)
-        for a in range(10):
-            r = nodes[a]
-            force[r, 0] += fz[a, 0]
-            force[r, 1] += fz[a, 1]
-            force[r, 2] += fz[a, 2]
+        scatter(force, nodes, fz)
     return bad
 
 
@@ -264,38 +259,10 @@ def tet10_zone_pass(pos, vel, gp, rows, bulk, shear, dt, gstress, stress, zf, ok
 def node_lists(nv, gp, rows):
     """Per gridpoint, the (zone, node) entries that add to it, in a fixed order (CSR): the
     entries of gridpoint r are nent[nstart[r]:nstart[r + 1]], each 10 k + a (node a of zone
-    rows[k]), ascending: the order of the serial scatter of ``tet10_step``. Made once per mesh.
-    Returns (nstart (nv + 1,), nent (10 k,)) int64."""
-    m = rows.shape[0]
-    nstart = np.zeros(nv + 1, dtype=np.int64)
-    for kk in range(m):
-        for a in range(10):
-            nstart[gp[rows[kk], a] + 1] += 1
-    for r in range(nv):
-        nstart[r + 1] += nstart[r]
-    fill = nstart[:nv].copy()
-    nent = np.empty(10 * m, dtype=np.int64)
-    for kk in range(m):
-        for a in range(10):
-            r = gp[rows[kk], a]
-            nent[fill[r]] = 10 * kk + a
-            fill[r] += 1
-    return nstart, nent
-
-
-@njit(cache=True, parallel=True)
-def node_sums(force, zf, ok, nstart, nent):
-    """force[r] += the zone forces zf of gridpoint r's entries (``node_lists``) in their fixed
-    order, in parallel over gridpoints: the sums do not depend on the thread count and equal the
-    serial scatter. Entries of zones with ok False are skipped."""
-    for r in prange(nstart.shape[0] - 1):
-        f0 = force[r, 0]; f1 = force[r, 1]; f2 = force[r, 2]
-        for e in range(nstart[r], nstart[r + 1]):
-            kk = nent[e] // 10
-            if ok[kk]:
-                a = nent[e] - 10 * kk
-                f0 += zf[kk, a, 0]; f1 += zf[kk, a, 1]; f2 += zf[kk, a, 2]
-        force[r, 0] = f0; force[r, 1] = f1; force[r, 2] = f2
+    rows[k]), ascending: the order of the serial scatter of ``tet10_step``
+    (``kernels/gather.node_lists``). Made once per mesh. Returns (nstart (nv + 1,), nent
+    (10 k,)) int64."""
+    return gather_lists(nv, np.arange(nv), gp, rows, 10)
 
 
 @njit(cache=True)
@@ -373,6 +340,38 @@ def tet10_lumped_mass(pos, gp, rows, density, mass):
 
 
 @njit(cache=True)
+def add_stiffness_bound(dng, wd, lam, G, nd, K, kdiag):
+    """kdiag[nd[a]] += the largest absolute row sum of node a's three rows of the element
+    stiffness K = sum_g wd[g] B_g^T D B_g (isotropic elastic, Lame lam and G), from the Cartesian
+    shape-function gradients dng (ng, n, 3); K (3 n, 3 n) is scratch. Shared by the 10-node
+    zones and the 20-node FE blocks (``tet10_stiffness``, ``feblock.feb_stiffness``)."""
+    n = dng.shape[1]
+    K[:, :] = 0.0
+    for g in range(wd.shape[0]):
+        dn = dng[g]
+        w = wd[g]
+        # block ab of B^T D B: lambda g_a g_b^T + G g_b g_a^T + G (g_a . g_b) I, g = grad N
+        for a in range(n):
+            for b in range(n):
+                dot = dn[a, 0] * dn[b, 0] + dn[a, 1] * dn[b, 1] + dn[a, 2] * dn[b, 2]
+                for i in range(3):
+                    for j in range(3):
+                        kij = lam * dn[a, i] * dn[b, j] + G * dn[b, i] * dn[a, j]
+                        if i == j:
+                            kij += G * dot
+                        K[3 * a + i, 3 * b + j] += w * kij
+    for a in range(n):
+        best = 0.0
+        for i in range(3):
+            rs = 0.0
+            for col in range(3 * n):
+                rs += abs(K[3 * a + i, col])
+            if rs > best:
+                best = rs
+        kdiag[nd[a]] += best
+
+
+@njit(cache=True)
 def tet10_stiffness(pos, gp, rows, bulk, shear, kdiag):
     """Nodal stiffness measure k_i of the text's Eq. (84)-(85) (dt_n = 2 min sqrt(m_i / k_i))
     for 10-node zones, added to kdiag[gp].
@@ -399,32 +398,24 @@ def tet10_stiffness(pos, gp, rows, bulk, shear, kdiag):
             if bad < 0:
                 bad = z
             continue
-        lam = bulk[z] - 2.0 * shear[z] / 3.0
-        G = shear[z]
-        K[:, :] = 0.0
-        for g in range(4):
-            dn = dn4[g]
-            wd = wd4[g]
-            # block ab of B^T D B: lambda g_a g_b^T + G g_b g_a^T + G (g_a . g_b) I, g = grad N
-            for a in range(10):
-                for b in range(10):
-                    dot = dn[a, 0] * dn[b, 0] + dn[a, 1] * dn[b, 1] + dn[a, 2] * dn[b, 2]
-                    for i in range(3):
-                        for j in range(3):
-                            kij = lam * dn[a, i] * dn[b, j] + G * dn[b, i] * dn[a, j]
-                            if i == j:
-                                kij += G * dot
-                            K[3 * a + i, 3 * b + j] += wd * kij
-        for a in range(10):
-            best = 0.0
-            for i in range(3):
-                rs = 0.0
-                for col in range(30):
-                    rs += abs(K[3 * a + i, col])
-                if rs > best:
-                    best = rs
-            kdiag[nodes[a]] += best
+        add_stiffness_bound(dn4, wd4, bulk[z] - 2.0 * shear[z] / 3.0, shear[z], nodes, K, kdiag)
     return bad
+
+
+@njit(cache=True)
+def add_body_force(wd, shp, rho, gvec, nd, force):
+    """force[nd[a]] += rho gvec sum_g wd[g] shp[g, a]: the consistent gravity load int rho N_a g dV
+    of one element from the weights w det J wd (ng,) and shape values shp (ng, n) at its
+    integration points. Shared by ``tet10_body_force`` and ``feblock.feb_body_force``."""
+    for a in range(shp.shape[1]):
+        w = 0.0
+        for g in range(wd.shape[0]):
+            w += wd[g] * shp[g, a]
+        w *= rho
+        r = nd[a]
+        force[r, 0] += w * gvec[0]
+        force[r, 1] += w * gvec[1]
+        force[r, 2] += w * gvec[2]
 
 
 @njit(cache=True)
@@ -465,15 +456,7 @@ def tet10_body_force(pos, gp, rows, density, gvec, force):
             if bad < 0:
                 bad = z
             continue
-        for a in range(10):
-            w = 0.0
-            for g in range(4):
-                w += wd4[g] * shp[g, a]
-            w *= density[z]
-            r = nodes[a]
-            force[r, 0] += w * gvec[0]
-            force[r, 1] += w * gvec[1]
-            force[r, 2] += w * gvec[2]
+        add_body_force(wd4, shp, density[z], gvec, nodes, force)
     return bad
 
 

@@ -46,6 +46,8 @@ import math
 import numpy as np
 from numba import njit
 
+from .motion import _sgn
+
 
 @njit(cache=True)
 def _area_vec(pos, i1, i2, i3, iopp):
@@ -209,15 +211,6 @@ def gp_externals(rows, link, mass, gravity, fapp, fface, force, fmag):
             for i in range(3):
                 force[m, i] += force[r, i]
             fmag[m] += fmag[r]
-
-
-@njit(cache=True)
-def _sgn(x):
-    if x > 0.0:
-        return 1.0
-    if x < 0.0:
-        return -1.0
-    return 0.0
 
 
 @njit(cache=True)

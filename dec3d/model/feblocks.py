@@ -38,7 +38,7 @@ from dec3d.kernels.feblock import feb_volume
 
 from .groups import group_field
 from .store import Field, Store
-from .zones import NZPROP, ZMODEL_NULL, zone_stores
+from .zones import NZPROP, ZMODEL_NULL, follow_block_rows, zone_stores
 
 _F = np.float64
 _I = np.int64
@@ -119,12 +119,8 @@ def follow_feblocks(model, vmap: np.ndarray | None, block_map: np.ndarray | None
     """Keep element node and block rows valid after ``compact_geometry`` / ``Store.compact``
     (called by ``zones.follow_geometry``): elements of dropped blocks go away."""
     es = model.store("feblocks")
-    if block_map is not None and es.n:
-        nb = block_map[es["block"]]
-        es["block"][:] = nb
-        keep = nb >= 0
-        if not keep.all():
-            es.compact(keep)
+    if block_map is not None:
+        follow_block_rows(es, block_map)
     if vmap is not None and es.n:
         for key in ("nodes", "slaves"):
             a = es[key]

@@ -129,6 +129,18 @@ def has_zones(model) -> bool:
     return "zones" in model.stores and model.store("zones").n > 0
 
 
+def follow_block_rows(store, block_map: np.ndarray) -> None:
+    """Renumber the ``block`` column of an element store (zones, FE elements) by ``block_map``
+    (old block row -> new, -1 dropped) and drop the elements of dropped blocks."""
+    if not store.n:
+        return
+    nb = block_map[store["block"]]
+    store["block"][:] = nb
+    keep = nb >= 0
+    if not keep.all():
+        store.compact(keep)
+
+
 def follow_geometry(model, vmap: np.ndarray | None, block_map: np.ndarray | None = None) -> None:
     """Keep zones and gridpoint links consistent after vertex rows moved (``vmap``: old -> new
     row, -1 dropped, from ``compact_geometry``) and/or block rows moved (``block_map``, from
@@ -139,12 +151,8 @@ def follow_geometry(model, vmap: np.ndarray | None, block_map: np.ndarray | None
     if "zones" not in model.stores:
         return
     zs = model.store("zones")
-    if block_map is not None and zs.n:
-        nb = block_map[zs["block"]]
-        zs["block"][:] = nb
-        remap_keep = nb >= 0
-        if not remap_keep.all():
-            zs.compact(remap_keep)
+    if block_map is not None:
+        follow_block_rows(zs, block_map)
     if vmap is None:
         return
     if zs.n:

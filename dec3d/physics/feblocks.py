@@ -34,6 +34,7 @@ from dec3d.kernels.feblock import (_slave_weights, feb_body_force, feb_element_p
 from dec3d.model.feblocks import feblock_store
 from dec3d.model.model import KIND_FE
 from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR
+from dec3d.physics.zones import block_elements
 
 _F = np.float64
 _I = np.int64
@@ -63,14 +64,8 @@ class FeStepper:
         es = feblock_store(model)
         b, v = model.blocks, model.vertices
         self.blocks = fe_blocks(model)
-        on = np.zeros(b.n, bool)
-        on[self.blocks] = True
-        erow = np.flatnonzero(on[es["block"]]).astype(_I)
-        cm = es["cmodel"][erow]
-        bad = ~np.isin(cm, (ZMODEL_NULL, ZMODEL_ELASTIC))
-        if bad.any():
-            raise error(f"FE elements of blocks {_ids(model, es['block'][erow[bad]])} have a constitutive model "
-                        "that does not cycle yet (only elastic and null)")
+        on, erow, cm = block_elements(model, es, self.blocks, (ZMODEL_NULL, ZMODEL_ELASTIC), error, "FE elements",
+                                      "yet (only elastic and null)")
         live = np.zeros(b.n, bool)
         live[es["block"][erow[cm == ZMODEL_ELASTIC]]] = True
         none = self.blocks[~live[self.blocks]]

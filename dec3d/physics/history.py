@@ -403,17 +403,13 @@ class HistorySet:
         """A stress component [Pa, tension positive] of the zone with id ``zone_id``."""
         col = ZONE_QUANTITIES[quantity]
         model = self.model
-        cache = {"row": -1}
+        row = _zone_row(model, zone_id)
 
         def value(eng) -> float:
-            zs = model.store("zones")
-            r = cache["row"]
-            if not (0 <= r < zs.n and zs["id"][r] == zone_id):
-                hit = np.flatnonzero(zs["id"] == zone_id)
-                if hit.size == 0:
-                    return float("nan")          # the zone has gone (its block deleted)
-                r = cache["row"] = int(hit[0])
-            return float(zs["stress"][r, col])
+            r = row()
+            if r < 0:
+                return float("nan")          # the zone has gone (its block deleted)
+            return float(model.store("zones")["stress"][r, col])
 
         return self.add(f"zone {zone_id} {quantity}", value, name,
                         {"kind": "zone", "quantity": quantity, "zone_id": int(zone_id)})
@@ -424,16 +420,13 @@ class HistorySet:
         corners -1/8, mid-edge nodes 1/4). NaN once the zone is gone."""
         fld, comp = GRIDPOINT_QUANTITIES[quantity]
         model = self.model
-        cache = {"row": -1}
+        row = _zone_row(model, zone_id)
 
         def value(eng) -> float:
+            r = row()
+            if r < 0:
+                return float("nan")
             zs = model.store("zones")
-            r = cache["row"]
-            if not (0 <= r < zs.n and zs["id"][r] == zone_id):
-                hit = np.flatnonzero(zs["id"] == zone_id)
-                if hit.size == 0:
-                    return float("nan")
-                r = cache["row"] = int(hit[0])
             nn = int(zs["nnode"][r])
             gp = zs["gp"][r, :nn]
             w = np.full(nn, 0.25) if nn == 4 else np.concatenate([np.full(4, -0.125), np.full(6, 0.25)])
@@ -465,6 +458,23 @@ class HistorySet:
             return probe(var)
 
         return self.add(f"fish {var}", value, name, {"kind": "fish", "quantity": var})
+
+
+def _zone_row(model, zone_id: int):
+    """A function giving the zones-store row of the zone with id ``zone_id`` (kept between calls,
+    looked up again when rows have moved), -1 once the zone is gone (its block deleted)."""
+    cache = {"row": -1}
+
+    def row() -> int:
+        zs = model.store("zones")
+        r = cache["row"]
+        if not (0 <= r < zs.n and zs["id"][r] == zone_id):
+            hit = np.flatnonzero(zs["id"] == zone_id)
+            if hit.size == 0:
+                return -1
+            r = cache["row"] = int(hit[0])
+        return r
+    return row
 
 
 def _contact_view(model, eng):

@@ -69,6 +69,21 @@ def _ids(model, rows) -> str:
     return head + (f" … ({len(ids)} blocks)" if len(ids) > 10 else "")
 
 
+def block_elements(model, store, blocks, allowed, error, what: str, only: str):
+    """The elements (zones or FE elements) of ``blocks`` in ``store``: (on (nblocks,) bool mask
+    of the blocks, rows int64, their constitutive model codes). Raises ``error`` naming the
+    blocks when an element has a model code not in ``allowed`` (``only`` says which cycle)."""
+    on = np.zeros(model.blocks.n, bool)
+    on[blocks] = True
+    rows = np.flatnonzero(on[store["block"]]).astype(_I)
+    cm = store["cmodel"][rows]
+    bad = ~np.isin(cm, allowed)
+    if bad.any():
+        raise error(f"{what} of blocks {_ids(model, store['block'][rows[bad]])} have a constitutive model that "
+                    f"does not cycle {only}")
+    return on, rows, cm
+
+
 def zoned_blocks(model) -> np.ndarray:
     """Rows of the live zoned (deformable) blocks."""
     b = model.blocks
@@ -84,14 +99,8 @@ class ZoneStepper:
         zs = zone_stores(model)
         b, v = model.blocks, model.vertices
         self.blocks = zoned_blocks(model)
-        on = np.zeros(b.n, bool)
-        on[self.blocks] = True
-        zrow = np.flatnonzero(on[zs["block"]]).astype(_I)
-        cm = zs["cmodel"][zrow]
-        bad = ~np.isin(cm, (ZMODEL_NULL, ZMODEL_ELASTIC, ZMODEL_MOHR))
-        if bad.any():
-            raise error(f"zones of blocks {_ids(model, zs['block'][zrow[bad]])} have a constitutive model that "
-                        "does not cycle (only elastic, mohr-coulomb and null)")
+        on, zrow, cm = block_elements(model, zs, self.blocks, (ZMODEL_NULL, ZMODEL_ELASTIC, ZMODEL_MOHR), error,
+                                      "zones", "(only elastic, mohr-coulomb and null)")
         act = (cm == ZMODEL_ELASTIC) | (cm == ZMODEL_MOHR)
         live = np.zeros(b.n, bool)
         live[zs["block"][zrow[act]]] = True

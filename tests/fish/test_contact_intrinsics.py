@@ -31,9 +31,12 @@ def test_contacts_before_any_cycle_and_their_geometry(session):
 
 def test_settled_contact_carries_the_weight(session):
     session.command(SETUP + "model cycle 3000\n"
-                    "fish define forces\n  local fsum = 0.0\n  local asum = 0.0\n"
+                    "fish define forces\n  local fsum = 0.0\n  local asum = 0.0\n  local dm = 0.0\n"
                     "  loop foreach local sc block.subcontact.list\n    fsum = fsum + block.subcontact.force.norm(sc)\n"
-                    "    asum = asum + block.subcontact.area(sc)\n  endloop\n  global fs = fsum\n  global ar = asum\n"
+                    "    asum = asum + block.subcontact.area(sc)\n"
+                    "    dm = dm + math.abs(block.subcontact.force.shear.mag(sc) - math.abs(block.subcontact.force.shear(sc)))\n"
+                    "    dm = dm + math.abs(block.subcontact.disp.shear.mag(sc) - math.abs(block.subcontact.disp.shear(sc)))\n"
+                    "  endloop\n  global fs = fsum\n  global ar = asum\n  global dm_ = dm\n"
                     "  local cl = block.contact.list\n"
                     "  global fc = block.contact.force.norm(cl(1))\n"
                     "  global fsh = math.abs(block.contact.force.shear(cl(1)))\nend\n@forces")
@@ -42,6 +45,7 @@ def test_settled_contact_carries_the_weight(session):
     assert v["fs"] == pytest.approx(v["fc"], rel=1e-12)    # the contact's force is its sub-contacts' sum
     assert v["ar"] == pytest.approx(1.0, rel=1e-6)         # the contact face is 1 m²
     assert v["fsh"] < 1e-6 * v["fc"]                        # no shear under vertical load
+    assert v["dm_"] == 0.0                                   # the .mag intrinsics are the vectors' lengths
 
 
 def test_contact_pointer_errors(session):

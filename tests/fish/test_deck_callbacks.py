@@ -20,10 +20,17 @@ if not DECKS.is_dir():
 SAFEGO = "yopi1838__Hanze_SAFEGO__"
 
 
+def run_with_deck(session, tmp_path, deck: str, as_name: str, text: str) -> None:
+    """Copy the public deck ``deck`` into tmp_path as ``as_name`` and run ``text`` (which calls it)."""
+    shutil.copy(DECKS / deck, tmp_path / as_name)
+    run = tmp_path / "run.dat"
+    run.write_text(text)
+    session.call(run)
+
+
 def test_safego_joint_force_as_a_callback_records_the_bed_joint_force(session, tmp_path):
-    shutil.copy(DECKS / f"{SAFEGO}1WB_EUCENTRE__1WB_SIN-01__03_Fish.dat", tmp_path / "03_Fish.dat")
-    deck = tmp_path / "run.dat"
-    deck.write_text(
+    run_with_deck(
+        session, tmp_path, f"{SAFEGO}1WB_EUCENTRE__1WB_SIN-01__03_Fish.dat", "03_Fish.dat",
         "block create brick 0 1 0 1 0 1\nblock create brick 0 1 0 1 1 1.5\nblock property density 2000\n"
         "block contact jmodel assign elastic\nblock contact property stiffness-normal 1e10 stiffness-shear 1e10\n"
         "model gravity 0 0 -10\nblock fix range position-z 0 1\n"
@@ -34,7 +41,6 @@ def test_safego_joint_force_as_a_callback_records_the_bed_joint_force(session, t
         "fish history @shear_bedjoint_B\nhistory rename \"shear_bedjoint_B\" name \"2\"\n"
         "fish callback add joint_force 0.1 interval 10\n"
         "model cycle 3000\n")
-    session.call(deck)
     v = session.variables
     assert v["norm_bedjoint_b"] == pytest.approx(1e4, rel=1e-2)
     assert abs(v["shear_bedjoint_b"]) < 1e-6 * 1e4
@@ -46,16 +52,14 @@ def test_safego_joint_force_as_a_callback_records_the_bed_joint_force(session, t
 
 
 def test_servo_spring_callback_follows_the_beam(session, tmp_path):
-    shutil.copy(DECKS / f"{SAFEGO}servo_spring.dat", tmp_path / "servo_spring.dat")
-    deck = tmp_path / "run.dat"
-    deck.write_text(
+    run_with_deck(
+        session, tmp_path, f"{SAFEGO}servo_spring.dat", "servo_spring.dat",
         "block create brick 0 1.292 0 2.47 0 0.21\nblock create brick 0 1.292 2.47 2.68 0 0.21\n"
         "block property density 2000\nblock contact jmodel assign elastic\n"
         "block contact property stiffness-normal 1e9 stiffness-shear 1e9\n"
         "model gravity 0 -10 0\nblock fix range position-y 0 2.47\n"
         "fish define cstav\n  ncstav = 0.0\nend\n"          # the deck's law 1 reads it; law 0 (used) does not
         "call 'servo_spring.dat'\nmodel cycle 100\n[dy_now = block.gp.disp.y(srv_gp)]\n")
-    session.call(deck)
     v = session.variables
     assert v["srv_calls"] == 5                                  # 100 steps, one update every 20
     assert v["dy_now"] < -1e-7                                  # the beam has settled on the base
