@@ -9,6 +9,13 @@ middle one of its mid-edge nodes); when all four carry the same stress the face 
 one 6-node triangle with the consistent loads of ``kernels.zones_ho.tri6_traction_loads`` (0 at
 the corners, A/3 at the mid-edge nodes for a flat face), which a 10-node mesh needs to carry a
 uniform stress exactly; thirds of the four triangles (A/12 and A/4) would not.
+A face of a hexahedral zone (two overlaid 5-tetrahedron sets, ``zones.hex``) is on the surface as
+two triangles split on one diagonal, while the other overlay splits it on the other diagonal;
+when both triangles carry the same stress the face is loaded as the quadrilateral: the mean of
+the thirds of the two splits (A/4 per corner of a flat parallelogram; thirds of one split alone
+would give A/3 at the diagonal's ends and A/6 at the others, and zone stresses would spread).
+The pairs are found from the zones: two loaded triangles of one block on one source face that
+are faces of tetrahedra of the same hexahedral zone and share two gridpoints.
 Only triangles on the outside of a joined continuum take loads: a triangle whose gridpoints
 (resolved to their link masters) are also a triangle of another block is interior.
 """
@@ -77,9 +84,66 @@ def recompute_fface(model) -> None:
         unit = a6 / np.linalg.norm(a6, axis=1)[:, None]
         trac = np.ascontiguousarray(np.einsum("kij,kj->ki", sig[members[:, 0]], unit))
         tri6_traction_loads(v["pos"], np.ascontiguousarray(tri6), trac, v["fface"])
-    force = np.einsum("kij,kj->ki", sig[thirds], an[thirds]) / 3.0
+    rest = np.flatnonzero(thirds)
+    pairs = _hex_quads(model, rows[rest], nodes[rest], s[rest])
+    weight = np.ones(len(rows))
+    if len(pairs):
+        pairs = rest[pairs]                                         # (q, 2) indices into rows
+        weight[pairs.ravel()] = 0.5                                 # half from this split …
+        t1, t2 = nodes[pairs[:, 0]], nodes[pairs[:, 1]]
+        in2 = (t1[:, :, None] == t2[:, None, :]).any(axis=2)        # (q, 3) nodes of t1 also in t2
+        o1 = t1[~in2]                                               # corner of t1 off the diagonal
+        o2 = t2[~(t2[:, :, None] == t1[:, None, :]).any(axis=2)]
+        d = t1[in2].reshape(-1, 2)                                  # the diagonal's two corners
+        up = an[pairs[:, 0]] + an[pairs[:, 1]]
+        sq = sig[pairs[:, 0]]
+        for k in range(2):                                          # … half from the other split
+            tri = np.column_stack([o1, o2, d[:, k]])
+            q = v["pos"][tri]
+            a2 = 0.5 * np.cross(q[:, 1] - q[:, 0], q[:, 2] - q[:, 0])
+            a2 *= np.where(np.einsum("ij,ij->i", a2, up) < 0.0, -1.0, 1.0)[:, None]
+            f2 = 0.5 * np.einsum("kij,kj->ki", sq, a2) / 3.0
+            for c in range(3):
+                np.add.at(v["fface"], tri[:, c], f2)
+    force = weight[thirds, None] * np.einsum("kij,kj->ki", sig[thirds], an[thirds]) / 3.0
     for k in range(3):
         np.add.at(v["fface"], nodes[thirds, k], force)
+
+
+def _hex_quads(model, frows: np.ndarray, nodes: np.ndarray, fstress: np.ndarray) -> np.ndarray:
+    """Pairs (q, 2) of indices into ``frows`` (face rows, triangle ``nodes`` (k, 3), stresses
+    ``fstress``) that are the two surface triangles of one face of one hexahedral zone with one
+    stress."""
+    zs = model.store("zones")
+    empty = np.zeros((0, 2), np.int64)
+    if not len(frows):
+        return empty
+    f = model.faces
+    blk = f["block"][frows]
+    hx = np.flatnonzero((zs["hex"] >= 0) & np.isin(zs["block"], np.unique(blk)))
+    if not len(hx):
+        return empty
+    g = zs["gp"][hx][:, :4]
+    tri = np.sort(np.concatenate([g[:, [0, 1, 2]], g[:, [0, 1, 3]], g[:, [0, 2, 3]], g[:, [1, 2, 3]]]), axis=1)
+    owner = np.tile(hx, 4)
+    # a surface triangle is a face of one tetrahedron only; faces inside the mesh appear twice
+    _, first, cnt = np.unique(tri, axis=0, return_index=True, return_counts=True)
+    keep = first[cnt == 1]
+    at = _lookup(tri[keep], np.sort(nodes, axis=1))
+    found = np.flatnonzero(at >= 0)
+    if len(found) < 2:
+        return empty
+    z = owner[keep[at[found]]]
+    key = np.column_stack([zs["block"][z], zs["hex"][z], f["source"][frows[found]]])
+    order = np.lexsort(key.T[::-1])
+    key, found = key[order], found[order]
+    same = np.all(key[1:] == key[:-1], axis=1)
+    # exactly two triangles per (block, hexahedron, source face)
+    start = np.flatnonzero(same & ~np.r_[False, same[:-1]] & ~np.r_[same[1:], False])
+    i, j = found[start], found[start + 1]
+    shared = (nodes[i][:, :, None] == nodes[j][:, None, :]).any(axis=2).sum(axis=1)
+    ok = (shared == 2) & np.all(fstress[i] == fstress[j], axis=1)
+    return np.column_stack([i[ok], j[ok]])
 
 
 #: the faces of a 10-node zone as 6-node triangles (zone node columns: corners 0-3, then the
