@@ -54,7 +54,9 @@ _STRESS_KEYS = ("stress-xx", "stress-yy", "stress-zz", "stress-xy", "stress-xz",
          range="face",
          doc="Apply a stress to the boundary triangles of zoned blocks in range (located by centroid).",
          details="The traction t = σ·n on each triangle, times its area, goes a third to each of its "
-                 "gridpoints every step. Loads add to what is there; only faces on the outside of a "
+                 "gridpoints every step; the two triangles of a hexahedral zone's face are loaded as the "
+                 "quadrilateral (the mean of its two diagonal splits: a quarter to each corner of a "
+                 "parallelogram) and the faces of 10-node zones as 6-node triangles. Loads add to what is there; only faces on the outside of a "
                  "joined continuum take them. `block face apply-remove` clears them.",
          examples=["block face apply stress-normal -1e6 range position-z 1",
                    "block face apply stress -1e6 -2e6 -1e6 0 0 0 range group 'hole'"])

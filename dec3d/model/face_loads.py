@@ -120,10 +120,16 @@ def _hex_quads(model, frows: np.ndarray, nodes: np.ndarray, fstress: np.ndarray)
         return empty
     f = model.faces
     blk = f["block"][frows]
-    hx = np.flatnonzero((zs["hex"] >= 0) & np.isin(zs["block"], np.unique(blk)))
+    # only tetrahedra with three loaded gridpoints can have a loaded triangle as a face (and both
+    # tetrahedra on any such face are kept, so the count of a face below is not changed)
+    loaded = np.zeros(model.vertices.n, bool)
+    loaded[nodes.ravel()] = True
+    g = zs["gp"][:, :4]
+    hx = np.flatnonzero((zs["hex"] >= 0) & (loaded[np.maximum(g, 0)].sum(axis=1) >= 3)
+                        & np.isin(zs["block"], np.unique(blk)))
     if not len(hx):
         return empty
-    g = zs["gp"][hx][:, :4]
+    g = g[hx]
     tri = np.sort(np.concatenate([g[:, [0, 1, 2]], g[:, [0, 1, 3]], g[:, [0, 2, 3]], g[:, [1, 2, 3]]]), axis=1)
     owner = np.tile(hx, 4)
     # a surface triangle is a face of one tetrahedron only; faces inside the mesh appear twice

@@ -27,7 +27,7 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
    on the gridpoints of 4-node zones, the consistent loads of ``zones_ho.tet10_body_force`` on
    those of 10-node zones, both counted in the applied-force magnitudes of the equilibrium
    ratio), applied and face forces (``model.face_loads``: 6-node faces of 10-node zones by
-   ``zones_ho.tri6_traction_loads``) and the sum onto masters (``gp_externals``), damping and
+   ``zones_ho.tri6_traction_loads``, hexahedral zone faces as quadrilaterals) and the sum onto masters (``gp_externals``), damping and
    motion (``gp_motion``).
 
 Zoned blocks are not bodies of the rigid motion kernel (``RigidEngine._groups`` leaves them
