@@ -113,3 +113,19 @@ def test_uniaxial_hex_cube_solved_by_face_stress(session):
     s = m.store("zones")["stress"]
     spread = np.abs(s - np.array([0, 0, SIG, 0, 0, 0])).max() / abs(SIG)
     assert spread <= 1e-6
+
+
+def test_joined_hex_blocks_top_loads_are_quarters(session):
+    # two joined bricks zoned conformingly: each block's zone faces loaded as quadrilaterals,
+    # the shared face takes nothing
+    session.command("block create brick 0 1 0 1 0 1")
+    session.command("block create brick 1 2 0 1 0 1")
+    session.command("block join")
+    session.command("block zone generate hexahedra divisions 1 1 1")
+    m = session.model
+    session.command(f"block face apply stress-zz {SIG} range position-z 1")
+    f, p = m.vertices["fface"], m.vertices["pos"]
+    np.testing.assert_allclose(f.sum(axis=0), [0.0, 0.0, SIG * 2.0], atol=1e-6)
+    top = np.isclose(p[:, 2], 1.0)
+    np.testing.assert_allclose(f[top, 2], SIG / 4, rtol=1e-12)   # one zone face per block row
+    assert np.all(f[~top] == 0.0)
