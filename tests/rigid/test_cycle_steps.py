@@ -2,6 +2,8 @@
 rigid-only and a mixed rigid/zoned model get, and that the rigid batch cut into kernel calls of
 one step each (Ctrl-C/progress granularity) changes no number."""
 import io
+import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -9,18 +11,8 @@ import dec3d
 from dec3d.physics import rigid
 from test_split_runs import stack
 
-MIXED = """model new
-block create brick 0 1 0 1 0 1
-block create brick 0 1 0 1 1 2
-block property density 2000
-block zone generate edgelength 0.5 range position-z 0 1
-block zone cmodel assign elastic
-block zone property bulk 5e8 shear 3e8 density 2000
-block gridpoint apply velocity 0 0 0 range position-z 0
-model gravity 0 0 -10
-block contact jmodel assign elastic
-block contact material-table default property stiffness-normal 1e9 stiffness-shear 1e9
-"""
+sys.path.insert(0, str(Path(__file__).parents[1] / "deformable"))
+from test_zone_split_runs import DECK as MIXED  # noqa: E402  (a rigid block on a zoned one)
 
 
 def names(s):
