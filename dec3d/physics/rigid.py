@@ -105,6 +105,8 @@ class RigidEngine(ContactDetection):
         self._cand = None             # candidate pairs (rows A, rows B) of the last cell map
         #: the deformable step of the last run on a model with zones (``physics.zones``), or None
         self._zstep = None
+        #: the steps of the last run's cycle, in order (``_Run``: RigidBatch, Clock, Hooks, ...)
+        self.steps: list = []
         contact_stores(model)
 
     # ------------------------------------------------------------ model-backed state
@@ -395,9 +397,10 @@ class RigidEngine(ContactDetection):
         for h, ns, nt, nv in snap["histories"]:
             del h.steps[ns:], h.times[nt:], h.values[nv:]
 
-    def _blowup(self, bad: int, dt: float, far: bool) -> RunError:
-        """The message of a run that became unstable at block row ``bad``: a spin blow-up
-        names the angular speed [rad/s], a translation blow-up the speed [m/s]."""
+    def _blowup(self, bad: int, dt: float, far: bool, step: int | None = None) -> RunError:
+        """The message of a run that became unstable at block row ``bad`` (at ``step``, default
+        the model's): a spin blow-up names the angular speed [rad/s], a translation blow-up the
+        speed [m/s]."""
         m = self.model
         b = m.blocks
         bid = int(b["id"][bad])
@@ -415,80 +418,24 @@ class RigidEngine(ContactDetection):
         else:
             what = f"reached velocity {v:.3g} m/s (time step {dt:.3g} s too large or stiffness too high)"
         tail = ": it can pass through other blocks unseen" if far and not spin else ""
-        return RunError(f"the run became unstable at step {m.step}: block {bid} {what}{tail}; "
+        return RunError(f"the run became unstable at step {m.step if step is None else step}: block {bid} {what}{tail}; "
                         "the model is back at its state before this command")
 
     def _cycle(self, nsteps: int, stop, max_time, warn=None) -> int:
+        """The cycle (3DEC theory, Fig. 13) as one driver over an ordered list of steps
+        (``self.steps``, built per run by ``_Run``): detection when due, then per batch of k
+        steps each step's ``advance`` in order, the clock, the hooks. Batches end at the next
+        detection, history sample, VTK snapshot, ``max_time`` or ``nsteps``."""
         m = self.model
-        b = m.blocks
-        live = ~b["hidden"]
-        if _has_gridpoints(m):
-            return self._cycle_zoned(nsteps, stop, max_time, warn)
-        if (b["mass"][live] <= 0).any():
-            raise RunError("a block has no mass: set `block property density` before cycling")
-        s = self.settings()
-        g = np.asarray(m.settings.gravity, dtype=_F)
-        mode, alpha = self.damping()
-        full = self.full_inertia()
-        gstart, gmember = self._groups()
-        self._group_cache = (gstart, gmember)
-        ng = len(gstart) - 1
-        # orientation of each block: its principal axes are kept current (below)
-        inertia = np.einsum("bij,bj,bkj->bik", b["principal_axes"], b["principal_moment"], b["principal_axes"])
-        gmass, gcen, _, gprin, gaxes, giscalar = group_properties(gstart, gmember, b["mass"], b["centroid"],
-                                                                  inertia, b["inertia_approx"],
-                                                                  b["principal_moment"], b["principal_axes"])
-        axes0 = gaxes.copy()
-        servo = new_servo(ng, ratio=float(s["servo_ratio"]))
-        if mode == DAMP_ADAPTIVE and len(s["servo"]) == NSERVO:
-            servo[:NSERVO] = s["servo"]
-        servo[S_HIST] = 0.0
-        fixity = (b["fixity"] | b["apply_fix"]).astype(np.uint8)
-        dt_fixed = float(s["timestep"]) if s["timestep"] else None
-        out = np.zeros(4)
-        vmax = 1e6
-        interval = max(1, int(m.settings.update_interval))
-        done = 0
-        progress = _Progress(nsteps, self)
-        fresh = self._signature != self._geometry_signature()
-        if fresh:
-            self.detect()
-        if warn is not None:
-            msg = self.stiffness_warning()
-            if msg:
-                warn(msg)
-        # Δt follows the contact stiffnesses: worked out again at every detection (below). A run
-        # that starts between two detections, on the step where the last run ended and with the
-        # geometry as it left it, goes on with that run's Δt, so that a run split into several
-        # commands (or saved and restored in between) takes exactly the steps of one run
-        last = s["dt_run"]
-        if (dt_fixed is None and not fresh and len(last) == 2 and int(last[1]) == m.step
-                and m.step % interval != 0):
-            dt, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, float(last[0]))
-        else:
-            dt, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt_fixed)
-        self.dt = dt
-        # detection also runs as soon as a block has moved CTOL/2 since the last one, so
-        # that two blocks approaching each other cannot close more than CTOL unseen
-        radius = self._radii()
-        acc = np.zeros(b.n)
-        motion = np.zeros(2)
-        trigger = 0.5 * self.tolerance()
-        due = False
-        chunk = 10                       # steps per kernel call, adapted to CHUNK_SECONDS
+        run = _Run(self, nsteps, warn)
+        self.steps = run.steps
+        interval = run.interval
         try:
-            while done < nsteps and not _StopFlag.requested:
-                if m.step % interval == 0 or due:
+            while run.done < nsteps and not _StopFlag.requested:
+                if run.detection_due():
                     self.detect()
-                    acc[:] = 0.0
-                    due = False
-                    if dt_fixed is None:
-                        # the contacts made or lost change the stiffness each body feels
-                        dt, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, None)
-                        self.dt = dt
-                    elif self.mass_scaling():
-                        _, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt)
-                k = min(nsteps - done, interval - m.step % interval)
+                    run.detected()
+                k = min(nsteps - run.done, interval - m.step % interval)
                 for h in self.step_hooks:
                     hi = int(getattr(h, "interval", 0) or 0)
                     if hi > 0:
@@ -497,74 +444,22 @@ class RigidEngine(ContactDetection):
                 if vtk and vtk["interval"] > 0:
                     k = max(1, min(k, vtk["last_step"] + vtk["interval"] - m.step))
                 if max_time is not None:
-                    left = int(math.ceil((max_time - m.time) / dt - 1e-9))
+                    left = int(math.ceil((max_time - m.time) / run.dt - 1e-9))
                     if left <= 0:
                         break
                     k = min(k, left)
-                cs, ss = self.contacts, self.subcontacts
-                # the batch of k steps runs as kernel calls of about CHUNK_SECONDS each, so that
-                # Ctrl-C and progress are seen in time; the split changes no number (the kernel
-                # carries its state in the arrays; time advances once per batch as before)
-                n_ok = 0
-                bad = -1
-                while n_ok < k:
-                    kk = min(k - n_ok, chunk)
+                n = k                    # each step passes on how many steps the batch really took
+                for st in run.steps:
                     t0 = _time.perf_counter()
-                    c_ok, bad = run_steps(kk, dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass, gisc,
-                                          gprin, gaxes, gcen, b["mass"], fixity, b["force"], b["moment"], b["fapp"],
-                                          b["mapp"], b["velocity"], b["spin"], b["centroid"], b["disp"],
-                                          b["vert_start"], b["vert_count"], m.vertices["pos"], cs["a"], cs["b"],
-                                          cs["normal"], cs["pos"], np.arange(cs.n, dtype=_I), cs["jmodel"],
-                                          cs["prop"], ss["contact"], ss["pos"], ss["area"], ss["fn"], ss["fs"],
-                                          ss["un"], ss["udil"], ss["us"], ss["state"], vmax, out, radius, acc,
-                                          trigger, motion)
-                    spent = _time.perf_counter() - t0
-                    self.timings["cycle"] += spent
-                    n_ok += c_ok
-                    if bad >= 0 or motion[1] > 0.0 or c_ok < kk:
-                        break
-                    if c_ok > 0:
-                        chunk = max(1, min(100000, int(c_ok * CHUNK_SECONDS / max(spent, 1e-9))))
-                    progress.update(done + n_ok)
-                    if _StopFlag.requested:
-                        break
-                due = motion[1] > 0.0
-                m.step += n_ok
-                m.time += n_ok * dt
-                done += n_ok
-                self._criteria = None
-                if bad >= 0:
-                    raise self._blowup(bad, dt, motion[1] == 2.0)
-                self.kinetic = float(out[2])
-                t0 = _time.perf_counter()
-                for hook in self.step_hooks:
-                    hook(self)
-                periodic_vtk(m)
-                self.timings["hooks"] += _time.perf_counter() - t0
-                progress.update(done)
+                    n = st.advance(n)
+                    if st.timing:
+                        self.timings[st.timing] += _time.perf_counter() - t0
+                run.progress.update(run.done)
                 if stop is not None and stop(self):
                     break
         finally:
-            self._group_cache = None
-            progress.close()
-            # keep each block's principal axes turning with its body; save the servo state
-            turn = np.einsum("gij,gkj->gik", gaxes, axes0)
-            gid = np.repeat(np.arange(ng), np.diff(gstart))
-            pa = b["principal_axes"]
-            # re-orthonormalised (polar factor): a slightly skew frame would grow threefold per
-            # call (Q A Aᵀ A), and after ~30 `model cycle` commands Euler's equations blow up
-            pa[gmember] = _orthonormal(np.einsum("bij,bjk->bik", turn[gid], pa[gmember]))
-            # a lone block takes back the kernel's own frame unchanged: the next run starts from
-            # exactly the axes this one ended with, so splitting a run into several `model cycle`
-            # commands (or save/restore between them) changes no bit
-            lone = np.diff(gstart) == 1
-            pa[gmember[gstart[:-1][lone]]] = gaxes[lone]
-            b["inertia"][gmember] = np.einsum("bij,bj,bkj->bik", pa[gmember], b["principal_moment"][gmember],
-                                              pa[gmember])
-            s["dt_run"] = [float(self.dt), int(m.step)]
-            if mode == DAMP_ADAPTIVE:
-                s["servo"] = [float(x) for x in servo[:NSERVO]]
-        return done
+            run.finish()
+        return run.done
 
     # ------------------------------------------------------------ models with zoned blocks
     def _zone_contacts_check(self) -> bool:
@@ -626,175 +521,6 @@ class RigidEngine(ContactDetection):
         zst.set_contact_stiffness(rows[on], kw[on])
         return out[0], out[1]
 
-    def _cycle_zoned(self, nsteps: int, stop, max_time, warn=None) -> int:
-        """``_cycle`` for a model with zoned blocks: per batch, the rigid bodies (if any) by
-        ``run_steps`` and the zoned blocks step by step (``physics.zones.ZoneStepper``) with the
-        same Δt. The two parts share no contact (``_zone_contacts_check``), so running the rigid
-        steps of a batch before the zone steps of that batch is the same as interleaving them."""
-        from .zones import ZoneStepper
-
-        m = self.model
-        b = m.blocks
-        rigid = ~b["hidden"] & ~_deformable(b["kind"])
-        if (b["mass"][rigid] <= 0).any():
-            raise RunError("a block has no mass: set `block property density` before cycling")
-        zst = ZoneStepper(m, RunError, warn)
-        self._zstep = zst
-        s = self.settings()
-        g = np.asarray(m.settings.gravity, dtype=_F)
-        mode, alpha = self.damping()
-        full = self.full_inertia()
-        large = bool(m.settings.large_strain)
-        gstart, gmember = self._groups()
-        self._group_cache = (gstart, gmember)
-        ng = len(gstart) - 1
-        inertia = np.einsum("bij,bj,bkj->bik", b["principal_axes"], b["principal_moment"], b["principal_axes"])
-        gmass, gcen, _, gprin, gaxes, giscalar = group_properties(gstart, gmember, b["mass"], b["centroid"],
-                                                                  inertia, b["inertia_approx"],
-                                                                  b["principal_moment"], b["principal_axes"])
-        axes0 = gaxes.copy()
-        servo = new_servo(ng, ratio=float(s["servo_ratio"]))
-        if mode == DAMP_ADAPTIVE and len(s["servo"]) == NSERVO:
-            servo[:NSERVO] = s["servo"]
-        servo[S_HIST] = 0.0
-        fixity = (b["fixity"] | b["apply_fix"]).astype(np.uint8)
-        dt_fixed = float(s["timestep"]) if s["timestep"] else None
-        out = np.zeros(4)
-        vmax = 1e6
-        interval = max(1, int(m.settings.update_interval))
-        done = 0
-        progress = _Progress(nsteps, self)
-        fresh = self._signature != self._geometry_signature()
-        if fresh:
-            self.detect()
-        mixed = self._zone_contacts_check()
-        last = s["dt_run"]
-        # between two detections, where the last run ended: go on as that run would have
-        between = not fresh and len(last) == 2 and int(last[1]) == m.step and m.step % interval != 0
-        if mixed:
-            wsub, wcon = self._mixed_weights(zst, recompute=not between)
-        if warn is not None:
-            msg = self.stiffness_warning()
-            if msg:
-                warn(msg)
-        scaled = self.mass_scaling()
-
-        def pick_dt() -> float:
-            """Δt for the contacts as they are now (worked out again at every detection)."""
-            if dt_fixed is not None:
-                return dt_fixed
-            dt_r = self._masses(gstart, gmember, gmass, giscalar, None)[0] if ng else math.inf
-            d = (dt_r if ng else float(s["scale_timestep"] or 1.0)) if scaled else min(dt_r, zst.natural_timestep())
-            return d if math.isfinite(d) and d > 0 else 1.0
-
-        # as in `_cycle`: a run starting between detections where the last one ended goes on
-        # with its Δt, so that split runs and save/restore change no number
-        if dt_fixed is None and between:
-            dt = float(last[0])
-        else:
-            dt = pick_dt()
-        zst.set_masses(dt, scaled)
-        if ng:
-            _, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt)
-        self.dt = dt
-        radius = self._radii()
-        acc = np.zeros(b.n)
-        motion = np.zeros(2)
-        trigger = 0.5 * self.tolerance()
-        due = False
-        loaded = large and "fstress" in m.faces and bool(np.any(m.faces["fstress"] != 0.0))
-        try:
-            while done < nsteps and not _StopFlag.requested:
-                # with no rigid body and small strain nothing moves that could make a contact
-                if (m.step % interval == 0 or due) and (ng or large):
-                    self.detect()
-                    mixed = self._zone_contacts_check()
-                    acc[:] = 0.0
-                    due = False
-                    if mixed:
-                        wsub, wcon = self._mixed_weights(zst)
-                    old_dt, dt = dt, pick_dt()
-                    self.dt = dt
-                    if scaled and ng:
-                        _, gimass, gisc = self._masses(gstart, gmember, gmass, giscalar, dt)
-                    if mixed or dt != old_dt:
-                        zst.set_masses(dt, scaled)
-                    if loaded:
-                        from dec3d.model.face_loads import recompute_fface
-                        recompute_fface(m)
-                k = min(nsteps - done, interval - m.step % interval)
-                for h in self.step_hooks:
-                    hi = int(getattr(h, "interval", 0) or 0)
-                    if hi > 0:
-                        k = min(k, hi - m.step % hi)
-                vtk = m.outputs.get("vtk")
-                if vtk and vtk["interval"] > 0:
-                    k = max(1, min(k, vtk["last_step"] + vtk["interval"] - m.step))
-                if max_time is not None:
-                    left = int(math.ceil((max_time - m.time) / dt - 1e-9))
-                    if left <= 0:
-                        break
-                    k = min(k, left)
-                t0 = _time.perf_counter()
-                bad = -1
-                n_ok = k
-                if mixed:
-                    n_ok = 0
-                    self._mixed_steps(k, zst, wsub, wcon, dt, g, mode, alpha, servo, full, gstart, gmember, gmass,
-                                      gimass, gisc, gprin, gaxes, gcen, fixity, large, vmax, out)
-                    n_ok = k
-                elif ng:
-                    cs, ss = self.contacts, self.subcontacts
-                    n_ok, bad = run_steps(k, dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass, gisc,
-                                          gprin, gaxes, gcen, b["mass"], fixity, b["force"], b["moment"], b["fapp"],
-                                          b["mapp"], b["velocity"], b["spin"], b["centroid"], b["disp"],
-                                          b["vert_start"], b["vert_count"], m.vertices["pos"], cs["a"], cs["b"],
-                                          cs["normal"], cs["pos"], np.arange(cs.n, dtype=_I), cs["jmodel"],
-                                          cs["prop"], ss["contact"], ss["pos"], ss["area"], ss["fn"], ss["fs"],
-                                          ss["un"], ss["udil"], ss["us"], ss["state"], vmax, out, radius, acc,
-                                          trigger, motion)
-                    if bad >= 0:
-                        raise self._blowup(bad, dt, motion[1] == 2.0)
-                for _ in range(0 if mixed else n_ok):
-                    zbad = zst.step(dt, g, mode, alpha, large, vmax)
-                    if zbad >= 0:
-                        raise zst.unstable(zbad, dt)
-                zb = zst.blocks
-                b["force"][zb] = 0.0            # contact forces on zoned blocks went to their gridpoints
-                b["moment"][zb] = 0.0
-                self.timings["cycle"] += _time.perf_counter() - t0
-                due = motion[1] > 0.0
-                m.step += n_ok
-                m.time += n_ok * dt
-                done += n_ok
-                self._criteria = None
-                self.kinetic = (float(out[2]) if ng else 0.0) + zst.kinetic
-                t0 = _time.perf_counter()
-                for hook in self.step_hooks:
-                    hook(self)
-                periodic_vtk(m)
-                self.timings["hooks"] += _time.perf_counter() - t0
-                progress.update(done)
-                if stop is not None and stop(self):
-                    break
-        finally:
-            self._group_cache = None
-            progress.close()
-            zst.finish(large)
-            s["dt_run"] = [float(self.dt), int(m.step)]
-            if ng:
-                turn = np.einsum("gij,gkj->gik", gaxes, axes0)
-                gid = np.repeat(np.arange(ng), np.diff(gstart))
-                pa = b["principal_axes"]
-                pa[gmember] = _orthonormal(np.einsum("bij,bjk->bik", turn[gid], pa[gmember]))
-                lone = np.diff(gstart) == 1
-                pa[gmember[gstart[:-1][lone]]] = gaxes[lone]
-                b["inertia"][gmember] = np.einsum("bij,bj,bkj->bik", pa[gmember], b["principal_moment"][gmember],
-                                                  pa[gmember])
-            if mode == DAMP_ADAPTIVE:
-                s["servo"] = [float(x) for x in servo[:NSERVO]]
-        return done
-
     def _mixed_steps(self, k, zst, wsub, wcon, dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass,
                      gisc, gprin, gaxes, gcen, fixity, large, vmax, out) -> None:
         """``k`` steps of a model where zoned and rigid blocks touch (3DEC theory, "Deformable
@@ -855,6 +581,296 @@ def _orthonormal(a: np.ndarray) -> np.ndarray:
     u, _, vt = np.linalg.svd(a[ok])
     out[ok] = u @ vt
     return out
+
+
+# ------------------------------------------------------------------ the cycle as a list of steps
+class _Run:
+    """What one ``model cycle`` works with, set up once (rigid groups and their properties,
+    damping/servo state, fixity, Δt, the zone stepper of zoned blocks), and its list of steps:
+
+    rigid blocks only:  RigidBatch → Clock → Hooks
+    with zoned blocks:  MixedContacts → RigidBatch → ZoneStep → Clock → Hooks
+
+    Each step has ``prepare()`` (after every detection) and ``advance(n) -> n`` (n steps of
+    the batch; a step may take fewer, e.g. the rigid kernel stops early when a block has moved
+    far enough to need a detection, and passes on how many it took). ``finish()`` stores what
+    the next run continues from (principal axes, servo state, ``dt_run``)."""
+
+    def __init__(self, eng: RigidEngine, nsteps: int, warn):
+        self.eng = eng
+        m = self.m = eng.model
+        b = self.b = m.blocks
+        self.zoned = _has_gridpoints(m)
+        body = ~b["hidden"] & ~_deformable(b["kind"]) if self.zoned else ~b["hidden"]
+        if (b["mass"][body] <= 0).any():
+            raise RunError("a block has no mass: set `block property density` before cycling")
+        self.zst = None
+        if self.zoned:
+            from .zones import ZoneStepper
+
+            self.zst = eng._zstep = ZoneStepper(m, RunError, warn)
+        s = self.s = eng.settings()
+        self.g = np.asarray(m.settings.gravity, dtype=_F)
+        self.mode, self.alpha = eng.damping()
+        self.full = eng.full_inertia()
+        self.large = bool(m.settings.large_strain)
+        gstart, gmember = self.gstart, self.gmember = eng._groups()
+        eng._group_cache = (gstart, gmember)
+        self.ng = len(gstart) - 1
+        # orientation of each block: its principal axes are kept current (finish)
+        inertia = np.einsum("bij,bj,bkj->bik", b["principal_axes"], b["principal_moment"], b["principal_axes"])
+        (self.gmass, self.gcen, _, self.gprin, self.gaxes,
+         self.giscalar) = group_properties(gstart, gmember, b["mass"], b["centroid"], inertia, b["inertia_approx"],
+                                           b["principal_moment"], b["principal_axes"])
+        self.axes0 = self.gaxes.copy()
+        servo = self.servo = new_servo(self.ng, ratio=float(s["servo_ratio"]))
+        if self.mode == DAMP_ADAPTIVE and len(s["servo"]) == NSERVO:
+            servo[:NSERVO] = s["servo"]
+        servo[S_HIST] = 0.0
+        self.fixity = (b["fixity"] | b["apply_fix"]).astype(np.uint8)
+        self.dt_fixed = float(s["timestep"]) if s["timestep"] else None
+        self.gimass = self.gisc = None
+        self.out = np.zeros(4)
+        self.vmax = 1e6
+        self.interval = max(1, int(m.settings.update_interval))
+        self.done = 0
+        self.progress = _Progress(nsteps, eng)
+        self.steps = ([MixedContacts(self), RigidBatch(self, chunked=False), ZoneStep(self)] if self.zoned
+                      else [RigidBatch(self, chunked=True)]) + [Clock(self), Hooks(self)]
+        fresh = eng._signature != eng._geometry_signature()
+        if fresh:
+            eng.detect()
+        self.mixed = eng._zone_contacts_check() if self.zoned else False
+        # Δt follows the contact stiffnesses: worked out again at every detection. A run that
+        # starts between two detections, on the step where the last run ended and with the
+        # geometry as it left it, goes on with that run's Δt (and contact-point weights), so
+        # that a run split into several commands (or saved and restored in between) takes
+        # exactly the steps of one run
+        last = s["dt_run"]
+        between = not fresh and len(last) == 2 and int(last[1]) == m.step and m.step % self.interval != 0
+        if self.mixed:
+            self.wsub, self.wcon = eng._mixed_weights(self.zst, recompute=not between)
+        if warn is not None:
+            msg = eng.stiffness_warning()
+            if msg:
+                warn(msg)
+        self.scaled = eng.mass_scaling()
+        dt_last = float(last[0]) if self.dt_fixed is None and between else None
+        if self.zoned:
+            dt = dt_last if dt_last is not None else self._zoned_dt()
+            self.zst.set_masses(dt, self.scaled)
+            if self.ng:
+                self.masses(dt)
+        else:
+            dt = self.masses(dt_last if dt_last is not None else self.dt_fixed)
+        self.dt = eng.dt = dt
+        # detection also runs as soon as a block has moved CTOL/2 since the last one, so
+        # that two blocks approaching each other cannot close more than CTOL unseen
+        self.radius = eng._radii()
+        self.acc = np.zeros(b.n)
+        self.motion = np.zeros(2)
+        self.trigger = 0.5 * eng.tolerance()
+        self.due = False
+        self.loaded = (self.large and "fstress" in m.faces and bool(np.any(m.faces["fstress"] != 0.0)))
+
+    def masses(self, dt):
+        """Inertial masses of the rigid groups for Δt ``dt`` (None: Δt from the stiffnesses); returns Δt."""
+        dt, self.gimass, self.gisc = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, dt)
+        return dt
+
+    def _zoned_dt(self) -> float:
+        """Δt of a model with zoned blocks for the contacts as they are now."""
+        if self.dt_fixed is not None:
+            return self.dt_fixed
+        ng = self.ng
+        dt_r = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, None)[0] if ng else math.inf
+        d = ((dt_r if ng else float(self.s["scale_timestep"] or 1.0)) if self.scaled
+             else min(dt_r, self.zst.natural_timestep()))
+        return d if math.isfinite(d) and d > 0 else 1.0
+
+    def detection_due(self) -> bool:
+        # (with zoned blocks, no rigid body and small strain nothing moves that could make a contact)
+        return ((self.m.step % self.interval == 0 or self.due)
+                and (not self.zoned or bool(self.ng) or self.large))
+
+    def detected(self) -> None:
+        """After a detection: contacts changed, so the steps prepare again and Δt and the
+        masses follow the new stiffnesses."""
+        eng = self.eng
+        if self.zoned:
+            self.mixed = eng._zone_contacts_check()
+        self.acc[:] = 0.0
+        self.due = False
+        for st in self.steps:
+            st.prepare()
+        if not self.zoned:
+            if self.dt_fixed is None:
+                # the contacts made or lost change the stiffness each body feels
+                self.dt = eng.dt = self.masses(None)
+            elif eng.mass_scaling():
+                self.masses(self.dt)
+            return
+        old_dt, self.dt = self.dt, self._zoned_dt()
+        eng.dt = self.dt
+        if self.scaled and self.ng:
+            self.masses(self.dt)
+        if self.mixed or self.dt != old_dt:
+            self.zst.set_masses(self.dt, self.scaled)
+        if self.loaded:
+            from dec3d.model.face_loads import recompute_fface
+            recompute_fface(self.m)
+
+    def finish(self) -> None:
+        eng, m, b, s = self.eng, self.m, self.b, self.s
+        eng._group_cache = None
+        self.progress.close()
+        if self.zoned:
+            self.zst.finish(self.large)
+        s["dt_run"] = [float(eng.dt), int(m.step)]
+        if self.ng or not self.zoned:
+            # keep each block's principal axes turning with its body
+            gstart, gmember, gaxes = self.gstart, self.gmember, self.gaxes
+            turn = np.einsum("gij,gkj->gik", gaxes, self.axes0)
+            gid = np.repeat(np.arange(self.ng), np.diff(gstart))
+            pa = b["principal_axes"]
+            # re-orthonormalised (polar factor): a slightly skew frame would grow threefold per
+            # call (Q A Aᵀ A), and after ~30 `model cycle` commands Euler's equations blow up
+            pa[gmember] = _orthonormal(np.einsum("bij,bjk->bik", turn[gid], pa[gmember]))
+            # a lone block takes back the kernel's own frame unchanged: the next run starts from
+            # exactly the axes this one ended with, so splitting a run into several `model cycle`
+            # commands (or save/restore between them) changes no bit
+            lone = np.diff(gstart) == 1
+            pa[gmember[gstart[:-1][lone]]] = gaxes[lone]
+            b["inertia"][gmember] = np.einsum("bij,bj,bkj->bik", pa[gmember], b["principal_moment"][gmember],
+                                              pa[gmember])
+        if self.mode == DAMP_ADAPTIVE:
+            s["servo"] = [float(x) for x in self.servo[:NSERVO]]
+
+
+class _Step:
+    """One step of the cycle: ``prepare()`` after each detection, ``advance(n)`` for n steps of a
+    batch (returns the steps taken); ``timing``: the counter of ``engine.timings`` it adds to."""
+    timing = "cycle"
+
+    def __init__(self, run: _Run):
+        self.run = run
+
+    def prepare(self) -> None:
+        pass
+
+    def advance(self, n: int) -> int:
+        return n
+
+    def __repr__(self) -> str:
+        return type(self).__name__
+
+
+class MixedContacts(_Step):
+    """Where zoned and rigid blocks touch: whole steps of sub-contact forces on gridpoints,
+    rigid motion and the zone step together (``RigidEngine._mixed_steps``)."""
+
+    def prepare(self) -> None:
+        r = self.run
+        if r.mixed:
+            r.wsub, r.wcon = r.eng._mixed_weights(r.zst)
+
+    def advance(self, n: int) -> int:
+        r = self.run
+        if r.mixed:
+            r.eng._mixed_steps(n, r.zst, r.wsub, r.wcon, r.dt, r.g, r.mode, r.alpha, r.servo, r.full, r.gstart,
+                               r.gmember, r.gmass, r.gimass, r.gisc, r.gprin, r.gaxes, r.gcen, r.fixity, r.large,
+                               r.vmax, r.out)
+        return n
+
+
+class RigidBatch(_Step):
+    """Contact forces and motion of the rigid bodies: the fused kernel ``cycle.run_steps``.
+    ``chunked``: in kernel calls of about CHUNK_SECONDS each, so that Ctrl-C and progress are
+    seen in time (the split changes no number: the kernel carries its state in the arrays)."""
+
+    def __init__(self, run: _Run, chunked: bool):
+        super().__init__(run)
+        self.chunked = chunked
+        self.chunk = 10                  # steps per kernel call, adapted to CHUNK_SECONDS
+
+    def advance(self, k: int) -> int:
+        r = self.run
+        if r.mixed or not r.ng:
+            return k
+        eng, m, b = r.eng, r.m, r.b
+        cs, ss = eng.contacts, eng.subcontacts
+        n_ok = 0
+        bad = -1
+        while n_ok < k:
+            kk = min(k - n_ok, self.chunk) if self.chunked else k
+            t0 = _time.perf_counter()
+            c_ok, bad = run_steps(kk, r.dt, r.g, r.mode, r.alpha, r.servo, r.full, r.gstart, r.gmember, r.gmass,
+                                  r.gimass, r.gisc, r.gprin, r.gaxes, r.gcen, b["mass"], r.fixity, b["force"],
+                                  b["moment"], b["fapp"], b["mapp"], b["velocity"], b["spin"], b["centroid"],
+                                  b["disp"], b["vert_start"], b["vert_count"], m.vertices["pos"], cs["a"], cs["b"],
+                                  cs["normal"], cs["pos"], np.arange(cs.n, dtype=_I), cs["jmodel"], cs["prop"],
+                                  ss["contact"], ss["pos"], ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"],
+                                  ss["us"], ss["state"], r.vmax, r.out, r.radius, r.acc, r.trigger, r.motion)
+            spent = _time.perf_counter() - t0
+            n_ok += c_ok
+            if bad >= 0 or r.motion[1] > 0.0 or c_ok < kk or not self.chunked:
+                break
+            if c_ok > 0:
+                self.chunk = max(1, min(100000, int(c_ok * CHUNK_SECONDS / max(spent, 1e-9))))
+            r.progress.update(r.done + n_ok)
+            if _StopFlag.requested:
+                break
+        if bad >= 0:
+            # (a rigid-only run names the step its batch reached, a zoned one the step it began at)
+            raise eng._blowup(bad, r.dt, r.motion[1] == 2.0, m.step + (n_ok if self.chunked else 0))
+        return n_ok
+
+
+class ZoneStep(_Step):
+    """The zoned (and FE) blocks: gridpoint forces from zone stresses, gridpoint motion
+    (``physics.zones.ZoneStepper``), n steps with the Δt of the rigid bodies (done within
+    ``MixedContacts`` where zoned and rigid blocks touch); contact forces on zoned blocks went
+    to their gridpoints, so the blocks' own sums are cleared."""
+
+    def advance(self, n: int) -> int:
+        r = self.run
+        zst = r.zst
+        for _ in range(0 if r.mixed else n):
+            zbad = zst.step(r.dt, r.g, r.mode, r.alpha, r.large, r.vmax)
+            if zbad >= 0:
+                raise zst.unstable(zbad, r.dt)
+        zb = zst.blocks
+        r.b["force"][zb] = 0.0
+        r.b["moment"][zb] = 0.0
+        return n
+
+
+class Clock(_Step):
+    """Step count and time move on by the steps taken; kinetic energy; detection due?"""
+    timing = None
+
+    def advance(self, n: int) -> int:
+        r = self.run
+        eng, m = r.eng, r.m
+        r.due = r.motion[1] > 0.0
+        m.step += n
+        m.time += n * r.dt
+        r.done += n
+        eng._criteria = None
+        eng.kinetic = (((float(r.out[2]) if r.ng else 0.0) + r.zst.kinetic) if r.zoned else float(r.out[2]))
+        return n
+
+
+class Hooks(_Step):
+    """The engine's step hooks (histories, FISH callbacks) and the periodic VTK snapshot."""
+    timing = "hooks"
+
+    def advance(self, n: int) -> int:
+        eng = self.run.eng
+        for hook in eng.step_hooks:
+            hook(eng)
+        periodic_vtk(eng.model)
+        return n
 
 
 def engine(model) -> RigidEngine:
