@@ -686,7 +686,7 @@ def _node_average_par(gp, rows, sel, node, vol, val, nstart, nent, nodesum, node
             out[k] = 0.25 * acc
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def zone_forces_plastic_parallel(pos, vel, gp, rows, zset, weight, nset, node, cmodel, prop, dt, large, nmd,
                                  stress, state, force, fmag, fstart, fent, nstart, nent):
     """``zone_forces_plastic`` on threads, bit for bit the same result for any thread count:
