@@ -644,10 +644,47 @@ def zone_forces_plastic(pos, vel, gp, rows, zset, weight, nset, node, cmodel, pr
     74-76 when ``nmd``); nodal forces times weight into ``force``, their magnitudes into
     ``fmag``."""
     nr = rows.shape[0]
+    de = np.empty((nr, 6))
+    vol = np.empty(nr)
+    av = np.empty((nr, 4, 3))
+    spin = np.empty((nr, 3))
+    dsp = np.empty(nr)
+    tet_strain_pass(pos, vel, gp, rows, dt, de, vol, av, spin)
+    # strain: hexahedral sets
+    ev, free, bar = _set_strain_mean(de, vol, zset, nset)
     nsz = node.shape[0]
-    zone_forces_plastic_ws(pos, vel, gp, rows, zset, weight, nset, node, cmodel, prop, dt, large, nmd,
-                           stress, state, force, fmag, np.empty((nr, 6)), np.empty(nr), np.empty(nr),
-                           np.empty(nr), np.empty((nr, 3)), np.empty(nsz), np.empty(nsz))
+    nodesum = np.empty(nsz)
+    nodevol = np.empty(nsz)
+    if nmd:
+        _node_average(gp, rows, free, node, vol, ev, nodesum, nodevol, bar)
+    for k in range(nr):
+        shift = (bar[k] - ev[k]) / 3.0
+        de[k, 0] += shift; de[k, 1] += shift; de[k, 2] += shift
+    if large:
+        for k in range(nr):
+            jaumann_rotate(stress[rows[k]], spin[k, 0], spin[k, 1], spin[k, 2])
+    zone_constitutive(rows, cmodel, prop, de, stress, state, dsp)
+    # stress: hexahedral sets average their mean stress; NMD corrects the others
+    md_stress_average(rows, zset, nset, vol, dsp, stress)
+    if nmd:
+        pb = dsp.copy()
+        _node_average(gp, rows, free, node, vol, dsp, nodesum, nodevol, pb)
+        for k in range(nr):
+            if free[k]:
+                z = rows[k]
+                c = dsp[k] - pb[k]
+                stress[z, 0] += c; stress[z, 1] += c; stress[z, 2] += c
+    for k in range(nr):
+        z = rows[k]
+        s = stress[z]
+        w = weight[k] / 3.0
+        for n in range(4):
+            r = gp[z, n]
+            fx = (s[0] * av[k, n, 0] + s[3] * av[k, n, 1] + s[4] * av[k, n, 2]) * w
+            fy = (s[3] * av[k, n, 0] + s[1] * av[k, n, 1] + s[5] * av[k, n, 2]) * w
+            fz = (s[4] * av[k, n, 0] + s[5] * av[k, n, 1] + s[2] * av[k, n, 2]) * w
+            force[r, 0] += fx; force[r, 1] += fy; force[r, 2] += fz
+            fmag[r] += math.sqrt(fx * fx + fy * fy + fz * fz)
 
 
 # --- the same step on threads --------------------------------------------------------------
@@ -718,6 +755,10 @@ def zone_forces_plastic_parallel(pos, vel, gp, rows, zset, weight, nset, node, c
 #   sweep C (only with Mohr-Coulomb zones): stress averaging and nodal forces.
 # The threaded kernel runs sweeps A-C over zones in parallel and makes every gridpoint sum by
 # the fixed-order gather of ``node_lists4``: bit for bit the serial result, any thread count.
+# Measured (bench/README.md): the threaded kernel beats the allocating serial one at 1e6 zones
+# even on one thread, but not at 1e4; the serial fused kernel is slower than both (cause not
+# found), so the stepper uses ``zone_forces_plastic`` below PARALLEL_MIN_ZONES zones and the
+# threaded ``*_ws`` kernel above; the serial ``*_ws`` kernel is kept as the tested serial form.
 
 def zone_scratch(nr, nvert, parallel):
     """Scratch of the ``*_ws`` kernels for ``nr`` zone entries and ``nvert`` gridpoint rows:
