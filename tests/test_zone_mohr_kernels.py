@@ -789,3 +789,39 @@ def test_parallel_step_is_bit_identical_to_serial():
             for a, b in zip(ref, out):
                 assert np.array_equal(a, b), (large, nmd, nt)
         assert (ref[1] > 0).sum() >= 2
+
+
+def test_step_with_kept_scratch_ignores_what_the_scratch_held():
+    """The stepper's kernels (``zone_forces_plastic_ws``, ``zone_forces_plastic_parallel_ws``)
+    reuse scratch from step to step: scratch full of NaN gives the bits of the allocating
+    kernel, elastic-only (forces in the constitutive sweep) and with Mohr-Coulomb zones."""
+    rng = np.random.default_rng(29)
+    pos, gp = _two_cubes(rng)
+    nzn, nv = len(gp), len(pos)
+    vel = rng.normal(size=(nv, 3)) * 3e-3
+    rows = np.arange(nzn, dtype=np.int64)
+    zset = np.array([0, 0, 0, 0, 0, -1, -1, -1, -1, -1], np.int64)
+    weight = np.where(zset >= 0, 0.5, 1.0)
+    node = np.arange(nv, dtype=np.int64); node[8] = 1
+    prop = _props(nzn, rng)
+    s0 = rng.normal(size=(nzn, 6)) * 2e5 + np.array([-1e6, -1e6, -1e6, 0, 0, 0])
+    fstart, fent = zm.node_lists4(nv, np.arange(nv, dtype=np.int64), gp, rows)
+    nstart, nent = zm.node_lists4(nv, node, gp, rows)
+    for cm in (np.ones(nzn, np.int8), np.array([2, 1, 2, 2, 1, 2, 1, 2, 2, 2], np.int8)):
+        for large, nmd in ((False, True), (True, True), (True, False)):
+            ref = [s0.copy(), np.zeros(nzn, np.int32), np.zeros((nv, 3)), np.zeros(nv)]
+            zm.zone_forces_plastic(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd, *ref)
+            assert np.abs(ref[2]).max() > 0.0
+            for par in (False, True):
+                ws = zm.zone_scratch(nzn, nv, par)
+                for a in ws:
+                    a[...] = np.nan
+                out = [s0.copy(), np.zeros(nzn, np.int32), np.zeros((nv, 3)), np.zeros(nv)]
+                if par:
+                    zm.zone_forces_plastic_parallel_ws(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0,
+                                                       large, nmd, *out, fstart, fent, nstart, nent, *ws)
+                else:
+                    zm.zone_forces_plastic_ws(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large,
+                                              nmd, *out, *ws[:7])
+                for a, b in zip(ref, out):
+                    assert np.array_equal(a, b), (cm[0], large, nmd, par)

@@ -52,7 +52,7 @@ import numpy as np
 from numba import njit, prange
 
 from .gather import node_lists
-from .zones import hooke_increment, tet_add_forces, tet_kinematics
+from .zones import _face_vector, hooke_increment, tet_add_forces, tet_kinematics
 
 # mirrors of dec3d.model.zones
 ZP_BULK = 0
@@ -723,7 +723,7 @@ def _node_average_par(gp, rows, sel, node, vol, val, nstart, nent, nodesum, node
             out[k] = 0.25 * acc
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def zone_forces_plastic_parallel(pos, vel, gp, rows, zset, weight, nset, node, cmodel, prop, dt, large, nmd,
                                  stress, state, force, fmag, fstart, fent, nstart, nent):
     """``zone_forces_plastic`` on threads, bit for bit the same result for any thread count:
@@ -731,67 +731,283 @@ def zone_forces_plastic_parallel(pos, vel, gp, rows, zset, weight, nset, node, c
     ``node_lists4(nvert, arange(nvert), gp, rows)``; nstart/nent: ``node_lists4(nvert, node, gp,
     rows)`` (only read when ``nmd``)."""
     nr = rows.shape[0]
-    de = np.empty((nr, 6))
-    vol = np.empty(nr)
-    av = np.empty((nr, 4, 3))
-    spin = np.empty((nr, 3))
-    dsp = np.zeros(nr)
-    for k in prange(nr):
-        vol[k] = tet_kinematics(pos, vel, gp, rows[k], dt, av[k], de[k], spin[k])
-    ev, free, bar = _set_strain_mean(de, vol, zset, nset)
-    nsz = nstart.shape[0] - 1
-    nodesum = np.empty(max(nsz, 0))
-    nodevol = np.empty(max(nsz, 0))
+    nsz = node.shape[0]
+    zone_forces_plastic_parallel_ws(pos, vel, gp, rows, zset, weight, nset, node, cmodel, prop, dt, large, nmd,
+                                    stress, state, force, fmag, fstart, fent, nstart, nent,
+                                    np.empty((nr, 6)), np.empty(nr), np.empty(nr), np.empty(nr),
+                                    np.empty((nr, 3)), np.empty(nsz), np.empty(nsz), np.empty((nr, 4, 3)),
+                                    np.empty((nr, 4)))
+
+
+# --- the step with its scratch kept by the caller, in fused sweeps ---------------------------
+#
+# ``zone_forces_plastic`` / ``zone_forces_plastic_parallel`` above make several sweeps over
+# per-zone temporaries allocated each step. The ``*_ws`` kernels below give the same numbers
+# (the same operations in the same order, so the same bits) in fewer sweeps over scratch the
+# stepper allocates once (``zone_scratch``):
+#   sweep A: strain increment, volume, spin; the hexahedral-set sums and (serial) the NMD
+#            gridpoint sums of ev vol and vol added as each zone is done (same order as before);
+#   sweep B: averaged volumetric increment, stress rotation, constitutive model, and, when no
+#            zone of ``rows`` is Mohr-Coulomb (no plastic correction can arise, so the stress
+#            averaging passes change nothing), the nodal forces, the face area vectors
+#            recomputed from the positions (the same formulas, so the same bits) rather than
+#            streamed from memory;
+#   sweep C (only with Mohr-Coulomb zones): stress averaging and nodal forces.
+# The threaded kernel runs sweeps A-C over zones in parallel and makes every gridpoint sum by
+# the fixed-order gather of ``node_lists4``: bit for bit the serial result, any thread count.
+# Measured (bench/README.md): the threaded kernel beats the allocating serial one at 1e6 zones
+# even on one thread, but not at 1e4; the serial fused kernel is slower than both (cause not
+# found), so the stepper uses ``zone_forces_plastic`` below PARALLEL_MIN_ZONES zones and the
+# threaded ``*_ws`` kernel above; the serial ``*_ws`` kernel is kept as the tested serial form.
+
+def zone_scratch(nr, nvert, parallel):
+    """Scratch of the ``*_ws`` kernels for ``nr`` zone entries and ``nvert`` gridpoint rows:
+    (de (nr, 6), vol, ev, dsp (nr,), spin (nr, 3), nodesum, nodevol (nvert,), zf (nr, 4, 3),
+    zm (nr, 4)); zf/zm are only used by the threaded kernel (empty otherwise)."""
+    nf = nr if parallel else 0
+    return (np.empty((nr, 6)), np.empty(nr), np.empty(nr), np.empty(nr), np.empty((nr, 3)),
+            np.empty(nvert), np.empty(nvert), np.empty((nf, 4, 3)), np.empty((nf, 4)))
+
+
+@njit(cache=True)
+def _any_mohr(rows, cmodel):
+    for k in range(rows.shape[0]):
+        if cmodel[rows[k]] == ZMODEL_MOHR:
+            return True
+    return False
+
+
+@njit(cache=True, inline="always")
+def _face_vectors(pos, gp, z, av):
+    """av (4, 3): the outward area vectors of the faces opposite nodes 0-3 of zone z, by the
+    formulas of ``tet_kinematics`` (same bits)."""
+    for n in range(4):
+        i1 = gp[z, (n + 1) % 4]; i2 = gp[z, (n + 2) % 4]; i3 = gp[z, (n + 3) % 4]
+        ax, ay, az = _face_vector(pos[i1], pos[i2], pos[i3], pos[gp[z, n]])
+        av[n, 0] = ax; av[n, 1] = ay; av[n, 2] = az
+
+
+@njit(cache=True, inline="always")
+def _zone_update(k, z, gp, zset, node, cmodel, prop, large, nmd, de, ev, spin, sv, ss,
+                 nodesum, nodevol, stress, state, d6, work):
+    """Sweep B for entry k (zone z) up to the constitutive model: volumetric increment averaged
+    (set mean, NMD gridpoint mean, or its own), stress rotated (large), model applied. Returns
+    the plastic mean-stress correction (0 unless Mohr-Coulomb yielded)."""
+    e = ev[k]
+    bar = e
+    h = zset[k]
+    if h >= 0:
+        if ss[h] > 0.0:
+            bar = sv[h] / ss[h]
+    elif nmd:
+        acc = 0.0
+        for n in range(4):
+            m = node[gp[z, n]]
+            acc += nodesum[m] / nodevol[m]
+        bar = 0.25 * acc
+    shift = (bar - e) / 3.0
+    d6[0] = de[k, 0] + shift; d6[1] = de[k, 1] + shift; d6[2] = de[k, 2] + shift
+    d6[3] = de[k, 3]; d6[4] = de[k, 4]; d6[5] = de[k, 5]
+    if large:
+        jaumann_rotate(stress[z], spin[k, 0], spin[k, 1], spin[k, 2])
+    code = cmodel[z]
+    d = 0.0
+    if code == ZMODEL_ELASTIC:
+        hooke_increment(stress[z], d6, prop[z, ZP_BULK], prop[z, ZP_SHEAR])
+    elif code == ZMODEL_MOHR:
+        if mohr_trial(stress[z], d6, prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
+                      prop[z, ZP_TANFRIC], prop[z, ZP_TENSION]):
+            state[z] = state[z] & (SHEAR_PAST | TENSION_PAST)
+        else:
+            bits, d = mohr_plastic(stress[z], prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
+                                   prop[z, ZP_TANFRIC], prop[z, ZP_TENSION], prop[z, ZP_TANDIL], work)
+            state[z] = merge_state(state[z], bits)
+    return d
+
+
+@njit(cache=True)
+def _set_sums(ev, vol, zset, nset):
+    sv = np.zeros(nset)
+    ss = np.zeros(nset)
+    for k in range(zset.shape[0]):
+        h = zset[k]
+        if h >= 0:
+            sv[h] += ev[k] * vol[k]
+            ss[h] += vol[k]
+    return sv, ss
+
+
+@njit(cache=True)
+def zone_forces_plastic_ws(pos, vel, gp, rows, zset, weight, nset, node, cmodel, prop, dt, large, nmd,
+                           stress, state, force, fmag, de, vol, ev, dsp, spin, nodesum, nodevol):
+    """``zone_forces_plastic`` (same arguments, same bits) in two or three sweeps over the
+    caller's scratch (``zone_scratch(len(rows), nvert, False)``)."""
+    nr = rows.shape[0]
+    av = np.empty((4, 3))
+    w3 = np.empty(3)
+    d6 = np.empty(6)
+    work = mohr_work()
     if nmd:
-        _node_average_par(gp, rows, free, node, vol, ev, nstart, nent, nodesum, nodevol, bar)
-    for k in prange(nr):
-        shift = (bar[k] - ev[k]) / 3.0
-        de[k, 0] += shift; de[k, 1] += shift; de[k, 2] += shift
+        for m in range(node.shape[0]):
+            nodesum[m] = 0.0
+            nodevol[m] = 0.0
+    # sweep A
+    for k in range(nr):
+        z = rows[k]
+        v = tet_kinematics(pos, vel, gp, z, dt, av, de[k], w3)
+        vol[k] = v
         if large:
-            jaumann_rotate(stress[rows[k]], spin[k, 0], spin[k, 1], spin[k, 2])
-    # constitutive pass in chunks, one scratch set per chunk
-    nch = 64
-    for ch in prange(nch):
-        work = mohr_work()
-        for k in range(ch * nr // nch, (ch + 1) * nr // nch):
-            z = rows[k]
-            code = cmodel[z]
-            if code == ZMODEL_ELASTIC:
-                hooke_increment(stress[z], de[k], prop[z, ZP_BULK], prop[z, ZP_SHEAR])
-            elif code == ZMODEL_MOHR:
-                if mohr_trial(stress[z], de[k], prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
-                              prop[z, ZP_TANFRIC], prop[z, ZP_TENSION]):
-                    state[z] = state[z] & (SHEAR_PAST | TENSION_PAST)
-                else:
-                    bits, d = mohr_plastic(stress[z], prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
-                                           prop[z, ZP_TANFRIC], prop[z, ZP_TENSION], prop[z, ZP_TANDIL], work)
-                    state[z] = merge_state(state[z], bits)
-                    dsp[k] = d
+            spin[k, 0] = w3[0]; spin[k, 1] = w3[1]; spin[k, 2] = w3[2]
+        ev[k] = de[k, 0] + de[k, 1] + de[k, 2]
+    if nmd:
+        for k in range(nr):
+            if zset[k] < 0:
+                z = rows[k]
+                e = ev[k] * vol[k]
+                v = vol[k]
+                for n in range(4):
+                    m = node[gp[z, n]]
+                    nodesum[m] += e
+                    nodevol[m] += v
+    sv, ss = _set_sums(ev, vol, zset, nset)
+    fused = not _any_mohr(rows, cmodel)
+    # sweep B
+    for k in range(nr):
+        z = rows[k]
+        dsp[k] = _zone_update(k, z, gp, zset, node, cmodel, prop, large, nmd, de, ev, spin, sv, ss,
+                              nodesum, nodevol, stress, state, d6, work)
+        if fused:
+            _face_vectors(pos, gp, z, av)
+            s = stress[z]
+            w = weight[k] / 3.0
+            for n in range(4):
+                r = gp[z, n]
+                fx = (s[0] * av[n, 0] + s[3] * av[n, 1] + s[4] * av[n, 2]) * w
+                fy = (s[3] * av[n, 0] + s[1] * av[n, 1] + s[5] * av[n, 2]) * w
+                fz = (s[4] * av[n, 0] + s[5] * av[n, 1] + s[2] * av[n, 2]) * w
+                force[r, 0] += fx; force[r, 1] += fy; force[r, 2] += fz
+                fmag[r] += math.sqrt(fx * fx + fy * fy + fz * fz)
+    if fused:
+        return
+    # sweep C: stress averaging, then the forces
     md_stress_average(rows, zset, nset, vol, dsp, stress)
     if nmd:
-        pb = dsp.copy()
-        _node_average_par(gp, rows, free, node, vol, dsp, nstart, nent, nodesum, nodevol, pb)
-        for k in prange(nr):
-            if free[k]:
+        for m in range(node.shape[0]):
+            nodesum[m] = 0.0
+            nodevol[m] = 0.0
+        for k in range(nr):
+            if zset[k] < 0:
                 z = rows[k]
-                c = dsp[k] - pb[k]
-                stress[z, 0] += c; stress[z, 1] += c; stress[z, 2] += c
-    zf = np.empty((nr, 4, 3))
-    zm_ = np.empty((nr, 4))
-    for k in prange(nr):
+                for n in range(4):
+                    m = node[gp[z, n]]
+                    nodesum[m] += dsp[k] * vol[k]
+                    nodevol[m] += vol[k]
+    for k in range(nr):
         z = rows[k]
+        if nmd and zset[k] < 0:
+            acc = 0.0
+            for n in range(4):
+                m = node[gp[z, n]]
+                acc += nodesum[m] / nodevol[m]
+            c = dsp[k] - 0.25 * acc
+            stress[z, 0] += c; stress[z, 1] += c; stress[z, 2] += c
+        _face_vectors(pos, gp, z, av)
         s = stress[z]
         w = weight[k] / 3.0
         for n in range(4):
-            fx = (s[0] * av[k, n, 0] + s[3] * av[k, n, 1] + s[4] * av[k, n, 2]) * w
-            fy = (s[3] * av[k, n, 0] + s[1] * av[k, n, 1] + s[5] * av[k, n, 2]) * w
-            fz = (s[4] * av[k, n, 0] + s[5] * av[k, n, 1] + s[2] * av[k, n, 2]) * w
-            zf[k, n, 0] = fx; zf[k, n, 1] = fy; zf[k, n, 2] = fz
-            zm_[k, n] = math.sqrt(fx * fx + fy * fy + fz * fz)
+            r = gp[z, n]
+            fx = (s[0] * av[n, 0] + s[3] * av[n, 1] + s[4] * av[n, 2]) * w
+            fy = (s[3] * av[n, 0] + s[1] * av[n, 1] + s[5] * av[n, 2]) * w
+            fz = (s[4] * av[n, 0] + s[5] * av[n, 1] + s[2] * av[n, 2]) * w
+            force[r, 0] += fx; force[r, 1] += fy; force[r, 2] += fz
+            fmag[r] += math.sqrt(fx * fx + fy * fy + fz * fz)
+
+
+@njit(cache=True, parallel=True)
+def _gather_node_sums(zset, val, vol, nstart, nent, nodesum, nodevol):
+    """nodesum[t], nodevol[t] = sums of val[k] vol[k] and vol[k] over the entries of target t
+    outside hexahedral sets, in the fixed order of ``node_lists4`` (the serial order)."""
+    for t in prange(nstart.shape[0] - 1):
+        a = 0.0
+        b = 0.0
+        for e in range(nstart[t], nstart[t + 1]):
+            k = nent[e] // 4
+            if zset[k] < 0:
+                a += val[k] * vol[k]
+                b += vol[k]
+        nodesum[t] = a
+        nodevol[t] = b
+
+
+@njit(cache=True, parallel=True)
+def zone_forces_plastic_parallel_ws(pos, vel, gp, rows, zset, weight, nset, node, cmodel, prop, dt, large, nmd,
+                                    stress, state, force, fmag, fstart, fent, nstart, nent,
+                                    de, vol, ev, dsp, spin, nodesum, nodevol, zf, zm):
+    """``zone_forces_plastic_ws`` on threads (``zone_scratch(len(rows), nvert, True)``; gather
+    lists as ``zone_forces_plastic_parallel``): bit for bit the serial result."""
+    nr = rows.shape[0]
+    nch = 256 if nr >= 256 else 1
+    # sweep A
+    for ch in prange(nch):
+        av = np.empty((4, 3))
+        w3 = np.empty(3)
+        for k in range(ch * nr // nch, (ch + 1) * nr // nch):
+            vol[k] = tet_kinematics(pos, vel, gp, rows[k], dt, av, de[k], w3)
+            if large:
+                spin[k, 0] = w3[0]; spin[k, 1] = w3[1]; spin[k, 2] = w3[2]
+            ev[k] = de[k, 0] + de[k, 1] + de[k, 2]
+    sv, ss = _set_sums(ev, vol, zset, nset)
+    if nmd:
+        _gather_node_sums(zset, ev, vol, nstart, nent, nodesum, nodevol)
+    fused = not _any_mohr(rows, cmodel)
+    # sweep B
+    for ch in prange(nch):
+        av = np.empty((4, 3))
+        d6 = np.empty(6)
+        work = mohr_work()
+        for k in range(ch * nr // nch, (ch + 1) * nr // nch):
+            z = rows[k]
+            dsp[k] = _zone_update(k, z, gp, zset, node, cmodel, prop, large, nmd, de, ev, spin, sv, ss,
+                                  nodesum, nodevol, stress, state, d6, work)
+            if fused:
+                _face_vectors(pos, gp, z, av)
+                s = stress[z]
+                w = weight[k] / 3.0
+                for n in range(4):
+                    fx = (s[0] * av[n, 0] + s[3] * av[n, 1] + s[4] * av[n, 2]) * w
+                    fy = (s[3] * av[n, 0] + s[1] * av[n, 1] + s[5] * av[n, 2]) * w
+                    fz = (s[4] * av[n, 0] + s[5] * av[n, 1] + s[2] * av[n, 2]) * w
+                    zf[k, n, 0] = fx; zf[k, n, 1] = fy; zf[k, n, 2] = fz
+                    zm[k, n] = math.sqrt(fx * fx + fy * fy + fz * fz)
+    if not fused:
+        # sweep C
+        md_stress_average(rows, zset, nset, vol, dsp, stress)
+        if nmd:
+            _gather_node_sums(zset, dsp, vol, nstart, nent, nodesum, nodevol)
+        for ch in prange(nch):
+            av = np.empty((4, 3))
+            for k in range(ch * nr // nch, (ch + 1) * nr // nch):
+                z = rows[k]
+                if nmd and zset[k] < 0:
+                    acc = 0.0
+                    for n in range(4):
+                        m = node[gp[z, n]]
+                        acc += nodesum[m] / nodevol[m]
+                    c = dsp[k] - 0.25 * acc
+                    stress[z, 0] += c; stress[z, 1] += c; stress[z, 2] += c
+                _face_vectors(pos, gp, z, av)
+                s = stress[z]
+                w = weight[k] / 3.0
+                for n in range(4):
+                    fx = (s[0] * av[n, 0] + s[3] * av[n, 1] + s[4] * av[n, 2]) * w
+                    fy = (s[3] * av[n, 0] + s[1] * av[n, 1] + s[5] * av[n, 2]) * w
+                    fz = (s[4] * av[n, 0] + s[5] * av[n, 1] + s[2] * av[n, 2]) * w
+                    zf[k, n, 0] = fx; zf[k, n, 1] = fy; zf[k, n, 2] = fz
+                    zm[k, n] = math.sqrt(fx * fx + fy * fy + fz * fz)
     for r in prange(fstart.shape[0] - 1):
         f0 = force[r, 0]; f1 = force[r, 1]; f2 = force[r, 2]; fm = fmag[r]
         for e in range(fstart[r], fstart[r + 1]):
             k = fent[e] // 4
             n = fent[e] - 4 * k
-            f0 += zf[k, n, 0]; f1 += zf[k, n, 1]; f2 += zf[k, n, 2]; fm += zm_[k, n]
+            f0 += zf[k, n, 0]; f1 += zf[k, n, 1]; f2 += zf[k, n, 2]; fm += zm[k, n]
         force[r, 0] = f0; force[r, 1] = f1; force[r, 2] = f2; fmag[r] = fm

@@ -19,7 +19,8 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
    the rigid Δt) or a time step was fixed (``block mechanical timestep`` / ``mass-scale
    timestep``). Dynamic runs: real masses and Δt = min over gridpoints of Eq. (84), and of the
    rigid Δt when rigid blocks cycle;
-4. each step (``step``): zone forces of the 4-node zones (``zone_mohr.zone_forces_plastic``
+4. each step (``step``): zone forces of the 4-node zones (``zone_mohr.zone_forces_plastic``,
+   ``zone_forces_plastic_parallel_ws`` from PARALLEL_MIN_ZONES zones on, the same bits,
    with elastic and Mohr-Coulomb zones mixed, mixed discretization in hexahedral sets and nodal
    mixed discretization, NMD, for the other tetrahedra when ``settings.mechanical["nmd"]`` is on,
    the default, ``block zone nodal-mixed-discretization``; with NMD off and only elastic zones
@@ -39,11 +40,10 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from dec3d.errors import Dec3dError
-from dec3d.kernels.zone_mohr import node_lists4, zone_forces_plastic, zone_forces_plastic_parallel
+from dec3d.kernels.zone_mohr import node_lists4, zone_forces_plastic, zone_forces_plastic_parallel_ws, zone_scratch
 from dec3d.kernels.zonestep import gp_externals, gp_motion, zone_forces, zone_mass_stiffness
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.model import KIND_DEFORMABLE
@@ -142,13 +142,17 @@ class ZoneStepper:
         if len(self.rows10):
             from dec3d.kernels import zones_ho
             self.ho = zones_ho.tet10_step
-        #: gather lists of the threaded plastic step (same bits as the serial one), big models only
+        #: gather lists of the threaded plastic step (same bits as the serial one), big models only;
+        #: taken on one thread too: its zone sweeps and gathers beat the serial scatter there as well
+        #: (``bench/zone_bench.py``)
         self.par = None
-        if self.plastic and len(self.rows4) >= PARALLEL_MIN_ZONES and numba.get_num_threads() > 1:
+        if self.plastic and len(self.rows4) >= PARALLEL_MIN_ZONES:
             nv = v.n
             fstart, fent = node_lists4(nv, np.arange(nv, dtype=_I), zs["gp"], self.rows4)
             nstart, nent = node_lists4(nv, self.node, zs["gp"], self.rows4)
             self.par = (fstart, fent, nstart, nent)
+        #: scratch of the plastic step, allocated once (``zone_mohr.zone_scratch``)
+        self.ws = zone_scratch(len(self.rows4), v.n, True) if self.par is not None else None
         # mixed-discretization sets of the 4-node zones: compact set numbers
         hx = zs["hex"][self.rows4]
         self.weight = np.where(zs["overlay"][self.rows4] >= 0, 0.5, 1.0)
@@ -274,9 +278,9 @@ class ZoneStepper:
             self.begin()
         pos, vel = v["pos"], v["velocity"]
         if self.par is not None:
-            zone_forces_plastic_parallel(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.node,
-                                         zs["cmodel"], zs["prop"], dt, large, self.nmd, zs["stress"], zs["state"],
-                                         facc, fmag, *self.par)
+            zone_forces_plastic_parallel_ws(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset,
+                                            self.node, zs["cmodel"], zs["prop"], dt, large, self.nmd, zs["stress"],
+                                            zs["state"], facc, fmag, *self.par, *self.ws)
         elif self.plastic:
             zone_forces_plastic(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.node,
                                 zs["cmodel"], zs["prop"], dt, large, self.nmd, zs["stress"], zs["state"], facc, fmag)
