@@ -14,6 +14,7 @@ import pytest
 
 from dec3d.errors import Dec3dError
 from dec3d.kernels import zone_mohr as zm
+from dec3d.kernels import zone_plastic as zp
 from dec3d.kernels.zones import tet_elastic_step
 from dec3d.model import zones as mz
 from dec3d.model.zone_mohr import angle_to_tangent, mohr_props_check, tangent_to_angle
@@ -332,7 +333,7 @@ def test_nmd_kernels_match_twin_and_pass_the_patch_test():
     vol = rng.uniform(0.1, 0.3, len(rows))
     de = rng.normal(size=(len(rows), 6)) * 1e-4
     dk = de.copy()
-    zm.nmd_strain_average(gp, rows, node, vol, dk)
+    zp.nmd_strain_average(gp, rows, node, vol, dk)
     ev = de[:, :3].sum(axis=1)
     bar = twin_node_average(gp[rows], ev, vol, node)
     want = de.copy()
@@ -344,7 +345,7 @@ def test_nmd_kernels_match_twin_and_pass_the_patch_test():
     # linked gridpoints average at their master
     node2 = node.copy(); node2[8] = 1; node2[10] = 5
     dk2 = de.copy()
-    zm.nmd_strain_average(gp, rows, node2, vol, dk2)
+    zp.nmd_strain_average(gp, rows, node2, vol, dk2)
     bar2 = twin_node_average(gp[rows], ev, vol, node2)
     assert np.allclose(dk2[:, :3].sum(1), bar2, atol=1e-16)
     # stress correction
@@ -352,7 +353,7 @@ def test_nmd_kernels_match_twin_and_pass_the_patch_test():
     dsp[::3] = 0.0
     s = rng.normal(size=(nz, 6)) * 1e6
     sk = s.copy()
-    zm.nmd_stress_correction(gp, rows, node, vol, dsp, sk)
+    zp.nmd_stress_correction(gp, rows, node, vol, dsp, sk)
     barp = twin_node_average(gp[rows], dsp, vol, node)
     want = s.copy()
     want[rows, :3] += (dsp - barp)[:, None]
@@ -360,10 +361,10 @@ def test_nmd_kernels_match_twin_and_pass_the_patch_test():
     # patch test: uniform values are left as they are
     du = np.tile(rng.normal(size=6) * 1e-4, (len(rows), 1))
     dku = du.copy()
-    zm.nmd_strain_average(gp, rows, node, vol, dku)
+    zp.nmd_strain_average(gp, rows, node, vol, dku)
     assert np.allclose(dku, du, rtol=1e-13, atol=0)
     su = s.copy()
-    zm.nmd_stress_correction(gp, rows, node, vol, np.full(len(rows), 3e4), su)
+    zp.nmd_stress_correction(gp, rows, node, vol, np.full(len(rows), 3e4), su)
     assert np.allclose(su, s, rtol=0, atol=1e-9)
 
 
@@ -379,7 +380,7 @@ def test_tet_zone_step_elastic_and_mohr_paths():
     # all elastic, no NMD: the same as tet_elastic_step
     cm = np.full(nz, mz.ZMODEL_ELASTIC, np.int8)
     sa, fa, st = s0.copy(), np.zeros((len(pos), 3)), np.zeros(nz, np.int32)
-    zm.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 0.5, False, sa, st, fa)
+    zp.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 0.5, False, sa, st, fa)
     sb, fb = s0.copy(), np.zeros_like(fa)
     tet_elastic_step(pos, vel, gp, prop[:, 0].copy(), prop[:, 1].copy(), 0.5, sb, fb)
     assert np.allclose(sa, sb, rtol=1e-12, atol=1e-6) and np.allclose(fa, fb, rtol=1e-12, atol=1e-6)
@@ -387,14 +388,14 @@ def test_tet_zone_step_elastic_and_mohr_paths():
     cm[:] = mz.ZMODEL_MOHR
     vel *= 30
     sa, fa, sta = s0.copy(), np.zeros_like(fa), np.zeros(nz, np.int32)
-    zm.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 1.0, False, sa, sta, fa)
+    zp.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 1.0, False, sa, sta, fa)
     sb, fb, stb = s0.copy(), np.zeros_like(fa), np.zeros(nz, np.int32)
     zm.tet_mohr_step(pos, vel, gp, rows, prop, 1.0, sb, stb, fb)
     assert np.array_equal(sa, sb) and np.array_equal(fa, fb) and np.array_equal(sta, stb)
     assert (sta > 0).sum() >= 3
     # with NMD: twin of the whole sequence (strain average, return, stress correction, forces)
     sa, fa, sta = s0.copy(), np.zeros_like(fa), np.zeros(nz, np.int32)
-    zm.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 1.0, True, sa, sta, fa)
+    zp.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 1.0, True, sa, sta, fa)
     kin = [twin_kinematics(pos[gp[z]], vel[gp[z]], 1.0) for z in rows]
     de = np.array([k[0] for k in kin]); vol = np.array([k[1] for k in kin])
     ev = de[:, :3].sum(1)
@@ -424,7 +425,7 @@ def _cube_step(stress, state, prop, rate, nmd):
     vel = CUBE * np.asarray(rate)
     rows = np.arange(5, dtype=np.int64)
     if nmd:
-        zm.tet_zone_step(CUBE, vel, CUBE5, rows, np.arange(8, dtype=np.int64),
+        zp.tet_zone_step(CUBE, vel, CUBE5, rows, np.arange(8, dtype=np.int64),
                          np.full(5, mz.ZMODEL_MOHR, np.int8), prop, 1.0, True, s, st, f)
     else:
         zm.tet_mohr_step(CUBE, vel, CUBE5, rows, prop, 1.0, s, st, f)
@@ -594,7 +595,7 @@ def test_md_stress_average_matches_twin():
     vol = rng.uniform(0.1, 1.0, len(rows))
     dsp = rng.normal(size=len(rows)) * 1e4
     sk = stress.copy()
-    zm.md_stress_average(rows, zset, 2, vol, dsp, sk)
+    zp.md_stress_average(rows, zset, 2, vol, dsp, sk)
     want = stress.copy()
     for h in (0, 1):
         ks = [k for k in range(len(rows)) if zset[k] == h]
@@ -607,7 +608,7 @@ def test_md_stress_average_matches_twin():
     # Eq. 67: a set that started with one mean stress ends with the volume-averaged one
     s2 = np.zeros((nz, 6)); s2[:, :3] = -1e6
     s2[rows, :3] -= dsp[:, None]                                   # each zone's own return
-    zm.md_stress_average(rows, zset, 2, vol, dsp, s2)
+    zp.md_stress_average(rows, zset, 2, vol, dsp, s2)
     for h in (0, 1):
         ks = [k for k in range(len(rows)) if zset[k] == h]
         pm = sum(s2[rows[k], :3].mean() * vol[k] for k in ks) / sum(vol[k] for k in ks)
@@ -655,7 +656,7 @@ def _footing_pressure(nmd, nx=16, nz=8, h=0.5, half_width=1.0, steps=10000, v0=2
     p = []
     for it in range(steps):
         f = np.zeros((nv, 3))
-        zm.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 1.0, nmd, stress, state, f)
+        zp.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 1.0, nmd, stress, state, f)
         if (it + 1) % (steps // 10) == 0:
             p.append(f[foot, 2].sum() / (half_width * h) / c)
         vel += np.where(fix, 0.0, (f - 0.8 * np.abs(f) * np.sign(vel)) / mass[:, None])
@@ -692,7 +693,7 @@ def test_zone_forces_plastic_matches_twin():
     st0 = np.zeros(nzn, np.int32)
     for large, nmd in ((False, False), (True, True), (False, True)):
         sk, stk, fk, mk = s0.copy(), st0.copy(), np.zeros((nv, 3)), np.zeros(nv)
-        zm.zone_forces_plastic(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd, sk, stk, fk, mk)
+        zp.zone_forces_plastic(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd, sk, stk, fk, mk)
         # twin
         kin = []
         for z in rows:
@@ -773,18 +774,18 @@ def test_parallel_step_is_bit_identical_to_serial():
     prop = _props(nzn, rng)
     cm = np.array([2, 1, 2, 2, 1, 2, 1, 2, 2, 2], np.int8)
     s0 = rng.normal(size=(nzn, 6)) * 2e5 + np.array([-1e6, -1e6, -1e6, 0, 0, 0])
-    fstart, fent = zm.node_lists4(nv, np.arange(nv, dtype=np.int64), gp, rows)
-    nstart, nent = zm.node_lists4(nv, node, gp, rows)
+    fstart, fent = zp.node_lists4(nv, np.arange(nv, dtype=np.int64), gp, rows)
+    nstart, nent = zp.node_lists4(nv, node, gp, rows)
     assert np.array_equal(np.bincount(gp.ravel(), minlength=nv), np.diff(fstart))
     for large, nmd in ((False, False), (True, True)):
         ref = [s0.copy(), np.zeros(nzn, np.int32), rng.normal(size=(nv, 3)), np.zeros(nv)]
         ref[3][:] = 1.0
         par = [a.copy() for a in ref]
-        zm.zone_forces_plastic(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd, *ref)
+        zp.zone_forces_plastic(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd, *ref)
         for nt in (1, 2):
             out = [a.copy() for a in par]
             numba.set_num_threads(min(nt, numba.config.NUMBA_NUM_THREADS))
-            zm.zone_forces_plastic_parallel(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd,
+            zp.zone_forces_plastic_parallel(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd,
                                             *out, fstart, fent, nstart, nent)
             for a, b in zip(ref, out):
                 assert np.array_equal(a, b), (large, nmd, nt)
@@ -805,23 +806,23 @@ def test_step_with_kept_scratch_ignores_what_the_scratch_held():
     node = np.arange(nv, dtype=np.int64); node[8] = 1
     prop = _props(nzn, rng)
     s0 = rng.normal(size=(nzn, 6)) * 2e5 + np.array([-1e6, -1e6, -1e6, 0, 0, 0])
-    fstart, fent = zm.node_lists4(nv, np.arange(nv, dtype=np.int64), gp, rows)
-    nstart, nent = zm.node_lists4(nv, node, gp, rows)
+    fstart, fent = zp.node_lists4(nv, np.arange(nv, dtype=np.int64), gp, rows)
+    nstart, nent = zp.node_lists4(nv, node, gp, rows)
     for cm in (np.ones(nzn, np.int8), np.array([2, 1, 2, 2, 1, 2, 1, 2, 2, 2], np.int8)):
         for large, nmd in ((False, True), (True, True), (True, False)):
             ref = [s0.copy(), np.zeros(nzn, np.int32), np.zeros((nv, 3)), np.zeros(nv)]
-            zm.zone_forces_plastic(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd, *ref)
+            zp.zone_forces_plastic(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd, *ref)
             assert np.abs(ref[2]).max() > 0.0
             for par in (False, True):
-                ws = zm.zone_scratch(nzn, nv, par)
+                ws = zp.zone_scratch(nzn, nv, par)
                 for a in ws:
                     a[...] = np.nan
                 out = [s0.copy(), np.zeros(nzn, np.int32), np.zeros((nv, 3)), np.zeros(nv)]
                 if par:
-                    zm.zone_forces_plastic_parallel_ws(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0,
+                    zp.zone_forces_plastic_parallel_ws(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0,
                                                        large, nmd, *out, fstart, fent, nstart, nent, *ws)
                 else:
-                    zm.zone_forces_plastic_ws(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large,
+                    zp.zone_forces_plastic_ws(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large,
                                               nmd, *out, *ws[:7])
                 for a, b in zip(ref, out):
                     assert np.array_equal(a, b), (cm[0], large, nmd, par)

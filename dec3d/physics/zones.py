@@ -19,7 +19,7 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
    the rigid Δt) or a time step was fixed (``block mechanical timestep`` / ``mass-scale
    timestep``). Dynamic runs: real masses and Δt = min over gridpoints of Eq. (84), and of the
    rigid Δt when rigid blocks cycle;
-4. each step (``step``): zone forces of the 4-node zones (``zone_mohr.zone_forces_plastic``,
+4. each step (``step``): zone forces of the 4-node zones (``zone_plastic.zone_forces_plastic``,
    ``zone_forces_plastic_parallel_ws`` from PARALLEL_MIN_ZONES zones on, the same bits,
    with elastic and Mohr-Coulomb zones mixed, mixed discretization in hexahedral sets and nodal
    mixed discretization, NMD, for the other tetrahedra when ``settings.mechanical["nmd"]`` is on,
@@ -43,7 +43,7 @@ import math
 import numpy as np
 
 from dec3d.errors import Dec3dError
-from dec3d.kernels.zone_mohr import node_lists4, zone_forces_plastic, zone_forces_plastic_parallel_ws, zone_scratch
+from dec3d.kernels.zone_plastic import node_lists4, zone_forces_plastic, zone_forces_plastic_parallel_ws, zone_scratch
 from dec3d.kernels.zonestep import gp_externals, gp_motion, zone_forces, zone_mass_stiffness
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.model import KIND_DEFORMABLE
@@ -151,7 +151,7 @@ class ZoneStepper:
             fstart, fent = node_lists4(nv, np.arange(nv, dtype=_I), zs["gp"], self.rows4)
             nstart, nent = node_lists4(nv, self.node, zs["gp"], self.rows4)
             self.par = (fstart, fent, nstart, nent)
-        #: scratch of the plastic step, allocated once (``zone_mohr.zone_scratch``)
+        #: scratch of the plastic step, allocated once (``zone_plastic.zone_scratch``)
         self.ws = zone_scratch(len(self.rows4), v.n, True) if self.par is not None else None
         # mixed-discretization sets of the 4-node zones: compact set numbers
         hx = zs["hex"][self.rows4]
