@@ -11,9 +11,10 @@ callee's file changes. So, at the import of ``dec3d`` (``guard``):
    (a read-only install) ``NUMBA_CACHE_DIR`` is pointed at a per-user folder
    (``$XDG_CACHE_HOME`` or ``~/.cache``, ``dec3d/numba``), else at a fresh temporary folder
    (kernels then compile in every process, nothing is kept);
-2. ``source_hash()`` is the SHA-256 of every ``*.py`` of this package (names and contents)
-   with the numba and Python versions; it is kept in ``STAMP`` in that folder. When it
-   differs, every cached kernel of the package (``*.nbi``, ``*.nbc``) there is deleted
+2. ``source_hash()`` is the SHA-256 of every ``*.py`` of this package and its sub-packages
+   (``kernels/joints``: one joint law per file) (names and contents) with the numba and Python
+   versions; it is kept in ``STAMP`` in each cache folder. When it differs, every cached
+   kernel of the package (``*.nbi``, ``*.nbc``) there is deleted
    (``clear_stale``) and the new hash is written: one kernel edited â†’ all recompile once.
 3. Cold start: when no cached kernel index is there (``is_cold``), the first compilation of a
    dec3d kernel in the process prints one line on stderr (``NOTICE``).
@@ -33,14 +34,14 @@ NOTICE = "dec3d: compiling kernels, first run only (a few seconds to a minute) â
 
 
 def source_hash(folder: Path = HERE) -> str:
-    """SHA-256 over the names and contents of ``folder/*.py`` (sorted by name), numba's and
-    Python's versions."""
+    """SHA-256 over the names (relative to ``folder``) and contents of every ``*.py`` under
+    ``folder`` (sorted), numba's and Python's versions."""
     import numba
 
     h = hashlib.sha256()
     h.update(f"numba {numba.__version__} python {sys.version_info[:2]}\n".encode())
-    for p in sorted(folder.glob("*.py")):
-        h.update(p.name.encode() + b"\0")
+    for p in sorted(folder.rglob("*.py")):
+        h.update(p.relative_to(folder).as_posix().encode() + b"\0")
         h.update(p.read_bytes())
         h.update(b"\0")
     return h.hexdigest()
@@ -160,8 +161,14 @@ def guard(folder: Path = HERE, package: str = "dec3d.kernels") -> None:
 
     if config.DISABLE_JIT:
         return
+    digest = source_hash(folder)
+    # numba keeps each source folder's caches apart (the joint laws in kernels/joints): each is
+    # cleared when anything under ``folder`` changed, since a kernel compiles its callees in
+    for sub in sorted({p.parent for p in folder.rglob("*.py")} - {folder}):
+        if "__pycache__" not in sub.parts:
+            clear_stale(cache_dir(sub), digest, sub)
     cdir = cache_dir(folder)
-    clear_stale(cdir, source_hash(folder), folder)
+    clear_stale(cdir, digest, folder)
     if is_cold(cdir, folder):
         from numba.core import event as ev
 

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from dec3d.errors import Dec3dError
-from dec3d.kernels.jointlaw import P_KN, P_KS, P_TANF
+from dec3d.kernels.joints import P_KN, P_KS
+from dec3d.kernels.joints.mohr import P_TANF
 from dec3d.physics.history import histories
 from dec3d.physics.rigid import engine
 

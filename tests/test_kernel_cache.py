@@ -7,15 +7,14 @@ import sys
 import types
 from pathlib import Path
 
+import pytest
 from conftest import ROOT
 
 from dec3d import kcache as K
 
 
 def _copy_kernels(dst: Path) -> Path:
-    dst.mkdir()
-    for p in (ROOT / "dec3d" / "kernels").glob("*.py"):
-        shutil.copy(p, dst / p.name)
+    shutil.copytree(ROOT / "dec3d" / "kernels", dst, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
     return dst
 
 
@@ -27,6 +26,9 @@ def test_source_hash_follows_every_kernel_file(tmp_path):
     assert K.source_hash(b) != K.source_hash(a)
     (b / "polygon2d.py").unlink()
     assert K.source_hash(b) != K.source_hash(a)
+    c = _copy_kernels(tmp_path / "c")               # a joint law (kernels/joints) is hashed too
+    (c / "joints" / "mohr.py").write_text((c / "joints" / "mohr.py").read_text() + "\n# edited\n")
+    assert K.source_hash(c) != K.source_hash(a)
 
 
 def test_clear_stale_deletes_only_this_package_caches_and_stamps(tmp_path):
@@ -68,23 +70,27 @@ def test_read_only_sources_cache_under_the_user_cache_dir(tmp_path, monkeypatch)
     assert cfg.CACHE_DIR == str(tmp_path / "mine")
 
 
-_CALLER = "from numba import njit\nfrom .callee import g\n\n\n@njit(cache=True)\ndef f():\n    return g() + 10\n"
+_CALLER = "from numba import njit\nfrom .{} import g\n\n\n@njit(cache=True)\ndef f():\n    return g() + 10\n"
 _CALLEE = "from numba import njit\n\n\n@njit(cache=True)\ndef g():\n    return {}\n"
 
 
-def test_edited_callee_reaches_the_cached_caller(tmp_path):
+@pytest.mark.parametrize("callee", ["callee", "sub.callee"])
+def test_edited_callee_reaches_the_cached_caller(tmp_path, callee):
     """A package laid out like dec3d (the guard run by its __init__, a cached kernel that
-    calls a cached kernel of another file). Editing the callee's file changes what the
-    caller returns in the next process; numba alone would keep the caller's old code. The
-    notice is printed while compiling on a cold cache, not on a warm one."""
+    calls a cached kernel of another file, also in a sub-package as the joint laws are).
+    Editing the callee's file changes what the caller returns in the next process; numba
+    alone would keep the caller's old code. The notice is printed while compiling on a cold
+    cache, not on a warm one."""
     pkg = tmp_path / "fakedec" / "kernels"
-    pkg.mkdir(parents=True)
+    (pkg / "sub").mkdir(parents=True)
+    (pkg / "sub" / "__init__.py").write_text("")
+    cfile = pkg / (callee.replace(".", "/") + ".py")
     (tmp_path / "fakedec" / "__init__.py").write_text(
         "from pathlib import Path\nfrom dec3d.kcache import guard\n"
         "guard(Path(__file__).parent / 'kernels', 'fakedec.kernels')\n")
     (pkg / "__init__.py").write_text("")
-    (pkg / "caller.py").write_text(_CALLER)
-    (pkg / "callee.py").write_text(_CALLEE.format(1))
+    (pkg / "caller.py").write_text(_CALLER.format(callee))
+    cfile.write_text(_CALLEE.format(1))
     env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
     env["PYTHONPATH"] = os.pathsep.join([str(tmp_path), str(ROOT)])
 
@@ -96,7 +102,7 @@ def test_edited_callee_reaches_the_cached_caller(tmp_path):
 
     assert run() == (11, 1)              # cold: compiled, one notice
     assert run() == (11, 0)              # warm: loaded from the cache, silent
-    (pkg / "callee.py").write_text(_CALLEE.format(2))
+    cfile.write_text(_CALLEE.format(2))
     assert run() == (12, 1)              # the edit is seen through the caller's cache
     assert run() == (12, 0)
 

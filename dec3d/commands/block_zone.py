@@ -229,7 +229,7 @@ def insitu_contact_forces(model, cmask, stress_at) -> tuple | None:
     The joint law works from the total normal displacement (Fn = −kn A (un − u_dil),
     dec3d.kernels.jointlaw), so un is set to u_dil − fn / (kn A) for the force to persist.
     Returns (sub-contact rows, fn, fs, un) or None when there are no contacts."""
-    from ..kernels.jointlaw import P_KN
+    from ..kernels.joints import P_KN
     from ..model.zone_quality import tensor
     if "contacts" not in model.stores:
         return None

@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit, prange
 
 from .commonplane import common_plane, contact_type
-from .jointlaw import ST_NEW
+from .joints import ST_NEW
 
 
 @njit(cache=True)

@@ -13,7 +13,7 @@ edge the two edge weights. A rigid side gets node -1 and moves with its block (E
 
 With the weights fixed between two detection passes, one step is:
   V = v_B(x) − v_A(x), v_side(x) = Σ wᵢ vᵢ (zoned) or ẋ + ω × (x − x̄) (rigid)   (Eq. 15)
-  the joint law of ``jointlaw.coulomb_one`` unchanged;
+  the joint law of the contact's model (``joints.joint_law``) unchanged;
   force on B: + (Fⁿ n + Fˢ), on A: −; to a zoned side's gridpoints in proportion wᵢ, to a
   rigid side's centroid with its moment (ERRATA Eqs. 28-32).
 """
@@ -23,8 +23,7 @@ import math
 
 from numba import njit
 
-from .jointlaw import (P_COH, P_COH_RES, P_KN, P_KS, P_TANDIL, P_TANF, P_TANF_RES, P_TEN, P_TEN_RES, P_ZDIL,
-                       ST_NEW, coulomb_one)
+from .joints import ST_NEW, joint_law
 
 
 @njit(cache=True)
@@ -190,12 +189,9 @@ def mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce
             du2 = 0.0
             dun = 0.0
             st0 &= ~ST_NEW
-        p = cprop[c]
-        fn, f0, f1, f2, un, ud, u0, u1, u2, st = coulomb_one(
-            p[P_KN], p[P_KS], p[P_TANF], p[P_COH], p[P_TEN], p[P_TANDIL], p[P_ZDIL],
-            p[P_TANF_RES], p[P_COH_RES], p[P_TEN_RES], cmodel[c], sc_area[s],
-            dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s], sc_udil[s],
-            sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
+        fn, f0, f1, f2, un, ud, u0, u1, u2, st = joint_law(
+            cmodel[c], cprop[c], sc_area[s], dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s],
+            sc_udil[s], sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
         sc_fn[s] = fn
         sc_fs[s, 0] = f0
         sc_fs[s, 1] = f1

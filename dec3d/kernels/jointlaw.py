@@ -1,4 +1,5 @@
-"""Sub-contact force update and the Coulomb-slip joint law (3DEC theory Eqs. 15-43, ERRATA).
+"""Sub-contact force update: kinematics of every sub-contact, its joint model's law, the sums on the
+blocks (3DEC theory Eqs. 15-32, ERRATA).
 
 Batched over sub-contacts; every array has the sub-contact as its first dimension.
 Units: forces N, displacements m, stiffness Pa/m, stresses Pa, areas m², angles as tangents.
@@ -12,101 +13,17 @@ Per sub-contact s of contact c (blocks A = ca[c], B = cb[c], normal n = cn[c], A
         no increment: counting it twice made impacts engage one step, v Δt, early)
   Fⁿ  = −Kn A (uⁿ − u_dil)  (Eq. 24 integrated: compression positive, zero while open)
   Fˢ := Fˢ − Ks A ΔUˢ                                          (Eqs. 25, 27)
-  intact: Tmax = −T A (Eq. 34), Fˢmax = c A + Fⁿ tan φ (Eq. 35 per ERRATA)
-  Fⁿ < Tmax → Fⁿ = Fˢ = 0, failed (Eq. 38); |Fˢ| > Fˢmax → scaled to the limit, failed,
-  slipping (Eq. 39); after failure c, T are the residual values (default 0) and φ the
-  residual friction (Eqs. 36-37); dilation only while slipping, Δu_dil = ±|ΔUˢ| tan ψ,
-  + when ΔUˢ is along the accumulated shear displacement, − against it, and none once
-  |uˢ| exceeds the dilation-zero limit (0: no limit) (Eqs. 41-43).
+  then the joint model's law (``joints``: one kernel file per model) gives Fⁿ, Fˢ and the state.
 Force on B = Fⁿ n + Fˢ at x, on A the negative; moments (x − centroid) × force (ERRATA Eqs. 28-32).
 
-prop columns (P_*): kn, ks, tan φ, c, T, tan ψ, u_zero, tan φ_res (NaN: = tan φ), c_res, T_res.
+prop columns: kn, ks for every model (``joints._common``), then the model's own (e.g. ``joints.mohr``).
 """
 from __future__ import annotations
-
-import math
 
 import numpy as np
 from numba import njit, prange
 
-P_KN = 0
-P_KS = 1
-P_TANF = 2
-P_COH = 3
-P_TEN = 4
-P_TANDIL = 5
-P_ZDIL = 6
-P_TANF_RES = 7
-P_COH_RES = 8
-P_TEN_RES = 9
-NPROP = 10
-
-ST_FAILED = 1
-ST_SLIP = 2
-ST_TENSION = 4
-#: set on a sub-contact made at a detection: its uⁿ is its own gap at the current positions,
-#: which already hold the motion of the step just taken, so its first update adds no
-#: displacement increment (cleared by that update)
-ST_NEW = 8
-
-MODEL_ELASTIC = 0
-MODEL_MOHR = 1
-
-
-@njit(cache=True)
-def coulomb_one(kn, ks, tanf, coh, ten, tandil, zdil, tanf_r, coh_r, ten_r, model,
-                area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
-    """Scalar core for one sub-contact (shear force already rotated by Eq. 23).
-
-    Returns (Fn, Fs0, Fs1, Fs2, un, udil, us0, us1, us2, state).
-    """
-    if tanf_r != tanf_r:                   # NaN: residual friction = peak friction
-        tanf_r = tanf
-    un += dun
-    us0 += dus0
-    us1 += dus1
-    us2 += dus2
-    fs0 -= ks * area * dus0
-    fs1 -= ks * area * dus1
-    fs2 -= ks * area * dus2
-    fn = -kn * area * (un - udil)
-    if model == MODEL_ELASTIC:
-        if fn < 0.0:
-            fn = 0.0
-            fs0 = 0.0
-            fs1 = 0.0
-            fs2 = 0.0
-        return fn, fs0, fs1, fs2, un, udil, us0, us1, us2, state & ~ST_SLIP
-    failed = (state & ST_FAILED) != 0
-    c = coh_r if failed else coh
-    t = ten_r if failed else ten
-    tf = tanf_r if failed else tanf
-    state = state & ~(ST_SLIP | ST_TENSION)
-    if fn < -t * area:                     # Eq. (38): tensile failure
-        return 0.0, 0.0, 0.0, 0.0, un, udil, us0, us1, us2, state | ST_FAILED | ST_TENSION
-    fsmax = c * area + fn * tf             # Eq. (35)
-    if fsmax < 0.0:
-        fsmax = 0.0
-    fsm = math.sqrt(fs0 * fs0 + fs1 * fs1 + fs2 * fs2)
-    if fsm > fsmax:                        # Eq. (39): shear failure
-        if not failed:
-            state = state | ST_FAILED
-            fsmax = coh_r * area + fn * tanf_r
-            if fsmax < 0.0:
-                fsmax = 0.0
-        r = fsmax / fsm if fsm > 0.0 else 0.0
-        fs0 *= r
-        fs1 *= r
-        fs2 *= r
-        state = state | ST_SLIP
-        dmag = math.sqrt(dus0 * dus0 + dus1 * dus1 + dus2 * dus2)
-        usm = math.sqrt(us0 * us0 + us1 * us1 + us2 * us2)
-        if tandil != 0.0 and dmag > 0.0 and (zdil <= 0.0 or usm <= zdil):
-            sgn = 1.0 if (dus0 * us0 + dus1 * us1 + dus2 * us2) >= 0.0 else -1.0
-            ddil = sgn * dmag * tandil     # Eq. (42), direction-dependent
-            udil += ddil
-            fn += kn * area * ddil         # Eq. (43)
-    return fn, fs0, fs1, fs2, un, udil, us0, us1, us2, state
+from .joints import ST_NEW, joint_law
 
 
 @njit(cache=True, parallel=True)
@@ -151,12 +68,9 @@ def subcontact_update(dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
             du2 = 0.0
             dun = 0.0
             st0 &= ~ST_NEW
-        fn, f0, f1, f2, un, ud, u0, u1, u2, st = coulomb_one(
-            cprop[c, P_KN], cprop[c, P_KS], cprop[c, P_TANF], cprop[c, P_COH], cprop[c, P_TEN],
-            cprop[c, P_TANDIL], cprop[c, P_ZDIL], cprop[c, P_TANF_RES], cprop[c, P_COH_RES],
-            cprop[c, P_TEN_RES], cmodel[c], sc_area[s],
-            dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s], sc_udil[s],
-            sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
+        fn, f0, f1, f2, un, ud, u0, u1, u2, st = joint_law(
+            cmodel[c], cprop[c], sc_area[s], dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s],
+            sc_udil[s], sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
         sc_fn[s] = fn
         sc_fs[s, 0] = f0
         sc_fs[s, 1] = f1

@@ -30,7 +30,7 @@ import numpy as np
 from dec3d.kernels.cellmap import cell_grid, cell_pairs, outside_grid
 from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, match_sorted,
                                       subcontact_gaps, vertex_point_areas)
-from dec3d.kernels.jointlaw import NPROP
+from dec3d.kernels.joints import NPROP
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.groups import group_field
 from dec3d.model.model import KIND_DEFORMABLE

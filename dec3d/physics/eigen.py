@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dec3d.kernels.jointlaw import P_KN, P_KS
+from dec3d.kernels.joints import P_KN, P_KS
 
 from .contacts import default_row
 from .rigid import engine, mech

@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from dec3d.kernels.jointlaw import (MODEL_MOHR, P_COH, P_COH_RES, P_TANDIL, P_TANF, P_TANF_RES, P_TEN,
-                                    P_TEN_RES)
+from dec3d.kernels.joints.mohr import CODE as MODEL_MOHR
+from dec3d.kernels.joints.mohr import P_COH, P_COH_RES, P_TANDIL, P_TANF, P_TANF_RES, P_TEN, P_TEN_RES
 
 #: equilibrium ratio of a stable trial (Itasca's equilibrium ratio, "Reaching Equilibrium": 1e-5)
 STABLE_RATIO = 1e-5

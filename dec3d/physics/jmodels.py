@@ -1,13 +1,14 @@
-"""Joint constitutive models: one registration per model (``@jmodel``-style declarations).
+"""Joint constitutive models: the registry, and the host files of the models (``physics/joints``).
 
-A model declares its name, the kernel code the force update dispatches on
-(``kernels.jointlaw``), and its property names with the kernel column each one fills
+A joint model is two files: its kernel ``dec3d/kernels/joints/<name>.py`` (the law, its code and
+its columns) and its host ``dec3d/physics/joints/<name>.py``, which calls ``jmodel`` once with the
+kernel module and the model's property names with the kernel column each one fills
 and how a user value becomes a column value (angles in degrees → tangents). The same
 declaration drives ``block contact property`` checking, the command reference and the
 save file (contacts keep ``jmodel`` code and ``prop`` row).
 
-Columns left unset hold their declared default; ``friction-residual`` left unset holds
-NaN, which the kernel reads as "the peak friction" so that setting `friction` later moves
+Columns left unset hold their declared default; a property with a ``fallback`` (mohr's
+``friction-residual``) left unset holds NaN, which the kernel reads as "the peak friction" so that setting `friction` later moves
 the residual friction with it, as 3DEC does.
 """
 from __future__ import annotations
@@ -20,8 +21,8 @@ import numpy as np
 
 from dec3d.io.state import register_known
 
-from dec3d.kernels.jointlaw import (MODEL_ELASTIC, MODEL_MOHR, NPROP, P_COH, P_COH_RES, P_KN, P_KS, P_TANDIL,
-                                    P_TANF, P_TANF_RES, P_TEN, P_TEN_RES, P_ZDIL)
+from dec3d.kernels.joints import MODELS as KERNELS
+from dec3d.kernels.joints import NPROP, P_KN, P_KS
 
 
 def _tan_deg(v: float) -> float:
@@ -45,9 +46,11 @@ class Prop:
     lo: float | None = 0.0
     hi: float | None = None
     hi_open: bool = False
+    #: property whose value this one shows while it holds NaN (unset residual friction: the friction)
+    fallback: str | None = None
 
 
-def _angle(name, column, doc, hi_open=True, **kw) -> Prop:
+def angle(name, column, doc, hi_open=True, **kw) -> Prop:
     """An angle property: degrees in [0, 90), kept as its tangent. Above 90° the tangent turns
     negative (a block would slide that 30° holds)."""
     return Prop(name, column, doc, "deg", _tan_deg, _atan_deg, hi=90.0, hi_open=hi_open, **kw)
@@ -82,8 +85,8 @@ class JointModel:
     def value(self, row: np.ndarray, name: str) -> float:
         p = self.props[name]
         x = row[p.column]
-        if name == "friction-residual" and x != x:
-            x = row[self.props["friction"].column]
+        if p.fallback is not None and x != x:
+            x = row[self.props[p.fallback].column]
         return p.from_column(x)
 
 
@@ -91,10 +94,15 @@ JOINT_MODELS: dict[str, JointModel] = {}
 MODEL_BY_CODE: dict[int, JointModel] = {}
 
 
-def jmodel(name: str, code: int, doc: str, props: list[Prop]) -> JointModel:
-    """Register a joint model."""
+def jmodel(kernel, doc: str, props: list[Prop]) -> JointModel:
+    """Register a joint model: ``kernel`` is its module in ``dec3d/kernels/joints`` (name, code)."""
+    name, code = kernel.NAME, kernel.CODE
     if name in JOINT_MODELS or code in MODEL_BY_CODE:
         raise ValueError(f"joint model '{name}' (code {code}) registered twice")
+    for p in props:
+        if not 0 <= p.column < kernel.NCOLS:
+            raise ValueError(f"joint model '{name}': property {p.name} in column {p.column}, the kernel reads "
+                             f"{kernel.NCOLS}")
     m = JointModel(name, code, doc, {p.name: p for p in props})
     JOINT_MODELS[name] = m
     MODEL_BY_CODE[code] = m
@@ -102,23 +110,28 @@ def jmodel(name: str, code: int, doc: str, props: list[Prop]) -> JointModel:
     return m
 
 
-_STIFF = [Prop("stiffness-normal", P_KN, "normal stiffness kn", "Pa/m"),
-          Prop("stiffness-shear", P_KS, "shear stiffness ks", "Pa/m")]
+#: the stiffnesses every model has (columns 0, 1 of every kernel)
+STIFFNESS = [Prop("stiffness-normal", P_KN, "normal stiffness kn", "Pa/m"),
+             Prop("stiffness-shear", P_KS, "shear stiffness ks", "Pa/m")]
 
-jmodel("elastic", MODEL_ELASTIC, "linear elastic joint, no tension (3DEC's `elastic`)", _STIFF)
 
-jmodel("mohr", MODEL_MOHR, "Coulomb slip with tension cut-off, cohesion and tension lost at first failure, "
-       "residual values and dilation (3DEC theory Eqs. 33-43 with the errata)", _STIFF + [
-           _angle("friction", P_TANF, "friction angle φ (90: never slips)", hi_open=False),
-           Prop("cohesion", P_COH, "cohesion c", "Pa"),
-           Prop("tension", P_TEN, "tensile strength T", "Pa"),
-           _angle("dilation", P_TANDIL, "dilation angle ψ"),
-           Prop("dilation-zero", P_ZDIL, "shear displacement at which dilation stops (0: never)", "m"),
-           _angle("friction-residual", P_TANF_RES, "residual friction angle (default: the friction angle)",
-                  hi_open=False, default=math.nan),
-           Prop("cohesion-residual", P_COH_RES, "residual cohesion", "Pa"),
-           Prop("tension-residual", P_TEN_RES, "residual tensile strength", "Pa"),
-       ])
+def _load_hosts() -> None:
+    """Import every host file of ``physics/joints`` (each registers its model) and check that
+    each joint-law kernel has its host."""
+    import importlib
+    import pkgutil
+
+    from dec3d.physics import joints
+
+    for info in pkgutil.iter_modules(joints.__path__):
+        if not info.name.startswith("_"):
+            importlib.import_module(f"{joints.__name__}.{info.name}")
+    missing = [k.NAME for k in KERNELS if k.NAME not in JOINT_MODELS]
+    if missing:
+        raise ImportError(f"joint-law kernels without a host file in dec3d/physics/joints: {missing}")
+
+
+_load_hosts()
 
 #: every property name of every model (command keywords)
 ALL_PROPS: tuple[str, ...] = tuple(dict.fromkeys(p for m in JOINT_MODELS.values() for p in m.props))

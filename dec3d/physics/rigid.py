@@ -22,7 +22,7 @@ from dec3d.io.vtk import periodic_vtk
 from dec3d.kernels.balance import body_balance
 from dec3d.kernels.cycle import run_steps
 from dec3d.kernels.gpcontact import mixed_move_points, mixed_subcontact_forces, surface_weights
-from dec3d.kernels.jointlaw import P_KN, P_KS
+from dec3d.kernels.joints import P_KN, P_KS
 from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST, block_timestep,
                                   rigid_motion_groups)
 from dec3d.model.model import KIND_DEFORMABLE, KIND_FE

@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 from dec3d.kernels.gpcontact import mixed_move_points, mixed_subcontact_forces, surface_weights
-from dec3d.kernels.jointlaw import NPROP, P_KN, P_KS, P_TANF
+from dec3d.kernels.joints import NPROP, P_KN, P_KS
+from dec3d.kernels.joints.mohr import P_TANF
 
 
 def _nearest_twin(p, tri):

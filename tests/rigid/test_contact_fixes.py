@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 from dec3d.kernels.contactmap import subcontact_gaps
-from dec3d.kernels.jointlaw import NPROP, P_KN, P_KS, ST_NEW, subcontact_forces
+from dec3d.kernels.jointlaw import subcontact_forces
+from dec3d.kernels.joints import NPROP, P_KN, P_KS, ST_NEW
 from dec3d.physics.history import histories
 from dec3d.physics.rigid import engine
 

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from dec3d.errors import BindError, CommandError
-from dec3d.kernels.jointlaw import NPROP, P_COH, P_COH_RES, P_KN, P_TANDIL, P_TANF, P_TANF_RES, P_TEN
+from dec3d.kernels.joints import NPROP, P_KN
+from dec3d.kernels.joints.mohr import P_COH, P_COH_RES, P_TANDIL, P_TANF, P_TANF_RES, P_TEN
 from dec3d.physics.fos import ContactStrengthTrials, FosError, bracket_fos, reduce_defaults, reduce_rows
 from dec3d.physics.rigid import engine
 

@@ -6,7 +6,8 @@ import pytest
 
 from dec3d.kernels.commonplane import (CT_EE, CT_EF, CT_FF, CT_VE, CT_VF, CT_VV, common_plane,
                                        contact_type)
-from dec3d.kernels.jointlaw import NPROP, coulomb_one
+from dec3d.kernels.joints import NPROP, joint_law
+from dec3d.kernels.joints import mohr as mohr_kernel
 from dec3d.kernels.motion import block_timestep, rigid_motion
 from reference.commonplane_ref import best_plane
 from reference.rigid_ref import coulomb_ref, hull_distance, rotate_rodrigues
@@ -132,6 +133,11 @@ def test_coulomb_kernel_matches_scalar_reference():
     rng = np.random.default_rng(3)
     p = dict(kn=1e9, ks=5e8, phi=math.radians(30), coh=2e4, ten=1e4, dil=math.radians(10), zdil=0.004,
              phir=math.radians(25), cohr=0.0, tenr=0.0)
+    m = mohr_kernel
+    prow = np.zeros(NPROP)
+    prow[[0, 1, m.P_TANF, m.P_COH, m.P_TEN, m.P_TANDIL, m.P_ZDIL, m.P_TANF_RES, m.P_COH_RES, m.P_TEN_RES]] = [
+        p["kn"], p["ks"], math.tan(p["phi"]), p["coh"], p["ten"], math.tan(p["dil"]), p["zdil"],
+        math.tan(p["phir"]), p["cohr"], p["tenr"]]
     for model, mcode in (("mohr", 1), ("elastic", 0)):
         st_k = dict(un=-1e-5, udil=0.0, fs=np.zeros(3), us=np.zeros(3), state=0)
         st_r = dict(un=-1e-5, udil=0.0, fs=np.zeros(3), us=np.zeros(3), failed=False)
@@ -139,9 +145,8 @@ def test_coulomb_kernel_matches_scalar_reference():
             dun = rng.normal() * 2e-7 - (1e-7 if step < 50 else 0.0)
             dus = rng.normal(size=3) * 5e-6 + np.array([4e-6, 0, 0]) * (1 if step < 300 else -1)
             dus[2] = 0.0
-            fn, f0, f1, f2, un, ud, u0, u1, u2, st = coulomb_one(
-                p["kn"], p["ks"], math.tan(p["phi"]), p["coh"], p["ten"], math.tan(p["dil"]), p["zdil"],
-                math.tan(p["phir"]), p["cohr"], p["tenr"], mcode, 0.25, dun, dus[0], dus[1], dus[2],
+            fn, f0, f1, f2, un, ud, u0, u1, u2, st = joint_law(
+                mcode, prow, 0.25, dun, dus[0], dus[1], dus[2],
                 st_k["un"], st_k["udil"], *st_k["fs"], *st_k["us"], st_k["state"])
             st_k.update(un=un, udil=ud, fs=np.array([f0, f1, f2]), us=np.array([u0, u1, u2]), state=st)
             rfn, rfs, run, rud, rus, rfail, _ = coulomb_ref(p, model, 0.25, dun, dus, st_r["un"], st_r["udil"],

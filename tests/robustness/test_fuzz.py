@@ -37,7 +37,7 @@ from dec3d.commands.budget import Budget
 from dec3d.commands.registry import REGISTRY
 from dec3d.commands.values import Choice, Flag, Num, Nums, OnOff
 from dec3d.errors import Dec3dError
-from dec3d.kernels.jointlaw import P_TANF_RES
+from dec3d.kernels.joints.mohr import P_TANF_RES
 from dec3d.session import Session
 
 MAX_STEPS = 30

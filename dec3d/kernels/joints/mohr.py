@@ -1,0 +1,73 @@
+"""Joint model ``mohr``: Coulomb slip with tension cut-off; cohesion and tension are lost at the
+first failure (residual values then hold), dilation while slipping (3DEC theory Eqs. 33-43,
+Eq. 35 as corrected in ERRATA).
+
+  intact: Tmax = −T A (Eq. 34), Fˢmax = c A + Fⁿ tan φ (Eq. 35)
+  Fⁿ < Tmax → Fⁿ = Fˢ = 0, failed (Eq. 38); |Fˢ| > Fˢmax → scaled to the limit, failed,
+  slipping (Eq. 39); after failure c, T are the residual values (default 0) and φ the residual
+  friction (Eqs. 36-37); dilation only while slipping, Δu_dil = ±|ΔUˢ| tan ψ, + when ΔUˢ is along
+  the accumulated shear displacement, − against it, none once |uˢ| exceeds the dilation-zero
+  limit (0: no limit) (Eqs. 41-43).
+"""
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from ._common import P_KN, P_KS, ST_FAILED, ST_SLIP, ST_TENSION, elastic_trial
+
+NAME = "mohr"
+CODE = 1          # kept in save files: never renumber
+P_TANF = 2        # tan φ
+P_COH = 3         # cohesion c [Pa]
+P_TEN = 4         # tensile strength T [Pa]
+P_TANDIL = 5      # tan ψ
+P_ZDIL = 6        # shear displacement at which dilation stops [m] (0: never)
+P_TANF_RES = 7    # residual tan φ (NaN: the peak value)
+P_COH_RES = 8     # residual cohesion [Pa]
+P_TEN_RES = 9     # residual tensile strength [Pa]
+NCOLS = 10
+
+
+@njit(cache=True)
+def law(p, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
+    """Elastic trial, then the Coulomb and tension limits."""
+    kn = p[P_KN]
+    tanf_r = p[P_TANF_RES]
+    if tanf_r != tanf_r:                   # NaN: residual friction = peak friction
+        tanf_r = p[P_TANF]
+    fn, fs0, fs1, fs2, un, us0, us1, us2 = elastic_trial(kn, p[P_KS], area, dun, dus0, dus1, dus2, un, udil,
+                                                         fs0, fs1, fs2, us0, us1, us2)
+    failed = (state & ST_FAILED) != 0
+    c = p[P_COH_RES] if failed else p[P_COH]
+    t = p[P_TEN_RES] if failed else p[P_TEN]
+    tf = tanf_r if failed else p[P_TANF]
+    state = state & ~(ST_SLIP | ST_TENSION)
+    if fn < -t * area:                     # Eq. (38): tensile failure
+        return 0.0, 0.0, 0.0, 0.0, un, udil, us0, us1, us2, state | ST_FAILED | ST_TENSION
+    fsmax = c * area + fn * tf             # Eq. (35)
+    if fsmax < 0.0:
+        fsmax = 0.0
+    fsm = math.sqrt(fs0 * fs0 + fs1 * fs1 + fs2 * fs2)
+    if fsm > fsmax:                        # Eq. (39): shear failure
+        if not failed:
+            state = state | ST_FAILED
+            fsmax = p[P_COH_RES] * area + fn * tanf_r
+            if fsmax < 0.0:
+                fsmax = 0.0
+        r = fsmax / fsm if fsm > 0.0 else 0.0
+        fs0 *= r
+        fs1 *= r
+        fs2 *= r
+        state = state | ST_SLIP
+        dmag = math.sqrt(dus0 * dus0 + dus1 * dus1 + dus2 * dus2)
+        usm = math.sqrt(us0 * us0 + us1 * us1 + us2 * us2)
+        tandil = p[P_TANDIL]
+        zdil = p[P_ZDIL]
+        if tandil != 0.0 and dmag > 0.0 and (zdil <= 0.0 or usm <= zdil):
+            sgn = 1.0 if (dus0 * us0 + dus1 * us1 + dus2 * us2) >= 0.0 else -1.0
+            ddil = sgn * dmag * tandil     # Eq. (42), direction-dependent
+            udil += ddil
+            fn += kn * area * ddil         # Eq. (43)
+    return fn, fs0, fs1, fs2, un, udil, us0, us1, us2, state

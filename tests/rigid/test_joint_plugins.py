@@ -1,0 +1,102 @@
+"""Joint models are plug-ins (issue 9): a model is a kernel file in dec3d/kernels/joints and a host
+file in dec3d/physics/joints, found by listing the folders. Adding one touches no other file."""
+import os
+import shutil
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+from conftest import ROOT
+
+from dec3d.kernels import joints
+from dec3d.physics.jmodels import JOINT_MODELS, MODEL_BY_CODE
+
+KERNEL = '''
+"""Test model: linear elastic joint that also carries tension (no cut-off)."""
+from numba import njit
+
+from ._common import P_KN, P_KS, elastic_trial
+
+NAME = "linear-tension"
+CODE = 7
+NCOLS = 3
+P_FACTOR = 2      # tension stiffness as a fraction of kn
+
+
+@njit(cache=True)
+def law(p, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
+    fn, fs0, fs1, fs2, un, us0, us1, us2 = elastic_trial(p[P_KN], p[P_KS], area, dun, dus0, dus1, dus2, un,
+                                                         udil, fs0, fs1, fs2, us0, us1, us2)
+    if fn < 0.0:
+        fn *= p[P_FACTOR]
+    return fn, fs0, fs1, fs2, un, udil, us0, us1, us2, state
+'''
+
+HOST = '''
+from dec3d.kernels.joints import linear_tension as kernel
+from dec3d.physics.jmodels import STIFFNESS, Prop, jmodel
+
+jmodel(kernel, "elastic joint carrying tension", STIFFNESS + [
+    Prop("tension-factor", kernel.P_FACTOR, "tension stiffness / kn", default=1.0)])
+'''
+
+DECK = '''
+model new
+block create brick 0 1 0 1 0 1
+block create brick 0 1 0 1 1 2
+block property density 2000
+block contact jmodel assign linear-tension
+block contact property stiffness-normal 1e9 stiffness-shear 1e9 tension-factor 0.5
+block fix range position-z 0 0.5
+block initialize velocity-z 1e-3 range position-z 1 2
+block mechanical damping none
+model cycle 20
+'''
+
+
+def test_models_found_by_listing_and_registered_once():
+    assert [m.NAME for m in joints.MODELS] == ["elastic", "mohr"]
+    assert set(JOINT_MODELS) == {m.NAME for m in joints.MODELS}
+    assert {c: m.name for c, m in MODEL_BY_CODE.items()} == {m.CODE: m.NAME for m in joints.MODELS}
+    assert joints.NPROP == max(m.NCOLS for m in joints.MODELS)
+
+
+def test_dispatch_calls_each_models_own_law():
+    """The chain picks the law by code: elastic drops tension, mohr limits shear."""
+    p = np.zeros(joints.NPROP)
+    p[0] = p[1] = 1e9
+    opened = joints.joint_law(joints.CODES["elastic"], p, 1.0, 1e-6, 0.0, 0.0, 0.0, 0.0, 0.0,
+                              0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0)
+    assert opened[0] == 0.0 and opened[4] == pytest.approx(1e-6)
+    p[joints.mohr.P_TANF] = 0.5
+    p[joints.mohr.P_TANF_RES] = np.nan          # residual friction = the friction
+    sheared = joints.joint_law(joints.CODES["mohr"], p, 1.0, -1e-6, 1e-5, 0.0, 0.0, 0.0, 0.0,
+                               0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0)
+    assert sheared[0] == pytest.approx(1e3) and abs(sheared[1]) == pytest.approx(500.0)   # Fs = Fn tan φ
+
+
+def test_a_new_model_is_two_new_files(tmp_path):
+    """A copy of the package with one kernel file and one host file added runs a deck with the
+    new model and its new property; no other file changes. (Plain Python: NUMBA_DISABLE_JIT.)"""
+    pkg = tmp_path / "dec3d"
+    shutil.copytree(ROOT / "dec3d", pkg, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    (pkg / "kernels" / "joints" / "linear_tension.py").write_text(KERNEL)
+    (pkg / "physics" / "joints" / "linear_tension.py").write_text(HOST)
+    (tmp_path / "pull.dat").write_text(DECK)
+    script = textwrap.dedent('''
+        import dec3d
+        from dec3d.session import Session
+        s = Session()
+        s.call("pull.dat")
+        sc = s.model.rigid_engine.subcontacts
+        print("FN", sc["fn"].sum(), "N", sc.n)
+    ''')
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1", PYTHONPATH=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env,
+                         cwd=tmp_path, timeout=600)
+    assert out.returncode == 0, out.stdout[-2000:] + out.stderr[-3000:]
+    fn = float(out.stdout.split("FN")[1].split()[0])
+    # opening 19-20 steps at 1e-3 m/s over 1 m² at 0.5 kn: a tensile force, which mohr/elastic would drop
+    assert fn < 0.0
