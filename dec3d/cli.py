@@ -10,7 +10,10 @@ from . import __version__
 
 
 def _run(args) -> int:
+    from . import warmup
+
     session = None
+    helper = warmup.start()          # cold cache: the cycle kernels compile on the other core
     try:
         from .errors import Dec3dError
         from .session import Session
@@ -50,6 +53,8 @@ def _run(args) -> int:
             step = session.model.step if session is not None else 0
         print(f"interrupted at step {step}", file=sys.stderr)
         return 130
+    finally:
+        warmup.stop(helper)
 
 
 def _batch(args) -> int:

@@ -31,6 +31,8 @@ HERE = Path(__file__).resolve().parent / "kernels"
 #: file in the cache folder holding the source hash the cached kernels were built from
 STAMP = "dec3d-kernels.sha256"
 NOTICE = "dec3d: compiling kernels, first run only (a few seconds to a minute) …"
+#: set by ``guard``: no cached kernel was found (``dec3d.warmup`` then compiles on the second core)
+COLD = False
 
 
 def source_hash(folder: Path = HERE) -> str:
@@ -169,7 +171,9 @@ def guard(folder: Path = HERE, package: str = "dec3d.kernels") -> None:
             clear_stale(cache_dir(sub), digest, sub)
     cdir = cache_dir(folder)
     clear_stale(cdir, digest, folder)
-    if is_cold(cdir, folder):
+    global COLD
+    COLD = is_cold(cdir, folder)
+    if COLD:
         from numba.core import event as ev
 
         ev.register("numba:compile", _notice_listener(package=package))

@@ -10,6 +10,9 @@ ROOT = Path(__file__).resolve().parent.parent
 # (default: `shared/` beside the repository). Tests that read them skip, with NO_DECKS as the reason,
 # when the folder is absent.
 SHARED = Path(os.environ.get("DEC3D_SHARED", ROOT.parent / "shared"))
+# no warm-up process (dec3d/warmup.py) from the `dec3d run`s of the tests: tests/test_warmup.py
+# runs it itself
+os.environ.setdefault("DEC3D_WARMUP", "0")
 DECKS = SHARED / "decks"
 NO_DECKS = (f"public 3DEC decks not found at {DECKS}: set DEC3D_SHARED=<folder holding decks/> "
             "or place shared/ beside the repository (README, 'Set up')")
