@@ -247,7 +247,10 @@ class ZoneStepper:
             cm[rows] = c
             lk = self.linked
             np.add.at(cm, link[lk], cm[lk])
-            self.cdash = np.abs(cm).sum(axis=2).max(axis=1)
+            cd = np.abs(cm).sum(axis=2).max(axis=1)
+            if self.fe is not None:
+                self.fe.slave_stiffness(cd)          # slave nodes' dashpots bound their masters'
+            self.cdash = cd
         self.dyn = dynamic_face_loads(model)
         #: model time of the next step (table loads are evaluated at it)
         self.clock = float(model.time)
