@@ -102,11 +102,13 @@ def _no_fish_history(call):
                  "points as they are when the command runs). A face carries one such table.\n\n"
                  "`quiet` puts the viscous boundary of Lysmer and Kuhlemeyer on the faces: dashpots with "
                  "tractions −ρC_p v_n (normal) and −ρC_s v_s (shear), C_p = ((K + 4G/3)/ρ)^½ and C_s = (G/ρ)^½ "
-                 "of the zone each face belongs to (FE blocks: of their elements), shared among the gridpoints "
-                 "like an applied stress. The time step and, in static runs, the scaled masses allow for the "
+                 "of the zone each face belongs to (FE blocks: of their elements) when the command runs, shared among the "
+                 "gridpoints like an applied stress. The time step and, in static runs, the scaled masses allow for the "
                  "dashpots. A wave comes in through a quiet base as a stress 2ρC_s v (shear) or 2ρC_p v (normal) "
                  "for the incident velocity v, e.g. `stress-xz` with a table (on a base whose outward normal is "
-                 "−z, `stress-xz −2ρC_s v` pushes +x). Faces of rigid blocks take neither.",
+                 "−z, `stress-xz −2ρC_s v` pushes +x). Faces of rigid blocks take neither. (3DEC 7 lists no `quiet` "
+                 "for `block face apply` and sets viscous boundaries on gridpoints, `block gridpoint apply quiet`, "
+                 "which dec3d does not have yet; `quiet` here is FLAC3D's `zone face apply quiet`.)",
          examples=["block face apply stress-normal -1e6 range position-z 1",
                    "block face apply stress -1e6 -2e6 -1e6 0 0 0 range group 'hole'",
                    "block face apply quiet range position-z 0",
