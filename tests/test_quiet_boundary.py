@@ -39,6 +39,9 @@ def test_binding_and_bad_input(session):
     with pytest.raises(CommandError, match="selected no boundary face"):
         session.command("block face apply quiet range position-z 5")
     assert not (session.model.faces["fquiet"] > 0).any()
+    session.command("table 1 add (0,0) (1,1)\nblock face apply stress-xz -1 hist tab 1 range position-z 0")
+    f = session.model.faces
+    assert (f["fdyn_tab"] == 0).sum() == 8 and np.allclose(f["fdyn"][f["fdyn_tab"] == 0, 4], -1.0)
 
 
 def test_quiet_refused_on_rigid_blocks_and_without_properties(session):
