@@ -398,6 +398,7 @@ def _settings_problem(d: dict) -> str | None:
               "props": lambda v: isinstance(v, dict) and all(isinstance(k, str) and _is_num(x) for k, x in v.items()),
               "signature": lambda v: isinstance(v, list) and all(_is_int(x) for x in v),
               "mtables": lambda v: isinstance(v, list) and all(_mtable_ok(t) for t in v),
+              "face_tables": lambda v: isinstance(v, list) and all(_face_table_ok(t) for t in v),
               "grid": lambda v: (isinstance(v, list) and len(v) == 3 and isinstance(v[0], list) and len(v[0]) == 3
                                  and all(_is_num(x) for x in v[0]) and _is_num(v[1]) and v[1] > 0
                                  and isinstance(v[2], list) and len(v[2]) == 3
@@ -416,6 +417,13 @@ def _mtable_ok(t) -> bool:
             and (t.get("groups") is None or (isinstance(t["groups"], list) and len(t["groups"]) == 2
                                              and all(isinstance(g, str) for g in t["groups"])))
             and (t.get("slot") is None or isinstance(t["slot"], str)))
+
+
+def _face_table_ok(t) -> bool:
+    """One table of `block face apply … table` (``dec3d.model.quiet``): id, x increasing, as many y."""
+    return (isinstance(t, dict) and (_is_int(t.get("id")) or isinstance(t.get("id"), str))
+            and isinstance(t.get("x"), list) and isinstance(t.get("y"), list) and 1 <= len(t["x"]) == len(t["y"])
+            and all(_is_num(x) for x in t["x"] + t["y"]) and all(a < b for a, b in zip(t["x"], t["x"][1:])))
 
 
 def _short(v) -> str:

@@ -657,6 +657,8 @@ class _Run:
         self.scaled = eng.mass_scaling()
         dt_last = float(last[0]) if self.dt_fixed is None and between else None
         if self.zoned:
+            if dt_last is not None and not self.scaled and getattr(self.zst, "cdash", None) is not None:
+                dt_last = min(dt_last, self.zst.natural_timestep())    # quiet faces applied since
             dt = dt_last if dt_last is not None else self._zoned_dt()
             self.zst.set_masses(dt, self.scaled)
             if self.ng:

@@ -228,22 +228,61 @@ class ZoneStepper:
         self.mtot = mtot
         self.ktot = ktot
         self.kzone = ktot.copy()
+        self._quiet_setup(model)
         self.facc = np.zeros((n, 3))
         self.fmag = np.zeros(n)
         self.out = np.zeros(4)
 
+    def _quiet_setup(self, model) -> None:
+        """Quiet boundaries and table-driven face stresses (``dec3d.model.quiet``): the dashpot
+        matrices per gridpoint row, each master's largest dashpot coefficient (Gershgorin bound of
+        its summed matrix, for Δt and the scaled masses) and the clock of the table loads."""
+        from dec3d.model.quiet import dynamic_face_loads, quiet_dashpots
+        self.quiet = quiet_dashpots(model)
+        self.cdash = None
+        if self.quiet is not None:
+            rows, c = self.quiet
+            link = model.vertices["link"]
+            cm = np.zeros((len(self.mtot), 3, 3))
+            cm[rows] = c
+            lk = self.linked
+            np.add.at(cm, link[lk], cm[lk])
+            cd = np.abs(cm).sum(axis=2).max(axis=1)
+            if self.fe is not None:
+                self.fe.slave_stiffness(cd)          # slave nodes' dashpots bound their masters'
+            self.cdash = cd
+        self.dyn = dynamic_face_loads(model)
+        #: model time of the next step (table loads are evaluated at it)
+        self.clock = float(model.time)
+
     # ------------------------------------------------------------ time step and masses
     def natural_timestep(self) -> float:
-        """Eq. (84): 2 min (m/k)^½ over the master gridpoints that have stiffness [s]."""
+        """Eq. (84): 2 min (m/k)^½ over the master gridpoints that have stiffness [s]. With quiet
+        boundaries a gridpoint with dashpot coefficient c takes the central-difference limit with
+        damping, Δt = (2/ω)((1 + ξ²)^½ − ξ), ω² = k/m, ξ = c/(2mω) (Belytschko, Liu and Moran,
+        "Nonlinear Finite Elements for Continua and Structures", explicit time integration), that
+        is k Δt²/4 + c Δt/2 = m: Δt = ((c² + 4km)^½ − c)/k."""
         m, k = self.mtot[self.masters], self.ktot[self.masters]
+        if self.cdash is not None:
+            c = self.cdash[self.masters]
+            on = ((k > 0) | (c > 0)) & (m > 0)
+            m, k, c = m[on], k[on], c[on]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                dt = np.where(k > 0, (np.sqrt(c * c + 4.0 * k * m) - c) / np.where(k > 0, k, 1.0), 2.0 * m / c)
+            return float(dt.min()) if len(dt) else math.inf
         on = (k > 0) & (m > 0)
         return float(2.0 * np.sqrt(m[on] / k[on]).min()) if on.any() else math.inf
 
     def set_masses(self, dt: float, scaled: bool) -> None:
-        """Inertial masses: density-scaled to Δt (m = k Δt²/4, Eq. 84) or the real ones."""
+        """Inertial masses: density-scaled to Δt (m = k Δt²/4, Eq. 84; + c Δt/2 at a gridpoint with
+        dashpots of a quiet boundary, see ``natural_timestep``) or the real ones."""
         v = self.model.vertices
         im = self.ktot * dt * dt / 4.0 if scaled else self.mtot.copy()
-        im[self.ktot <= 0] = 0.0
+        if scaled and self.cdash is not None:
+            im += self.cdash * dt / 2.0
+            im[(self.ktot <= 0) & (self.cdash <= 0)] = 0.0
+        else:
+            im[self.ktot <= 0] = 0.0
         v["imass"][self.masters] = im[self.masters]
         lk = self.linked
         v["imass"][lk] = v["imass"][v["link"][lk]]
@@ -301,6 +340,8 @@ class ZoneStepper:
             self._body_force10(gravity)
             facc[self.r10] += self.fb10
             fmag[self.r10] += self.fb10mag
+        if self.quiet is not None or self.dyn:
+            self._boundary_forces(vel, dt)
         gp_externals(self.rows, v["link"], self.gmass, gravity, v["fapp"], v["fface"], facc, fmag)
         if fe is not None:
             fe.slave_forces(facc)
@@ -309,6 +350,21 @@ class ZoneStepper:
         if fe is not None:
             fe.follow(vel, v["disp"], *((pos,) if large else ()))
         return bad
+
+    def _boundary_forces(self, vel, dt) -> None:
+        """Dashpot forces −C v of the quiet boundaries (velocities of the last step) and the
+        table-driven face loads at the model time of this step (``dec3d.model.quiet``)."""
+        facc, fmag = self.facc, self.fmag
+        if self.quiet is not None:
+            rows, c = self.quiet
+            facc[rows] -= np.einsum("kij,kj->ki", c, vel[rows])
+        if self.dyn:
+            from dec3d.model.quiet import table_value
+            for xs, ys, rows, unit in self.dyn:
+                f = table_value(xs, ys, self.clock) * unit
+                facc[rows] += f
+                fmag[rows] += np.sqrt((f * f).sum(axis=1))
+        self.clock += dt
 
     def _body_force10(self, gravity) -> None:
         """The consistent gravity loads of the 10-node zones (FE-block text 003_*, "Gravity
