@@ -251,9 +251,9 @@ def salencon_measures(model, p0: float, p_i: float, a: float, cohesion: float, f
       mean over the zones it passes through of |σ − σ_exact| / p0 in %, σ at the zone centroid
       (σ_r, σ_θ rotated by the centroid's angle); ``line_zones`` how many.
     - ``sigr``, ``sigt``: the same mean over every zone of the model."""
-    zs, vs = model.store("zones"), model.vertices
-    if zs.n == 0:
+    if "zones" not in model.stores or model.store("zones").n == 0:
         raise ValueError("salencon: the model has no zones")
+    zs, vs = model.store("zones"), model.vertices
     pos = vs["pos"]
     r0, _, _ = salencon_exact(np.array([a]), p0, p_i, a, cohesion, friction)
     grp, w, stress, centre = _zone_groups(zs, pos)
