@@ -226,6 +226,8 @@ def _zones_on_ray(zs, pos, theta: float, y: float, r_from: float, r_to: float, s
     rows = np.flatnonzero((zs["cmodel"] > 0) & (zs["overlay"] <= 0))
     corner = pos[zs["gp"][rows, :4]]
     edges = np.transpose(corner[:, 1:] - corner[:, :1], (0, 2, 1))           # columns p1-p0, p2-p0, p3-p0
+    ok = np.abs(np.linalg.det(edges)) > 1e-12 * np.abs(edges).max() ** 3     # flat tetrahedra hold no point
+    rows, corner, edges = rows[ok], corner[ok], edges[ok]
     inv = np.linalg.inv(edges)
     c, s = np.cos(np.radians(theta)), np.sin(np.radians(theta))
     found = []

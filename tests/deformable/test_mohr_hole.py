@@ -129,3 +129,33 @@ def test_mohr_hole_without_nmd_scatters_the_plastic_stresses(tmp_path):
     t_on = int(((s_on.model.store("zones")["state"] & 8) != 0).sum())
     t_off = int(((s_off.model.store("zones")["state"] & 8) != 0).sum())
     assert t_off > 3 * max(t_on, 1)
+
+
+def test_salencon_measures_take_a_hexahedral_zone_as_one(tmp_path):
+    """Hexahedral zones (ten overlaid tetrahedra each, two sets of five): a zone's stress and
+    centroid are those of its set, and its area counts once: with every zone yielded the plastic
+    radius is again that of the whole 10 m x 10 m quarter; with the closed form at each hexahedron's
+    centroid the stress errors vanish."""
+    deck = tmp_path / "hex.dat"
+    text = ROOT.joinpath("verification", "D3_elastic_hole_hex", "deck.dat").read_text()
+    deck.write_text(text.replace("model cycle 2000", ""))
+    s = Session(out_dir=tmp_path)
+    s.call(deck)
+    zs, pos = s.model.store("zones"), s.model.vertices["pos"]
+    assert (zs["hex"] >= 0).all()
+    cen4 = pos[zs["gp"][:, :4]].mean(axis=1)
+    for h in np.unique(zs["hex"]):
+        rows = np.flatnonzero(zs["hex"] == h)
+        w = zs["volume"][rows]
+        cen4[rows] = (cen4[rows] * w[:, None]).sum(axis=0) / w.sum()
+    r, th = np.hypot(cen4[:, 0], cen4[:, 2]), np.arctan2(cen4[:, 2], cen4[:, 0])
+    _, sr, st = salencon_exact(r, P0, 0.0, A, C, PHI)
+    c, sn = np.cos(th), np.sin(th)
+    zs["stress"][:] = 0.0
+    zs["stress"][:, 0] = -(sr * c * c + st * sn * sn)
+    zs["stress"][:, 2] = -(sr * sn * sn + st * c * c)
+    zs["stress"][:, 4] = -(sr - st) * sn * c
+    zs["state"][:] = 4
+    m = salencon_measures(s.model, P0, 0.0, A, C, PHI, 45.0)
+    assert m["sigr_line"] < 1e-9 and m["sigt_line"] < 1e-9 and m["sigt"] < 1e-9
+    assert m["radius"] == pytest.approx(math.sqrt(400.0 / math.pi), rel=1e-9)
