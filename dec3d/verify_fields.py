@@ -18,7 +18,8 @@ measures are the ones that verification defines (its FISH file ``ElasticHole.fis
 blocks (shared/verification/PROBLEMS.md D1, D2), measures in their functions' docstrings.
 
 ``zone_block``: the mean zone stress and the yielding fractions of one block (the triaxial
-specimens of D4). ``footing``: the mean pressure under a strip footing (D5).
+specimens of D4). ``footing``: the mean pressure under a strip footing (D5). ``salencon``: the
+plastic radius and the stresses around a hole in a Mohr-Coulomb medium (D6).
 """
 from __future__ import annotations
 
@@ -158,9 +159,138 @@ def footing_measures(model, half_width: float, surface: float, length: float, co
     return {"q": q, "q_c": q / cohesion}
 
 
+# ---------------------------------------------------------------- D6: the Mohr-Coulomb hole
+def salencon_exact(r: np.ndarray, p0: float, p_i: float, a: float, cohesion: float, friction: float):
+    """Salençon (1969): a circular hole of radius a, internal pressure p_i, in an infinite,
+    elastic-perfectly plastic Mohr-Coulomb medium (cohesion c, friction angle φ in degrees) under
+    the isotropic far-field stress p0, plane strain; as written in Itasca's verification problem
+    "Cylindrical Hole in an Infinite Mohr-Coulomb Medium" (3DEC/FLAC3D verification problems).
+    Compression positive. Returns (R0, σ_r(r), σ_θ(r)):
+
+        K_p = (1 + sin φ)/(1 − sin φ),  q = 2 c tan(45° + φ/2) = 2 c √K_p
+        R0  = a [ 2/(K_p + 1) · (p0 + q/(K_p − 1)) / (p_i + q/(K_p − 1)) ]^(1/(K_p − 1))
+        r ≤ R0:  σ_r = −q/(K_p − 1) + (p_i + q/(K_p − 1)) (r/a)^(K_p − 1)
+                 σ_θ = −q/(K_p − 1) + K_p (p_i + q/(K_p − 1)) (r/a)^(K_p − 1)
+        r > R0:  σ_r = p0 − (p0 − σ_re)(R0/r)²,  σ_θ = p0 + (p0 − σ_re)(R0/r)²,
+                 σ_re = (2 p0 − q)/(K_p + 1)  (the radial stress at the elastic-plastic boundary)
+
+    The stresses do not depend on the dilation angle or the elastic constants."""
+    sphi = np.sin(np.radians(friction))
+    kp = (1.0 + sphi) / (1.0 - sphi)
+    q = 2.0 * cohesion * np.sqrt(kp)
+    h = q / (kp - 1.0)
+    r0 = a * (2.0 / (kp + 1.0) * (p0 + h) / (p_i + h)) ** (1.0 / (kp - 1.0))
+    sre = (2.0 * p0 - q) / (kp + 1.0)
+    r = np.asarray(r, dtype=float)
+    inside = r <= r0
+    grow = (p_i + h) * (r / a) ** (kp - 1.0)
+    decay = (p0 - sre) * (r0 / r) ** 2
+    sr = np.where(inside, -h + grow, p0 - decay)
+    st = np.where(inside, -h + kp * grow, p0 + decay)
+    return float(r0), sr, st
+
+
+def _zone_groups(zs, pos):
+    """Zones as 3DEC shows them: a 4-node tetrahedron is one zone, a hexahedral zone the ten
+    tetrahedra of its two overlays. Returns (group of each row, its weight in the area: the row
+    volume, halved for the overlaid tetrahedra of a hexahedron, each set filling it once), and per
+    group the volume-weighted stress and centroid."""
+    hexid = zs["hex"]
+    key = np.where(hexid >= 0, hexid, -1 - np.arange(zs.n))
+    _, grp = np.unique(key, return_inverse=True)
+    w = zs["volume"] * np.where(hexid >= 0, 0.5, 1.0)
+    cen = pos[zs["gp"][:, :4]].mean(axis=1)
+    ng = int(grp.max()) + 1
+    wsum = np.bincount(grp, w, ng)
+    stress = np.stack([np.bincount(grp, w * zs["stress"][:, k], ng) for k in range(6)], axis=1) / wsum[:, None]
+    centre = np.stack([np.bincount(grp, w * cen[:, k], ng) for k in range(3)], axis=1) / wsum[:, None]
+    return grp, w, stress, centre
+
+
+def _polar(stress: np.ndarray, centre: np.ndarray):
+    """(r, σ_r, σ_θ) of zones about the y axis, compression positive, from xx, zz and xz
+    (tension positive) at the zone centroid."""
+    th = np.arctan2(centre[:, 2], centre[:, 0])
+    mean = 0.5 * (stress[:, 0] + stress[:, 2])
+    half = 0.5 * (stress[:, 0] - stress[:, 2])
+    sxz = stress[:, 4]
+    sr = -(mean + half * np.cos(2.0 * th) + sxz * np.sin(2.0 * th))
+    st = -(mean - half * np.cos(2.0 * th) - sxz * np.sin(2.0 * th))
+    return np.hypot(centre[:, 0], centre[:, 2]), sr, st
+
+
+def _zones_on_ray(zs, pos, theta: float, y: float, r_from: float, r_to: float, step: float) -> np.ndarray:
+    """Rows of the zones a radial line at angle ``theta`` (degrees from +x towards +z) in the plane
+    y = ``y`` passes through, sampled every ``step`` from ``r_from`` to ``r_to`` (one overlay of a
+    hexahedral set is enough to find its zone)."""
+    rows = np.flatnonzero((zs["cmodel"] > 0) & (zs["overlay"] <= 0))
+    corner = pos[zs["gp"][rows, :4]]
+    edges = np.transpose(corner[:, 1:] - corner[:, :1], (0, 2, 1))           # columns p1-p0, p2-p0, p3-p0
+    ok = np.abs(np.linalg.det(edges)) > 1e-12 * np.abs(edges).max() ** 3     # flat tetrahedra hold no point
+    rows, corner, edges = rows[ok], corner[ok], edges[ok]
+    inv = np.linalg.inv(edges)
+    c, s = np.cos(np.radians(theta)), np.sin(np.radians(theta))
+    found = []
+    for r in np.arange(r_from, r_to, step):
+        lam = np.einsum("mij,mj->mi", inv, np.array([r * c, y, r * s]) - corner[:, 0])
+        inside = (lam >= -1e-9).all(axis=1) & (lam.sum(axis=1) <= 1.0 + 1e-9)
+        found.extend(rows[inside][:1])
+    return np.unique(np.array(found, dtype=np.int64))
+
+
+def salencon_measures(model, p0: float, p_i: float, a: float, cohesion: float, friction: float,
+                      theta: float) -> dict[str, float]:
+    """The hole of ``salencon_exact`` about the y axis through the origin (a sector model, e.g. a
+    quarter, plane strain in y). Measures:
+
+    - ``radius``: the plastic radius [m], the radius of the circle whose sector (the model's angular
+      span) has the area of the hole plus the zones that have yielded (any plastic state bit, shear
+      or tension, now or past): R = √(2 (A_hole + A_yield) / span), A_yield the yielded zones' volume
+      over the model's thickness, A_hole the fan of the hole wall's gridpoints (the wall polygon as
+      zoned). ``radius_exact``: R0 of the closed form. ``radius_far``: the largest centroid radius
+      of a yielded zone.
+    - ``sigr_line``, ``sigt_line``: along the radial line at ``theta`` degrees in the mid-plane, the
+      mean over the zones it passes through of |σ − σ_exact| / p0 in %, σ at the zone centroid
+      (σ_r, σ_θ rotated by the centroid's angle); ``line_zones`` how many.
+    - ``sigr``, ``sigt``: the same mean over every zone of the model."""
+    if "zones" not in model.stores or model.store("zones").n == 0:
+        raise ValueError("salencon: the model has no zones")
+    zs, vs = model.store("zones"), model.vertices
+    pos = vs["pos"]
+    r0, _, _ = salencon_exact(np.array([a]), p0, p_i, a, cohesion, friction)
+    grp, w, stress, centre = _zone_groups(zs, pos)
+    rz, sr, st = _polar(stress, centre)
+    _, sr_e, st_e = salencon_exact(rz, p0, p_i, a, cohesion, friction)
+    gp = np.flatnonzero(vs["zoned"])
+    y = pos[gp, 1]
+    length = float(y.max() - y.min())
+    ang = np.arctan2(pos[gp, 2], pos[gp, 0])
+    span = float(ang.max() - ang.min())
+    rg = np.hypot(pos[gp, 0], pos[gp, 2])
+    wall = gp[(np.abs(rg - a) <= 1e-3 * a) & (np.abs(y - y.min()) <= 1e-6 * max(length, a))]
+    if len(wall) < 2 or length <= 0.0:
+        raise ValueError("salencon: no hole wall of radius a found on the model's first y plane")
+    wth = np.sort(np.unique(np.round(np.arctan2(pos[wall, 2], pos[wall, 0]), 12)))
+    a_hole = 0.5 * a * a * float(np.sin(np.diff(wth)).sum())
+    yielded = (zs["state"] != 0) & (zs["cmodel"] > 0)
+    a_yield = float(w[yielded].sum()) / length
+    yg = np.zeros(int(grp.max()) + 1, bool)
+    yg[grp[yielded]] = True
+    line = np.unique(grp[_zones_on_ray(zs, pos, theta, 0.5 * (y.min() + y.max()), a, float(rg.max()), 0.01 * a)])
+    if not len(line):
+        raise ValueError(f"salencon: the radial line at {theta:g} degrees meets no zone")
+    err_r = 100.0 * np.abs(sr - sr_e) / p0
+    err_t = 100.0 * np.abs(st - st_e) / p0
+    return {"radius": float(np.sqrt(2.0 * (a_hole + a_yield) / span)), "radius_exact": r0,
+            "radius_far": float(rz[yg].max()) if yg.any() else a,
+            "sigr_line": float(err_r[line].mean()), "sigt_line": float(err_t[line].mean()),
+            "line_zones": float(len(line)), "sigr": float(err_r.mean()), "sigt": float(err_t.mean())}
+
+
 #: derive kinds that read the model: name -> (function, its parameter names)
 FIELDS = {"kirsch": (kirsch_errors, ("p1", "p2", "a", "bulk", "shear")),
           "uniaxial": (uniaxial_measures, ("sigma",)),
           "self_weight": (self_weight_measures, ("density", "g", "height")),
           "zone_block": (zone_block_measures, ("block",)),
-          "footing": (footing_measures, ("half_width", "surface", "length", "cohesion"))}
+          "footing": (footing_measures, ("half_width", "surface", "length", "cohesion")),
+          "salencon": (salencon_measures, ("p0", "p_i", "a", "cohesion", "friction", "theta"))}

@@ -12,12 +12,17 @@ from .values import FLAG, ONOFF, Choice, Num, P, Text
 @command("block delete", range="block",
          doc="Delete the blocks in range (all blocks without a range).",
          details="Block ids are not reused. Followers of a deleted leader follow the lowest remaining block "
-                 "of their joined group.",
+                 "of their joined group. Zoned blocks of a joined group that remain keep sharing their gridpoints "
+                 "(the links of shared gridpoints are made again, so a gridpoint whose master row was in a "
+                 "deleted block is not split): deleting zoned blocks excavates.",
          examples=["block delete range cylinder end-1 0 0 0 end-2 0 1 0 radius 0 1",
                    "block delete range plane dip 0 dip-direction 0 below",
                    "block delete range pos-x 0.3230 0.4038"])
 def block_delete(session, call):
-    delete_blocks(session.model, session.range_mask(call, "block"))
+    from ..model.zone_mesh import relink
+
+    if delete_blocks(session.model, session.range_mask(call, "block")):
+        relink(session.model)
 
 
 @command("block hide", positional=[P("mode", ONOFF, "on hides, off shows again", default=True)], range="block",
