@@ -1,0 +1,258 @@
+"""Energy tracking of the rigid-block cycle (`model energy`, `model history energy …`).
+
+3DEC keeps a running sum of each energy component, worked out at every step (3DEC theory, "Energy
+Calculation": boundary work W, stored strain energy, energy dissipated in joint shear W_j, kinetic
+energy U_k, work dissipated by mass damping W_k; docs.itascacg.com). dec3d does the same for its
+rigid blocks with two steps put around the cycle's own steps (``_Run`` in ``physics.rigid``) while
+tracking is on:
+
+    EnergyBefore → RigidBatch → EnergyAfter → Clock → Hooks
+
+``EnergyBefore`` lets the batch take one step and copies the state before it; ``EnergyAfter`` reads
+the state after it and adds the step's energies (kernels ``dec3d.kernels.energy``). Neither the joint
+laws nor the motion kernels know about it, so tracking costs nothing while it is off.
+
+Conventions (the leapfrog time levels, see ``kernels/energy.py``): every work of step n is the force
+at tⁿ times the displacement with the mid velocity v̄ⁿ = (v(n−½) + v(n+½))/2, which is exactly what
+changes the kinetic energy at the half steps; kinetic and strain energies are reported at t + Δt/2.
+The components (running sums since tracking was switched on or reset, joules):
+
+- ``block-kinetic``  kinetic energy of the rigid bodies (½ m V² + ½ ωᵀ J ω, full inertia tensor; the
+  inertial masses the motion uses, i.e. the real ones unless density scaling is on);
+- ``block-strain``   strain energy stored in the blocks: 0 (rigid blocks; zoned blocks are not tracked yet);
+- ``contact-strain`` elastic energy of the contact springs, Σ Fn²/(2 kn A) + |Fs|²/(2 ks A), at t + Δt/2;
+- ``contact-slip``   work done on the springs less the change of their elastic energy: what Coulomb slip
+  and the tension cut-off dissipated;
+- ``body``           work done by gravity;
+- ``boundary``       work of the applied forces and moments and of the reactions of fixed velocity or
+  rotation components (applied velocities);
+- ``damping``        work of all forces on the free components less the change of kinetic energy: what the
+  mechanical damping (local, combined, adaptive global or viscous) took;
+- ``contact-change`` strain energy that appeared (or vanished) between two steps without work: sub-contacts
+  made or dropped at a detection, properties changed by a command;
+- ``kinetic-change`` kinetic energy that appeared between steps without work: new masses of density scaling
+  at a detection, velocities set by a command;
+- ``error``          the balance: (kinetic + strain now − at the start) + slip + damping − body − boundary
+  − contact-change − kinetic-change; ``error-relative`` is |error| / (|body| + |boundary|).
+
+The state is plain JSON in ``model.settings.mechanical["energy"]``: saved and restored with the model, put
+back by a failed cycle, and a run split into several commands gives the same sums.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from dec3d.io.state import register_known
+from dec3d.kernels.jointlaw import P_KN, ST_NEW
+from dec3d.kernels.energy import contact_strain, group_energy, group_kinetic, spring_work, subcontact_increments
+
+_F = np.float64
+_I = np.int64
+
+#: the accumulated components (running sums)
+SUMS = ("body", "boundary", "damping", "contact-slip", "contact-change", "kinetic-change")
+#: every quantity `model history energy` and `model energy list` know, in the order they are listed
+QUANTITIES = ("block-kinetic", "block-strain", "contact-strain", "contact-slip", "body", "boundary", "damping",
+              "contact-change", "kinetic-change", "error", "error-relative")
+#: the state keys besides the sums: kinetic and strain energy after the last step, and at the start
+STATE = ("kinetic", "strain", "kinetic0", "strain0")
+
+
+def new_state(active: bool) -> dict:
+    d = {"active": bool(active), "started": False}
+    for k in SUMS + STATE:
+        d[k] = 0.0
+    return d
+
+
+def energy_state(model) -> dict:
+    """The model's energy record (made, inactive, on first use)."""
+    m = model.settings.mechanical
+    e = m.get("energy")
+    if not isinstance(e, dict):
+        e = m["energy"] = new_state(False)
+    return e
+
+
+def is_active(model) -> bool:
+    e = model.settings.mechanical.get("energy")
+    return isinstance(e, dict) and bool(e.get("active"))
+
+
+def state_problem(e) -> str | None:
+    """What is wrong with a saved energy record (None: nothing); ``dec3d.io.state`` asks."""
+    if not isinstance(e, dict):
+        return "is not an object"
+    if not isinstance(e.get("active"), bool) or not isinstance(e.get("started"), bool):
+        return "`active` or `started` is not true or false"
+    for k in SUMS + STATE:
+        v = e.get(k)
+        if not isinstance(v, (int, float)) or isinstance(v, bool) or not np.isfinite(v):
+            return f"`{k}` is not a finite number"
+    extra = set(e) - set(SUMS + STATE) - {"active", "started"}
+    if extra:
+        return f"unknown entries {', '.join(sorted(extra))}"
+    return None
+
+
+def values(model) -> dict[str, float]:
+    """Every quantity of QUANTITIES [J] (error-relative: a fraction) as the record holds them."""
+    e = energy_state(model)
+    out = {"block-kinetic": e["kinetic"], "block-strain": 0.0, "contact-strain": e["strain"]}
+    for k in SUMS:
+        out[k] = e[k]
+    err = ((e["kinetic"] + e["strain"] - e["kinetic0"] - e["strain0"]) + e["contact-slip"] + e["damping"]
+           - e["body"] - e["boundary"] - e["contact-change"] - e["kinetic-change"])
+    out["error"] = err
+    done = abs(e["body"]) + abs(e["boundary"])
+    out["error-relative"] = abs(err) / done if done > 0.0 else 0.0
+    return {q: float(out[q]) for q in QUANTITIES}
+
+
+def value(model, quantity: str) -> float:
+    return values(model)[quantity]
+
+
+def refuse_gridpoints(run, error) -> None:
+    """Energy tracking covers rigid blocks only: a model with zoned or FE blocks is refused with
+    ``error`` (the engine's RunError) before anything cycles."""
+    if run.zoned:
+        raise error("energy tracking (`model energy active on`) covers rigid blocks only; zoned and FE blocks "
+                    "are not supported yet: switch it off with `model energy active off`")
+
+
+def energy_steps(run, steps: list, error) -> list:
+    """The run's step list (… → Clock → Hooks) with the energy steps put in: EnergyBefore first,
+    EnergyAfter just before the clock."""
+    refuse_gridpoints(run, error)
+    tr = _Tracker(run)
+    return [EnergyBefore(run, tr)] + steps[:-2] + [EnergyAfter(run, tr)] + steps[-2:]
+
+
+class _Tracker:
+    """The state before a step (copies) and the group map, shared by the two steps."""
+
+    def __init__(self, run):
+        self.run = run
+        self.before = None
+
+    def _gid(self):
+        r = self.run
+        gid = np.full(r.b.n, -1, dtype=_I)
+        gid[r.gmember] = np.repeat(np.arange(r.ng, dtype=_I), np.diff(r.gstart))
+        return gid
+
+    def _strain(self, fn, du, flag):
+        eng = self.run.eng
+        cs, ss = eng.contacts, eng.subcontacts
+        return contact_strain(cs["normal"], cs["prop"], ss["contact"], ss["area"], fn, ss["fs"], du, flag)
+
+    def _normal_forces(self):
+        """The sub-contact normal forces as the joint law holds them. A detection makes the normal force
+        of every sub-contact it recomputes zero and keeps its normal displacement uⁿ: the law sets
+        Fn = −kn A (uⁿ − u_dil) again at the next update (Eq. 24). Such a stale zero (Fn = 0 while the
+        spring is closed, uⁿ − u_dil < 0, which no update leaves) is taken as that force, so that a
+        detection neither makes nor loses strain energy."""
+        eng = self.run.eng
+        cs, ss = eng.contacts, eng.subcontacts
+        fn = ss["fn"].copy()
+        closed = ss["un"] - ss["udil"]
+        ka = cs["prop"][ss["contact"], P_KN] * ss["area"]
+        stale = (fn == 0.0) & (closed < 0.0) & (ka > 0.0)
+        fn[stale] = -ka[stale] * closed[stale]
+        return fn
+
+    def _du(self):
+        r = self.run
+        eng, b = r.eng, r.b
+        cs, ss = eng.contacts, eng.subcontacts
+        du = np.empty((ss.n, 3))
+        subcontact_increments(r.dt, b["centroid"], b["velocity"], b["spin"], cs["a"], cs["b"], ss["contact"],
+                              ss["pos"], du)
+        return du
+
+    def begin(self) -> None:
+        r = self.run
+        e = energy_state(r.m)
+        b = r.b
+        ss = r.eng.subcontacts
+        du = self._du()
+        flag = (ss["state"] & ST_NEW) != 0
+        fn = self._normal_forces()
+        u_n, u_half, u_flag = self._strain(fn, du, flag)
+        k = group_kinetic(r.full, r.gstart, r.gmember, r.gmass, r.gimass, r.gisc, r.gprin, b["centroid"], r.gcen,
+                          b["velocity"], b["spin"], r.gaxes)
+        if not e["started"]:
+            e["started"] = True
+            e["kinetic0"] = e["kinetic"] = float(k)
+            e["strain0"] = e["strain"] = float(u_half)
+        # what changed between the last step and this one without work
+        e["kinetic-change"] += float(k) - e["kinetic"]
+        e["contact-change"] += float(u_half) - e["strain"]
+        self.before = {"du": du, "flag": flag, "u_n": u_n, "u_flag": u_flag, "centroid": b["centroid"].copy(),
+                       "velocity": b["velocity"].copy(), "spin": b["spin"].copy(), "gcen": r.gcen.copy(),
+                       "gaxes": r.gaxes.copy(), "sc_pos": ss["pos"].copy(), "fn": fn,
+                       "fs": ss["fs"].copy(), "gid": self._gid()}
+
+    def end(self, n: int) -> None:
+        r = self.run
+        if n <= 0 or self.before is None:
+            return
+        e = energy_state(r.m)
+        b = r.b
+        cs, ss = r.eng.contacts, r.eng.subcontacts
+        bf = self.before
+        self.before = None
+        out = np.zeros(7)
+        group_energy(r.dt, r.g, r.full, r.gstart, r.gmember, r.gmass, r.gimass, r.gisc, r.gprin, r.fixity,
+                     b["mass"], b["fapp"], b["mapp"], bf["centroid"], bf["gcen"], bf["velocity"], bf["spin"],
+                     bf["gaxes"], b["centroid"], r.gcen, b["velocity"], b["spin"], r.gaxes, bf["gid"], cs["a"],
+                     cs["b"], cs["normal"], ss["contact"], bf["sc_pos"], ss["fn"], ss["fs"], out)
+        flag = bf["flag"]
+        w, w_flag = spring_work(cs["normal"], ss["contact"], bf["fn"], bf["fs"], ss["fn"], ss["fs"], bf["du"], flag)
+        u_n, u_half, u_flag = self._strain(ss["fn"], self._du(), flag)
+        e["body"] += float(out[0])
+        e["boundary"] += float(out[1] + out[2])
+        e["damping"] += float(out[6])
+        # slip: work on the springs less the change of their elastic energy; the sub-contacts made at
+        # the last detection (flag) take their force from their gap: what they gain is no slip
+        e["contact-slip"] += float((w - w_flag) - ((u_n - u_flag) - (bf["u_n"] - bf["u_flag"])))
+        e["contact-change"] += float((u_flag - bf["u_flag"]) - w_flag)
+        e["kinetic"] = float(out[5])
+        e["strain"] = float(u_half)
+
+
+class _EnergyStep:
+    timing = "cycle"
+
+    def __init__(self, run, tracker):
+        self.run = run
+        self.tracker = tracker
+
+    def prepare(self) -> None:
+        pass
+
+    def __repr__(self) -> str:
+        return type(self).__name__
+
+
+class EnergyBefore(_EnergyStep):
+    """Energy tracking, first half: the batch takes one step; the state before it is copied."""
+
+    def advance(self, n: int) -> int:
+        if n <= 0 or not self.run.ng:
+            return n
+        self.tracker.begin()
+        return 1
+
+
+class EnergyAfter(_EnergyStep):
+    """Energy tracking, second half: the energies of the step just taken are added up."""
+
+    def advance(self, n: int) -> int:
+        if self.run.ng:
+            self.tracker.end(n)
+        return n
+
+
+register_known(energy_problem=state_problem)
