@@ -11,6 +11,7 @@ from .values import ONOFF, Choice, P
 _DOC = {"block-kinetic": "kinetic energy of the rigid blocks (½ m V² + ½ ωᵀ J ω, full inertia tensor)",
         "block-strain": "strain energy stored in the blocks (0: rigid blocks)",
         "contact-strain": "elastic energy of the contact springs, Σ Fn²/(2 kn A) + |Fs|²/(2 ks A)",
+        "stored": "block-kinetic + block-strain + contact-strain",
         "contact-slip": "energy dissipated in the contacts (Coulomb slip, tension cut-off)",
         "body": "work done by gravity",
         "boundary": "work of the applied forces and moments and of the reactions of fixed or applied velocities",

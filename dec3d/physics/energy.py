@@ -21,6 +21,7 @@ The components (running sums since tracking was switched on or reset, joules):
   inertial masses the motion uses, i.e. the real ones unless density scaling is on);
 - ``block-strain``   strain energy stored in the blocks: 0 (rigid blocks; zoned blocks are not tracked yet);
 - ``contact-strain`` elastic energy of the contact springs, Σ Fn²/(2 kn A) + |Fs|²/(2 ks A), at t + Δt/2;
+- ``stored``         block-kinetic + block-strain + contact-strain;
 - ``contact-slip``   work done on the springs less the change of their elastic energy: what Coulomb slip
   and the tension cut-off dissipated;
 - ``body``           work done by gravity;
@@ -52,7 +53,7 @@ _I = np.int64
 #: the accumulated components (running sums)
 SUMS = ("body", "boundary", "damping", "contact-slip", "contact-change", "kinetic-change")
 #: every quantity `model history energy` and `model energy list` know, in the order they are listed
-QUANTITIES = ("block-kinetic", "block-strain", "contact-strain", "contact-slip", "body", "boundary", "damping",
+QUANTITIES = ("block-kinetic", "block-strain", "contact-strain", "stored", "contact-slip", "body", "boundary", "damping",
               "contact-change", "kinetic-change", "error", "error-relative")
 #: the state keys besides the sums: kinetic and strain energy after the last step, and at the start
 STATE = ("kinetic", "strain", "kinetic0", "strain0")
@@ -99,6 +100,7 @@ def values(model) -> dict[str, float]:
     """Every quantity of QUANTITIES [J] (error-relative: a fraction) as the record holds them."""
     e = energy_state(model)
     out = {"block-kinetic": e["kinetic"], "block-strain": 0.0, "contact-strain": e["strain"]}
+    out["stored"] = e["kinetic"] + e["strain"]
     for k in SUMS:
         out[k] = e[k]
     err = ((e["kinetic"] + e["strain"] - e["kinetic0"] - e["strain0"]) + e["contact-slip"] + e["damping"]
