@@ -1,0 +1,318 @@
+"""Energy tracking (`model energy`, `model history energy`; dec3d/physics/energy.py, kernels/energy.py):
+slow twins of the kernels, the step list, the balance with and without damping, split and restored
+runs, bad input."""
+import io
+import json
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import dec3d
+from dec3d.errors import Dec3dError
+from dec3d.kernels import energy as K
+from dec3d.physics.energy import values
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "deformable"))
+from test_zone_split_runs import DECK as MIXED  # noqa: E402  (a rigid block on a zoned one)
+
+BOUNCE = """model new
+block create brick 0 1 0 1 -1 0
+block create brick 0 1 0 1 1 2
+block property density 2000
+model gravity 0 0 -10
+block contact jmodel assign elastic
+block contact material-table default property stiffness-normal 10e6 stiffness-shear 10e6
+block fix range position-z -1 0
+block mechanical damping none
+block mechanical timestep 4e-4
+model energy active on
+"""
+
+# two blocks leaning on each other on a tilted base, local damping: rotation, friction, density scaling
+TOPPLE = """model new
+block create brick -2 4 -2 3 -1 0
+block create brick 0 1 0 1 0 2.5
+block create brick 1 2 0 1 0 1
+block property density 2500
+model gravity 3 0.5 -9.5
+block contact jmodel assign mohr
+block contact material-table default property stiffness-normal 1e8 stiffness-shear 1e8 friction 25
+block fix range position-z -1 0
+model energy active on
+"""
+
+
+def session(tmp_path, text):
+    s = dec3d.Session(out_dir=tmp_path, stdout=io.StringIO())
+    s.command(text)
+    return s
+
+
+# ------------------------------------------------------------------ slow twins of the kernels
+def _rng_contacts(seed, nb=5, nc=6, ns=15):
+    r = np.random.default_rng(seed)
+    d = {"bpos": r.normal(size=(nb, 3)), "bvel": r.normal(size=(nb, 3)), "bspin": r.normal(size=(nb, 3)),
+         "ca": r.integers(0, nb - 1, nc), "cn": r.normal(size=(nc, 3)), "sc": r.integers(0, nc, ns),
+         "pos": r.normal(size=(ns, 3)), "area": r.uniform(0.1, 1.0, ns), "fn": r.normal(size=ns) * 1e3,
+         "fs": r.normal(size=(ns, 3)) * 1e3, "fn0": r.normal(size=ns) * 1e3, "fs0": r.normal(size=(ns, 3)) * 1e3,
+         "flag": r.random(ns) < 0.3, "prop": np.abs(r.normal(size=(nc, 10))) * 1e6}
+    d["cb"] = d["ca"] + 1
+    d["cn"] /= np.linalg.norm(d["cn"], axis=1)[:, None]
+    d["prop"][0, 1] = 0.0                       # a contact without shear stiffness stores no shear energy
+    d["sc"][0] = 0
+    return d
+
+
+def _slow_increments(d, dt):
+    out = []
+    for s, c in enumerate(d["sc"]):
+        x = d["pos"][s]
+        a, b = d["ca"][c], d["cb"][c]
+        vb = d["bvel"][b] + np.cross(d["bspin"][b], x - d["bpos"][b])
+        va = d["bvel"][a] + np.cross(d["bspin"][a], x - d["bpos"][a])
+        out.append((vb - va) * dt)
+    return np.array(out)
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_contact_kernels_against_slow_twins(seed):
+    d = _rng_contacts(seed)
+    dt = 1e-3
+    du = np.empty((len(d["sc"]), 3))
+    K.subcontact_increments(dt, d["bpos"], d["bvel"], d["bspin"], d["ca"], d["cb"], d["sc"], d["pos"], du)
+    slow_du = _slow_increments(d, dt)
+    assert np.allclose(du, slow_du, rtol=1e-12, atol=1e-15)
+    # strain energy: Fn^2/(2 kn A) + |Fs|^2/(2 ks A); half step: minus half the force on B times du
+    u = uf = corr = 0.0
+    for s, c in enumerate(d["sc"]):
+        kn, ks = d["prop"][c][0] * d["area"][s], d["prop"][c][1] * d["area"][s]
+        e = (d["fn"][s] ** 2 / (2 * kn) if kn > 0 else 0.0) + (d["fs"][s] @ d["fs"][s] / (2 * ks) if ks > 0 else 0.0)
+        u += e
+        uf += e if d["flag"][s] else 0.0
+        corr += (d["fn"][s] * d["cn"][c] + d["fs"][s]) @ slow_du[s]
+    got = K.contact_strain(d["cn"], d["prop"], d["sc"], d["area"], d["fn"], d["fs"], du, d["flag"])
+    assert np.allclose(got, (u, u - corr / 2, uf), rtol=1e-12)
+    w = wf = 0.0
+    for s, c in enumerate(d["sc"]):
+        f = (d["fn0"][s] + d["fn"][s]) * d["cn"][c] + d["fs0"][s] + d["fs"][s]
+        ws = -0.5 * f @ slow_du[s]
+        w += ws
+        wf += ws if d["flag"][s] else 0.0
+    got = K.spring_work(d["cn"], d["sc"], d["fn0"], d["fs0"], d["fn"], d["fs"], du, d["flag"])
+    assert np.allclose(got, (w, wf), rtol=1e-12)
+
+
+def _slow_group_energy(dt, g, full, gstart, gmember, gmass, gimass, gisc, gprin, fixity, mass, fapp, mapp,
+                       b0, b1, gid, ca, cb, cn, sc, pos0, fn, fs):
+    """Per group: forces and moments about its centroid (gravity, applied, contact), its velocity at the
+    centroid before and after, works with the mean of the two, kinetic energies."""
+    tot = np.zeros(7)
+    for k in range(len(gstart) - 1):
+        mem = gmember[gstart[k]:gstart[k + 1]]
+        if not len(mem):
+            continue
+        C0 = b0["gcen"][k]
+        grav = np.zeros(6)
+        app = np.zeros(6)
+        con = np.zeros(6)
+        for bl in mem:
+            arm = b0["cen"][bl] - C0
+            grav += np.r_[mass[bl] * g, np.cross(arm, mass[bl] * g)]
+            app += np.r_[fapp[bl], mapp[bl] + np.cross(arm, fapp[bl])]
+        for s, c in enumerate(sc):
+            f = fn[s] * cn[c] + fs[s]
+            for blk, sign in ((cb[c], 1.0), (ca[c], -1.0)):
+                if gid[blk] == k:
+                    con += sign * np.r_[f, np.cross(pos0[s] - C0, f)]
+        lead = mem[0]
+
+        def state(bs, C):
+            w = bs["spin"][lead]
+            return np.r_[bs["vel"][lead] - np.cross(w, bs["cen"][lead] - C), w]
+
+        q0, q1 = state(b0, C0), state(b1, b1["gcen"][k])
+        ratio = gimass[k] / gmass[k]
+
+        def kin(q, axes):
+            if full:
+                J = axes @ np.diag(gprin[k] * ratio) @ axes.T
+                return 0.5 * gimass[k] * q[:3] @ q[:3] + 0.5 * q[3:] @ J @ q[3:]
+            return 0.5 * gimass[k] * q[:3] @ q[:3] + 0.5 * gisc[k] * q[3:] @ q[3:]
+
+        k0, k1 = kin(q0, b0["axes"][k]), kin(q1, b1["axes"][k])
+        step = 0.5 * (q0 + q1) * dt
+        fixed = np.array([(fixity[lead] >> i) & 1 for i in range(6)], bool)
+        wr = -((grav + app + con) * step)[fixed].sum()
+        wb, wa, wc = (grav * step).sum(), (app * step).sum(), (con * step).sum()
+        tot += [wb, wa, wr, wc, k0, k1, wb + wa + wr + wc - (k1 - k0)]
+    return tot
+
+
+@pytest.mark.parametrize("full", [False, True])
+def test_group_energy_against_slow_twin(full):
+    r = np.random.default_rng(7 if full else 8)
+    nb = 5
+    gstart = np.array([0, 2, 3, 3, 4])            # a joined pair, a lone block, an empty group, another lone one
+    gmember = np.array([1, 0, 2, 4])
+    gid = np.array([0, 0, 1, -1, 3])
+    ng = 4
+    mass = r.uniform(1, 3, nb)
+    gmass = np.array([mass[0] + mass[1], mass[2], 1.0, mass[4]])
+    gimass = gmass * r.uniform(1.0, 2.0, ng)
+    gisc = r.uniform(1, 2, ng)
+    gprin = r.uniform(1, 2, (ng, 3))
+
+    def frame(seed):
+        q, _ = np.linalg.qr(np.random.default_rng(seed).normal(size=(3, 3)))
+        return q
+
+    b0 = {"cen": r.normal(size=(nb, 3)), "vel": r.normal(size=(nb, 3)), "spin": r.normal(size=(nb, 3)),
+          "gcen": r.normal(size=(ng, 3)), "axes": np.array([frame(i) for i in range(ng)])}
+    b1 = {"cen": r.normal(size=(nb, 3)), "vel": r.normal(size=(nb, 3)), "spin": r.normal(size=(nb, 3)),
+          "gcen": r.normal(size=(ng, 3)), "axes": np.array([frame(10 + i) for i in range(ng)])}
+    fixity = np.array([0, 0b100101, 0b1000, 0, 7], np.uint8)
+    fapp, mapp = r.normal(size=(nb, 3)), r.normal(size=(nb, 3))
+    g = np.array([0.3, -0.2, -9.8])
+    ca = np.array([0, 2, 3, 1])
+    cb = np.array([2, 4, 4, 2])
+    cn = r.normal(size=(4, 3))
+    sc = np.array([0, 1, 1, 2, 3])
+    pos0 = r.normal(size=(5, 3))
+    fn, fs = r.normal(size=5), r.normal(size=(5, 3))
+    out = np.zeros(7)
+    K.group_energy(1e-2, g, full, gstart, gmember, gmass, gimass, gisc, gprin, fixity, mass, fapp, mapp,
+                   b0["cen"], b0["gcen"], b0["vel"], b0["spin"], b0["axes"], b1["cen"], b1["gcen"], b1["vel"],
+                   b1["spin"], b1["axes"], gid, ca, cb, cn, sc, pos0, fn, fs, out)
+    slow = _slow_group_energy(1e-2, g, full, gstart, gmember, gmass, gimass, gisc, gprin, fixity, mass, fapp, mapp,
+                              b0, b1, gid, ca, cb, cn, sc, pos0, fn, fs)
+    assert np.allclose(out, slow, rtol=1e-12, atol=1e-12)
+    k = K.group_kinetic(full, gstart, gmember, gmass, gimass, gisc, gprin, b1["cen"], b1["gcen"], b1["vel"],
+                        b1["spin"], b1["axes"])
+    assert k == pytest.approx(slow[5], rel=1e-12)
+
+
+# ------------------------------------------------------------------ the engine
+def names(s):
+    return [repr(st) for st in s.model.rigid_engine.steps]
+
+
+def test_step_list_and_bounce_balance(tmp_path):
+    s = session(tmp_path, BOUNCE + "model history name 'ek' energy block-kinetic\n"
+                "model history mechanical kinetic-energy\nhistory interval 1\nmodel cycle 1400\n")
+    assert names(s) == ["EnergyBefore", "RigidBatch", "EnergyAfter", "Clock", "Hooks"]
+    v = values(s.model)
+    m, g = 2000.0, 10.0
+    # the block's fall so far, from its own displacement: gravity work = m g |dz| (mid-step positions)
+    dz = s.model.blocks["disp"][1, 2]
+    assert v["body"] == pytest.approx(-m * g * dz, rel=2e-3)
+    assert abs(v["damping"]) < 1e-6 and abs(v["error"]) < 1e-6 * v["body"]
+    assert abs(v["contact-slip"]) < 1e-3 * v["body"]
+    # the tracked kinetic energy is the engine's (real masses: no density scaling without damping)
+    hs = s.model.history_set.items
+    assert np.allclose(hs[0].values, hs[1].values, rtol=1e-12, atol=1e-9)
+
+
+def test_damped_rotating_model_balances(tmp_path):
+    """Local damping, density scaling, rotation, friction: the damping takes energy, the balance closes."""
+    s = session(tmp_path, TOPPLE + "model cycle 600\n")
+    v = values(s.model)
+    assert v["damping"] > 0.05 * v["body"] > 0.0
+    assert v["error-relative"] < 1e-3
+    s.command("block mechanical damping combined\nmodel cycle 300\n")
+    v2 = values(s.model)
+    assert v2["damping"] >= v["damping"] and values(s.model)["error-relative"] < 1e-3
+
+
+def test_energy_off_changes_nothing(tmp_path):
+    on = session(tmp_path, TOPPLE + "model cycle 200\n")
+    off = session(tmp_path, TOPPLE.replace("model energy active on", "") + "model cycle 200\n")
+    assert names(off) == ["RigidBatch", "Clock", "Hooks"]
+    assert "energy" not in off.model.settings.mechanical
+    for k in ("centroid", "velocity", "spin"):
+        assert np.array_equal(on.model.blocks[k], off.model.blocks[k])
+
+
+def test_split_and_restored_runs_give_the_same_totals(tmp_path):
+    one = session(tmp_path, BOUNCE + "model cycle 1180\n")
+    split = session(tmp_path, BOUNCE + "model cycle 450\nmodel cycle 377\n")
+    split.command("model save 'half'")
+    again = session(tmp_path, "model restore 'half'\nmodel cycle 353\n")
+    a, b = values(one.model), values(again.model)
+    assert a["contact-strain"] > 1000.0                   # in the middle of the bounce
+    for q in a:
+        assert b[q] == pytest.approx(a[q], rel=1e-9, abs=1e-9), q
+
+
+def test_switching_on_resets_and_list_reports(tmp_path):
+    s = session(tmp_path, BOUNCE + "model cycle 200\nmodel energy active off\nmodel cycle 50\n")
+    body = values(s.model)["body"]
+    assert body > 0.0 and values(s.model)["body"] == body          # off: the sums stay
+    s.command("model energy active on\nmodel energy list\n")
+    assert s.results["energy.body"] == 0.0 and s.results["energy.error"] == 0.0
+    s.command("model cycle 10\nmodel energy list\n")
+    assert s.results["energy.body"] > 0.0
+    s.command("model energy reset\nmodel energy list\n")
+    assert s.results["energy.body"] == 0.0
+    s.command("block mechanical energy off\n")
+    assert s.model.settings.mechanical["energy"]["active"] is False
+
+
+def test_energy_histories_survive_save_restore(tmp_path):
+    s = session(tmp_path, BOUNCE + "model history name 'es' energy contact-strain\nhistory interval 5\n"
+                "model cycle 100\nmodel save 'h'\n")
+    r = session(tmp_path, "model restore 'h'\nmodel cycle 100\n")
+    h = r.model.history_set.find("es")
+    assert h.spec == {"kind": "energy", "quantity": "contact-strain"} and len(h.values) == 40
+    assert h.values[:20] == s.model.history_set.find("es").values
+
+
+@pytest.mark.parametrize("text, message", [
+    ("model energy active maybe", "on"),
+    ("model energy active", "on"),
+    ("model history energy potential", "potential"),
+    ("model energy list now", "now"),
+])
+def test_bad_commands(tmp_path, text, message):
+    s = dec3d.Session(out_dir=tmp_path, stdout=io.StringIO())
+    with pytest.raises(Dec3dError) as exc:
+        s.command(text)
+    assert message in str(exc.value)
+
+
+def test_duplicate_history_name(tmp_path):
+    s = session(tmp_path, BOUNCE + "model history name 'e' energy body\n")
+    with pytest.raises(Dec3dError, match="a history named 'e' exists already"):
+        s.command("model history name 'e' energy damping\n")
+
+
+def test_zoned_model_is_refused_and_left_as_it_was(tmp_path):
+    s = session(tmp_path, MIXED + "model energy active on\n")
+    before = s.model.vertices["pos"].copy()
+    with pytest.raises(Dec3dError, match="covers rigid blocks only"):
+        s.command("model cycle 5\n")
+    assert s.model.step == 0 and np.array_equal(s.model.vertices["pos"], before)
+
+
+@pytest.mark.parametrize("bad, message", [({"active": "yes"}, "`active` or `started`"),
+                                          ({"body": float("nan")}, None), ({"body": "x"}, "`body` is not a finite"),
+                                          ({"surprise": 1.0}, "unknown entries surprise")])
+def test_bad_energy_record_in_a_save_file_is_refused(tmp_path, bad, message):
+    s = session(tmp_path, BOUNCE + "model cycle 20\nmodel save 'ok'\n")
+    src = tmp_path / "ok.sav"
+    with zipfile.ZipFile(src) as z:
+        members = {n: z.read(n) for n in z.namelist()}
+    meta_name = next(n for n in members if n.endswith(".json"))
+    meta = json.loads(members[meta_name])
+    meta["settings"]["mechanical"]["energy"].update(bad)
+    members[meta_name] = json.dumps(meta).replace("NaN", "1e999").encode()
+    with zipfile.ZipFile(tmp_path / "bad.sav", "w") as z:
+        for n, b in members.items():
+            z.writestr(n, b)
+    with pytest.raises(Dec3dError) as exc:
+        s.command("model restore 'bad'\n")
+    assert "energy record" in str(exc.value) or "not finite" in str(exc.value) or "JSON" in str(exc.value)
+    if message:
+        assert message in str(exc.value)
