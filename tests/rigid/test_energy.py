@@ -316,3 +316,31 @@ def test_bad_energy_record_in_a_save_file_is_refused(tmp_path, bad, message):
     assert "energy record" in str(exc.value) or "not finite" in str(exc.value) or "JSON" in str(exc.value)
     if message:
         assert message in str(exc.value)
+
+
+def test_applied_velocity_work_goes_into_friction(tmp_path):
+    """A block dragged at a held velocity on a frictional base (φ = 30°): the reaction of the applied
+    velocity does the work, the joint dissipates μ W d of it (d the distance dragged)."""
+    s = session(tmp_path, """model new
+block create brick -1 6 -1 2 -1 0
+block create brick 0 1 0 1 0 1
+block property density 2000
+model gravity 0 0 -10
+block contact jmodel assign mohr
+block contact material-table default property stiffness-normal 1e8 stiffness-shear 1e8 friction 30
+block fix range position-z -1 0
+model solve ratio 1e-7
+block mechanical damping none
+model energy active on
+block apply velocity-x 0.5 range position-z 0 1
+block apply rvelocity 0 0 0 range position-z 0 1
+model cycle 1000
+""")
+    v = values(s.model)
+    d = s.model.blocks["disp"][1, 0]
+    assert d > 0.05
+    mu_w = np.tan(np.radians(30.0)) * 2000 * 10
+    assert v["contact-slip"] == pytest.approx(mu_w * d, rel=0.01)
+    assert v["boundary"] == pytest.approx(mu_w * d, rel=0.01)
+    assert v["block-kinetic"] == pytest.approx(0.5 * 2000 * 0.25, rel=1e-9)     # set by the applied velocity
+    assert abs(v["body"]) < 1e-3 and abs(v["damping"]) < 1e-6 and v["error-relative"] < 1e-9
