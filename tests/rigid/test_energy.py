@@ -344,3 +344,26 @@ model cycle 1000
     assert v["boundary"] == pytest.approx(mu_w * d, rel=0.01)
     assert v["block-kinetic"] == pytest.approx(0.5 * 2000 * 0.25, rel=1e-9)     # set by the applied velocity
     assert abs(v["body"]) < 1e-3 and abs(v["damping"]) < 1e-6 and v["error-relative"] < 1e-9
+
+
+def test_damped_settling_stores_half_the_gravity_work(tmp_path):
+    """A cube settling onto an elastic joint from rest under local damping (the R3 set-up): gravity does
+    m g δ, the spring stores ½ k δ² = ½ m g δ, the damping takes the other half (Clapeyron)."""
+    s = session(tmp_path, """model new
+block create brick 0 1 0 1 -1 0
+block create brick 0 1 0 1 0 1
+block property density 2000
+model gravity 0 0 -10
+block contact jmodel assign elastic
+block contact material-table default property stiffness-normal 10e6 stiffness-shear 10e6
+block fix range position-z -1 0
+model energy active on
+model solve ratio 1e-7
+""")
+    v = values(s.model)
+    delta = -s.model.blocks["disp"][1, 2]
+    assert delta == pytest.approx(2000 * 10 / 1e7, rel=1e-3)
+    assert v["body"] == pytest.approx(2000 * 10 * delta, rel=1e-3)
+    assert v["contact-strain"] == pytest.approx(0.5 * v["body"], rel=2e-3)
+    assert v["damping"] == pytest.approx(0.5 * v["body"], rel=2e-3)
+    assert v["block-kinetic"] < 1e-6 * v["body"] and abs(v["contact-slip"]) < 1e-3 * v["body"]
