@@ -8,15 +8,16 @@ from ..physics.history import histories
 from .registry import command
 from .values import ONOFF, Choice, P
 
-_DOC = {"block-kinetic": "kinetic energy of the rigid blocks (½ m V² + ½ ωᵀ J ω, full inertia tensor)",
-        "block-strain": "strain energy stored in the blocks (0: rigid blocks)",
+_DOC = {"block-kinetic": "kinetic energy of the rigid blocks (½ m V² + ½ ωᵀ J ω, full inertia tensor) and gridpoints",
+        "block-strain": "elastic strain energy of the zones, Σ V (p²/(2K) + s:s/(4G))",
         "contact-strain": "elastic energy of the contact springs, Σ Fn²/(2 kn A) + |Fs|²/(2 ks A)",
         "stored": "block-kinetic + block-strain + contact-strain",
+        "block-plastic": "energy dissipated by plastic flow in the zones",
         "contact-slip": "energy dissipated in the contacts (Coulomb slip, tension cut-off)",
         "body": "work done by gravity",
         "boundary": "work of the applied forces and moments and of the reactions of fixed or applied velocities",
         "damping": "energy taken by the mechanical damping",
-        "contact-change": "contact strain energy that appeared between steps without work (detections, commands)",
+        "strain-change": "strain energy that appeared between steps without work (detections, commands)",
         "kinetic-change": "kinetic energy that appeared between steps without work (density scaling, commands)",
         "error": "the energy balance (0 when every joule is accounted for)",
         "error-relative": "|error| / (|body| + |boundary|)"}
@@ -26,9 +27,10 @@ _DETAILS = ("Running sums since tracking was switched on (or reset), worked out 
             "kinetic and contact strain energy are those at t + Δt/2, so that an undamped elastic model keeps "
             "kinetic + strain − work constant to round-off. Kinetic energy uses the masses the motion uses: the "
             "real ones unless density scaling is on (`block mechanical damping none` turns it off). "
-            "Balance: (kinetic + strain now − at the start) + contact-slip + damping = body + boundary + "
-            "contact-change + kinetic-change, up to `error`. Rigid blocks only: a model with zoned or FE blocks "
-            "does not cycle while tracking is on. While tracking is on the cycle runs one step per kernel call "
+            "Balance: (kinetic + strain now − at the start) + block-plastic + contact-slip + damping = body + "
+            "boundary + strain-change + kinetic-change, up to `error`. Rigid blocks and zoned blocks of 4-node "
+            "zones: a model with FE blocks, 10-node zones or contacts between zoned and rigid blocks does not "
+            "cycle while tracking is on. While tracking is on the cycle runs one step per kernel call "
             "(slower).")
 
 

@@ -249,3 +249,75 @@ def group_kinetic(full, gstart, gmember, gmass, gimass, giscalar, gprin, cen, gc
         tot += _kinetic(gimass[g], giscalar[g], gprin[g, 0] * rs, gprin[g, 1] * rs, gprin[g, 2] * rs, full, axes[g],
                         v0, v1, v2, w0, w1, w2)
     return tot
+
+
+# ------------------------------------------------------------------ zoned blocks (4-node zones)
+@njit(cache=True)
+def _tet_gradients(pos, gp, z, grad):
+    """Shape-function gradients grad (4, 3) of the linear tetrahedron z; returns its volume [m³]."""
+    r0 = gp[z, 0]
+    jm = np.empty((3, 3))
+    for a in range(3):
+        for i in range(3):
+            jm[i, a] = pos[gp[z, a + 1], i] - pos[r0, i]
+    det = (jm[0, 0] * (jm[1, 1] * jm[2, 2] - jm[1, 2] * jm[2, 1])
+           - jm[0, 1] * (jm[1, 0] * jm[2, 2] - jm[1, 2] * jm[2, 0])
+           + jm[0, 2] * (jm[1, 0] * jm[2, 1] - jm[1, 1] * jm[2, 0]))
+    # rows of J⁻¹ are the gradients of the natural coordinates ξ₁ ξ₂ ξ₃ (= N₁ N₂ N₃)
+    inv = np.empty((3, 3))
+    inv[0, 0] = (jm[1, 1] * jm[2, 2] - jm[1, 2] * jm[2, 1]) / det
+    inv[0, 1] = (jm[0, 2] * jm[2, 1] - jm[0, 1] * jm[2, 2]) / det
+    inv[0, 2] = (jm[0, 1] * jm[1, 2] - jm[0, 2] * jm[1, 1]) / det
+    inv[1, 0] = (jm[1, 2] * jm[2, 0] - jm[1, 0] * jm[2, 2]) / det
+    inv[1, 1] = (jm[0, 0] * jm[2, 2] - jm[0, 2] * jm[2, 0]) / det
+    inv[1, 2] = (jm[0, 2] * jm[1, 0] - jm[0, 0] * jm[1, 2]) / det
+    inv[2, 0] = (jm[1, 0] * jm[2, 1] - jm[1, 1] * jm[2, 0]) / det
+    inv[2, 1] = (jm[0, 1] * jm[2, 0] - jm[0, 0] * jm[2, 1]) / det
+    inv[2, 2] = (jm[0, 0] * jm[1, 1] - jm[0, 1] * jm[1, 0]) / det
+    for i in range(3):
+        grad[0, i] = -(inv[0, i] + inv[1, i] + inv[2, i])
+        for a in range(3):
+            grad[a + 1, i] = inv[a, i]
+    return abs(det) / 6.0
+
+
+@njit(cache=True)
+def zone_internal_forces(pos, gp, rows, weight, stress, force):
+    """Add to force (nv, 3) the gridpoint forces of the 4-node zones ``rows`` (weights ``weight``, the
+    overlay factor) from their stresses (xx yy zz xy xz yz, tension positive): f_n = −w V σ ∇N_n,
+    the force the zone step applies for the stress it holds."""
+    grad = np.empty((4, 3))
+    for k in range(rows.shape[0]):
+        z = rows[k]
+        vol = _tet_gradients(pos, gp, z, grad) * weight[k]
+        s = stress[z]
+        for n in range(4):
+            r = gp[z, n]
+            force[r, 0] -= vol * (s[0] * grad[n, 0] + s[3] * grad[n, 1] + s[4] * grad[n, 2])
+            force[r, 1] -= vol * (s[3] * grad[n, 0] + s[1] * grad[n, 1] + s[5] * grad[n, 2])
+            force[r, 2] -= vol * (s[4] * grad[n, 0] + s[5] * grad[n, 1] + s[2] * grad[n, 2])
+
+
+@njit(cache=True)
+def zone_strain(pos, gp, rows, weight, stress, bulk, shear):
+    """Elastic strain energy [J] of the 4-node zones ``rows``: Σ w V (p²/(2K) + s:s/(4G)), p the mean
+    stress, s the deviator (σ : C⁻¹ : σ / 2 of isotropic elasticity; 3DEC theory, "Energy Calculation":
+    stored strain energy)."""
+    grad = np.empty((4, 3))
+    u = 0.0
+    for k in range(rows.shape[0]):
+        z = rows[k]
+        vol = _tet_gradients(pos, gp, z, grad) * weight[k]
+        s = stress[z]
+        p = (s[0] + s[1] + s[2]) / 3.0
+        d0 = s[0] - p
+        d1 = s[1] - p
+        d2 = s[2] - p
+        ss = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5])
+        e = 0.0
+        if bulk[z] > 0.0:
+            e += p * p / (2.0 * bulk[z])
+        if shear[z] > 0.0:
+            e += ss / (4.0 * shear[z])
+        u += vol * e
+    return u
