@@ -29,7 +29,7 @@ _DETAILS = ("Running sums since tracking was switched on (or reset), worked out 
             "real ones unless density scaling is on (`block mechanical damping none` turns it off). "
             "Balance: (kinetic + strain now − at the start) + block-plastic + contact-slip + damping = body + "
             "boundary + strain-change + kinetic-change, up to `error`. Rigid blocks and zoned blocks of 4-node "
-            "zones: a model with FE blocks, 10-node zones or contacts between zoned and rigid blocks does not "
+            "zones (also in contact with rigid blocks): a model with FE blocks or 10-node zones does not "
             "cycle while tracking is on. While tracking is on the cycle runs one step per kernel call "
             "(slower).")
 

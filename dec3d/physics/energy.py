@@ -38,8 +38,9 @@ The components (running sums since tracking was switched on or reset, joules):
 - ``error``          the balance: (stored now − at the start) + plastic + slip + damping − body − boundary
   − strain-change − kinetic-change; ``error-relative`` is |error| / (|body| + |boundary|).
 
-Zoned blocks: 4-node zones (elastic, Mohr-Coulomb), not touching rigid blocks; FE blocks, 10-node zones and
-zoned blocks in contact with rigid ones are refused while tracking is on (``refuse_unsupported``). The
+Zoned blocks: 4-node zones (elastic, Mohr-Coulomb), also in contact with rigid blocks (a zoned side of a
+sub-contact moves with, and loads, the gridpoints of its surface triangle by the interpolation weights of
+``gpcontact``); FE blocks and 10-node zones are refused while tracking is on (``refuse_unsupported``). The
 zone forces are f = −w V σ ∇N from the stresses the zone step leaves (the force it applies).
 
 The state is plain JSON in ``model.settings.mechanical["energy"]``: saved and restored with the model, put
@@ -123,17 +124,14 @@ def value(model, quantity: str) -> float:
 
 
 def refuse_unsupported(run, error) -> None:
-    """Energy tracking covers rigid blocks and zoned blocks of 4-node zones that touch no rigid block:
-    anything else (FE blocks, 10-node zones, contacts between zoned and rigid blocks) is refused with
-    ``error`` (the engine's RunError), before the step that would need it."""
+    """Energy tracking covers rigid blocks and zoned blocks of 4-node zones: FE blocks and 10-node zones
+    are refused with ``error`` (the engine's RunError) before anything cycles."""
     zst = run.zst
     what = None
     if zst is not None and zst.fe is not None:
         what = "FE blocks"
     elif zst is not None and len(zst.rows10):
         what = "10-node zones"
-    elif getattr(run, "mixed", False):
-        what = "contacts between zoned and rigid blocks"
     if what:
         raise error(f"energy tracking (`model energy active on`) covers rigid blocks and 4-node zones; {what} "
                     "are not supported yet: switch it off with `model energy active off`")
@@ -189,7 +187,37 @@ class _Tracker:
         du = np.empty((ss.n, 3))
         subcontact_increments(r.dt, b["centroid"], b["velocity"], b["spin"], cs["a"], cs["b"], ss["contact"],
                               ss["pos"], du)
+        if r.mixed:
+            # a zoned side moves with the gridpoints of the surface triangle under the point (gpcontact)
+            gv = r.m.vertices["velocity"]
+            for nodes, w, sign in ((r.wsub[2], r.wsub[3], 1.0), (r.wsub[0], r.wsub[1], -1.0)):
+                z = nodes[:, 0] >= 0
+                if not z.any():
+                    continue
+                side = cs["b"] if sign > 0 else cs["a"]
+                blk = side[ss["contact"][z]]
+                x = ss["pos"][z]
+                rigid = b["velocity"][blk] + np.cross(b["spin"][blk], x - b["centroid"][blk])
+                ww = np.where(nodes[z] >= 0, w[z], 0.0)
+                interp = (ww[:, :, None] * gv[np.maximum(nodes[z], 0)]).sum(axis=1)
+                du[z] += sign * (interp - rigid) * r.dt
         return du
+
+    def _contact_on_gridpoints(self):
+        """The sub-contact forces on the gridpoints of zoned sides (shared by the interpolation weights),
+        summed onto the master gridpoints."""
+        r = self.run
+        cs, ss = r.eng.contacts, r.eng.subcontacts
+        v = r.m.vertices
+        f = np.zeros((v.n, 3))
+        if r.mixed:
+            c = ss["contact"]
+            fb = ss["fn"][:, None] * cs["normal"][c] + ss["fs"]
+            for nodes, w, sign in ((r.wsub[2], r.wsub[3], 1.0), (r.wsub[0], r.wsub[1], -1.0)):
+                on = nodes >= 0
+                s_idx = np.nonzero(on)[0]
+                np.add.at(f, nodes[on], sign * w[on][:, None] * fb[s_idx])
+        return self._to_masters(f)
 
     def _rigid_kinetic(self) -> float:
         r = self.run
@@ -319,14 +347,16 @@ class _Tracker:
         im = v["imass"][zst.masters]
         held = np.stack([((h >> i) & 1) | ((h >> (3 + i)) & 1) for i in range(3)], axis=1).astype(bool)
         held |= (im <= 0.0)[:, None]
-        total = fi + grav + app
+        con = self._contact_on_gridpoints()
+        total = fi + grav + app + con
         w_body = float((grav * step).sum())
         w_app = float((app * step).sum())
         w_react = -float((total * step)[held].sum())
         w_int = float((fi * step).sum())
+        w_con = float((con * step).sum())
         e["body"] += w_body
         e["boundary"] += w_app + w_react
-        e["damping"] += (w_body + w_app + w_react + w_int) - (k1 - bf["kz"])
+        e["damping"] += (w_body + w_app + w_react + w_int + w_con) - (k1 - bf["kz"])
         # the zones' stresses took the increment v(n−½) Δt: trapezoid work on them less the change of U
         w_zone = -0.5 * dt * float(((bf["fi"] + fi) * vm0).sum())
         e["block-plastic"] += w_zone - (uz1 - bf["uz"])
