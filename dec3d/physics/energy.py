@@ -1,16 +1,18 @@
-"""Energy tracking of the rigid-block cycle (`model energy`, `model history energy …`).
+"""Energy tracking of the cycle (`model energy`, `model history energy …`).
 
 3DEC keeps a running sum of each energy component, worked out at every step (3DEC theory, "Energy
 Calculation": boundary work W, stored strain energy, energy dissipated in joint shear W_j, kinetic
-energy U_k, work dissipated by mass damping W_k; docs.itascacg.com). dec3d does the same for its
-rigid blocks with two steps put around the cycle's own steps (``_Run`` in ``physics.rigid``) while
-tracking is on:
+energy U_k, work dissipated by mass damping W_k; docs.itascacg.com). dec3d does the same for its rigid
+blocks, contacts and zones with two steps put around the cycle's own steps (``_Run`` in
+``physics.rigid``) while tracking is on:
 
     EnergyBefore → RigidBatch → EnergyAfter → Clock → Hooks
+    EnergyBefore → MixedContacts → RigidBatch → ZoneStep → EnergyAfter → Clock → Hooks   (zoned blocks)
 
 ``EnergyBefore`` lets the batch take one step and copies the state before it; ``EnergyAfter`` reads
 the state after it and adds the step's energies (kernels ``dec3d.kernels.energy``). Neither the joint
-laws nor the motion kernels know about it, so tracking costs nothing while it is off.
+laws nor the motion kernels nor the zone step know about it, so tracking costs nothing while it is off
+(while it is on, the cycle runs one step per kernel call: about half the speed on a 64-block stack).
 
 Conventions (the leapfrog time levels, see ``kernels/energy.py``): every work of step n is the force
 at tⁿ times the displacement with the mid velocity v̄ⁿ = (v(n−½) + v(n+½))/2, which is exactly what
