@@ -530,3 +530,13 @@ def test_rigid_block_bouncing_on_a_zoned_block_undamped(tmp_path):
     v = values(s.model)
     assert v["block-kinetic"] > 0.1 * v["body"] > 0.0
     assert abs(v["damping"]) < 1e-9 * v["body"] and v["error-relative"] < 1e-9
+
+
+def test_split_and_restored_run_with_zones_gives_the_same_totals(tmp_path):
+    deck = D7.replace("model energy", "block mechanical damping none\nmodel energy")
+    one = session(tmp_path, deck + "model cycle 300\n")
+    session(tmp_path, deck + "model cycle 130\nmodel save 'z'\n")
+    again = session(tmp_path, "model restore 'z'\nmodel cycle 170\n")
+    a, b = values(one.model), values(again.model)
+    assert a["block-strain"] > 0.1 and a["block-kinetic"] > 0.1
+    assert a == b
