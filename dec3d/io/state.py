@@ -354,12 +354,12 @@ def register_known(**entries) -> None:
 
 
 def _known() -> dict:
-    if not {"joint_models", "joint_model_codes", "histories"} <= KNOWN.keys():
+    if not {"joint_models", "joint_model_codes", "histories", "energy_problem"} <= KNOWN.keys():
         # a restore called before anything imported the physics layer (e.g. ``dec3d.io.state``
         # used on its own): load the registering modules by name, which keeps the import arrows
         # of the layers (physics -> io) as they are
         import importlib
-        for name in ("dec3d.physics.jmodels", "dec3d.physics.history"):
+        for name in ("dec3d.physics.jmodels", "dec3d.physics.history", "dec3d.physics.energy"):
             importlib.import_module(name)
     return KNOWN
 
@@ -406,6 +406,10 @@ def _settings_problem(d: dict) -> str | None:
     for k, ok in checks.items():
         if k in m and not ok(m[k]):
             return f"mechanical setting `{k}` has the value {_short(m[k])}, which is not allowed"
+    if "energy" in m:
+        why = _known()["energy_problem"](m["energy"])
+        if why:
+            return f"the energy record {why}"
     return None
 
 

@@ -211,6 +211,8 @@ class HistorySet:
             if not isinstance(zid, int) or isinstance(zid, bool) or zid < 1:
                 raise ValueError(f"history {hid}: zone id {zid!r} is not a whole number ≥ 1")
             h = self.add_zone(q, zid, name)
+        elif kind == "energy" and q in _energy_quantities():
+            h = self.add_energy(q, name)
         elif kind == "fish" and isinstance(q, str) and FISH_NAME.fullmatch(q):
             h = self.add_fish(q, name)
         else:
@@ -445,6 +447,14 @@ class HistorySet:
         return self.add(f"mechanical {quantity}", value, name, {"kind": "model", "quantity": quantity})
 
 
+    def add_energy(self, quantity: str, name: str | None = None) -> History:
+        """`model history energy`: an energy component of ``physics.energy`` (its running sums)."""
+        from .energy import value as energy_value
+
+        model = self.model
+        return self.add(f"energy {quantity}", lambda eng: energy_value(model, quantity), name,
+                        {"kind": "energy", "quantity": quantity})
+
     def add_fish(self, var: str, name: str | None = None) -> History:
         """`fish history`: the value of a FISH global variable, or of a FISH function called at each
         sample. The FISH run time reaches the model as ``model.fish_probe(var)`` (set by the session's
@@ -458,6 +468,12 @@ class HistorySet:
             return probe(var)
 
         return self.add(f"fish {var}", value, name, {"kind": "fish", "quantity": var})
+
+
+def _energy_quantities() -> tuple:
+    from .energy import QUANTITIES
+
+    return QUANTITIES
 
 
 def _zone_row(model, zone_id: int):

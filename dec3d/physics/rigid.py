@@ -32,6 +32,7 @@ from dec3d.model.zones import has_zones
 
 from .bodies import group_properties, inertial_masses, new_servo
 from .contacts import ContactDetection, contact_stores, default_row
+from .energy import is_active as is_energy_active
 from .jmodels import JOINT_MODELS
 from .runcontrol import CycleInterrupted, _Progress, _sigint_stops_cycling, _StopFlag, request_stop  # noqa: F401  (request_stop: part of this module's API)
 
@@ -637,6 +638,10 @@ class _Run:
         self.progress = _Progress(nsteps, eng)
         self.steps = ([MixedContacts(self), RigidBatch(self, chunked=False), ZoneStep(self)] if self.zoned
                       else [RigidBatch(self, chunked=True)]) + [Clock(self), Hooks(self)]
+        if is_energy_active(m):
+            # energy tracking (`model energy active on`): EnergyBefore → … → EnergyAfter → Clock → Hooks
+            from .energy import energy_steps
+            self.steps = energy_steps(self, self.steps, RunError)
         fresh = eng._signature != eng._geometry_signature()
         if fresh:
             eng.detect()
