@@ -390,6 +390,7 @@ def _settings_problem(d: dict) -> str | None:
               "frac": lambda v: _is_num(v) and v > 0,
               "servo_ratio": lambda v: _is_num(v) and v > 0,
               "dynamic": lambda v: isinstance(v, bool),
+              "dt_mode": lambda v: isinstance(v, list) and len(v) == 2 and isinstance(v[0], bool) and _is_num(v[1]),
               "dyn_time": lambda v: _is_num(v) and v >= 0,
               "rayleigh": lambda v: isinstance(v, list) and (v == [] or (
                   len(v) == 3 and _is_num(v[0]) and 0 <= v[0] < 1 and _is_num(v[1]) and v[1] >= 0

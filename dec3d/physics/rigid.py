@@ -668,6 +668,9 @@ class _Run:
         # exactly the steps of one run
         last = s["dt_run"]
         between = not fresh and len(last) == 2 and int(last[1]) == m.step and m.step % self.interval != 0
+        # ... unless the masses or the damping's time-step rule changed since (dynamic mode, damping)
+        self.dt_mode = [bool(eng.mass_scaling()), float(eng.rayleigh_beta())]
+        between = between and s.get("dt_mode", self.dt_mode) == self.dt_mode
         if self.mixed:
             self.wsub, self.wcon = eng._mixed_weights(self.zst, recompute=not between)
         if warn is not None:
@@ -747,6 +750,7 @@ class _Run:
         if self.zoned:
             self.zst.finish(self.large)
         s["dt_run"] = [float(eng.dt), int(m.step)]
+        s["dt_mode"] = self.dt_mode
         if self.ng or not self.zoned:
             # keep each block's principal axes turning with its body
             gstart, gmember, gaxes = self.gstart, self.gmember, self.gaxes
