@@ -19,9 +19,9 @@ Everything is kept in ``model.settings.mechanical`` (plain JSON, so `model save|
   large (α = 2ξω, or β = 2ξ/ω), so that the damping ratio at f is still ξ (dec3d's reading: the
   page could not be checked for this detail). The mass term is viscous damping of the body,
   gridpoint and node velocities (``kernels.motion`` mode 4, ``kernels.zonestep.gp_motion`` mode 4);
-  the stiffness term acts on the sub-contacts of rigid blocks (``kernels.rayleigh``; not yet on zone
-  stresses, nor on contacts between rigid and zoned blocks). Stiffness damping lowers the stable
-  step: Δt = Δt₀ (√(1 + λ²) − λ), λ = β / Δt₀ (the central-difference limit 2/ω (√(1 + ξ²) − ξ)
+  the stiffness term acts on the sub-contacts of rigid blocks (``kernels.rayleigh``) and on the 4-node
+  zones as a damping stress β D ε̇ (``zone_stiffness_damping``; not yet on 10-node zones, FE blocks, nor
+  on contacts between rigid and zoned blocks). Stiffness damping lowers the stable step: Δt = Δt₀ (√(1 + λ²) − λ), λ = β / Δt₀ (the central-difference limit 2/ω (√(1 + ξ²) − ξ)
   for the highest mode Δt₀ allows, ω = 2/Δt₀, ξ = β ω / 2).
 - ``timefns``: the time functions of `block apply … table|fish` and `block gridpoint apply … table|fish`
   (``TimeFunctions``).
@@ -106,6 +106,36 @@ def damping_text(model) -> str:
     if m["dynamic"]:
         return f"none ({mode} damping is set and is not applied in dynamic mode)"
     return mode
+
+
+def zone_stiffness_damping(zst, beta: float, pos, vel, facc) -> None:
+    """Add the gridpoint forces of the damping stresses β D ε̇ of the 4-node zones to ``facc``: the zone
+    step's own kernel, run on zero stresses with the strain increment of the current velocities over a
+    unit time (so it returns −K v, the forces being linear in the stresses and the strains in the
+    velocities), with Mohr-Coulomb zones taken as elastic (the damping stress is not limited by their
+    strength; null zones stay null), times β. ``zst`` is the ``physics.zones.ZoneStepper``."""
+    from dec3d.kernels.zone_plastic import zone_forces_plastic
+    from dec3d.kernels.zonestep import zone_forces
+    from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_MOHR
+
+    zs = zst.model.store("zones")
+    sc = getattr(zst, "_rayleigh_scratch", None)
+    if sc is None or sc[0].shape != zs["stress"].shape or sc[2].shape != facc.shape:
+        cm = np.where(zs["cmodel"] == ZMODEL_MOHR, ZMODEL_ELASTIC, zs["cmodel"]).astype(zs["cmodel"].dtype)
+        sc = zst._rayleigh_scratch = (np.zeros_like(zs["stress"]), np.zeros_like(zs["state"]), np.zeros_like(facc),
+                                      np.zeros(facc.shape[0]), cm)
+    stress, state, f, fm, cm = sc
+    stress[:] = 0.0
+    state[:] = 0
+    f[:] = 0.0
+    fm[:] = 0.0
+    if zst.plastic:
+        zone_forces_plastic(pos, vel, zs["gp"], zst.rows4, zst.zset, zst.weight, zst.nset, zst.node, cm, zs["prop"],
+                            1.0, False, zst.nmd, stress, state, f, fm)
+    else:
+        zone_forces(pos, vel, zs["gp"], zst.rows4, zst.zset, zst.weight, zst.nset, zst.bulk, zst.shear, 1.0, False,
+                    stress, f, fm)
+    facc[zst.rows] += beta * f[zst.rows]
 
 
 # ------------------------------------------------------------------ time functions

@@ -654,6 +654,8 @@ class _Run:
         self.steps = ([MixedContacts(self), RigidBatch(self, chunked=False), ZoneStep(self)] if self.zoned
                       else [RigidBatch(self, chunked=True)]) + [Clock(self), Hooks(self)]
         self.beta = eng.rayleigh_beta()
+        if self.zst is not None:
+            self.zst.beta = self.beta
         self.dynamic = bool(s["dynamic"])
         if has_timefns(m):
             self.steps.insert(0, TimeFunctions(self))
@@ -708,7 +710,7 @@ class _Run:
         ng = self.ng
         dt_r = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, None)[0] if ng else math.inf
         d = ((dt_r if ng else float(self.s["scale_timestep"] or 1.0)) if self.scaled
-             else min(dt_r, self.zst.natural_timestep()))
+             else min(dt_r, stiffness_timestep(self.zst.natural_timestep(), self.beta)))
         return d if math.isfinite(d) and d > 0 else 1.0
 
     def detection_due(self) -> bool:
