@@ -63,7 +63,7 @@ class RunError(Dec3dError):
 
 
 #: vertex fields the deformable step changes (saved before a run, put back if it fails)
-_GP_STATE = ("velocity", "disp", "force", "mass", "imass")
+_GP_STATE = ("velocity", "disp", "force", "mass", "imass", "vapp", "fapp")   # (vapp, fapp: time functions)
 
 
 def _deformable(kind):
