@@ -266,6 +266,12 @@ def test_gridpoint_time_functions(tmp_path):
     with pytest.raises(CommandError) as e:
         s.command("block gridpoint apply velocity-x 1 fish nothing range position-z 0")
     assert "no FISH function `nothing`" in str(e.value)
+    with pytest.raises(CommandError) as e:
+        s.command("block gridpoint apply force-z 1 table 42 range position-z 1")
+    assert "there is no table 42" in str(e.value)
+    with pytest.raises(BindError) as e:
+        s.command("block gridpoint apply force-z 1 table 1 fish f")
+    assert "not both" in str(e.value)
 
 
 def newmark_slip(accel, g_tan_phi, t_end, dt=2e-6):
