@@ -117,7 +117,7 @@ META_CASES = [
      "mechanical setting `rayleigh` has the value [0.05, 10, \"both\", 1], which is not allowed"),
     (("settings", "mechanical", "timefns"), [{"on": "block", "kind": "velocity", "comp": 5, "ids": [1],
                                               "value": 1.0, "last": 0.0, "table": 1, "fish": None}],
-     'mechanical setting `timefns` has the value [{"on": "block", "kind": "velocity", "comp": 5, "ids": [1],…, '
+     'mechanical setting `timefns` has the value [{"comp": 5, "fish": null, "ids": [1], "kind": "velocity", …, '
      'which is not allowed'),
     (("settings", "gravity"), [0, 0, "down"], "gravity [0, 0, 'down'] is not 3 finite numbers"),
     (("time",), math.nan, "the time nan is not a finite number ≥ 0"),
