@@ -11,6 +11,7 @@ Each folder of `verification/` holds a `problem.toml`:
     [[derive]]  name = "..."  kind = "slope" | "curvature" | "mean" | "max" | "min"
                 csv = "<history export file>"  history = "<name>"  [vs = "<name>"]
                 [t0 = <s>]  [t1 = <s>]       # window, seconds after the file's first sample
+    [[derive]]  name = "..."  kind = "damping-ratio"  csv = …  history = …  [t0, t1]   # log decrement
     [[derive]]  name = "..."  kind = "trend" | "plunge"  of = ["<qx>", "<qy>", "<qz>"]   # degrees
     [[derive]]  name = "..."  kind = "kirsch"  p1 = …  p2 = …  a = …  bulk = …  shear = …
                 # a closed-form field against the model state (``dec3d.verify_fields``): adds
@@ -18,7 +19,10 @@ Each folder of `verification/` holds a `problem.toml`:
 
 `derive` adds quantities worked out from exported history files (kind = "deck"): the least-squares
 slope d(history)/dt (or d(history)/d(vs) with `vs`), the curvature 2·c₂ of a least-squares quadratic
-c₀ + c₁t + c₂t² (an acceleration from a displacement), or the mean/max/min over the window; and the
+c₀ + c₁t + c₂t² (an acceleration from a displacement), the mean/max/min over the window, the damping
+ratio ξ = δ/√(4π² + δ²) of a decaying oscillation about zero (δ the logarithmic decrement: ln of the
+first over the last positive peak, each refined by a parabola through its three samples, over the number
+of periods between them; `damping_ratio`); and the
 trend (clockwise from +y) and plunge (down from horizontal) of a vector of three other quantities.
 
 Every `[[expect]]` is either a bar the measurement must meet (a value with its tolerance, or `below`)
@@ -89,6 +93,20 @@ def _column(rows: list[list[str]], name: str, path: Path):
     raise KeyError(f"{path.name}: no history '{name}' (columns: {', '.join(head[2:])})")
 
 
+def damping_ratio(v) -> float:
+    """ξ of a sampled oscillation about zero, from the logarithmic decrement of its positive peaks."""
+    peaks = []
+    for i in range(1, len(v) - 1):
+        if v[i] > 0.0 and v[i] > v[i - 1] and v[i] >= v[i + 1]:
+            y0, y1, y2 = v[i - 1], v[i], v[i + 1]
+            den = y0 - 2.0 * y1 + y2
+            peaks.append(y1 - 0.125 * (y0 - y2) ** 2 / den if den else y1)
+    if len(peaks) < 3:
+        raise ValueError("damping-ratio: fewer than three positive peaks in the window")
+    delta = math.log(peaks[0] / peaks[-1]) / (len(peaks) - 1)
+    return delta / math.sqrt(4.0 * math.pi ** 2 + delta ** 2)
+
+
 def derive(d: dict, q: dict[str, float], out: Path) -> float:
     """One `[[derive]]` quantity (see the module docstring)."""
     import csv
@@ -116,6 +134,8 @@ def derive(d: dict, q: dict[str, float], out: Path) -> float:
         return float(2.0 * np.polyfit(x[sel], v[sel], 2)[0])
     if kind in ("mean", "max", "min"):
         return float(getattr(np, kind)(v[sel]))
+    if kind == "damping-ratio":
+        return damping_ratio(v[sel])
     raise ValueError(f"derive {d.get('name', kind)}: unknown kind {kind!r}")
 
 

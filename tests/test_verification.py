@@ -24,7 +24,8 @@ def test_every_verification_problem_is_there():
                                          "D1_uniaxial_tet", "D1_uniaxial_hex", "D1_uniaxial_ho", "D2_self_weight",
                                          "D3_elastic_hole_tet", "D3_elastic_hole_hex", "D3_elastic_hole_ho",
                                          "D4_triaxial", "D5_strip_footing", "D6_mohr_hole", "D7_rigid_on_deformable",
-                                         "E1_eigenmodes", "DY3_shear_wave_quiet_base", "DY5_energy"}
+                                         "E1_eigenmodes", "DY1_rayleigh_block_on_spring", "DY2_newmark_sliding_block",
+                                         "DY3_shear_wave_quiet_base", "DY5_energy"}
 
 
 def _demo(tmp_path, expects: str):

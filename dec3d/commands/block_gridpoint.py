@@ -5,6 +5,8 @@ import numpy as np
 
 from ..errors import BindError
 from ..model.zones import zone_stores
+from ..physics.dynamic import add_timefn, load_time, remove_timefns, timefn_factor
+from .block_apply import _TIMEFN, check_timefn, timefn_source, where_text
 from .registry import command
 from .values import FLAG, Num, Nums, P
 
@@ -29,16 +31,22 @@ def _gridpoints(session, call, what: str) -> np.ndarray:
                    *[P(f"velocity-{a}", Num(), f"the {a} component held", units="m/s") for a in _AX],
                    P("force", Nums(3, 3), "fx fy fz applied force", units="N"),
                    *[P(f"force-{a}", Num(), f"the {a} component of the applied force", units="N") for a in _AX],
-                   P("table", Num(integer=True), "the value is multiplied by this table of time",
-                     supported=False)],
-         range="gridpoint",
+                   P("table", _TIMEFN, "time function: the value is multiplied by table <id> at the current time"),
+                   P("fish", _TIMEFN, "time function: the value is multiplied by FISH function <s> at the current "
+                     "time")],
+         range="gridpoint", check=check_timefn,
          doc="Hold velocity components, or apply a force, at the gridpoints of zoned blocks in range.",
          details="A velocity condition holds the component at the value every step; a force is added to "
                  "the gridpoint's unbalanced force every step (a new value replaces the old one). Vertices "
-                 "of rigid blocks are not gridpoints (use `block fix` / `block apply` for them).",
+                 "of rigid blocks are not gridpoints (use `block fix` / `block apply` for them). With `table <id>` "
+                 "or `fish <name>` the value is multiplied at every step by the table at the current time (linear "
+                 "interpolation) or the FISH function's value (as `block apply`: the dynamic time in dynamic "
+                 "mode, else the model's time; a velocity at the middle of the step, a force at its start; such a "
+                 "force adds to the constant one).",
          examples=["block gridpoint apply velocity-z 0 range position-z 0",
                    "block gridpoint apply velocity 0 0 0 range position-x 0",
-                   "block gridpoint apply force 0 0 -1e3 range position 0 0 1"])
+                   "block gridpoint apply force 0 0 -1e3 range position 0 0 1",
+                   "block gridpoint apply velocity-y 1 table 1 range position-z 0"])
 def block_gridpoint_apply(session, call):
     a = call.args
     given = [k for k in ("velocity", "velocity_x", "velocity_y", "velocity_z", "force", "force_x", "force_y",
@@ -48,8 +56,32 @@ def block_gridpoint_apply(session, call):
     for k in given:
         if not np.isfinite(np.asarray(a[k], float)).all():
             raise BindError(f"`{k.replace('_', '-')}` must be finite", call.locations.get(k, call.location))
+    table, fish = timefn_source(session, call)
     rows = _gridpoints(session, call, "block gridpoint apply")
-    v = session.model.vertices
+    m = session.model
+    v = m.vertices
+    if table is not None or fish is not None:
+        from .fish_cmds import attach_fish
+
+        attach_fish(session)
+        where = where_text(call)
+        for k in given:
+            kind = k.split("_")[0]
+            val = np.asarray(a[k], float).reshape(-1)
+            comps = range(3) if "_" not in k else ("xyz".index(k[-1]),)
+            for j, i in enumerate(comps):
+                x = float(val[j] if len(val) == 3 else val[0])
+                add_timefn(m, "gridpoint", kind, i, x, rows, table=table, fish=fish, where=where)
+                if kind == "velocity":
+                    e = m.settings.mechanical["timefns"][-1]
+                    v["vapp"][rows, i] = x * timefn_factor(m, e, load_time(m))
+                    v["apply_fix"][rows] |= np.uint8(1 << i)
+        return
+    for i, ax in enumerate(_AX):
+        if a["velocity"] is not None or a[f"velocity_{ax}"] is not None:
+            remove_timefns(m, "gridpoint", rows, {("velocity", i)})
+        if a["force"] is not None or a[f"force_{ax}"] is not None:
+            remove_timefns(m, "gridpoint", rows, {("force", i)})
     if a["velocity"] is not None:
         v["vapp"][rows] = np.asarray(a["velocity"], float)
         v["apply_fix"][rows] |= np.uint8(7)
@@ -81,9 +113,11 @@ def block_gridpoint_apply_remove(session, call):
     v = session.model.vertices
     for i, ax in enumerate(_AX):
         if everything or a["velocity"] or a[f"velocity_{ax}"]:
+            remove_timefns(session.model, "gridpoint", rows, {("velocity", i)})
             v["apply_fix"][rows] &= np.uint8(~(1 << i) & 0xFF)
             v["vapp"][rows, i] = 0.0
         if everything or a["force"] or a[f"force_{ax}"]:
+            remove_timefns(session.model, "gridpoint", rows, {("force", i)})
             v["fapp"][rows, i] = 0.0
 
 

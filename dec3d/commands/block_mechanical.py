@@ -8,7 +8,8 @@ from .registry import command
 from .values import FLAG, Choice, Deferred, Num, Nums, P, ValueRangeError
 
 
-_DAMPING_NOT_YET = ("rayleigh", "maxwell")
+_DAMPING_NOT_YET = ("maxwell",)
+_RAYLEIGH_FORMS = ("mass", "stiffness")
 
 
 def _check_damping(call):
@@ -19,7 +20,19 @@ def _check_damping(call):
     if mode in _DAMPING_NOT_YET:
         raise NotSupportedError(f"`block mechanical damping {mode}` is not supported yet",
                                 call.locations.get("mode", call.location),
-                                hint="implemented: local [α], combined [α], global [ratio], none")
+                                hint="implemented: local [α], combined [α], global [ratio], none, "
+                                     "rayleigh <fraction> <frequency> [mass|stiffness]")
+    if call.args["form"] is not None and mode != "rayleigh":
+        raise BindError(f"`{call.args['form']}` belongs to rayleigh damping, not {mode}",
+                        call.locations.get("form", call.location))
+    if mode == "rayleigh":
+        if len(call.args["alpha"]) != 2:
+            raise BindError("rayleigh damping takes two values: <fraction of critical damping> <frequency [Hz]>",
+                            where)
+        vals = call.args["alpha"]
+        if not any(isinstance(v, Deferred) for v in vals):
+            _rayleigh(vals, where)
+        return
     if len(call.args["alpha"]) > 1:
         raise BindError(f"{mode} damping takes one value", where)
     if mode == "none" and call.args["alpha"]:
@@ -35,6 +48,24 @@ _ALPHA = {"local": Num(lo=0, hi=1, hi_open=True), "combined": Num(lo=0, hi=1, hi
           "global": Num(lo=0, lo_open=True)}
 
 
+def _rayleigh(vals, where) -> tuple[float, float]:
+    """(fraction, frequency) of rayleigh damping: the fraction in [0, 1), the frequency ≥ 0 and > 0 when
+    the fraction is (3DEC decks write `rayleigh 0 0` for no damping)."""
+    from ..errors import BindError
+
+    try:
+        xi = Num(lo=0, hi=1, hi_open=True).convert(vals[0], where)
+    except ValueRangeError as exc:
+        raise exc.named("the fraction of critical damping") from None
+    try:
+        f = Num(lo=0).convert(vals[1], where)
+    except ValueRangeError as exc:
+        raise exc.named("the rayleigh frequency") from None
+    if xi > 0 and f <= 0:
+        raise BindError(f"rayleigh damping with fraction {xi:g} needs a frequency > 0 Hz, got {f:g}", where)
+    return float(xi), float(f)
+
+
 def _alpha(mode, value, where) -> float:
     rule = _ALPHA.get(mode, Num())
     try:
@@ -46,21 +77,37 @@ def _alpha(mode, value, where) -> float:
 @command("block mechanical damping",
          positional=[P("mode", Choice(("local", "global", "combined", "none", "rayleigh", "maxwell")),
                        "damping form", required=True),
-                     P("alpha", Nums(0, 6), "coefficient α of local and combined damping, in [0, 1); target ratio of global, > 0",
-                       default=())],
+                     P("alpha", Nums(0, 6), "coefficient α of local and combined damping, in [0, 1); target ratio "
+                       "of global, > 0; rayleigh: fraction of critical damping and frequency [Hz]", default=()),
+                     P("form", Choice(_RAYLEIGH_FORMS), "rayleigh only: the mass- or stiffness-proportional term "
+                       "alone")],
          check=_check_damping,
          doc="Set the mechanical damping (default: local, α = 0.8, with density scaling).",
          details="`local [α]` (3DEC theory Eq. 79), `combined [α]` (Eq. 83: local damping on the velocity and "
                  "on the force rate), `global [ratio]` (adaptive global viscous damping, Cundall 1982: a servo "
                  "keeps the ratio of damping power to the rate of change of kinetic energy at 0.5 or the value "
                  "given), `none` (dynamic runs: no damping, no density scaling, full inertia with Euler's "
-                 "equations). `rayleigh` and `maxwell` are known and not supported yet.",
+                 "equations), `rayleigh <fraction> <frequency> [mass|stiffness]` (Rayleigh damping C = αM + βK "
+                 "with the damping ratio `fraction` least at `frequency` Hz: α = ξω, β = ξ/ω, ω = 2π f; one "
+                 "term alone is doubled so that the ratio at f stays ξ; the mass term damps body and gridpoint "
+                 "velocities, the stiffness term the sub-contacts of rigid blocks and the 4-node zones (damping "
+                 "stress β D ε̇), and lowers the time step; "
+                 "real masses and full inertia, as with `none`; see dec3d.physics.dynamic). In dynamic mode "
+                 "(`model dynamic active on`) only rayleigh damping is applied. `maxwell` is known and not "
+                 "supported yet.",
          examples=["block mechanical damping local 0.8", "block mechanical damping combined",
-                   "block mechanical damping global", "block mechanical damping none"])
+                   "block mechanical damping global", "block mechanical damping none",
+                   "block mechanical damping rayleigh 0.05 10", "block mech damp rayleigh 0.06 10.87 mass",
+                   "block mechanical damping rayleigh 0 0"])
 def damping(session, call):
     s = mech(session.model)
     mode = call.args["mode"]
     where = call.locations.get("alpha", call.location)
+    if mode == "rayleigh":
+        xi, f = _rayleigh(call.args["alpha"], where)
+        s["damping"] = mode
+        s["rayleigh"] = [xi, f, call.args["form"] or "both"]
+        return
     alpha = _alpha(mode, call.args["alpha"][0], where) if call.args["alpha"] else None
     s["damping"] = mode
     if mode in ("local", "combined"):

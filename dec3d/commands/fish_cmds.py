@@ -104,6 +104,7 @@ def attach_fish(session, model=None) -> None:
     model = session.model if model is None else model
     rt = session.fish_rt
     model.fish_probe = rt.probe
+    model.fish_table = lambda tid: rt.tables.get(tid.lower() if type(tid) is str else tid)   # time functions
     if rt.callbacks:
         from ..physics.rigid import engine
 

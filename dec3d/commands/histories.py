@@ -274,7 +274,7 @@ for _q in CONTACT_QUANTITIES:
 
 
 # other 3DEC history sources, known by name and not implemented yet
-for _other in ("dynamic", "energy", "fluid", "thermal"):
+for _other in ("energy", "fluid", "thermal"):        # (`model history dynamic`: commands/model_dynamic.py)
     REGISTRY.know(f"model history {_other}")
 
 

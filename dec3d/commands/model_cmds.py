@@ -38,7 +38,7 @@ def _check_configure(call):
          doc="Enable an optional process or element type for the rest of the model's life; or set the number "
              "of threads the calculation uses.",
          details="Options: " + ", ".join(CONFIGURE_OPTIONS) + ". Each is recorded once, in the order given; "
-                 "the engine reads them (dynamic: damping defaults for dynamic runs; highorder: 10-node "
+                 "the engine reads them (dynamic: recorded only, dynamic mode is `model dynamic active on`; highorder: 10-node "
                  "tetrahedra; feblock: 20-node brick FE blocks). `threads n` sets how many threads the parallel "
                  "kernels (contact forces, motion, point updates) use from now on, at most the number of cores "
                  "(numba's NUMBA_NUM_THREADS); `threads` alone prints the count. The environment variable "

@@ -469,6 +469,12 @@ def _mech_time_total(rt):
     return float(rt.session.model.time)
 
 
+@intrinsic("dynamic.time.total")
+def _dynamic_time_total(rt):
+    """The dynamic time [s]: accumulated while `model dynamic active on` (set by `model dynamic time-total`)."""
+    return float(rt.session.model.settings.mechanical.get("dyn_time", 0.0))
+
+
 #: ``ENGINE[0](model)`` -> the model's rigid engine (registered by dec3d.commands.fish_cmds; FISH imports
 #: no physics). mech.timestep and mech.solve read it.
 ENGINE: list = [None]

@@ -381,7 +381,7 @@ def _settings_problem(d: dict) -> str | None:
     m = d.get("mechanical", {})
     if not isinstance(m, dict):
         return "the mechanical settings are not an object"
-    choices = {"damping": ("local", "combined", "global", "none"), "mass_scale": ("on", "off", "auto"),
+    choices = {"damping": ("local", "combined", "global", "none", "rayleigh"), "mass_scale": ("on", "off", "auto"),
                "inertia": ("full", "scalar", "auto"), "jmodel": tuple(sorted(_known()["joint_models"]))}
     for k, options in choices.items():
         if k in m and m[k] not in options:
@@ -389,6 +389,13 @@ def _settings_problem(d: dict) -> str | None:
     checks = {"alpha": lambda v: _is_num(v) and 0 <= v < 1,
               "frac": lambda v: _is_num(v) and v > 0,
               "servo_ratio": lambda v: _is_num(v) and v > 0,
+              "dynamic": lambda v: isinstance(v, bool),
+              "dt_mode": lambda v: isinstance(v, list) and len(v) == 2 and isinstance(v[0], bool) and _is_num(v[1]),
+              "dyn_time": lambda v: _is_num(v) and v >= 0,
+              "rayleigh": lambda v: isinstance(v, list) and (v == [] or (
+                  len(v) == 3 and _is_num(v[0]) and 0 <= v[0] < 1 and _is_num(v[1]) and v[1] >= 0
+                  and v[2] in ("both", "mass", "stiffness"))),
+              "timefns": _timefns_ok,
               "ctol": lambda v: v is None or (_is_num(v) and v > 0),
               "timestep": lambda v: v is None or (_is_num(v) and v >= 0),
               "scale_timestep": lambda v: v is None or (_is_num(v) and v > 0),
@@ -411,6 +418,14 @@ def _settings_problem(d: dict) -> str | None:
         if why:
             return f"the energy record {why}"
     return None
+
+
+def _timefns_ok(v) -> bool:
+    """The time functions of applied conditions (checked by ``physics.dynamic``, registered at import)."""
+    if "timefns_problem" not in KNOWN:
+        import importlib
+        importlib.import_module("dec3d.physics.dynamic")
+    return KNOWN["timefns_problem"](v) is None
 
 
 def _mtable_ok(t) -> bool:

@@ -26,6 +26,7 @@ from numba import get_num_threads, njit, prange
 
 from .jointlaw import block_lists, block_sums, subcontact_update
 from .motion import rigid_motion_groups
+from .rayleigh import contact_stiffness_damping
 
 
 #: a model with less work per step than this (sub-contacts + 4 × bodies) runs the serial twin of
@@ -66,7 +67,7 @@ def _run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
               mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
               ca, cb, cn, cc, cown, cmodel, cprop,
               sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
-              vmax, out, radius, acc, trigger, motion):
+              vmax, out, radius, acc, trigger, motion, beta):
     """Take up to ``nsteps`` steps of Δt = dt [s]; arrays as in ``subcontact_forces`` and
     ``rigid_motion_groups`` (cc (nc, 3) contact reference points, cown (nc,) = arange(nc)).
 
@@ -77,6 +78,8 @@ def _run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
     motion (2,): [0] the largest step motion of any block [m] (kept across calls: max),
     [1] 1.0 if the batch ended on the trigger, 2.0 if a block moved farther than its radius
     in one step (then returned as unstable: it can pass through other blocks unseen).
+    beta [s]: the stiffness-proportional term of Rayleigh damping on the sub-contacts (0: none;
+    ``rayleigh.contact_stiffness_damping``).
     Returns (steps done, first unstable block row or −1). An unstable step is not finished:
     the caller reports it and the arrays hold the state at that step.
     """
@@ -89,6 +92,9 @@ def _run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
     for _ in range(nsteps):
         subcontact_update(dt, centroid, vel, spin, ca, cb, cn, cmodel, cprop,
                           sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg)
+        if beta > 0.0:
+            contact_stiffness_damping(beta, centroid, vel, spin, ca, cb, cn, cprop, sc_contact, sc_pos, sc_area,
+                                      sc_fn, sc_state, sg)
         block_sums(centroid, force, moment, sc_pos, sg, bstart, bent)
         g = rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
                                 gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
@@ -126,7 +132,7 @@ def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
               mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
               ca, cb, cn, cc, cown, cmodel, cprop,
               sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
-              vmax, out, radius, acc, trigger, motion):
+              vmax, out, radius, acc, trigger, motion, beta=0.0):
     """``_run_steps`` (the kernel, documented there); a small model (``SERIAL_BELOW``), or any
     model on one thread, runs its serial twin ``_run_steps_1`` (the same numbers: every sum has a
     fixed order)."""
@@ -135,7 +141,7 @@ def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
             mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
             ca, cb, cn, cc, cown, cmodel, cprop,
             sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
-            vmax, out, radius, acc, trigger, motion)
+            vmax, out, radius, acc, trigger, motion, float(beta))
     if sc_contact.shape[0] + 4 * gmember.shape[0] >= SERIAL_BELOW and get_num_threads() > 1:
         return _run_steps(*args)
     return _run_steps_1(*args)
@@ -161,4 +167,5 @@ _run_steps_1 = _serial_twin(
     subcontact_update=_serial_twin(subcontact_update, "_subcontact_update_1"),
     block_sums=_serial_twin(block_sums, "_block_sums_1"),
     rigid_motion_groups=_serial_twin(rigid_motion_groups, "_rigid_motion_groups_1"),
-    _move_points=_serial_twin(_move_points, "_move_points_1"))
+    _move_points=_serial_twin(_move_points, "_move_points_1"),
+    contact_stiffness_damping=_serial_twin(contact_stiffness_damping, "_contact_stiffness_damping_1"))

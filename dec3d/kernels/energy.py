@@ -33,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .jointlaw import P_KN, P_KS
+from .joints import P_KN, P_KS
 
 
 @njit(cache=True)

@@ -66,6 +66,9 @@ Damping (``damp_mode``), with α = ``alpha`` for modes 1 and 2:
      same force with the sign of Eq. 78. Ḟ_u,i is taken as F_u,i(t) − F_u,i(t−Δt) from the
      previous unbalanced force stored in ``servo`` (see below); on the first step (no history)
      sgn(Ḟ) = 0, i.e. half the local damping. Same for the moment with ω.
+  4  Rayleigh, mass-proportional term: viscous damping with the fixed coefficient α_v = ``alpha``
+     [1/s] in D₁, D₂ of Eq. 49 (translation and rotation); the stiffness-proportional term acts on
+     the contacts (``kernels.rayleigh``). See ``dec3d.physics.dynamic``.
   3  adaptive global (Cundall 1982; 3DEC theory Eq. 77, "damping auto"): viscous, mass
      proportional damping α_v (D₁, D₂ of Eq. 49) on translation and rotation, with α_v adjusted by a
      servo so that R = Σ P / Σ |Ė_k| tends to ``servo[S_RATIO]`` (0.5). P = α_v (m_i v² + ω·L)
@@ -229,8 +232,8 @@ def block_timestep(mass_min, k_max, frac):
 S_ALPHA, S_WORK, S_DEK, S_NWIN, S_RATIO, S_WINDOW, S_FACTOR, S_LASTR, S_HIST, S_CALLS = range(10)
 #: number of global entries at the head of the servo array
 NSERVO = 10
-#: damp_mode codes
-DAMP_NONE, DAMP_LOCAL, DAMP_COMBINED, DAMP_ADAPTIVE = 0, 1, 2, 3
+#: damp_mode codes (4: Rayleigh, its mass-proportional term: viscous α_v = ``alpha``, fixed)
+DAMP_NONE, DAMP_LOCAL, DAMP_COMBINED, DAMP_ADAPTIVE, DAMP_RAYLEIGH = 0, 1, 2, 3, 4
 
 
 @njit(cache=True)
@@ -304,6 +307,8 @@ def rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
             av = 0.02 / dt
         av = min(max(av, 1e-4 / dt), 1.0 / dt)
         servo[S_ALPHA] = av
+    elif damp_mode == 4:
+        av = alpha          # Rayleigh damping's mass-proportional term (dec3d.physics.dynamic)
     al = alpha if (damp_mode == 1 or damp_mode == 2) else 0.0
     d1 = 1.0 - av * dt * 0.5
     d2 = 1.0 / (1.0 + av * dt * 0.5)

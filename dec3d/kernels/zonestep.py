@@ -244,7 +244,11 @@ def gp_motion(masters, linked, link, force, fprev, mass, imass, held, vapp, vel,
                     fd = alpha * abs(f) * _sgn(vel[r, i])
                 elif mode == 2:
                     fd = alpha * abs(f) * (_sgn(vel[r, i]) - _sgn(f - fprev[r, i])) * 0.5
-                vel[r, i] += (f - fd) * dt / m
+                if mode == 4:       # Rayleigh, mass term: viscous α = alpha [1/s], central form of Eq. 49
+                    h = 0.5 * alpha * dt
+                    vel[r, i] = ((1.0 - h) * vel[r, i] + f * dt / m) / (1.0 + h)
+                else:
+                    vel[r, i] += (f - fd) * dt / m
             force[r, i] = f
             fprev[r, i] = f
             u2 += f * f

@@ -53,7 +53,7 @@ from __future__ import annotations
 import numpy as np
 
 from dec3d.io.state import register_known
-from dec3d.kernels.jointlaw import P_KN, ST_NEW
+from dec3d.kernels.joints import P_KN, ST_NEW
 from dec3d.kernels.energy import (contact_strain, group_energy, group_kinetic, spring_work, subcontact_increments,
                                   zone_internal_forces, zone_strain)
 

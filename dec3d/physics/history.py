@@ -189,7 +189,7 @@ class HistorySet:
             h = self.add_rotation(q, block_id(), name, prev=prev)
         elif kind == "point" and q in BLOCK_QUANTITIES and BLOCK_QUANTITIES[q][0] in ("centroid", "disp", "velocity"):
             h = self.add_point(q, block_id(), num_list("point", 3), name, p_origin=num_list("origin", 3))
-        elif kind == "model" and q in MODEL_QUANTITIES:
+        elif kind == "model" and (q in MODEL_QUANTITIES or q == "dynamic-time-total"):
             h = self.add_model(q, name)
         elif kind == "gridpoint" and q in GRIDPOINT_QUANTITIES:
             local = spec.get("local")
@@ -441,6 +441,11 @@ class HistorySet:
     def add_model(self, quantity: str, name: str | None = None) -> History:
         if quantity.startswith(("ratio", "unbalanced")):   # the measures of `model solve` (RigidEngine.criteria)
             value = lambda eng: float(eng.criteria()[quantity])   # noqa: E731
+        elif quantity == "dynamic-time-total":               # `model history dynamic time-total`
+            from .dynamic import dynamic_time
+
+            value = lambda eng: dynamic_time(eng.model)           # noqa: E731
+            return self.add("dynamic time-total", value, name, {"kind": "model", "quantity": quantity})
         else:
             attr = {"time-total": "time", "kinetic-energy": "kinetic"}[quantity]
             value = lambda eng: float(getattr(eng, attr))          # noqa: E731

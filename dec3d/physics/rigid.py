@@ -23,8 +23,8 @@ from dec3d.kernels.balance import body_balance
 from dec3d.kernels.cycle import run_steps
 from dec3d.kernels.gpcontact import mixed_move_points, mixed_subcontact_forces, surface_weights
 from dec3d.kernels.joints import P_KN, P_KS
-from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST, block_timestep,
-                                  rigid_motion_groups)
+from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, DAMP_RAYLEIGH, NSERVO, S_HIST,
+                                  block_timestep, rigid_motion_groups)
 from dec3d.model.model import KIND_DEFORMABLE, KIND_FE
 from dec3d.model.store import Store
 from dec3d.model.feblocks import has_feblocks
@@ -33,6 +33,7 @@ from dec3d.model.zones import has_zones
 from .bodies import group_properties, inertial_masses, new_servo
 from .contacts import ContactDetection, contact_stores, default_row
 from .energy import is_active as is_energy_active
+from .dynamic import DYN_DEFAULTS, TimeFunctions, has_timefns, rayleigh_coefficients, stiffness_timestep
 from .jmodels import JOINT_MODELS
 from .runcontrol import CycleInterrupted, _Progress, _sigint_stops_cycling, _StopFlag, request_stop  # noqa: F401  (request_stop: part of this module's API)
 
@@ -53,6 +54,7 @@ MECH_DEFAULTS = {
     "servo_ratio": 0.5,        # its target ratio
     "scale_timestep": None,    # Δt wanted with density scaling [s] (None: Eq. 87, median body)
     "dt_run": [],              # [Δt, step]: the step the last rigid run ended on and the Δt it was using
+    **DYN_DEFAULTS,            # dynamic mode, dynamic time, Rayleigh damping, time functions (physics.dynamic)
 }
 
 
@@ -62,7 +64,7 @@ class RunError(Dec3dError):
 
 
 #: vertex fields the deformable step changes (saved before a run, put back if it fails)
-_GP_STATE = ("velocity", "disp", "force", "mass", "imass")
+_GP_STATE = ("velocity", "disp", "force", "mass", "imass", "vapp", "fapp")   # (vapp, fapp: time functions)
 
 
 def _deformable(kind):
@@ -85,7 +87,7 @@ def mech(model) -> dict:
     m = model.settings.mechanical
     for k, v in MECH_DEFAULTS.items():
         if k not in m:
-            m[k] = dict(v) if isinstance(v, dict) else v
+            m[k] = dict(v) if isinstance(v, dict) else list(v) if isinstance(v, list) else v
     return m
 
 
@@ -163,18 +165,32 @@ class RigidEngine(ContactDetection):
         return block_timestep(mmin, kn * area, float(s["frac"])) or 1e-3
 
     def damping(self) -> tuple[int, float]:
-        """(damping mode code, α) for the motion kernel."""
+        """(damping mode code, α) for the motion kernel (Rayleigh: α is its mass term's viscous
+        coefficient; in dynamic mode the static forms are off, physics.dynamic)."""
         s = self.settings()
+        if s["damping"] == "rayleigh":
+            return DAMP_RAYLEIGH, rayleigh_coefficients(self.model)[0]
+        if s["dynamic"]:
+            return DAMP_NONE, 0.0
         code = {"none": DAMP_NONE, "local": DAMP_LOCAL, "combined": DAMP_COMBINED, "global": DAMP_ADAPTIVE}
         return code[s["damping"]], float(s["alpha"])
 
+    def rayleigh_beta(self) -> float:
+        """β [s] of Rayleigh damping's stiffness term on the contacts (0: none)."""
+        return rayleigh_coefficients(self.model)[1] if self.settings()["damping"] == "rayleigh" else 0.0
+
+    def _dynamic_style(self) -> bool:
+        """Real masses and full inertia: dynamic mode, or no (or Rayleigh) damping."""
+        s = self.settings()
+        return bool(s["dynamic"]) or s["damping"] in ("none", "rayleigh")
+
     def mass_scaling(self) -> bool:
         s = self.settings()
-        return s["mass_scale"] == "on" or (s["mass_scale"] == "auto" and s["damping"] != "none")
+        return s["mass_scale"] == "on" or (s["mass_scale"] == "auto" and not self._dynamic_style())
 
     def full_inertia(self) -> bool:
         s = self.settings()
-        return s["inertia"] == "full" or (s["inertia"] == "auto" and s["damping"] == "none")
+        return s["inertia"] == "full" or (s["inertia"] == "auto" and self._dynamic_style())
 
     # ------------------------------------------------------------ cycling
     def _groups(self):
@@ -207,7 +223,7 @@ class RigidEngine(ContactDetection):
         s = self.settings()
         frac = float(s["frac"])
         if not self.mass_scaling() or not len(gmass):
-            dt = dt_fixed if dt_fixed is not None else self.timestep()
+            dt = dt_fixed if dt_fixed is not None else stiffness_timestep(self.timestep(), self.rayleigh_beta())
             return dt, gmass.copy(), giscalar.copy()
         kg = self._stiffness_sums(gstart, gmember)
         if dt_fixed is None and s["scale_timestep"]:
@@ -638,6 +654,12 @@ class _Run:
         self.progress = _Progress(nsteps, eng)
         self.steps = ([MixedContacts(self), RigidBatch(self, chunked=False), ZoneStep(self)] if self.zoned
                       else [RigidBatch(self, chunked=True)]) + [Clock(self), Hooks(self)]
+        self.beta = eng.rayleigh_beta()
+        if self.zst is not None:
+            self.zst.beta = self.beta
+        self.dynamic = bool(s["dynamic"])
+        if has_timefns(m):
+            self.steps.insert(0, TimeFunctions(self))
         if is_energy_active(m):
             # energy tracking (`model energy active on`): EnergyBefore → … → EnergyAfter → Clock → Hooks
             from .energy import energy_steps
@@ -653,6 +675,9 @@ class _Run:
         # exactly the steps of one run
         last = s["dt_run"]
         between = not fresh and len(last) == 2 and int(last[1]) == m.step and m.step % self.interval != 0
+        # ... unless the masses or the damping's time-step rule changed since (dynamic mode, damping)
+        self.dt_mode = [bool(eng.mass_scaling()), float(eng.rayleigh_beta())]
+        between = between and s.get("dt_mode", self.dt_mode) == self.dt_mode
         if self.mixed:
             self.wsub, self.wcon = eng._mixed_weights(self.zst, recompute=not between)
         if warn is not None:
@@ -692,7 +717,7 @@ class _Run:
         ng = self.ng
         dt_r = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, None)[0] if ng else math.inf
         d = ((dt_r if ng else float(self.s["scale_timestep"] or 1.0)) if self.scaled
-             else min(dt_r, self.zst.natural_timestep()))
+             else min(dt_r, stiffness_timestep(self.zst.natural_timestep(), self.beta)))
         return d if math.isfinite(d) and d > 0 else 1.0
 
     def detection_due(self) -> bool:
@@ -734,6 +759,7 @@ class _Run:
         if self.zoned:
             self.zst.finish(self.large)
         s["dt_run"] = [float(eng.dt), int(m.step)]
+        s["dt_mode"] = self.dt_mode
         if self.ng or not self.zoned:
             # keep each block's principal axes turning with its body
             gstart, gmember, gaxes = self.gstart, self.gmember, self.gaxes
@@ -817,7 +843,7 @@ class RigidBatch(_Step):
                                   b["disp"], b["vert_start"], b["vert_count"], m.vertices["pos"], cs["a"], cs["b"],
                                   cs["normal"], cs["pos"], np.arange(cs.n, dtype=_I), cs["jmodel"], cs["prop"],
                                   ss["contact"], ss["pos"], ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"],
-                                  ss["us"], ss["state"], r.vmax, r.out, r.radius, r.acc, r.trigger, r.motion)
+                                  ss["us"], ss["state"], r.vmax, r.out, r.radius, r.acc, r.trigger, r.motion, r.beta)
             spent = _time.perf_counter() - t0
             n_ok += c_ok
             if bad >= 0 or r.motion[1] > 0.0 or c_ok < kk or not self.chunked:
@@ -862,6 +888,8 @@ class Clock(_Step):
         r.due = r.motion[1] > 0.0
         m.step += n
         m.time += n * r.dt
+        if r.dynamic:
+            r.s["dyn_time"] += n * r.dt
         r.done += n
         eng._criteria = None
         eng.kinetic = (((float(r.out[2]) if r.ng else 0.0) + r.zst.kinetic) if r.zoned else float(r.out[2]))

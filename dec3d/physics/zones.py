@@ -139,6 +139,8 @@ class ZoneStepper:
         #: NMD averaging node of each vertex row: its link master (one gridpoint of a joined set) or itself
         self.node = np.ascontiguousarray(np.where(link0 >= 0, link0, np.arange(v.n, dtype=_I)))
         self.ho = None
+        #: β [s] of Rayleigh damping's stiffness term (set by the engine's run; 0: none)
+        self.beta = 0.0
         if len(self.rows10):
             from dec3d.kernels import zones_ho
             self.ho = zones_ho.tet10_step
@@ -328,6 +330,9 @@ class ZoneStepper:
                         dt, large, zs["stress"], facc, fmag)
         if self.ho is not None:
             self.ho(pos, vel, zs["gp"], self.rows10, self.bulk, self.shear, dt, zs["gstress"], zs["stress"], facc)
+        if self.beta > 0.0:             # Rayleigh damping's stiffness term (physics.dynamic)
+            from .dynamic import zone_stiffness_damping
+            zone_stiffness_damping(self, self.beta, pos, vel, facc)
         fe = self.fe
         if fe is not None:
             e = fe.forces(pos, vel, dt, gravity, facc, fmag)

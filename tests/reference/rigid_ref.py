@@ -99,6 +99,8 @@ def motion_groups_ref(dt, gravity, damp_mode, alpha, servo, full_inertia,
         av = servo[0] if servo[0] > 0 else rule["start"] / dt
         av = min(max(av, lo), hi)
         servo[0] = av
+    elif damp_mode == 4:                     # Rayleigh's mass term: viscous damping with α_v = alpha, fixed
+        av = alpha
     al = alpha if damp_mode in (1, 2) else 0.0
     D1, D2 = 1 - av * dt / 2, 1 / (1 + av * dt / 2)
 

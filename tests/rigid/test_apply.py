@@ -1,8 +1,8 @@
-"""`block apply` / `block apply-remove`: values land in the block store; time functions refused; physics."""
+"""`block apply` / `block apply-remove`: values land in the block store; physics (time functions: tests/test_dynamic.py)."""
 import numpy as np
 import pytest
 
-from dec3d.errors import BindError, Dec3dError, NotSupportedError
+from dec3d.errors import BindError, CommandError, Dec3dError
 
 TWO = """model new
 block create brick 0 1 0 1 0 1
@@ -64,12 +64,13 @@ def test_apply_remove_variants(session):
 
 
 def test_errors_name_line_and_column(session):
-    with pytest.raises(NotSupportedError) as e:
-        session.load_text(TWO + "block apply velocity-z 1 table 1 range id 2\n")
-    assert e.value.location.line == 5 and e.value.location.column == 32 and "table" in str(e.value)
-    with pytest.raises(NotSupportedError) as e:
-        session.load_text(TWO + "block apply vel-x 1 fish cos_ range pos-z -0.4 0\n")
-    assert e.value.location.line == 5 and "fish" in str(e.value)
+    # time functions: the table / FISH function must exist when the command runs (tests/test_dynamic.py)
+    with pytest.raises(CommandError) as e:
+        session.run_items(session.load_text(TWO + "block apply velocity-z 1 table 1 range id 2\n"))
+    assert e.value.location.line == 5 and e.value.location.column == 32 and "no table 1" in str(e.value)
+    with pytest.raises(CommandError) as e:
+        session.run_items(session.load_text(TWO + "block apply vel-x 1 fish cos_ range pos-z -0.4 0\n"))
+    assert e.value.location.line == 5 and "no FISH function `cos_`" in str(e.value)
     with pytest.raises(BindError) as e:
         session.load_text(TWO + "block apply force 1 2\n")
     assert e.value.location.line == 5 and "3" in str(e.value)

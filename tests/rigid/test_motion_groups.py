@@ -96,7 +96,7 @@ def _random_model(rng):
     return m
 
 
-@pytest.mark.parametrize("mode", [0, 1, 2, 3])
+@pytest.mark.parametrize("mode", [0, 1, 2, 3, 4])
 @pytest.mark.parametrize("full", [False, True])
 @pytest.mark.parametrize("seed", range(3))
 def test_kernel_matches_twin(mode, full, seed):

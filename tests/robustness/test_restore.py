@@ -104,13 +104,21 @@ def _set(path, value):
 
 META_CASES = [
     (("settings", "mechanical", "damping"), "bogus",
-     "mechanical setting `damping` is 'bogus', not one of local, combined, global, none"),
+     "mechanical setting `damping` is 'bogus', not one of local, combined, global, none, rayleigh"),
     (("settings", "mechanical", "jmodel"), "magic",
      "mechanical setting `jmodel` is 'magic', not one of elastic, mohr"),
     (("settings", "mechanical", "frac"), "abc",
      'mechanical setting `frac` has the value "abc", which is not allowed'),
     (("settings", "mechanical", "alpha"), 1.5,
      "mechanical setting `alpha` has the value 1.5, which is not allowed"),
+    (("settings", "mechanical", "dyn_time"), -2.0,
+     "mechanical setting `dyn_time` has the value -2.0, which is not allowed"),
+    (("settings", "mechanical", "rayleigh"), [0.05, 10, "both", 1],
+     "mechanical setting `rayleigh` has the value [0.05, 10, \"both\", 1], which is not allowed"),
+    (("settings", "mechanical", "timefns"), [{"on": "block", "kind": "velocity", "comp": 5, "ids": [1],
+                                              "value": 1.0, "last": 0.0, "table": 1, "fish": None}],
+     'mechanical setting `timefns` has the value [{"comp": 5, "fish": null, "ids": [1], "kind": "velocity", …, '
+     'which is not allowed'),
     (("settings", "gravity"), [0, 0, "down"], "gravity [0, 0, 'down'] is not 3 finite numbers"),
     (("time",), math.nan, "the time nan is not a finite number ≥ 0"),
     (("tolerance",), -1.0, "the tolerance -1.0 is not a finite number > 0"),

@@ -1,0 +1,282 @@
+"""Dynamic mode (`model dynamic`), Rayleigh damping and time functions of applied conditions.
+
+Everything is kept in ``model.settings.mechanical`` (plain JSON, so `model save|restore` carries it):
+
+- ``dynamic`` (bool) and ``dyn_time`` [s]: dynamic mode and the dynamic time, which runs on only while
+  dynamic mode is on (Itasca, `model dynamic` command page: "time-total f: the accumulated dynamic time
+  for the model. This can be reset to any value, and will continue to be accumulated during cycling").
+  In dynamic mode the engine uses the real masses and full inertia (no density scaling of rigid blocks,
+  zone gridpoints or FE nodes, unless `block mechanical mass-scale on` asks for it explicitly), the
+  time step of the 3DEC theory text (Eqs. 84, 87, 88) without scaling, and only Rayleigh damping:
+  the static forms (local, combined, adaptive global) are not applied in dynamic mode (dec3d follows
+  the Itasca codes' rule that static damping is off in dynamic mode; `model dynamic list` says which
+  damping is in effect).
+- ``rayleigh``: [fraction ξ, frequency f [Hz], "both" | "mass" | "stiffness"] of `block mechanical
+  damping rayleigh`. Rayleigh damping (Itasca 3DEC "Dynamic Analysis", Damping: C = α M + β K,
+  Bathe and Wilson 1976) gives mode ω the damping ratio ξ(ω) = (α/ω + β ω)/2, least at
+  ω_min = √(α/β) where it is ξ_min = √(αβ); with ξ_min = ξ and ω_min = 2π f:
+  α = ξ ω_min [1/s], β = ξ / ω_min [s]. One term alone (`mass` or `stiffness`) is taken twice as
+  large (α = 2ξω, or β = 2ξ/ω), so that the damping ratio at f is still ξ (dec3d's reading: the
+  page could not be checked for this detail). The mass term is viscous damping of the body,
+  gridpoint and node velocities (``kernels.motion`` mode 4, ``kernels.zonestep.gp_motion`` mode 4);
+  the stiffness term acts on the sub-contacts of rigid blocks (``kernels.rayleigh``) and on the 4-node
+  zones as a damping stress β D ε̇ (``zone_stiffness_damping``; not yet on 10-node zones, FE blocks, nor
+  on contacts between rigid and zoned blocks). Stiffness damping lowers the stable step: Δt = Δt₀ (√(1 + λ²) − λ), λ = β / Δt₀ (the central-difference limit 2/ω (√(1 + ξ²) − ξ)
+  for the highest mode Δt₀ allows, ω = 2/Δt₀, ξ = β ω / 2).
+- ``timefns``: the time functions of `block apply … table|fish` and `block gridpoint apply … table|fish`
+  (``TimeFunctions``).
+"""
+from __future__ import annotations
+
+import math
+from bisect import bisect_left
+
+import numpy as np
+
+from dec3d.errors import Dec3dError
+from dec3d.io.state import register_known
+
+#: the settings this module keeps, with their defaults (``rigid.MECH_DEFAULTS`` takes them over)
+DYN_DEFAULTS = {"dynamic": False, "dyn_time": 0.0, "rayleigh": [], "timefns": []}
+RAYLEIGH_FORMS = ("both", "mass", "stiffness")
+
+
+class TimeFunctionError(Dec3dError):
+    """A time function cannot be evaluated while cycling (its table or FISH function is gone, or the
+    value is not a finite number)."""
+
+
+def _mech(model) -> dict:
+    m = model.settings.mechanical
+    for k, v in DYN_DEFAULTS.items():
+        if k not in m:
+            m[k] = list(v) if isinstance(v, list) else v
+    return m
+
+
+def is_dynamic(model) -> bool:
+    return bool(_mech(model)["dynamic"])
+
+
+def dynamic_time(model) -> float:
+    return float(_mech(model)["dyn_time"])
+
+
+def load_time(model) -> float:
+    """The time of the time functions: the dynamic time in dynamic mode, else the model's time."""
+    return dynamic_time(model) if is_dynamic(model) else float(model.time)
+
+
+def rayleigh_coefficients(model) -> tuple[float, float]:
+    """(α [1/s], β [s]) of the model's Rayleigh damping (0, 0 when it has none)."""
+    r = _mech(model)["rayleigh"]
+    if len(r) != 3:
+        return 0.0, 0.0
+    xi, f, form = float(r[0]), float(r[1]), r[2]
+    if xi <= 0.0 or f <= 0.0:
+        return 0.0, 0.0
+    w = 2.0 * math.pi * f
+    if form == "mass":
+        return 2.0 * xi * w, 0.0
+    if form == "stiffness":
+        return 0.0, 2.0 * xi / w
+    return xi * w, xi / w
+
+
+def stiffness_timestep(dt0: float, beta: float) -> float:
+    """Δt₀ lowered for stiffness-proportional damping β [s] (see the module text)."""
+    if beta <= 0.0 or not dt0 > 0.0:
+        return dt0
+    lam = beta / dt0
+    return dt0 * (math.sqrt(1.0 + lam * lam) - lam)
+
+
+def damping_text(model) -> str:
+    """The damping in effect, in words (for `model dynamic list`)."""
+    m = _mech(model)
+    mode = m["damping"]
+    if mode == "rayleigh":
+        xi, f, form = m["rayleigh"]
+        a, b = rayleigh_coefficients(model)
+        what = {"both": "mass and stiffness", "mass": "mass only", "stiffness": "stiffness only"}[form]
+        return (f"rayleigh, fraction {xi:g} at {f:g} Hz ({what}: α = {a:.6g} 1/s, β = {b:.6g} s)"
+                if a or b else "rayleigh with fraction or frequency 0: no damping")
+    if mode == "none":
+        return "none"
+    if m["dynamic"]:
+        return f"none ({mode} damping is set and is not applied in dynamic mode)"
+    return mode
+
+
+def zone_stiffness_damping(zst, beta: float, pos, vel, facc) -> None:
+    """Add the gridpoint forces of the damping stresses β D ε̇ of the 4-node zones to ``facc``: the zone
+    step's own kernel, run on zero stresses with the strain increment of the current velocities over a
+    unit time (so it returns −K v, the forces being linear in the stresses and the strains in the
+    velocities), with Mohr-Coulomb zones taken as elastic (the damping stress is not limited by their
+    strength; null zones stay null), times β. ``zst`` is the ``physics.zones.ZoneStepper``."""
+    from dec3d.kernels.zone_plastic import zone_forces_plastic
+    from dec3d.kernels.zonestep import zone_forces
+    from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_MOHR
+
+    zs = zst.model.store("zones")
+    sc = getattr(zst, "_rayleigh_scratch", None)
+    if sc is None or sc[0].shape != zs["stress"].shape or sc[2].shape != facc.shape:
+        cm = np.where(zs["cmodel"] == ZMODEL_MOHR, ZMODEL_ELASTIC, zs["cmodel"]).astype(zs["cmodel"].dtype)
+        sc = zst._rayleigh_scratch = (np.zeros_like(zs["stress"]), np.zeros_like(zs["state"]), np.zeros_like(facc),
+                                      np.zeros(facc.shape[0]), cm)
+    stress, state, f, fm, cm = sc
+    stress[:] = 0.0
+    state[:] = 0
+    f[:] = 0.0
+    fm[:] = 0.0
+    if zst.plastic:
+        zone_forces_plastic(pos, vel, zs["gp"], zst.rows4, zst.zset, zst.weight, zst.nset, zst.node, cm, zs["prop"],
+                            1.0, False, zst.nmd, stress, state, f, fm)
+    else:
+        zone_forces(pos, vel, zs["gp"], zst.rows4, zst.zset, zst.weight, zst.nset, zst.bulk, zst.shear, 1.0, False,
+                    stress, f, fm)
+    facc[zst.rows] += beta * f[zst.rows]
+
+
+# ------------------------------------------------------------------ time functions
+
+#: kinds of condition: (store, field, fixity bit base or None for forces)
+KINDS = {("block", "velocity"): ("velocity", 1), ("block", "rvelocity"): ("spin", 8),
+         ("block", "force"): ("fapp", None), ("block", "moment"): ("mapp", None),
+         ("gridpoint", "velocity"): ("vapp", 1), ("gridpoint", "force"): ("fapp", None)}
+
+
+def add_timefn(model, on: str, kind: str, comp: int, value: float, ids, table=None, fish=None,
+               where: str = "") -> None:
+    """Record a time function: the ``comp`` component of ``kind`` of the ``ids`` (block ids, or gridpoint
+    vertex rows) is ``value`` × table(t) or × fish() while cycling. A velocity replaces the velocity time
+    functions of that component on those ids; a force adds to what is there (as applied forces do)."""
+    if KINDS[(on, kind)][1] is not None:
+        remove_timefns(model, on, ids, {(kind, comp)})
+    _mech(model)["timefns"].append({"on": on, "kind": kind, "comp": int(comp), "value": float(value),
+                                    "table": table, "fish": fish, "ids": [int(i) for i in ids], "last": 0.0,
+                                    "where": where})
+
+
+def remove_timefns(model, on: str, ids, which) -> None:
+    """Drop ``ids`` from the time functions of ``on`` whose (kind, comp) is in ``which``."""
+    drop = set(int(i) for i in ids)
+    keep = []
+    for e in _mech(model)["timefns"]:
+        if e["on"] == on and (e["kind"], e["comp"]) in which:
+            e["ids"] = [i for i in e["ids"] if i not in drop]
+            if not e["ids"]:
+                continue
+        keep.append(e)
+    _mech(model)["timefns"][:] = keep
+
+
+def has_timefns(model) -> bool:
+    return bool(_mech(model)["timefns"])
+
+
+def interpolate(xs, ys, x: float) -> float:
+    """Linear interpolation in a table of increasing xs; the end values hold outside (as FISH `table`)."""
+    if x <= xs[0]:
+        return float(ys[0])
+    if x >= xs[-1]:
+        return float(ys[-1])
+    k = bisect_left(xs, x)
+    x0, x1, y0, y1 = xs[k - 1], xs[k], ys[k - 1], ys[k]
+    return float(y0 + (y1 - y0) * (x - x0) / (x1 - x0))
+
+
+def timefn_factor(model, e: dict, t: float) -> float:
+    """table(t) or the FISH function's value now, for time function ``e``."""
+    at = f"{e['where']}: " if e.get("where") else ""
+    if e.get("table") is not None:
+        get = getattr(model, "fish_table", None)
+        tab = get(e["table"]) if get is not None else None
+        if tab is None:
+            raise TimeFunctionError(f"{at}there is no table {e['table']} any more (used by `{e['on']} apply "
+                                    f"{e['kind']} … table {e['table']}`)")
+        if not tab.xs:
+            raise TimeFunctionError(f"{at}table {e['table']} has no points")
+        return interpolate(tab.xs, tab.ys, t)
+    probe = getattr(model, "fish_probe", None)
+    if probe is None:
+        raise TimeFunctionError(f"{at}no FISH run time for `fish {e['fish']}`")
+    v = float(probe(e["fish"]))
+    if not math.isfinite(v):
+        raise TimeFunctionError(f"{at}FISH function `{e['fish']}` gave {v} at time {t:g} s")
+    return v
+
+
+class TimeFunctions:
+    """A step of the cycle (first in ``rigid._Run.steps`` when the model has time functions): before
+    each step, every time-function condition is set for the time of that step, and the batch is cut to
+    one step. A velocity is taken at the middle of the step (t + Δt/2: velocities live at half steps in
+    the central-difference scheme), a force at its start t. The time is ``load_time``."""
+    timing = "hooks"
+
+    def __init__(self, run):
+        self.run = run
+        self.prepare()
+
+    def prepare(self) -> None:
+        m = self.run.m
+        ids = m.blocks["id"]
+        order = np.argsort(ids, kind="stable")
+        self.rows = []
+        for e in _mech(m)["timefns"]:
+            want = np.asarray(e["ids"], np.int64)
+            if e["on"] == "block":
+                k = np.searchsorted(ids[order], want)
+                k = np.minimum(k, max(len(order) - 1, 0))
+                ok = (len(order) > 0) & (ids[order][k] == want) if len(order) else np.zeros(len(want), bool)
+                self.rows.append(order[k[ok]])
+            else:
+                self.rows.append(want[(want >= 0) & (want < m.vertices.n)])
+
+    def advance(self, n: int) -> int:
+        r = self.run
+        m = r.m
+        t = load_time(m)
+        for e, rows in zip(_mech(m)["timefns"], self.rows):
+            field, bit = KINDS[(e["on"], e["kind"])]
+            arr = (m.blocks if e["on"] == "block" else m.vertices)[field]
+            i = e["comp"]
+            if bit is not None:
+                val = e["value"] * timefn_factor(m, e, t + 0.5 * r.dt)
+                arr[rows, i] = val
+                if e["on"] == "gridpoint" and r.zst is not None:
+                    # the zone stepper holds its own copy of the held velocities, on the master rows
+                    link = m.vertices["link"][rows]
+                    r.zst.vapp[np.where(link >= 0, link, rows), i] = val
+            else:
+                new = e["value"] * timefn_factor(m, e, t)
+                arr[rows, i] += new - e["last"]
+                e["last"] = new
+        return min(n, 1)
+
+    def __repr__(self) -> str:
+        return "TimeFunctions"
+
+
+def timefns_state_problem(v) -> str | None:
+    """Why a save file's ``timefns`` setting is not acceptable (None: it is)."""
+    if not isinstance(v, list):
+        return "is not a list"
+    for e in v:
+        if not isinstance(e, dict) or (e.get("on"), e.get("kind")) not in KINDS:
+            return "has an entry that is not a known condition"
+        if e.get("comp") not in (0, 1, 2) or not isinstance(e.get("ids"), list):
+            return "has an entry with a bad component or id list"
+        if not all(isinstance(i, int) and not isinstance(i, bool) for i in e["ids"]):
+            return "has an entry whose ids are not whole numbers"
+        for k in ("value", "last"):
+            if not isinstance(e.get(k), (int, float)) or not math.isfinite(e[k]):
+                return f"has an entry whose {k} is not a finite number"
+        if (e.get("table") is None) == (e.get("fish") is None):
+            return "has an entry that names neither (or both) a table and a FISH function"
+        if not isinstance(e.get("fish") or "", str) or not isinstance(e.get("table") or 0, (int, str)):
+            return "has an entry with a bad table id or FISH name"
+    return None
+
+
+register_known(timefns_problem=timefns_state_problem)
