@@ -209,16 +209,24 @@ def main() -> int:
     ap.add_argument("--dynamic", action="store_true",
                     help="every block keeps moving (the stack slides on the base; with "
                          "--full-detection: detection at every step)")
+    ap.add_argument("--setup", default="",
+                    help="with --equilibrium: extra command lines after the scene, separated by ';' "
+                         "(e.g. 'block mechanical mass-scale body; block mechanical damping global')")
     ap.add_argument("--child", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.equilibrium:
         print(f"machine: {machine()}")
+        setup = "".join(line.strip() + "\n" for line in args.setup.split(";") if line.strip())
+        print(f"setup: {args.setup or '(scene as is: local damping 0.8, Eq. 87 density scaling)'}; "
+              f"load average before: {os.getloadavg()[0]:.2f}")
         for n in args.n:
-            runs = [equilibrium(n, args.jmodel) for _ in range(args.repeat)]
+            runs = [equilibrium(n, args.jmodel, solve=setup) for _ in range(args.repeat)]
+            t = statistics.median(r['seconds'] for r in runs)
             print(f"n {n}: steps {runs[0]['steps']} reached {runs[0]['reached']} "
                   f"reaction err {runs[0]['reaction_error']:.2e} vmax {runs[0]['max_speed']:.2e} "
-                  f"wall median {statistics.median(r['seconds'] for r in runs):.2f} s "
-                  f"(runs {[round(r['seconds'], 2) for r in runs]})", flush=True)
+                  f"wall median {t:.2f} s (runs {[round(r['seconds'], 2) for r in runs]}), "
+                  f"{1e3 * t / max(1, runs[0]['steps']):.3f} ms/step; load average {os.getloadavg()[0]:.2f}",
+                  flush=True)
         return 0
     if args.child:
         print(json.dumps(one(args.child, args.steps, args.jmodel, args.full_detection,

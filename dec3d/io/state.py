@@ -382,6 +382,7 @@ def _settings_problem(d: dict) -> str | None:
     if not isinstance(m, dict):
         return "the mechanical settings are not an object"
     choices = {"damping": ("local", "combined", "global", "none"), "mass_scale": ("on", "off", "auto"),
+               "scaling": ("eq87", "body"),
                "inertia": ("full", "scalar", "auto"), "jmodel": tuple(sorted(_known()["joint_models"]))}
     for k, options in choices.items():
         if k in m and m[k] not in options:
@@ -389,6 +390,7 @@ def _settings_problem(d: dict) -> str | None:
     checks = {"alpha": lambda v: _is_num(v) and 0 <= v < 1,
               "frac": lambda v: _is_num(v) and v > 0,
               "servo_ratio": lambda v: _is_num(v) and v > 0,
+              "safety": lambda v: _is_num(v) and 0 < v < 1,
               "ctol": lambda v: v is None or (_is_num(v) and v > 0),
               "timestep": lambda v: v is None or (_is_num(v) and v >= 0),
               "scale_timestep": lambda v: v is None or (_is_num(v) and v > 0),

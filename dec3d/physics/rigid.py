@@ -20,6 +20,7 @@ import numpy as np
 from dec3d.errors import Dec3dError
 from dec3d.io.vtk import periodic_vtk
 from dec3d.kernels.balance import body_balance
+from dec3d.kernels.bodyscale import body_row_sums
 from dec3d.kernels.cycle import run_steps
 from dec3d.kernels.gpcontact import mixed_move_points, mixed_subcontact_forces, surface_weights
 from dec3d.kernels.jointlaw import P_KN, P_KS
@@ -51,6 +52,8 @@ MECH_DEFAULTS = {
     "servo": [],               # adaptive global damping state (kernels.motion, first NSERVO entries)
     "servo_ratio": 0.5,        # its target ratio
     "scale_timestep": None,    # Δt wanted with density scaling [s] (None: Eq. 87, median body)
+    "scaling": "eq87",         # density scaling: eq87 (Eq. 87, masses only raised) | body (stiffness row sums)
+    "safety": 0.8,             # body scaling: ω_max Δt ≤ 2 × safety
     "dt_run": [],              # [Δt, step]: the step the last rigid run ended on and the Δt it was using
 }
 
@@ -208,6 +211,8 @@ class RigidEngine(ContactDetection):
         if not self.mass_scaling() or not len(gmass):
             dt = dt_fixed if dt_fixed is not None else self.timestep()
             return dt, gmass.copy(), giscalar.copy()
+        if s["scaling"] == "body":
+            return self._body_masses(gstart, gmember, gmass, giscalar, dt_fixed)
         kg = self._stiffness_sums(gstart, gmember)
         if dt_fixed is None and s["scale_timestep"]:
             dt_fixed = float(s["scale_timestep"])
@@ -220,6 +225,51 @@ class RigidEngine(ContactDetection):
             dt = (block_timestep(float(np.median(gmass[on])), float(np.median(kg[on])), frac)
                   if on.any() else self.timestep())
         im, isc = inertial_masses(gmass, giscalar, kg, dt, frac)
+        return dt, im, isc
+
+    def _body_masses(self, gstart, gmember, gmass, giscalar, dt_fixed):
+        """Density scaling by body (``mass-scale body``): every body's inertial mass and scalar
+        inertia set from the Gershgorin row sums of the contact stiffness around it (kernel
+        ``bodyscale.body_row_sums``) so that each body has the same critical step, and the
+        largest natural frequency ω_max of the scaled system obeys ω_max Δt ≤ 2 × safety:
+
+            m_i = R_t (Δt / 2s)²,   I_i = R_r (Δt / 2s)²   (bodies without contacts keep m and I).
+
+        Δt: the one at which the body of median m / R_t keeps its real mass (or the step given
+        with `mass-scale ... timestep`). This is the 3DEC theory text's nodal step (Eq. 84, mass
+        over the sum of the stiffnesses around the node, here bounded over the six degrees of freedom
+        of a rigid body) used the way "Mass (Density) Scaling" uses it: inertial masses chosen so
+        that every part of the model has the same step. With full inertia (Euler's equations) the
+        principal moments take the larger of the two ratios m_i / m, I_i / I."""
+        s = self.settings()
+        safety = float(s["safety"])
+        b = self.model.blocks
+        cs, ss = self.contacts, self.subcontacts
+        ng = len(gstart) - 1
+        gid = np.full(b.n, -1, dtype=_I)
+        gid[gmember] = np.repeat(np.arange(ng), np.diff(gstart))
+        gcen = np.add.reduceat(b["mass"][gmember][:, None] * b["centroid"][gmember], gstart[:-1], axis=0) / gmass[:, None]
+        rho = np.sqrt(giscalar / gmass)
+        held = (b["fixity"] | b["apply_fix"])[gmember[gstart[:-1]]].astype(_I)
+        rt = np.zeros(ng)
+        rr = np.zeros(ng)
+        body_row_sums(gid, gcen, rho, held, cs["a"], cs["b"], cs["normal"], np.ascontiguousarray(cs["prop"][:, P_KN]),
+                      np.ascontiguousarray(cs["prop"][:, P_KS]), ss["contact"], ss["pos"], ss["area"], rt, rr)
+        if dt_fixed is None and s["scale_timestep"]:
+            dt_fixed = float(s["scale_timestep"])
+        on = rt > 0
+        if dt_fixed is not None:
+            dt = dt_fixed
+        elif on.any():
+            dt = 2.0 * safety * float(np.median(np.sqrt(gmass[on] / rt[on])))
+        else:
+            dt = self.timestep()
+        f = (dt / (2.0 * safety)) ** 2
+        im = np.where(on, rt * f, gmass)
+        isc = np.where(rr > 0, rr * f, giscalar)
+        if self.full_inertia():
+            ratio = np.maximum(im / gmass, isc / giscalar)
+            im, isc = gmass * ratio, giscalar * ratio
         return dt, im, isc
 
     # ------------------------------------------------------------ equilibrium measures
