@@ -154,11 +154,13 @@ def equilibrium(n: int, jmodel: str = "mohr", cap: int = 100000,
         # update interval apart); the check is inside the timed wall
         en = engine(s.model)
         t0 = time.perf_counter()
+        c0 = time.process_time()
         en.cycle(cap, stop=lambda _: at_equilibrium(s)[0])
         wall = time.perf_counter() - t0
+        cpu = time.process_time() - c0
         steps = s.model.step
         done, err, vmax = at_equilibrium(s)
-    return dict(blocks=n ** 3, steps=steps, seconds=wall, reached=done, reaction_error=err,
+    return dict(blocks=n ** 3, steps=steps, seconds=wall, cpu_seconds=cpu, reached=done, reaction_error=err,
                 max_speed=vmax)
 
 
@@ -225,7 +227,9 @@ def main() -> int:
             print(f"n {n}: steps {runs[0]['steps']} reached {runs[0]['reached']} "
                   f"reaction err {runs[0]['reaction_error']:.2e} vmax {runs[0]['max_speed']:.2e} "
                   f"wall median {t:.2f} s (runs {[round(r['seconds'], 2) for r in runs]}), "
-                  f"{1e3 * t / max(1, runs[0]['steps']):.3f} ms/step; load average {os.getloadavg()[0]:.2f}",
+                  f"{1e3 * t / max(1, runs[0]['steps']):.3f} ms/step; CPU median "
+                  f"{statistics.median(r['cpu_seconds'] for r in runs):.2f} s (all threads); "
+                  f"load average {os.getloadavg()[0]:.2f}",
                   flush=True)
         return 0
     if args.child:

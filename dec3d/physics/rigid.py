@@ -21,6 +21,7 @@ from dec3d.errors import Dec3dError
 from dec3d.io.vtk import periodic_vtk
 from dec3d.kernels.balance import body_balance
 from dec3d.kernels.bodyscale import body_row_sums
+from dec3d.kernels.contactmap import blocks_moved
 from dec3d.kernels.cycle import run_steps
 from dec3d.kernels.gpcontact import mixed_move_points, mixed_subcontact_forces, surface_weights
 from dec3d.kernels.jointlaw import P_KN, P_KS
@@ -32,7 +33,9 @@ from dec3d.model.feblocks import has_feblocks
 from dec3d.model.zones import has_zones
 
 from .bodies import group_properties, inertial_masses, new_servo
+from . import contacts as _contacts
 from .contacts import ContactDetection, contact_stores, default_row
+from .history import HistorySet
 from .jmodels import JOINT_MODELS
 from .runcontrol import CycleInterrupted, _Progress, _sigint_stops_cycling, _StopFlag, request_stop  # noqa: F401  (request_stop: part of this module's API)
 
@@ -74,6 +77,9 @@ def _deformable(kind):
 
 def _has_gridpoints(m) -> bool:
     return has_zones(m) or has_feblocks(m)
+
+#: leave out a periodic detection that would look at no pair again (``_Run.quiet``)
+SKIP_QUIET = True
 
 #: target wall time of one kernel call [s]: Ctrl-C and progress are seen at least this often
 CHUNK_SECONDS = 0.2
@@ -248,7 +254,8 @@ class RigidEngine(ContactDetection):
         ng = len(gstart) - 1
         gid = np.full(b.n, -1, dtype=_I)
         gid[gmember] = np.repeat(np.arange(ng), np.diff(gstart))
-        gcen = np.add.reduceat(b["mass"][gmember][:, None] * b["centroid"][gmember], gstart[:-1], axis=0) / gmass[:, None]
+        mc = b["mass"][gmember][:, None] * b["centroid"][gmember]
+        gcen = np.add.reduceat(mc, gstart[:-1], axis=0) / gmass[:, None]
         rho = np.sqrt(giscalar / gmass)
         held = (b["fixity"] | b["apply_fix"])[gmember[gstart[:-1]]].astype(_I)
         rt = np.zeros(ng)
@@ -483,8 +490,11 @@ class RigidEngine(ContactDetection):
         try:
             while run.done < nsteps and not _StopFlag.requested:
                 if run.detection_due():
-                    self.detect()
-                    run.detected()
+                    if run.quiet():
+                        run.skipped()
+                    else:
+                        self.detect()
+                        run.detected()
                 k = min(nsteps - run.done, interval - m.step % interval)
                 for h in self.step_hooks:
                     hi = int(getattr(h, "interval", 0) or 0)
@@ -690,6 +700,8 @@ class _Run:
         fresh = eng._signature != eng._geometry_signature()
         if fresh:
             eng.detect()
+        #: a detection has run in this run (``quiet`` never leaves out the first one)
+        self.looked = fresh
         self.mixed = eng._zone_contacts_check() if self.zoned else False
         # Δt follows the contact stiffnesses: worked out again at every detection. A run that
         # starts between two detections, on the step where the last run ended and with the
@@ -743,10 +755,37 @@ class _Run:
         return ((self.m.step % self.interval == 0 or self.due)
                 and (not self.zoned or bool(self.ng) or self.large))
 
+    def quiet(self) -> bool:
+        """Whether the detection now due may be left out (``SKIP_QUIET``): no block has moved more
+        than QUIET × CTOL since it was last looked at, so detection would look at no pair again
+        and keep every contact and sub-contact as it is. Never for the first detection of a run
+        (commands between runs may have changed contact defaults, which a detection applies), nor
+        with zoned blocks, a motion trigger, a geometry change, or a step hook other than
+        histories (a FISH callback may change what a detection reads)."""
+        eng = self.eng
+        if (not SKIP_QUIET or not self.looked or self.zoned or self.due or _contacts.QUIET <= 0.0
+                or eng._signature != eng._geometry_signature() or eng.settings().get("grid") is None
+                or any(not isinstance(h, HistorySet) for h in eng.step_hooks)):
+            return False
+        t0 = _time.perf_counter()
+        b, v = self.b, self.m.vertices
+        moved = np.zeros(b.n, bool)
+        blocks_moved(v["pos"], v["look_pos"], b["vert_start"], b["vert_count"], _contacts.QUIET * eng.tolerance(),
+                     moved)
+        eng.timings["detect"] += _time.perf_counter() - t0
+        return not moved.any()
+
+    def skipped(self) -> None:
+        """A detection left out: what one that keeps every contact would do — the motion
+        bounds start again; contacts, Δt and masses stay."""
+        self.acc[:] = 0.0
+        self.due = False
+
     def detected(self) -> None:
         """After a detection: contacts changed, so the steps prepare again and Δt and the
         masses follow the new stiffnesses."""
         eng = self.eng
+        self.looked = True
         if self.zoned:
             self.mixed = eng._zone_contacts_check()
         self.acc[:] = 0.0
