@@ -76,7 +76,8 @@ def damping(session, call):
                        "on, off, automatic (on unless damping is none), or body (on, by body stiffness)")],
          keywords=[P("timestep", Num(lo=0, lo_open=True), "time step the scaled masses must allow", units="s"),
                    P("safety", Num(lo=0, lo_open=True, hi=1, hi_open=True),
-                     "with body: ω_max Δt ≤ 2 × safety (default 0.8)")],
+                     "with body: ω_max Δt ≤ 2 × safety (default 0.7 with local or combined damping, 0.8 "
+                     "with global)")],
          doc="Density (mass) scaling of the rigid blocks for static runs (3DEC theory, \"Mass (Density) Scaling\").",
          details="`on`/`automatic`: each body's inertial mass is raised to the smallest value stable at the time "
                  "step by Eq. (87) (m_i = max(m, K (Δt / 2 frac)²), K the sum of its contact stiffnesses; the "
@@ -85,8 +86,10 @@ def damping(session, call):
                  "inertia are set from the Gershgorin row sums R of the contact stiffness around it over its six "
                  "degrees of freedom (m_i = R_t (Δt / 2s)², I_i = R_r (Δt / 2s)², s = `safety`), which bounds the "
                  "largest natural frequency by ω_max Δt ≤ 2s; lighter and heavier bodies alike, so the slow modes "
-                 "of a stack settle in far fewer steps (about 5× fewer on a 10-layer cube stack). Gravity always "
-                 "keeps the real mass. `on`, `off` and `automatic` return to Eq. (87). Default: automatic.",
+                 "of a stack settle in far fewer steps (a 10-layer cube stack: 7090 steps with Eq. 87, 1840 with "
+                 "`body`, 740 with `body` and `damping global`). The default s is 0.7 with local or combined damping "
+                 "(their sign rule lags at larger steps: a rocking column failed to settle at 0.8) and 0.8 with "
+                 "global damping. Gravity always keeps the real mass. `on`, `off` and `automatic` return to Eq. (87). Default: automatic.",
          examples=["block mechanical mass-scale on", "block mechanical mass-scale off",
                    "block mechanical mass-scale on timestep 1e-4", "block mechanical mass-scale body",
                    "block mechanical mass-scale body safety 0.7"])

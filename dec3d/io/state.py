@@ -390,7 +390,7 @@ def _settings_problem(d: dict) -> str | None:
     checks = {"alpha": lambda v: _is_num(v) and 0 <= v < 1,
               "frac": lambda v: _is_num(v) and v > 0,
               "servo_ratio": lambda v: _is_num(v) and v > 0,
-              "safety": lambda v: _is_num(v) and 0 < v < 1,
+              "safety": lambda v: v is None or (_is_num(v) and 0 < v < 1),
               "ctol": lambda v: v is None or (_is_num(v) and v > 0),
               "timestep": lambda v: v is None or (_is_num(v) and v >= 0),
               "scale_timestep": lambda v: v is None or (_is_num(v) and v > 0),

@@ -56,7 +56,7 @@ MECH_DEFAULTS = {
     "servo_ratio": 0.5,        # its target ratio
     "scale_timestep": None,    # Δt wanted with density scaling [s] (None: Eq. 87, median body)
     "scaling": "eq87",         # density scaling: eq87 (Eq. 87, masses only raised) | body (stiffness row sums)
-    "safety": 0.8,             # body scaling: ω_max Δt ≤ 2 × safety
+    "safety": None,            # body scaling: ω_max Δt ≤ 2 × safety (None: SAFETY by damping mode)
     "dt_run": [],              # [Δt, step]: the step the last rigid run ended on and the Δt it was using
 }
 
@@ -77,6 +77,12 @@ def _deformable(kind):
 
 def _has_gridpoints(m) -> bool:
     return has_zones(m) or has_feblocks(m)
+
+#: default ``safety`` of density scaling by body, per damping mode: local (and combined) damping
+#: takes the sign of a half-step-old velocity, which at ω Δt near 1.6 lags enough to sustain a
+#: rocking cycle (a joined column failed to settle at 0.8, settled at 0.75); the viscous
+#: adaptive damping settles there (dec3d's measurements, bench/README.md)
+SAFETY = {"local": 0.7, "combined": 0.7, "global": 0.8, "none": 0.8}
 
 #: leave out a periodic detection that would look at no pair again (``_Run.quiet``)
 SKIP_QUIET = True
@@ -248,7 +254,7 @@ class RigidEngine(ContactDetection):
         that every part of the model has the same step. With full inertia (Euler's equations) the
         principal moments take the larger of the two ratios m_i / m, I_i / I."""
         s = self.settings()
-        safety = float(s["safety"])
+        safety = float(s["safety"] or SAFETY.get(s["damping"], 0.7))
         b = self.model.blocks
         cs, ss = self.contacts, self.subcontacts
         ng = len(gstart) - 1
