@@ -4,7 +4,8 @@ State lives in the model: contacts and sub-contacts are two stores (``contacts``
 ``subcontacts``, saved and restored with the rest; ``contacts.py``), the engine settings and
 detection bookkeeping are ``model.settings.mechanical`` (plain JSON) and a few vertex/block
 fields. The ``RigidEngine`` object on the model holds only what can be rebuilt: the
-candidate pairs, the time step and timings. A restored run continues bit for bit.
+candidate pairs, the time step and timings. A restored run continues bit for bit (with
+`mass-scale body`: to round-off, its masses are worked out again from the geometry).
 
 Detection is ``contacts.ContactDetection`` (mixed in). Cycling (kernel ``cycle.run_steps``):
 many steps per call, up to the next detection, history sample, VTK snapshot or solve check.
