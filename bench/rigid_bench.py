@@ -154,11 +154,13 @@ def equilibrium(n: int, jmodel: str = "mohr", cap: int = 100000,
         # update interval apart); the check is inside the timed wall
         en = engine(s.model)
         t0 = time.perf_counter()
+        c0 = time.process_time()
         en.cycle(cap, stop=lambda _: at_equilibrium(s)[0])
         wall = time.perf_counter() - t0
+        cpu = time.process_time() - c0
         steps = s.model.step
         done, err, vmax = at_equilibrium(s)
-    return dict(blocks=n ** 3, steps=steps, seconds=wall, reached=done, reaction_error=err,
+    return dict(blocks=n ** 3, steps=steps, seconds=wall, cpu_seconds=cpu, reached=done, reaction_error=err,
                 max_speed=vmax)
 
 
@@ -209,16 +211,26 @@ def main() -> int:
     ap.add_argument("--dynamic", action="store_true",
                     help="every block keeps moving (the stack slides on the base; with "
                          "--full-detection: detection at every step)")
+    ap.add_argument("--setup", default="",
+                    help="with --equilibrium: extra command lines after the scene, separated by ';' "
+                         "(e.g. 'block mechanical mass-scale body; block mechanical damping global')")
     ap.add_argument("--child", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.equilibrium:
         print(f"machine: {machine()}")
+        setup = "".join(line.strip() + "\n" for line in args.setup.split(";") if line.strip())
+        print(f"setup: {args.setup or '(scene as is: local damping 0.8, Eq. 87 density scaling)'}; "
+              f"load average before: {os.getloadavg()[0]:.2f}")
         for n in args.n:
-            runs = [equilibrium(n, args.jmodel) for _ in range(args.repeat)]
+            runs = [equilibrium(n, args.jmodel, solve=setup) for _ in range(args.repeat)]
+            t = statistics.median(r['seconds'] for r in runs)
             print(f"n {n}: steps {runs[0]['steps']} reached {runs[0]['reached']} "
                   f"reaction err {runs[0]['reaction_error']:.2e} vmax {runs[0]['max_speed']:.2e} "
-                  f"wall median {statistics.median(r['seconds'] for r in runs):.2f} s "
-                  f"(runs {[round(r['seconds'], 2) for r in runs]})", flush=True)
+                  f"wall median {t:.2f} s (runs {[round(r['seconds'], 2) for r in runs]}), "
+                  f"{1e3 * t / max(1, runs[0]['steps']):.3f} ms/step; CPU median "
+                  f"{statistics.median(r['cpu_seconds'] for r in runs):.2f} s (all threads); "
+                  f"load average {os.getloadavg()[0]:.2f}",
+                  flush=True)
         return 0
     if args.child:
         print(json.dumps(one(args.child, args.steps, args.jmodel, args.full_detection,

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import CommandError
 from ..physics.rigid import engine, mech
 from .registry import command
 from .values import FLAG, Choice, Deferred, Num, Nums, P, ValueRangeError
@@ -118,20 +119,41 @@ def damping(session, call):
 
 
 @command("block mechanical mass-scale",
-         positional=[P("mode", Choice(("on", "off", "automatic")), "on, off, or automatic (on unless damping is none)")],
-         keywords=[P("timestep", Num(lo=0, lo_open=True), "time step the scaled masses must allow", units="s")],
+         positional=[P("mode", Choice(("on", "off", "automatic", "body")),
+                       "on, off, automatic (on unless damping is none), or body (on, by body stiffness)")],
+         keywords=[P("timestep", Num(lo=0, lo_open=True), "time step the scaled masses must allow", units="s"),
+                   P("safety", Num(lo=0, lo_open=True, hi=1, hi_open=True),
+                     "with body: ω_max Δt ≤ 2 × safety (default 0.7 with local or combined damping, 0.8 "
+                     "with global)")],
          doc="Density (mass) scaling of the rigid blocks for static runs (3DEC theory, \"Mass (Density) Scaling\").",
-         details="Each body's inertial mass is raised to the smallest value stable at the time step by Eq. (87) "
-                 "(m_i = max(m, K (Δt / 2 frac)²), K the sum of its contact stiffnesses; the inertia by the same "
-                 "ratio); gravity keeps the real mass. The step is Eq. (87) for a body of median mass and "
-                 "stiffness, or the value given. Default: automatic.",
+         details="`on`/`automatic`: each body's inertial mass is raised to the smallest value stable at the time "
+                 "step by Eq. (87) (m_i = max(m, K (Δt / 2 frac)²), K the sum of its contact stiffnesses; the "
+                 "inertia by the same ratio); the step is Eq. (87) for a body of median mass and stiffness, or "
+                 "the value given. `body` (dec3d): every body gets the same critical step — its inertial mass and "
+                 "inertia are set from the Gershgorin row sums R of the contact stiffness around it over its six "
+                 "degrees of freedom (m_i = R_t (Δt / 2s)², I_i = R_r (Δt / 2s)², s = `safety`), which bounds the "
+                 "largest natural frequency by ω_max Δt ≤ 2s; lighter and heavier bodies alike, so the slow modes "
+                 "of a stack settle in far fewer steps (a 10-layer cube stack: 7090 steps with Eq. 87, 1840 with "
+                 "`body`, 740 with `body` and `damping global`). The default s is 0.7 with local or combined damping "
+                 "(their sign rule lags at larger steps: a rocking column failed to settle at 0.8) and 0.8 with "
+                 "global damping. Gravity always keeps the real mass. With `body` the masses are worked out from the "
+                 "geometry at each detection and run start, so a run split into several commands (or saved and "
+                 "restored between them) agrees with one run to round-off (about 1e-13 m), not bit for bit. `on`, `off` and `automatic` return to Eq. (87). Default: automatic.",
          examples=["block mechanical mass-scale on", "block mechanical mass-scale off",
-                   "block mechanical mass-scale on timestep 1e-4"])
+                   "block mechanical mass-scale on timestep 1e-4", "block mechanical mass-scale body",
+                   "block mechanical mass-scale body safety 0.7"])
 def mass_scale(session, call):
     s = mech(session.model)
     mode = call.args["mode"]
+    scaling = s["scaling"] if mode is None else "body" if mode == "body" else "eq87"
+    if call.args["safety"] is not None and scaling != "body":
+        raise CommandError("`safety` goes with `mass-scale body` (Eq. 87 scaling uses its frac)",
+                           call.locations.get("safety", call.location))
     if mode is not None:
-        s["mass_scale"] = "auto" if mode == "automatic" else mode
+        s["mass_scale"] = {"automatic": "auto", "body": "on"}.get(mode, mode)
+        s["scaling"] = scaling
+    if call.args["safety"] is not None:
+        s["safety"] = float(call.args["safety"])
     if call.args["timestep"] is not None:
         s["mass_scale"] = "on"
         s["scale_timestep"] = float(call.args["timestep"])

@@ -382,6 +382,7 @@ def _settings_problem(d: dict) -> str | None:
     if not isinstance(m, dict):
         return "the mechanical settings are not an object"
     choices = {"damping": ("local", "combined", "global", "none", "rayleigh"), "mass_scale": ("on", "off", "auto"),
+               "scaling": ("eq87", "body"),
                "inertia": ("full", "scalar", "auto"), "jmodel": tuple(sorted(_known()["joint_models"]))}
     for k, options in choices.items():
         if k in m and m[k] not in options:
@@ -396,6 +397,7 @@ def _settings_problem(d: dict) -> str | None:
                   len(v) == 3 and _is_num(v[0]) and 0 <= v[0] < 1 and _is_num(v[1]) and v[1] >= 0
                   and v[2] in ("both", "mass", "stiffness"))),
               "timefns": _timefns_ok,
+              "safety": lambda v: v is None or (_is_num(v) and 0 < v < 1),
               "ctol": lambda v: v is None or (_is_num(v) and v > 0),
               "timestep": lambda v: v is None or (_is_num(v) and v >= 0),
               "scale_timestep": lambda v: v is None or (_is_num(v) and v > 0),

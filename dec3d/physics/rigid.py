@@ -4,7 +4,8 @@ State lives in the model: contacts and sub-contacts are two stores (``contacts``
 ``subcontacts``, saved and restored with the rest; ``contacts.py``), the engine settings and
 detection bookkeeping are ``model.settings.mechanical`` (plain JSON) and a few vertex/block
 fields. The ``RigidEngine`` object on the model holds only what can be rebuilt: the
-candidate pairs, the time step and timings. A restored run continues bit for bit.
+candidate pairs, the time step and timings. A restored run continues bit for bit (with
+`mass-scale body`: to round-off, its masses are worked out again from the geometry).
 
 Detection is ``contacts.ContactDetection`` (mixed in). Cycling (kernel ``cycle.run_steps``):
 many steps per call, up to the next detection, history sample, VTK snapshot or solve check.
@@ -20,6 +21,8 @@ import numpy as np
 from dec3d.errors import Dec3dError
 from dec3d.io.vtk import periodic_vtk
 from dec3d.kernels.balance import body_balance
+from dec3d.kernels.bodyscale import body_row_sums
+from dec3d.kernels.contactmap import blocks_moved
 from dec3d.kernels.cycle import run_steps
 from dec3d.kernels.gpcontact import mixed_move_points, mixed_subcontact_forces, surface_weights
 from dec3d.kernels.joints import P_KN, P_KS
@@ -31,11 +34,13 @@ from dec3d.model.feblocks import has_feblocks
 from dec3d.model.zones import has_zones
 
 from .bodies import group_properties, inertial_masses, new_servo
+from . import contacts as _contacts
 from .contacts import ContactDetection, contact_stores, default_row
 from .energy import is_active as is_energy_active
 from .dynamic import DYN_DEFAULTS, TimeFunctions, has_timefns, rayleigh_coefficients, stiffness_timestep
+from .history import HistorySet
 from .jmodels import JOINT_MODELS
-from .runcontrol import CycleInterrupted, _Progress, _sigint_stops_cycling, _StopFlag, request_stop  # noqa: F401  (request_stop: part of this module's API)
+from .runcontrol import CycleInterrupted, _Progress, _sigint_stops_cycling, _StopFlag  # noqa: F401  (request_stop: part of this module's API)
 
 _F = np.float64
 _I = np.int64
@@ -53,6 +58,8 @@ MECH_DEFAULTS = {
     "servo": [],               # adaptive global damping state (kernels.motion, first NSERVO entries)
     "servo_ratio": 0.5,        # its target ratio
     "scale_timestep": None,    # Δt wanted with density scaling [s] (None: Eq. 87, median body)
+    "scaling": "eq87",         # density scaling: eq87 (Eq. 87, masses only raised) | body (stiffness row sums)
+    "safety": None,            # body scaling: ω_max Δt ≤ 2 × safety (None: SAFETY by damping mode)
     "dt_run": [],              # [Δt, step]: the step the last rigid run ended on and the Δt it was using
     **DYN_DEFAULTS,            # dynamic mode, dynamic time, Rayleigh damping, time functions (physics.dynamic)
 }
@@ -74,6 +81,15 @@ def _deformable(kind):
 
 def _has_gridpoints(m) -> bool:
     return has_zones(m) or has_feblocks(m)
+
+#: default ``safety`` of density scaling by body, per damping mode: local (and combined) damping
+#: takes the sign of a half-step-old velocity, which at ω Δt near 1.6 lags enough to sustain a
+#: rocking cycle (a joined column failed to settle at 0.8, settled at 0.75); the viscous
+#: adaptive damping settles there (dec3d's measurements, bench/README.md)
+SAFETY = {"local": 0.7, "combined": 0.7, "global": 0.8, "none": 0.8}
+
+#: leave out a periodic detection that would look at no pair again (``_Run.quiet``)
+SKIP_QUIET = True
 
 #: target wall time of one kernel call [s]: Ctrl-C and progress are seen at least this often
 CHUNK_SECONDS = 0.2
@@ -225,6 +241,8 @@ class RigidEngine(ContactDetection):
         if not self.mass_scaling() or not len(gmass):
             dt = dt_fixed if dt_fixed is not None else stiffness_timestep(self.timestep(), self.rayleigh_beta())
             return dt, gmass.copy(), giscalar.copy()
+        if s["scaling"] == "body":
+            return self._body_masses(gstart, gmember, gmass, giscalar, dt_fixed)
         kg = self._stiffness_sums(gstart, gmember)
         if dt_fixed is None and s["scale_timestep"]:
             dt_fixed = float(s["scale_timestep"])
@@ -237,6 +255,52 @@ class RigidEngine(ContactDetection):
             dt = (block_timestep(float(np.median(gmass[on])), float(np.median(kg[on])), frac)
                   if on.any() else self.timestep())
         im, isc = inertial_masses(gmass, giscalar, kg, dt, frac)
+        return dt, im, isc
+
+    def _body_masses(self, gstart, gmember, gmass, giscalar, dt_fixed):
+        """Density scaling by body (``mass-scale body``): every body's inertial mass and scalar
+        inertia set from the Gershgorin row sums of the contact stiffness around it (kernel
+        ``bodyscale.body_row_sums``) so that each body has the same critical step, and the
+        largest natural frequency ω_max of the scaled system obeys ω_max Δt ≤ 2 × safety:
+
+            m_i = R_t (Δt / 2s)²,   I_i = R_r (Δt / 2s)²   (bodies without contacts keep m and I).
+
+        Δt: the one at which the body of median m / R_t keeps its real mass (or the step given
+        with `mass-scale ... timestep`). This is the 3DEC theory text's nodal step (Eq. 84, mass
+        over the sum of the stiffnesses around the node, here bounded over the six degrees of freedom
+        of a rigid body) used the way "Mass (Density) Scaling" uses it: inertial masses chosen so
+        that every part of the model has the same step. With full inertia (Euler's equations) the
+        principal moments take the larger of the two ratios m_i / m, I_i / I."""
+        s = self.settings()
+        safety = float(s["safety"] or SAFETY.get(s["damping"], 0.7))
+        b = self.model.blocks
+        cs, ss = self.contacts, self.subcontacts
+        ng = len(gstart) - 1
+        gid = np.full(b.n, -1, dtype=_I)
+        gid[gmember] = np.repeat(np.arange(ng), np.diff(gstart))
+        mc = b["mass"][gmember][:, None] * b["centroid"][gmember]
+        gcen = np.add.reduceat(mc, gstart[:-1], axis=0) / gmass[:, None]
+        rho = np.sqrt(giscalar / gmass)
+        held = (b["fixity"] | b["apply_fix"])[gmember[gstart[:-1]]].astype(_I)
+        rt = np.zeros(ng)
+        rr = np.zeros(ng)
+        body_row_sums(gid, gcen, rho, held, cs["a"], cs["b"], cs["normal"], np.ascontiguousarray(cs["prop"][:, P_KN]),
+                      np.ascontiguousarray(cs["prop"][:, P_KS]), ss["contact"], ss["pos"], ss["area"], rt, rr)
+        if dt_fixed is None and s["scale_timestep"]:
+            dt_fixed = float(s["scale_timestep"])
+        on = rt > 0
+        if dt_fixed is not None:
+            dt = dt_fixed
+        elif on.any():
+            dt = 2.0 * safety * float(np.median(np.sqrt(gmass[on] / rt[on])))
+        else:
+            dt = self.timestep()
+        f = (dt / (2.0 * safety)) ** 2
+        im = np.where(on, rt * f, gmass)
+        isc = np.where(rr > 0, rr * f, giscalar)
+        if self.full_inertia():
+            ratio = np.maximum(im / gmass, isc / giscalar)
+            im, isc = gmass * ratio, giscalar * ratio
         return dt, im, isc
 
     # ------------------------------------------------------------ equilibrium measures
@@ -450,8 +514,11 @@ class RigidEngine(ContactDetection):
         try:
             while run.done < nsteps and not _StopFlag.requested:
                 if run.detection_due():
-                    self.detect()
-                    run.detected()
+                    if run.quiet():
+                        run.skipped()
+                    else:
+                        self.detect()
+                        run.detected()
                 k = min(nsteps - run.done, interval - m.step % interval)
                 for h in self.step_hooks:
                     hi = int(getattr(h, "interval", 0) or 0)
@@ -667,6 +734,8 @@ class _Run:
         fresh = eng._signature != eng._geometry_signature()
         if fresh:
             eng.detect()
+        #: a detection has run in this run (``quiet`` never leaves out the first one)
+        self.looked = fresh
         self.mixed = eng._zone_contacts_check() if self.zoned else False
         # Δt follows the contact stiffnesses: worked out again at every detection. A run that
         # starts between two detections, on the step where the last run ended and with the
@@ -725,10 +794,37 @@ class _Run:
         return ((self.m.step % self.interval == 0 or self.due)
                 and (not self.zoned or bool(self.ng) or self.large))
 
+    def quiet(self) -> bool:
+        """Whether the detection now due may be left out (``SKIP_QUIET``): no block has moved more
+        than QUIET × CTOL since it was last looked at, so detection would look at no pair again
+        and keep every contact and sub-contact as it is. Never for the first detection of a run
+        (commands between runs may have changed contact defaults, which a detection applies), nor
+        with zoned blocks, a motion trigger, a geometry change, or a step hook other than
+        histories (a FISH callback may change what a detection reads)."""
+        eng = self.eng
+        if (not SKIP_QUIET or not self.looked or self.zoned or self.due or _contacts.QUIET <= 0.0
+                or eng._signature != eng._geometry_signature() or eng.settings().get("grid") is None
+                or any(not isinstance(h, HistorySet) for h in eng.step_hooks)):
+            return False
+        t0 = _time.perf_counter()
+        b, v = self.b, self.m.vertices
+        moved = np.zeros(b.n, bool)
+        blocks_moved(v["pos"], v["look_pos"], b["vert_start"], b["vert_count"], _contacts.QUIET * eng.tolerance(),
+                     moved)
+        eng.timings["detect"] += _time.perf_counter() - t0
+        return not moved.any()
+
+    def skipped(self) -> None:
+        """A detection left out: what one that keeps every contact would do — the motion
+        bounds start again; contacts, Δt and masses stay."""
+        self.acc[:] = 0.0
+        self.due = False
+
     def detected(self) -> None:
         """After a detection: contacts changed, so the steps prepare again and Δt and the
         masses follow the new stiffnesses."""
         eng = self.eng
+        self.looked = True
         if self.zoned:
             self.mixed = eng._zone_contacts_check()
         self.acc[:] = 0.0
