@@ -114,6 +114,31 @@ def surface_weights(owner, pts, ca, cb, zoned, vpos, bfstart, bfcount, fvstart, 
 
 
 @njit(cache=True)
+def vertex_sides(kind, key0, ca, cb, sc_contact, zoned, nodes_a, w_a, nodes_b, w_b):
+    """The vertex side of vertex-face sub-contacts on a zoned block is its own gridpoint (3DEC
+    theory, "Sub-contact Force Update": on the vertex side the force is added to that gridpoint,
+    whose velocity is the vertex velocity): node key0 with weight 1, in place of the nearest
+    triangle ``surface_weights`` found (the point on the c-p lies off the vertex by half the gap).
+    kind (ns,) 0 A's vertex, 1 B's vertex, others untouched; key0 (ns,) the vertex row."""
+    for s in range(kind.shape[0]):
+        k = kind[s]
+        if k != 0 and k != 1:
+            continue
+        c = sc_contact[s]
+        blk = ca[c] if k == 0 else cb[c]
+        if not zoned[blk]:
+            continue
+        nodes = nodes_a if k == 0 else nodes_b
+        w = w_a if k == 0 else w_b
+        nodes[s, 0] = key0[s]
+        nodes[s, 1] = -1
+        nodes[s, 2] = -1
+        w[s, 0] = 1.0
+        w[s, 1] = 0.0
+        w[s, 2] = 0.0
+
+
+@njit(cache=True)
 def _side_velocity(x0, x1, x2, blk, nodes, w, i, bpos, bvel, bspin, gvel):
     if nodes[i, 0] < 0:
         r0 = x0 - bpos[blk, 0]
