@@ -8,8 +8,14 @@ interpolation factors of the point in the face triangle).
 Every sub-contact gets, for each of its two sides, up to three gridpoint rows and weights
 (``nodes`` (k, 3) int64, ``w`` (k, 3)): the surface triangle of that block nearest to the
 point and the barycentric coordinates of the nearest point of the triangle (clamped to it,
-so they are ≥ 0 and sum to 1). A vertex sub-contact gets weight 1 on its vertex, one on an
-edge the two edge weights. A rigid side gets node -1 and moves with its block (Eq. 11).
+so they are ≥ 0 and sum to 1) — the face side's interpolation factors of the text;
+``vertex_sides`` then puts the vertex side of a vertex sub-contact on its own gridpoint
+(weight 1). A rigid side gets node -1 and moves with its block (Eq. 11). Between two zoned
+blocks both sides are interpolated this way: the force on B goes to B's gridpoints, its
+opposite to A's, so the two blocks' forces and (when the point lies in both faces) moments
+balance exactly. The weights are made at each detection and kept until the next (the text:
+"sub-contact locations and weights are updated every 10 steps"), which relocates a
+sub-contact onto the triangle its gridpoint has moved onto.
 
 With the weights fixed between two detection passes, one step is:
   V = v_B(x) − v_A(x), v_side(x) = Σ wᵢ vᵢ (zoned) or ẋ + ω × (x − x̄) (rigid)   (Eq. 15)
