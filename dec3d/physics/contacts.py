@@ -431,6 +431,18 @@ class ContactDetection:
             look[sel] = vpos[sel]
         self.timings["detect"] += _time.perf_counter() - t0
 
+    def follow_defaults(self) -> None:
+        """Contacts that follow the material-table defaults (``own_props`` 0) take them now, as a
+        detection would (for runs in which no detection is due: zoned blocks alone in small strain)."""
+        cs = self.contacts
+        if not cs.n:
+            return
+        s = self.settings()
+        follow = cs["own_props"] == 0
+        for code in np.unique(cs["jmodel"][follow]):
+            sel = follow & (cs["jmodel"] == code)
+            cs["prop"][sel] = default_row(s, int(code))
+
     def ensure_contacts(self) -> None:
         """Detect now if the blocks changed since the last detection (3DEC keeps contacts
         current whenever blocks exist, so contact commands see them before any cycle)."""

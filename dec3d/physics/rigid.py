@@ -21,7 +21,8 @@ from dec3d.errors import Dec3dError
 from dec3d.io.vtk import periodic_vtk
 from dec3d.kernels.balance import body_balance
 from dec3d.kernels.cycle import run_steps
-from dec3d.kernels.gpcontact import mixed_move_points, mixed_subcontact_forces, surface_weights, vertex_sides
+from dec3d.kernels.gpcontact import (mixed_move_points, mixed_subcontact_forces, surface_weights,
+                                    take_contact_forces, vertex_sides)
 from dec3d.kernels.jointlaw import P_KN, P_KS
 from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, NSERVO, S_HIST, block_timestep,
                                   rigid_motion_groups)
@@ -540,17 +541,15 @@ class RigidEngine(ContactDetection):
         gvel = v["velocity"]
         gc = np.zeros((v.n, 3))
         touched = np.unique(np.concatenate((wsub[0].ravel(), wsub[2].ravel())))
-        touched = touched[touched >= 0]
+        touched = np.ascontiguousarray(touched[touched >= 0])
         cown = np.arange(cs.n, dtype=_I)
         for _ in range(k):
             facc = zst.begin()
-            gc[touched] = 0.0
             mixed_subcontact_forces(dt, b["centroid"], b["velocity"], b["spin"], b["force"], b["moment"], gvel, gc,
                                     cs["a"], cs["b"], cs["normal"], cs["jmodel"], cs["prop"], ss["contact"], ss["pos"],
                                     ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"],
                                     *wsub)
-            facc[touched] += gc[touched]
-            zst.fmag[touched] += np.linalg.norm(gc[touched], axis=1)
+            take_contact_forces(touched, gc, facc, zst.fmag)
             if len(gmember):
                 gbad = rigid_motion_groups(dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass, gisc,
                                            gprin, gaxes, gcen, b["mass"], fixity, b["force"], b["moment"], b["fapp"],
@@ -644,10 +643,12 @@ class _Run:
         self.steps = ([MixedContacts(self), RigidBatch(self, chunked=False), ZoneStep(self)] if self.zoned
                       else [RigidBatch(self, chunked=True)]) + [Clock(self), Hooks(self)]
         fresh = eng._signature != eng._geometry_signature()
-        if fresh or (self.zoned and not self.ng and not self.large):
+        if fresh:
+            eng.detect()
+        elif self.zoned and not self.ng and not self.large:
             # (zoned blocks alone in small strain never reach a periodic detection: the contacts
             # take the material-table defaults set since the last one here)
-            eng.detect()
+            eng.follow_defaults()
         self.mixed = eng._zone_contacts_check() if self.zoned else False
         # Δt follows the contact stiffnesses: worked out again at every detection. A run that
         # starts between two detections, on the step where the last run ended and with the

@@ -164,3 +164,20 @@ def test_joined_zoned_pairs_carry_no_area():
     joined_zoned_inert(sc, area, zoned, leader, ra, rb)
     assert list(area) == [0.0, 0.0, 0.3, 0.4, 0.5]
 
+
+
+def test_take_contact_forces_adds_forces_and_magnitudes_and_clears():
+    from dec3d.kernels.gpcontact import take_contact_forces
+    rng = np.random.default_rng(5)
+    gc = rng.normal(size=(6, 3))
+    facc = rng.normal(size=(6, 3))
+    fmag = rng.random(6)
+    rows = np.array([4, 1, 2])
+    want_f, want_m, want_gc = facc.copy(), fmag.copy(), gc.copy()
+    for r in rows:                           # the twin: plain Python per row
+        want_f[r] = [facc[r, d] + gc[r, d] for d in range(3)]
+        want_m[r] = fmag[r] + sum(x * x for x in gc[r]) ** 0.5
+        want_gc[r] = 0.0
+    take_contact_forces(rows, gc, facc, fmag)
+    assert np.allclose(facc, want_f, rtol=1e-15, atol=0) and np.allclose(fmag, want_m, rtol=1e-15, atol=0)
+    assert np.array_equal(gc, want_gc)       # rows not listed keep their values
