@@ -24,7 +24,7 @@ def test_every_verification_problem_is_there():
                                          "D1_uniaxial_tet", "D1_uniaxial_hex", "D1_uniaxial_ho", "D2_self_weight",
                                          "D3_elastic_hole_tet", "D3_elastic_hole_hex", "D3_elastic_hole_ho",
                                          "D4_triaxial", "D5_strip_footing", "D7_rigid_on_deformable",
-                                         "D8_jointed_deformable"}
+                                         "D8_jointed_deformable", "D9_wedge_deformable"}
 
 
 def _demo(tmp_path, expects: str):
