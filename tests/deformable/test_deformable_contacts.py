@@ -190,3 +190,28 @@ def test_pressed_and_sheared_zoned_blocks_split_and_restored_are_one_run(tmp_pat
     assert one[3].sum() > 0 and np.abs(one[4]).max() > 0 and np.abs(one[1]).max() > 1e-4
     for a, b in zip(one, split):
         assert np.array_equal(a, b)
+
+
+def test_joint_stiffness_between_zoned_blocks_enters_the_time_step(tmp_path):
+    """Dynamic run (no damping, real masses): Δt = 2 min (m / k)^½ over the gridpoints (Eq. 84),
+    k the zones' stiffness plus the joint's max(kn, ks)·area of every sub-contact, shared to the
+    gridpoints by its weights (Eq. 85), on both zoned blocks. A very stiff joint sets Δt."""
+    dts = {}
+    for kn in ("1e8", "1e14"):
+        s = _run(tmp_path, _stack(kn=kn) + ["block mechanical damping none", "model cycle 1"])
+        m = s.model
+        zst = m.rigid_engine._zstep
+        ss, cs = m.store("subcontacts"), m.store("contacts")
+        kj = np.zeros(m.vertices.n)
+        for k in range(ss.n):
+            ka = float(kn) * ss["area"][k]
+            for nodes, w in ((ss["gp_a"][k], ss["gw_a"][k]), (ss["gp_b"][k], ss["gw_b"][k])):
+                for g, wi in zip(nodes, w):
+                    if g >= 0:
+                        kj[g] += wi * ka
+        assert set(ss["kind"]) == {0, 1} and cs["prop"][0, 0] == float(kn)
+        rows = zst.masters
+        want = 2.0 * np.sqrt(zst.mtot[rows] / (zst.kzone[rows] + kj[rows])).min()
+        assert abs(m.rigid_engine.dt / want - 1) < 1e-12
+        dts[kn] = m.rigid_engine.dt
+    assert dts["1e14"] < 0.2 * dts["1e8"]
