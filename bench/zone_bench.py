@@ -16,7 +16,13 @@ The scene is built through the public command API (``dec3d.Session().command``).
 a fresh process (``--child``); the median of ``--repeat`` runs is printed, with the machine and
 /proc/loadavg before and after (the machine is shared: read the figures with the load).
 
-    python bench/zone_bench.py [--zones 1e4 1e5 1e6] [--steps 50] [--repeat 3] [--threads 1 2]
+    python bench/zone_bench.py [--zones 1e4 1e5 1e6] [--steps 50] [--repeat 3] [--threads 1 2] [--jointed]
+
+``--jointed``: the cube cut by three orthogonal joint sets (spacing 0.25 m) into 64 blocks, each
+zoned, Coulomb joints (kn = ks = 1e11 Pa/m, friction 30°) between them (contacts between
+deformable blocks: a sub-contact at every surface gridpoint of both blocks on each joint), under
+gravity and 1 MPa on the top face, rollers on the sides and base. Also printed: the sub-contacts
+and sub-contact updates/s (sub-contacts × timed steps / wall time).
 
 ``--threads N`` calls numba.set_num_threads(N) in each run (dec3d has no `model configure
 threads` command; numba's own count is the default).  The edge length for N zones is
@@ -54,6 +60,29 @@ def deck(length: float) -> str:
     ]) + "\n"
 
 
+def deck_jointed(length: float) -> str:
+    """The unit cube in 4 × 4 × 4 blocks (three joint sets), each zoned at ``length``, jointed."""
+    return "\n".join([
+        "model new",
+        "block create brick 0 1 0 1 0 1",
+        "block cut joint-set dip 90 dip-direction 90 origin 0.25 0 0 spacing 0.25 number 3",
+        "block cut joint-set dip 90 dip-direction 0 origin 0 0.25 0 spacing 0.25 number 3",
+        "block cut joint-set dip 0 dip-direction 0 origin 0 0 0.25 spacing 0.25 number 3",
+        f"block zone generate edgelength {length:.6g}",
+        "block zone cmodel assign elastic",
+        "block zone property young 10e9 poisson 0.25 density 2500",
+        "block contact jmodel assign mohr",
+        "block contact material-table default property stiffness-normal 1e11 stiffness-shear 1e11 friction 30",
+        "model gravity 0 0 -10",
+        "block gridpoint apply velocity-z 0 range position-z 0",
+        "block gridpoint apply velocity-x 0 range position-x 0",
+        "block gridpoint apply velocity-x 0 range position-x 1",
+        "block gridpoint apply velocity-y 0 range position-y 0",
+        "block gridpoint apply velocity-y 0 range position-y 1",
+        "block face apply stress-zz -1e6 range position-z 1",
+    ]) + "\n"
+
+
 def _rss_bytes() -> int:
     with open("/proc/self/status", encoding="utf-8") as f:
         for line in f:
@@ -78,7 +107,7 @@ def _stepper_bytes(model) -> int:
     return int(sum(v.nbytes for v in vars(zst).values() if isinstance(v, np.ndarray)))
 
 
-def one(zones: float, steps: int, threads: int | None = None) -> dict:
+def one(zones: float, steps: int, threads: int | None = None, jointed: bool = False) -> dict:
     """Build, warm up and time in this process."""
     import io
     import tempfile
@@ -94,14 +123,15 @@ def one(zones: float, steps: int, threads: int | None = None) -> dict:
 
     with tempfile.TemporaryDirectory() as d:
         # compile the kernels on a tiny cube first, so the RSS growth is the model's
+        scene = deck_jointed if jointed else deck
         w = dec3d.Session(out_dir=d, stdout=io.StringIO())
-        w.command(deck(0.5))
+        w.command(scene(0.5))
         w.command(f"model cycle {WARMUP}")
         del w
         s = dec3d.Session(out_dir=d, stdout=io.StringIO())
         rss0 = _rss_bytes()
         t0 = time.perf_counter()
-        s.command(deck(edge_length(zones)))
+        s.command(scene(edge_length(zones)))
         t1 = time.perf_counter()
         s.command(f"model cycle {WARMUP}")
         t2 = time.perf_counter()
@@ -113,7 +143,9 @@ def one(zones: float, steps: int, threads: int | None = None) -> dict:
         out = dict(threads=numba.get_num_threads(), zones=nz, gridpoints=m.vertices.n,
                    zoning_s=t1 - t0, warmup_s=t2 - t1, seconds=t3 - t2,
                    zones_b=_store_bytes(m.store("zones")), gp_b=_store_bytes(m.vertices),
-                   stepper_b=_stepper_bytes(m), rss_growth_b=rss1 - rss0)
+                   stepper_b=_stepper_bytes(m), rss_growth_b=rss1 - rss0, blocks=m.blocks.n,
+                   subcontacts=m.store("subcontacts").n if "subcontacts" in m.stores else 0,
+                   contacts_b=sum(_store_bytes(m.store(k)) for k in ("contacts", "subcontacts") if k in m.stores))
     return out
 
 
@@ -132,25 +164,29 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=3, help="runs per size (median printed)")
     ap.add_argument("--threads", type=int, nargs="+", default=[0],
                     help="numba thread counts to run (numba.set_num_threads); 0: numba's own")
+    ap.add_argument("--jointed", action="store_true", help="the cube in 64 jointed zoned blocks")
     ap.add_argument("--child", type=float, help=argparse.SUPPRESS)
     ap.add_argument("--child-threads", type=int, default=0, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
-        print(json.dumps(one(args.child, args.steps, args.child_threads or None)))
+        print(json.dumps(one(args.child, args.steps, args.child_threads or None, args.jointed)))
         return 0
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     from rigid_bench import machine, run_children
 
     print(f"machine: {machine()}")
     print(f"loadavg before: {loadavg()}")
-    print(f"scene: unit cube of 4-node tetrahedra under gravity, elastic, base held; {WARMUP} warm-up + "
-          f"{args.steps} timed steps, median of {args.repeat}")
+    what = ("unit cube in 64 jointed zoned blocks (Coulomb joints), gravity + 1 MPa on top, rollers"
+            if args.jointed else "unit cube of 4-node tetrahedra under gravity, elastic, base held")
+    print(f"scene: {what}; {WARMUP} warm-up + {args.steps} timed steps, median of {args.repeat}")
     print(f"{'threads':>7} {'zones':>8} {'gridpts':>8} {'zoning s':>8} {'seconds':>8} {'min..max':>15} "
-          f"{'zone-cyc/s':>11} {'zones B/z':>9} {'gp B/z':>7} {'step B/z':>8} {'total B/z':>9} {'RSS B/z':>8}")
+          f"{'zone-cyc/s':>11} {'zones B/z':>9} {'gp B/z':>7} {'step B/z':>8} {'total B/z':>9} {'RSS B/z':>8}"
+          + (f" {'subcont':>8} {'sub-upd/s':>10} {'cont B/z':>8}" if args.jointed else ""))
     for th in args.threads:
         for n in args.zones:
             runs = run_children([sys.executable, os.path.abspath(__file__), "--child", str(n),
-                                 "--steps", str(args.steps), "--child-threads", str(th)],
+                                 "--steps", str(args.steps), "--child-threads", str(th)]
+                                + (["--jointed"] if args.jointed else []),
                                 args.repeat, f"zones = {n:g}")
             sec = [r["seconds"] for r in runs]
             t = statistics.median(sec)
@@ -162,7 +198,9 @@ def main(argv=None) -> int:
             print(f"{r0['threads']:>7} {nz:>8} {r0['gridpoints']:>8} "
                   f"{statistics.median(r['zoning_s'] for r in runs):>8.2f} {t:>8.3f} "
                   f"{min(sec):>7.3f}..{max(sec):<7.3f} {rate:>11.4g} {zb:>9.0f} {gb:>7.0f} {sb:>8.0f} "
-                  f"{zb + gb + sb:>9.0f} {rss:>8.0f}", flush=True)
+                  f"{zb + gb + sb:>9.0f} {rss:>8.0f}"
+                  + (f" {r0['subcontacts']:>8} {r0['subcontacts'] * args.steps / t:>10.4g} "
+                     f"{r0['contacts_b'] / nz:>8.0f}" if args.jointed else ""), flush=True)
     print(f"loadavg after: {loadavg()}")
     return 0
 

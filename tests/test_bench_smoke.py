@@ -94,3 +94,22 @@ def test_zone_bench_edge_length_gives_about_the_zones_asked():
     loops = np.array([[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]]).ravel()
     _pts, tets, _tris, _src = mesh_convex(v, np.arange(0, 25, 4), loops, zb.edge_length(2e4))
     assert abs(len(tets) / 2e4 - 1) < 0.25
+
+
+def test_zone_bench_jointed_case_prints_its_subcontact_figures():
+    """bench/zone_bench.py --jointed on a coarse 64-block cube, one thread: sub-contacts on the joints
+    between the zoned blocks, a positive sub-contact update rate and contact memory per zone."""
+    out = subprocess.run([sys.executable, str(ROOT / "bench" / "zone_bench.py"), "--zones", "1000", "--steps", "3",
+                          "--repeat", "1", "--threads", "1", "--jointed"], capture_output=True, text=True,
+                         timeout=300, cwd=ROOT,
+                         env={**os.environ, "PYTHONPATH": os.pathsep.join(
+                             [str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])})
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert "64 jointed zoned blocks" in lines[2]
+    head = next(i for i, ln in enumerate(lines) if ln.split()[:2] == ["threads", "zones"])
+    assert lines[head].split()[-4:] == ["subcont", "sub-upd/s", "cont", "B/z"]
+    row = lines[head + 1].split()
+    # every one of the 64 blocks has at least 4 zones; the 144 face-face joints have sub-contacts
+    assert int(row[1]) >= 64 * 4 and int(row[-3]) >= 144 * 3
+    assert float(row[-2]) > 0 and float(row[-1]) > 0

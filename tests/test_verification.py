@@ -24,6 +24,7 @@ def test_every_verification_problem_is_there():
                                          "D1_uniaxial_tet", "D1_uniaxial_hex", "D1_uniaxial_ho", "D2_self_weight",
                                          "D3_elastic_hole_tet", "D3_elastic_hole_hex", "D3_elastic_hole_ho",
                                          "D4_triaxial", "D5_strip_footing", "D6_mohr_hole", "D7_rigid_on_deformable",
+                                         "D8_jointed_deformable", "D9_wedge_deformable",
                                          "E1_eigenmodes", "DY1_rayleigh_block_on_spring", "DY2_newmark_sliding_block",
                                          "DY3_shear_wave_quiet_base", "DY5_energy"}
 

@@ -8,8 +8,14 @@ interpolation factors of the point in the face triangle).
 Every sub-contact gets, for each of its two sides, up to three gridpoint rows and weights
 (``nodes`` (k, 3) int64, ``w`` (k, 3)): the surface triangle of that block nearest to the
 point and the barycentric coordinates of the nearest point of the triangle (clamped to it,
-so they are ≥ 0 and sum to 1). A vertex sub-contact gets weight 1 on its vertex, one on an
-edge the two edge weights. A rigid side gets node -1 and moves with its block (Eq. 11).
+so they are ≥ 0 and sum to 1) — the face side's interpolation factors of the text;
+``vertex_sides`` then puts the vertex side of a vertex sub-contact on its own gridpoint
+(weight 1). A rigid side gets node -1 and moves with its block (Eq. 11). Between two zoned
+blocks both sides are interpolated this way: the force on B goes to B's gridpoints, its
+opposite to A's, so the two blocks' forces and (when the point lies in both faces) moments
+balance exactly. The weights are made at each detection and kept until the next (the text:
+"sub-contact locations and weights are updated every 10 steps"), which relocates a
+sub-contact onto the triangle its gridpoint has moved onto.
 
 With the weights fixed between two detection passes, one step is:
   V = v_B(x) − v_A(x), v_side(x) = Σ wᵢ vᵢ (zoned) or ẋ + ω × (x − x̄) (rigid)   (Eq. 15)
@@ -113,49 +119,28 @@ def surface_weights(owner, pts, ca, cb, zoned, vpos, bfstart, bfcount, fvstart, 
 
 
 @njit(cache=True)
-def _side_velocity(x0, x1, x2, blk, nodes, w, i, bpos, bvel, bspin, gvel):
-    if nodes[i, 0] < 0:
-        r0 = x0 - bpos[blk, 0]
-        r1 = x1 - bpos[blk, 1]
-        r2 = x2 - bpos[blk, 2]
-        wv = bspin[blk]
-        return (bvel[blk, 0] + wv[1] * r2 - wv[2] * r1,
-                bvel[blk, 1] + wv[2] * r0 - wv[0] * r2,
-                bvel[blk, 2] + wv[0] * r1 - wv[1] * r0)
-    v0 = 0.0
-    v1 = 0.0
-    v2 = 0.0
-    for j in range(3):
-        g = nodes[i, j]
-        if g >= 0:
-            v0 += w[i, j] * gvel[g, 0]
-            v1 += w[i, j] * gvel[g, 1]
-            v2 += w[i, j] * gvel[g, 2]
-    return v0, v1, v2
-
-
-@njit(cache=True)
-def _side_force(sign, g0, g1, g2, x0, x1, x2, blk, nodes, w, i, bpos, bforce, bmoment, gforce):
-    f0 = sign * g0
-    f1 = sign * g1
-    f2 = sign * g2
-    if nodes[i, 0] < 0:
-        r0 = x0 - bpos[blk, 0]
-        r1 = x1 - bpos[blk, 1]
-        r2 = x2 - bpos[blk, 2]
-        bforce[blk, 0] += f0
-        bforce[blk, 1] += f1
-        bforce[blk, 2] += f2
-        bmoment[blk, 0] += r1 * f2 - r2 * f1
-        bmoment[blk, 1] += r2 * f0 - r0 * f2
-        bmoment[blk, 2] += r0 * f1 - r1 * f0
-        return
-    for j in range(3):
-        g = nodes[i, j]
-        if g >= 0:
-            gforce[g, 0] += w[i, j] * f0
-            gforce[g, 1] += w[i, j] * f1
-            gforce[g, 2] += w[i, j] * f2
+def vertex_sides(kind, key0, ca, cb, sc_contact, zoned, nodes_a, w_a, nodes_b, w_b):
+    """The vertex side of vertex-face sub-contacts on a zoned block is its own gridpoint (3DEC
+    theory, "Sub-contact Force Update": on the vertex side the force is added to that gridpoint,
+    whose velocity is the vertex velocity): node key0 with weight 1, in place of the nearest
+    triangle ``surface_weights`` found (the point on the c-p lies off the vertex by half the gap).
+    kind (ns,) 0 A's vertex, 1 B's vertex, others untouched; key0 (ns,) the vertex row."""
+    for s in range(kind.shape[0]):
+        k = kind[s]
+        if k != 0 and k != 1:
+            continue
+        c = sc_contact[s]
+        blk = ca[c] if k == 0 else cb[c]
+        if not zoned[blk]:
+            continue
+        nodes = nodes_a if k == 0 else nodes_b
+        w = w_a if k == 0 else w_b
+        nodes[s, 0] = key0[s]
+        nodes[s, 1] = -1
+        nodes[s, 2] = -1
+        w[s, 0] = 1.0
+        w[s, 1] = 0.0
+        w[s, 2] = 0.0
 
 
 @njit(cache=True)
@@ -165,22 +150,44 @@ def mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce
                             nodes_a, w_a, nodes_b, w_b):
     """One force update of every sub-contact when some blocks are zoned: as
     ``jointlaw.subcontact_forces``, with each zoned side's velocity interpolated from its
-    gridpoints (gvel (nv, 3)) and its force shared to them (added to gforce (nv, 3))."""
+    gridpoints (gvel (nv, 3)) and its force shared to them (added to gforce (nv, 3)).
+
+    (Both sides are written out in one loop over ``side`` rather than through a helper that
+    returns a tuple: numba compiled that form some 40 times slower.)"""
     for s in range(sc_contact.shape[0]):
         c = sc_contact[s]
-        a = ca[c]
-        b = cb[c]
         n0 = cn[c, 0]
         n1 = cn[c, 1]
         n2 = cn[c, 2]
         x0 = sc_pos[s, 0]
         x1 = sc_pos[s, 1]
         x2 = sc_pos[s, 2]
-        va0, va1, va2 = _side_velocity(x0, x1, x2, a, nodes_a, w_a, s, bpos, bvel, bspin, gvel)
-        vb0, vb1, vb2 = _side_velocity(x0, x1, x2, b, nodes_b, w_b, s, bpos, bvel, bspin, gvel)
-        du0 = (vb0 - va0) * dt
-        du1 = (vb1 - va1) * dt
-        du2 = (vb2 - va2) * dt
+        # V = v_B(x) - v_A(x) (Eq. 15), each side rigid (Eq. 11) or interpolated (zoned)
+        du0 = 0.0
+        du1 = 0.0
+        du2 = 0.0
+        for side in range(2):
+            blk = ca[c] if side == 0 else cb[c]
+            nodes = nodes_a if side == 0 else nodes_b
+            w = w_a if side == 0 else w_b
+            sg = -1.0 if side == 0 else 1.0
+            if nodes[s, 0] < 0:
+                r0 = x0 - bpos[blk, 0]
+                r1 = x1 - bpos[blk, 1]
+                r2 = x2 - bpos[blk, 2]
+                du0 += sg * (bvel[blk, 0] + bspin[blk, 1] * r2 - bspin[blk, 2] * r1)
+                du1 += sg * (bvel[blk, 1] + bspin[blk, 2] * r0 - bspin[blk, 0] * r2)
+                du2 += sg * (bvel[blk, 2] + bspin[blk, 0] * r1 - bspin[blk, 1] * r0)
+            else:
+                for j in range(3):
+                    g = nodes[s, j]
+                    if g >= 0:
+                        du0 += sg * w[s, j] * gvel[g, 0]
+                        du1 += sg * w[s, j] * gvel[g, 1]
+                        du2 += sg * w[s, j] * gvel[g, 2]
+        du0 *= dt
+        du1 *= dt
+        du2 *= dt
         dun = du0 * n0 + du1 * n1 + du2 * n2
         st0 = sc_state[s]
         if st0 & ST_NEW:
@@ -202,11 +209,32 @@ def mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce
         sc_us[s, 1] = u1
         sc_us[s, 2] = u2
         sc_state[s] = st
-        g0 = fn * n0 + f0
-        g1 = fn * n1 + f1
-        g2 = fn * n2 + f2
-        _side_force(1.0, g0, g1, g2, x0, x1, x2, b, nodes_b, w_b, s, bpos, bforce, bmoment, gforce)
-        _side_force(-1.0, g0, g1, g2, x0, x1, x2, a, nodes_a, w_a, s, bpos, bforce, bmoment, gforce)
+        # force on B: + (Fn n + Fs), on A: - (ERRATA Eqs. 28-32); B first, then A
+        for side in range(2):
+            blk = cb[c] if side == 0 else ca[c]
+            nodes = nodes_b if side == 0 else nodes_a
+            w = w_b if side == 0 else w_a
+            sg = 1.0 if side == 0 else -1.0
+            g0 = sg * (fn * n0 + f0)
+            g1 = sg * (fn * n1 + f1)
+            g2 = sg * (fn * n2 + f2)
+            if nodes[s, 0] < 0:
+                r0 = x0 - bpos[blk, 0]
+                r1 = x1 - bpos[blk, 1]
+                r2 = x2 - bpos[blk, 2]
+                bforce[blk, 0] += g0
+                bforce[blk, 1] += g1
+                bforce[blk, 2] += g2
+                bmoment[blk, 0] += r1 * g2 - r2 * g1
+                bmoment[blk, 1] += r2 * g0 - r0 * g2
+                bmoment[blk, 2] += r0 * g1 - r1 * g0
+            else:
+                for j in range(3):
+                    g = nodes[s, j]
+                    if g >= 0:
+                        gforce[g, 0] += w[s, j] * g0
+                        gforce[g, 1] += w[s, j] * g1
+                        gforce[g, 2] += w[s, j] * g2
 
 
 @njit(cache=True)
@@ -218,8 +246,46 @@ def mixed_move_points(dt, ca, cb, owner, pts, bpos, bvel, bspin, gvel, nodes_a, 
         x0 = pts[i, 0]
         x1 = pts[i, 1]
         x2 = pts[i, 2]
-        va0, va1, va2 = _side_velocity(x0, x1, x2, ca[c], nodes_a, w_a, i, bpos, bvel, bspin, gvel)
-        vb0, vb1, vb2 = _side_velocity(x0, x1, x2, cb[c], nodes_b, w_b, i, bpos, bvel, bspin, gvel)
-        pts[i, 0] += 0.5 * dt * (va0 + vb0)
-        pts[i, 1] += 0.5 * dt * (va1 + vb1)
-        pts[i, 2] += 0.5 * dt * (va2 + vb2)
+        m0 = 0.0
+        m1 = 0.0
+        m2 = 0.0
+        for side in range(2):
+            blk = ca[c] if side == 0 else cb[c]
+            nodes = nodes_a if side == 0 else nodes_b
+            w = w_a if side == 0 else w_b
+            if nodes[i, 0] < 0:
+                r0 = x0 - bpos[blk, 0]
+                r1 = x1 - bpos[blk, 1]
+                r2 = x2 - bpos[blk, 2]
+                m0 += bvel[blk, 0] + bspin[blk, 1] * r2 - bspin[blk, 2] * r1
+                m1 += bvel[blk, 1] + bspin[blk, 2] * r0 - bspin[blk, 0] * r2
+                m2 += bvel[blk, 2] + bspin[blk, 0] * r1 - bspin[blk, 1] * r0
+            else:
+                for j in range(3):
+                    g = nodes[i, j]
+                    if g >= 0:
+                        m0 += w[i, j] * gvel[g, 0]
+                        m1 += w[i, j] * gvel[g, 1]
+                        m2 += w[i, j] * gvel[g, 2]
+        pts[i, 0] = x0 + 0.5 * dt * m0
+        pts[i, 1] = x1 + 0.5 * dt * m1
+        pts[i, 2] = x2 + 0.5 * dt * m2
+
+
+@njit(cache=True)
+def take_contact_forces(rows, gc, facc, fmag):
+    """The contact forces gathered in gc (nv, 3) on gridpoint rows ``rows`` go to the step's force
+    accumulator facc and their magnitudes to fmag (the applied-force magnitude of the equilibrium
+    ratio); gc is zeroed there for the next step."""
+    for k in range(rows.shape[0]):
+        g = rows[k]
+        f0 = gc[g, 0]
+        f1 = gc[g, 1]
+        f2 = gc[g, 2]
+        facc[g, 0] += f0
+        facc[g, 1] += f1
+        facc[g, 2] += f2
+        fmag[g] += math.sqrt(f0 * f0 + f1 * f1 + f2 * f2)
+        gc[g, 0] = 0.0
+        gc[g, 1] = 0.0
+        gc[g, 2] = 0.0

@@ -160,6 +160,18 @@ def zoned_side_carries(sc_contact, kind, area, za, zb) -> None:
     area[sel] *= scale[c[sel]]
 
 
+def joined_zoned_inert(sc_c, area, zoned, leader, ra, rb) -> None:
+    """Contacts between two zoned blocks of one joined set (``block join``) carry no force: the
+    blocks share their gridpoints there (linked rows), so their sub-contacts get area 0 (dropped
+    by the caller), in place. sc_c (ns,) contact index of each sub-contact; area (ns,) [m²];
+    zoned (nb,) bool; leader (nb,) row of the leader (-1 or itself: not joined); ra, rb (nc,) rows."""
+    if not len(sc_c):
+        return
+    lead = np.where(leader < 0, np.arange(len(leader)), leader)
+    inert = zoned[ra] & zoned[rb] & (lead[ra] == lead[rb])
+    area[inert[sc_c]] = 0.0
+
+
 def default_row(s: dict, code: int) -> np.ndarray:
     """Property row of a contact of model ``code`` that follows the material-table defaults
     (the default properties this model has)."""
@@ -356,6 +368,7 @@ class ContactDetection:
         zoned = b["kind"] == KIND_DEFORMABLE
         if zoned.any():
             zoned_side_carries(sc_c, kind, area, zoned[f_ra], zoned[f_rb])
+            joined_zoned_inert(sc_c, area, zoned, b["leader"], f_ra, f_rb)
         live = area > 0.0
         if not live.all():
             sc_c, kind, key0, key1, pos, area = (x[live] for x in (sc_c, kind, key0, key1, pos, area))
@@ -417,6 +430,18 @@ class ContactDetection:
             sel = moved[m.vertices["block"]]
             look[sel] = vpos[sel]
         self.timings["detect"] += _time.perf_counter() - t0
+
+    def follow_defaults(self) -> None:
+        """Contacts that follow the material-table defaults (``own_props`` 0) take them now, as a
+        detection would (for runs in which no detection is due: zoned blocks alone in small strain)."""
+        cs = self.contacts
+        if not cs.n:
+            return
+        s = self.settings()
+        follow = cs["own_props"] == 0
+        for code in np.unique(cs["jmodel"][follow]):
+            sel = follow & (cs["jmodel"] == code)
+            cs["prop"][sel] = default_row(s, int(code))
 
     def ensure_contacts(self) -> None:
         """Detect now if the blocks changed since the last detection (3DEC keeps contacts

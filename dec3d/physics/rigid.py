@@ -24,7 +24,8 @@ from dec3d.kernels.balance import body_balance
 from dec3d.kernels.bodyscale import body_row_sums
 from dec3d.kernels.contactmap import blocks_moved
 from dec3d.kernels.cycle import run_steps
-from dec3d.kernels.gpcontact import mixed_move_points, mixed_subcontact_forces, surface_weights
+from dec3d.kernels.gpcontact import (mixed_move_points, mixed_subcontact_forces, surface_weights,
+                                    take_contact_forces, vertex_sides)
 from dec3d.kernels.joints import P_KN, P_KS
 from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, DAMP_RAYLEIGH, NSERVO, S_HIST,
                                   block_timestep, rigid_motion_groups)
@@ -547,22 +548,26 @@ class RigidEngine(ContactDetection):
 
     # ------------------------------------------------------------ models with zoned blocks
     def _zone_contacts_check(self) -> bool:
-        """Contacts between two zoned blocks are not wired yet (issue "deformable blocks II"):
-        refuse them, except between blocks of one joined set (linked gridpoints make those
-        inert). Returns whether some contact joins a zoned block and a rigid one."""
+        """Whether some contact has a zoned side (its sub-contact forces go to gridpoints, in
+        ``_mixed_steps``): zoned against rigid, or zoned against zoned (sub-contacts at the
+        surface gridpoints of both; within one joined set they carry none, see
+        ``contacts.joined_zoned_inert``). Contacts between two deformable blocks of which one is
+        an FE block are refused (not wired)."""
         b, cs = self.model.blocks, self.contacts
         if not cs.n:
             return False
-        za = _deformable(b["kind"][cs["a"]])
-        zb = _deformable(b["kind"][cs["b"]])
+        kind = b["kind"]
+        za = _deformable(kind[cs["a"]])
+        zb = _deformable(kind[cs["b"]])
         lead = np.where(b["leader"] < 0, np.arange(b.n), b["leader"])
-        bad = za & zb & (lead[cs["a"]] != lead[cs["b"]])
+        bad = (za & zb & (lead[cs["a"]] != lead[cs["b"]])
+               & ((kind[cs["a"]] == KIND_FE) | (kind[cs["b"]] == KIND_FE)))
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
-            raise RunError(f"{int(bad.sum())} contacts join two zoned (deformable) blocks that are not joined (the "
-                           f"first between blocks {int(cs['ida'][k])} and {int(cs['idb'][k])}): contacts between "
-                           "deformable blocks do not cycle yet (issue 10, next part); nothing was cycled")
-        return bool((za ^ zb).any())
+            raise RunError(f"{int(bad.sum())} contacts join an FE block to another deformable block that is not "
+                           f"joined to it (the first between blocks {int(cs['ida'][k])} and {int(cs['idb'][k])}): "
+                           "such contacts do not cycle yet; nothing was cycled")
+        return bool((za ^ zb).any() or (za & zb & (cs["sub_count"] > 0)).any())
 
     def _mixed_weights(self, zst, recompute: bool = True) -> tuple:
         """Gridpoint rows and interpolation weights of every sub-contact and contact point on a
@@ -591,6 +596,8 @@ class RigidEngine(ContactDetection):
                 k = len(owner)
                 na, wa, nb, wb = np.empty((k, 3), _I), np.empty((k, 3)), np.empty((k, 3), _I), np.empty((k, 3))
                 surface_weights(np.ascontiguousarray(owner), st["pos"], cs["a"], cs["b"], *geo, na, wa, nb, wb)
+                if st is ss:
+                    vertex_sides(ss["kind"], ss["key0"], cs["a"], cs["b"], owner, zoned, na, wa, nb, wb)
                 st["gp_a"][:] = na
                 st["gw_a"][:] = wa
                 st["gp_b"][:] = nb
@@ -618,17 +625,15 @@ class RigidEngine(ContactDetection):
         gvel = v["velocity"]
         gc = np.zeros((v.n, 3))
         touched = np.unique(np.concatenate((wsub[0].ravel(), wsub[2].ravel())))
-        touched = touched[touched >= 0]
+        touched = np.ascontiguousarray(touched[touched >= 0])
         cown = np.arange(cs.n, dtype=_I)
         for _ in range(k):
             facc = zst.begin()
-            gc[touched] = 0.0
             mixed_subcontact_forces(dt, b["centroid"], b["velocity"], b["spin"], b["force"], b["moment"], gvel, gc,
                                     cs["a"], cs["b"], cs["normal"], cs["jmodel"], cs["prop"], ss["contact"], ss["pos"],
                                     ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"],
                                     *wsub)
-            facc[touched] += gc[touched]
-            zst.fmag[touched] += np.linalg.norm(gc[touched], axis=1)
+            take_contact_forces(touched, gc, facc, zst.fmag)
             if len(gmember):
                 gbad = rigid_motion_groups(dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass, gisc,
                                            gprin, gaxes, gcen, b["mass"], fixity, b["force"], b["moment"], b["fapp"],
@@ -734,6 +739,10 @@ class _Run:
         fresh = eng._signature != eng._geometry_signature()
         if fresh:
             eng.detect()
+        elif self.zoned and not self.ng and not self.large:
+            # (zoned blocks alone in small strain never reach a periodic detection: the contacts
+            # take the material-table defaults set since the last one here)
+            eng.follow_defaults()
         #: a detection has run in this run (``quiet`` never leaves out the first one)
         self.looked = fresh
         self.mixed = eng._zone_contacts_check() if self.zoned else False

@@ -32,9 +32,9 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
    motion (``gp_motion``).
 
 Zoned blocks are not bodies of the rigid motion kernel (``RigidEngine._groups`` leaves them
-out). Contacts between a zoned and a rigid block add their forces to the gridpoints
-(``RigidEngine._mixed_steps``, kernels of ``gpcontact``); contacts between two zoned blocks are
-refused unless both are of one joined set (linked gridpoints make those inert).
+out). Contacts between a zoned block and a rigid or another zoned block add their forces to the
+gridpoints (``RigidEngine._mixed_steps``, kernels of ``gpcontact``); between zoned blocks of one
+joined set they carry none (shared gridpoints).
 """
 from __future__ import annotations
 

@@ -130,17 +130,6 @@ def test_zoned_block_without_a_model_is_refused(tmp_path):
         s.command("model cycle 5")
 
 
-def test_contact_between_two_zoned_blocks_is_refused_and_changes_nothing(tmp_path):
-    s = _run(tmp_path, ["block create brick 0 1 0 1 0 1", "block create brick 0 1 0 1 -1 0",
-                        "model gravity 9.81", "block zone generate edgelength 0.5", *_ELASTIC,
-                        "block gridpoint apply velocity 0 0 0 range position-z -1"])
-    before = s.model.vertices["pos"].copy()
-    with pytest.raises(Dec3dError, match="contacts join two zoned .deformable. blocks that are not joined.*"
-                                         "do not cycle yet"):
-        s.command("model cycle 10")
-    assert s.model.step == 0 and np.array_equal(s.model.vertices["pos"], before)
-
-
 @pytest.mark.parametrize("large", ["on", "off"])
 def test_rigid_block_resting_on_a_zoned_block(tmp_path, large):
     """A rigid 1 m cube (ρ = 2000) on a zoned 1 m cube (E = 1 GPa, ν = 0.25, ρ = 2000) on rollers
