@@ -41,7 +41,7 @@ from .energy import is_active as is_energy_active
 from .dynamic import DYN_DEFAULTS, TimeFunctions, has_timefns, rayleigh_coefficients, stiffness_timestep
 from .history import HistorySet
 from .jmodels import JOINT_MODELS
-from .runcontrol import CycleInterrupted, _Progress, _sigint_stops_cycling, _StopFlag  # noqa: F401  (request_stop: part of this module's API)
+from .runcontrol import CycleInterrupted, _Progress, _sigint_stops_cycling, _StopFlag, request_stop  # noqa: F401  (request_stop: part of this module's API)
 
 _F = np.float64
 _I = np.int64
