@@ -167,7 +167,7 @@ def test_save_restore_round_trip_and_bad_file(tmp_path):
 
 def test_needs_configure(session):
     session.command("block create brick 0 1 0 1 0 1")
-    for cmd in ("feblock generate 1 1 1", "feblock list"):
+    for cmd in ("feblock generate 1 1 1", "feblock list", "feblock change density 2000"):
         with pytest.raises(Dec3dError, match=r"needs `model configure feblock` first"):
             session.command(cmd)
     assert "feblocks" not in session.model.stores

@@ -23,7 +23,8 @@ def test_every_verification_problem_is_there():
                                          "S1_fredlund_krahn_slope", "S1_ru025", "S2_kim_dam",
                                          "D1_uniaxial_tet", "D1_uniaxial_hex", "D1_uniaxial_ho", "D2_self_weight",
                                          "D3_elastic_hole_tet", "D3_elastic_hole_hex", "D3_elastic_hole_ho",
-                                         "D4_triaxial", "D5_strip_footing", "D7_rigid_on_deformable"}
+                                         "D4_triaxial", "D5_strip_footing", "D7_rigid_on_deformable",
+                                         "FE1_cantilever"}
 
 
 def _demo(tmp_path, expects: str):
