@@ -277,3 +277,39 @@ def test_seed_fem_beam_runs_unmodified_and_prints_an_error_below_one_percent(tmp
     tip = np.flatnonzero(np.all(abs(v["pos"] - [10, 1, 1]) < 1e-9, axis=1))[0]
     assert abs(100 * abs(-v["disp"][tip, 2] - 0.4) / 0.4 - err) < 1e-9
 
+
+
+@pytest.mark.parametrize("nq", [2, 3])
+def test_f2_patch_distorted_element_under_uniform_stress_through_its_boundary_nodes(nq):
+    """F2 of the issue, driven by forces: one distorted 20-node element (mid-edge nodes moved,
+    faces not planar) loaded at its nodes (all on its boundary) by the forces of a uniform stress
+    sigma0 (twin: sum_g w det J B^T sigma0, the rule of the element), held 3-2-1 against rigid
+    motion only, solved statically with the stiffness the kernel applies (2x2x2 with the hourglass
+    control, which makes the single element solvable; 3x3x3 as it is): every Gauss point carries
+    sigma0 to 1e-8 relative, and the hourglass stresses stay zero."""
+    x = distorted(11, amp=0.12)
+    s0 = np.array([3e5, -1e5, 2e5, 4e4, -6e4, 5e4])              # xx yy zz xy xz yz
+    # B rows are xx yy zz 2xy 2xz 2yz (engineering shear): B^T sigma with sigma xx yy zz xy xz yz
+    f = np.zeros(60)
+    for p, w in zip(*twin_rule(nq)):
+        B, dj = b_matrix(x, p)
+        f += w * dj * B.T @ s0
+    pos, nodes, rows = one(x)
+    Ke = np.zeros((60, 60))
+    for j in range(60):
+        v = np.zeros((20, 3))
+        v.flat[j] = 1.0
+        fk = np.zeros((20, 3))
+        feb_step(pos, v, nodes, rows, np.array([K]), np.array([G]), 1.0, np.zeros((1, 27, 6)), np.zeros((1, 6)),
+                 fk, nq, HOURGLASS)
+        Ke[:, j] = -fk.ravel()
+    held = [0, 1, 2, 3 * 1 + 1, 3 * 1 + 2, 3 * 3 + 2]            # node 1 xyz, node 2 yz, node 4 z
+    free = np.setdiff1d(np.arange(60), held)
+    u = np.zeros(60)
+    u[free] = np.linalg.solve(Ke[np.ix_(free, free)], f[free])
+    gs, st = np.zeros((1, 27, 6)), np.zeros((1, 6))
+    feb_step(pos, u.reshape(20, 3), nodes, rows, np.array([K]), np.array([G]), 1.0, gs, st, np.zeros((20, 3)), nq,
+             HOURGLASS)
+    assert np.abs(gs[0, :nq ** 3] - s0).max() < 1e-8 * np.abs(s0).max()
+    if nq == 2:
+        assert np.abs(gs[0, 8:14]).max() < 1e-8 * np.abs(s0).max()
