@@ -313,3 +313,49 @@ def test_f2_patch_distorted_element_under_uniform_stress_through_its_boundary_no
     assert np.abs(gs[0, :nq ** 3] - s0).max() < 1e-8 * np.abs(s0).max()
     if nq == 2:
         assert np.abs(gs[0, 8:14]).max() < 1e-8 * np.abs(s0).max()
+
+
+# ----------------------------------------------------------------------------- which elements get it
+def test_exposed_elements_are_rows_one_element_across_in_two_directions():
+    """Counted on the reduced stiffness of free regular meshes (spurious modes = zero modes - 6):
+    1x1x1 6, 2x1x1 3, 4x1x1 5, 2x2x1 0, 3x3x1 0, 2x2x2 0; exposed_elements marks every element
+    of the first three and none of the others."""
+    from test_feblock_kernels import _global_stiffness
+
+    from dec3d.model.feblocks import exposed_elements
+
+    for shape, spurious in (((1, 1, 1), 6), ((2, 1, 1), 3), ((4, 1, 1), 5), ((2, 2, 1), 0), ((3, 3, 1), 0),
+                            ((2, 2, 2), 0), ((1, 3, 2), 0)):
+        pos, nodes = beam_mesh(*shape, *(float(n) for n in shape))
+        w = np.linalg.eigvalsh(_global_stiffness(pos, nodes, K, G, 2))
+        assert (w < 1e-9 * w.max()).sum() - 6 == spurious, shape
+        mask = exposed_elements(nodes)
+        assert mask.all() if spurious else not mask.any(), shape
+
+
+def test_generate_sets_the_control_where_the_mesh_needs_it_and_change_overrides(session):
+    from dec3d.errors import Dec3dError
+
+    session.command("model configure feblock\nblock create brick 0 10 0 1 0 1\nblock create brick 0 1 3 4 0 1\n"
+                    "block create brick 0 1 6 7 0 1\n"
+                    "feblock generate 1 1 1 range id 1\nfeblock generate 0.5 0.5 1 range id 2\n"
+                    "feblock generate 1 1 1 integration 3 range id 3")
+    es = session.model.store("feblocks")
+    h = es["hourglass"][: es.n]
+    blk = session.model.blocks["id"][es["block"][: es.n]]
+    assert (h[blk == 1] == HOURGLASS).all() and len(h[blk == 1]) == 10
+    assert (h[blk == 2] == 0).all() and len(h[blk == 2]) == 4          # 2 x 2 x 1: held by its neighbours
+    assert (h[blk == 3] == 0).all()                                       # 3x3x3: no spurious mode
+    assert session.output.getvalue().count("one element thick") == 1
+    es["gstress"][: es.n, 8:14] = 1.0
+    session.command("feblock change hourglass 0.05 range position-x 0 5 position-y 0 1")
+    assert np.allclose(es["hourglass"][: es.n][blk == 1], [0.05] * 5 + [HOURGLASS] * 5)
+    session.command("feblock change hourglass 0 range position-y 6 7")
+    assert (es["gstress"][: es.n][blk == 3, 8:14] == 1.0).all()          # 3x3x3 rows 8-13 are Gauss points
+    session.command("feblock change hourglass 0 range position-y 0 1")
+    assert (es["hourglass"][: es.n][blk == 1] == 0).all() and (es["gstress"][: es.n][blk == 1, 8:14] == 0).all()
+    before = es["hourglass"][: es.n].copy()
+    for bad in ("feblock change hourglass -0.1", "feblock change hourglass 1.5"):
+        with pytest.raises(Dec3dError, match="hourglass"):
+            session.command(bad)
+    assert np.array_equal(es["hourglass"][: es.n], before)
