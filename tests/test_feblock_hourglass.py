@@ -359,3 +359,15 @@ def test_generate_sets_the_control_where_the_mesh_needs_it_and_change_overrides(
         with pytest.raises(Dec3dError, match="hourglass"):
             session.command(bad)
     assert np.array_equal(es["hourglass"][: es.n], before)
+
+
+def test_block_groups_select_their_fe_elements(session):
+    """`feblock change … range group` matches an element's own groups or its block's (as zones do):
+    the tunnel-liner deck sets its liner by the group of the prism blocks."""
+    session.command("model configure feblock\nblock create brick 0 2 0 1 0 1 group 'liner'\n"
+                    "block create brick 0 1 3 4 0 1\nfeblock generate 1 1 1\n"
+                    "feblock change cmodel elastic young 30e9 poisson 0.2 density 2400 range group 'liner'")
+    es = session.model.store("feblocks")
+    blk = session.model.blocks["id"][es["block"][: es.n]]
+    assert (es["cmodel"][: es.n][blk == 1] != 0).all() and (es["cmodel"][: es.n][blk == 2] == 0).all()
+    assert "selected no FE element" not in session.output.getvalue()
