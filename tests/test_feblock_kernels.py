@@ -545,7 +545,8 @@ def test_one_element_thick_2x2x2_has_a_free_end_zero_energy_mode_that_point_load
     """Why the 2x2x2 cantilever below is loaded by a uniform end traction: with one element
     through the thickness the reduced rule leaves one zero-energy mode (the free end face's
     corners moving in and out), and the text's three top-edge point loads have a component on
-    it, so an explicit run drifts along it without bound. A uniform traction on the end face is
+    it, so an explicit run without hourglass control (``feblock_hg``, tested in
+    test_feblock_hourglass.py) drifts along it without bound. A uniform traction on the end face is
     orthogonal to it. The 3x3x3 rule has no such mode."""
     E, nu = 1e6, 0.2
     K, G = E / (3 * (1 - 2 * nu)), E / (2 * (1 + nu))

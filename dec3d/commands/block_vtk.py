@@ -28,7 +28,11 @@ STEM = OutPath(stem=True)
                  "threshold on it to see one set), stress (XX YY ZZ XY YZ XZ, ParaView's tensor order), mean_stress, "
                  "principal_stress and von_mises, and gridpoint displacement and velocity as point data. When the "
                  "model has rigid blocks too, the zones go to `<file>_zones_<nnnn>.vtu` (part 1 of the same "
-                 "time in the .pvd), since meshio reads no file mixing polyhedra with other cells.",
+                 "time in the .pvd), since meshio reads no file mixing polyhedra with other cells. The elements of FE "
+                 "blocks go to `<file>_fe_<nnnn>.vtu` (part 2): quadratic hexahedra (VTK 25) with point data "
+                 "displacement, velocity and vertex_row, and cell data element_id, block_id, gauss, volume, "
+                 "cmodel, stress (the element's volume-weighted mean of its Gauss-point stresses, XX YY ZZ XY "
+                 "YZ XZ) and stress_gauss_mean.",
          examples=["block vtk", "block vtk 'jointed' interval 100", "block vtk filename 'out/blocks'",
                    "block vtk off"])
 def block_vtk(session, call):

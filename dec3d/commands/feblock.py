@@ -7,6 +7,7 @@ from ..errors import BindError, CommandError, ResourceError
 from ..geometry.assemble import block_poly
 from ..geometry.febmesh import (MeshFileError, brick_corners, brick_mesh, complete_20, divisions, mesh_surface,
                                 parse_fe_mesh, side_faces)
+from ..kernels.feblock_hg import HOURGLASS
 from ..model.feblocks import add_feblock, element_volumes, feblock_store, install_feblock_mesh, set_material
 from ..model.model import KIND_DEFORMABLE, KIND_FE
 from ..model.zones import ZMODEL_ELASTIC, ZMODEL_NULL
@@ -38,7 +39,12 @@ def _need_configured(session, call, what: str) -> None:
                  "(`block gridpoint apply …` acts on them). The surface is approximated by eight triangles per "
                  "element face around a mid-face slave node, as in the FE-block text. Needs `model configure "
                  "feblock`. A block that is not an 8-vertex hexahedron, or a zoned block, is an error and "
-                 "nothing is changed; blocks already FE blocks are left as they are.",
+                 "nothing is changed; blocks already FE blocks are left as they are. With 2 x 2 x 2 "
+                 "integration, elements with no neighbour across the faces normal to two of their axes (a "
+                 "mesh one element across in two directions) have zero-energy modes; they get a small "
+                 "stiffness-based hourglass control (0.1 of the elastic moduli on the strain the eight points "
+                 "miss, at the six face centres), which leaves uniform, linear and bilinear strain fields alone. "
+                 "`feblock change hourglass` sets it per element.",
          examples=["feblock generate 1 1 1", "feblock generate 20 2.5 20 range group 'liner'",
                    "feblock generate 0.5 0.5 0.5 integration 3"])
 def feblock_generate(session, call):
@@ -81,13 +87,14 @@ def feblock_generate(session, call):
     thin = []
     for bid, points, elems, slaves, tris, src, nmaster, n in plans:
         row = int(np.flatnonzero(b["id"][: b.n] == bid)[0])      # rows move as blocks are rewritten
-        install_feblock_mesh(model, row, points, elems, slaves, tris, src, nmaster, nq)
-        if nq == 2 and min(n) == 1:
+        sl = install_feblock_mesh(model, row, points, elems, slaves, tris, src, nmaster, nq)
+        if (model.store("feblocks")["hourglass"][sl] > 0).any():
             thin.append(bid)
     if thin:
-        session.write(f"warning: {call.location}: blocks {', '.join(str(i) for i in thin[:10])} are one element "
-                      "thick: with 2x2x2 integration their free faces have a zero-energy mode that point loads can "
-                      "drive without bound; use `integration 3` or distributed loads")
+        session.write(f"note: {call.location}: blocks {', '.join(str(i) for i in thin[:10])} are one element "
+                      "thick in two directions: with 2x2x2 integration their cross-sections have a zero-energy "
+                      f"mode, held by hourglass control (eps_h = {HOURGLASS:g}; `feblock change hourglass`); "
+                      "`integration 3` has no such mode")
 
 
 @command("feblock read", positional=[P("file", InPath(), "the mesh file", required=True)],
@@ -147,21 +154,26 @@ _CMODELS = {"elastic": ZMODEL_ELASTIC, "null": ZMODEL_NULL}
                    P("poisson", Num(lo=-1, hi=0.5, lo_open=True, hi_open=True), "Poisson's ratio, -1 < nu < 0.5"),
                    P("bulk", _POS, "bulk modulus K", units="Pa"),
                    P("shear", _POS, "shear modulus G", units="Pa"),
-                   P("density", _POS, "mass density", units="kg/m³")],
+                   P("density", _POS, "mass density", units="kg/m³"),
+                   P("hourglass", Num(lo=0, hi=1), "hourglass control eps_h of 2x2x2 elements, 0 to 1 "
+                     "(0: none; dec3d keyword)")],
          range="block",
          doc="Set the constitutive model and properties of the FE elements in range.",
          details="The FE-block text assigns material per element with `feblock change`; the range selects "
-                 "elements by their centroid (the mean of their corners), id or group. Moduli are kept as bulk "
+                 "elements by their centroid (the mean of their corners), id or group. `hourglass` sets the "
+                 "hourglass control of 2x2x2 elements (ignored by 3x3x3 ones; see `feblock generate`). Moduli are kept as bulk "
                  "and shear (give bulk/shear or young/poisson, not both pairs); young or poisson alone keeps "
                  "the other as the element's present moduli give it.",
          examples=["feblock change cmodel elastic young 30e9 poisson 0.2 density 2400",
+                   "feblock change hourglass 0.05 range group 'liner'",
                    "feblock change density 2500 range position-x 0 5"])
 def feblock_change(session, call):
     _need_configured(session, call, "feblock change")
     a = call.args
-    keys = [k for k in ("cmodel", "young", "poisson", "bulk", "shear", "density") if a[k] is not None]
+    keys = [k for k in ("cmodel", "young", "poisson", "bulk", "shear", "density", "hourglass") if a[k] is not None]
     if not keys:
-        raise BindError("`feblock change` needs cmodel, young, poisson, bulk, shear or density", call.location)
+        raise BindError("`feblock change` needs cmodel, young, poisson, bulk, shear, density or hourglass",
+                        call.location)
     if (a["bulk"] is not None or a["shear"] is not None) and (a["young"] is not None or a["poisson"] is not None):
         raise BindError("`feblock change`: give bulk/shear or young/poisson, not both pairs in one command",
                         call.location)
@@ -176,6 +188,12 @@ def feblock_change(session, call):
                      a["poisson"], a["bulk"], a["shear"], a["density"])
     except ValueError as exc:
         raise BindError(f"`feblock change`: young and poisson are both needed: {exc}", call.location) from None
+    if a["hourglass"] is not None:
+        es = model.store("feblocks")
+        es["hourglass"][rows] = float(a["hourglass"])
+        if float(a["hourglass"]) == 0.0:
+            two = rows[es["nq"][rows] == 2]
+            es["gstress"][two, 8:14] = 0.0           # the control's stresses go with it (2x2x2 rows only)
 
 
 @command("feblock list", range="block",

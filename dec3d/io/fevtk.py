@@ -4,12 +4,14 @@ element (issue 12, "Output").
 The element node order of ``feblocks.nodes`` (the corrected Table 1 of the FE-block text,
 shared/seeds/ERRATA.md) is VTK's order for type 25, so the connectivity is written as it is.
 Points are the element (master) nodes, each once, in ascending vertex row. Point data:
-``displacement`` (pos − origin, ``dec3d.model.kinematics``), ``velocity``, ``vertex_row``.
-Cell data: ``element_id``, ``block_id``, ``gauss`` (2 or 3 per direction), ``volume``, ``cmodel``,
-``stress`` (6 components xx yy zz xy xz yz, tension positive: the volume-weighted mean of the
-Gauss-point stresses, ``feblocks.stress``) and ``stress_gauss_mean`` (their plain mean). Same
-XML writer as ``dec3d.io.vtk`` (inline base64, deterministic bytes); meshio reads the cells as
-``hexahedron20``.
+``displacement`` (the node's own, ``vertices.disp``: FE nodes are gridpoints, and in small strain
+their positions stay put), ``velocity``, ``vertex_row``. Cell data: ``element_id``, ``block_id``,
+``gauss`` (2 or 3 per direction), ``volume``, ``cmodel``, ``stress`` (tension positive, in VTK's
+symmetric-tensor order XX YY ZZ XY YZ XZ like the zones of ``dec3d.io.vtk``: the volume-weighted
+mean of the Gauss-point stresses, ``feblocks.stress``) and ``stress_gauss_mean`` (their plain
+mean, same order; the hourglass rows of 2 x 2 x 2 elements are not stresses and are left out).
+Same XML writer as ``dec3d.io.vtk`` (inline base64, deterministic bytes); meshio reads the cells
+as ``hexahedron20``. ``block vtk`` writes this file beside its snapshot (``VtkSeries``).
 """
 from __future__ import annotations
 
@@ -18,8 +20,7 @@ import os
 import numpy as np
 
 from dec3d.io.finite import require_finite
-from dec3d.io.vtk import _data_array
-from dec3d.model.kinematics import vertex_displacement
+from dec3d.io.vtk import VTK_TENSOR_ORDER, _data_array
 
 VTK_QUADRATIC_HEXAHEDRON = 25
 
@@ -40,7 +41,7 @@ def write_feblocks_vtu(model, path: str | os.PathLike) -> str:
     conn = remap[nodes].ravel() if ne else np.zeros(0, np.int64)
     pos = v["pos"][used]
     require_finite("Points", pos)
-    disp = vertex_displacement(model)[used] if v.n else np.zeros((0, 3))
+    disp = v["disp"][used]
     ind = "      "
     parts = ['<?xml version="1.0"?>\n',
              '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">\n',
@@ -57,8 +58,8 @@ def write_feblocks_vtu(model, path: str | os.PathLike) -> str:
         ng = nq ** 3
         gmean = np.array([es["gstress"][e, : ng[e]].mean(axis=0) for e in range(ne)])
         cell = {"element_id": es["id"][:ne], "block_id": b["id"][es["block"][:ne]], "gauss": es["nq"][:ne],
-                "volume": es["volume"][:ne], "cmodel": es["cmodel"][:ne], "stress": es["stress"][:ne],
-                "stress_gauss_mean": gmean}
+                "volume": es["volume"][:ne], "cmodel": es["cmodel"][:ne],
+                "stress": es["stress"][:ne][:, VTK_TENSOR_ORDER], "stress_gauss_mean": gmean[:, VTK_TENSOR_ORDER]}
     else:
         cell = {"element_id": np.zeros(0, np.int64)}
     for key, arr in cell.items():

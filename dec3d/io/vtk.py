@@ -26,7 +26,8 @@ each by zone row; they carry their block's cell data and ``zone_id`` (0 on polyh
 polyhedra). Gridpoints' point data are their own displacement and velocity. meshio reads no file
 mixing polyhedra with other cells, so a series snapshot of a model with both rigid blocks and zones
 is two files: ``<stem>_<nnnn>.vtu`` (rigid blocks) and ``<stem>_zones_<nnnn>.vtu`` (zones), parts 0
-and 1 of the same time in the .pvd.
+and 1 of the same time in the .pvd. FE blocks are polyhedra of their triangulated surface here;
+their 20-node elements go to ``<stem>_fe_<nnnn>.vtu`` (``dec3d.io.fevtk``), part 2.
 """
 from __future__ import annotations
 
@@ -200,8 +201,8 @@ def write_vtu(model, path: str | os.PathLike, cells: str = "all", point_data: di
     parts.append(f'    <Piece NumberOfPoints="{v.n}" NumberOfCells="{ncell}">\n')
     parts.append('      <PointData Vectors="displacement">\n')
     disp, vel = vertex_displacement(model), vertex_velocity(model)
-    if zoned:
-        # gridpoints move on their own: their displacement and velocity are the vertex store's
+    if zoned or "feslave" in v:
+        # gridpoints (zones, FE nodes) move on their own: their displacement and velocity are the vertex store's
         gp = v["zoned"]
         disp[gp], vel[gp] = v["disp"][gp], v["velocity"][gp]
     parts.append(_data_array("displacement", disp, ind + "  "))
@@ -296,6 +297,12 @@ class VtkSeries:
         else:
             write_vtu(model, vtu)
             self.entries.append((float(time), vtu))
+        if "feblocks" in model.stores and model.store("feblocks").n:
+            # FE elements as quadratic hexahedra (VTK 25) beside, as part 2 (``dec3d.io.fevtk``)
+            from dec3d.io.fevtk import write_feblocks_vtu
+            fvtu = self.guard(f"{self.stem}_fe_{k:04d}.vtu")
+            write_feblocks_vtu(model, fvtu)
+            self.entries.append((float(time), fvtu, 2))
         self.count += 1
         write_pvd(self.guard(self.pvd_path), self.entries)
         return vtu

@@ -44,6 +44,7 @@ the stores) and returns the first such element row (-1 if none) for the host to 
 import numpy as np
 from numba import njit, prange
 
+from .feblock_hg import hg_jacobians, hg_step
 from .gather import node_lists, node_sums, scatter
 from .zones_ho import add_body_force, add_stiffness_bound
 
@@ -154,6 +155,25 @@ def ref_tables(nq):
     return shp, dref, wts
 
 
+@njit(cache=True)
+def hg_tables():
+    """Tables of the hourglass control (``feblock_hg``): master derivatives (6, 20, 3) at the
+    face centres (YSLAVE rows 0-5) and the trilinear weights (6, 8) of the 2 x 2 x 2 Gauss points
+    at them, w_pg = prod_i (1 + 3 y_gi p_i) / 2."""
+    pts, wts = gauss_rule(np.int64(2))
+    n = np.empty(20)
+    dface = np.empty((6, 20, 3))
+    wpg = np.empty((6, 8))
+    for p in range(6):
+        shape20(YSLAVE[p, 0], YSLAVE[p, 1], YSLAVE[p, 2], n, dface[p])
+        for g in range(8):
+            w = 1.0
+            for i in range(3):
+                w *= 0.5 * (1.0 + 3.0 * pts[g, i] * YSLAVE[p, i])
+            wpg[p, g] = w
+    return dface, wpg
+
+
 @njit(cache=True, inline='always')
 def _jacobian(x, dxi):
     """det J and the entries i_kj = dy_k/dx_j of J^-1 at one point, from the master derivatives
@@ -250,14 +270,36 @@ def _jac_inv(x, dxi, jinv):
     return det
 
 
+@njit(cache=True, inline='always')
+def _gauss_force(sxx, syy, szz, sxy, sxz, syz, ji, d, fe):
+    """fe[a] -= (S J^-T) dN_a/dy for the weighted stress S (w det J sigma) of one point."""
+    p00 = sxx * ji[0, 0] + sxy * ji[0, 1] + sxz * ji[0, 2]
+    p01 = sxx * ji[1, 0] + sxy * ji[1, 1] + sxz * ji[1, 2]
+    p02 = sxx * ji[2, 0] + sxy * ji[2, 1] + sxz * ji[2, 2]
+    p10 = sxy * ji[0, 0] + syy * ji[0, 1] + syz * ji[0, 2]
+    p11 = sxy * ji[1, 0] + syy * ji[1, 1] + syz * ji[1, 2]
+    p12 = sxy * ji[2, 0] + syy * ji[2, 1] + syz * ji[2, 2]
+    p20 = sxz * ji[0, 0] + syz * ji[0, 1] + szz * ji[0, 2]
+    p21 = sxz * ji[1, 0] + syz * ji[1, 1] + szz * ji[1, 2]
+    p22 = sxz * ji[2, 0] + syz * ji[2, 1] + szz * ji[2, 2]
+    for a in range(20):
+        n0 = d[a, 0]; n1 = d[a, 1]; n2 = d[a, 2]
+        fe[a, 0] -= p00 * n0 + p01 * n1 + p02 * n2
+        fe[a, 1] -= p10 * n0 + p11 * n1 + p12 * n2
+        fe[a, 2] -= p20 * n0 + p21 * n1 + p22 * n2
+
+
 @njit(cache=True)
-def _elem_step(xe, ve, dref, wts, lam, g2, dt, sg, se, fe, jinv, wd):
+def _elem_step(xe, ve, dref, wts, lam, g2, dt, sg, se, fe, jinv, wd, hg, dface, wpg, jf, eg, tg):
     """Stress update and nodal forces of one element (node coordinates xe, velocities ve
     (20, 3)): Gauss-point stresses sg (>= ng, 6) and mean se (6,) updated, fe (20, 3) filled
     with the element's force on each node. False, changing nothing, when det J is not positive
-    at a Gauss point. Works in master coordinates: grad v = (sum_a v_a (x) dN_a/dy) J^-1 and
-    f_a = -(w det J sigma J^-T) dN_a/dy, the same sums as B^T sigma without forming grad N."""
+    at a Gauss point (or, with the control, at a face centre). Works in master coordinates:
+    grad v = (sum_a v_a (x) dN_a/dy) J^-1 and f_a = -(w det J sigma J^-T) dN_a/dy, the same sums
+    as B^T sigma without forming grad N. With 8 points and hg > 0 the hourglass control of
+    ``feblock_hg`` is added (sg rows 8-13; scratch jf (6, 3, 3), eg and tg (8, 6))."""
     ng = wts.shape[0]
+    ctl = ng == 8 and hg > 0.0
     vol = 0.0
     for g in range(ng):
         det = _jac_inv(xe, dref[g], jinv[g])
@@ -265,6 +307,8 @@ def _elem_step(xe, ve, dref, wts, lam, g2, dt, sg, se, fe, jinv, wd):
             return False
         wd[g] = wts[g] * det
         vol += wd[g]
+    if ctl and not hg_jacobians(xe, dface, jf):
+        return False
     for a in range(20):
         fe[a, 0] = 0.0
         fe[a, 1] = 0.0
@@ -310,28 +354,24 @@ def _elem_step(xe, ve, dref, wts, lam, g2, dt, sg, se, fe, jinv, wd):
         fv = w / vol
         for c in range(6):
             se[c] += fv * s[c]
-        sxx = s[0] * w; syy = s[1] * w; szz = s[2] * w
-        sxy = s[3] * w; sxz = s[4] * w; syz = s[5] * w
-        # P[i, k] = w det J sum_j sigma_ij J^-1[k, j]
-        p00 = sxx * ji[0, 0] + sxy * ji[0, 1] + sxz * ji[0, 2]
-        p01 = sxx * ji[1, 0] + sxy * ji[1, 1] + sxz * ji[1, 2]
-        p02 = sxx * ji[2, 0] + sxy * ji[2, 1] + sxz * ji[2, 2]
-        p10 = sxy * ji[0, 0] + syy * ji[0, 1] + syz * ji[0, 2]
-        p11 = sxy * ji[1, 0] + syy * ji[1, 1] + syz * ji[1, 2]
-        p12 = sxy * ji[2, 0] + syy * ji[2, 1] + syz * ji[2, 2]
-        p20 = sxz * ji[0, 0] + syz * ji[0, 1] + szz * ji[0, 2]
-        p21 = sxz * ji[1, 0] + syz * ji[1, 1] + szz * ji[1, 2]
-        p22 = sxz * ji[2, 0] + syz * ji[2, 1] + szz * ji[2, 2]
-        for a in range(20):
-            n0 = d[a, 0]; n1 = d[a, 1]; n2 = d[a, 2]
-            fe[a, 0] -= p00 * n0 + p01 * n1 + p02 * n2
-            fe[a, 1] -= p10 * n0 + p11 * n1 + p12 * n2
-            fe[a, 2] -= p20 * n0 + p21 * n1 + p22 * n2
+        if ctl:
+            e = eg[g]
+            e[0] = exx; e[1] = eyy; e[2] = ezz; e[3] = exy; e[4] = exz; e[5] = eyz
+        else:
+            _gauss_force(s[0] * w, s[1] * w, s[2] * w, s[3] * w, s[4] * w, s[5] * w, ji, d, fe)
+    if ctl:
+        hg_step(ve, dface, jf, wpg, vol, lam, g2, hg, dt, eg, sg, tg, fe)
+        for g in range(8):
+            s = sg[g]
+            w = wd[g]
+            t = tg[g]
+            _gauss_force(s[0] * w - t[0], s[1] * w - t[1], s[2] * w - t[2], s[3] * w - t[3], s[4] * w - t[4],
+                         s[5] * w - t[5], jinv[g], dref[g], fe)
     return True
 
 
 @njit(cache=True)
-def feb_step(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, force, nq):
+def feb_step(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, force, nq, hg=0.0):
     """One elastic step of the 20-node elements in ``rows`` with the nq x nq x nq rule.
 
     pos, vel (nv, 3): node positions and velocities; nodes (ne, 20) node rows; rows (k,) int64
@@ -340,10 +380,15 @@ def feb_step(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, force, nq)
     At each Gauss point: grad v = sum_I v_I (x) grad N_I (Eq. 4-5 with velocities), strain
     increment sym(grad v) dt (Eq. 3, 6), gstress += lambda tr(de) I + 2 G de (elastic model),
     then stress[e] = volume-weighted mean and force[nodes[e, a]] += -sum_g w det J sigma . grad N_a
-    (Eq. 7), element by element in the order of rows. Modifies gstress, stress, force. Returns
+    (Eq. 7), element by element in the order of rows; hg > 0 adds the hourglass control of
+    ``feblock_hg`` to 2 x 2 x 2 elements (eps_h = hg). Modifies gstress, stress, force. Returns
     the first element row skipped (det J not positive at a Gauss point), -1 if none.
     """
     shp, dref, wts = ref_tables(nq)
+    dface, wpg = hg_tables()
+    jf = np.empty((6, 3, 3))
+    eg = np.empty((8, 6))
+    tg = np.empty((8, 6))
     ng = wts.shape[0]
     jinv = np.empty((ng, 3, 3))
     wd = np.empty(ng)
@@ -357,7 +402,7 @@ def feb_step(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, force, nq)
         _gather(pos, nodes, e, nd, xe)
         _gather(vel, nodes, e, nd, ve)
         if not _elem_step(xe, ve, dref, wts, bulk[e] - 2.0 * shear[e] / 3.0, 2.0 * shear[e], dt,
-                          gstress[e], stress[e], fe, jinv, wd):
+                          gstress[e], stress[e], fe, jinv, wd, hg, dface, wpg, jf, eg, tg):
             if bad < 0:
                 bad = e
             continue
@@ -366,9 +411,13 @@ def feb_step(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, force, nq)
 
 
 @njit(cache=True)
-def _element_chunk(lo, hi, pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq):
+def _element_chunk(lo, hi, pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq, hg):
     """Elements rows[lo:hi] of the element pass (see ``feb_element_pass``)."""
     shp, dref, wts = ref_tables(nq)
+    dface, wpg = hg_tables()
+    jf = np.empty((6, 3, 3))
+    eg = np.empty((8, 6))
+    tg = np.empty((8, 6))
     ng = wts.shape[0]
     jinv = np.empty((ng, 3, 3))
     wd = np.empty(ng)
@@ -380,11 +429,11 @@ def _element_chunk(lo, hi, pos, vel, nodes, rows, bulk, shear, dt, gstress, stre
         _gather(pos, nodes, e, nd, xe)
         _gather(vel, nodes, e, nd, ve)
         ok[kk] = _elem_step(xe, ve, dref, wts, bulk[e] - 2.0 * shear[e] / 3.0, 2.0 * shear[e], dt,
-                            gstress[e], stress[e], fe[kk], jinv, wd)
+                            gstress[e], stress[e], fe[kk], jinv, wd, hg, dface, wpg, jf, eg, tg)
 
 
 @njit(cache=True, parallel=True)
-def feb_element_pass(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq):
+def feb_element_pass(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq, hg=0.0):
     """The element half of ``feb_step_parallel``, in parallel over chunks of rows (each element
     writes only its own rows): stress update, and fe[k] (20, 3) = the force of element rows[k]
     on each of its nodes; ok[k] = False for an element with det J not positive (untouched)."""
@@ -392,13 +441,13 @@ def feb_element_pass(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe
     nchunk = (n + CHUNK - 1) // CHUNK
     for c in prange(nchunk):
         _element_chunk(c * CHUNK, min(n, (c + 1) * CHUNK), pos, vel, nodes, rows, bulk, shear, dt, gstress,
-                       stress, fe, ok, nq)
+                       stress, fe, ok, nq, hg)
 
 
 @njit(cache=True)
-def feb_element_pass_serial(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq):
+def feb_element_pass_serial(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq, hg=0.0):
     """``feb_element_pass`` on the calling thread (small meshes: no thread start-up), same results."""
-    _element_chunk(0, rows.shape[0], pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq)
+    _element_chunk(0, rows.shape[0], pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq, hg)
 
 
 @njit(cache=True)
@@ -446,13 +495,13 @@ def feb_node_sums_mag_serial(force, fmag, fe, ok, nstart, nent):
 
 @njit(cache=True)
 def feb_step_parallel(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, force, nq,
-                      fe, ok, nstart, nent):
+                      fe, ok, nstart, nent, hg=0.0):
     """``feb_step`` on several threads, bit for bit the same result whatever the thread count
     (and the same as ``feb_step``): a parallel element pass into the scratch fe (len(rows), 20,
     3) [N] and ok (len(rows),) bool, then fixed-order sums per node over the lists of
     ``feb_node_lists(len(force), nodes, rows)``. Returns the first element row skipped in the
     order of rows (-1 none)."""
-    feb_element_pass(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq)
+    feb_element_pass(pos, vel, nodes, rows, bulk, shear, dt, gstress, stress, fe, ok, nq, hg)
     node_sums(force, fe, ok, nstart, nent)
     for kk in range(rows.shape[0]):
         if not ok[kk]:
@@ -552,20 +601,25 @@ def feb_lumped_mass(pos, nodes, rows, density, mass):
 
 
 @njit(cache=True)
-def feb_stiffness(pos, nodes, rows, bulk, shear, kdiag, nq):
+def feb_stiffness(pos, nodes, rows, bulk, shear, kdiag, nq, hg=0.0):
     """Per-node stiffness bound for the explicit time step, added to kdiag[nodes].
 
     The text takes its time step from the fictitious tetrahedral discretization ("Solution
     Algorithm"); this uses a bound that is safe by construction instead: the element stiffness
     K = sum_g w det J B^T D B with the nq-rule of the forces (never used for forces, only
-    here) and, per node, the largest absolute row sum of its three rows. Summed over elements
-    it bounds the global row sums, so by Gershgorin's theorem the largest eigenvalue of M^-1 K
-    is at most max_i k_i / m_i for any diagonal mass, and dt <= 2 min sqrt(m_i / k_i) is stable.
-    Modifies kdiag; returns the first element row skipped, -1 if none."""
+    here; with nq = 2 and hg > 0 plus the hourglass stiffness of ``feblock_hg``, its six face
+    points weighted hg V / 6) and, per node, the largest absolute row sum of its three rows.
+    Summed over elements it bounds the global row sums, so by Gershgorin's theorem the largest
+    eigenvalue of M^-1 K is at most max_i k_i / m_i for any diagonal mass, and
+    dt <= 2 min sqrt(m_i / k_i) is stable. Modifies kdiag; returns the first element row
+    skipped, -1 if none."""
     shp, dref, wts = ref_tables(nq)
     ng = wts.shape[0]
-    dng = np.empty((ng, 20, 3))
-    wd = np.empty(ng)
+    with_hg = ng == 8 and hg > 0.0
+    nh = ng + 6 if with_hg else ng
+    dface, wpg = hg_tables()
+    dng = np.empty((nh, 20, 3))
+    wd = np.empty(nh)
     nd = np.empty(20, np.int64)
     xe = np.empty((20, 3))
     K = np.empty((60, 60))
@@ -573,7 +627,22 @@ def feb_stiffness(pos, nodes, rows, bulk, shear, kdiag, nq):
     for kk in range(rows.shape[0]):
         e = rows[kk]
         _gather(pos, nodes, e, nd, xe)
-        if not _elem_grads(xe, dref, wts, dng, wd):
+        ok = _elem_grads(xe, dref, wts, dng[:ng], wd[:ng])
+        if ok and with_hg:
+            vol = 0.0
+            for g in range(8):
+                vol += wd[g]
+            for p in range(6):
+                # grad of dB_p: grad N(p) - sum_g w_pg grad N(g)
+                h = dng[8 + p]
+                ok = ok and _grad_n(xe, dface[p], h) > 0.0
+                for g in range(8):
+                    w = wpg[p, g]
+                    for a in range(20):
+                        for j in range(3):
+                            h[a, j] -= w * dng[g, a, j]
+                wd[8 + p] = hg * vol / 6.0
+        if not ok:
             if bad < 0:
                 bad = e
             continue

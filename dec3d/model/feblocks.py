@@ -21,7 +21,11 @@ The deformable step (``dec3d.physics.zones``) is to move masters only and call t
     volume ()        m³     volume (reference configuration)
     centroid (3,)    m      mean of the 8 corners (reference configuration): the point range elements test
     stress (6,)      Pa     xx yy zz xy xz yz, tension positive: volume-weighted mean of gstress
-    gstress (27, 6)  Pa     Gauss-point stresses (the first nq³ rows used), y1 fastest
+    gstress (27, 6)  Pa     Gauss-point stresses (the first nq³ rows used), y1 fastest; with
+                            hourglass control, rows 8-13 hold its stresses (``kernels.feblock_hg``)
+    hourglass ()     -      eps_h of the hourglass control of a 2 x 2 x 2 element (0: none). Set
+                            to ``HOURGLASS`` when the element is made if its mesh leaves it exposed
+                            (``exposed_elements``), else 0; ``feblock change hourglass`` sets it
     cmodel ()        int8   constitutive model code (``zones.ZMODEL_*``); 0: none assigned
     prop (NZPROP,)   SI     constitutive properties by ``zones.ZP_*`` column
     state ()         int32  plastic state bits
@@ -34,7 +38,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from dec3d.kernels.feblock import feb_volume
+from dec3d.kernels.feblock import FACES, feb_volume
+from dec3d.kernels.feblock_hg import HOURGLASS
 
 from .groups import group_field
 from .store import Field, Store
@@ -57,6 +62,7 @@ def _fields() -> dict[str, Field]:
         "centroid": Field((3,), _F, 0.0),
         "stress": Field((6,), _F, 0.0),
         "gstress": Field((NGAUSS_MAX, 6), _F, 0.0),
+        "hourglass": Field((), _F, 0.0),
         "cmodel": Field((), np.int8, ZMODEL_NULL),
         "prop": Field((NZPROP,), _F, 0.0),
         "state": Field((), np.int32, 0),
@@ -164,6 +170,26 @@ def install_feblock_mesh(model, row: int, points: np.ndarray, elems: np.ndarray,
     return _attach(model, row, points, elems, slaves, nmaster, nq)
 
 
+def exposed_elements(elems: np.ndarray) -> np.ndarray:
+    """Elements (local node lists (ne, 20)) whose 2 x 2 x 2 zero-energy modes their mesh does not
+    hold: those with no neighbour across any of the four faces normal to two of their master axes
+    (a row of elements one element across in two directions, as the FE-block text's cantilever).
+    Measured on regular meshes (free, reduced rule): 1 x 1 x 1 elements have 6 spurious modes,
+    2 x 1 x 1 three, n x 1 x 1 more with n; 2 x 2 x 1, 3 x 3 x 1 and 2 x 2 x 2 none (the face
+    neighbours lock the modes), so elements with neighbours across faces of two axes need no
+    control. Returns a bool (ne,) mask."""
+    elems = np.asarray(elems, _I)
+    ne = len(elems)
+    if not ne:
+        return np.zeros(0, bool)
+    keys = np.sort(elems[:, FACES[:, :4]], axis=2).reshape(ne * 6, 4)
+    _, inv, cnt = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+    inner = (cnt[inv.ravel()] > 1).reshape(ne, 6)
+    # FACES: 0, 1 normal to y3; 2, 3 normal to y2; 4, 5 normal to y1
+    held = np.stack([inner[:, 4] | inner[:, 5], inner[:, 2] | inner[:, 3], inner[:, 0] | inner[:, 1]], axis=1)
+    return held.sum(axis=1) <= 1
+
+
 def _attach(model, row, points, elems, slaves, nmaster, nq) -> slice:
     """Gridpoint fields of block ``row``'s (new) vertices and its element rows."""
     from .model import KIND_FE
@@ -184,6 +210,7 @@ def _attach(model, row, points, elems, slaves, nmaster, nq) -> slice:
     es["slaves"][sl] = np.where(sv >= 0, sv + v0, -1)
     es["block"][sl] = row
     es["nq"][sl] = nq
+    es["hourglass"][sl] = np.where(exposed_elements(elems), HOURGLASS, 0.0) if nq == 2 else 0.0
     start_id = int(es["id"][: sl.start].max()) + 1 if sl.start else 1
     es["id"][sl] = np.arange(start_id, start_id + m)
     vol, _ = element_volumes(points, elems)

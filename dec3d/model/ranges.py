@@ -148,8 +148,8 @@ def mask_group(model, store_name: str, names: str | Sequence[str],
         own = _in_groups(model, store, names, None)
         blocks = _in_groups(model, model.blocks, names, None)
         return own | blocks[store["a"]] | blocks[store["b"]]
-    if store.name == "zones":
-        # a zone is in a group when it is, or when its block is (block groups select zones)
+    if store.name in ("zones", "feblocks"):
+        # a zone (FE element) is in a group when it is, or when its block is (block groups select zones)
         return _in_groups(model, store, names, slot) | _in_groups(model, model.blocks, names, slot)[store["block"]]
     return _in_groups(model, store, names, slot)
 

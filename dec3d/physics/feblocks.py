@@ -16,7 +16,8 @@ F^G (Eq. 8). ``FeStepper`` holds what a run needs and has no motion of its own:
    with the factor it converges;
    ``gweight`` (ρ ∫ N_a dV per node: consistent gravity F^G = gweight g, Eq. 8);
 3. each step: ``forces`` adds F^S of the elastic elements (``feb_step``, 2×2×2 or 3×3×3 per
-   element) and F^G to the force accumulator; ``slave_forces`` sends what contacts and face loads
+   element; 2×2×2 elements with the hourglass control of ``kernels.feblock_hg`` where their
+   ``feblocks.hourglass`` is not 0) and F^G to the force accumulator; ``slave_forces`` sends what contacts and face loads
    put on slave nodes to the masters (Eq. 9) — call it after those are added and before the
    motion; ``follow`` moves the slave nodes with the masters (positions in large strain,
    velocities, displacements) after the motion.
@@ -84,10 +85,14 @@ class FeStepper:
         self.nodes = np.ascontiguousarray(es["nodes"])
         self.slaves = np.ascontiguousarray(es["slaves"])
         nq = es["nq"][el]
-        self.groups = [(np.int64(q), np.ascontiguousarray(el[nq == q])) for q in (2, 3) if (nq == q).any()]
+        hg = es["hourglass"][el] if "hourglass" in es else np.zeros(len(el))
+        hg = np.where(nq == 2, hg, 0.0)
+        # one kernel call per (Gauss rule, hourglass eps_h): elements their mesh holds run without control
+        self.groups = [(np.int64(q), float(h), np.ascontiguousarray(el[(nq == q) & (hg == h)]))
+                       for q in (2, 3) for h in np.unique(hg[nq == q])]
         # per Gauss rule: scratch of the parallel element pass and the fixed-order node lists
         self.scratch = [(np.empty((len(r), 20, 3)), np.empty(len(r), np.bool_), *feb_node_lists(v.n, self.nodes, r))
-                        for _, r in self.groups]
+                        for _, _, r in self.groups]
         self.erows = np.ascontiguousarray(erow)
         n = v.n
         pos = np.ascontiguousarray(v["pos"])
@@ -98,8 +103,8 @@ class FeStepper:
         first = feb_lumped_mass(pos, self.nodes, np.ascontiguousarray(el), self.density, self.mass)
         first = max(first, feb_body_force(pos, self.nodes, np.ascontiguousarray(el), self.density,
                                           np.array([0.0, 0.0, 1.0]), gw))
-        for q, rows in self.groups:
-            first = max(first, feb_stiffness(pos, self.nodes, rows, self.bulk, self.shear, self.stiff, q))
+        for q, h, rows in self.groups:
+            first = max(first, feb_stiffness(pos, self.nodes, rows, self.bulk, self.shear, self.stiff, q, h))
         if first >= 0:
             raise error(f"FE element {int(es['id'][first])} (block {int(b['id'][es['block'][first]])}) has a "
                         "non-positive Jacobian at a Gauss point")
@@ -119,11 +124,11 @@ class FeStepper:
         gs, st = es["gstress"], es["stress"]
         mag = fmag if fmag is not None else np.zeros(len(facc))
         first = -1
-        for (q, rows), (fe, ok, nstart, nent) in zip(self.groups, self.scratch):
+        for (q, h, rows), (fe, ok, nstart, nent) in zip(self.groups, self.scratch):
             # small meshes on the calling thread: starting the threads costs more than the work
             par = len(rows) > PARALLEL_MIN
             (feb_element_pass if par else feb_element_pass_serial)(pos, vel, self.nodes, rows, self.bulk,
-                                                                  self.shear, dt, gs, st, fe, ok, q)
+                                                                  self.shear, dt, gs, st, fe, ok, q, h)
             (feb_node_sums_mag if par else feb_node_sums_mag_serial)(facc, mag, fe, ok, nstart, nent)
             if first < 0 and not ok.all():
                 first = int(rows[np.flatnonzero(~ok)[0]])
