@@ -200,8 +200,8 @@ def write_vtu(model, path: str | os.PathLike, cells: str = "all", point_data: di
     parts.append(f'    <Piece NumberOfPoints="{v.n}" NumberOfCells="{ncell}">\n')
     parts.append('      <PointData Vectors="displacement">\n')
     disp, vel = vertex_displacement(model), vertex_velocity(model)
-    if zoned:
-        # gridpoints move on their own: their displacement and velocity are the vertex store's
+    if "zoned" in v:
+        # gridpoints (zones' and FE nodes) move on their own: their displacement and velocity are the vertex store's
         gp = v["zoned"]
         disp[gp], vel[gp] = v["disp"][gp], v["velocity"][gp]
     parts.append(_data_array("displacement", disp, ind + "  "))
