@@ -238,13 +238,17 @@ def contact_group(session, call):
         session.model.groups.assign(e.contacts, rows, a["name"], a["slot"])
 
 
-@command("block contact reset", positional=[P("what", Choice(("displacement", "state", "force")),
+@command("block contact reset", positional=[P("what", Choice(("displacement", "state", "force", "overlap")),
                                                  "what to reset", required=True)],
          range="contact",
          doc="Reset the sub-contacts of the contacts in range: `displacement` zeroes the accumulated shear "
              "displacement and dilation (the normal displacement is kept, so forces do not jump), "
-             "`state` clears the slip and failure flags, `force` zeroes the shear forces.",
-         examples=["block contact reset displacement", "block contact reset state range group 'joint'"])
+             "`state` clears the slip and failure flags, `force` zeroes the shear forces; `overlap` (dec3d) "
+             "makes the sub-contacts whose blocks overlap just touching (normal displacement set to the "
+             "dilation, normal and shear forces and shear displacement zero; gaps are kept), so a support "
+             "built against rock that has moved starts unloaded and takes load only from later movement.",
+         examples=["block contact reset displacement", "block contact reset state range group 'joint'",
+                   "block contact reset overlap range group-intersection 'liner' 'rock'"])
 def contact_reset(session, call):
     e, sel = _contacts_in_range(session, call)
     ss = e.subcontacts
@@ -256,5 +260,11 @@ def contact_reset(session, call):
         ss["udil"][rows] = 0.0
     elif what == "state":
         ss["state"][rows] = 0
+    elif what == "overlap":
+        rows &= ss["un"] < ss["udil"]
+        ss["un"][rows] = ss["udil"][rows]
+        ss["fn"][rows] = 0.0
+        ss["fs"][rows] = 0.0
+        ss["us"][rows] = 0.0
     else:
         ss["fs"][rows] = 0.0

@@ -9,20 +9,79 @@ from .registry import command
 from .values import FLAG, ONOFF, Choice, Num, P, Text
 
 
-@command("block delete", range="block",
+@command("block delete", keywords=[P("reaction", Num(lo=0.0, hi=1.0), "fraction of the deleted blocks' contact "
+                                     "forces left on the rigid blocks that remain, as applied loads (dec3d)")],
+         range="block",
          doc="Delete the blocks in range (all blocks without a range).",
          details="Block ids are not reused. Followers of a deleted leader follow the lowest remaining block "
                  "of their joined group. Zoned blocks of a joined group that remain keep sharing their gridpoints "
                  "(the links of shared gridpoints are made again, so a gridpoint whose master row was in a "
-                 "deleted block is not split): deleting zoned blocks excavates.",
+                 "deleted block is not split): deleting zoned blocks excavates. With `reaction f` (dec3d) the "
+                 "sub-contact forces the deleted blocks exert on each remaining rigid block (normal and shear, "
+                 "as they are now) are summed into a force and a moment about its centroid, and f times them "
+                 "is added to its applied force and moment (`block apply`): an excavation whose face keeps a "
+                 "fraction f of its reaction, as 3DEC decks do with `block face apply stress` of part of the "
+                 "in-situ stress on zoned blocks. Remove the loads later with `block apply-remove force moment`.",
          examples=["block delete range cylinder end-1 0 0 0 end-2 0 1 0 radius 0 1",
                    "block delete range plane dip 0 dip-direction 0 below",
-                   "block delete range pos-x 0.3230 0.4038"])
+                   "block delete range pos-x 0.3230 0.4038",
+                   "block delete reaction 0.5 range group 'exc'"])
 def block_delete(session, call):
     from ..model.zone_mesh import relink
 
-    if delete_blocks(session.model, session.range_mask(call, "block")):
+    mask = np.asarray(session.range_mask(call, "block"), bool)
+    loads = None
+    if call.args["reaction"] is not None:
+        loads = reaction_loads(session.model, mask, call.location)
+    if delete_blocks(session.model, mask):
         relink(session.model)
+    if loads is not None:
+        ids, f, m = loads
+        b = session.model.blocks
+        row_of = {int(i): r for r, i in enumerate(b["id"])}
+        rows = np.array([row_of[int(i)] for i in ids], np.int64)
+        frac = float(call.args["reaction"])
+        np.add.at(b["fapp"], rows, frac * f)
+        np.add.at(b["mapp"], rows, frac * m)
+
+
+def reaction_loads(model, mask, location):
+    """(ids, forces, moments) of the remaining blocks: the sum of the sub-contact forces that the
+    blocks of ``mask`` exert on each of them, and its moment about the block's centroid.
+    The force on a contact's second block B is fn n + fs (n the unit normal A → B, fn compression
+    positive, fs the shear force on B); A takes the opposite. Nothing is changed here."""
+    from ..errors import CommandError
+    from ..model.model import KIND_RIGID
+
+    b = model.blocks
+    ids = np.zeros(0, np.int64)
+    if "contacts" not in model.stores or not mask.any():
+        return ids, np.zeros((0, 3)), np.zeros((0, 3))
+    cs, ss = model.store("contacts"), model.store("subcontacts")
+    row_of = {int(i): r for r, i in enumerate(b["id"])}
+    gone = set(int(i) for i in b["id"][mask])
+    acc = {}
+    for k in range(ss.n):
+        c = int(ss["contact"][k])
+        ia, ib = int(cs["ida"][c]), int(cs["idb"][c])
+        if (ia in gone) == (ib in gone) or ia not in row_of or ib not in row_of:
+            continue
+        fb = ss["fn"][k] * cs["normal"][c] + ss["fs"][k]           # force on B
+        keep, force = (ib, fb) if ia in gone else (ia, -fb)
+        r = row_of[keep]
+        if b["kind"][r] != KIND_RIGID or (b["leader"][r] >= 0 and b["leader"][r] != r):
+            raise CommandError(f"`block delete reaction`: block {keep} next to the deleted blocks is "
+                               f"{'joined to another' if b['kind'][r] == KIND_RIGID else 'not rigid'}; the "
+                               "reaction is applied to rigid, unjoined blocks only; nothing was deleted", location)
+        f, m = acc.setdefault(keep, (np.zeros(3), np.zeros(3)))
+        f += force
+        m += np.cross(ss["pos"][k] - b["centroid"][r], force)
+    ids = np.array(sorted(acc), np.int64)
+    f = np.array([acc[i][0] for i in ids]).reshape(-1, 3)
+    m = np.array([acc[i][1] for i in ids]).reshape(-1, 3)
+    if not (np.isfinite(f).all() and np.isfinite(m).all()):
+        raise CommandError("`block delete reaction`: a contact force is not finite; nothing was deleted", location)
+    return ids, f, m
 
 
 @command("block hide", positional=[P("mode", ONOFF, "on hides, off shows again", default=True)], range="block",
@@ -52,7 +111,10 @@ def block_group(session, call):
                  "joined group a selected block already belongs to.",
          examples=["block join on", "block join range group 'wall'", "block join off range id 3"])
 def block_join(session, call):
+    from ..model.zone_mesh import relink
+
     join_blocks(session.model, session.range_mask(call, "block"), on=call.args["mode"])
+    relink(session.model)            # zoned and FE blocks of one joined set share their coincident gridpoints
 
 
 @command("block property", keywords=[P("density", Num(lo=0, lo_open=True), "mass density", required=True,

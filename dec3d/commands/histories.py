@@ -13,7 +13,7 @@ from ..io.history import write_csv, write_png
 from ..physics.history import (BLOCK_QUANTITIES, CONTACT_QUANTITIES, GRIDPOINT_QUANTITIES, MODEL_QUANTITIES,
                                POINT_QUANTITIES, RIGID_QUANTITIES, ROTATION_QUANTITIES, ZONE_QUANTITIES, figures,
                                histories, nearest_block_id, nearest_gridpoint, zone_at)
-from ..model.model import KIND_DEFORMABLE
+from ..model.model import KIND_DEFORMABLE, KIND_FE
 from .registry import REGISTRY, command
 from .values import NUMBERISH, VEC3, Choice, Num, OutPath, P, Text, ValueType, _number_literal
 
@@ -92,8 +92,8 @@ def _block_history(quantity, kind="block"):
                 raise CommandError(str(exc), call.location)
         row = int(np.flatnonzero(m.blocks["id"] == bid)[0])
         if (point is None and call.args["position"] is not None and quantity in GRIDPOINT_QUANTITIES
-                and m.blocks["kind"][row] == KIND_DEFORMABLE):
-            # a zoned block: the gridpoint of the nearest block nearest the point
+                and m.blocks["kind"][row] in (KIND_DEFORMABLE, KIND_FE)):
+            # a zoned or FE block: the gridpoint of the nearest block nearest the point
             local = nearest_gridpoint(m, row, call.args["position"])
             histories(m).add_gridpoint(quantity, bid, local, name)
         elif point is not None:

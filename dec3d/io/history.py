@@ -8,18 +8,22 @@ from dec3d.io.finite import require_finite
 
 
 def write_csv(path: Path, hists, vs=None) -> None:
-    """Columns: step, time, [the `vs` history,] then each history; one row per sample."""
+    """Columns: step, time, [the `vs` history,] then each history; one row per step any of them
+    sampled, aligned by step (a history made later, or deleted blocks' histories, leave cells empty)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     cols = ([vs] if vs is not None else []) + list(hists)
-    n = min(len(h.values) for h in cols) if cols else 0
     for h in cols:
-        require_finite(f"history {h.name} ({h.label})", h.values[:n], missing_ok=True)   # NaN: no value yet
+        require_finite(f"history {h.name} ({h.label})", h.values, missing_ok=True)   # NaN: no value yet
+    at = [dict(zip(h.steps, h.values)) for h in cols]
+    times = {}
+    for h in cols:
+        times.update(zip(h.steps, h.times))
     with open(path, "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(["step", "time"] + [f"{h.name} ({h.label})" for h in cols])
-        for i in range(n):
-            w.writerow([cols[0].steps[i], repr(cols[0].times[i])] +
-                       [repr(h.values[i]) if h.values[i] == h.values[i] else "" for h in cols])
+        for step in sorted(times):
+            vals = [a.get(step, float("nan")) for a in at]
+            w.writerow([step, repr(times[step])] + [repr(v) if v == v else "" for v in vals])
 
 
 def write_png(path: Path, hist, vs=None) -> None:

@@ -17,6 +17,7 @@ from dec3d.geometry.assemble import block_poly
 from dec3d.geometry.errors import GeometryError
 from dec3d.geometry.zoning import (face_planes, hex_corners, imprint_segments, inside, mesh_convex, mesh_hex,
                                    to_high_order)
+from .model import KIND_FE
 from .store import Field
 from .zones import install_block_mesh, zone_stores
 
@@ -192,19 +193,23 @@ def _compact(model) -> None:
 def relink(model) -> int:
     """Point each duplicate gridpoint of a joined set (same coordinates, another zoned block of
     the same leader) at its master, the lowest row; returns the number of links."""
-    if "zones" not in model.stores:
-        return 0
     v, b = model.vertices, model.blocks
+    fe = b["kind"][: b.n] == KIND_FE
+    if "zones" not in model.stores and not fe.any():
+        return 0
     link = v["link"]
-    zoned = zoned_blocks(model)
+    zoned = zoned_blocks(model) | fe
     link[v["zoned"]] = -1
     lead = b["leader"][: b.n]
+    # FE slave nodes (mid-face) follow their own element's masters: never linked
+    free = ~v["feslave"] if "feslave" in v else np.ones(v.n, bool)
     n = 0
     for ld in np.unique(lead[zoned]):
         rows = np.flatnonzero(zoned & (lead == ld))
         if len(rows) < 2:
             continue
         gp = np.concatenate([np.arange(b["vert_start"][r], b["vert_start"][r] + b["vert_count"][r]) for r in rows])
+        gp = gp[free[gp]]
         pos = v["pos"][gp] + 0.0
         _, inv = np.unique(pos, axis=0, return_inverse=True)
         inv = inv.ravel()

@@ -13,6 +13,7 @@ from typing import Callable
 
 import numpy as np
 
+from dec3d.errors import CommandError
 from dec3d.io.state import register_known
 from dec3d.model.kinematics import block_rotation, unwrap_rotation
 
@@ -64,6 +65,20 @@ class History:
         self.values.append(float(self.value(eng)))
 
 
+class _BlockGone(LookupError):
+    def __init__(self, block_id: int):
+        super().__init__(block_id)
+        self.block_id = int(block_id)
+
+
+def _live_row(b, block_id: int) -> int:
+    """Row of block ``block_id``; _BlockGone when it was deleted (reported by the sampler)."""
+    rows = np.flatnonzero(b["id"] == block_id)
+    if rows.size == 0:
+        raise _BlockGone(block_id)
+    return int(rows[0])
+
+
 class HistorySet:
     def __init__(self, model):
         self.model = model
@@ -74,7 +89,13 @@ class HistorySet:
         """Step hook: sample every history when the step count is a multiple of the interval."""
         if self.items and eng.step % self.interval == 0:
             # every value first: one that fails (a FISH history's function) leaves no history a sample ahead
-            values = [float(h.value(eng)) for h in self.items]
+            try:
+                values = [float(h.value(eng)) for h in self.items]
+            except _BlockGone as exc:
+                h = next(h for h in self.items if h.spec.get("block_id") == exc.block_id)
+                raise CommandError(f"history '{h.name}' ({h.label}) follows block {exc.block_id}, which was "
+                                   "deleted: `history delete` it before deleting its block, or place it on a "
+                                   "block that stays") from None
             step, time = int(eng.step), float(eng.time)
             for h, v in zip(self.items, values):
                 h.steps.append(step)
@@ -238,7 +259,7 @@ class HistorySet:
             b = model.blocks
             r = cache["row"]
             if not (0 <= r < b.n and b["id"][r] == block_id):
-                r = cache["row"] = int(np.flatnonzero(b["id"] == block_id)[0])
+                r = cache["row"] = _live_row(b, block_id)
             v = b[fld][r]
             return float(np.linalg.norm(v)) if comp is None else float(v[comp])
 
@@ -249,7 +270,7 @@ class HistorySet:
         b = self.model.blocks
         r = cache.get("row", -1)
         if not (0 <= r < b.n and b["id"][r] == block_id):
-            r = cache["row"] = int(np.flatnonzero(b["id"] == block_id)[0])
+            r = cache["row"] = _live_row(b, block_id)
         return r
 
     def add_rotation(self, quantity: str, block_id: int, name: str | None = None, prev=None) -> History:
@@ -329,7 +350,7 @@ class HistorySet:
 
         def value(eng) -> float:
             bb = model.blocks
-            r = int(np.flatnonzero(bb["id"] == block_id)[0])
+            r = _live_row(bb, block_id)
             st = int(bb["vert_start"][r])
             arms = model.vertices["pos"][st:st + c] - bb["centroid"][r]
             rot = best_rotation(arms0, arms)
