@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .contact_intrinsics import CONTACTS
 from .intrinsics import intrinsic, setter
 from .values import FishValueError, Vec, type_name
 
@@ -76,8 +77,11 @@ def _contact_loads(model):
     b = model.blocks
     f = np.zeros((b.n, 3))
     mo = np.zeros((b.n, 3))
-    st = model.stores
-    cs, ss = st.get("contacts"), st.get("subcontacts")
+    if CONTACTS[0] is not None:           # detected again when the blocks changed (a `block delete`)
+        cs, ss = CONTACTS[0](model)
+    else:
+        st = model.stores
+        cs, ss = st.get("contacts"), st.get("subcontacts")
     if cs is None or ss is None or ss.n == 0:
         return f, mo
     c = ss["contact"]

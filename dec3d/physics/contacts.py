@@ -448,3 +448,6 @@ class ContactDetection:
         current whenever blocks exist, so contact commands see them before any cycle)."""
         if self._geometry_signature() != self._signature:
             self.detect()
+            # the blocks changed between runs: the next run works its Δt out afresh instead of
+            # going on with the last run's (``_Run``: a run continuing where one ended)
+            self.settings()["dt_run"] = []

@@ -71,3 +71,22 @@ def test_mech_solve_is_the_measure_model_solve_uses(session):
     hs = session.model.history_set
     assert session.variables["r"] == hs.find("r").values[-1] > 0
     assert session.variables["u"] == hs.find("u").values[-1] > 0
+
+
+def test_unbalanced_force_right_after_block_delete(session):
+    """`block delete` moves block rows; block.force.unbal reads the contacts detected again for the
+    blocks that are left (it used to index the old rows: a Python IndexError). Three stacked 1 m
+    cubes (2000 kg each, g = 10), the top one deleted after 20 steps: the middle block's unbalanced
+    force is its weight less what its contact with the base carries, and the lone contact left is
+    the base-middle one."""
+    session.command("block create brick 0 1 0 1 0 1\nblock create brick 0 1 0 1 1 2\nblock create brick 0 1 0 1 2 3\n"
+                    "block property density 2000\n"
+                    "block contact property stiffness-normal 1e9 stiffness-shear 1e9\n"
+                    "block fix range position-z 0 1\nmodel gravity 0 0 -10\nmodel cycle 20\n"
+                    "block delete range position-z 2 3")
+    session.command("[fz = block.force.unbal.z(block.find(2))]\n[nc = list.size(block.contact.list)]")
+    m = session.model
+    ss = m.store("subcontacts")
+    v = session.variables
+    assert v["nc"] == 1
+    assert v["fz"] == pytest.approx(ss["fn"][: ss.n].sum() - 20000.0, rel=1e-9, abs=1e-6)
