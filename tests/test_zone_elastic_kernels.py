@@ -195,3 +195,48 @@ def test_partition_and_scatter_plan():
             want = sorted(e for e, tt in foreign.items() if tt == t)
             assert list(pslot[tstart[i]:tstart[i + 1]]) == [slot[e] for e in want]
         assert sorted(ptgt.tolist()) == sorted(set(foreign.values()))
+
+
+@pytest.mark.parametrize("mode, large", [(0, False), (1, True), (2, False), (3, True)])
+def test_threaded_motion_gives_the_serial_motions_bits(mode, large):
+    """``zonestep.gp_motion_ws`` (masters on threads, reductions in master order) against
+    ``gp_motion`` (twin-tested in tests/deformable/test_zone_step_kernels.py): every array and
+    out[0..3] the same bits, 1 and 2 threads; the first runaway master in master order is named."""
+    from dec3d.kernels.zonestep import gp_motion, gp_motion_ws
+    rng = np.random.default_rng(40 + mode)
+    n = 3000
+    link = np.full(n, -1, np.int64)
+    linked = np.sort(rng.choice(n, 300, replace=False))
+    masters = np.setdiff1d(np.arange(n), linked)
+    link[linked] = rng.choice(masters, len(linked))
+    force, fprev = rng.normal(size=(n, 3)) * 1e3, rng.normal(size=(n, 3)) * 1e3
+    mtot, imass = rng.uniform(1, 2, n), rng.uniform(1, 2, n)
+    imass[masters[::97]] = 0.0
+    held = rng.choice(np.array([0, 0, 0, 1, 5, 7, 8, 40], np.uint8), n)
+    vapp, vel = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
+    vel[masters[::50], 1] = 0.0
+    force[masters[700], 0] = 1e12                       # two runaways: the first in master order counts
+    force[masters[1900], 2] = np.nan
+    held[masters[[700, 1900]]] = 0
+    imass[masters[[700, 1900]]] = 1.0
+    keep = numba.get_num_threads()
+    try:
+        for vmax in (1e6, 1e30):
+            base = [force, fprev, vel, rng.normal(size=(n, 3)), rng.normal(size=(n, 3))]
+            ref = [a.copy() for a in base]
+            out_ref = np.zeros(4)
+            bad_ref = gp_motion(masters, linked, link, ref[0], ref[1], mtot, imass, held, vapp, ref[2], ref[3], ref[4],
+                                0.3, mode, 0.8, large, vmax, out_ref)
+            assert bad_ref == (masters[700] if vmax == 1e6 else masters[1900])
+            for nt in (1, 2):
+                numba.set_num_threads(min(nt, numba.config.NUMBA_NUM_THREADS))
+                got = [a.copy() for a in base]
+                out = np.zeros(4)
+                bad = gp_motion_ws(masters, linked, link, got[0], got[1], mtot, imass, held, vapp, got[2], got[3],
+                                   got[4], 0.3, mode, 0.8, large, vmax, out, np.full((len(masters), 5), np.nan))
+                assert bad == bad_ref
+                np.testing.assert_array_equal(out, out_ref)
+                for a, b in zip(ref, got):
+                    np.testing.assert_array_equal(a, b)
+    finally:
+        numba.set_num_threads(keep)

@@ -30,7 +30,7 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
    those of 10-node zones, both counted in the applied-force magnitudes of the equilibrium
    ratio), applied and face forces (``model.face_loads``: 6-node faces of 10-node zones by
    ``zones_ho.tri6_traction_loads``, hexahedral zone faces as quadrilaterals) and the sum onto masters (``gp_externals``), damping and
-   motion (``gp_motion``).
+   motion (``gp_motion_ws``, the bits of ``gp_motion`` on threads).
 
 Zoned blocks are not bodies of the rigid motion kernel (``RigidEngine._groups`` leaves them
 out). Contacts between a zoned and a rigid block add their forces to the gridpoints
@@ -46,7 +46,7 @@ import numpy as np
 from dec3d.errors import Dec3dError
 from dec3d.kernels.zone_elastic import ElasticPlan, elastic_zone_step
 from dec3d.kernels.zone_plastic import node_lists4, zone_forces_plastic, zone_forces_plastic_parallel_ws, zone_scratch
-from dec3d.kernels.zonestep import gp_externals, gp_motion, zone_mass_stiffness
+from dec3d.kernels.zonestep import gp_externals, gp_motion_ws, zone_mass_stiffness
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.model import KIND_DEFORMABLE
 from dec3d.model.zone_mohr import mohr_props_check
@@ -240,6 +240,7 @@ class ZoneStepper:
         self.ktot = ktot
         self.kzone = ktot.copy()
         self.facc = np.zeros((n, 3))
+        self.mwork = np.empty((len(self.masters), 5))      # (scratch of ``gp_motion_ws``)
         self.fmag = np.zeros(n)
         self.out = np.zeros(4)
 
@@ -275,8 +276,14 @@ class ZoneStepper:
     def begin(self) -> np.ndarray:
         """Start a step: the gridpoint force accumulator zeroed and returned (contact forces
         may be added to it before ``step(…, begun=True)``)."""
-        self.facc[self.rows] = 0.0
-        self.fmag[self.rows] = 0.0
+        if 2 * len(self.rows) > len(self.fmag):
+            # (rows off the zoned blocks are never written: zeroing all of it is the same, and
+            # cheaper than the indexed write when most rows are gridpoints)
+            self.facc[:] = 0.0
+            self.fmag[:] = 0.0
+        else:
+            self.facc[self.rows] = 0.0
+            self.fmag[self.rows] = 0.0
         return self.facc
 
     def step(self, dt: float, gravity: np.ndarray, mode: int, alpha: float, large: bool, vmax: float,
@@ -316,8 +323,8 @@ class ZoneStepper:
         gp_externals(self.rows, v["link"], self.gmass, gravity, v["fapp"], v["fface"], facc, fmag)
         if fe is not None:
             fe.slave_forces(facc)
-        bad = gp_motion(self.masters, self.linked, v["link"], facc, v["force"], self.mtot, v["imass"], self.held,
-                        self.vapp, vel, v["disp"], pos, dt, mode, alpha, large, vmax, self.out)
+        bad = gp_motion_ws(self.masters, self.linked, v["link"], facc, v["force"], self.mtot, v["imass"], self.held,
+                           self.vapp, vel, v["disp"], pos, dt, mode, alpha, large, vmax, self.out, self.mwork)
         if fe is not None:
             fe.follow(vel, v["disp"], *((pos,) if large else ()))
         return bad
