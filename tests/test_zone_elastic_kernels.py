@@ -240,3 +240,54 @@ def test_threaded_motion_gives_the_serial_motions_bits(mode, large):
                     np.testing.assert_array_equal(a, b)
     finally:
         numba.set_num_threads(keep)
+
+
+#: two zoned blocks apart: 4-node tetrahedra and hexahedral (mixed-discretization) zones, large
+#: strain, gravity, a held base, a side load
+_DECK = """model new
+block create brick 0 1 0 1 0 1
+block create brick 2 3 0 1 0 1
+block zone generate edgelength 0.3 range position-x 0 1
+block zone generate hexahedra divisions 3 2 3 range position-x 2 3
+block zone cmodel assign elastic
+block zone property bulk 5e8 shear 3e8 density 2000
+block gridpoint apply velocity 0 0 0 range position-z 0
+block gridpoint apply force-x 2e5 range position-z 1
+model gravity 0 0 -10
+model large-strain on
+"""
+
+
+def _model_run(tmp_path, monkeypatch, threads, elastic, nmd="on", steps=60):
+    import io
+
+    import dec3d
+    import dec3d.physics.zones as pz
+
+    monkeypatch.setattr(pz, "ELASTIC_KERNEL", elastic)
+    monkeypatch.setattr(pz, "PARALLEL_MIN_ZONES", 0)          # the threaded kernels on this small model
+    keep = numba.get_num_threads()
+    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    try:
+        s = dec3d.Session(out_dir=tmp_path, stdout=io.StringIO())
+        s.command(_DECK + f"block zone nodal-mixed-discretization {nmd}\nmodel cycle {steps}\n")
+    finally:
+        numba.set_num_threads(keep)
+    m = s.model
+    zst = m.rigid_engine._zstep
+    assert (zst.fast is not None) == elastic and zst.nset > 0
+    return (m.store("zones")["stress"].copy(), m.vertices["disp"].copy(), m.vertices["velocity"].copy(),
+            np.array([m.rigid_engine.kinetic, m.rigid_engine.criteria()["unbalanced-maximum"]]))
+
+
+@pytest.mark.parametrize("nmd", ["on", "off"])
+def test_model_runs_give_the_same_bits_with_either_kernel_and_thread_count(tmp_path, monkeypatch, nmd):
+    """A whole run (60 steps, large strain, tetrahedra and hexahedral sets): the elastic kernel
+    on 1 and 2 threads and the plastic kernels give the same stresses, displacements,
+    velocities, kinetic energy and unbalanced force, bit for bit."""
+    ref = _model_run(tmp_path, monkeypatch, 1, False, nmd)
+    assert np.abs(ref[1]).max() > 1e-7                             # it moved
+    for threads in (1, 2):
+        got = _model_run(tmp_path, monkeypatch, threads, True, nmd)
+        for a, b in zip(ref, got):
+            np.testing.assert_array_equal(a, b)

@@ -66,6 +66,11 @@ TET10_STIFFNESS_MARGIN = 2.0
 PARALLEL_MIN_ZONES = 20000
 
 
+#: step zones with ``zone_elastic.elastic_zone_step`` when none is Mohr-Coulomb (False: always
+#: the plastic kernels, which give the same bits; for tests)
+ELASTIC_KERNEL = True
+
+
 def _ids(model, rows) -> str:
     ids = sorted(set(int(i) for i in model.blocks["id"][np.asarray(rows, _I)]))
     head = ", ".join(str(i) for i in ids[:10])
@@ -160,7 +165,7 @@ class ZoneStepper:
         #: no Mohr-Coulomb zone: the elastic step (``zone_elastic.elastic_zone_step``, the bits of
         #: the plastic step) on one part of the zones per thread from PARALLEL_MIN_ZONES zones on
         self.fast = None
-        if not len(mo) and len(self.rows4):
+        if ELASTIC_KERNEL and not len(mo) and len(self.rows4):
             import numba
 
             nch = numba.get_num_threads() if len(self.rows4) >= PARALLEL_MIN_ZONES else 1
