@@ -81,17 +81,24 @@ def twin_elastic_step(pos, vel, gp, rows, zset, weight, node, bulk, shear, dt, l
             fmag[gp[z, n]] += np.linalg.norm(f)
 
 
-def _case(seed, n=3):
+def _case(seed, n=3, plain=False):
+    """A jittered lattice: ``plain`` steps every zone, no sets, unit weights, no links (the
+    plan then passes rows, zset and weight empty); otherwise a subset of the zones, two
+    hexahedral sets with half weights and one linked gridpoint."""
     rng = np.random.default_rng(seed)
     pos, gp = _lattice(n, rng)
     nz, nv = len(gp), len(pos)
     vel = rng.normal(size=(nv, 3)) * 1e-3
-    rows = np.sort(rng.choice(nz, nz - 7, replace=False)).astype(np.int64)    # not every zone
-    zset = np.full(len(rows), -1, np.int64)
-    zset[:12] = np.repeat(np.arange(2), 6)            # two cubes' tetrahedra as mixed sets
-    weight = np.where(zset >= 0, 0.5, 1.0)
     node = np.arange(nv, dtype=np.int64)
-    node[gp[rows[40], 1]] = gp[rows[40], 0]           # one linked gridpoint (averages at its master)
+    if plain:
+        rows = np.arange(nz, dtype=np.int64)
+        zset = np.full(nz, -1, np.int64)
+    else:
+        rows = np.sort(rng.choice(nz, nz - 7, replace=False)).astype(np.int64)    # not every zone
+        zset = np.full(len(rows), -1, np.int64)
+        zset[:12] = np.repeat(np.arange(2), 6)            # two cubes' tetrahedra as mixed sets
+        node[gp[rows[40], 1]] = gp[rows[40], 0]           # one linked gridpoint (averages at its master)
+    weight = np.where(zset >= 0, 0.5, 1.0)
     prop = np.zeros((nz, mz.NZPROP))
     prop[:, mz.ZP_BULK] = K * rng.uniform(0.5, 1.5, nz)
     prop[:, mz.ZP_SHEAR] = G * rng.uniform(0.5, 1.5, nz)
@@ -104,9 +111,9 @@ def _run(case, large, nmd, nparts, identity_node=False):
     nv = len(pos)
     if identity_node:
         node = np.arange(nv, dtype=np.int64)
-    plan = ze.ElasticPlan(gp, rows, node, zset, nv, nparts)
+    plan = ze.ElasticPlan(gp, rows, node, zset, weight, nv, nparts)
     st, f, fm = stress.copy(), np.ones((nv, 3)), np.full(nv, 0.5)
-    ze.elastic_zone_step(pos, vel, plan.g4, plan.n4, rows, zset, weight, int(zset.max()) + 1,
+    ze.elastic_zone_step(pos, vel, plan.g4, plan.n4, plan.rows, plan.zset, plan.weight, int(zset.max()) + 1,
                          np.ascontiguousarray(prop[:, mz.ZP_BULK]), np.ascontiguousarray(prop[:, mz.ZP_SHEAR]),
                          0.7, large, nmd, st, f, fm, *plan.args())
     return st, f, fm
@@ -128,10 +135,14 @@ def test_elastic_step_matches_twin(large, nmd):
     assert np.abs(st[rows] - stress[rows]).min() > 0.0
 
 
-@pytest.mark.parametrize("large, nmd", [(False, True), (True, True), (True, False)])
-def test_elastic_step_gives_the_plastic_steps_bits_for_any_parts_and_threads(large, nmd):
-    case = _case(11)
+@pytest.mark.parametrize("large, nmd, plain", [(False, True, False), (True, True, False), (True, False, False),
+                                               (False, True, True), (True, True, True)])
+def test_elastic_step_gives_the_plastic_steps_bits_for_any_parts_and_threads(large, nmd, plain):
+    case = _case(11, plain=plain)
     pos, vel, gp, rows, zset, weight, node, prop, stress = case
+    plan = ze.ElasticPlan(gp, rows, node, zset, weight, len(pos), 2)
+    assert (len(plan.rows), len(plan.zset), len(plan.weight)) == ((0, 0, 0) if plain else (len(rows),) * 3)
+    assert (plan.n4 is plan.g4) == plain
     nv = len(pos)
     ref = [stress.copy(), np.zeros(len(gp), np.int32), np.ones((nv, 3)), np.full(nv, 0.5)]
     zp.zone_forces_plastic(pos, vel, gp, rows, zset, weight, int(zset.max()) + 1, node, np.ones(len(gp), np.int8),

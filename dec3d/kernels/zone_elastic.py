@@ -224,7 +224,9 @@ def elastic_zone_step(pos, vel, g4, n4, rows, zset, weight, nset, bulk, shear, d
 
     g4 (nr, 4) int32: gridpoint rows of each entry's zone (gp[rows, :4]); n4 (nr, 4) int32:
     their averaging nodes (node[g4]; g4 itself without linked gridpoints); zset, weight, nset,
-    large, nmd as ``zone_forces_plastic``; bulk, shear per zone row; stress (nzones, 6) updated;
+    large, nmd as ``zone_forces_plastic``, except that rows may be empty (entry k is zone row k),
+    zset empty when nset is 0 and weight empty when every weight is 1 (``ElasticPlan`` passes
+    them so: fewer streams through memory); bulk, shear per zone row; stress (nzones, 6) updated;
     force (nvert, 3) and fmag (nvert,) added to. Parts pstart, pk: ``partition_entries``; fbits
     … fpslot: ``scatter_plan(g4, nvert, pstart, pk, all entries)``; nbits … npslot:
     ``scatter_plan(n4, nvert, pstart, pk, zset < 0)`` (read when ``nmd``). Scratch: nodesum,
@@ -246,7 +248,7 @@ def elastic_zone_step(pos, vel, g4, n4, rows, zset, weight, nset, bulk, shear, d
                 d0, d1, d2, d3, d4, d5, w0, w1, w2 = _strain(vel, i0, i1, i2, i3, a0x, a0y, a0z, a1x, a1y, a1z,
                                                              a2x, a2y, a2z, a3x, a3y, a3z, vol, dt)
                 e = d0 + d1 + d2
-                if zset[k] >= 0:
+                if nset > 0 and zset[k] >= 0:
                     evs[k] = e
                     vols[k] = vol
                 elif nmd:
@@ -285,7 +287,7 @@ def elastic_zone_step(pos, vel, g4, n4, rows, zset, weight, nset, bulk, shear, d
                                                             a2x, a2y, a2z, a3x, a3y, a3z, vol, dt)
             e = d0 + d1 + d2
             bar = e
-            h = zset[k]
+            h = zset[k] if nset > 0 else -1
             if h >= 0:
                 if ss[h] > 0.0:
                     bar = sv[h] / ss[h]
@@ -298,7 +300,7 @@ def elastic_zone_step(pos, vel, g4, n4, rows, zset, weight, nset, bulk, shear, d
                 bar = 0.25 * acc
             shift = (bar - e) / 3.0
             d0 += shift; d1 += shift; d2 += shift
-            z = rows[k]
+            z = rows[k] if rows.shape[0] > 0 else k
             s0 = stress[z, 0]; s1 = stress[z, 1]; s2 = stress[z, 2]
             s3 = stress[z, 3]; s4 = stress[z, 4]; s5 = stress[z, 5]
             if large:
@@ -322,7 +324,7 @@ def elastic_zone_step(pos, vel, g4, n4, rows, zset, weight, nset, bulk, shear, d
             s5 += 2.0 * G * d5
             stress[z, 0] = s0; stress[z, 1] = s1; stress[z, 2] = s2
             stress[z, 3] = s3; stress[z, 4] = s4; stress[z, 5] = s5
-            w = weight[k] / 3.0
+            w = weight[k] / 3.0 if weight.shape[0] > 0 else 1.0 / 3.0
             b = fbits[k]
             fx, fy, fz, fm = _force(s0, s1, s2, s3, s4, s5, a0x, a0y, a0z, w)
             j = _add(force, fmag, i0, fx, fy, fz, fm, b & 1, sb, j)
@@ -368,9 +370,14 @@ class ElasticPlan:
     ``nchunk``: chunks of zone entries (any count gives the same bits; one per thread keeps
     the foreign entries few)."""
 
-    def __init__(self, gp, rows, node, zset, nvert, nchunk):
+    def __init__(self, gp, rows, node, zset, weight, nvert, nchunk):
         nr = len(rows)
-        self.g4, self.n4, ident = node_table(gp, rows, node)
+        #: rows, zset and weight as ``elastic_zone_step`` takes them (empty when they say nothing)
+        self.rows = np.zeros(0, np.int64) if np.array_equal(rows, np.arange(nr)) else rows
+        self.zset = zset if (zset >= 0).any() else np.zeros(0, np.int64)
+        self.weight = weight if (weight != 1.0).any() else np.zeros(0)
+        self.g4, n4, ident = node_table(gp, rows, node)
+        self.n4 = self.g4 if ident else n4          # (one array: the kernel's result boxes it twice)
         self.pstart, self.pk = partition_entries(self.g4, nvert, nchunk)
         fp = scatter_plan(self.g4, nvert, self.pstart, self.pk, np.ones(nr, np.bool_))
         free = zset < 0

@@ -169,7 +169,7 @@ class ZoneStepper:
             import numba
 
             nch = numba.get_num_threads() if len(self.rows4) >= PARALLEL_MIN_ZONES else 1
-            self.fast = ElasticPlan(zs["gp"], self.rows4, self.node, self.zset, v.n, nch)
+            self.fast = ElasticPlan(zs["gp"], self.rows4, self.node, self.zset, self.weight, v.n, nch)
         elif self.plastic and len(self.rows4) >= PARALLEL_MIN_ZONES:
             nv = v.n
             fstart, fent = node_lists4(nv, np.arange(nv, dtype=_I), zs["gp"], self.rows4)
@@ -302,7 +302,7 @@ class ZoneStepper:
         pos, vel = v["pos"], v["velocity"]
         fast = self.fast
         if fast is not None:
-            elastic_zone_step(pos, vel, fast.g4, fast.n4, self.rows4, self.zset, self.weight, self.nset, self.bulk,
+            elastic_zone_step(pos, vel, fast.g4, fast.n4, fast.rows, fast.zset, fast.weight, self.nset, self.bulk,
                               self.shear, dt, large, self.nmd, zs["stress"], facc, fmag, *fast.args())
         elif self.par is not None:
             zone_forces_plastic_parallel_ws(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset,
