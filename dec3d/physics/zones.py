@@ -46,7 +46,7 @@ import numpy as np
 from dec3d.errors import Dec3dError
 from dec3d.kernels.zone_elastic import ElasticPlan, elastic_zone_step
 from dec3d.kernels.zone_plastic import node_lists4, zone_forces_plastic, zone_forces_plastic_parallel_ws, zone_scratch
-from dec3d.kernels.zonestep import gp_externals, gp_motion_ws, zone_mass_stiffness
+from dec3d.kernels.zonestep import gp_externals, gp_motion, gp_motion_ws, zone_mass_stiffness
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.model import KIND_DEFORMABLE
 from dec3d.model.zone_mohr import mohr_props_check
@@ -245,7 +245,8 @@ class ZoneStepper:
         self.ktot = ktot
         self.kzone = ktot.copy()
         self.facc = np.zeros((n, 3))
-        self.mwork = np.empty((len(self.masters), 5))      # (scratch of ``gp_motion_ws``)
+        #: scratch of ``gp_motion_ws`` (threaded motion, big models only)
+        self.mwork = np.empty((len(self.masters) if len(self.rows4) >= PARALLEL_MIN_ZONES else 0, 5))
         self.fmag = np.zeros(n)
         self.out = np.zeros(4)
 
@@ -328,8 +329,11 @@ class ZoneStepper:
         gp_externals(self.rows, v["link"], self.gmass, gravity, v["fapp"], v["fface"], facc, fmag)
         if fe is not None:
             fe.slave_forces(facc)
-        bad = gp_motion_ws(self.masters, self.linked, v["link"], facc, v["force"], self.mtot, v["imass"], self.held,
-                           self.vapp, vel, v["disp"], pos, dt, mode, alpha, large, vmax, self.out, self.mwork)
+        # (threads pay from a few thousand gridpoints on; both give the same bits)
+        move = gp_motion_ws if len(self.rows4) >= PARALLEL_MIN_ZONES else gp_motion
+        bad = move(self.masters, self.linked, v["link"], facc, v["force"], self.mtot, v["imass"], self.held,
+                   self.vapp, vel, v["disp"], pos, dt, mode, alpha, large, vmax, self.out,
+                   *((self.mwork,) if move is gp_motion_ws else ()))
         if fe is not None:
             fe.follow(vel, v["disp"], *((pos,) if large else ()))
         return bad
