@@ -5,7 +5,9 @@ Figures per N (issue 10 targets on this machine: >= 2e7 zone-cycles/s with 2 thr
 zones; <= 1 kB per zone; zoning 1e6 zones <= 30 s):
 
 - zone-cycles/s: zones x timed steps / wall time of `model cycle S` (after warm-up steps that
-  also compile the kernels and build the engine's zone stepper);
+  also compile the kernels; the timed command builds its own zone stepper, as every `model
+  cycle` does); "cpu s": the process's CPU time over the same command (all threads), which the
+  other loads of a shared machine inflate less than the wall time;
 - memory per zone: bytes of the live rows of the ``zones`` store, of the gridpoint store
   (``model.vertices``: positions, velocities, forces, masses of every gridpoint) and of the
   numpy arrays the engine's zone stepper holds, each divided by the zone count; and the growth
@@ -104,7 +106,21 @@ def _stepper_bytes(model) -> int:
     zst = getattr(eng, "_zstep", None) if eng is not None else None
     if zst is None:
         return 0
-    return int(sum(v.nbytes for v in vars(zst).values() if isinstance(v, np.ndarray)))
+    seen: dict[int, int] = {}
+
+    def walk(x, depth=0):
+        if isinstance(x, np.ndarray):
+            seen[id(x)] = x.nbytes          # (an array held twice counts once)
+        elif isinstance(x, (tuple, list)):
+            for y in x:
+                walk(y, depth)
+        elif depth == 0 and hasattr(x, "__dict__") and type(x).__module__.startswith("dec3d.kernels"):
+            for y in vars(x).values():      # plans of the kernels the stepper holds (``ElasticPlan``)
+                walk(y, 1)
+
+    for v in vars(zst).values():
+        walk(v)
+    return int(sum(seen.values()))
 
 
 def one(zones: float, steps: int, threads: int | None = None, jointed: bool = False) -> dict:
@@ -135,13 +151,15 @@ def one(zones: float, steps: int, threads: int | None = None, jointed: bool = Fa
         t1 = time.perf_counter()
         s.command(f"model cycle {WARMUP}")
         t2 = time.perf_counter()
+        c2 = time.process_time()
         s.command(f"model cycle {steps}")
         t3 = time.perf_counter()
+        c3 = time.process_time()
         rss1 = _rss_bytes()
         m = s.model
         nz = m.store("zones").n
         out = dict(threads=numba.get_num_threads(), zones=nz, gridpoints=m.vertices.n,
-                   zoning_s=t1 - t0, warmup_s=t2 - t1, seconds=t3 - t2,
+                   zoning_s=t1 - t0, warmup_s=t2 - t1, seconds=t3 - t2, cpu_s=c3 - c2,
                    zones_b=_store_bytes(m.store("zones")), gp_b=_store_bytes(m.vertices),
                    stepper_b=_stepper_bytes(m), rss_growth_b=rss1 - rss0, blocks=m.blocks.n,
                    subcontacts=m.store("subcontacts").n if "subcontacts" in m.stores else 0,
@@ -180,7 +198,7 @@ def main(argv=None) -> int:
             if args.jointed else "unit cube of 4-node tetrahedra under gravity, elastic, base held")
     print(f"scene: {what}; {WARMUP} warm-up + {args.steps} timed steps, median of {args.repeat}")
     print(f"{'threads':>7} {'zones':>8} {'gridpts':>8} {'zoning s':>8} {'seconds':>8} {'min..max':>15} "
-          f"{'zone-cyc/s':>11} {'zones B/z':>9} {'gp B/z':>7} {'step B/z':>8} {'total B/z':>9} {'RSS B/z':>8}"
+          f"{'zone-cyc/s':>11} {'zones B/z':>9} {'gp B/z':>7} {'step B/z':>8} {'total B/z':>9} {'RSS B/z':>8} {'cpu s':>7}"
           + (f" {'subcont':>8} {'sub-upd/s':>10} {'cont B/z':>8}" if args.jointed else ""))
     for th in args.threads:
         for n in args.zones:
@@ -198,7 +216,7 @@ def main(argv=None) -> int:
             print(f"{r0['threads']:>7} {nz:>8} {r0['gridpoints']:>8} "
                   f"{statistics.median(r['zoning_s'] for r in runs):>8.2f} {t:>8.3f} "
                   f"{min(sec):>7.3f}..{max(sec):<7.3f} {rate:>11.4g} {zb:>9.0f} {gb:>7.0f} {sb:>8.0f} "
-                  f"{zb + gb + sb:>9.0f} {rss:>8.0f}"
+                  f"{zb + gb + sb:>9.0f} {rss:>8.0f} {statistics.median(r['cpu_s'] for r in runs):>7.3f}"
                   + (f" {r0['subcontacts']:>8} {r0['subcontacts'] * args.steps / t:>10.4g} "
                      f"{r0['contacts_b'] / nz:>8.0f}" if args.jointed else ""), flush=True)
     print(f"loadavg after: {loadavg()}")

@@ -334,9 +334,14 @@ def zone_forces_plastic_parallel(pos, vel, gp, rows, zset, weight, nset, node, c
 # The threaded kernel runs sweeps A-C over zones in parallel and makes every gridpoint sum by
 # the fixed-order gather of ``node_lists4``: bit for bit the serial result, any thread count.
 # Measured (bench/README.md): the threaded kernel beats the allocating serial one at 1e6 zones
-# even on one thread, but not at 1e4; the serial fused kernel is slower than both (cause not
-# found), so the stepper uses ``zone_forces_plastic`` below PARALLEL_MIN_ZONES zones and the
-# threaded ``*_ws`` kernel above; the serial ``*_ws`` kernel is kept as the tested serial form.
+# even on one thread, but not at 1e4; the serial fused kernel is slower than both: the
+# Mohr-Coulomb branch of ``_zone_update`` inside sweep B's loop costs about a third of the
+# kernel even when no zone takes it (1e6 elastic zones, one thread: 339 ms with the branch,
+# 221 ms with it removed, the same as ``zone_forces_plastic``, whose constitutive pass is a loop
+# of its own; array views passed to the helpers cost a further ~5 %). So the stepper uses
+# ``zone_forces_plastic`` below PARALLEL_MIN_ZONES zones and the threaded ``*_ws`` kernel above
+# when some zone is Mohr-Coulomb; with none, ``zone_elastic.elastic_zone_step`` (the same bits,
+# scalar locals, no Mohr branch); the serial ``*_ws`` kernel is kept as the tested serial form.
 
 def zone_scratch(nr, nvert, parallel):
     """Scratch of the ``*_ws`` kernels for ``nr`` zone entries and ``nvert`` gridpoint rows:

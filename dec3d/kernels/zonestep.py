@@ -44,7 +44,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from .motion import _sgn
 
@@ -190,11 +190,12 @@ def zone_forces(pos, vel, gp, rows, zset, weight, nset, bulk, shear, dt, large, 
             fmag[r] += math.sqrt(fx * fx + fy * fy + fz * fz)
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def gp_externals(rows, link, mass, gravity, fapp, fface, force, fmag):
     """Add gravity m g (real mass), applied and face forces to each gridpoint row of ``rows``
-    (their magnitudes to ``fmag``), then sum each linked row's force and fmag onto its master."""
-    for k in range(rows.shape[0]):
+    (their magnitudes to ``fmag``), then sum each linked row's force and fmag onto its master
+    (rows in parallel, the sums onto masters in row order: the same bits for any thread count)."""
+    for k in prange(rows.shape[0]):
         r = rows[k]
         tot = 0.0
         for i in range(3):
@@ -265,6 +266,74 @@ def gp_motion(masters, linked, link, force, fprev, mass, imass, held, vapp, vel,
         if bad < 0 and not (sp <= vmax * vmax):
             bad = r
     for k in range(linked.shape[0]):
+        r = linked[k]
+        mr = link[r]
+        for i in range(3):
+            vel[r, i] = vel[mr, i]
+            disp[r, i] = disp[mr, i]
+            force[r, i] = force[mr, i]
+            fprev[r, i] = fprev[mr, i]
+            if large:
+                pos[r, i] = pos[mr, i]
+    out[0] = umax
+    out[1] = usum
+    out[2] = ke
+    out[3] = bad
+    return bad
+
+
+@njit(cache=True, parallel=True)
+def gp_motion_ws(masters, linked, link, force, fprev, mass, imass, held, vapp, vel, disp, pos, dt, mode, alpha,
+                 large, vmax, out, work):
+    """``gp_motion`` (same arguments, same bits) with the masters moved in parallel: each
+    master's unbalanced force magnitude, kinetic-energy terms and speed test go to ``work``
+    (len(masters), 5), then out[0..3] are reduced from it in master order, as ``gp_motion``
+    accumulates them. Returns the first unstable master row or -1."""
+    nm = masters.shape[0]
+    for k in prange(nm):
+        r = masters[k]
+        m = imass[r]
+        u2 = 0.0
+        for i in range(3):
+            f = force[r, i]
+            if held[r] & (1 << i):
+                vel[r, i] = vapp[r, i]
+                f = 0.0
+            elif held[r] & (8 << i) or m <= 0.0:
+                f = 0.0
+            else:
+                fd = 0.0
+                if mode == 1 or mode == 3:
+                    fd = alpha * abs(f) * _sgn(vel[r, i])
+                elif mode == 2:
+                    fd = alpha * abs(f) * (_sgn(vel[r, i]) - _sgn(f - fprev[r, i])) * 0.5
+                vel[r, i] += (f - fd) * dt / m
+            force[r, i] = f
+            fprev[r, i] = f
+            u2 += f * f
+            d = vel[r, i] * dt
+            disp[r, i] += d
+            if large:
+                pos[r, i] += d
+            work[k, 1 + i] = 0.5 * mass[r] * vel[r, i] * vel[r, i]
+        work[k, 0] = math.sqrt(u2)
+        sp = vel[r, 0] * vel[r, 0] + vel[r, 1] * vel[r, 1] + vel[r, 2] * vel[r, 2]
+        work[k, 4] = 0.0 if sp <= vmax * vmax else 1.0
+    umax = 0.0
+    usum = 0.0
+    ke = 0.0
+    bad = -1
+    for k in range(nm):
+        ke += work[k, 1]
+        ke += work[k, 2]
+        ke += work[k, 3]
+        u = work[k, 0]
+        usum += u
+        if u > umax:
+            umax = u
+        if bad < 0 and work[k, 4] != 0.0:
+            bad = masters[k]
+    for k in prange(linked.shape[0]):
         r = linked[k]
         mr = link[r]
         for i in range(3):

@@ -19,17 +19,18 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
    the rigid Δt) or a time step was fixed (``block mechanical timestep`` / ``mass-scale
    timestep``). Dynamic runs: real masses and Δt = min over gridpoints of Eq. (84), and of the
    rigid Δt when rigid blocks cycle;
-4. each step (``step``): zone forces of the 4-node zones (``zone_plastic.zone_forces_plastic``,
-   ``zone_forces_plastic_parallel_ws`` from PARALLEL_MIN_ZONES zones on, the same bits,
-   with elastic and Mohr-Coulomb zones mixed, mixed discretization in hexahedral sets and nodal
-   mixed discretization, NMD, for the other tetrahedra when ``settings.mechanical["nmd"]`` is on,
-   the default, ``block zone nodal-mixed-discretization``; with NMD off and only elastic zones
-   the elastic ``zonestep.zone_forces``; 10-node zones by ``zones_ho.tet10_step``), gravity (m g
+4. each step (``step``): zone forces of the 4-node zones (mixed discretization in hexahedral
+   sets and nodal mixed discretization, NMD, for the other tetrahedra when
+   ``settings.mechanical["nmd"]`` is on, the default, ``block zone nodal-mixed-discretization``):
+   with no Mohr-Coulomb zone ``zone_elastic.elastic_zone_step`` (threads from PARALLEL_MIN_ZONES
+   zones on), otherwise ``zone_plastic.zone_forces_plastic`` (``zone_forces_plastic_parallel_ws``
+   from PARALLEL_MIN_ZONES zones on), all with the same bits for the same zones; 10-node zones
+   by ``zones_ho.tet10_step``), gravity (m g
    on the gridpoints of 4-node zones, the consistent loads of ``zones_ho.tet10_body_force`` on
    those of 10-node zones, both counted in the applied-force magnitudes of the equilibrium
    ratio), applied and face forces (``model.face_loads``: 6-node faces of 10-node zones by
    ``zones_ho.tri6_traction_loads``, hexahedral zone faces as quadrilaterals) and the sum onto masters (``gp_externals``), damping and
-   motion (``gp_motion``).
+   motion (``gp_motion_ws``, the bits of ``gp_motion`` on threads).
 
 Zoned blocks are not bodies of the rigid motion kernel (``RigidEngine._groups`` leaves them
 out). Contacts between a zoned block and a rigid or another zoned block add their forces to the
@@ -43,8 +44,9 @@ import math
 import numpy as np
 
 from dec3d.errors import Dec3dError
+from dec3d.kernels.zone_elastic import ElasticPlan, elastic_zone_step
 from dec3d.kernels.zone_plastic import node_lists4, zone_forces_plastic, zone_forces_plastic_parallel_ws, zone_scratch
-from dec3d.kernels.zonestep import gp_externals, gp_motion, zone_forces, zone_mass_stiffness
+from dec3d.kernels.zonestep import gp_externals, gp_motion, gp_motion_ws, zone_mass_stiffness
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.model import KIND_DEFORMABLE
 from dec3d.model.zone_mohr import mohr_props_check
@@ -58,9 +60,15 @@ _I = np.int64
 #: spare; the D3 10-node hole deck went unstable at step 130 with it and runs with twice it
 TET10_STIFFNESS_MARGIN = 2.0
 
-#: 4-node zones from which the plastic step runs on threads (``zone_forces_plastic_parallel``,
-#: bit-identical to the serial kernel, so the choice never changes a result)
+#: 4-node zones from which the zone step runs on threads (``elastic_zone_step`` in one part
+#: per thread, ``zone_forces_plastic_parallel_ws``; both bit-identical to the serial kernel, so
+#: the choice never changes a result)
 PARALLEL_MIN_ZONES = 20000
+
+
+#: step zones with ``zone_elastic.elastic_zone_step`` when none is Mohr-Coulomb (False: always
+#: the plastic kernels, which give the same bits; for tests)
+ELASTIC_KERNEL = True
 
 
 def _ids(model, rows) -> str:
@@ -148,13 +156,6 @@ class ZoneStepper:
         #: taken on one thread too: its zone sweeps and gathers beat the serial scatter there as well
         #: (``bench/zone_bench.py``)
         self.par = None
-        if self.plastic and len(self.rows4) >= PARALLEL_MIN_ZONES:
-            nv = v.n
-            fstart, fent = node_lists4(nv, np.arange(nv, dtype=_I), zs["gp"], self.rows4)
-            nstart, nent = node_lists4(nv, self.node, zs["gp"], self.rows4)
-            self.par = (fstart, fent, nstart, nent)
-        #: scratch of the plastic step, allocated once (``zone_plastic.zone_scratch``)
-        self.ws = zone_scratch(len(self.rows4), v.n, True) if self.par is not None else None
         # mixed-discretization sets of the 4-node zones: compact set numbers
         hx = zs["hex"][self.rows4]
         self.weight = np.where(zs["overlay"][self.rows4] >= 0, 0.5, 1.0)
@@ -163,6 +164,21 @@ class ZoneStepper:
             _, inv = np.unique(hx[hx >= 0], return_inverse=True)
             self.zset[hx >= 0] = inv.ravel()
         self.nset = int(self.zset.max()) + 1 if len(self.zset) else 0
+        #: no Mohr-Coulomb zone: the elastic step (``zone_elastic.elastic_zone_step``, the bits of
+        #: the plastic step) on one part of the zones per thread from PARALLEL_MIN_ZONES zones on
+        self.fast = None
+        if ELASTIC_KERNEL and not len(mo) and len(self.rows4):
+            import numba
+
+            nch = numba.get_num_threads() if len(self.rows4) >= PARALLEL_MIN_ZONES else 1
+            self.fast = ElasticPlan(zs["gp"], self.rows4, self.node, self.zset, self.weight, v.n, nch)
+        elif self.plastic and len(self.rows4) >= PARALLEL_MIN_ZONES:
+            nv = v.n
+            fstart, fent = node_lists4(nv, np.arange(nv, dtype=_I), zs["gp"], self.rows4)
+            nstart, nent = node_lists4(nv, self.node, zs["gp"], self.rows4)
+            self.par = (fstart, fent, nstart, nent)
+        #: scratch of the plastic step, allocated once (``zone_plastic.zone_scratch``)
+        self.ws = zone_scratch(len(self.rows4), v.n, True) if self.par is not None else None
         self.bulk = np.ascontiguousarray(p[:, ZP_BULK])
         self.shear = np.ascontiguousarray(p[:, ZP_SHEAR])
         self.density = np.ascontiguousarray(p[:, ZP_DENSITY])
@@ -232,6 +248,8 @@ class ZoneStepper:
         self.kzone = ktot.copy()
         self._quiet_setup(model)
         self.facc = np.zeros((n, 3))
+        #: scratch of ``gp_motion_ws`` (threaded motion, big models only)
+        self.mwork = np.empty((len(self.masters) if len(self.rows4) >= PARALLEL_MIN_ZONES else 0, 5))
         self.fmag = np.zeros(n)
         self.out = np.zeros(4)
 
@@ -305,8 +323,14 @@ class ZoneStepper:
     def begin(self) -> np.ndarray:
         """Start a step: the gridpoint force accumulator zeroed and returned (contact forces
         may be added to it before ``step(…, begun=True)``)."""
-        self.facc[self.rows] = 0.0
-        self.fmag[self.rows] = 0.0
+        if 2 * len(self.rows) > len(self.fmag):
+            # (rows off the zoned blocks are never written: zeroing all of it is the same, and
+            # cheaper than the indexed write when most rows are gridpoints)
+            self.facc[:] = 0.0
+            self.fmag[:] = 0.0
+        else:
+            self.facc[self.rows] = 0.0
+            self.fmag[self.rows] = 0.0
         return self.facc
 
     def step(self, dt: float, gravity: np.ndarray, mode: int, alpha: float, large: bool, vmax: float,
@@ -318,16 +342,17 @@ class ZoneStepper:
         if not begun:
             self.begin()
         pos, vel = v["pos"], v["velocity"]
-        if self.par is not None:
+        fast = self.fast
+        if fast is not None:
+            elastic_zone_step(pos, vel, fast.g4, fast.n4, fast.rows, fast.zset, fast.weight, self.nset, self.bulk,
+                              self.shear, dt, large, self.nmd, zs["stress"], facc, fmag, *fast.args())
+        elif self.par is not None:
             zone_forces_plastic_parallel_ws(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset,
                                             self.node, zs["cmodel"], zs["prop"], dt, large, self.nmd, zs["stress"],
                                             zs["state"], facc, fmag, *self.par, *self.ws)
-        elif self.plastic:
+        elif len(self.rows4):
             zone_forces_plastic(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.node,
                                 zs["cmodel"], zs["prop"], dt, large, self.nmd, zs["stress"], zs["state"], facc, fmag)
-        else:
-            zone_forces(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.bulk, self.shear,
-                        dt, large, zs["stress"], facc, fmag)
         if self.ho is not None:
             self.ho(pos, vel, zs["gp"], self.rows10, self.bulk, self.shear, dt, zs["gstress"], zs["stress"], facc)
         if self.beta > 0.0:             # Rayleigh damping's stiffness term (physics.dynamic)
@@ -350,8 +375,11 @@ class ZoneStepper:
         gp_externals(self.rows, v["link"], self.gmass, gravity, v["fapp"], v["fface"], facc, fmag)
         if fe is not None:
             fe.slave_forces(facc)
-        bad = gp_motion(self.masters, self.linked, v["link"], facc, v["force"], self.mtot, v["imass"], self.held,
-                        self.vapp, vel, v["disp"], pos, dt, mode, alpha, large, vmax, self.out)
+        # (threads pay from a few thousand gridpoints on; both give the same bits)
+        move = gp_motion_ws if len(self.rows4) >= PARALLEL_MIN_ZONES else gp_motion
+        bad = move(self.masters, self.linked, v["link"], facc, v["force"], self.mtot, v["imass"], self.held,
+                   self.vapp, vel, v["disp"], pos, dt, mode, alpha, large, vmax, self.out,
+                   *((self.mwork,) if move is gp_motion_ws else ()))
         if fe is not None:
             fe.follow(vel, v["disp"], *((pos,) if large else ()))
         return bad
