@@ -64,6 +64,11 @@ LARGE = {
     "zones-static": ["block create brick 0 1 0 1 0 1", "block zone generate hexahedra divisions 2 2 2",
                      "block zone cmodel assign elastic", "block zone property young 2e7 poisson 0.3 density 2000",
                      *_ROLL, "model gravity 0 0 -10", "block face apply stress-zz -1e6 range position-z 1"],
+    # (a'') zones alone, 10-node zones (consistent gravity loads on the reference geometry)
+    "zones-10node": ["model configure highorder", "block create brick 0 1 0 1 0 1",
+                     "block zone generate high-order-tetra edgelength 0.5", "block zone cmodel assign elastic",
+                     "block zone property young 2e7 poisson 0.3 density 2000", *_ROLL, "model gravity 0 0 -10",
+                     "block mechanical damping none", "block face apply stress-zz -1e6 range position-z 1"],
     # (b) a rigid block on a zoned one
     "rigid-on-zoned": [ln for ln in DECK.splitlines()[1:] if ln] + ["block zone property young 2e7 poisson 0.3"],
     # (c) two zoned blocks pressed and sheared across a Coulomb joint, no damping
@@ -106,6 +111,7 @@ def run_large(tmp_path, case, chunks, save_at=None):
 
 
 @pytest.mark.parametrize("case, split, save", [("zones", 47, True), ("zones", 40, False), ("zones-static", 47, True),
+                                               ("zones-10node", 47, True),
                                                ("rigid-on-zoned", 47, False), ("rigid-on-zoned", 53, True),
                                                ("zoned-zoned", 47, True), ("rigid-on-fe", 47, True)])
 def test_large_strain_split_and_restored_runs_are_one_run(tmp_path, case, split, save):
