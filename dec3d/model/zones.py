@@ -40,6 +40,11 @@ Gridpoint fields added to ``vertices`` (rigid-block vertices leave them at their
     vapp (3,)        m/s    applied velocity components (``block gridpoint apply velocity``)
     apply_fix ()     uint8  bits 0-2: the x, y, z velocity components held at ``vapp``
     zoned ()         bool   True for the gridpoints of a zoned (deformable) block
+    gpos0 (3,)       m      reference positions of the real (lumped) masses and consistent gravity
+                            loads: set at the first run that uses the gridpoint, kept (mass is conserved)
+    gpos_geo (3,)    m      positions the zones' stiffness, quiet dashpots and table face loads were
+                            last worked out on (large strain: at every detection step)
+    gref ()          uint8  bit 0: ``gpos0`` set, bit 1: ``gpos_geo`` set (``physics.zones``)
 (``pos``, ``velocity``, ``disp``, ``force``, ``mass`` and ``fixity`` are the vertex store's own:
 ``mass`` is the real lumped mass [kg], ``force`` the unbalanced force of the last step [N].)
 
@@ -109,17 +114,21 @@ _GP_FIELDS = {
     "vapp": Field((3,), _F, 0.0),
     "apply_fix": Field((), np.uint8, 0),
     "zoned": Field((), np.bool_, False),
+    "gpos0": Field((3,), _F, 0.0),
+    "gpos_geo": Field((3,), _F, 0.0),
+    "gref": Field((), np.uint8, 0),
 }
 
 
 def zone_stores(model) -> Store:
     """The model's ``zones`` store, made (with the gridpoint and face fields) on first use.
-    Idempotent; restore calls it before loading a save file that has zones."""
-    if "zones" in model.stores:
-        return model.store("zones")
+    Idempotent; restore calls it before loading a save file that has zones (gridpoint fields
+    that file lacks are added with their fill here too)."""
     for key, spec in _GP_FIELDS.items():
         if key not in model.vertices:
             model.vertices.add_field(key, spec)
+    if "zones" in model.stores:
+        return model.store("zones")
     if "source" not in model.faces:
         model.faces.add_field("source", Field((), _I, -1))
     return model.add_store(Store("zones", _zone_fields(), capacity=256))

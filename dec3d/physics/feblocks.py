@@ -59,8 +59,10 @@ def _ids(model, rows) -> str:
 
 
 class FeStepper:
-    def __init__(self, model, error):
-        """``error``: the exception class to raise (the engine's ``RunError``)."""
+    def __init__(self, model, error, ref=None, geo=None):
+        """``error``: the exception class to raise (the engine's ``RunError``); ``ref``: the
+        positions of the masses and gravity weights, ``geo``: those of the stiffness (both
+        (nv, 3), default the current positions; see ``physics.zones.ZoneStepper``)."""
         self.model = model
         es = feblock_store(model)
         b, v = model.blocks, model.vertices
@@ -95,26 +97,39 @@ class FeStepper:
                         for _, _, r in self.groups]
         self.erows = np.ascontiguousarray(erow)
         n = v.n
-        pos = np.ascontiguousarray(v["pos"])
+        self.error = error
+        pos = np.ascontiguousarray(v["pos"] if ref is None else ref)
         self.mass = np.zeros(n)
-        self.stiff = np.zeros(n)
         self.gweight = np.zeros(n)
         gw = np.zeros((n, 3))
         first = feb_lumped_mass(pos, self.nodes, np.ascontiguousarray(el), self.density, self.mass)
         first = max(first, feb_body_force(pos, self.nodes, np.ascontiguousarray(el), self.density,
                                           np.array([0.0, 0.0, 1.0]), gw))
-        for q, h, rows in self.groups:
-            first = max(first, feb_stiffness(pos, self.nodes, rows, self.bulk, self.shear, self.stiff, q, h))
-        if first >= 0:
-            raise error(f"FE element {int(es['id'][first])} (block {int(b['id'][es['block'][first]])}) has a "
-                        "non-positive Jacobian at a Gauss point")
-        self.stiff *= DAMPING_MARGIN
+        self._check(first)
         self.gweight = gw[:, 2].copy()
+        self.stiffness(v["pos"] if geo is None else geo)
         vb = v["block"]
         mine = v["zoned"] & on[np.maximum(vb, 0)] & (vb >= 0)
         self.rows = np.flatnonzero(mine).astype(_I)
         self.masters = np.ascontiguousarray(self.rows[~v["feslave"][self.rows]])
         self.slave_rows = np.ascontiguousarray(self.rows[v["feslave"][self.rows]])
+
+    def _check(self, first: int) -> None:
+        if first >= 0:
+            es, b = self.model.store("feblocks"), self.model.blocks
+            raise self.error(f"FE element {int(es['id'][first])} (block {int(b['id'][es['block'][first]])}) has "
+                             "a non-positive Jacobian at a Gauss point")
+
+    def stiffness(self, geo) -> None:
+        """``stiff``: the nodal stiffness of the elements on the positions ``geo`` (large strain:
+        worked out again on the schedule of ``ZoneStepper.regeometry``)."""
+        pos = np.ascontiguousarray(geo)
+        self.stiff = np.zeros(len(pos))
+        first = -1
+        for q, h, rows in self.groups:
+            first = max(first, feb_stiffness(pos, self.nodes, rows, self.bulk, self.shear, self.stiff, q, h))
+        self._check(first)
+        self.stiff *= DAMPING_MARGIN
 
     def forces(self, pos, vel, dt: float, gravity, facc, fmag=None) -> int:
         """Add the element forces F^S (stresses updated; elements on the threads, node sums in a

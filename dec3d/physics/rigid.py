@@ -834,6 +834,12 @@ class _Run:
         masses follow the new stiffnesses."""
         eng = self.eng
         self.looked = True
+        # large strain: the zones' stiffness (Δt, scaled masses) follows the geometry at every
+        # detection step that is a multiple of the update interval — the step number alone, so
+        # a split or restored run takes the same steps (``ZoneStepper.regeometry``)
+        regeo = self.zoned and self.large and self.m.step % self.interval == 0
+        if regeo:
+            self.zst.regeometry()
         if self.zoned:
             self.mixed = eng._zone_contacts_check()
         self.acc[:] = 0.0
@@ -851,7 +857,7 @@ class _Run:
         eng.dt = self.dt
         if self.scaled and self.ng:
             self.masses(self.dt)
-        if self.mixed or self.dt != old_dt:
+        if self.mixed or self.dt != old_dt or regeo:
             self.zst.set_masses(self.dt, self.scaled)
         if self.loaded:
             from dec3d.model.face_loads import recompute_fface

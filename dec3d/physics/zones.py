@@ -185,10 +185,15 @@ class ZoneStepper:
         # FE blocks (issue 12): their nodes move with the gridpoints; forces, masses and slave
         # nodes come from dec3d.physics.feblocks.FeStepper
         self.fe = None
+        # reference positions (``_references``): of the masses (kept) and of the stiffness
+        self.large = bool(model.settings.large_strain)
         if has_feblocks(model):
-            from .feblocks import FeStepper
-            self.fe = FeStepper(model, error)
-            on[self.fe.blocks] = True
+            from .feblocks import FeStepper, fe_blocks
+            on[fe_blocks(model)] = True
+            self.ref, geo = self._references(on)
+            self.fe = FeStepper(model, error, self.ref, geo)
+        else:
+            self.ref, geo = self._references(on)
         # gridpoints: rows of the zoned blocks, masters and linked copies (FE slave nodes are neither)
         vb = v["block"]
         gpmask = v["zoned"] & on[np.maximum(vb, 0)] & (vb >= 0)
@@ -210,11 +215,11 @@ class ZoneStepper:
                 self.vapp[mst, i] = np.where((held[mst] & bit) != 0, self.vapp[mst, i], v["vapp"][lk[own], i])
             np.bitwise_or.at(held, link[lk], held[lk])
         self.held = np.ascontiguousarray(held)
-        # masses and stiffness (reference: positions now)
+        # real masses on the reference positions, stiffness on the geometry of the last update
         n = v.n
         mass = np.zeros(n)
         stiff = np.zeros(n)
-        zone_mass_stiffness(v["pos"], zs["gp"], zs["nnode"], zs["overlay"], self.rows4, self.bulk, self.shear,
+        zone_mass_stiffness(self.ref, zs["gp"], zs["nnode"], zs["overlay"], self.rows4, self.bulk, self.shear,
                             self.density, mass, stiff)
         #: mass whose weight is lumped (m g per gridpoint): that of the 4-node zones; 10-node zones
         #: load their gridpoints with the consistent body force instead (``tet10_body_force``)
@@ -223,35 +228,107 @@ class ZoneStepper:
         self._g10 = None
         if len(self.rows10):
             from dec3d.kernels import zones_ho
-            k10 = np.zeros(n)
-            bad = max(zones_ho.tet10_lumped_mass(v["pos"], zs["gp"], self.rows10, self.density, mass),
-                      zones_ho.tet10_stiffness(v["pos"], zs["gp"], self.rows10, self.bulk, self.shear, k10))
-            stiff += TET10_STIFFNESS_MARGIN * k10
-            if bad >= 0:
-                raise error(f"10-node zone {int(zs['id'][bad])} of block {int(b['id'][zs['block'][bad]])} is "
-                            "inverted or flat (its Jacobian is not positive at a Gauss point)")
+            self._bad10(zones_ho.tet10_lumped_mass(self.ref, zs["gp"], self.rows10, self.density, mass))
             g10 = zs["gp"][self.rows10]
             self.r10 = np.unique(g10[g10 >= 0]).astype(_I)
         if self.fe is not None:
             mass += self.fe.mass
-            stiff += self.fe.stiff
         v["mass"][self.rows] = mass[self.rows]
         if self.fe is not None:
             self.blocks = np.concatenate((self.blocks, self.fe.blocks))
         mtot = mass.copy()
-        ktot = stiff.copy()
         lk = self.linked
         np.add.at(mtot, link[lk], mass[lk])
-        np.add.at(ktot, link[lk], stiff[lk])
         self.mtot = mtot
-        self.ktot = ktot
-        self.kzone = ktot.copy()
-        self._quiet_setup(model)
+        #: contact stiffness of the joint term of Eq. (85) per master (``set_contact_stiffness``)
+        self.kj = None
+        self._stiffness(geo, fe=False)
+        #: model time of the next step (table loads are evaluated at it)
+        self.clock = float(model.time)
         self.facc = np.zeros((n, 3))
         #: scratch of ``gp_motion_ws`` (threaded motion, big models only)
         self.mwork = np.empty((len(self.masters) if len(self.rows4) >= PARALLEL_MIN_ZONES else 0, 5))
         self.fmag = np.zeros(n)
         self.out = np.zeros(4)
+
+    def _references(self, on) -> tuple[np.ndarray, np.ndarray]:
+        """(positions of the real masses, positions of the stiffness), each (nv, 3), for the
+        gridpoints of the blocks ``on``. Mass is conserved: the lumped masses (and consistent
+        gravity loads) are those of the geometry a gridpoint had when a run first used it
+        (``vertices.gpos0``). The stiffness (Eq. 86, hence Δt and the density-scaled masses), the
+        quiet dashpots and table-driven face loads follow the geometry in large strain, worked out
+        again at every detection step (``regeometry``, a multiple of the update interval: a rule
+        of the step number alone); a run starts from the positions of the last such update
+        (``vertices.gpos_geo``), so a run split into several commands, or saved and restored in
+        between, takes exactly the steps of one run. In small strain both are the positions."""
+        v = self.model.vertices
+        vb = v["block"]
+        rows = np.flatnonzero(v["zoned"] & on[np.maximum(vb, 0)] & (vb >= 0))
+        pos, flag = v["pos"], v["gref"]
+        new = rows[(flag[rows] & 1) == 0]
+        v["gpos0"][new] = pos[new]
+        flag[new] |= 1
+        ref = pos.copy()
+        ref[rows] = v["gpos0"][rows]
+        if not self.large:
+            v["gpos_geo"][rows] = pos[rows]
+            flag[rows] |= 2
+            return ref, pos
+        new = rows[(flag[rows] & 2) == 0]
+        v["gpos_geo"][new] = pos[new]
+        flag[new] |= 2
+        geo = pos.copy()
+        geo[rows] = v["gpos_geo"][rows]
+        return ref, geo
+
+    def _bad10(self, bad: int) -> None:
+        if bad >= 0:
+            zs, b = self.model.store("zones"), self.model.blocks
+            raise self.error(f"10-node zone {int(zs['id'][bad])} of block {int(b['id'][zs['block'][bad]])} is "
+                             "inverted or flat (its Jacobian is not positive at a Gauss point)")
+
+    def _stiffness(self, geo, fe: bool = True) -> None:
+        """The node stiffness of the zones (and FE elements; ``fe``: work theirs out again too) on
+        the positions ``geo``, summed onto masters (``kzone``, ``ktot`` with the contacts' joint
+        term), and the quiet dashpots and table face loads on them."""
+        m = self.model
+        zs, v = m.store("zones"), m.vertices
+        n = v.n
+        stiff = np.zeros(n)
+        zone_mass_stiffness(geo, zs["gp"], zs["nnode"], zs["overlay"], self.rows4, self.bulk, self.shear,
+                            self.density, np.zeros(n), stiff)
+        if len(self.rows10):
+            from dec3d.kernels import zones_ho
+            k10 = np.zeros(n)
+            self._bad10(zones_ho.tet10_stiffness(geo, zs["gp"], self.rows10, self.bulk, self.shear, k10))
+            stiff += TET10_STIFFNESS_MARGIN * k10
+        if self.fe is not None:
+            if fe:
+                self.fe.stiffness(geo)
+            stiff += self.fe.stiff
+        lk = self.linked
+        np.add.at(stiff, v["link"][lk], stiff[lk])
+        self.kzone = stiff
+        self.ktot = stiff.copy() if self.kj is None else self.kzone + self.kj
+        pos = v["pos"]
+        if np.shares_memory(geo, pos):
+            self._quiet_setup(m)
+        else:
+            # the dashpots and face-load shares read the model's positions: on ``geo`` for a moment
+            now = pos.copy()
+            pos[:] = geo
+            try:
+                self._quiet_setup(m)
+            finally:
+                pos[:] = now
+
+    def regeometry(self) -> None:
+        """Large strain, at a detection step: stiffness, dashpots and table face loads on the
+        positions now (``_references``); the caller sets the masses again (``set_masses``)."""
+        v = self.model.vertices
+        v["gpos_geo"][self.rows] = v["pos"][self.rows]
+        v["gref"][self.rows] |= 2
+        self._stiffness(v["pos"])
 
     def _quiet_setup(self, model) -> None:
         """Quiet boundaries and table-driven face stresses (``dec3d.model.quiet``): the dashpot
@@ -272,8 +349,6 @@ class ZoneStepper:
                 self.fe.slave_stiffness(cd)          # slave nodes' dashpots bound their masters'
             self.cdash = cd
         self.dyn = dynamic_face_loads(model)
-        #: model time of the next step (table loads are evaluated at it)
-        self.clock = float(model.time)
 
     # ------------------------------------------------------------ time step and masses
     def natural_timestep(self) -> float:
@@ -317,6 +392,7 @@ class ZoneStepper:
         np.add.at(kj, rows, k)
         if self.fe is not None:
             self.fe.slave_stiffness(kj)
+        self.kj = kj
         self.ktot = self.kzone + kj
 
     # ------------------------------------------------------------ one step
@@ -401,7 +477,7 @@ class ZoneStepper:
 
     def _body_force10(self, gravity) -> None:
         """The consistent gravity loads of the 10-node zones (FE-block text 003_*, "Gravity
-        Forces": F_a = ρ g ∫ N_a dV), on the geometry at the start of the run, made again when the
+        Forces": F_a = ρ g ∫ N_a dV), on the reference geometry of the masses (``_references``), made again when the
         gravity changes: ``fb10`` (per row of ``r10``) and their magnitudes ``fb10mag``."""
         g = tuple(float(x) for x in gravity)
         if g == self._g10:
@@ -409,7 +485,7 @@ class ZoneStepper:
         from dec3d.kernels.zones_ho import tet10_body_force
         m = self.model
         f = np.zeros((m.vertices.n, 3))
-        tet10_body_force(m.vertices["pos"], m.store("zones")["gp"], self.rows10, self.density, np.asarray(g, _F), f)
+        tet10_body_force(self.ref, m.store("zones")["gp"], self.rows10, self.density, np.asarray(g, _F), f)
         self.fb10 = f[self.r10]
         self.fb10mag = np.sqrt((self.fb10 ** 2).sum(axis=1))
         self._g10 = g

@@ -181,9 +181,7 @@ def _pressed(tmp_path, chunks, save_at=None):
 def test_pressed_and_sheared_zoned_blocks_split_and_restored_are_one_run(tmp_path):
     """Two zoned blocks (non-matching grids) pressed and sheared across a Coulomb joint, no damping:
     one run of 120 steps, or 47 + 73 with `model save`/`model restore` in between, give the same
-    bits. (Small strain: in large strain a split run of zoned blocks is not bit-identical, with or
-    without contacts between zoned blocks, because a new run's zone stepper takes its stiffness
-    from the deformed zones.)"""
+    bits (small strain; large strain: ``test_zone_split_runs.py``)."""
     one = _pressed(tmp_path, [120])
     split = _pressed(tmp_path, [47, 73], save_at=0)
     assert one[3].sum() > 0 and np.abs(one[4]).max() > 0 and np.abs(one[1]).max() > 1e-4
