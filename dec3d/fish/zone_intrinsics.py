@@ -7,7 +7,8 @@ Itasca's 3DEC 7 FISH reference: block.zone.list, .num, .find, .id, .block, .vol,
 
 A gridpoint is handed to FISH as its index: its row in the ``vertices`` store + 1 (gridpoints are
 vertices, dec3d.model.zones; the vertices of rigid blocks are gridpoints too, as in 3DEC). The
-index stays valid until blocks are made, deleted or zoned. block.gplist(b) (the block's gridpoints), block.gp.list, .num, .find, .id, .block
+index stays valid until blocks are made, deleted or zoned. block.gplist(b) (the block's gridpoints,
+a list), block.gp.list, .num, .find, .id, .block
 (host block id; .hostblock too), .near(x, y, z | v), .zoned, .pos, .disp, .vel, .force (with .x .y .z):
 a gridpoint of a zoned block reads its own fields (displacement, velocity, unbalanced force of the
 last step); a vertex of a rigid block reads the block's motion there (displacement pos - origin,
