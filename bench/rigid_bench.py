@@ -14,6 +14,11 @@ process (peak RSS from resource.getrusage is per process); the median is printed
 
     python bench/rigid_bench.py [--n 10 20] [--steps 100] [--repeat 3] [--jmodel mohr|elastic]
                                 [--full-detection] [--threads N]
+    python bench/rigid_bench.py --quake [--nx 40] [--nz 25] [--steps 200] [--repeat 3] [--threads-list 1 2]
+
+``--quake``: the dynamic earthquake case of bench/quake_bench.py (a masonry wall of about 1000
+blocks on a base driven by a synthetic ground-velocity table, dynamic mode, Rayleigh 5 %): simulated
+seconds per wall second at the real time step.
 
 ``--threads N`` calls numba.set_num_threads(N) in each run; the numba threading layer and the
 thread count actually used are printed (a layer of "n/a" means no parallel kernel ran).
@@ -196,6 +201,11 @@ def _fmt(x) -> str:
 
 
 def main() -> int:
+    if "--quake" in sys.argv[1:]:      # the dynamic earthquake case: bench/quake_bench.py
+        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+        import quake_bench
+
+        return quake_bench.main(sys.argv[1:])
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, nargs="+", default=[10, 20], help="cubes per side")
     ap.add_argument("--steps", type=int, default=100, help="timed steps S")

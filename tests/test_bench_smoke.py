@@ -3,6 +3,9 @@ import os
 import subprocess
 import sys
 
+import numpy as np
+import pytest
+
 from conftest import ROOT
 
 
@@ -113,3 +116,68 @@ def test_zone_bench_jointed_case_prints_its_subcontact_figures():
     # every one of the 64 blocks has at least 4 zones; the 144 face-face joints have sub-contacts
     assert int(row[1]) >= 64 * 4 and int(row[-3]) >= 144 * 3
     assert float(row[-2]) > 0 and float(row[-1]) > 0
+
+
+def test_rigid_bench_quake_case_on_a_tiny_wall():
+    """`rigid_bench.py --quake` on a 3-brick, 2-course wall, one thread: the scene line and one row
+    whose simulated time is the timed steps times the step, with a positive rate."""
+    out = subprocess.run([sys.executable, str(ROOT / "bench" / "rigid_bench.py"), "--quake", "--nx", "3", "--nz", "2",
+                          "--steps", "10", "--repeat", "1", "--threads-list", "1"],
+                         capture_output=True, text=True, timeout=300, cwd=ROOT,
+                         env={**os.environ, "PYTHONPATH": os.pathsep.join(
+                             [str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])})
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert lines[0].startswith("machine: ") and "masonry wall 3 bricks x 2 courses" in lines[1]
+    import re
+
+    row = re.match(r"threads 1: blocks (\d+) contacts (\d+) dt (\S+) s .* simulated (\S+) s; "
+                   r"sim s per wall s (\S+); load average", lines[2])
+    assert row, lines[2]
+    # base + 3 bricks + (2 full + 2 half) bricks
+    assert int(row.group(1)) == 1 + 3 + 4 and int(row.group(2)) > 0
+    dt = float(row.group(3))
+    assert dt > 0 and float(row.group(4)) == pytest.approx(10 * dt, rel=1e-3)
+    assert float(row.group(5)) > 0
+
+
+def test_quake_record_is_a_drift_free_band_limited_ground_motion():
+    """The synthetic record: same seed, same record; the peak acceleration is the one asked for
+    (to the base-line correction); the velocity is the trapezoid integral of the acceleration and
+    ends at rest; almost all the energy lies in the 0.5..10 Hz band."""
+    sys.path.insert(0, str(ROOT / "bench"))
+    try:
+        import quake_bench as qb
+    finally:
+        sys.path.pop(0)
+    t, a, v = qb.record(seed=7, duration=4.0, dt=0.01, pga=3.0)
+    t2, a2, v2 = qb.record(seed=7, duration=4.0, dt=0.01, pga=3.0)
+    assert np.array_equal(a, a2) and np.array_equal(v, v2)
+    assert not np.array_equal(a, qb.record(seed=8)[1])
+    assert len(t) == 401 and t[-1] == pytest.approx(4.0)
+    assert np.abs(a).max() == pytest.approx(3.0, rel=0.05)
+    # integral checked independently: v(t_k) = sum of trapezoids up to t_k
+    acc = 0.0
+    for k in range(1, len(t)):
+        acc += 0.5 * (a[k] + a[k - 1]) * (t[k] - t[k - 1])
+        assert v[k] == pytest.approx(acc, abs=1e-12)
+    assert abs(v[-1]) < 1e-12 and v[0] == 0.0
+    spec = np.abs(np.fft.rfft(a)) ** 2
+    f = np.fft.rfftfreq(len(a), 0.01)
+    assert spec[(f >= 0.3) & (f <= 12.0)].sum() > 0.95 * spec.sum()
+
+
+def test_quake_base_follows_the_velocity_record():
+    """The base block of the quake scene moves with the record: its x velocity after the steps is
+    the table's velocity at the middle of the last step (the time-function rule of `block apply`)."""
+    sys.path.insert(0, str(ROOT / "bench"))
+    try:
+        import quake_bench as qb
+    finally:
+        sys.path.pop(0)
+    r = qb.one(3, 2, 500, 1)
+    t, _, v = qb.record()
+    assert r["finite"] and r["simulated"] == pytest.approx(500 * r["dt"], rel=1e-9)
+    expected = np.interp(r["dyn_time"] - r["dt"] / 2, t, v)
+    assert abs(expected) > 1e-6
+    assert r["base_vx"] == pytest.approx(expected, rel=1e-6)

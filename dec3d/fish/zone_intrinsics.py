@@ -7,7 +7,8 @@ Itasca's 3DEC 7 FISH reference: block.zone.list, .num, .find, .id, .block, .vol,
 
 A gridpoint is handed to FISH as its index: its row in the ``vertices`` store + 1 (gridpoints are
 vertices, dec3d.model.zones; the vertices of rigid blocks are gridpoints too, as in 3DEC). The
-index stays valid until blocks are made, deleted or zoned. block.gp.list, .num, .find, .id, .block
+index stays valid until blocks are made, deleted or zoned. block.gplist(b) (the block's gridpoints,
+a list), block.gp.list, .num, .find, .id, .block
 (host block id; .hostblock too), .near(x, y, z | v), .zoned, .pos, .disp, .vel, .force (with .x .y .z):
 a gridpoint of a zoned block reads its own fields (displacement, velocity, unbalanced force of the
 last step); a vertex of a rigid block reads the block's motion there (displacement pos - origin,
@@ -232,7 +233,9 @@ _gp_family("block.gp.force", _gp_force)
 
 @intrinsic("block.gplist", 1)
 def _gplist(rt, b):
-    """The first gridpoint of block `b` (walk on with block.gp.next; 0 ends the walk)."""
+    """The gridpoints of block `b`, as a list (what `loop foreach g block.gplist(b)` walks in the
+    public decks, compas_3dec's displacement.dat and SAFEGO's 06_dynamic_load.dat); block.gp.next
+    still walks from one of them to the next."""
     if type(b) is not int:
         raise FishValueError(f"`block.gplist` takes a block id, not a {type_name(b)}")
     m = rt.session.model
@@ -240,7 +243,8 @@ def _gplist(rt, b):
     if len(rows) == 0:
         raise FishValueError(f"`block.gplist`: there is no block with id {b}")
     k = int(rows[0])
-    return int(m.blocks["vert_start"][k]) + 1 if int(m.blocks["vert_count"][k]) else 0
+    start = int(m.blocks["vert_start"][k])
+    return list(range(start + 1, start + int(m.blocks["vert_count"][k]) + 1))
 
 
 @intrinsic("block.gp.next", 1)

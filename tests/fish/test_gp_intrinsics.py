@@ -103,12 +103,18 @@ def test_empty_model_has_no_gridpoints(session):
 
 def test_gplist_walk_visits_each_gridpoint_of_a_block_once(session, model):
     m = model
-    session.command("fish define walk(b)\n  local n = 0\n  local g = block.gplist(b)\n  loop while g # 0\n"
+    # block.gp.next from the first entry of block.gplist, 0 after the last
+    session.command("fish define walk(b)\n  local n = 0\n  local l = block.gplist(b)\n  local g = l(1)\n  loop while g # 0\n"
                     "    n = n + 1\n    if block.gp.block(g) # b then\n      n = -1000\n    endif\n"
                     "    g = block.gp.next(g)\n  endloop\n  walk = n\nend\n[n1 = walk(1)]\n[n2 = walk(2)]")
     k1, k2 = (int(np.nonzero(m.blocks["id"] == i)[0][0]) for i in (1, 2))
     assert session.variables["n1"] == int(m.blocks["vert_count"][k1]) > 0
     assert session.variables["n2"] == int(m.blocks["vert_count"][k2]) == 8
+    # `loop foreach` over the list (as the public decks write it): each gridpoint once, all of block 2
+    session.command("fish define each(b)\n  local s = 0\n  local n = 0\n  loop foreach g block.gplist(b)\n"
+                    "    n = n + 1\n    if block.gp.block(g) = b then\n      s = s + 1\n    endif\n"
+                    "  endloop\n  each = n * 1000 + s\nend\n[e2 = each(2)]")
+    assert session.variables["e2"] == 8 * 1000 + 8
     with pytest.raises(ExpressionError) as e:
         session.command("[q = block.gplist(9)]")
     assert "`block.gplist`: there is no block with id 9" in e.value.message
