@@ -358,3 +358,15 @@ def test_fish_history_and_callback_go_on_after_a_restore(session):
     h = session.model.history_set.find("n")
     assert h.steps == [2, 4, 6, 8] and h.values == [2.0, 4.0, 6.0, 8.0]
     assert session.variables["n"] == 8
+
+
+def test_a_negative_callback_goes_on_after_a_restore_before_the_forces(session):
+    """A -100 callback survives `model save|restore` and still runs before the step's forces: it gives the
+    block a fresh applied force before step 3 (the step after the restore), and step 3 already moves it."""
+    session.command(FREE.replace("mech.cycle = 0", "mech.cycle = 2") + "fish callback add pre -100\n"
+                    "model cycle 2\nmodel save 'r'\nmodel new\nmodel restore 'r'\nfish callback list\nmodel cycle 1\n"
+                    "[dt = mech.timestep]")
+    assert session.output.getvalue().splitlines()[-1] == "-100  pre  interval 1  (before the step's forces)"
+    v = session.variables
+    assert (v["sb"], v["vb"]) == (2, 0.0)
+    assert session.model.blocks["velocity"][0, 0] == pytest.approx(500.0 * v["dt"] / 1000.0, rel=1e-12)
