@@ -170,7 +170,14 @@ def _engine(model):
     return engine(model)
 
 
+def _joint_model(code):
+    from ..physics.jmodels import MODEL_BY_CODE
+
+    return MODEL_BY_CODE.get(code)
+
+
 contact_intrinsics.CONTACTS[0] = _current_contacts
+contact_intrinsics.JMODELS[0] = _joint_model
 intrinsics.ENGINE[0] = _engine
 
 

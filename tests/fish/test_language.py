@@ -60,6 +60,8 @@ CASES = [
     # math intrinsics (math.log is base 10, math.ln natural, per Itasca)
     ("fish define f\n io.out(math.log(1000))\n io.out(math.ln(math.exp(2)))\n io.out(math.sqrt(16))\n"
      " io.out(math.abs(-3))\n io.out(math.round(2.5))\nend\n@f", ["3.0", "2.0", "4.0", "3", "3"]),
+    # `def` for `fish define`, keywords and names in any case
+    ("DEF twice(X)\n  TWICE = x * 2\nEND\n[io.out(twice(21))]", ["42"]),
     # a deck value from a FISH function and a global it sets
     ("fish define props\n dens = 2650\nend\n@props\nfish define grav\n grav = -9.81\nend\n"
      "model gravity 0 0 [grav]\n[io.out(string(dens))]", ["2650"]),
