@@ -187,8 +187,6 @@ def test_legacy_fish_is_named(session):
 
 
 def test_keyboard_interrupt_leaves_the_runtime_consistent(session):
-    from dec3d.fish import request_stop
-
     session.command("fish define spin\n loop while 1\n  n = n + 1\n  if n = 5000 then\n   stop_me\n  endif\n endloop\nend")
     session.fish_rt.functions["stop_me"] = _StopNow(session.fish_rt)
     with pytest.raises(KeyboardInterrupt):
