@@ -14,7 +14,7 @@ import math
 import re
 from functools import reduce
 
-from ..errors import BindError, CommandError, Dec3dError
+from ..errors import BindError, CommandError, Dec3dError, NotSupportedError
 from ..fish import contact_intrinsics, intrinsics
 from ..lang.abbrev import matches
 from .registry import command
@@ -363,12 +363,23 @@ CYCLE_SEQUENCE = (
 )
 
 
-@command("program list cycle-sequence",
-         doc="Print dec3d's cycle sequence: where FISH callbacks run in a step, and the steps of the last run.",
+def _check_program_list(call):
+    what = call.args["what"]
+    if what is None or (isinstance(what, str) and matches(what, ["cycle-sequence"]) != ["cycle-sequence"]):
+        shown = "`program list`" + (f" `{what}`" if what is not None else " without a keyword")
+        raise NotSupportedError(f"{shown} is not supported yet", call.locations.get("what", call.location),
+                                hint="dec3d lists: cycle-sequence")
+
+
+@command("program list", positional=[P("what", Text(), "what to list: `cycle-sequence` (the only one dec3d has)")],
+         check=_check_program_list,
+         doc="`program list cycle-sequence`: print dec3d's cycle sequence — where FISH callbacks run in a step — "
+             "and the steps of the last run.",
          details="A callback at a negative position (`fish callback add f -100`) runs before the step's "
                  "calculations, one at a position ≥ 0 after its motion; the numbers are dec3d's own (one "
-                 "calculation point, 0), not 3DEC's list. The last line names the step objects of the last "
-                 "`model cycle|solve` in order (`RigidEngine.steps`), or says that nothing has cycled yet.",
+                 "calculation point, 0), not 3DEC's list. The last lines name the step objects of the last "
+                 "`model cycle|solve` in order (`RigidEngine.steps`, or that nothing has cycled yet) and the "
+                 "callbacks. Other `program list` keywords of 3DEC are not supported yet.",
          examples=["program list cycle-sequence"])
 def program_list_cycle_sequence(session, call):
     session.write("position  what runs")

@@ -370,3 +370,14 @@ def test_a_negative_callback_goes_on_after_a_restore_before_the_forces(session):
     v = session.variables
     assert (v["sb"], v["vb"]) == (2, 0.0)
     assert session.model.blocks["velocity"][0, 0] == pytest.approx(500.0 * v["dt"] / 1000.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("cmd, msg, col", [("program list", "`program list` without a keyword is not supported yet", 1),
+                                           ("program list information",
+                                            "`program list` `information` is not supported yet", 14)])
+def test_other_program_list_keywords_are_not_supported_yet(session, cmd, msg, col):
+    from dec3d.errors import NotSupportedError
+
+    with pytest.raises(NotSupportedError) as e:
+        session.command(cmd)
+    assert e.value.message == msg and e.value.location.column == col
