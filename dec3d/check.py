@@ -12,7 +12,9 @@ same binder, the same FISH-name bookkeeping and the same resolution of called fi
   stops a run);
 - legacy syntax: 3DEC 5 syntax (stops a run);
 - a `fish define` is compiled as the run compiles it: runnable, or not supported yet when it
-  uses FISH intrinsics dec3d lacks (they fail when the function is called), or legacy syntax;
+  uses FISH intrinsics dec3d lacks (they fail when the function is called), or legacy syntax; a line
+  that calls such a function (directly or through others: `[…]`, `@f`, `fish callback add f`,
+  `fish history f`) is reported as not runnable too, where the run would stop;
 - error: anything else that stops a run (a called file that is missing, an undefined FISH name,
   a bad keyword or value).
 
@@ -21,6 +23,7 @@ followed and FISH names it never assigns are taken to come from the deck that ca
 """
 from __future__ import annotations
 
+import re
 import sys
 from collections import Counter
 from dataclasses import dataclass
@@ -46,6 +49,10 @@ class LineReport:
     what: str          # command name, what happens, or the error message
     file: str = "<input>"
     column: int = 1
+    #: when the problem stops `dec3d run`: "bind" (before anything runs), "called" (a `fish define` whose
+    #: body cannot run: only when the function is called), "run" (a line that calls such a function),
+    #: "cycle" (a callback or FISH history of such a function: the first cycling step that calls it)
+    when: str = "bind"
 
 
 class _Walker:
@@ -59,9 +66,12 @@ class _Walker:
         # output folder; default extensions; only regular files under the deck's or output folder)
         self.session = Session()
         self.reports: list[LineReport] = []
+        #: FISH functions whose bodies cannot run (name -> (status, why)) and the names each function calls
+        self.bad_fns: dict[str, tuple[str, str]] = {}
+        self.fn_calls: dict[str, set] = {}
 
-    def add(self, deck, line, status, what, column=1):
-        self.reports.append(LineReport(line, status, what, deck.filename, column))
+    def add(self, deck, line, status, what, column=1, when="bind"):
+        self.reports.append(LineReport(line, status, what, deck.filename, column, when))
 
     def problem(self, deck, raw, status, exc):
         loc = exc.location
@@ -73,8 +83,43 @@ class _Walker:
         """A `fish define`: parsed, its command lines bound and its body compiled, as `dec3d run`
         does when it reads the deck (nothing runs)."""
         self.ctx.define_fish(block)
-        for r in _check_fish(block, deck, self.ctx):
-            self.add(deck, r.line, r.status, r.what)
+        name = block.name.lower()
+        self.bad_fns.pop(name, None)                     # a later define replaces the function
+        for r in _check_fish(block, deck, self.ctx, self.fn_calls):
+            self.add(deck, r.line, r.status, r.what, when=r.when)
+            if r.when == "called":
+                self.bad_fns[name] = (r.status, r.what)
+
+    def _blocked_call(self, raw, item) -> tuple[str, str, str] | None:
+        """(status, why, when) when the line calls (directly, or through other functions) a FISH function whose
+        body cannot run: its `[…]`/`@name` values, a bare `@f`/`[f]` line, `fish callback add f`,
+        `fish history f` (when "cycle": the run stops at the first step that calls it)."""
+        if not self.bad_fns:
+            return None
+        names, when = set(), "run"
+        for tok in raw.tokens:
+            if tok.type in ("EXPR", "ATNAME"):
+                names.update(n.lower() for n in _IDENT.findall(_QUOTED.sub("", str(tok))))
+        if isinstance(item, CommandCall):
+            path = item.command.path
+            if path[:3] == ("fish", "callback", "add") and isinstance(item.args.get("function"), str):
+                names.add(item.args["function"].lower())
+                when = "cycle"
+            elif path == ("fish", "history") and isinstance(item.args.get("what"), tuple):
+                names.add(str(item.args["what"][1]).lower())
+                when = "cycle"
+        seen, todo = set(), list(names)
+        while todo:
+            n = todo.pop()
+            if n in seen:
+                continue
+            seen.add(n)
+            if n in self.bad_fns:
+                status, why = self.bad_fns[n]
+                lead = "calls" if when == "run" else "registers for cycling a FISH function that calls"
+                return status, f"{lead} FISH function `{n}`, which cannot run ({why})", when
+            todo.extend(self.fn_calls.get(n, ()))
+        return None
 
     def walk(self, text: str, filename: str, base_dir: Path, stack: tuple[SourceLocation, ...] = ()) -> None:
         deck = parse_deck(text, filename, stack)
@@ -99,6 +144,10 @@ class _Walker:
                 continue
             except Dec3dError as exc:
                 self.problem(deck, raw, ERROR, exc)
+                continue
+            blocked = self._blocked_call(raw, item)
+            if blocked is not None:
+                self.add(deck, raw.line, blocked[0], blocked[1], when=blocked[2])
                 continue
             if not isinstance(item, CommandCall):
                 self.add(deck, raw.line, RUNNABLE, item.source)
@@ -141,9 +190,10 @@ class _Walker:
         self.walk(text, str(target), target.parent, stack + (item.location,))
 
 
-def _check_fish(block, deck, ctx) -> list[LineReport]:
+def _check_fish(block, deck, ctx, fn_calls=None) -> list[LineReport]:
     """A `fish define`: parsed, its command lines bound and its body compiled (nothing runs).
-    Intrinsics dec3d does not implement make it "not supported yet", naming them."""
+    Intrinsics dec3d does not implement make it "not supported yet", naming them (``when`` "called": the
+    run stops only when the function is called). ``fn_calls`` gets the names the body calls."""
     from .fish import FishRuntime, compile_function, parse_block
 
     what = f"fish define {block.name}"
@@ -190,13 +240,18 @@ def _check_fish(block, deck, ctx) -> list[LineReport]:
         fn = compile_function(rt, fdef, bound)
     except Dec3dError as exc:
         return out + [LineReport(exc.location.line if exc.location else block.line, ERROR, exc.format())]
-    legacy = sorted(n for n in _called_names(fdef.body) if n in LEGACY_FISH and n not in ctx.fish_functions)
+    called = _called_names(fdef.body)
+    if fn_calls is not None:
+        fn_calls[block.name.lower()] = {n.lower() for n in called}
+    legacy = sorted(n for n in called if n in LEGACY_FISH and n not in ctx.fish_functions)
     if legacy:
         hints = "; ".join(f"`{n}` -> {LEGACY_FISH[n]}" for n in legacy)
-        return out + [LineReport(block.line, LEGACY, f"{what} uses 3DEC 5 (legacy) FISH intrinsics: {hints}")]
+        return out + [LineReport(block.line, LEGACY, f"{what} uses 3DEC 5 (legacy) FISH intrinsics: {hints}",
+                                 deck.filename, 1, "called")]
     if fn.unsupported:
         names = ", ".join(f"`{n}`" for n in sorted(fn.unsupported))
-        return out + [LineReport(block.line, NOT_SUPPORTED, f"{what}: FISH intrinsic(s) not supported yet: {names}")]
+        return out + [LineReport(block.line, NOT_SUPPORTED, f"{what}: FISH intrinsic(s) not supported yet: {names}",
+                                 deck.filename, 1, "called")]
     return out + [LineReport(block.line, RUNNABLE, what)]
 
 
@@ -210,6 +265,10 @@ LEGACY_FISH = {
     "z_sig3": "block.zone.stress.prin.z", "open": "file.open", "write": "file.write", "close": "file.close",
     "lose_array": "(lists are freed automatically)", "c_near": "block.contact.near",
 }
+
+
+_QUOTED = re.compile(r"'[^']*'|\"[^\"]*\"")
+_IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*")
 
 
 def _called_names(body) -> set:
@@ -242,12 +301,18 @@ def check_file(path: str | Path, standalone: bool = False) -> list[LineReport]:
     return check_text(p.read_text(encoding="utf-8", errors="replace"), str(p), p.parent, standalone)
 
 
+def _before(a: LineReport, b: LineReport, reports: list[LineReport]) -> bool:
+    """Whether report ``a`` comes before ``b`` in reading order."""
+    return next(i for i, r in enumerate(reports) if r is a) < next(i for i, r in enumerate(reports) if r is b)
+
+
 def summary(reports: list[LineReport]) -> Counter:
     return Counter(r.status for r in reports)
 
 
 def main(paths: list[str], verbose: bool = False) -> int:
-    """Exit 0 when every deck would run, 1 when one would stop, 2 when a deck cannot be read."""
+    """Exit 0 when every deck would run, 1 when one would stop or has FISH functions that cannot run, 2 when a
+    deck cannot be read."""
     worst = 0
     for path in paths:
         p = Path(path)
@@ -274,9 +339,26 @@ def main(paths: list[str], verbose: bool = False) -> int:
         for r in reports:
             if r.status in BLOCKERS or verbose:
                 print(f"  {r.file}:{r.line}:{r.column}: {r.status}: {r.what}")
-        if blockers:
-            first = blockers[0]
+        at_bind = [r for r in blockers if r.when == "bind"]
+        at_run = [r for r in blockers if r.when == "run"]
+        at_cycle = [r for r in blockers if r.when == "cycle"]
+        if at_bind:
+            first = at_bind[0]
             print(f"  dec3d run would stop before running anything, at {first.file}:{first.line}")
+        elif at_run or at_cycle:
+            first = (at_run or at_cycle)[0]
+            if at_cycle and (not at_run or _before(at_cycle[0], first, reports)):
+                c = at_cycle[0]
+                print(f"  dec3d run would stop at the first cycling step after {c.file}:{c.line} (a callback or "
+                      "history calls a FISH function that cannot run)" +
+                      (f", or at {first.file}:{first.line}, where one is called" if at_run else ""))
+            else:
+                print(f"  dec3d run would run the lines before {first.file}:{first.line} and stop there: it calls "
+                      "a FISH function that cannot run")
+        elif blockers:
+            print("  dec3d run would run to the end: no line calls the FISH functions above (they stop a run "
+                  "only when called)")
+        if blockers:
             worst = max(worst, 1)
         else:
             print("  no line stops `dec3d run` before it starts (what happens while it runs is not checked)")

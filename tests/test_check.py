@@ -5,7 +5,7 @@ import shutil
 import pytest
 
 from conftest import DECKS
-from dec3d.check import DOES_NOTHING, ERROR, NOT_SUPPORTED, RUNNABLE, check_file
+from dec3d.check import DOES_NOTHING, ERROR, LEGACY, NOT_SUPPORTED, RUNNABLE, check_file
 from dec3d.cli import main
 
 MAIN = """model new
@@ -123,3 +123,47 @@ def test_elastic_hole_master_reports_the_called_decks(tmp_path):
     assert {r.status for r in calls} == {RUNNABLE}
     defines = [r for r in reports if r.what.startswith("fish define")]
     assert len(defines) >= 4 and {r.status for r in defines} == {RUNNABLE}
+
+
+# a function with an intrinsic dec3d lacks and one with 3DEC 5 FISH compile (the run reads the deck), and
+# stop the run only when called; `c` reaches `a` through its body
+CALLS = """block create brick 0 1 0 1 0 1
+fish define b
+  out('x')
+end
+fish define a
+  a = block.gp.dsf(1)
+end
+fish define c
+  c = a + 1
+end
+model title 'ran'
+[io.out('a is only a string here')]
+{line13}
+"""
+
+
+@pytest.mark.parametrize("line13, status, when, says", [
+    ("@a", NOT_SUPPORTED, "run", "would run the lines before {deck}:13 and stop there"),
+    ("[x = c]", NOT_SUPPORTED, "run", "would run the lines before {deck}:13 and stop there"),
+    ("[b]", LEGACY, "run", "would run the lines before {deck}:13 and stop there"),
+    ("fish callback add c 1.0", NOT_SUPPORTED, "cycle", "would stop at the first cycling step after {deck}:13"),
+    ("model title 'no call'", RUNNABLE, "bind", "would run to the end: no line calls the FISH functions above")])
+def test_lines_that_call_functions_that_cannot_run_are_reported_where_the_run_stops(tmp_path, capsys, line13,
+                                                                                    status, when, says):
+    deck = tmp_path / "d.dat"
+    deck.write_text(CALLS.format(line13=line13))
+    reports = check_file(deck)
+    by = {r.line: r for r in reports}
+    assert (by[2].status, by[2].when) == (LEGACY, "called") and (by[5].status, by[5].when) == (NOT_SUPPORTED, "called")
+    assert by[8].status == RUNNABLE and by[11].status == RUNNABLE and by[12].status == RUNNABLE
+    assert (by[13].status, by[13].when) == (status, when)
+    assert main(["check", str(deck)]) == 1
+    assert says.format(deck=deck) in capsys.readouterr().out
+    # the run agrees: it runs line 11 (the title) and stops at line 13 only when that line calls the function
+    rc = main(["run", "-q", str(deck), "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    if when == "run":
+        assert rc == 1 and f"called from {deck}:13" in err
+    else:
+        assert rc == 0

@@ -3,8 +3,9 @@ prepass).
 
 `fish history` records a FISH global (or the value of a FISH function, called at each sample) as one of
 the model's histories (dec3d.physics.history), so `history export`, `history rename` and save files treat
-it like any other. `fish callback add` runs a FISH function during cycling, from a step hook of the rigid
-engine (`RigidEngine.step_hooks`). The FISH run time reaches the model through `attach_fish` (the model
+it like any other. `fish callback add` runs a FISH function during cycling: at a negative position from the
+`FishBefore` step first in the step list (`RigidEngine.pre_steps`), before the step's forces; at a position
+≥ 0 from a step hook of the rigid engine (`RigidEngine.step_hooks`), after its motion. The FISH run time reaches the model through `attach_fish` (the model
 gets `fish_probe`, the engine the callback hook); `model restore` calls it again for the restored model.
 """
 from __future__ import annotations
@@ -13,7 +14,7 @@ import math
 import re
 from functools import reduce
 
-from ..errors import BindError, CommandError, Dec3dError
+from ..errors import BindError, CommandError, Dec3dError, NotSupportedError
 from ..fish import contact_intrinsics, intrinsics
 from ..lang.abbrev import matches
 from .registry import command
@@ -80,27 +81,64 @@ def fish_list(session, call):
 # ------------------------------------------------------------------ attaching the run time to a model
 
 class FishCallbackHook:
-    """Step hook of the rigid engine: runs the session's FISH callbacks after each step whose number
-    their interval divides. ``interval`` (the gcd of the callbacks' intervals) makes the engine end a
-    batch of steps at every step a callback is due, so a callback sees the model after exactly that step."""
+    """Step hook of the rigid engine: runs the session's FISH callbacks at positions ≥ 0 after each step
+    whose number their interval divides. ``interval`` (the gcd of those callbacks' intervals) makes the
+    engine end a batch of steps at every step one is due, so it sees the model after exactly that step."""
 
     def __init__(self, rt):
         self.rt = rt
 
     @property
     def interval(self) -> int:
-        ivs = [cb[2] for cb in self.rt.callbacks]
+        ivs = [cb[2] for cb in self.rt.callbacks if cb[0] >= 0]
         return reduce(math.gcd, ivs) if ivs else 0
 
     def __call__(self, eng) -> None:
         if self.rt.callbacks:
-            self.rt.run_callbacks(int(eng.step))
+            self.rt.run_callbacks(int(eng.step), before=False)
+
+
+class FishBefore:
+    """A step of the cycle, first in the step list (``RigidEngine.pre_steps``): the FISH callbacks at negative
+    positions, called before anything of the step they are due at (step s = the model's step + 1: they see
+    the model after step s − 1, and what they set — applied forces, velocities, face loads — acts in step
+    s). The batch then ends before the next step one of them is due at."""
+    timing = "hooks"
+
+    def __init__(self, rt, run):
+        self.rt, self.run = rt, run
+
+    def prepare(self) -> None:
+        pass
+
+    def advance(self, n: int) -> int:
+        ivs = [cb[2] for cb in self.rt.callbacks if cb[0] < 0]
+        if not ivs:
+            return n
+        nxt = int(self.run.m.step) + 1
+        if any(nxt % iv == 0 for iv in ivs):
+            self.rt.run_callbacks(nxt, before=True)
+        return max(1, min(n, min(iv - nxt % iv for iv in ivs)))
+
+    def __repr__(self) -> str:
+        return "FishBefore"
+
+
+class _MakeFishBefore:
+    """The factory ``RigidEngine.pre_steps`` holds: one ``FishBefore`` per run."""
+
+    def __init__(self, rt):
+        self.rt = rt
+
+    def __call__(self, run) -> FishBefore:
+        return FishBefore(self.rt, run)
 
 
 def attach_fish(session, model=None) -> None:
     """Give ``model`` (default: the session's) the FISH run time: ``model.fish_probe`` for FISH histories,
     and, when there are callbacks, the callback hook first among the rigid engine's step hooks (before the
-    histories, so a history sees what a callback set in the same step)."""
+    histories, so a history sees what a callback set in the same step) and the ``FishBefore`` step first in
+    its step list (callbacks at negative positions)."""
     model = session.model if model is None else model
     rt = session.fish_rt
     model.fish_probe = rt.probe
@@ -108,9 +146,12 @@ def attach_fish(session, model=None) -> None:
     if rt.callbacks:
         from ..physics.rigid import engine
 
-        hooks = engine(model).step_hooks
+        eng = engine(model)
+        hooks = eng.step_hooks
         if not any(isinstance(h, FishCallbackHook) and h.rt is rt for h in hooks):
             hooks.insert(0, FishCallbackHook(rt))
+        if not any(isinstance(f, _MakeFishBefore) and f.rt is rt for f in eng.pre_steps):
+            eng.pre_steps.append(_MakeFishBefore(rt))
 
 
 def _current_contacts(model):
@@ -129,7 +170,14 @@ def _engine(model):
     return engine(model)
 
 
+def _joint_model(code):
+    from ..physics.jmodels import MODEL_BY_CODE
+
+    return MODEL_BY_CODE.get(code)
+
+
 contact_intrinsics.CONTACTS[0] = _current_contacts
+contact_intrinsics.JMODELS[0] = _joint_model
 intrinsics.ENGINE[0] = _engine
 
 
@@ -239,14 +287,23 @@ _EVENT = P("event", Text(), "a named event (`event 'zone_delete'`)", supported=F
                                           P("position", _Position(), "its position in the cycle sequence",
                                             required=True)],
          keywords=[P("interval", INT, "call it every n steps (default 1)", default=1), _EVENT],
-         doc="Call a FISH function during cycling, after every step (or every `interval` steps).",
-         details="dec3d calls every callback once after each step it is due, with the step's state complete "
-                 "(positions, velocities, contact forces, `mech.cycle` and `mech.time` of that step); callbacks "
-                 "run in increasing position (3DEC's cycle-sequence number; two at one position in the order "
-                 "added) and before histories are sampled. The position only orders callbacks: dec3d has no "
-                 "calls inside the step. An error in the function stops the cycle with the function's line and the "
-                 "callback command in the FISH stack; the model is put back as it was before the cycle command "
-                 "(as for any error while cycling), FISH variables keep what the callbacks set.",
+         doc="Call a FISH function during cycling, at a position in the cycle sequence, every step (or every "
+             "`interval` steps).",
+         details="The position places the call in each step (`program list cycle-sequence` prints dec3d's "
+                 "sequence): a negative position calls the function before anything of the step it is due at — "
+                 "after contact detection, before time functions, contact forces and motion — so what it sets "
+                 "(an applied force or velocity, a face load, a property) acts in that same step (3DEC's "
+                 "`fish callback add srv_update -100.0`); it sees the model after the previous step "
+                 "(`mech.cycle` = the step before). A position ≥ 0 calls it after the step's motion and clock, "
+                 "with the step's state complete (positions, velocities, contact forces, `mech.cycle` and "
+                 "`mech.time` of that step), before histories are sampled. Callbacks on the same side run in "
+                 "increasing position (two at one position in the order added); due means the step's number is "
+                 "a multiple of `interval`. dec3d's numbers are its own: 3DEC's cycle sequence has more points "
+                 "(its positions between its calculations are all mapped to one side of dec3d's single step: "
+                 "negative before it, others after). An error in the function stops the cycle with the "
+                 "function's line and the callback command in the FISH stack; the model is put back as it was "
+                 "before the cycle command (as for any error while cycling), FISH variables keep what the "
+                 "callbacks set.",
          examples=["fish callback add joint_force 0.1 interval 1000", "fish callback add @srv_update -100.0"])
 def fish_callback_add(session, call):
     name = call.args["function"]
@@ -291,7 +348,48 @@ def fish_callback_list(session, call):
     if not rt.callbacks:
         session.write("no FISH callbacks")
     for pos, name, interval, _site in rt.callbacks:
-        session.write(f"{pos:g}  {name}  interval {interval}")
+        when = "before the step's forces" if pos < 0 else "after the step's motion"
+        session.write(f"{pos:g}  {name}  interval {interval}  ({when})")
+
+
+#: dec3d's cycle sequence: (position, what runs there), for `program list cycle-sequence`
+CYCLE_SEQUENCE = (
+    ("", "contact detection, when due (every `model update-interval` steps, or a block moved CTOL/2)"),
+    ("< 0", "FISH callbacks at negative positions, in increasing position (`FishBefore`)"),
+    ("0", "the step: time functions (`block apply … table|fish`), energy record, contact forces, rigid-block "
+          "motion, zone and FE-block forces and gridpoint motion, then the clock (step and time move on)"),
+    ("≥ 0", "FISH callbacks at positions ≥ 0, in increasing position (step hook)"),
+    ("", "histories, periodic VTK snapshots (step hooks)"),
+)
+
+
+def _check_program_list(call):
+    what = call.args["what"]
+    if what is None or (isinstance(what, str) and matches(what, ["cycle-sequence"]) != ["cycle-sequence"]):
+        shown = "`program list`" + (f" `{what}`" if what is not None else " without a keyword")
+        raise NotSupportedError(f"{shown} is not supported yet", call.locations.get("what", call.location),
+                                hint="dec3d lists: cycle-sequence")
+
+
+@command("program list", positional=[P("what", Text(), "what to list: `cycle-sequence` (the only one dec3d has)")],
+         check=_check_program_list,
+         doc="`program list cycle-sequence`: print dec3d's cycle sequence — where FISH callbacks run in a step — "
+             "and the steps of the last run.",
+         details="A callback at a negative position (`fish callback add f -100`) runs before the step's "
+                 "calculations, one at a position ≥ 0 after its motion; the numbers are dec3d's own (one "
+                 "calculation point, 0), not 3DEC's list. The last lines name the step objects of the last "
+                 "`model cycle|solve` in order (`RigidEngine.steps`, or that nothing has cycled yet) and the "
+                 "callbacks. Other `program list` keywords of 3DEC are not supported yet.",
+         examples=["program list cycle-sequence"])
+def program_list_cycle_sequence(session, call):
+    session.write("position  what runs")
+    for pos, what in CYCLE_SEQUENCE:
+        session.write(f"{pos:>8}  {what}")
+    eng = getattr(session.model, "rigid_engine", None)          # (listing makes no engine)
+    steps = eng.steps if eng is not None else []
+    session.write("last run's steps: " + (" -> ".join(repr(st) for st in steps) if steps else "none (not cycled yet)"))
+    for pos, name, interval, _site in session.fish_rt.callbacks:
+        session.write(f"callback {pos:g}  {name}  interval {interval}")
 
 
 # ------------------------------------------------------------------ table

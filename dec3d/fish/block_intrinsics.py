@@ -3,7 +3,7 @@
 A block is handed to FISH as its id (an integer; ids are never reused), which is what
 `block.list` holds and `block.find` returns (0, FISH's null, when no live block has it).
 Names and meanings follow Itasca's 3DEC 7 FISH reference (block.id, block.pos, block.vel,
-block.disp, block.mass, block.vol, block.group, block.fix).
+block.disp, block.mass, block.vol, block.group, block.fix, block.near).
 """
 from __future__ import annotations
 
@@ -43,6 +43,24 @@ def _block_find(rt, b):
     if type(b) is not int:
         raise FishValueError(f"`block.find` takes a block id (an integer), not a {type_name(b)}")
     return b if rt.session.model.block_rows([b])[0] >= 0 else 0
+
+
+@intrinsic("block.near", 1, 3)
+def _block_near(rt, *xyz):
+    """The block whose centroid is nearest (x, y, z) (or a vector); 0 when there is no block. Ties: the lowest
+    id. (dec3d's meaning: the distance to the centroid, not to the block's surface.)"""
+    if len(xyz) == 1 and type(xyz[0]) is Vec:
+        xyz = tuple(xyz[0])
+    if len(xyz) != 3 or any(type(c) not in (int, float) or c - c for c in xyz):
+        raise FishValueError("`block.near` takes a vector or three finite numbers x, y, z")
+    b = rt.session.model.blocks
+    if b.n == 0:
+        return 0
+    d = b["centroid"] - np.array(xyz, dtype=float)
+    d2 = np.einsum("ij,ij->i", d, d)
+    ids = b["id"]
+    best = np.nonzero(d2 == d2.min())[0]
+    return int(ids[best].min())
 
 
 @intrinsic("block.id", 1)

@@ -304,3 +304,40 @@ def _sub_ss(rt, s):
     ss, k = _sub_row(rt, s, "block.subcontact.stress.shear")
     a = _per_area(ss, k, "block.subcontact.stress.shear")
     return _vec(ss["fs"][k] / a)
+
+
+# ---------------------------------------------------------------- joint-model properties
+
+#: ``JMODELS[0](code)`` -> the joint model of that code (``physics.jmodels.JointModel``: ``name``, ``props``,
+#: ``value(row, name)``), or None; set by dec3d.commands.fish_cmds (FISH imports no physics)
+JMODELS: list = [None]
+
+
+def _prop(rt, cs, r, name, fname):
+    if type(name) is not str:
+        raise FishValueError(f"`{fname}` takes a property name (a string), not a {type_name(name)}")
+    m = JMODELS[0](int(cs["jmodel"][r])) if JMODELS[0] is not None else None
+    if m is None:                                # pragma: no cover - every stored code has a host model
+        raise FishValueError(f"`{fname}`: the contact has an unknown joint model")
+    key = name.lower()
+    if key not in m.props:
+        raise FishValueError(f"`{fname}`: joint model `{m.name}` has no property '{name}' "
+                             f"(it has {', '.join(sorted(m.props))})")
+    return float(m.value(cs["prop"][r], key))
+
+
+@intrinsic("block.contact.prop", 2)
+def _c_prop(rt, c, name):
+    """A property of the contact's joint model, by the name `block contact property` uses, in the same
+    units (angles in degrees; an unset residual friction reads as the friction)."""
+    cs, r = _contact_row(rt, c, "block.contact.prop")
+    return _prop(rt, cs, r, name, "block.contact.prop")
+
+
+@intrinsic("block.subcontact.prop", 2)
+def _s_prop(rt, s, name):
+    """The property of the sub-contact's contact (3DEC keeps joint properties per sub-contact; dec3d per
+    contact, so every sub-contact of a contact reads the same value)."""
+    _sub_row(rt, s, "block.subcontact.prop")
+    cs, r = _contact_row(rt, ContactPtr("contact", s.key[:2], s.hint), "block.subcontact.prop")
+    return _prop(rt, cs, r, name, "block.subcontact.prop")

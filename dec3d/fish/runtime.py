@@ -193,10 +193,12 @@ class FishRuntime:
         raise self.error_at(site, f"`fish history {name}`: the value is a {type_name(v)}, not a number")
 
     # ------------------------------------------------------------ callbacks
-    def run_callbacks(self, step: int) -> None:
-        """Call every `fish callback` function whose interval divides `step` (in position order)."""
-        for _pos, name, interval, site in list(self.callbacks):
-            if step % interval:
+    def run_callbacks(self, step: int, before: bool | None = None) -> None:
+        """Call every `fish callback` function whose interval divides `step` (in position order);
+        ``before``: only those at negative positions (True, before the step's forces) or at positions
+        ≥ 0 (False, after its motion); None: all."""
+        for pos, name, interval, site in list(self.callbacks):
+            if step % interval or (before is not None and (pos < 0) != before):
                 continue
             fn = self.functions.get(name)
             if fn is None:

@@ -3,7 +3,7 @@
 A zone is handed to FISH as its id (an integer from 1, what `block.zone.list` holds and
 `block.zone.find` returns; 0, FISH's null, when no zone has it), as blocks are. Names follow
 Itasca's 3DEC 7 FISH reference: block.zone.list, .num, .find, .id, .block, .vol, .pos,
-.stress and its six components (tension positive), .gp(z, i) (the gridpoint at node i, from 1).
+.stress and its six components (tension positive), .state (plastic state bits), .gp(z, i) (the gridpoint at node i, from 1).
 
 A gridpoint is handed to FISH as its index: its row in the ``vertices`` store + 1 (gridpoints are
 vertices, dec3d.model.zones; the vertices of rigid blocks are gridpoints too, as in 3DEC). The
@@ -106,6 +106,14 @@ for _c, _k in enumerate(_COMP):
         _, st, r = _row(rt, z, full)
         return float(st["stress"][r, c])
     intrinsic(f"block.zone.stress.{_k}", 1)(_sc)
+
+
+@intrinsic("block.zone.state", 1)
+def _state(rt, z):
+    """The zone's plastic state bits (Itasca's flags, as the `zones` store keeps them): 1 shear-now,
+    2 tension-now, 4 shear-past, 8 tension-past; 0 never yielded (elastic zones are always 0)."""
+    _, st, r = _row(rt, z, "block.zone.state")
+    return int(st["state"][r])
 
 
 @intrinsic("block.zone.gp", 2)

@@ -120,6 +120,9 @@ class RigidEngine(ContactDetection):
         #: callables hook(engine) run after every batch of steps (histories register here);
         #: a hook with an ``interval`` attribute gets a batch boundary at every multiple of it
         self.step_hooks: list = []
+        #: factories ``make(run) -> step`` put first in every run's step list, before the forces
+        #: (FISH callbacks at negative cycle-sequence positions, ``commands.fish_cmds``)
+        self.pre_steps: list = []
         #: seconds per phase; "hooks" covers histories and periodic VTK snapshots
         self.timings = {"detect": 0.0, "search": 0.0, "subcontacts": 0.0, "cycle": 0.0, "hooks": 0.0}
         self._cand = None             # candidate pairs (rows A, rows B) of the last cell map
@@ -736,6 +739,7 @@ class _Run:
             # energy tracking (`model energy active on`): EnergyBefore → … → EnergyAfter → Clock → Hooks
             from .energy import energy_steps
             self.steps = energy_steps(self, self.steps, RunError)
+        self.steps[:0] = [make(self) for make in eng.pre_steps]
         fresh = eng._signature != eng._geometry_signature()
         if fresh:
             eng.detect()

@@ -90,3 +90,32 @@ def test_unbalanced_force_right_after_block_delete(session):
     v = session.variables
     assert v["nc"] == 1
     assert v["fz"] == pytest.approx(ss["fn"][: ss.n].sum() - 20000.0, rel=1e-9, abs=1e-6)
+
+
+def test_block_near_is_the_nearest_centroid(session):
+    """Centroids (1, 0.5, 0.5) and (0.5, 0.5, 1.5): (0.2, 0.5, 1.8) is nearer the second; the point
+    (0.75, 0.5, 1.0) is 0.25² + 0.5² from both, a tie the lower id takes; no block gives 0."""
+    session.command("[e = block.near(0, 0, 0)]")
+    assert session.variables["e"] == 0
+    session.command("block create brick 0 2 0 1 0 1\nblock create brick 0 1 0 1 1 2\n"
+                    "[a = block.near(0.2, 0.5, 1.8)]\n[b = block.near(vector(1.9, 0.1, 0.1))]\n"
+                    "[t = block.near(0.75, 0.5, 1.0)]")
+    v = session.variables
+    assert (v["a"], v["b"], v["t"]) == (2, 1, 1)
+    for text in ("[q = block.near(1, 2)]", "[q = block.near('a', 0, 0)]"):
+        with pytest.raises(ExpressionError) as e:
+            session.command(text)
+        assert "`block.near` takes a vector or three finite numbers x, y, z" in e.value.message
+
+
+def test_clock_and_gravity_intrinsics(session):
+    """time.kernel (processor ms) and time.clock (wall hundredths of a second) grow while FISH works;
+    global.gravity reads `model gravity`."""
+    session.command("model gravity 1 -2 -9.5\n[g = global.gravity]\n[gz = global.gravity.z]\n"
+                    "[k0 = time.kernel]\n[c0 = time.clock]\n"
+                    "fish define busy\n local s = 0\n loop local i (1, 300000)\n  s = s + i\n endloop\n busy = s\nend\n"
+                    "[s = busy]\n[k1 = time.kernel]\n[c1 = time.clock]")
+    v = session.variables
+    assert tuple(v["g"]) == (1.0, -2.0, -9.5) and v["gz"] == -9.5
+    assert v["s"] == 300000 * 300001 // 2
+    assert v["k1"] > v["k0"] and type(v["c1"]) is int and v["c1"] >= v["c0"] >= 0

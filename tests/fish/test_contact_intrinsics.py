@@ -88,3 +88,29 @@ def test_contact_walks_and_subcontact_stress(session):
     assert v["nc"] == cs.n == 1 and v["ns"] == int(cs["sub_count"][0]) == ss.n
     assert v["smax"] == pytest.approx(max(ss["fn"][k] / ss["area"][k] for k in range(ss.n)), rel=1e-12)
     assert v["t"] == int(cs["type"][0])
+
+
+def test_contact_and_subcontact_properties_read_back_in_command_units(session):
+    """`block contact property` values come back through block.contact.prop / block.subcontact.prop as the
+    command took them: friction in degrees (kept as its tangent), an unset residual friction as the friction."""
+    session.command(SETUP + "block contact jmodel assign mohr\n"
+                    "block contact property stiffness-normal 2e9 stiffness-shear 1e9 friction 30 cohesion 1e5\n"
+                    "fish define first\n  local cl = block.contact.list\n  first = cl(1)\nend\n"
+                    "fish define props\n  local c = first\n  local sl = block.contact.subcontactlist(c)\n"
+                    "  global kn = block.contact.prop(c, 'stiffness-normal')\n"
+                    "  global phi = block.subcontact.prop(sl(1), 'friction')\n"
+                    "  global phir = block.subcontact.prop(sl(list.size(sl)), 'Friction-Residual')\n"
+                    "  global coh = block.contact.prop(c, 'cohesion')\n  global ten = block.contact.prop(c, 'tension')\n"
+                    "end\n@props")
+    v = session.variables
+    assert (v["kn"], v["coh"], v["ten"]) == (2e9, 1e5, 0.0)
+    assert v["phi"] == pytest.approx(30.0, rel=1e-12) and v["phir"] == pytest.approx(30.0, rel=1e-12)
+    for text, msg in [("[q = block.contact.prop(first, 'G_I')]",
+                       "`block.contact.prop`: joint model `mohr` has no property 'G_I' (it has cohesion,"),
+                      ("[q = block.contact.prop(first, 3)]",
+                       "`block.contact.prop` takes a property name (a string), not a integer"),
+                      ("[q = block.subcontact.prop(first, 'friction')]",
+                       "`block.subcontact.prop` takes a sub-contact")]:
+        with pytest.raises(ExpressionError) as e:
+            session.command(text)
+        assert msg in e.value.message

@@ -5,8 +5,9 @@
   'BrickToFoundation' in slot 'components'; on a 1 x 1 x 0.5 m brick (density 2000 kg/m³, g = 10 m/s²)
   settled on a fixed base the normal force is its weight, 1 × 1 × 0.5 × 2000 × 10 = 1e4 N, and the
   shear force is zero; the deck's `fish history @norm_bedjoint_B` / `history rename` lines record it.
-- `servo_spring.dat` srv_update (law 0, the spring) runs every step and updates every 20 steps:
-  F = F0 + k dy with dy the y displacement of the beam gridpoint nearest its probe point.
+- `servo_spring.dat` srv_update (law 0, the spring) runs every step, at position -100 (before the step's
+  forces), and updates every 20 steps: F = F0 + k dy with dy the y displacement of the beam gridpoint
+  nearest its probe point.
 """
 import shutil
 
@@ -59,14 +60,16 @@ def test_servo_spring_callback_follows_the_beam(session, tmp_path):
         "block contact property stiffness-normal 1e9 stiffness-shear 1e9\n"
         "model gravity 0 -10 0\nblock fix range position-y 0 2.47\n"
         "fish define cstav\n  ncstav = 0.0\nend\n"          # the deck's law 1 reads it; law 0 (used) does not
-        "call 'servo_spring.dat'\nmodel cycle 100\n[dy_now = block.gp.disp.y(srv_gp)]\n")
+        "call 'servo_spring.dat'\nmodel cycle 99\n[dy_99 = block.gp.disp.y(srv_gp)]\nmodel cycle 1\n"
+        "[dy_now = block.gp.disp.y(srv_gp)]\n")
     v = session.variables
     assert v["srv_calls"] == 5                                  # 100 steps, one update every 20
     assert v["dy_now"] < -1e-7                                  # the beam has settled on the base
-    assert v["srv_dy"] == v["dy_now"]                           # the last update was at step 100
-    assert v["srv_f"] == pytest.approx(v["srv_f0"] + v["srv_k"] * v["dy_now"], rel=1e-15)
+    # position -100: the last update ran before step 100's forces, on the state after step 99
+    assert v["srv_dy"] == v["dy_99"] != v["dy_now"]
+    assert v["srv_f"] == pytest.approx(v["srv_f0"] + v["srv_k"] * v["dy_99"], rel=1e-15)
     # the lowest force goes with the lowest beam position (the beam bounces while it settles)
-    assert v["srv_dymin"] <= v["dy_now"] and v["srv_fmin"] == pytest.approx(
+    assert v["srv_dymin"] <= v["dy_99"] and v["srv_fmin"] == pytest.approx(
         v["srv_f0"] + v["srv_k"] * v["srv_dymin"], rel=1e-15)
     pos = session.model.vertices["pos"][v["srv_gp"] - 1]
     assert pos[1] == pytest.approx(2.68 + v["dy_now"], abs=1e-12)    # a gridpoint of the beam's top face

@@ -93,10 +93,67 @@ def test_callbacks_run_in_position_order_at_their_interval(session):
                     "fish define b\n  log = list.append(log, 'b' + string(mech.cycle))\nend\n"
                     "fish callback add b 5.0 interval 2\nfish callback add a -1.0 interval 3\nmodel cycle 6\n"
                     "fish callback list")
-    assert session.variables["log"] == ["b2", "a3", "b4", "a6", "b6"]
-    assert session.output.getvalue().splitlines()[-2:] == ["-1  a  interval 3", "5  b  interval 2"]
+    # b (position 5) after steps 2, 4, 6; a (position -1) before steps 3 and 6, seeing the step before
+    assert session.variables["log"] == ["b2", "a2", "b4", "a5", "b6"]
+    assert session.output.getvalue().splitlines()[-2:] == ["-1  a  interval 3  (before the step's forces)",
+                                                           "5  b  interval 2  (after the step's motion)"]
     session.command("fish callback remove a\n[log = list.sequence(0)]\nmodel cycle 2")
     assert session.variables["log"] == ["b8"]
+
+
+# a free 1 m brick, no gravity, no damping: one step of an applied force F gives v = F Δt / m
+FREE = ("block create brick 0 1 0 1 0 1\nblock property density 1000\nblock mechanical damping none\n"
+        "model gravity 0 0 0\n[f0 = 500.0]\n"
+        "fish define pre\n  sb = mech.cycle\n  vb = block.vel.x(block.find(1))\n"
+        "  if mech.cycle = 0 then\n    block.force.app.x(block.find(1)) = f0\n  endif\nend\n"
+        "fish define post\n  sa = mech.cycle\n  va = block.vel.x(block.find(1))\nend\n")
+
+
+def test_a_negative_position_acts_in_the_same_step_and_a_positive_one_sees_the_motion(session):
+    """`srv_update -100.0`-style: the -100 callback sets an applied force before step 1's forces, so step 1
+    already moves the block (v = F Δt / m, central difference from rest); the +50 one runs after step 1's
+    motion and reads that velocity with mech.cycle = 1, the -100 one read the state before it (cycle 0, v 0)."""
+    session.command(FREE + "fish callback add post 50\nfish callback add pre -100\nmodel cycle 1\n"
+                    "[dt = mech.timestep]\n[m = block.mass(block.find(1))]")
+    v = session.variables
+    assert v["m"] == pytest.approx(1000.0, rel=1e-12)        # real mass: damping none scales nothing
+    assert (v["sb"], v["vb"], v["sa"]) == (0, 0.0, 1)
+    assert v["va"] == pytest.approx(500.0 * v["dt"] / 1000.0, rel=1e-12)
+    assert session.model.blocks["velocity"][0, 0] == v["va"]
+    assert [repr(st) for st in session.model.rigid_engine.steps] == ["FishBefore", "RigidBatch", "Clock", "Hooks"]
+
+
+def test_the_same_force_set_after_motion_acts_one_step_later(session):
+    """The control: at +50 the force set at cycle 0 cannot be set (the first call sees cycle 1), so with the
+    condition moved to cycle 1 the block is still at rest after step 1 and moves in step 2."""
+    session.command(FREE.replace("mech.cycle = 0", "mech.cycle = 1") + "fish callback add pre 50\nmodel cycle 1")
+    assert session.model.blocks["velocity"][0, 0] == 0.0
+    session.command("model cycle 1\n[dt = mech.timestep]")
+    assert session.model.blocks["velocity"][0, 0] == pytest.approx(500.0 * session.variables["dt"] / 1000.0,
+                                                                    rel=1e-12)
+
+
+def test_a_negative_callback_with_an_interval_runs_before_each_due_step(session):
+    """interval 4 at -10: before steps 4, 8, 12 (it sees cycles 3, 7, 11); the batches end there (the split
+    changes nothing: the same log for one run and for three)."""
+    text = BRICK + "[log = list.sequence(0)]\nfish define a\n  log = list.append(log, mech.cycle)\nend\n" \
+                   "fish callback add a -10 interval 4\n"
+    session.command(text + "model cycle 13")
+    assert session.variables["log"] == [3, 7, 11]
+    z13 = session.model.blocks["centroid"][0, 2]
+    session.command("model new\n" + text + "model cycle 5\nmodel cycle 3\nmodel cycle 5")
+    assert session.variables["log"] == [3, 7, 11] and session.model.blocks["centroid"][0, 2] == z13
+
+
+def test_program_list_cycle_sequence_names_the_positions_and_the_last_steps(session):
+    session.command("program list cycle-sequence")
+    out = session.output.getvalue().splitlines()
+    assert out[0] == "position  what runs" and out[-1] == "last run's steps: none (not cycled yet)"
+    assert [ln.split()[0] for ln in out[1:-1] if ln.split()[0] in ("<", "0", "≥")] == ["<", "0", "≥"]
+    session.command(BRICK + "fish define a\n  a = 1\nend\nfish callback add a -3.5\nmodel cycle 2\n"
+                    "program list cycle-sequence")
+    out = session.output.getvalue().splitlines()
+    assert out[-2:] == ["last run's steps: FishBefore -> RigidBatch -> Clock -> Hooks", "callback -3.5  a  interval 1"]
 
 
 def test_an_error_in_a_callback_stops_the_cycle_with_the_fish_line(session, tmp_path):
@@ -301,3 +358,26 @@ def test_fish_history_and_callback_go_on_after_a_restore(session):
     h = session.model.history_set.find("n")
     assert h.steps == [2, 4, 6, 8] and h.values == [2.0, 4.0, 6.0, 8.0]
     assert session.variables["n"] == 8
+
+
+def test_a_negative_callback_goes_on_after_a_restore_before_the_forces(session):
+    """A -100 callback survives `model save|restore` and still runs before the step's forces: it gives the
+    block a fresh applied force before step 3 (the step after the restore), and step 3 already moves it."""
+    session.command(FREE.replace("mech.cycle = 0", "mech.cycle = 2") + "fish callback add pre -100\n"
+                    "model cycle 2\nmodel save 'r'\nmodel new\nmodel restore 'r'\nfish callback list\nmodel cycle 1\n"
+                    "[dt = mech.timestep]")
+    assert session.output.getvalue().splitlines()[-1] == "-100  pre  interval 1  (before the step's forces)"
+    v = session.variables
+    assert (v["sb"], v["vb"]) == (2, 0.0)
+    assert session.model.blocks["velocity"][0, 0] == pytest.approx(500.0 * v["dt"] / 1000.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("cmd, msg, col", [("program list", "`program list` without a keyword is not supported yet", 1),
+                                           ("program list information",
+                                            "`program list` `information` is not supported yet", 14)])
+def test_other_program_list_keywords_are_not_supported_yet(session, cmd, msg, col):
+    from dec3d.errors import NotSupportedError
+
+    with pytest.raises(NotSupportedError) as e:
+        session.command(cmd)
+    assert e.value.message == msg and e.value.location.column == col

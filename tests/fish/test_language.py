@@ -60,6 +60,8 @@ CASES = [
     # math intrinsics (math.log is base 10, math.ln natural, per Itasca)
     ("fish define f\n io.out(math.log(1000))\n io.out(math.ln(math.exp(2)))\n io.out(math.sqrt(16))\n"
      " io.out(math.abs(-3))\n io.out(math.round(2.5))\nend\n@f", ["3.0", "2.0", "4.0", "3", "3"]),
+    # `def` for `fish define`, keywords and names in any case
+    ("DEF twice(X)\n  TWICE = x * 2\nEND\n[io.out(twice(21))]", ["42"]),
     # a deck value from a FISH function and a global it sets
     ("fish define props\n dens = 2650\nend\n@props\nfish define grav\n grav = -9.81\nend\n"
      "model gravity 0 0 [grav]\n[io.out(string(dens))]", ["2650"]),
@@ -185,8 +187,6 @@ def test_legacy_fish_is_named(session):
 
 
 def test_keyboard_interrupt_leaves_the_runtime_consistent(session):
-    from dec3d.fish import request_stop
-
     session.command("fish define spin\n loop while 1\n  n = n + 1\n  if n = 5000 then\n   stop_me\n  endif\n endloop\nend")
     session.fish_rt.functions["stop_me"] = _StopNow(session.fish_rt)
     with pytest.raises(KeyboardInterrupt):

@@ -45,3 +45,23 @@ def test_zone_ids_out_of_row_order_still_find_their_zone(session):
     zs["volume"][:] = np.arange(1, zs.n + 1)      # the row number + 1, to see which row is read
     session.command("[v1 = block.zone.vol(1)]\n[vn = block.zone.vol(5)]")
     assert session.variables["v1"] == 5.0 and session.variables["vn"] == 1.0
+
+
+def test_zone_state_reads_the_plastic_state_of_a_yielding_specimen(tmp_path):
+    """The Mohr-Coulomb specimen pulled to its tension cut-off (tests/deformable/test_zone_mohr_cycle.py):
+    every zone is tension-now (bit 2) while pulled, and only tension-past (8) once unloaded; FISH reads the
+    same bits the zones store holds."""
+    from tests.deformable.test_zone_mohr_cycle import _session, _specimen
+
+    s = _session(tmp_path, _specimen(0.0, 2e-7, tension=5e5))
+    walk = ("[st = list.sequence(0)]\nfish define states\n loop foreach z block.zone.list\n"
+            "  st = list.append(st, block.zone.state(z))\n endloop\nend\n@states")
+    s.command("model cycle 3000\n" + walk)
+    zs = s.model.store("zones")
+    assert s.variables["st"] == [int(x) for x in zs["state"]]
+    assert all(x & 2 for x in s.variables["st"])
+    s.command("block gridpoint apply velocity-z -2e-7 range position-z 1\nmodel cycle 50\n" + walk)
+    assert s.variables["st"] == [8] * zs.n
+    with pytest.raises(ExpressionError) as e:
+        s.command("[q = block.zone.state(99)]")
+    assert "`block.zone.state`: there is no zone with id 99" in e.value.message
