@@ -274,6 +274,8 @@ class VtkSeries:
         self.stem = os.fspath(stem)
         self.entries: list[tuple] = []
         self.count = 0                  # snapshots written
+        #: also write the sub-contacts (``<stem>_contacts_<nnnn>.vtu``, the last part of each time)
+        self.contacts = False
         #: guard(file) -> file: checks each file before it is written (``Session.out_path``)
         self.guard = guard or (lambda f: f)
 
@@ -296,21 +298,28 @@ class VtkSeries:
         else:
             write_vtu(model, vtu)
             self.entries.append((float(time), vtu))
+        if self.contacts:
+            from dec3d.io.contactvtk import write_contacts_vtu
+            cvtu = self.guard(f"{self.stem}_contacts_{k:04d}.vtu")
+            write_contacts_vtu(model, cvtu)
+            self.entries.append((float(time), cvtu, 2 if mixed(model) else 1))
         self.count += 1
         write_pvd(self.guard(self.pvd_path), self.entries)
         return vtu
 
 
-def request_vtk(model, stem: str, interval: int = 0, guard=None) -> None:
+def request_vtk(model, stem: str, interval: int = 0, guard=None, contacts: bool = False) -> None:
     """Ask for snapshots of ``model`` into the series ``stem`` (``<stem>_<nnnn>.vtu`` and
     ``<stem>.pvd``): one now, and every ``interval`` steps afterwards when interval > 0.
     Requests for the same stem continue its series. ``guard(file)`` checks each file before
-    it is written (the session's output-folder rule)."""
+    it is written (the session's output-folder rule). ``contacts``: each snapshot also writes the
+    sub-contacts (``dec3d.io.contactvtk``)."""
     req = model.outputs.get("vtk")
     if req is None or req["series"].stem != stem:
         req = {"series": VtkSeries(stem, guard), "interval": 0, "last_step": None}
         model.outputs["vtk"] = req
     req["interval"] = int(interval)
+    req["series"].contacts = bool(contacts)
     req["series"].write(model, model.time)
     req["last_step"] = model.step
 
