@@ -22,7 +22,7 @@ a fresh process (``--child``); the median of ``--repeat`` runs is printed, with 
 ``--cmodel``: the constitutive models to time, one after the other for each thread count and size
 (back to back, so the ratio is read at one load). ``mohr-coulomb`` gives the same elastic
 constants and cohesion 10 kPa, friction 30°, dilation 0, tension 5 kPa. Both cubes (not the
-jointed one) start from the in-situ stress σxx = σyy = -10 kPa, σzz = -80 kPa, beyond that strength, so
+jointed one) start from the in-situ stress σxx = -10, σyy = -40, σzz = -80 kPa, beyond that strength, so
 every Mohr-Coulomb zone yields at the first step and the plastic return runs, not only the yield
 test: the worst case for the Mohr-Coulomb cycle (the count of zones that have yielded is printed).
 The Mohr-Coulomb rate is also printed as a ratio to the elastic one when both are asked for
@@ -60,10 +60,12 @@ def edge_length(zones: float) -> float:
     return (ZONE_DENSITY / zones) ** (1.0 / 3.0)
 
 
-#: Mohr-Coulomb strength: with the in-situ stress below (σ3 = -10 kPa, σ1 = -80 kPa; strength
-#: σ1 = σ3 Nφ + 2c √Nφ = 64.6 kPa) every zone starts beyond the yield surface and flows
+#: Mohr-Coulomb strength: with the in-situ stress below (σ3 = -10 kPa, σ2 = -40 kPa, σ1 = -80 kPa;
+#: strength σ1 = σ3 Nφ + 2c √Nφ = 64.6 kPa) every zone starts beyond the yield surface and flows.
+#: Three distinct principal stresses: the return is the single-plane (shear) one; with σ2 = σ3
+#: (a triaxial compression edge) every zone would take the slower two-plane edge return instead
 MOHR = "block zone property cohesion 1e4 friction 30 dilation 0 tension 5e3"
-INSITU = "block insitu stress -1e4 -1e4 -8e4 0 0 0"
+INSITU = "block insitu stress -1e4 -4e4 -8e4 0 0 0"
 #: Mohr-Coulomb zones far from yield (``--cmodel mohr-coulomb-strong``): the yield test only
 MOHR_STRONG = "block zone property cohesion 1e9 friction 30 dilation 0 tension 1e9"
 _STRENGTH = {"mohr-coulomb": MOHR, "mohr-coulomb-strong": MOHR_STRONG}
