@@ -84,3 +84,30 @@ def test_rigid_blocks_without_contacts_write_an_empty_file(tmp_path):
     _run(tmp_path, "model new\nblock create brick 0 1 0 1 0 1\nblock vtk 'lone' contacts\n")
     text = (tmp_path / "out" / "lone_contacts_0000.vtu").read_text()
     assert 'NumberOfPoints="0" NumberOfCells="0"' in text
+
+
+def test_mixed_model_lists_the_contacts_after_the_zones(tmp_path):
+    """A rigid block resting on a zoned one: the snapshot is the rigid blocks (part 0), the zones
+    (part 1) and the sub-contacts (part 2, the part after the others of the same time), and the
+    contact file holds the rigid/deformable contact's points, all on the interface z = 1."""
+    _run(tmp_path, """model new
+block create brick 0 1 0 1 0 1
+block create brick 0 1 0 1 1 2
+block zone generate edgelength 0.5 range position-z 0 1
+block zone cmodel assign elastic
+block zone property young 1e9 poisson 0.25 density 2000
+block property density 2000 range position-z 1 2
+block contact jmodel assign elastic
+block contact material-table default property stiffness-normal 1e10 stiffness-shear 1e10
+model gravity 0 0 -10
+block gridpoint apply velocity 0 0 0 range position-z 0
+model cycle 5
+block vtk 'mix' contacts
+""")
+    out = tmp_path / "out"
+    pvd = (out / "mix.pvd").read_text()
+    for part, name in enumerate(("mix_0000.vtu", "mix_zones_0000.vtu", "mix_contacts_0000.vtu")):
+        assert f'part="{part}" file="{name}"' in pvd
+    m = meshio.read(out / "mix_contacts_0000.vtu")
+    assert len(m.points) > 4
+    np.testing.assert_allclose(m.points[:, 2], 1.0, atol=1e-6)

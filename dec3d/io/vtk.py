@@ -288,6 +288,7 @@ class VtkSeries:
         if folder:
             os.makedirs(folder, exist_ok=True)
         k = self.count
+        first = len(self.entries)          # this snapshot's entries start here
         vtu = self.guard(f"{self.stem}_{k:04d}.vtu")
         if mixed(model):
             # meshio reads no file mixing polyhedra with other cells: the zones go beside, as part 1
@@ -299,10 +300,12 @@ class VtkSeries:
             write_vtu(model, vtu)
             self.entries.append((float(time), vtu))
         if self.contacts:
+            # the sub-contacts as points (``dec3d.io.contactvtk``): the part after the others of this time
             from dec3d.io.contactvtk import write_contacts_vtu
             cvtu = self.guard(f"{self.stem}_contacts_{k:04d}.vtu")
             write_contacts_vtu(model, cvtu)
-            self.entries.append((float(time), cvtu, 2 if mixed(model) else 1))
+            part = 1 + max((e[2] if len(e) > 2 else 0) for e in self.entries[first:])
+            self.entries.append((float(time), cvtu, part))
         self.count += 1
         write_pvd(self.guard(self.pvd_path), self.entries)
         return vtu
