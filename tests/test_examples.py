@@ -112,9 +112,10 @@ def test_tunnel_jointed_mc_yields_slips_and_converges_like_kirsch(jointed_tunnel
     """examples/deformable/tunnel_jointed_mc.dat, each excavation stage against the saved initial state:
     zones yield around the opening (newly yielded zones within 2 radii) and none beyond 5 radii;
     joints slip near the opening (sub-contacts within 2 radii slipping, with shear displacements five
-    times the initial ones); the crown moves down by 1 to 10 times the elastic Kirsch convergence
-    (plane strain, far field σh = 8 MPa across, σv = 12 MPa: u = a/(4G) [(σh + σv) − (σh − σv)(3 − 4ν)]
-    = 2.56 mm: the jointed, yielding rock converges more); everything is finite, and two runs write
+    times the initial ones, and those still slipping at the end all within 3 radii); the crown moves
+    down by 1 to 10 times the elastic Kirsch convergence (plane strain, far field σh = 8 MPa across,
+    σv = 12 MPa: u = a/(4G) [(σh + σv) − (σh − σv)(3 − 4ν)] = 2.56 mm: the jointed, yielding rock
+    converges more); everything is finite, and two runs write
     the same bytes."""
     import meshio
     import numpy as np
@@ -148,6 +149,10 @@ def test_tunnel_jointed_mc_yields_slips_and_converges_like_kirsch(jointed_tunnel
         r = np.hypot(c.points[:, 0], c.points[:, 2])
         slip = c.point_data["slip"] != 0
         assert (slip & (r < 2 * a)).sum() > 20, stage
+        # the joints still slipping at the end of the stage are those next to the opening (the
+        # "failed" bit, in `slip`, is also left on joints farther out by the excavation's transient)
+        now = (c.point_data["state"] & 2) != 0
+        assert now.sum() > 10 and r[now].max() < 3 * a, stage
         us = c.point_data["shear_displacement_magnitude"]
         assert us[r < 2 * a].max() > 5 * us0[r0 < 2 * a].max(), stage
         # the same gridpoints (points are not renumbered by the excavation: match by position)
