@@ -181,3 +181,25 @@ def test_quake_base_follows_the_velocity_record():
     expected = np.interp(r["dyn_time"] - r["dt"] / 2, t, v)
     assert abs(expected) > 1e-6
     assert r["base_vx"] == pytest.approx(expected, rel=1e-6)
+
+
+def test_zone_bench_mohr_coulomb_case_runs_beside_the_elastic_one():
+    """bench/zone_bench.py --cmodel elastic mohr-coulomb on a tiny cube: one row per model, the
+    Mohr-Coulomb cube has zones that yielded (its in-situ stress is beyond its strength), the elastic one none,
+    and the ratio line is the quotient of the two printed rates (to its rounding)."""
+    out = subprocess.run([sys.executable, str(ROOT / "bench" / "zone_bench.py"), "--zones", "1500",
+                          "--steps", "3", "--repeat", "1", "--threads", "1", "--cmodel", "elastic", "mohr-coulomb"],
+                         capture_output=True, text=True, timeout=300, cwd=ROOT,
+                         env={**os.environ, "PYTHONPATH": os.pathsep.join(
+                             [str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])})
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln.split()[:2] == ["threads", "zones"])
+    assert lines[head].split()[-2:] == ["cmodel", "yielded"]
+    el, mc = lines[head + 1].split(), lines[head + 2].split()
+    assert el[-2] == "elastic" and mc[-2] == "mohr-coulomb" and el[1] == mc[1]
+    assert int(el[-1]) == 0 and int(mc[-1]) > 0
+    ratio = lines[head + 3]
+    assert ratio.startswith("MC / elastic zone-cycles/s:") and "target >= 0.5" in ratio
+    got = float(ratio.split(":")[1].split()[0])
+    assert got == pytest.approx(float(mc[6]) / float(el[6]), abs=0.01 + 1e-3 * got)

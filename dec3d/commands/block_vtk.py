@@ -12,7 +12,8 @@ STEM = OutPath(stem=True)
          keywords=[P("filename", STEM, "same as the positional file name"),
                    P("interval", Num(integer=True, lo=0), "also write every this many steps (0: only now)",
                      default=0),
-                   P("off", FLAG, "stop writing snapshots every N steps", bare=True)],
+                   P("off", FLAG, "stop writing snapshots every N steps", bare=True),
+                   P("contacts", FLAG, "also write the sub-contacts to `<file>_contacts_<nnnn>.vtu`", bare=True)],
          doc="Write the blocks to `<file>_<nnnn>.vtu` and list the snapshots in `<file>.pvd` (ParaView).",
          details="Each block is a polyhedron cell with its faces (cells ordered by vertex count, then block; "
                  "find a block by `block_id`). Cell data: block_id, group:<slot> (group codes; field data "
@@ -32,8 +33,14 @@ STEM = OutPath(stem=True)
                  "blocks go to `<file>_fe_<nnnn>.vtu` (part 2): quadratic hexahedra (VTK 25) with point data "
                  "displacement, velocity and vertex_row, and cell data element_id, block_id, gauss, volume, "
                  "cmodel, stress (the element's volume-weighted mean of its Gauss-point stresses, XX YY ZZ XY "
-                 "YZ XZ) and stress_gauss_mean.",
+                 "YZ XZ) and stress_gauss_mean. With `contacts`, each "
+                 "snapshot also writes the sub-contacts (rigid and deformable contacts) as points to "
+                 "`<file>_contacts_<nnnn>.vtu`, the last part of the same time in the .pvd, with point data "
+                 "contact_id, block_a, block_b, kind, area, state (joint-law bits: 1 failed, 2 slipping now, 4 open), "
+                 "slip (1 where failed or slipping), normal, normal_force, normal_stress, shear_force, "
+                 "shear_force_magnitude, normal_displacement, shear_displacement and shear_displacement_magnitude.",
          examples=["block vtk", "block vtk 'jointed' interval 100", "block vtk filename 'out/blocks'",
+                   "block vtk 'stage1' contacts",
                    "block vtk off"])
 def block_vtk(session, call):
     a = call.args
@@ -46,4 +53,4 @@ def block_vtk(session, call):
     pvd = session.out_path(STEM.final(name), where)       # <stem>.pvd, checked; the stem is beside it
     # every snapshot file is checked too when it is written (a symlink may appear later)
     request_vtk(session.model, str(pvd.with_suffix("")), interval=a["interval"],
-                guard=lambda f: str(session.out_path(f, where)))
+                guard=lambda f: str(session.out_path(f, where)), contacts=bool(a["contacts"]))

@@ -266,7 +266,10 @@ def insitu_contact_forces(model, cmask, stress_at) -> tuple | None:
                  "contact or of its blocks) takes the force of the traction on its plane: normal force "
                  "−A n·σ·n (compression positive), shear force −A (σ·n − (n·σ·n) n) on the second block, A its "
                  "area, n the contact normal; its normal displacement is set so the joint law keeps that force. "
-                 "Contacts made later start from their own gap. Displacements are not changed.",
+                 "The contacts are detected first if the blocks changed since the last detection (as 3DEC "
+                 "keeps them current), and those following the material-table defaults take them, so the "
+                 "force is kept with the stiffness they will cycle with. Contacts made later "
+                 "start from their own gap. Displacements are not changed.",
          examples=["block insitu stress -30e6 -30e6 -15e6 0 0 0",
                    "block insitu stress -1e6 -1e6 -2e6 0 0 0 gradient-z 1e4 1e4 2e4 0 0 0 range group 'rock'"])
 def block_insitu(session, call):
@@ -287,6 +290,15 @@ def block_insitu(session, call):
     for i in range(6):
         updates += stress_updates(m, zrows, i, lambda x, i=i: stress_at(x)[..., i])
     contact = None
+    if m.blocks.n > 1:
+        # contacts as 3DEC keeps them (current whenever blocks exist), with the joint properties
+        # of the material table now: a contact made before `material-table default property …`
+        # still had the old stiffness, so the normal displacement set below would not have kept
+        # the force (it fell to zero at the first cycle, when the contact took the new kn)
+        from ..physics.rigid import engine
+        eng = engine(m)
+        eng.ensure_contacts()
+        eng.follow_defaults()
     if "contacts" in m.stores and m.store("contacts").n:
         try:
             cmask = session.range_mask(call, "contact")

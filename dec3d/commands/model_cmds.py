@@ -69,8 +69,13 @@ def model_configure(session, call):
                                               required=True)],
          doc="Switch large-strain mode (geometry updated and new contacts detected as blocks move).",
          details="Rigid blocks in dec3d always move in large strain: their vertices, contacts and sub-contacts "
-                 "are updated as they move whatever this setting says. It is kept in the model for deformable "
-                 "blocks (not implemented yet).",
+                 "are updated as they move whatever this setting says. For deformable (zoned) blocks and FE "
+                 "blocks it matters: with `on` the gridpoints move with their displacements, zone strain rates "
+                 "are taken on the current geometry, zone stresses turn with the material's spin, zone volumes "
+                 "are updated after each run, and contacts are detected again as blocks move; with `off` (the "
+                 "default) gridpoint positions stay where the zones were made (displacements are still "
+                 "accumulated) and, in a model of deformable blocks only, contacts are not detected again while "
+                 "cycling (nothing moves that could make one).",
          examples=["model large-strain on", "model large-strain off"])
 def model_large_strain(session, call):
     session.model.settings.large_strain = call.args["mode"]

@@ -275,6 +275,8 @@ class VtkSeries:
         self.stem = os.fspath(stem)
         self.entries: list[tuple] = []
         self.count = 0                  # snapshots written
+        #: also write the sub-contacts (``<stem>_contacts_<nnnn>.vtu``, the last part of each time)
+        self.contacts = False
         #: guard(file) -> file: checks each file before it is written (``Session.out_path``)
         self.guard = guard or (lambda f: f)
 
@@ -287,6 +289,7 @@ class VtkSeries:
         if folder:
             os.makedirs(folder, exist_ok=True)
         k = self.count
+        first = len(self.entries)          # this snapshot's entries start here
         vtu = self.guard(f"{self.stem}_{k:04d}.vtu")
         if mixed(model):
             # meshio reads no file mixing polyhedra with other cells: the zones go beside, as part 1
@@ -303,21 +306,30 @@ class VtkSeries:
             fvtu = self.guard(f"{self.stem}_fe_{k:04d}.vtu")
             write_feblocks_vtu(model, fvtu)
             self.entries.append((float(time), fvtu, 2))
+        if self.contacts:
+            # the sub-contacts as points (``dec3d.io.contactvtk``): the part after the others of this time
+            from dec3d.io.contactvtk import write_contacts_vtu
+            cvtu = self.guard(f"{self.stem}_contacts_{k:04d}.vtu")
+            write_contacts_vtu(model, cvtu)
+            part = 1 + max((e[2] if len(e) > 2 else 0) for e in self.entries[first:])
+            self.entries.append((float(time), cvtu, part))
         self.count += 1
         write_pvd(self.guard(self.pvd_path), self.entries)
         return vtu
 
 
-def request_vtk(model, stem: str, interval: int = 0, guard=None) -> None:
+def request_vtk(model, stem: str, interval: int = 0, guard=None, contacts: bool = False) -> None:
     """Ask for snapshots of ``model`` into the series ``stem`` (``<stem>_<nnnn>.vtu`` and
     ``<stem>.pvd``): one now, and every ``interval`` steps afterwards when interval > 0.
     Requests for the same stem continue its series. ``guard(file)`` checks each file before
-    it is written (the session's output-folder rule)."""
+    it is written (the session's output-folder rule). ``contacts``: each snapshot also writes the
+    sub-contacts (``dec3d.io.contactvtk``)."""
     req = model.outputs.get("vtk")
     if req is None or req["series"].stem != stem:
         req = {"series": VtkSeries(stem, guard), "interval": 0, "last_step": None}
         model.outputs["vtk"] = req
     req["interval"] = int(interval)
+    req["series"].contacts = bool(contacts)
     req["series"].write(model, model.time)
     req["last_step"] = model.step
 
