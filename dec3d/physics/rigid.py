@@ -27,14 +27,16 @@ from dec3d.kernels.cycle import run_steps
 from dec3d.kernels.gpcontact import (mixed_move_points, mixed_subcontact_forces, surface_weights,
                                     take_contact_forces, vertex_sides)
 from dec3d.kernels.joints import P_KN, P_KS
-from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, DAMP_RAYLEIGH, NSERVO, S_HIST,
-                                  block_timestep, rigid_motion_groups)
+from dec3d.kernels.bundles import (NSERVO, Bodies, Bounds, Contacts, Groups, SubContacts, load_servo, new_damping,
+                                   new_servo, servo_values)
+from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, DAMP_RAYLEIGH, block_timestep,
+                                  rigid_motion_groups)
 from dec3d.model.model import KIND_DEFORMABLE, KIND_FE
 from dec3d.model.store import Store
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.zones import has_zones
 
-from .bodies import group_properties, inertial_masses, new_servo
+from .bodies import group_properties, inertial_masses
 from . import contacts as _contacts
 from .contacts import ContactDetection, contact_stores, default_row
 from .energy import is_active as is_energy_active
@@ -612,8 +614,7 @@ class RigidEngine(ContactDetection):
         zst.set_contact_stiffness(rows[on], kw[on])
         return out[0], out[1]
 
-    def _mixed_steps(self, k, zst, wsub, wcon, dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass,
-                     gisc, gprin, gaxes, gcen, fixity, large, vmax, out) -> None:
+    def _mixed_steps(self, k, zst, wsub, wcon, dt, g, full, damping, groups, bodies, large, vmax, out) -> None:
         """``k`` steps of a model where zoned and rigid blocks touch (3DEC theory, "Deformable
         blocks": a sub-contact on a deformable block moves with the gridpoints of the surface it
         lies on, its force goes to them by the interpolation factors): sub-contact forces
@@ -627,6 +628,7 @@ class RigidEngine(ContactDetection):
         touched = np.unique(np.concatenate((wsub[0].ravel(), wsub[2].ravel())))
         touched = np.ascontiguousarray(touched[touched >= 0])
         cown = np.arange(cs.n, dtype=_I)
+        gstart, gmember = groups.start, groups.member
         for _ in range(k):
             facc = zst.begin()
             mixed_subcontact_forces(dt, b["centroid"], b["velocity"], b["spin"], b["force"], b["moment"], gvel, gc,
@@ -635,13 +637,10 @@ class RigidEngine(ContactDetection):
                                     *wsub)
             take_contact_forces(touched, gc, facc, zst.fmag)
             if len(gmember):
-                gbad = rigid_motion_groups(dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass, gisc,
-                                           gprin, gaxes, gcen, b["mass"], fixity, b["force"], b["moment"], b["fapp"],
-                                           b["mapp"], b["velocity"], b["spin"], b["centroid"], b["disp"],
-                                           b["vert_start"], b["vert_count"], v["pos"], vmax, out)
+                gbad = rigid_motion_groups(dt, g, full, damping, groups, bodies, vmax, out)
                 if gbad >= 0 or not math.isfinite(out[0]):
                     raise self._blowup(int(gmember[gstart[gbad]]) if gbad >= 0 else int(gmember[0]), dt, False)
-            zbad = zst.step(dt, g, mode, alpha, large, vmax, begun=True)
+            zbad = zst.step(dt, g, damping.mode, damping.alpha, large, vmax, begun=True)
             if zbad >= 0:
                 raise zst.unstable(zbad, dt)
             mixed_move_points(dt, cs["a"], cs["b"], cown, cs["pos"], b["centroid"], b["velocity"], b["spin"], gvel,
@@ -712,10 +711,12 @@ class _Run:
          self.giscalar) = group_properties(gstart, gmember, b["mass"], b["centroid"], inertia, b["inertia_approx"],
                                            b["principal_moment"], b["principal_axes"])
         self.axes0 = self.gaxes.copy()
-        servo = self.servo = new_servo(self.ng, ratio=float(s["servo_ratio"]))
+        servo = new_servo(ratio=float(s["servo_ratio"]))
         if self.mode == DAMP_ADAPTIVE and len(s["servo"]) == NSERVO:
-            servo[:NSERVO] = s["servo"]
-        servo[S_HIST] = 0.0
+            load_servo(servo, s["servo"])
+        servo.hist[0] = 0.0             # (no previous forces of these groups yet)
+        #: the damping state of the run (``kernels.bundles.Damping``: mode, α, servo, previous forces)
+        self.damping = new_damping(self.mode, self.alpha, self.ng, servo)
         self.fixity = (b["fixity"] | b["apply_fix"]).astype(np.uint8)
         self.dt_fixed = float(s["timestep"]) if s["timestep"] else None
         self.gimass = self.gisc = None
@@ -782,6 +783,17 @@ class _Run:
         self.trigger = 0.5 * eng.tolerance()
         self.due = False
         self.loaded = (self.large and "fstress" in m.faces and bool(np.any(m.faces["fstress"] != 0.0)))
+
+    def groups(self) -> Groups:
+        """The rigid groups of the run as the motion kernel takes them (their inertial masses
+        change with Δt, so the bundle is made again per kernel call)."""
+        return Groups(self.gstart, self.gmember, self.gmass, self.gimass, self.gisc, self.gprin, self.gaxes, self.gcen)
+
+    def bodies(self) -> Bodies:
+        """The block store's motion fields and the vertex positions, as the kernels take them."""
+        b = self.b
+        return Bodies(b["mass"], self.fixity, b["force"], b["moment"], b["fapp"], b["mapp"], b["velocity"], b["spin"],
+                      b["centroid"], b["disp"], b["vert_start"], b["vert_count"], self.m.vertices["pos"])
 
     def masses(self, dt):
         """Inertial masses of the rigid groups for Δt ``dt`` (None: Δt from the stiffnesses); returns Δt."""
@@ -882,7 +894,7 @@ class _Run:
             b["inertia"][gmember] = np.einsum("bij,bj,bkj->bik", pa[gmember], b["principal_moment"][gmember],
                                               pa[gmember])
         if self.mode == DAMP_ADAPTIVE:
-            s["servo"] = [float(x) for x in self.servo[:NSERVO]]
+            s["servo"] = servo_values(self.damping.servo)
 
 
 class _Step:
@@ -915,9 +927,8 @@ class MixedContacts(_Step):
     def advance(self, n: int) -> int:
         r = self.run
         if r.mixed:
-            r.eng._mixed_steps(n, r.zst, r.wsub, r.wcon, r.dt, r.g, r.mode, r.alpha, r.servo, r.full, r.gstart,
-                               r.gmember, r.gmass, r.gimass, r.gisc, r.gprin, r.gaxes, r.gcen, r.fixity, r.large,
-                               r.vmax, r.out)
+            r.eng._mixed_steps(n, r.zst, r.wsub, r.wcon, r.dt, r.g, r.full, r.damping, r.groups(), r.bodies(),
+                               r.large, r.vmax, r.out)
         return n
 
 
@@ -935,20 +946,19 @@ class RigidBatch(_Step):
         r = self.run
         if r.mixed or not r.ng:
             return k
-        eng, m, b = r.eng, r.m, r.b
+        eng, m = r.eng, r.m
         cs, ss = eng.contacts, eng.subcontacts
+        contacts = Contacts(cs["a"], cs["b"], cs["normal"], cs["pos"], np.arange(cs.n, dtype=_I), cs["jmodel"],
+                            cs["prop"])
+        subs = SubContacts(*(ss[k] for k in SubContacts._fields))
+        bounds = Bounds(r.radius, r.acc, r.trigger, r.motion)
         n_ok = 0
         bad = -1
         while n_ok < k:
             kk = min(k - n_ok, self.chunk) if self.chunked else k
             t0 = _time.perf_counter()
-            c_ok, bad = run_steps(kk, r.dt, r.g, r.mode, r.alpha, r.servo, r.full, r.gstart, r.gmember, r.gmass,
-                                  r.gimass, r.gisc, r.gprin, r.gaxes, r.gcen, b["mass"], r.fixity, b["force"],
-                                  b["moment"], b["fapp"], b["mapp"], b["velocity"], b["spin"], b["centroid"],
-                                  b["disp"], b["vert_start"], b["vert_count"], m.vertices["pos"], cs["a"], cs["b"],
-                                  cs["normal"], cs["pos"], np.arange(cs.n, dtype=_I), cs["jmodel"], cs["prop"],
-                                  ss["contact"], ss["pos"], ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"],
-                                  ss["us"], ss["state"], r.vmax, r.out, r.radius, r.acc, r.trigger, r.motion, r.beta)
+            c_ok, bad = run_steps(kk, r.dt, r.g, r.full, r.damping, r.groups(), r.bodies(), contacts, subs, bounds,
+                                  r.vmax, r.out, r.beta)
             spent = _time.perf_counter() - t0
             n_ok += c_ok
             if bad >= 0 or r.motion[1] > 0.0 or c_ok < kk or not self.chunked:
