@@ -143,8 +143,9 @@ def test_the_layer_check_catches_upward_imports(tmp_path):
         "dec3d/ssdem/s.py:1: dec3d.ssdem imports dec3d.physics.rigid"]
 
 
-#: the one kernel module that also lists its folder: the joint-law plug-ins (kernels/joints)
-FINDS_PLUGINS = {"joints/__init__.py": {"importlib", "pkgutil"}}
+#: the kernel modules with one more standard-library import: the one that lists its folder (the
+#: joint-law plug-ins, kernels/joints) and the named bundles of arrays (namedtuple)
+FINDS_PLUGINS = {"joints/__init__.py": {"importlib", "pkgutil"}, "bundles.py": {"collections"}}
 
 
 def test_kernels_import_only_numpy_numba_math_config():
@@ -156,7 +157,7 @@ def test_kernels_import_only_numpy_numba_math_config():
                 for a in node.names:
                     assert a.name.split(".")[0] in {"numpy", "numba", "math"} | extra, f"{f}: {a.name}"
             elif isinstance(node, ast.ImportFrom) and not node.level:
-                assert (node.module or "").split(".")[0] in {"numpy", "numba", "math", "__future__"} \
+                assert (node.module or "").split(".")[0] in {"numpy", "numba", "math", "__future__"} | extra \
                     or node.module == "dec3d.config" or node.module.startswith("dec3d.kernels"), f"{f}: from {node.module}"
     # relative imports of kernels are held to dec3d.kernels and dec3d.config by test_imports_follow_the_layers
 

@@ -121,3 +121,41 @@ def test_kernel_twins_pass_as_plain_python():
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-2000:]
     ran = sum(line.split("[")[0].count(".") for line in out.stdout.splitlines() if line.rstrip().endswith("%]"))
     assert ran >= 100, out.stdout[-3000:]
+
+
+_BUNDLE_CALL = """
+import numpy as np
+from dec3d.kernels.bundles import Bodies, Groups, new_damping
+from dec3d.kernels.motion import rigid_motion_groups as k
+z = lambda: np.zeros((1, 3))
+verts = np.array([[i, j, l] for l in (0.0, 1.0) for j in (0.0, 1.0) for i in (0.0, 1.0)])
+groups = Groups(np.array([0, 1]), np.array([0]), np.ones(1), np.ones(1), np.ones(1), np.ones((1, 3)),
+                np.eye(3)[None].copy(), np.full((1, 3), 0.5))
+bodies = Bodies(np.ones(1), np.zeros(1, np.uint8), z(), z(), z(), z(), np.array([[0.0, 0.0, -1.0]]), z(),
+                np.full((1, 3), 0.5), z(),
+                np.array([0]), np.array([8]), verts)
+out = np.zeros(4)
+k(0.1, np.array([0.0, 0.0, -10.0]), False, new_damping(2, 0.8, 1), groups, bodies, 1e6, out)
+print(bodies.vel[0, 2], sum(k.stats.cache_hits.values()), sum(k.stats.cache_misses.values()))
+"""
+
+
+def test_a_kernel_taking_bundles_is_loaded_from_the_cache_in_the_next_process(tmp_path):
+    """Kernels take namedtuples of arrays (``kernels.bundles``): numba's cache must still hit for
+    them, or every run would compile again. Two processes on one empty cache folder: the first
+    compiles (a miss), the second loads (a hit) and gets the same step (a lone 1 kg block moving
+    down at 1 m/s under g = −10 m/s², Δt 0.1 s, combined damping with no force history: half the
+    local damping force, v = −1 − 10 (1 − 0.8/2) · 0.1 = −1.6 m/s)."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+    env.update(PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+
+    def run():
+        out = subprocess.run([sys.executable, "-c", _BUNDLE_CALL], capture_output=True, text=True, env=env,
+                             cwd=tmp_path, timeout=600)
+        assert out.returncode == 0, out.stderr[-3000:]
+        v, hits, misses = out.stdout.split()
+        return float(v), int(hits), int(misses)
+
+    v, hits, misses = run()
+    assert v == pytest.approx(-1.6, rel=1e-12) and (hits, misses) == (0, 1)
+    assert run() == (v, 1, 0)

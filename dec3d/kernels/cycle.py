@@ -62,20 +62,17 @@ def _move_points(dt, ca, cb, owner, pts, centroid, vel, spin):
 
 
 @njit(cache=True)
-def _run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
-              gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
-              mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
-              ca, cb, cn, cc, cown, cmodel, cprop,
-              sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
-              vmax, out, radius, acc, trigger, motion, beta):
-    """Take up to ``nsteps`` steps of Δt = dt [s]; arrays as in ``subcontact_forces`` and
-    ``rigid_motion_groups`` (cc (nc, 3) contact reference points, cown (nc,) = arange(nc)).
+def _run_steps(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies, contacts, subs, bounds, vmax, out):
+    """Take up to ``nsteps`` steps of Δt = dt [s]. Bundles (``kernels.bundles``): damping, groups,
+    bodies as ``rigid_motion_groups`` takes them; contacts (``Contacts``: pos (nc, 3) the contact
+    reference points, own (nc,) = arange(nc)) and subs (``SubContacts``) as
+    ``jointlaw.subcontact_update`` reads them; bounds (``Bounds``) the detection trigger.
 
     out (4,): as ``rigid_motion_groups`` fills it, for the last step.
-    Motion bound for contact detection: each block's step motion |v| Δt + |ω| Δt r (radius
-    (nb,) m: largest centroid-to-vertex distance) is added to acc (nb,) [m]; the batch ends
-    after the step in which some acc exceeds ``trigger`` [m] (the host then detects again).
-    motion (2,): [0] the largest step motion of any block [m] (kept across calls: max),
+    Motion bound for contact detection: each block's step motion |v| Δt + |ω| Δt r (bounds.radius
+    (nb,) m: largest centroid-to-vertex distance) is added to bounds.acc (nb,) [m]; the batch ends
+    after the step in which some acc exceeds ``bounds.trigger`` [m] (the host then detects again).
+    bounds.motion (2,): [0] the largest step motion of any block [m] (kept across calls: max),
     [1] 1.0 if the batch ended on the trigger, 2.0 if a block moved farther than its radius
     in one step (then returned as unstable: it can pass through other blocks unseen).
     beta [s]: the stiffness-proportional term of Rayleigh damping on the sub-contacts (0: none;
@@ -83,6 +80,11 @@ def _run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
     Returns (steps done, first unstable block row or −1). An unstable step is not finished:
     the caller reports it and the arrays hold the state at that step.
     """
+    gstart, gmember = groups.start, groups.member
+    centroid, vel, spin, force, moment = bodies.centroid, bodies.vel, bodies.spin, bodies.force, bodies.moment
+    ca, cb, cn, cc, cown, cmodel, cprop = contacts
+    sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state = subs
+    radius, acc, trigger, motion = bounds
     done = 0
     bad = -1
     motion[1] = 0.0
@@ -96,10 +98,7 @@ def _run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
             contact_stiffness_damping(beta, centroid, vel, spin, ca, cb, cn, cprop, sc_contact, sc_pos, sc_area,
                                       sc_fn, sc_state, sg)
         block_sums(centroid, force, moment, sc_pos, sg, bstart, bent)
-        g = rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
-                                gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
-                                mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp,
-                                vstart, vcount, vpos, vmax, out)
+        g = rigid_motion_groups(dt, gravity, full_inertia, damping, groups, bodies, vmax, out)
         done += 1
         if g >= 0 or not math.isfinite(out[0]):
             bad = gmember[gstart[g]] if g >= 0 else (gmember[0] if gmember.shape[0] else 0)
@@ -127,22 +126,14 @@ def _run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
     return done, bad
 
 
-def run_steps(nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
-              gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
-              mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
-              ca, cb, cn, cc, cown, cmodel, cprop,
-              sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
-              vmax, out, radius, acc, trigger, motion, beta=0.0):
+def run_steps(nsteps, dt, gravity, full_inertia, damping, groups, bodies, contacts, subs, bounds, vmax, out,
+              beta=0.0):
     """``_run_steps`` (the kernel, documented there); a small model (``SERIAL_BELOW``), or any
     model on one thread, runs its serial twin ``_run_steps_1`` (the same numbers: every sum has a
     fixed order)."""
-    args = (nsteps, dt, gravity, damp_mode, alpha, servo, full_inertia,
-            gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
-            mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos,
-            ca, cb, cn, cc, cown, cmodel, cprop,
-            sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
-            vmax, out, radius, acc, trigger, motion, float(beta))
-    if sc_contact.shape[0] + 4 * gmember.shape[0] >= SERIAL_BELOW and get_num_threads() > 1:
+    args = (nsteps, dt, gravity, bool(full_inertia), float(beta), damping, groups, bodies, contacts, subs,
+            bounds, vmax, out)
+    if subs.contact.shape[0] + 4 * groups.member.shape[0] >= SERIAL_BELOW and get_num_threads() > 1:
         return _run_steps(*args)
     return _run_steps_1(*args)
 

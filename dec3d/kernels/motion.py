@@ -8,9 +8,7 @@ Motion", "Mechanical Damping", "Numerical Stability", "Mass (Density) Scaling") 
 combined damping is made of contributions from "changes in the sign of the velocity" and "changes
 in the sign of the total force", with the local damping coefficient).
 
-``rigid_motion`` (one block per row; the engine's kernel today)
----------------------------------------------------------------
-Central differences on velocities at half steps. For each moving block (a leader row):
+Central differences on velocities at half steps (one rigid body):
 
   F_u = F + F_applied + m g                       unbalanced force [N]
   local damping (Eq. 79 applied to rigid blocks): F_d,i = α_l |F_u,i| sgn(ẋ_i)
@@ -43,7 +41,7 @@ The group velocity V at C is recovered from the leader (first member): V = v_lea
 
 Translation: Eq. 49 with the group's inertial mass.
 Rotation, ``full_inertia`` False: Eq. 46/49 with the scalar inertia ``giscalar`` (quasi-static,
-as ``rigid_motion``; the gyroscopic term of Eq. 45 is dropped, so a torque-free body keeps ω).
+as above; the gyroscopic term of Eq. 45 is dropped, so a torque-free body keeps ω).
 Rotation, ``full_inertia`` True (Euler's equations, Eq. 45, for dynamic runs), written as
 dL/dt = M for the world angular momentum L = J ω, J = R diag(I₁, I₂, I₃) Rᵀ, R = ``gaxes``:
   * L lives at half steps like ω. It is not stored: at the start of a step it is rebuilt from the
@@ -64,39 +62,30 @@ Damping (``damp_mode``), with α = ``alpha`` for modes 1 and 2:
          F_d,i = α |F_u,i| [sgn(ẋ_i) − sgn(Ḟ_u,i)] / 2        (subtracted from F_u as in Eq. 78)
      Eq. 83 is written for a damping force *added* to F: α|F|(sgn(Ḟ) − sgn(u̇))/2; this is the
      same force with the sign of Eq. 78. Ḟ_u,i is taken as F_u,i(t) − F_u,i(t−Δt) from the
-     previous unbalanced force stored in ``servo`` (see below); on the first step (no history)
+     previous unbalanced force stored in ``damping.prev`` (see below); on the first step (no history)
      sgn(Ḟ) = 0, i.e. half the local damping. Same for the moment with ω.
   4  Rayleigh, mass-proportional term: viscous damping with the fixed coefficient α_v = ``alpha``
      [1/s] in D₁, D₂ of Eq. 49 (translation and rotation); the stiffness-proportional term acts on
      the contacts (``kernels.rayleigh``). See ``dec3d.physics.dynamic``.
   3  adaptive global (Cundall 1982; 3DEC theory Eq. 77, "damping auto"): viscous, mass
      proportional damping α_v (D₁, D₂ of Eq. 49) on translation and rotation, with α_v adjusted by a
-     servo so that R = Σ P / Σ |Ė_k| tends to ``servo[S_RATIO]`` (0.5). P = α_v (m_i v² + ω·L)
+     servo so that R = Σ P / Σ |Ė_k| tends to ``servo.ratio`` (0.5). P = α_v (m_i v² + ω·L)
      is the damping power of a group (evaluated as α_v (E_k(t−Δt/2) + E_k(t+Δt/2)), i.e. 2α_v E_k
      at mid step) and |Ė_k| the magnitude of the change of the group's (inertial) kinetic energy
      over the step. Eq. 77 sums the signed rates; their sum over a cycle of a freely decaying
      system is −Σ P, so R = −1 whatever α_v: the magnitude is the reading that makes the servo
      meaningful (for one oscillator of circular frequency w, R = π α_v / (2w), so R = 0.5 gives
-     α_v = w/π, about 16 % of critical). Every ``servo[S_WINDOW]`` steps the accumulated works
-     are compared: α_v ← α_v·f if R < ratio, α_v ← α_v/f if R > ratio (f = ``servo[S_FACTOR]``),
+     α_v = w/π, about 16 % of critical). Every ``servo.window`` steps the accumulated works
+     are compared: α_v ← α_v·f if R < ratio, α_v ← α_v/f if R > ratio (f = ``servo.factor``),
      bounded to [1e-4/Δt, 1/Δt] (1/Δt keeps D₁ ≥ 1/2; the floor
      keeps the servo able to recover within ~70 windows when a settled model is loaded again). A servo that starts at 0 starts at
      0.02/Δt. The update rule (a multiplicative bang-bang servo) is this code's own: the texts
      give only the target ratio.
 
-``servo`` layout (float64, persists across calls; ``dec3d.physics.bodies.new_servo`` makes one):
-  [0] S_ALPHA   current adaptive viscous coefficient α_v [1/s]
-  [1] S_WORK    damping work Σ P Δt accumulated over the current window [J]
-  [2] S_DEK     Σ |ΔE_k| accumulated over the current window [J]
-  [3] S_NWIN    steps in the current window
-  [4] S_RATIO   target ratio R (0.5)
-  [5] S_WINDOW  window length [steps] (10)
-  [6] S_FACTOR  servo factor f (1.1)
-  [7] S_LASTR   last measured R (diagnostic)
-  [8] S_HIST    1 when the tail holds the previous unbalanced forces of these same groups
-  [9] S_CALLS   number of calls
-  [NSERVO + 6 g : NSERVO + 6 g + 6]  previous F_u (3) and M_u (3) of group g, for combined
-      damping only (modes 0, 1, 3 need only NSERVO entries). Set S_HIST to 0 when the groups change.
+The damping state is the ``Damping`` bundle (``kernels.bundles``, fields named there): the
+adaptive servo (``Servo``: α_v, the window's works, target ratio, window, factor, …; persists
+across runs) and ``prev`` (ng, 6), each group's previous F_u (3) and M_u (3) for combined damping,
+valid while ``servo.hist`` is 1 (set it to 0 when the groups change).
 
 ``out`` (4,): [0] max |F_u| over groups (fixed components left out) [N]; [1] Σ over members of
 |m g_i| + |F_i| (contact force) [N]; [2] kinetic energy with the real masses and inertia
@@ -133,91 +122,6 @@ def _sgn(x):
 
 
 @njit(cache=True)
-def rigid_motion(dt, gravity, alpha_local, alpha_visc, rows, mass, imass, iinert, fixity,
-                 force, moment, fapp, mapp, vel, spin, centroid, disp,
-                 vstart, vcount, vpos, vmax):
-    """Advance blocks ``rows`` (int64 (k,)) by one step Δt [s].
-
-    gravity (3,) m/s²; mass (nb,) kg gravitational; imass (nb,) kg inertial; iinert (nb,) kg·m²
-    scalar inertia; fixity (nb,) uint8; force/moment/fapp/mapp/vel/spin/centroid/disp (nb, 3);
-    vstart/vcount (nb,) vertex ranges; vpos (nv, 3) vertex positions, all updated in place.
-    vmax: a speed [m/s] above which the run is declared unstable.
-    Returns (bad row or −1, max |unbalanced force| [N], sum of |m g| + |F| over the rows [N]).
-    """
-    d1 = 1.0 - alpha_visc * dt * 0.5
-    d2 = 1.0 / (1.0 + alpha_visc * dt * 0.5)
-    fmax = 0.0
-    fsum = 0.0
-    bad = -1
-    for k in range(rows.shape[0]):
-        b = rows[k]
-        fx = fixity[b]
-        dx0 = 0.0
-        dx1 = 0.0
-        dx2 = 0.0
-        un2 = 0.0
-        for i in range(3):
-            fu = force[b, i] + fapp[b, i] + mass[b] * gravity[i]
-            if (fx >> i) & 1:
-                fu = 0.0
-            else:
-                v = vel[b, i]
-                fd = alpha_local * abs(fu) * _sgn(v)
-                vel[b, i] = (d1 * v + (fu - fd) / imass[b] * dt) * d2
-            un2 += fu * fu
-            fsum += abs(mass[b] * gravity[i]) + abs(force[b, i])
-        un = math.sqrt(un2)
-        if un > fmax:
-            fmax = un
-        for i in range(3):
-            if not (fx >> (3 + i)) & 1:
-                mu = moment[b, i] + mapp[b, i]
-                w = spin[b, i]
-                md = alpha_local * abs(mu) * _sgn(w)
-                spin[b, i] = (d1 * w + (mu - md) / iinert[b] * dt) * d2
-        dx0 = vel[b, 0] * dt
-        dx1 = vel[b, 1] * dt
-        dx2 = vel[b, 2] * dt
-        a0 = 0.5 * spin[b, 0] * dt
-        a1 = 0.5 * spin[b, 1] * dt
-        a2 = 0.5 * spin[b, 2] * dt
-        sp = abs(vel[b, 0]) + abs(vel[b, 1]) + abs(vel[b, 2])
-        if not (sp < vmax) or not math.isfinite(spin[b, 0] + spin[b, 1] + spin[b, 2]):
-            if bad < 0:
-                bad = b
-            continue
-        h = 2.0 / (1.0 + a0 * a0 + a1 * a1 + a2 * a2)
-        c0 = centroid[b, 0]
-        c1 = centroid[b, 1]
-        c2 = centroid[b, 2]
-        for v in range(vstart[b], vstart[b] + vcount[b]):
-            r0 = vpos[v, 0] - c0
-            r1 = vpos[v, 1] - c1
-            r2 = vpos[v, 2] - c2
-            t0 = a1 * r2 - a2 * r1
-            t1 = a2 * r0 - a0 * r2
-            t2 = a0 * r1 - a1 * r0
-            s0 = r0 + t0
-            s1 = r1 + t1
-            s2 = r2 + t2
-            vpos[v, 0] = c0 + dx0 + r0 + h * (a1 * s2 - a2 * s1)
-            vpos[v, 1] = c1 + dx1 + r1 + h * (a2 * s0 - a0 * s2)
-            vpos[v, 2] = c2 + dx2 + r2 + h * (a0 * s1 - a1 * s0)
-        centroid[b, 0] = c0 + dx0
-        centroid[b, 1] = c1 + dx1
-        centroid[b, 2] = c2 + dx2
-        disp[b, 0] += dx0
-        disp[b, 1] += dx1
-        disp[b, 2] += dx2
-    for k in range(rows.shape[0]):
-        b = rows[k]
-        for i in range(3):
-            force[b, i] = 0.0
-            moment[b, i] = 0.0
-    return bad, fmax, fsum
-
-
-@njit(cache=True)
 def block_timestep(mass_min, k_max, frac):
     """Eq. (87): Δt_b = frac · 2 · sqrt(M_min / K_max) [s]; M_min kg, K_max N/m."""
     if k_max <= 0.0:
@@ -229,9 +133,6 @@ def block_timestep(mass_min, k_max, frac):
 # groups of joined blocks, full inertia, damping modes
 # ----------------------------------------------------------------------------------------------
 
-S_ALPHA, S_WORK, S_DEK, S_NWIN, S_RATIO, S_WINDOW, S_FACTOR, S_LASTR, S_HIST, S_CALLS = range(10)
-#: number of global entries at the head of the servo array
-NSERVO = 10
 #: damp_mode codes (4: Rayleigh, its mass-proportional term: viscous α_v = ``alpha``, fixed)
 DAMP_NONE, DAMP_LOCAL, DAMP_COMBINED, DAMP_ADAPTIVE, DAMP_RAYLEIGH = 0, 1, 2, 3, 4
 
@@ -278,41 +179,39 @@ def _jmul(ax, p0, p1, p2, x0, x1, x2):
 
 
 @njit(cache=True, parallel=True)
-def rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
-                        gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid,
-                        mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp,
-                        vstart, vcount, vpos, vmax, out):
+def rigid_motion_groups(dt, gravity, full_inertia, damping, groups, bodies, vmax, out):
     """Advance every group of joined blocks by one step Δt [s] (see the module docstring).
 
-    gravity (3,) m/s²; damp_mode 0 none / 1 local / 2 combined / 3 adaptive global; alpha the
-    local coefficient of modes 1-2; servo float64 state (layout in the module docstring);
-    full_inertia bool. gstart (ng+1,) int64, gmember int64 block rows (first = leader);
-    gmass (ng,) kg real, gimass (ng,) kg inertial, giscalar (ng,) kg·m² scalar (scaled) inertia,
-    gprin (ng, 3) kg·m² unscaled principal moments, gaxes (ng, 3, 3) principal axes as columns and
-    gcentroid (ng, 3) m, both updated. Per block: mass (nb,) kg, fixity (nb,) uint8, force, moment,
-    fapp, mapp, vel, spin, centroid, disp (nb, 3); vstart/vcount (nb,) vertex ranges into vpos
-    (nv, 3). vmax [m/s] the speed of a blow-up. out (4,) float64 filled as documented.
+    gravity (3,) m/s²; full_inertia bool (Euler's equations); damping a ``bundles.Damping``
+    (mode 0 none / 1 local / 2 combined / 3 adaptive global / 4 Rayleigh; alpha the local
+    coefficient of modes 1-2 or Rayleigh's mass term; the servo and ``prev`` updated);
+    groups a ``bundles.Groups`` (axes and centroid updated); bodies a ``bundles.Bodies`` (every
+    motion field and the vertices updated). vmax [m/s] the speed of a blow-up. out (4,) float64
+    filled as documented.
     Returns the first unstable group index or −1.
     """
+    damp_mode, alpha, servo, prev = damping
+    gstart, gmember, gmass, gimass, giscalar, gprin, gaxes, gcentroid = groups
+    mass, fixity, force, moment, fapp, mapp, vel, spin, centroid, disp, vstart, vcount, vpos = bodies
     ng = gstart.shape[0] - 1
     hist = False
     if damp_mode == 2:
-        if servo.shape[0] < NSERVO + 6 * ng:
-            raise ValueError("combined damping needs a servo array of NSERVO + 6*ng entries")
-        hist = servo[S_HIST] != 0.0
+        if prev.shape[0] < ng:
+            raise ValueError("combined damping needs the previous forces of every group (Damping.prev (ng, 6))")
+        hist = servo.hist[0] != 0.0
     av = 0.0
     if damp_mode == 3:
-        av = servo[S_ALPHA]
+        av = servo.alpha[0]
         if not av > 0.0:
             av = 0.02 / dt
         av = min(max(av, 1e-4 / dt), 1.0 / dt)
-        servo[S_ALPHA] = av
+        servo.alpha[0] = av
     elif damp_mode == 4:
         av = alpha          # Rayleigh damping's mass-proportional term (dec3d.physics.dynamic)
     al = alpha if (damp_mode == 1 or damp_mode == 2) else 0.0
     d1 = 1.0 - av * dt * 0.5
     d2 = 1.0 / (1.0 + av * dt * 0.5)
-    # every group in parallel (each writes only its own rows: its members, its servo tail,
+    # every group in parallel (each writes only its own rows: its members, its ``prev`` row,
     # gaxes[g], gcentroid[g], and its terms below), then the sums in group order: the same
     # numbers whatever the thread count, and those of one serial loop over the groups
     fterm = np.zeros((gmember.shape[0], 3))
@@ -368,7 +267,6 @@ def rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
             mi = gimass[g]
             ek0 = 0.5 * mi * (v0 * v0 + v1 * v1 + v2 * v2)
             # translation (Eq. 49)
-            base = NSERVO + 6 * g
             un2 = 0.0
             nv0 = v0
             nv1 = v1
@@ -378,8 +276,8 @@ def rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
                 v = v0 if i == 0 else (v1 if i == 1 else v2)
                 fp = 0.0
                 if damp_mode == 2:
-                    fp = servo[base + i]
-                    servo[base + i] = fu
+                    fp = prev[g, i]
+                    prev[g, i] = fu
                 if (fx >> i) & 1:
                     fu = 0.0
                 else:
@@ -406,8 +304,8 @@ def rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
                     w = w0 if i == 0 else (w1 if i == 1 else w2)
                     mp = 0.0
                     if damp_mode == 2:
-                        mp = servo[base + 3 + i]
-                        servo[base + 3 + i] = mu
+                        mp = prev[g, 3 + i]
+                        prev[g, 3 + i] = mu
                     if not (fx >> (3 + i)) & 1:
                         md = _ldamp(damp_mode, al, mu, w, mp, hist)
                         nw = (d1 * w + (mu - md) / isc * dt) * d2
@@ -434,8 +332,8 @@ def rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
                     w = w0 if i == 0 else (w1 if i == 1 else w2)
                     mp = 0.0
                     if damp_mode == 2:
-                        mp = servo[base + 3 + i]
-                        servo[base + 3 + i] = mu
+                        mp = prev[g, 3 + i]
+                        prev[g, 3 + i] = mu
                     if not (fx >> (3 + i)) & 1:
                         md = _ldamp(damp_mode, al, mu, w, mp, hist)
                         if i == 0:
@@ -568,24 +466,24 @@ def rigid_motion_groups(dt, gravity, damp_mode, alpha, servo, full_inertia,
             force[b, i] = 0.0
             moment[b, i] = 0.0
     if damp_mode == 2:
-        servo[S_HIST] = 1.0
+        servo.hist[0] = 1.0
     if damp_mode == 3:
-        servo[S_WORK] += work
-        servo[S_DEK] += dek
-        servo[S_NWIN] += 1.0
-        win = servo[S_WINDOW] if servo[S_WINDOW] >= 1.0 else 10.0
-        if servo[S_NWIN] >= win:
-            ratio = servo[S_RATIO] if servo[S_RATIO] > 0.0 else 0.5
-            fac = servo[S_FACTOR] if servo[S_FACTOR] > 1.0 else 1.1
-            if servo[S_DEK] > 0.0:
-                r = servo[S_WORK] / servo[S_DEK]
-                servo[S_LASTR] = r
-                a = servo[S_ALPHA] * fac if r < ratio else servo[S_ALPHA] / fac
-                servo[S_ALPHA] = min(max(a, 1e-4 / dt), 1.0 / dt)
-            servo[S_WORK] = 0.0
-            servo[S_DEK] = 0.0
-            servo[S_NWIN] = 0.0
-    servo[S_CALLS] += 1.0
+        servo.work[0] += work
+        servo.dek[0] += dek
+        servo.nwin[0] += 1.0
+        win = servo.window[0] if servo.window[0] >= 1.0 else 10.0
+        if servo.nwin[0] >= win:
+            ratio = servo.ratio[0] if servo.ratio[0] > 0.0 else 0.5
+            fac = servo.factor[0] if servo.factor[0] > 1.0 else 1.1
+            if servo.dek[0] > 0.0:
+                r = servo.work[0] / servo.dek[0]
+                servo.lastr[0] = r
+                a = servo.alpha[0] * fac if r < ratio else servo.alpha[0] / fac
+                servo.alpha[0] = min(max(a, 1e-4 / dt), 1.0 / dt)
+            servo.work[0] = 0.0
+            servo.dek[0] = 0.0
+            servo.nwin[0] = 0.0
+    servo.calls[0] += 1.0
     out[0] = fmax
     out[1] = fsum
     out[2] = ke

@@ -1,27 +1,10 @@
 """Host-side preparation of the moving bodies for the motion kernel (``kernels.motion``):
-the servo array of the damping modes, composite properties of joined blocks, and the
-inertial masses of density scaling. Plain numpy, run once per ``model cycle``/detection.
+composite properties of joined blocks and the inertial masses of density scaling (the damping
+state is ``kernels.bundles.Damping``). Plain numpy, run once per ``model cycle``/detection.
 """
 from __future__ import annotations
 
 import numpy as np
-
-from dec3d.kernels.motion import NSERVO, S_ALPHA, S_FACTOR, S_RATIO, S_WINDOW
-
-
-def servo_size(ng):
-    """Length of a servo array good for every damping mode with ``ng`` groups."""
-    return NSERVO + 6 * int(ng)
-
-
-def new_servo(ng, ratio=0.5, window=10, factor=1.1, alpha0=0.0):
-    """A fresh servo array (layout in the module docstring) for ``ng`` groups."""
-    s = np.zeros(servo_size(ng))
-    s[S_ALPHA] = alpha0
-    s[S_RATIO] = ratio
-    s[S_WINDOW] = window
-    s[S_FACTOR] = factor
-    return s
 
 
 def group_properties(gstart, gmember, mass, centroid, inertia, inertia_approx, prin=None, axes=None):

@@ -208,7 +208,7 @@ def timefn_factor(model, e: dict, t: float) -> float:
 
 
 class TimeFunctions:
-    """A step of the cycle (first in ``rigid._Run.steps`` when the model has time functions): before
+    """A step of the cycle (first in ``steps._Run.steps`` when the model has time functions): before
     each step, every time-function condition is set for the time of that step, and the batch is cut to
     one step. A velocity is taken at the middle of the step (t + Δt/2: velocities live at half steps in
     the central-difference scheme), a force at its start t. The time is ``load_time``."""

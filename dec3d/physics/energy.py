@@ -4,7 +4,7 @@
 Calculation": boundary work W, stored strain energy, energy dissipated in joint shear W_j, kinetic
 energy U_k, work dissipated by mass damping W_k; docs.itascacg.com). dec3d does the same for its rigid
 blocks, contacts and zones with two steps put around the cycle's own steps (``_Run`` in
-``physics.rigid``) while tracking is on:
+``physics.steps``) while tracking is on:
 
     EnergyBefore → RigidBatch → EnergyAfter → Clock → Hooks
     EnergyBefore → MixedContacts → RigidBatch → ZoneStep → EnergyAfter → Clock → Hooks   (zoned blocks)

@@ -7,8 +7,10 @@ fields. The ``RigidEngine`` object on the model holds only what can be rebuilt: 
 candidate pairs, the time step and timings. A restored run continues bit for bit (with
 `mass-scale body`: to round-off, its masses are worked out again from the geometry).
 
-Detection is ``contacts.ContactDetection`` (mixed in). Cycling (kernel ``cycle.run_steps``):
-many steps per call, up to the next detection, history sample, VTK snapshot or solve check.
+Detection is ``contacts.ContactDetection`` and contacts with a zoned side
+``mixedcontacts.MixedContactSteps`` (both mixed in). Cycling (``_cycle``) drives the ordered
+list of steps of ``physics.steps`` (``_Run``, ``RigidBatch`` → kernel ``cycle.run_steps``, …):
+many steps per kernel call, up to the next detection, history sample, VTK snapshot or solve check.
 """
 from __future__ import annotations
 
@@ -19,29 +21,24 @@ import time as _time
 import numpy as np
 
 from dec3d.errors import Dec3dError
-from dec3d.io.vtk import periodic_vtk
 from dec3d.kernels.balance import body_balance
 from dec3d.kernels.bodyscale import body_row_sums
-from dec3d.kernels.contactmap import blocks_moved
-from dec3d.kernels.cycle import run_steps
-from dec3d.kernels.gpcontact import (mixed_move_points, mixed_subcontact_forces, surface_weights,
-                                    take_contact_forces, vertex_sides)
 from dec3d.kernels.joints import P_KN, P_KS
-from dec3d.kernels.motion import (DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, DAMP_RAYLEIGH, NSERVO, S_HIST,
-                                  block_timestep, rigid_motion_groups)
-from dec3d.model.model import KIND_DEFORMABLE, KIND_FE
+from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_NONE, DAMP_RAYLEIGH, block_timestep
 from dec3d.model.store import Store
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.zones import has_zones
 
-from .bodies import group_properties, inertial_masses, new_servo
-from . import contacts as _contacts
+from .bodies import inertial_masses
 from .contacts import ContactDetection, contact_stores, default_row
-from .energy import is_active as is_energy_active
-from .dynamic import DYN_DEFAULTS, TimeFunctions, has_timefns, rayleigh_coefficients, stiffness_timestep
-from .history import HistorySet
+from .dynamic import DYN_DEFAULTS, rayleigh_coefficients, stiffness_timestep
 from .jmodels import JOINT_MODELS
-from .runcontrol import CycleInterrupted, _Progress, _sigint_stops_cycling, _StopFlag, request_stop  # noqa: F401  (request_stop: part of this module's API)
+from .mixedcontacts import MixedContactSteps, _deformable
+from . import runcontrol as _runcontrol
+from .runcontrol import CycleInterrupted, _sigint_stops_cycling, _StopFlag
+
+#: part of this module's API (Ctrl-C's effect without a signal: stop at the end of the batch)
+request_stop = _runcontrol.request_stop
 
 _F = np.float64
 _I = np.int64
@@ -75,11 +72,6 @@ class RunError(Dec3dError):
 _GP_STATE = ("velocity", "disp", "force", "mass", "imass", "vapp", "fapp")   # (vapp, fapp: time functions)
 
 
-def _deformable(kind):
-    """Zoned and FE blocks: they move by their gridpoints (nodes), not as rigid bodies."""
-    return (kind == KIND_DEFORMABLE) | (kind == KIND_FE)
-
-
 def _has_gridpoints(m) -> bool:
     return has_zones(m) or has_feblocks(m)
 
@@ -89,11 +81,6 @@ def _has_gridpoints(m) -> bool:
 #: adaptive damping settles there (dec3d's measurements, bench/README.md)
 SAFETY = {"local": 0.7, "combined": 0.7, "global": 0.8, "none": 0.8}
 
-#: leave out a periodic detection that would look at no pair again (``_Run.quiet``)
-SKIP_QUIET = True
-
-#: target wall time of one kernel call [s]: Ctrl-C and progress are seen at least this often
-CHUNK_SECONDS = 0.2
 #: local/maximum ratios are scaled by this so that they mean about the same as the average
 #: (Itasca, ``zone ratio`` / ``structure ratio`` command pages, see ``RigidEngine.criteria``)
 RATIO_SCALE = 0.1
@@ -108,7 +95,7 @@ def mech(model) -> dict:
     return m
 
 
-class RigidEngine(ContactDetection):
+class RigidEngine(ContactDetection, MixedContactSteps):
     def __init__(self, model):
         self.model = model
         self.dt = 0.0
@@ -512,6 +499,8 @@ class RigidEngine(ContactDetection):
         steps each step's ``advance`` in order, the clock, the hooks. Batches end at the next
         detection, history sample, VTK snapshot, ``max_time`` or ``nsteps``."""
         m = self.model
+        from .steps import _Run
+
         run = _Run(self, nsteps, warn)
         self.steps = run.steps
         interval = run.interval
@@ -549,109 +538,6 @@ class RigidEngine(ContactDetection):
             run.finish()
         return run.done
 
-    # ------------------------------------------------------------ models with zoned blocks
-    def _zone_contacts_check(self) -> bool:
-        """Whether some contact has a zoned side (its sub-contact forces go to gridpoints, in
-        ``_mixed_steps``): zoned against rigid, or zoned against zoned (sub-contacts at the
-        surface gridpoints of both; within one joined set they carry none, see
-        ``contacts.joined_zoned_inert``). Contacts between two deformable blocks of which one is
-        an FE block are refused (not wired)."""
-        b, cs = self.model.blocks, self.contacts
-        if not cs.n:
-            return False
-        kind = b["kind"]
-        za = _deformable(kind[cs["a"]])
-        zb = _deformable(kind[cs["b"]])
-        lead = np.where(b["leader"] < 0, np.arange(b.n), b["leader"])
-        bad = (za & zb & (lead[cs["a"]] != lead[cs["b"]])
-               & ((kind[cs["a"]] == KIND_FE) | (kind[cs["b"]] == KIND_FE)))
-        if bad.any():
-            k = int(np.flatnonzero(bad)[0])
-            raise RunError(f"{int(bad.sum())} contacts join an FE block to another deformable block that is not "
-                           f"joined to it (the first between blocks {int(cs['ida'][k])} and {int(cs['idb'][k])}): "
-                           "such contacts do not cycle yet; nothing was cycled")
-        return bool((za ^ zb).any() or (za & zb & (cs["sub_count"] > 0)).any())
-
-    def _mixed_weights(self, zst, recompute: bool = True) -> tuple:
-        """Gridpoint rows and interpolation weights of every sub-contact and contact point on a
-        zoned side (``gpcontact.surface_weights``), and the contact stiffness they give the
-        gridpoints (the joint term of Eq. 85: max(kn, ks) · area, shared by the weights).
-
-        They are kept in the contact stores (``gp_a gw_a gp_b gw_b``): made at a detection and
-        used until the next one, so a run that starts between two detections (a split run, a
-        restored model) takes them as the last run left them (``recompute=False``) instead of
-        working them out from points that have moved since."""
-        m = self.model
-        b, f, v = m.blocks, m.faces, m.vertices
-        cs, ss = self.contacts, self.subcontacts
-        zoned = _deformable(b["kind"])
-        stores = ((ss, ss["contact"]), (cs, np.arange(cs.n, dtype=_I)))
-        if not recompute:
-            # kept weights are usable only if every point on a zoned side has its triangle
-            for st, owner in stores:
-                for side, key in (("a", "gp_a"), ("b", "gp_b")):
-                    if (st[key][zoned[cs[side][owner]], 0] < 0).any():
-                        recompute = True
-        if recompute:
-            geo = (zoned, v["pos"], b["face_start"], b["face_count"], f["vstart"], f["nvert"],
-                   m.face_vertices["vertex"])
-            for st, owner in stores:
-                k = len(owner)
-                na, wa, nb, wb = np.empty((k, 3), _I), np.empty((k, 3)), np.empty((k, 3), _I), np.empty((k, 3))
-                surface_weights(np.ascontiguousarray(owner), st["pos"], cs["a"], cs["b"], *geo, na, wa, nb, wb)
-                if st is ss:
-                    vertex_sides(ss["kind"], ss["key0"], cs["a"], cs["b"], owner, zoned, na, wa, nb, wb)
-                st["gp_a"][:] = na
-                st["gw_a"][:] = wa
-                st["gp_b"][:] = nb
-                st["gw_b"][:] = wb
-        out = [tuple(st[key] for key in ("gp_a", "gw_a", "gp_b", "gw_b")) for st, _ in stores]
-        na, wa, nb, wb = out[0]
-        c = ss["contact"]
-        kk = np.maximum(cs["prop"][c, P_KN], cs["prop"][c, P_KS]) * ss["area"]
-        rows = np.concatenate((na.ravel(), nb.ravel()))
-        kw = np.concatenate(((wa * kk[:, None]).ravel(), (wb * kk[:, None]).ravel()))
-        on = rows >= 0
-        zst.set_contact_stiffness(rows[on], kw[on])
-        return out[0], out[1]
-
-    def _mixed_steps(self, k, zst, wsub, wcon, dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass,
-                     gisc, gprin, gaxes, gcen, fixity, large, vmax, out) -> None:
-        """``k`` steps of a model where zoned and rigid blocks touch (3DEC theory, "Deformable
-        blocks": a sub-contact on a deformable block moves with the gridpoints of the surface it
-        lies on, its force goes to them by the interpolation factors): sub-contact forces
-        (``gpcontact.mixed_subcontact_forces``), rigid motion, the zone step with the contact
-        forces on the gridpoints, then the contact points move (``mixed_move_points``)."""
-        m = self.model
-        b, v = m.blocks, m.vertices
-        cs, ss = self.contacts, self.subcontacts
-        gvel = v["velocity"]
-        gc = np.zeros((v.n, 3))
-        touched = np.unique(np.concatenate((wsub[0].ravel(), wsub[2].ravel())))
-        touched = np.ascontiguousarray(touched[touched >= 0])
-        cown = np.arange(cs.n, dtype=_I)
-        for _ in range(k):
-            facc = zst.begin()
-            mixed_subcontact_forces(dt, b["centroid"], b["velocity"], b["spin"], b["force"], b["moment"], gvel, gc,
-                                    cs["a"], cs["b"], cs["normal"], cs["jmodel"], cs["prop"], ss["contact"], ss["pos"],
-                                    ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"],
-                                    *wsub)
-            take_contact_forces(touched, gc, facc, zst.fmag)
-            if len(gmember):
-                gbad = rigid_motion_groups(dt, g, mode, alpha, servo, full, gstart, gmember, gmass, gimass, gisc,
-                                           gprin, gaxes, gcen, b["mass"], fixity, b["force"], b["moment"], b["fapp"],
-                                           b["mapp"], b["velocity"], b["spin"], b["centroid"], b["disp"],
-                                           b["vert_start"], b["vert_count"], v["pos"], vmax, out)
-                if gbad >= 0 or not math.isfinite(out[0]):
-                    raise self._blowup(int(gmember[gstart[gbad]]) if gbad >= 0 else int(gmember[0]), dt, False)
-            zbad = zst.step(dt, g, mode, alpha, large, vmax, begun=True)
-            if zbad >= 0:
-                raise zst.unstable(zbad, dt)
-            mixed_move_points(dt, cs["a"], cs["b"], cown, cs["pos"], b["centroid"], b["velocity"], b["spin"], gvel,
-                              *wcon)
-            mixed_move_points(dt, cs["a"], cs["b"], ss["contact"], ss["pos"], b["centroid"], b["velocity"],
-                              b["spin"], gvel, *wsub)
-
     def timing_report(self) -> str:
         """The time spent per phase since the counters were last zeroed (seconds, share)."""
         t = self.timings
@@ -662,365 +548,6 @@ class RigidEngine(ContactDetection):
 
         return "\n".join([f"{'phase':<20}{'seconds':>9}{'share':>8}"] +
                          [f"{k:<20}{v:9.3f}{100 * v / tot:7.1f}%" for k, v in rows] + [thread_report()])
-
-
-def _orthonormal(a: np.ndarray) -> np.ndarray:
-    """The nearest rotation to each (3, 3) matrix of ``a`` (the polar factor U Vᵀ of its SVD)."""
-    ok = np.isfinite(a).all(axis=(1, 2))       # a blown-up run is rolled back; leave its NaN frames alone
-    if not ok.any():
-        return a
-    out = a.copy()
-    u, _, vt = np.linalg.svd(a[ok])
-    out[ok] = u @ vt
-    return out
-
-
-# ------------------------------------------------------------------ the cycle as a list of steps
-class _Run:
-    """What one ``model cycle`` works with, set up once (rigid groups and their properties,
-    damping/servo state, fixity, Δt, the zone stepper of zoned blocks), and its list of steps:
-
-    rigid blocks only:  RigidBatch → Clock → Hooks
-    with zoned blocks:  MixedContacts → RigidBatch → ZoneStep → Clock → Hooks
-
-    Each step has ``prepare()`` (after every detection) and ``advance(n) -> n`` (n steps of
-    the batch; a step may take fewer, e.g. the rigid kernel stops early when a block has moved
-    far enough to need a detection, and passes on how many it took). ``finish()`` stores what
-    the next run continues from (principal axes, servo state, ``dt_run``)."""
-
-    def __init__(self, eng: RigidEngine, nsteps: int, warn):
-        self.eng = eng
-        m = self.m = eng.model
-        b = self.b = m.blocks
-        self.zoned = _has_gridpoints(m)
-        body = ~b["hidden"] & ~_deformable(b["kind"]) if self.zoned else ~b["hidden"]
-        if (b["mass"][body] <= 0).any():
-            raise RunError("a block has no mass: set `block property density` before cycling")
-        self.zst = None
-        if self.zoned:
-            from .zones import ZoneStepper
-
-            self.zst = eng._zstep = ZoneStepper(m, RunError, warn)
-        s = self.s = eng.settings()
-        self.g = np.asarray(m.settings.gravity, dtype=_F)
-        self.mode, self.alpha = eng.damping()
-        self.full = eng.full_inertia()
-        self.large = bool(m.settings.large_strain)
-        gstart, gmember = self.gstart, self.gmember = eng._groups()
-        eng._group_cache = (gstart, gmember)
-        self.ng = len(gstart) - 1
-        # orientation of each block: its principal axes are kept current (finish)
-        inertia = np.einsum("bij,bj,bkj->bik", b["principal_axes"], b["principal_moment"], b["principal_axes"])
-        (self.gmass, self.gcen, _, self.gprin, self.gaxes,
-         self.giscalar) = group_properties(gstart, gmember, b["mass"], b["centroid"], inertia, b["inertia_approx"],
-                                           b["principal_moment"], b["principal_axes"])
-        self.axes0 = self.gaxes.copy()
-        servo = self.servo = new_servo(self.ng, ratio=float(s["servo_ratio"]))
-        if self.mode == DAMP_ADAPTIVE and len(s["servo"]) == NSERVO:
-            servo[:NSERVO] = s["servo"]
-        servo[S_HIST] = 0.0
-        self.fixity = (b["fixity"] | b["apply_fix"]).astype(np.uint8)
-        self.dt_fixed = float(s["timestep"]) if s["timestep"] else None
-        self.gimass = self.gisc = None
-        self.out = np.zeros(4)
-        self.vmax = 1e6
-        self.interval = max(1, int(m.settings.update_interval))
-        self.done = 0
-        self.progress = _Progress(nsteps, eng)
-        self.steps = ([MixedContacts(self), RigidBatch(self, chunked=False), ZoneStep(self)] if self.zoned
-                      else [RigidBatch(self, chunked=True)]) + [Clock(self), Hooks(self)]
-        self.beta = eng.rayleigh_beta()
-        if self.zst is not None:
-            self.zst.beta = self.beta
-        self.dynamic = bool(s["dynamic"])
-        if has_timefns(m):
-            self.steps.insert(0, TimeFunctions(self))
-        if is_energy_active(m):
-            # energy tracking (`model energy active on`): EnergyBefore → … → EnergyAfter → Clock → Hooks
-            from .energy import energy_steps
-            self.steps = energy_steps(self, self.steps, RunError)
-        self.steps[:0] = [make(self) for make in eng.pre_steps]
-        fresh = eng._signature != eng._geometry_signature()
-        if fresh:
-            eng.detect()
-        elif self.zoned and not self.ng and not self.large:
-            # (zoned blocks alone in small strain never reach a periodic detection: the contacts
-            # take the material-table defaults set since the last one here)
-            eng.follow_defaults()
-        #: a detection has run in this run (``quiet`` never leaves out the first one)
-        self.looked = fresh
-        self.mixed = eng._zone_contacts_check() if self.zoned else False
-        # Δt follows the contact stiffnesses: worked out again at every detection. A run that
-        # starts between two detections, on the step where the last run ended and with the
-        # geometry as it left it, goes on with that run's Δt (and contact-point weights), so
-        # that a run split into several commands (or saved and restored in between) takes
-        # exactly the steps of one run
-        last = s["dt_run"]
-        between = not fresh and len(last) == 2 and int(last[1]) == m.step and m.step % self.interval != 0
-        # ... unless the masses or the damping's time-step rule changed since (dynamic mode, damping)
-        self.dt_mode = [bool(eng.mass_scaling()), float(eng.rayleigh_beta())]
-        between = between and s.get("dt_mode", self.dt_mode) == self.dt_mode
-        if self.mixed:
-            self.wsub, self.wcon = eng._mixed_weights(self.zst, recompute=not between)
-        if warn is not None:
-            msg = eng.stiffness_warning()
-            if msg:
-                warn(msg)
-        self.scaled = eng.mass_scaling()
-        dt_last = float(last[0]) if self.dt_fixed is None and between else None
-        if self.zoned:
-            if dt_last is not None and not self.scaled and getattr(self.zst, "cdash", None) is not None:
-                dt_last = min(dt_last, self.zst.natural_timestep())    # quiet faces applied since
-            dt = dt_last if dt_last is not None else self._zoned_dt()
-            self.zst.set_masses(dt, self.scaled)
-            if self.ng:
-                self.masses(dt)
-        else:
-            dt = self.masses(dt_last if dt_last is not None else self.dt_fixed)
-        self.dt = eng.dt = dt
-        # detection also runs as soon as a block has moved CTOL/2 since the last one, so
-        # that two blocks approaching each other cannot close more than CTOL unseen
-        self.radius = eng._radii()
-        self.acc = np.zeros(b.n)
-        self.motion = np.zeros(2)
-        self.trigger = 0.5 * eng.tolerance()
-        self.due = False
-        self.loaded = (self.large and "fstress" in m.faces and bool(np.any(m.faces["fstress"] != 0.0)))
-
-    def masses(self, dt):
-        """Inertial masses of the rigid groups for Δt ``dt`` (None: Δt from the stiffnesses); returns Δt."""
-        dt, self.gimass, self.gisc = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, dt)
-        return dt
-
-    def _zoned_dt(self) -> float:
-        """Δt of a model with zoned blocks for the contacts as they are now."""
-        if self.dt_fixed is not None:
-            return self.dt_fixed
-        ng = self.ng
-        dt_r = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, None)[0] if ng else math.inf
-        d = ((dt_r if ng else float(self.s["scale_timestep"] or 1.0)) if self.scaled
-             else min(dt_r, stiffness_timestep(self.zst.natural_timestep(), self.beta)))
-        return d if math.isfinite(d) and d > 0 else 1.0
-
-    def detection_due(self) -> bool:
-        # (with zoned blocks, no rigid body and small strain nothing moves that could make a contact)
-        return ((self.m.step % self.interval == 0 or self.due)
-                and (not self.zoned or bool(self.ng) or self.large))
-
-    def quiet(self) -> bool:
-        """Whether the detection now due may be left out (``SKIP_QUIET``): no block has moved more
-        than QUIET × CTOL since it was last looked at, so detection would look at no pair again
-        and keep every contact and sub-contact as it is. Never for the first detection of a run
-        (commands between runs may have changed contact defaults, which a detection applies), nor
-        with zoned blocks, a motion trigger, a geometry change, or a step hook other than
-        histories (a FISH callback may change what a detection reads)."""
-        eng = self.eng
-        if (not SKIP_QUIET or not self.looked or self.zoned or self.due or _contacts.QUIET <= 0.0
-                or eng._signature != eng._geometry_signature() or eng.settings().get("grid") is None
-                or any(not isinstance(h, HistorySet) for h in eng.step_hooks)):
-            return False
-        t0 = _time.perf_counter()
-        b, v = self.b, self.m.vertices
-        moved = np.zeros(b.n, bool)
-        blocks_moved(v["pos"], v["look_pos"], b["vert_start"], b["vert_count"], _contacts.QUIET * eng.tolerance(),
-                     moved)
-        eng.timings["detect"] += _time.perf_counter() - t0
-        return not moved.any()
-
-    def skipped(self) -> None:
-        """A detection left out: what one that keeps every contact would do — the motion
-        bounds start again; contacts, Δt and masses stay."""
-        self.acc[:] = 0.0
-        self.due = False
-
-    def detected(self) -> None:
-        """After a detection: contacts changed, so the steps prepare again and Δt and the
-        masses follow the new stiffnesses."""
-        eng = self.eng
-        self.looked = True
-        # large strain: the zones' stiffness (Δt, scaled masses) follows the geometry at every
-        # detection step that is a multiple of the update interval — the step number alone, so
-        # a split or restored run takes the same steps (``ZoneStepper.regeometry``)
-        regeo = self.zoned and self.large and self.m.step % self.interval == 0
-        if regeo:
-            self.zst.regeometry()
-        if self.zoned:
-            self.mixed = eng._zone_contacts_check()
-        self.acc[:] = 0.0
-        self.due = False
-        for st in self.steps:
-            st.prepare()
-        if not self.zoned:
-            if self.dt_fixed is None:
-                # the contacts made or lost change the stiffness each body feels
-                self.dt = eng.dt = self.masses(None)
-            elif eng.mass_scaling():
-                self.masses(self.dt)
-            return
-        old_dt, self.dt = self.dt, self._zoned_dt()
-        eng.dt = self.dt
-        if self.scaled and self.ng:
-            self.masses(self.dt)
-        if self.mixed or self.dt != old_dt or regeo:
-            self.zst.set_masses(self.dt, self.scaled)
-        if self.loaded:
-            from dec3d.model.face_loads import recompute_fface
-            recompute_fface(self.m)
-
-    def finish(self) -> None:
-        eng, m, b, s = self.eng, self.m, self.b, self.s
-        eng._group_cache = None
-        self.progress.close()
-        if self.zoned:
-            self.zst.finish(self.large)
-        s["dt_run"] = [float(eng.dt), int(m.step)]
-        s["dt_mode"] = self.dt_mode
-        if self.ng or not self.zoned:
-            # keep each block's principal axes turning with its body
-            gstart, gmember, gaxes = self.gstart, self.gmember, self.gaxes
-            turn = np.einsum("gij,gkj->gik", gaxes, self.axes0)
-            gid = np.repeat(np.arange(self.ng), np.diff(gstart))
-            pa = b["principal_axes"]
-            # re-orthonormalised (polar factor): a slightly skew frame would grow threefold per
-            # call (Q A Aᵀ A), and after ~30 `model cycle` commands Euler's equations blow up
-            pa[gmember] = _orthonormal(np.einsum("bij,bjk->bik", turn[gid], pa[gmember]))
-            # a lone block takes back the kernel's own frame unchanged: the next run starts from
-            # exactly the axes this one ended with, so splitting a run into several `model cycle`
-            # commands (or save/restore between them) changes no bit
-            lone = np.diff(gstart) == 1
-            pa[gmember[gstart[:-1][lone]]] = gaxes[lone]
-            b["inertia"][gmember] = np.einsum("bij,bj,bkj->bik", pa[gmember], b["principal_moment"][gmember],
-                                              pa[gmember])
-        if self.mode == DAMP_ADAPTIVE:
-            s["servo"] = [float(x) for x in self.servo[:NSERVO]]
-
-
-class _Step:
-    """One step of the cycle: ``prepare()`` after each detection, ``advance(n)`` for n steps of a
-    batch (returns the steps taken); ``timing``: the counter of ``engine.timings`` it adds to."""
-    timing = "cycle"
-
-    def __init__(self, run: _Run):
-        self.run = run
-
-    def prepare(self) -> None:
-        pass
-
-    def advance(self, n: int) -> int:
-        return n
-
-    def __repr__(self) -> str:
-        return type(self).__name__
-
-
-class MixedContacts(_Step):
-    """Where zoned and rigid blocks touch: whole steps of sub-contact forces on gridpoints,
-    rigid motion and the zone step together (``RigidEngine._mixed_steps``)."""
-
-    def prepare(self) -> None:
-        r = self.run
-        if r.mixed:
-            r.wsub, r.wcon = r.eng._mixed_weights(r.zst)
-
-    def advance(self, n: int) -> int:
-        r = self.run
-        if r.mixed:
-            r.eng._mixed_steps(n, r.zst, r.wsub, r.wcon, r.dt, r.g, r.mode, r.alpha, r.servo, r.full, r.gstart,
-                               r.gmember, r.gmass, r.gimass, r.gisc, r.gprin, r.gaxes, r.gcen, r.fixity, r.large,
-                               r.vmax, r.out)
-        return n
-
-
-class RigidBatch(_Step):
-    """Contact forces and motion of the rigid bodies: the fused kernel ``cycle.run_steps``.
-    ``chunked``: in kernel calls of about CHUNK_SECONDS each, so that Ctrl-C and progress are
-    seen in time (the split changes no number: the kernel carries its state in the arrays)."""
-
-    def __init__(self, run: _Run, chunked: bool):
-        super().__init__(run)
-        self.chunked = chunked
-        self.chunk = 10                  # steps per kernel call, adapted to CHUNK_SECONDS
-
-    def advance(self, k: int) -> int:
-        r = self.run
-        if r.mixed or not r.ng:
-            return k
-        eng, m, b = r.eng, r.m, r.b
-        cs, ss = eng.contacts, eng.subcontacts
-        n_ok = 0
-        bad = -1
-        while n_ok < k:
-            kk = min(k - n_ok, self.chunk) if self.chunked else k
-            t0 = _time.perf_counter()
-            c_ok, bad = run_steps(kk, r.dt, r.g, r.mode, r.alpha, r.servo, r.full, r.gstart, r.gmember, r.gmass,
-                                  r.gimass, r.gisc, r.gprin, r.gaxes, r.gcen, b["mass"], r.fixity, b["force"],
-                                  b["moment"], b["fapp"], b["mapp"], b["velocity"], b["spin"], b["centroid"],
-                                  b["disp"], b["vert_start"], b["vert_count"], m.vertices["pos"], cs["a"], cs["b"],
-                                  cs["normal"], cs["pos"], np.arange(cs.n, dtype=_I), cs["jmodel"], cs["prop"],
-                                  ss["contact"], ss["pos"], ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"],
-                                  ss["us"], ss["state"], r.vmax, r.out, r.radius, r.acc, r.trigger, r.motion, r.beta)
-            spent = _time.perf_counter() - t0
-            n_ok += c_ok
-            if bad >= 0 or r.motion[1] > 0.0 or c_ok < kk or not self.chunked:
-                break
-            if c_ok > 0:
-                self.chunk = max(1, min(100000, int(c_ok * CHUNK_SECONDS / max(spent, 1e-9))))
-            r.progress.update(r.done + n_ok)
-            if _StopFlag.requested:
-                break
-        if bad >= 0:
-            # (a rigid-only run names the step its batch reached, a zoned one the step it began at)
-            raise eng._blowup(bad, r.dt, r.motion[1] == 2.0, m.step + (n_ok if self.chunked else 0))
-        return n_ok
-
-
-class ZoneStep(_Step):
-    """The zoned (and FE) blocks: gridpoint forces from zone stresses, gridpoint motion
-    (``physics.zones.ZoneStepper``), n steps with the Δt of the rigid bodies (done within
-    ``MixedContacts`` where zoned and rigid blocks touch); contact forces on zoned blocks went
-    to their gridpoints, so the blocks' own sums are cleared."""
-
-    def advance(self, n: int) -> int:
-        r = self.run
-        zst = r.zst
-        for _ in range(0 if r.mixed else n):
-            zbad = zst.step(r.dt, r.g, r.mode, r.alpha, r.large, r.vmax)
-            if zbad >= 0:
-                raise zst.unstable(zbad, r.dt)
-        zb = zst.blocks
-        r.b["force"][zb] = 0.0
-        r.b["moment"][zb] = 0.0
-        return n
-
-
-class Clock(_Step):
-    """Step count and time move on by the steps taken; kinetic energy; detection due?"""
-    timing = None
-
-    def advance(self, n: int) -> int:
-        r = self.run
-        eng, m = r.eng, r.m
-        r.due = r.motion[1] > 0.0
-        m.step += n
-        m.time += n * r.dt
-        if r.dynamic:
-            r.s["dyn_time"] += n * r.dt
-        r.done += n
-        eng._criteria = None
-        eng.kinetic = (((float(r.out[2]) if r.ng else 0.0) + r.zst.kinetic) if r.zoned else float(r.out[2]))
-        return n
-
-
-class Hooks(_Step):
-    """The engine's step hooks (histories, FISH callbacks) and the periodic VTK snapshot."""
-    timing = "hooks"
-
-    def advance(self, n: int) -> int:
-        eng = self.run.eng
-        for hook in eng.step_hooks:
-            hook(eng)
-        periodic_vtk(eng.model)
-        return n
 
 
 def engine(model) -> RigidEngine:

@@ -10,7 +10,8 @@ from dec3d.errors import Dec3dError
 from dec3d.kernels.bodyscale import body_row_sums
 from dec3d.kernels.joints import P_KN, P_KS
 from dec3d.physics.eigen import assemble
-from dec3d.physics.rigid import _Run, engine, mech
+from dec3d.physics.rigid import engine, mech
+from dec3d.physics.steps import _Run
 from reference.bodyscale_ref import row_sums_ref
 
 

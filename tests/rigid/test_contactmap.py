@@ -157,18 +157,21 @@ def test_cp_batch_against_the_best_plane_of_each_pair():
     assert gap[2] == pytest.approx(cpref.best_plane(blocks[3], blocks[4])[0], abs=1e-6) and gap[2] > 1.0
 
 
-def _run_steps_kernel(st, nsteps, dt, g, damp_mode, alpha, servo):
-    """The kernel call, kept thin (arrays of the state dict `st`, updated in place)."""
+def _run_steps_kernel(st, nsteps, dt, g, damping):
+    """The kernel call, kept thin (bundles of the arrays of the state dict `st`, updated in place)."""
+    from dec3d.kernels.bundles import Bodies, Bounds, Contacts, Groups, SubContacts
+
     G, B, C, S = st["groups"], st["blocks"], st["contacts"], st["sub"]
     nb = len(B["mass"])
-    done, bad = run_steps(nsteps, dt, g, damp_mode, alpha, servo, False,
-                          G["gstart"], G["gmember"], G["gmass"], G["gimass"], G["giscalar"], G["gprin"],
-                          G["gaxes"], G["gcentroid"], B["mass"], B["fixity"], B["force"], B["moment"], B["fapp"],
-                          B["mapp"], B["vel"], B["spin"], B["centroid"], B["disp"], B["vstart"], B["vcount"],
-                          st["verts"], C["a"], C["b"], C["normal"], C["pos"], np.arange(len(C["a"]), dtype=np.int64),
-                          C["jmodel"], C["prop"], S["contact"], S["pos"], S["area"], S["fn"], S["fs"], S["un"],
-                          S["udil"], S["us"], S["state"], 1e6, st["out"], np.ones(nb), np.zeros(nb), 1e9, np.zeros(2))
-    return done, bad
+    groups = Groups(G["gstart"], G["gmember"], G["gmass"], G["gimass"], G["giscalar"], G["gprin"], G["gaxes"],
+                    G["gcentroid"])
+    bodies = Bodies(B["mass"], B["fixity"], B["force"], B["moment"], B["fapp"], B["mapp"], B["vel"], B["spin"],
+                    B["centroid"], B["disp"], B["vstart"], B["vcount"], st["verts"])
+    contacts = Contacts(C["a"], C["b"], C["normal"], C["pos"], np.arange(len(C["a"]), dtype=np.int64), C["jmodel"],
+                        C["prop"])
+    subs = SubContacts(*(S[k] for k in SubContacts._fields))
+    bounds = Bounds(np.ones(nb), np.zeros(nb), 1e9, np.zeros(2))
+    return run_steps(nsteps, dt, g, False, damping, groups, bodies, contacts, subs, bounds, 1e6, st["out"])
 
 
 def test_run_steps_against_the_cycle_written_from_the_equations(session):
@@ -178,7 +181,8 @@ def test_run_steps_against_the_cycle_written_from_the_equations(session):
     import copy
     import math
 
-    from dec3d.physics.bodies import group_properties, new_servo
+    from dec3d.kernels.bundles import new_damping, new_servo, servo_values
+    from dec3d.physics.bodies import group_properties
     from reference.cycle_ref import step_ref
 
     m, e = _model(session, STACK)
@@ -198,12 +202,12 @@ def test_run_steps_against_the_cycle_written_from_the_equations(session):
     st0 = copy.deepcopy(st0)                      # plain copies of every array
     fast, slow = copy.deepcopy(st0), copy.deepcopy(st0)
     g, dt, n = np.array([0.0, 0.0, -10.0]), e.timestep(), 40
-    assert _run_steps_kernel(fast, n, dt, g, 1, 0.8, new_servo(len(gm))) == (n, -1)
+    assert _run_steps_kernel(fast, n, dt, g, new_damping(1, 0.8, len(gm))) == (n, -1)
 
     phi = math.radians(30.0)                      # the deck: mohr, kn = ks = 1e8 Pa/m, friction 30°
     law = [("mohr", dict(kn=1e8, ks=1e8, phi=phi, coh=0.0, ten=0.0, dil=0.0, zdil=0.0, phir=phi, cohr=0.0,
                          tenr=0.0))] * len(cs["a"])
-    servo = new_servo(len(gm))
+    servo = np.concatenate([servo_values(new_servo()), np.zeros(6 * len(gm))])     # the twin's flat layout
     for _ in range(n):
         assert step_ref(dt, g, 1, 0.8, servo, False, slow["groups"], slow["blocks"], slow["verts"],
                         slow["contacts"], law, slow["sub"], 1e6, slow["out"]) == -1

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 import dec3d
-from dec3d.physics import rigid
+from dec3d.physics import steps
 from test_split_runs import stack
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "deformable"))
@@ -45,7 +45,7 @@ def test_rigid_batch_in_one_step_calls_is_bit_identical(tmp_path, monkeypatch):
         return b["centroid"].copy(), b["velocity"].copy(), s.model.stores["subcontacts"]["fn"].copy()
 
     whole = state()
-    monkeypatch.setattr(rigid, "CHUNK_SECONDS", 1e-15)     # every kernel call after the first: one step
+    monkeypatch.setattr(steps, "CHUNK_SECONDS", 1e-15)     # every kernel call after the first: one step
     cut = state()
     assert np.abs(whole[1]).max() > 1e-5
     for a, b in zip(whole, cut):

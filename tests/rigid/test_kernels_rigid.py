@@ -8,7 +8,8 @@ from dec3d.kernels.commonplane import (CT_EE, CT_EF, CT_FF, CT_VE, CT_VF, CT_VV,
                                        contact_type)
 from dec3d.kernels.joints import NPROP, joint_law
 from dec3d.kernels.joints import mohr as mohr_kernel
-from dec3d.kernels.motion import block_timestep, rigid_motion
+from dec3d.kernels.bundles import Bodies, Groups, new_damping
+from dec3d.kernels.motion import block_timestep, rigid_motion_groups
 from reference.commonplane_ref import best_plane
 from reference.rigid_ref import coulomb_ref, hull_distance, rotate_rodrigues
 
@@ -159,21 +160,31 @@ def test_coulomb_kernel_matches_scalar_reference():
                 assert bool(st & 1) == rfail
 
 
+def _one_block(dt, gravity, alpha, mass, imass, iinert, vel, spin, cen, verts):
+    """One step of a lone block (a group of one) through ``rigid_motion_groups``: local damping
+    ``alpha`` (none when 0), scalar inertia ``iinert``; vel/spin/cen (1, 3) and verts (8, 3)
+    updated in place. Returns (bad group or −1, max |unbalanced force|)."""
+    z = np.zeros((1, 3))
+    groups = Groups(np.array([0, 1]), np.array([0]), np.array([mass]), np.array([imass]), np.array([iinert]),
+                    np.ones((1, 3)), np.eye(3)[None].copy(), cen.copy())
+    bodies = Bodies(np.array([mass]), np.zeros(1, np.uint8), z.copy(), z.copy(), z.copy(), z.copy(), vel, spin,
+                    cen, z.copy(), np.array([0]), np.array([8]), verts)
+    out = np.zeros(4)
+    bad = rigid_motion_groups(dt, gravity, False, new_damping(1 if alpha else 0, alpha, 1), groups, bodies, 1e6,
+                              out)
+    return bad, out[0]
+
+
 def test_motion_free_spin_is_rigid_and_matches_cayley_rotation():
     v = _cube(-0.5, -0.5, -0.5)
     cen = np.zeros((1, 3))
-    one = np.ones(1)
     vel = np.zeros((1, 3))
     spin = np.array([[0.3, -1.0, 2.0]])
-    z = np.zeros((1, 3))
-    disp = np.zeros((1, 3))
     dt = 1e-3
     ref = v.copy()
     for _ in range(1000):
-        bad, fmax, _ = rigid_motion(dt, np.zeros(3), 0.0, 0.0, np.array([0]), one, one, one,
-                                    np.zeros(1, np.uint8), z.copy(), z.copy(), z, z, vel, spin, cen, disp,
-                                    np.array([0]), np.array([8]), v, 1e6)
-        assert bad == -1
+        bad, fmax = _one_block(dt, np.zeros(3), 0.0, 1.0, 1.0, 1.0, vel, spin, cen, v)
+        assert bad == -1 and fmax == 0.0
         ref = np.array([rotate_rodrigues(r, spin[0] * dt) for r in ref])
     np.testing.assert_allclose(v, ref, atol=1e-12)
     d = np.linalg.norm(v[:, None] - v[None], axis=2)
@@ -185,22 +196,17 @@ def test_motion_local_damping_and_gravity_step():
     # one step from rest under gravity: ẋ = (F_u − α|F_u| sgn 0) Δt / m = g Δt
     v = _cube()
     vel = np.zeros((1, 3))
-    args = (np.array([0]), np.full(1, 2.0), np.full(1, 2.0), np.ones(1), np.zeros(1, np.uint8),
-            np.zeros((1, 3)), np.zeros((1, 3)), np.zeros((1, 3)), np.zeros((1, 3)), vel, np.zeros((1, 3)),
-            v.mean(0)[None].copy(), np.zeros((1, 3)), np.array([0]), np.array([8]), v, 1e6)
-    rigid_motion(0.01, np.array([0, 0, -10.0]), 0.8, 0.0, *args)
+    cen = v.mean(0)[None].copy()
+    _one_block(0.01, np.array([0, 0, -10.0]), 0.8, 2.0, 2.0, 1.0, vel, np.zeros((1, 3)), cen, v)
     assert vel[0, 2] == pytest.approx(-0.1)
-    rigid_motion(0.01, np.array([0, 0, -10.0]), 0.8, 0.0, *args)
+    _one_block(0.01, np.array([0, 0, -10.0]), 0.8, 2.0, 2.0, 1.0, vel, np.zeros((1, 3)), cen, v)
     assert vel[0, 2] == pytest.approx(-0.1 - 0.2 * 0.1)   # damping force 0.8 |F| opposes motion
 
 
 def test_blow_up_is_reported_with_the_row():
     v = _cube()
     vel = np.array([[1e9, 0, 0]])
-    bad, *_ = rigid_motion(0.01, np.zeros(3), 0.0, 0.0, np.array([0]), np.ones(1), np.ones(1), np.ones(1),
-                           np.zeros(1, np.uint8), np.zeros((1, 3)), np.zeros((1, 3)), np.zeros((1, 3)),
-                           np.zeros((1, 3)), vel, np.zeros((1, 3)), np.zeros((1, 3)), np.zeros((1, 3)),
-                           np.array([0]), np.array([8]), v, 1e6)
+    bad, _ = _one_block(0.01, np.zeros(3), 0.0, 1.0, 1.0, 1.0, vel, np.zeros((1, 3)), v.mean(0)[None].copy(), v)
     assert bad == 0
 
 

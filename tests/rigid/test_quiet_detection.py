@@ -1,10 +1,11 @@
-"""Periodic detections left out while nothing has moved (``rigid.SKIP_QUIET``, ``_Run.quiet``):
+"""Periodic detections left out while nothing has moved (``steps.SKIP_QUIET``, ``steps._Run.quiet``):
 the same numbers as a run that detects every interval, far fewer detections, and the first
 detection of each run still made (it applies contact defaults changed between runs)."""
 import numpy as np
 import pytest
 
 import dec3d.physics.rigid as rigid
+import dec3d.physics.steps as steps
 from dec3d.physics.rigid import engine
 
 STACK = """model new
@@ -25,7 +26,7 @@ block contact material-table default property stiffness-normal 1e9 stiffness-she
 
 def _counted(monkeypatch):
     n = {"skipped": 0, "detect": 0}
-    skipped, detect = rigid._Run.skipped, rigid.RigidEngine.detect
+    skipped, detect = steps._Run.skipped, rigid.RigidEngine.detect
 
     def count_skip(self):
         n["skipped"] += 1
@@ -35,7 +36,7 @@ def _counted(monkeypatch):
         n["detect"] += 1
         detect(self, *a, **k)
 
-    monkeypatch.setattr(rigid._Run, "skipped", count_skip)
+    monkeypatch.setattr(steps._Run, "skipped", count_skip)
     monkeypatch.setattr(rigid.RigidEngine, "detect", count_detect)
     return n
 
@@ -52,7 +53,7 @@ def test_left_out_detections_change_no_bit(session, monkeypatch, damping):
     split over two commands too; the rule leaves out most of the detections."""
     out = {}
     for skip in (False, True):
-        monkeypatch.setattr(rigid, "SKIP_QUIET", skip)
+        monkeypatch.setattr(steps, "SKIP_QUIET", skip)
         n = _counted(monkeypatch)
         m = _run(session, STACK + f"block mechanical damping {damping}\nmodel cycle 250\nmodel cycle 250\n")
         ss = engine(m).subcontacts

@@ -237,12 +237,12 @@ def test_progress_lines_when_the_output_is_not_a_terminal(session, monkeypatch, 
 
 def test_kernel_calls_split_for_ctrl_c_change_no_number(tmp_path, monkeypatch):
     """Batches run as kernel calls of about CHUNK_SECONDS; one step per call gives the same bits."""
-    import dec3d.physics.rigid as rigid
+    import dec3d.physics.steps as steps
     from dec3d.session import Session
 
     runs = []
-    for seconds in (rigid.CHUNK_SECONDS, 1e-12):
-        monkeypatch.setattr(rigid, "CHUNK_SECONDS", seconds)
+    for seconds in (steps.CHUNK_SECONDS, 1e-12):
+        monkeypatch.setattr(steps, "CHUNK_SECONDS", seconds)
         s = Session(out_dir=tmp_path, stdout=io.StringIO())
         _run(s, STACK.replace("model cycle 20\n", "model update-interval 50\nblock initialize velocity-x 0.01 "
                                                   "range position-z 1 2\nmodel cycle 120\n"))
