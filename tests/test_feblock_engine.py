@@ -81,9 +81,10 @@ def test_rigid_block_resting_on_an_fe_block(tmp_path, large):
     M = 1.2 GPa), joint kn = ks = 10 GPa/m. Contact forces reach the FE nodes through the surface
     triangles (slave mid-face nodes, Eq. 9): the contact carries the weight W = 20 kN, the FE
     block's mean sigma_zz is -(W + its own weight / 2) / A, and the rigid block settles by about
-    W/M H + rho g H^2/(2M) + W/(kn A) = 27.0 micro-m: measured 29.1 (+7.8 %; the sub-contacts are
-    point-like loads at the rigid face's corners and the FE surface nodes, and a quadratic surface
-    dents more under them than the zoned block's, +3.3 % there): bar 10 %."""
+    W/M H + rho g H^2/(2M) + W/(kn A) = 27.0 micro-m: measured 27.23 (+0.84 %, small strain; the FE
+    side carries the whole overlap at its surface nodes, as a zoned side does against a rigid face:
+    `contacts.zoned_side_carries`; with both sides' nodes carrying half it was 29.1, +7.8 %, the
+    rigid corners denting the quadratic surface): bar 2 %."""
     s = Session(out_dir=tmp_path, stdout=io.StringIO())
     for line in ["model configure feblock", "block create brick 0 1 0 1 0 1", "block create brick 0 1 0 1 1 2",
                  "block property density 2000", "feblock generate 0.5 0.5 0.5 integration 3 range position-z 0 1",
@@ -102,4 +103,4 @@ def test_rigid_block_resting_on_an_fe_block(tmp_path, large):
     mean = (es["stress"][:, 2] * es["volume"]).sum() / es["volume"].sum()
     assert mean == pytest.approx(-(W + 2000 * 10 / 2), rel=1e-3)
     settle = W / M + 2000 * 10 / (2 * M) + W / 1e10
-    assert -b["disp"][rigid, 2] == pytest.approx(settle, rel=0.10)
+    assert -b["disp"][rigid, 2] == pytest.approx(settle, rel=0.02)

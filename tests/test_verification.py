@@ -26,7 +26,8 @@ def test_every_verification_problem_is_there():
                                          "D4_triaxial", "D5_strip_footing", "D6_mohr_hole", "D7_rigid_on_deformable",
                                          "D8_jointed_deformable", "D9_wedge_deformable",
                                          "E1_eigenmodes", "DY1_rayleigh_block_on_spring", "DY2_newmark_sliding_block",
-                                         "DY3_shear_wave_quiet_base", "DY5_energy", "FE1_cantilever"}
+                                         "DY3_shear_wave_quiet_base", "DY5_energy", "FE1_cantilever",
+                                         "FE2_fe_deformable_contacts"}
 
 
 def _demo(tmp_path, expects: str):

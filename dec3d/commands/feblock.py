@@ -1,4 +1,4 @@
-"""`feblock generate|list`: FE blocks of 20-node bricks (FE-block text, shared/seeds/003_*)."""
+"""`feblock generate|read|change|gravity|list`: FE blocks of 20-node bricks (FE-block text, shared/seeds/003_*)."""
 from __future__ import annotations
 
 import numpy as np
@@ -12,7 +12,7 @@ from ..model.feblocks import add_feblock, element_volumes, feblock_store, instal
 from ..model.model import KIND_DEFORMABLE, KIND_FE
 from ..model.zones import ZMODEL_ELASTIC, ZMODEL_NULL
 from .registry import command
-from .values import Choice, InPath, Num, Nums, P, Text
+from .values import FLAG, Choice, InPath, Num, Nums, P, Text
 
 # Memory budget: about 3 kB per element (stress at 27 Gauss points, 20 node rows, nodes);
 # refuse beyond this many elements per command.
@@ -194,6 +194,30 @@ def feblock_change(session, call):
         if float(a["hourglass"]) == 0.0:
             two = rows[es["nq"][rows] == 2]
             es["gstress"][two, 8:14] = 0.0           # the control's stresses go with it (2x2x2 rows only)
+
+
+@command("feblock gravity", keywords=[P("delete", FLAG, "take the gravity forces off instead", bare=True)],
+         range="block",
+         doc="Put the gravity forces of `model gravity` back on the FE blocks in range, or take them off (delete).",
+         details="dec3d's reading: the FE-block text names `feblock gravity` without defining it, and says that "
+                 "FE blocks take gravity by the consistent nodal forces of its Eq. (8) (rho ∫ N_I dV g per node) "
+                 "rather than m g at the nodes. In dec3d FE blocks carry those forces under `model gravity` by "
+                 "default; `feblock gravity delete` removes them from every element of the FE blocks in range "
+                 "(their mass, for inertia and damping, stays), and `feblock gravity` puts them back. The "
+                 "choice is kept per element in the model (`model save|restore`). No FE block in range is a "
+                 "warning; without `model configure feblock`, an error.",
+         examples=["feblock gravity delete", "feblock gravity delete range group 'liner'", "feblock gravity"])
+def feblock_gravity(session, call):
+    _need_configured(session, call, "feblock gravity")
+    model = session.model
+    es = feblock_store(model)
+    b = model.blocks
+    sel = session.range_mask(call, "block") & (b["kind"] == KIND_FE)
+    rows = np.flatnonzero(sel[es["block"][: es.n]]) if es.n else np.zeros(0, np.int64)
+    if not len(rows):
+        session.write(f"warning: {call.location}: `feblock gravity` found no FE block in range")
+        return
+    es["gravity"][rows] = 0 if call.args["delete"] else 1
 
 
 @command("feblock list", range="block",

@@ -29,6 +29,8 @@ The deformable step (``dec3d.physics.zones``) is to move masters only and call t
     cmodel ()        int8   constitutive model code (``zones.ZMODEL_*``); 0: none assigned
     prop (NZPROP,)   SI     constitutive properties by ``zones.ZP_*`` column
     state ()         int32  plastic state bits
+    gravity ()       uint8  1: the element carries its consistent gravity forces (Eq. 8) under
+                            `model gravity`; 0: not (`feblock gravity delete`, dec3d's reading)
     group (nslots,)  int32  group codes per slot, -1 none
 
 Vertex field added:
@@ -66,6 +68,7 @@ def _fields() -> dict[str, Field]:
         "cmodel": Field((), np.int8, ZMODEL_NULL),
         "prop": Field((NZPROP,), _F, 0.0),
         "state": Field((), np.int32, 0),
+        "gravity": Field((), np.uint8, 1),
         "group": group_field(),
     }
 
@@ -75,7 +78,10 @@ def feblock_store(model) -> Store:
     ``feslave`` vertex field) on first use. Idempotent."""
     zone_stores(model)
     if "feblocks" in model.stores:
-        return model.store("feblocks")
+        es = model.store("feblocks")
+        if "gravity" not in es:                  # (a model saved before `feblock gravity`)
+            es.add_field("gravity", Field((), np.uint8, 1))
+        return es
     if "feslave" not in model.vertices:
         model.vertices.add_field("feslave", Field((), np.bool_, False))
     return model.add_store(Store("feblocks", _fields(), capacity=64))

@@ -33,7 +33,7 @@ from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelo
 from dec3d.kernels.joints import NPROP
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.groups import group_field
-from dec3d.model.model import KIND_DEFORMABLE
+from dec3d.model.model import KIND_DEFORMABLE, KIND_FE
 from dec3d.model.ranges import pairs_in_groups
 from dec3d.model.store import Field, Store
 
@@ -366,8 +366,11 @@ class ContactDetection:
                            b["face_start"], b["face_count"], f["vstart"], f["nvert"], fv["vertex"],
                            self.point_area(), area)
         zoned = b["kind"] == KIND_DEFORMABLE
-        if zoned.any():
-            zoned_side_carries(sc_c, kind, area, zoned[f_ra], zoned[f_rb])
+        # FE blocks are deformable sides too: against a zoned or an FE block both sides' surface
+        # nodes carry half (the two spring sets of the zoned pair); against a rigid block the FE side all
+        deform = zoned | (b["kind"] == KIND_FE)
+        if deform.any():
+            zoned_side_carries(sc_c, kind, area, deform[f_ra], deform[f_rb])
             joined_zoned_inert(sc_c, area, zoned, b["leader"], f_ra, f_rb)
         live = area > 0.0
         if not live.all():

@@ -14,7 +14,8 @@ F^G (Eq. 8). ``FeStepper`` holds what a run needs and has no motion of its own:
    (1 + α)^½: measured on the cantilever of fem_beam.dat, m = k Δt²/4 with the bare bound and
    α = 0.8 diverges within 60 steps (the largest eigenvalue of M⁻¹K is 2.43/Δt², above 4/1.8);
    with the factor it converges;
-   ``gweight`` (ρ ∫ N_a dV per node: consistent gravity F^G = gweight g, Eq. 8);
+   ``gweight`` (ρ ∫ N_a dV per node: consistent gravity F^G = gweight g, Eq. 8; elements whose
+   ``feblocks.gravity`` is 0, `feblock gravity delete`, add none);
 3. each step: ``forces`` adds F^S of the elastic elements (``feb_step``, 2×2×2 or 3×3×3 per
    element; 2×2×2 elements with the hourglass control of ``kernels.feblock_hg`` where their
    ``feblocks.hourglass`` is not 0) and F^G to the force accumulator; ``slave_forces`` sends what contacts and face loads
@@ -103,7 +104,9 @@ class FeStepper:
         self.gweight = np.zeros(n)
         gw = np.zeros((n, 3))
         first = feb_lumped_mass(pos, self.nodes, np.ascontiguousarray(el), self.density, self.mass)
-        first = max(first, feb_body_force(pos, self.nodes, np.ascontiguousarray(el), self.density,
+        # consistent gravity only of the elements that carry it (``feblocks.gravity``, `feblock gravity`)
+        grav = el[es["gravity"][el] != 0] if "gravity" in es else el
+        first = max(first, feb_body_force(pos, self.nodes, np.ascontiguousarray(grav), self.density,
                                           np.array([0.0, 0.0, 1.0]), gw))
         self._check(first)
         self.gweight = gw[:, 2].copy()

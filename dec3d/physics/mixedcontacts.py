@@ -29,24 +29,14 @@ class MixedContactSteps:
         """Whether some contact has a zoned side (its sub-contact forces go to gridpoints, in
         ``_mixed_steps``): zoned against rigid, or zoned against zoned (sub-contacts at the
         surface gridpoints of both; within one joined set they carry none, see
-        ``contacts.joined_zoned_inert``). Contacts between two deformable blocks of which one is
-        an FE block are refused (not wired)."""
+        ``contacts.joined_zoned_inert``). FE blocks count as zoned: their surface nodes (the slave
+        mid-face nodes too, whose forces reach the masters by Eq. 9) are the gridpoints."""
         b, cs = self.model.blocks, self.contacts
         if not cs.n:
             return False
         kind = b["kind"]
         za = _deformable(kind[cs["a"]])
         zb = _deformable(kind[cs["b"]])
-        lead = np.where(b["leader"] < 0, np.arange(b.n), b["leader"])
-        bad = (za & zb & (lead[cs["a"]] != lead[cs["b"]])
-               & ((kind[cs["a"]] == KIND_FE) | (kind[cs["b"]] == KIND_FE)))
-        if bad.any():
-            from .rigid import RunError
-
-            k = int(np.flatnonzero(bad)[0])
-            raise RunError(f"{int(bad.sum())} contacts join an FE block to another deformable block that is not "
-                           f"joined to it (the first between blocks {int(cs['ida'][k])} and {int(cs['idb'][k])}): "
-                           "such contacts do not cycle yet; nothing was cycled")
         return bool((za ^ zb).any() or (za & zb & (cs["sub_count"] > 0)).any())
 
     def _mixed_weights(self, zst, recompute: bool = True) -> tuple:

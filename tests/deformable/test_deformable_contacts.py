@@ -141,22 +141,6 @@ def test_insitu_stress_sets_deformable_contact_forces_in_equilibrium(tmp_path):
     assert cs.n == 1
 
 
-def test_contact_between_an_fe_block_and_a_zoned_block_is_refused_and_changes_nothing(tmp_path):
-    from dec3d.errors import Dec3dError
-    s = _run(tmp_path, ["model configure feblock", "block create brick 0 1 0 1 0 1", "block create brick 0 1 0 1 1 2",
-                        "feblock generate 0.5 0.5 0.5 integration 3 range position-z 0 1",
-                        "block zone generate edgelength 0.5 range position-z 1 2",
-                        "block zone cmodel assign elastic", f"block zone property young {E:g} poisson {NU:g} density 2000",
-                        "feblock change cmodel elastic young 1e9 poisson 0.25 density 2000",
-                        "model gravity 0 0 -10", *_ROLLERS])
-    before = s.model.vertices["pos"].copy()
-    with pytest.raises(Dec3dError, match=r"1 contacts join an FE block to another deformable block that is not "
-                                         r"joined to it \(the first between blocks 1 and 2\).*nothing was cycled"):
-        s.command("model cycle 5")
-    assert s.model.step == 0 and np.array_equal(s.model.vertices["pos"], before)
-
-
-
 def _pressed(tmp_path, chunks, save_at=None):
     import io
 
