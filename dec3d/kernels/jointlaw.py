@@ -69,7 +69,7 @@ def subcontact_update(dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
             dun = 0.0
             st0 &= ~ST_NEW
         fn, f0, f1, f2, un, ud, u0, u1, u2, st = joint_law(
-            cmodel[c], cprop[c], sc_area[s], dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s],
+            cmodel[c], cprop, c, sc_area[s], dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s],
             sc_udil[s], sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
         sc_fn[s] = fn
         sc_fs[s, 0] = f0

@@ -26,11 +26,11 @@ P_FACTOR = 2      # tension stiffness as a fraction of kn
 
 
 @njit(cache=True)
-def law(p, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
-    fn, fs0, fs1, fs2, un, us0, us1, us2 = elastic_trial(p[P_KN], p[P_KS], area, dun, dus0, dus1, dus2, un,
+def law(p, c, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
+    fn, fs0, fs1, fs2, un, us0, us1, us2 = elastic_trial(p[c, P_KN], p[c, P_KS], area, dun, dus0, dus1, dus2, un,
                                                          udil, fs0, fs1, fs2, us0, us1, us2)
     if fn < 0.0:
-        fn *= p[P_FACTOR]
+        fn *= p[c, P_FACTOR]
     return fn, fs0, fs1, fs2, un, udil, us0, us1, us2, state
 '''
 
@@ -67,12 +67,12 @@ def test_dispatch_calls_each_models_own_law():
     """The chain picks the law by code: elastic drops tension, mohr limits shear."""
     p = np.zeros(joints.NPROP)
     p[0] = p[1] = 1e9
-    opened = joints.joint_law(joints.CODES["elastic"], p, 1.0, 1e-6, 0.0, 0.0, 0.0, 0.0, 0.0,
+    opened = joints.joint_law(joints.CODES["elastic"], p[None, :], 0, 1.0, 1e-6, 0.0, 0.0, 0.0, 0.0, 0.0,
                               0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0)
     assert opened[0] == 0.0 and opened[4] == pytest.approx(1e-6)
     p[joints.mohr.P_TANF] = 0.5
     p[joints.mohr.P_TANF_RES] = np.nan          # residual friction = the friction
-    sheared = joints.joint_law(joints.CODES["mohr"], p, 1.0, -1e-6, 1e-5, 0.0, 0.0, 0.0, 0.0,
+    sheared = joints.joint_law(joints.CODES["mohr"], p[None, :], 0, 1.0, -1e-6, 1e-5, 0.0, 0.0, 0.0, 0.0,
                                0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0)
     assert sheared[0] == pytest.approx(1e3) and abs(sheared[1]) == pytest.approx(500.0)   # Fs = Fn tan φ
 

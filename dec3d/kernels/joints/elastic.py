@@ -10,10 +10,10 @@ CODE = 0          # kept in save files: never renumber
 NCOLS = 2         # property columns read: kn, ks
 
 
-@njit(cache=True)
-def law(p, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
+@njit(cache=True, inline="always")
+def law(p, c, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
     """Elastic trial; an opening joint (tensile normal force) carries nothing."""
-    fn, fs0, fs1, fs2, un, us0, us1, us2 = elastic_trial(p[P_KN], p[P_KS], area, dun, dus0, dus1, dus2, un,
+    fn, fs0, fs1, fs2, un, us0, us1, us2 = elastic_trial(p[c, P_KN], p[c, P_KS], area, dun, dus0, dus1, dus2, un,
                                                          udil, fs0, fs1, fs2, us0, us1, us2)
     if fn < 0.0:
         return 0.0, 0.0, 0.0, 0.0, un, udil, us0, us1, us2, state & ~ST_SLIP

@@ -30,30 +30,30 @@ P_TEN_RES = 9     # residual tensile strength [Pa]
 NCOLS = 10
 
 
-@njit(cache=True)
-def law(p, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
+@njit(cache=True, inline="always")
+def law(p, c, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
     """Elastic trial, then the Coulomb and tension limits."""
-    kn = p[P_KN]
-    tanf_r = p[P_TANF_RES]
+    kn = p[c, P_KN]
+    tanf_r = p[c, P_TANF_RES]
     if tanf_r != tanf_r:                   # NaN: residual friction = peak friction
-        tanf_r = p[P_TANF]
-    fn, fs0, fs1, fs2, un, us0, us1, us2 = elastic_trial(kn, p[P_KS], area, dun, dus0, dus1, dus2, un, udil,
+        tanf_r = p[c, P_TANF]
+    fn, fs0, fs1, fs2, un, us0, us1, us2 = elastic_trial(kn, p[c, P_KS], area, dun, dus0, dus1, dus2, un, udil,
                                                          fs0, fs1, fs2, us0, us1, us2)
     failed = (state & ST_FAILED) != 0
-    c = p[P_COH_RES] if failed else p[P_COH]
-    t = p[P_TEN_RES] if failed else p[P_TEN]
-    tf = tanf_r if failed else p[P_TANF]
+    coh = p[c, P_COH_RES] if failed else p[c, P_COH]
+    t = p[c, P_TEN_RES] if failed else p[c, P_TEN]
+    tf = tanf_r if failed else p[c, P_TANF]
     state = state & ~(ST_SLIP | ST_TENSION)
     if fn < -t * area:                     # Eq. (38): tensile failure
         return 0.0, 0.0, 0.0, 0.0, un, udil, us0, us1, us2, state | ST_FAILED | ST_TENSION
-    fsmax = c * area + fn * tf             # Eq. (35)
+    fsmax = coh * area + fn * tf           # Eq. (35)
     if fsmax < 0.0:
         fsmax = 0.0
     fsm = math.sqrt(fs0 * fs0 + fs1 * fs1 + fs2 * fs2)
     if fsm > fsmax:                        # Eq. (39): shear failure
         if not failed:
             state = state | ST_FAILED
-            fsmax = p[P_COH_RES] * area + fn * tanf_r
+            fsmax = p[c, P_COH_RES] * area + fn * tanf_r
             if fsmax < 0.0:
                 fsmax = 0.0
         r = fsmax / fsm if fsm > 0.0 else 0.0
@@ -63,8 +63,8 @@ def law(p, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, 
         state = state | ST_SLIP
         dmag = math.sqrt(dus0 * dus0 + dus1 * dus1 + dus2 * dus2)
         usm = math.sqrt(us0 * us0 + us1 * us1 + us2 * us2)
-        tandil = p[P_TANDIL]
-        zdil = p[P_ZDIL]
+        tandil = p[c, P_TANDIL]
+        zdil = p[c, P_ZDIL]
         if tandil != 0.0 and dmag > 0.0 and (zdil <= 0.0 or usm <= zdil):
             sgn = 1.0 if (dus0 * us0 + dus1 * us1 + dus2 * us2) >= 0.0 else -1.0
             ddil = sgn * dmag * tandil     # Eq. (42), direction-dependent
