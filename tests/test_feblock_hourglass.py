@@ -2,7 +2,7 @@
 numpy twin, what it must and must not resist, and the FE-block text's fem_beam.dat (seed 003_*)
 run as written: default 2x2x2 integration, one element thick, three point loads on the tip edge.
 
-The twin builds the hourglass stiffness from the test twin of test_feblock_kernels (serendipity
+The twin builds the hourglass stiffness from the test twin of feblock_twin (serendipity
 shape functions from the node table, complex-step derivatives, numpy Gauss points), with the
 trilinear interpolation written as products of 1-D Lagrange polynomials through the two Gauss
 abscissae, and the mean inverse Jacobian from numpy's inverse."""
@@ -11,8 +11,8 @@ import io
 import numpy as np
 import pytest
 from conftest import SHARED
-from test_feblock_kernels import (b_matrix, beam_mesh, brick, d_matrix, distorted, one, twin_dn, twin_rule,
-                                  twin_step)
+from feblock_twin import (b_matrix, beam_mesh, brick, d_matrix, distorted, one, twin_dn, twin_rule,
+                          twin_step)
 
 from dec3d.kernels.feblock import feb_node_lists, feb_step, feb_step_parallel, feb_stiffness
 from dec3d.kernels.feblock_hg import HOURGLASS
@@ -184,7 +184,7 @@ def test_parallel_step_with_control_is_bit_identical(hg):
 
 
 def _relax_steps(pos, nodes, fext, fix, hg, steps=None, tol=1e-7, check=500, maxsteps=400000):
-    """Dynamic relaxation as tests/test_feblock_kernels.relax (local damping 0.8, dt = 1, masses
+    """Dynamic relaxation as tests/test_feblock_beams.relax (local damping 0.8, dt = 1, masses
     from the stiffness bound), 2x2x2 with control hg; until converged or for exactly ``steps``."""
     ne = len(nodes)
     rows = np.arange(ne, dtype=np.int64)
@@ -320,7 +320,7 @@ def test_exposed_elements_are_rows_one_element_across_in_two_directions():
     """Counted on the reduced stiffness of free regular meshes (spurious modes = zero modes - 6):
     1x1x1 6, 2x1x1 3, 4x1x1 5, 2x2x1 0, 3x3x1 0, 2x2x2 0; exposed_elements marks every element
     of the first three and none of the others."""
-    from test_feblock_kernels import _global_stiffness
+    from test_feblock_beams import _global_stiffness
 
     from dec3d.model.feblocks import exposed_elements
 

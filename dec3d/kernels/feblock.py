@@ -1,37 +1,14 @@
-"""20-node serendipity bricks (FE blocks): shape functions, Gauss-point strains and stresses,
-nodal forces by integration of the Gauss-point stresses, lumped masses, nodal stiffness,
-consistent gravity and face loads, slave (mid-face) nodes.
+"""20-node serendipity bricks (FE blocks): Gauss-point strains and stresses, nodal forces by
+integration of the Gauss-point stresses, lumped masses, nodal stiffness, consistent gravity.
+Node tables, shape functions, Gauss rules, slave nodes and face loads are in
+``kernels/feblock_shape`` (re-exported here), the Jacobian in ``kernels/feblock_jac``.
 
 Source: the FE-block text (shared/seeds/003_*, "Structural Finite Elements") with the
 corrections of shared/seeds/ERRATA.md (section 003). The text follows Hughes (1987).
 
-Node order (``feblocks.nodes``): Table 1 of the text as corrected, which is the CalculiX /
-Abaqus C3D20 and VTK type 25 (quadratic hexahedron) order. Master coordinates y = (y1 y2 y3):
-
-    corners   1 (-1 -1 -1)  2 ( 1 -1 -1)  3 ( 1  1 -1)  4 (-1  1 -1)
-              5 (-1 -1  1)  6 ( 1 -1  1)  7 ( 1  1  1)  8 (-1  1  1)
-    mid-edge  9 ( 0 -1 -1) 10 ( 1  0 -1) 11 ( 0  1 -1) 12 (-1  0 -1)
-             13 ( 0 -1  1) 14 ( 1  0  1) 15 ( 0  1  1) 16 (-1  0  1)   (errata: 13-16)
-             17 (-1 -1  0) 18 ( 1 -1  0) 19 ( 1  1  0) 20 (-1  1  0)
-
-(0-based in the arrays: node I is index I - 1.) Slave nodes (Table 2): 21-26 at the face
-centres y3 = -1, y3 = 1, y2 = -1, y2 = 1, y1 = -1, y1 = 1, and 27 at the element centre; their
-motion is interpolated from the 20 masters by the shape functions (text, "Element
-Implementation") and forces on them go to the masters by Eq. (9), F_I = N_I P.
-
-Shape functions ("Shape Functions and Derivatives"), with y_Ik the node's master coordinates:
-corners N = 1/8 (1 + y_I1 y1)(1 + y_I2 y2)(1 + y_I3 y3)(y_I1 y1 + y_I2 y2 + y_I3 y3 - 2), and
-dN/dy1 = 1/8 y_I1 (1 + y_I2 y2)(1 + y_I3 y3)(2 y_I1 y1 + y_I2 y2 + y_I3 y3 - 1) (errata: +2,
-likewise for y2, y3); mid-edge nodes with y_Ik = 0 on axis k: N = 1/4 (1 - yk^2)(1 + ...)(1 + ...)
-(the text's three families 9/11/13/15, 10/12/14/16, 17-20; errata: the last derivative of
-17-20 is d/dy3).
-
-Quadrature (text, "Stresses and Nodal Forces", Eq. 7): "2 x 2 x 2 or 3 x 3 x 3 Gauss points may
-be used", 2 x 2 x 2 (reduced) the default. ``nq`` = 2 or 3 selects the rule; Gauss points are
-numbered with y1 fastest, then y2, then y3 (points -1/sqrt 3, 1/sqrt 3, weights 1; or
--sqrt(3/5), 0, sqrt(3/5), weights 5/9, 8/9, 5/9). ``gstress[e, g]`` (e, 27, 6) holds the stress
-of point g (the first 8 used with nq = 2), xx yy zz xy xz yz, tension positive (the store order
-of ``zones``; the text's vector is 11 22 33 23 31 12), and ``stress[e]`` the volume-weighted
+``gstress[e, g]`` (e, 27, 6) holds the stress of Gauss point g (the first 8 used with nq = 2;
+numbering in ``feblock_shape``), xx yy zz xy xz yz, tension positive (the store order of
+``zones``; the text's vector is 11 22 33 23 31 12), and ``stress[e]`` the volume-weighted
 mean sum_g w_g det J_g sigma_g / V.
 
 Sign convention as ``kernels/zones_ho``: ``force[r]`` accumulates the force the element exerts
@@ -45,176 +22,21 @@ import numpy as np
 from numba import njit, prange
 
 from .feblock_hg import hg_jacobians, hg_step
+from .feblock_jac import grad_n, jac_inv
+from .feblock_shape import (FACES, NGMAX, YNODE, YSLAVE, _slave_weights, feb_gauss_positions, feb_slave_forces,
+                            feb_slave_interp, gauss_rule, hg_tables, quad8_traction_loads, ref_tables, shape20)
 from .gather import node_lists, node_sums, scatter
 from .zones_ho import add_body_force, add_stiffness_bound
 
-#: master coordinates of the 20 nodes (corrected Table 1), 0-based rows
-YNODE = np.array([
-    [-1.0, -1.0, -1.0], [1.0, -1.0, -1.0], [1.0, 1.0, -1.0], [-1.0, 1.0, -1.0],
-    [-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [1.0, 1.0, 1.0], [-1.0, 1.0, 1.0],
-    [0.0, -1.0, -1.0], [1.0, 0.0, -1.0], [0.0, 1.0, -1.0], [-1.0, 0.0, -1.0],
-    [0.0, -1.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0], [-1.0, 0.0, 1.0],
-    [-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]])
-
-#: master coordinates of the slave nodes 21-27 (Table 2)
-YSLAVE = np.array([[0.0, 0.0, -1.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0], [0.0, 1.0, 0.0],
-                   [-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
-
-#: the six faces (Table 3, 0-based): 4 corners counter-clockwise seen from outside, then the
-#: mid-edge nodes of edges c0c1 c1c2 c2c3 c3c0; the face's slave node is 20 + face
-FACES = np.array([[1, 0, 3, 2, 8, 11, 10, 9], [4, 5, 6, 7, 12, 13, 14, 15],
-                  [0, 1, 5, 4, 8, 17, 12, 16], [2, 3, 7, 6, 10, 19, 14, 18],
-                  [3, 0, 4, 7, 11, 16, 15, 19], [1, 2, 6, 5, 9, 18, 13, 17]], dtype=np.int64)
-
-NGMAX = 27
+#: public kernels, and (from ``feblock_shape``) the tables, rules, slave-node and face-load kernels
+__all__ = ["feb_step", "feb_element_pass", "feb_element_pass_serial", "feb_node_lists", "feb_node_sums_mag",
+           "feb_node_sums_mag_serial", "feb_step_parallel", "feb_forces", "feb_volume", "feb_lumped_mass",
+           "feb_stiffness", "feb_body_force", "CHUNK", "FACES", "NGMAX", "YNODE", "YSLAVE", "_slave_weights",
+           "feb_gauss_positions", "feb_slave_forces", "feb_slave_interp", "gauss_rule", "hg_tables",
+           "quad8_traction_loads", "ref_tables", "shape20"]
 
 #: elements per work unit of the parallel element pass
 CHUNK = 256
-
-
-@njit(cache=True)
-def shape20(y1, y2, y3, n, dn):
-    """Shape functions n (20,) and their master derivatives dn (20, 3) at (y1, y2, y3)."""
-    for a in range(20):
-        a1 = YNODE[a, 0]
-        a2 = YNODE[a, 1]
-        a3 = YNODE[a, 2]
-        if a < 8:
-            p1 = 1.0 + a1 * y1
-            p2 = 1.0 + a2 * y2
-            p3 = 1.0 + a3 * y3
-            s = a1 * y1 + a2 * y2 + a3 * y3
-            n[a] = 0.125 * p1 * p2 * p3 * (s - 2.0)
-            dn[a, 0] = 0.125 * a1 * p2 * p3 * (2.0 * a1 * y1 + a2 * y2 + a3 * y3 - 1.0)
-            dn[a, 1] = 0.125 * a2 * p3 * p1 * (2.0 * a2 * y2 + a1 * y1 + a3 * y3 - 1.0)
-            dn[a, 2] = 0.125 * a3 * p1 * p2 * (2.0 * a3 * y3 + a1 * y1 + a2 * y2 - 1.0)
-        elif a1 == 0.0:           # 9, 11, 13, 15
-            q = 1.0 - y1 * y1
-            p2 = 1.0 + a2 * y2
-            p3 = 1.0 + a3 * y3
-            n[a] = 0.25 * q * p2 * p3
-            dn[a, 0] = -0.5 * y1 * p2 * p3
-            dn[a, 1] = 0.25 * a2 * q * p3
-            dn[a, 2] = 0.25 * a3 * q * p2
-        elif a2 == 0.0:           # 10, 12, 14, 16
-            q = 1.0 - y2 * y2
-            p1 = 1.0 + a1 * y1
-            p3 = 1.0 + a3 * y3
-            n[a] = 0.25 * q * p3 * p1
-            dn[a, 0] = 0.25 * a1 * q * p3
-            dn[a, 1] = -0.5 * y2 * p3 * p1
-            dn[a, 2] = 0.25 * a3 * q * p1
-        else:                     # 17-20
-            q = 1.0 - y3 * y3
-            p1 = 1.0 + a1 * y1
-            p2 = 1.0 + a2 * y2
-            n[a] = 0.25 * q * p1 * p2
-            dn[a, 0] = 0.25 * a1 * q * p2
-            dn[a, 1] = 0.25 * a2 * q * p1
-            dn[a, 2] = -0.5 * y3 * p1 * p2
-
-
-@njit(cache=True)
-def gauss_rule(nq):
-    """Points (nq^3, 3) and weights (nq^3,) of the nq x nq x nq Gauss rule (nq = 2 or 3),
-    y1 fastest. Any other nq is taken as 2."""
-    if nq == 3:
-        r = np.sqrt(0.6)
-        x = np.array([-r, 0.0, r])
-        w = np.array([5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0])
-        m = 3
-    else:
-        r = 1.0 / np.sqrt(3.0)
-        x = np.array([-r, r])
-        w = np.array([1.0, 1.0])
-        m = 2
-    pts = np.empty((m * m * m, 3))
-    wts = np.empty(m * m * m)
-    g = 0
-    for k in range(m):
-        for j in range(m):
-            for i in range(m):
-                pts[g, 0] = x[i]
-                pts[g, 1] = x[j]
-                pts[g, 2] = x[k]
-                wts[g] = w[i] * w[j] * w[k]
-                g += 1
-    return pts, wts
-
-
-@njit(cache=True)
-def ref_tables(nq):
-    """Shape functions (ng, 20), master derivatives (ng, 20, 3) and weights (ng,) at the Gauss
-    points of the nq-rule."""
-    pts, wts = gauss_rule(nq)
-    ng = pts.shape[0]
-    shp = np.empty((ng, 20))
-    dref = np.empty((ng, 20, 3))
-    for g in range(ng):
-        shape20(pts[g, 0], pts[g, 1], pts[g, 2], shp[g], dref[g])
-    return shp, dref, wts
-
-
-@njit(cache=True)
-def hg_tables():
-    """Tables of the hourglass control (``feblock_hg``): master derivatives (6, 20, 3) at the
-    face centres (YSLAVE rows 0-5) and the trilinear weights (6, 8) of the 2 x 2 x 2 Gauss points
-    at them, w_pg = prod_i (1 + 3 y_gi p_i) / 2."""
-    pts, wts = gauss_rule(np.int64(2))
-    n = np.empty(20)
-    dface = np.empty((6, 20, 3))
-    wpg = np.empty((6, 8))
-    for p in range(6):
-        shape20(YSLAVE[p, 0], YSLAVE[p, 1], YSLAVE[p, 2], n, dface[p])
-        for g in range(8):
-            w = 1.0
-            for i in range(3):
-                w *= 0.5 * (1.0 + 3.0 * pts[g, i] * YSLAVE[p, i])
-            wpg[p, g] = w
-    return dface, wpg
-
-
-@njit(cache=True, inline='always')
-def _jacobian(x, dxi):
-    """det J and the entries i_kj = dy_k/dx_j of J^-1 at one point, from the master derivatives
-    dxi (20, 3) and the element's node coordinates x (20, 3) (text: J_km = dN_I/dy_m x_Ik,
-    Y = J^-1). Returns (det, i00, i01, i02, i10, i11, i12, i20, i21, i22), the inverse all
-    zeros when det J is not positive. Scalars only (every Gauss point of every element)."""
-    j00 = 0.0; j01 = 0.0; j02 = 0.0
-    j10 = 0.0; j11 = 0.0; j12 = 0.0
-    j20 = 0.0; j21 = 0.0; j22 = 0.0
-    for a in range(20):
-        x0 = x[a, 0]; x1 = x[a, 1]; x2 = x[a, 2]
-        d0 = dxi[a, 0]; d1 = dxi[a, 1]; d2 = dxi[a, 2]
-        j00 += x0 * d0; j01 += x0 * d1; j02 += x0 * d2
-        j10 += x1 * d0; j11 += x1 * d1; j12 += x1 * d2
-        j20 += x2 * d0; j21 += x2 * d1; j22 += x2 * d2
-    c00 = j11 * j22 - j12 * j21
-    c01 = j12 * j20 - j10 * j22
-    c02 = j10 * j21 - j11 * j20
-    det = j00 * c00 + j01 * c01 + j02 * c02
-    if not det > 0.0:
-        return det, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    r = 1.0 / det
-    return (det, c00 * r, (j02 * j21 - j01 * j22) * r, (j01 * j12 - j02 * j11) * r,
-            c01 * r, (j00 * j22 - j02 * j20) * r, (j02 * j10 - j00 * j12) * r,
-            c02 * r, (j01 * j20 - j00 * j21) * r, (j00 * j11 - j01 * j10) * r)
-
-
-@njit(cache=True)
-def _grad_n(x, dxi, dn):
-    """Cartesian derivatives dn (20, 3) = dN_a/dx_j at one point from the master derivatives
-    dxi (20, 3) and the element's node coordinates x (20, 3) (text, Eq. 5: N_I,m = dN_I/dy_j
-    Y_jm). Returns det J; dn is left as it was when det J is not positive."""
-    det, i00, i01, i02, i10, i11, i12, i20, i21, i22 = _jacobian(x, dxi)
-    if not det > 0.0:
-        return det
-    for a in range(20):
-        d0 = dxi[a, 0]; d1 = dxi[a, 1]; d2 = dxi[a, 2]
-        dn[a, 0] = d0 * i00 + d1 * i10 + d2 * i20
-        dn[a, 1] = d0 * i01 + d1 * i11 + d2 * i21
-        dn[a, 2] = d0 * i02 + d1 * i12 + d2 * i22
-    return det
 
 
 @njit(cache=True)
@@ -233,7 +55,7 @@ def _elem_grads(x, dref, wts, dng, wd):
     """Cartesian derivatives dng (ng, 20, 3) and w_g det J_g (ng,) at every Gauss point of one
     element with node coordinates x (20, 3). False when det J is not positive at some point."""
     for g in range(wts.shape[0]):
-        det = _grad_n(x, dref[g], dng[g])
+        det = grad_n(x, dref[g], dng[g])
         if not det > 0.0:
             return False
         wd[g] = wts[g] * det
@@ -255,19 +77,6 @@ def _elem_force(dng, wd, sg, fe):
             fe[a, 0] -= w * (s[0] * dn[a, 0] + s[3] * dn[a, 1] + s[4] * dn[a, 2])
             fe[a, 1] -= w * (s[3] * dn[a, 0] + s[1] * dn[a, 1] + s[5] * dn[a, 2])
             fe[a, 2] -= w * (s[4] * dn[a, 0] + s[5] * dn[a, 1] + s[2] * dn[a, 2])
-
-
-@njit(cache=True)
-def _jac_inv(x, dxi, jinv):
-    """Inverse Jacobian jinv (3, 3) (jinv[k, j] = dy_k/dx_j) at one point; returns det J (jinv
-    untouched when not positive)."""
-    det, i00, i01, i02, i10, i11, i12, i20, i21, i22 = _jacobian(x, dxi)
-    if not det > 0.0:
-        return det
-    jinv[0, 0] = i00; jinv[0, 1] = i01; jinv[0, 2] = i02
-    jinv[1, 0] = i10; jinv[1, 1] = i11; jinv[1, 2] = i12
-    jinv[2, 0] = i20; jinv[2, 1] = i21; jinv[2, 2] = i22
-    return det
 
 
 @njit(cache=True, inline='always')
@@ -302,7 +111,7 @@ def _elem_step(xe, ve, dref, wts, lam, g2, dt, sg, se, fe, jinv, wd, hg, dface, 
     ctl = ng == 8 and hg > 0.0
     vol = 0.0
     for g in range(ng):
-        det = _jac_inv(xe, dref[g], jinv[g])
+        det = jac_inv(xe, dref[g], jinv[g])
         if not det > 0.0:
             return False
         wd[g] = wts[g] * det
@@ -635,7 +444,7 @@ def feb_stiffness(pos, nodes, rows, bulk, shear, kdiag, nq, hg=0.0):
             for p in range(6):
                 # grad of dB_p: grad N(p) - sum_g w_pg grad N(g)
                 h = dng[8 + p]
-                ok = ok and _grad_n(xe, dface[p], h) > 0.0
+                ok = ok and grad_n(xe, dface[p], h) > 0.0
                 for g in range(8):
                     w = wpg[p, g]
                     for a in range(20):
@@ -672,131 +481,3 @@ def feb_body_force(pos, nodes, rows, density, gvec, force):
             continue
         add_body_force(wd, shp, density[e], gvec, nd, force)
     return bad
-
-
-@njit(cache=True)
-def quad8_traction_loads(pos, quad, traction, force):
-    """Consistent nodal forces of a uniform traction on 8-node element faces:
-    force[quad[f, a]] += traction[f] int N_a dA (Eq. 8/9 applied to a surface load).
-
-    quad (k, 8): the face's 4 corners counter-clockwise seen from outside, then the mid-edge
-    nodes of edges 01 12 23 30 (the layout of ``FACES``); traction (k, 3) [Pa]. The 8-node
-    serendipity face functions (the brick's restricted to a face) are integrated by the 3 x 3
-    Gauss rule, exact for flat parallelogram faces, where a face of area A gives -A/12 at each
-    corner and A/3 at each mid-edge node. Modifies force."""
-    r = np.sqrt(0.6)
-    x = np.array([-r, 0.0, r])
-    wq = np.array([5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0])
-    # master coordinates (s, t) of the 8 face nodes
-    cs = np.array([-1.0, 1.0, 1.0, -1.0, 0.0, 1.0, 0.0, -1.0])
-    ct = np.array([-1.0, -1.0, 1.0, 1.0, -1.0, 0.0, 1.0, 0.0])
-    n = np.empty(8)
-    ds = np.empty(8)
-    dt = np.empty(8)
-    for f in range(quad.shape[0]):
-        for i in range(3):
-            for j in range(3):
-                s = x[i]
-                t = x[j]
-                for a in range(8):
-                    a1 = cs[a]
-                    a2 = ct[a]
-                    if a < 4:
-                        n[a] = 0.25 * (1.0 + a1 * s) * (1.0 + a2 * t) * (a1 * s + a2 * t - 1.0)
-                        ds[a] = 0.25 * a1 * (1.0 + a2 * t) * (2.0 * a1 * s + a2 * t)
-                        dt[a] = 0.25 * a2 * (1.0 + a1 * s) * (2.0 * a2 * t + a1 * s)
-                    elif a1 == 0.0:
-                        n[a] = 0.5 * (1.0 - s * s) * (1.0 + a2 * t)
-                        ds[a] = -s * (1.0 + a2 * t)
-                        dt[a] = 0.5 * a2 * (1.0 - s * s)
-                    else:
-                        n[a] = 0.5 * (1.0 - t * t) * (1.0 + a1 * s)
-                        ds[a] = 0.5 * a1 * (1.0 - t * t)
-                        dt[a] = -t * (1.0 + a1 * s)
-                t1x = 0.0; t1y = 0.0; t1z = 0.0; t2x = 0.0; t2y = 0.0; t2z = 0.0
-                for a in range(8):
-                    p = pos[quad[f, a]]
-                    t1x += ds[a] * p[0]; t1y += ds[a] * p[1]; t1z += ds[a] * p[2]
-                    t2x += dt[a] * p[0]; t2y += dt[a] * p[1]; t2z += dt[a] * p[2]
-                cx = t1y * t2z - t1z * t2y
-                cy = t1z * t2x - t1x * t2z
-                cz = t1x * t2y - t1y * t2x
-                da = np.sqrt(cx * cx + cy * cy + cz * cz) * wq[i] * wq[j]
-                for a in range(8):
-                    rr = quad[f, a]
-                    w = da * n[a]
-                    force[rr, 0] += w * traction[f, 0]
-                    force[rr, 1] += w * traction[f, 1]
-                    force[rr, 2] += w * traction[f, 2]
-
-
-@njit(cache=True)
-def feb_gauss_positions(pos, nodes, rows, out, nq):
-    """Positions of the Gauss points of the nq-rule: out[e, g] = sum_a N_a(y_g) x_a
-    (out (ne, >= nq^3, 3)). Modifies out."""
-    shp, dref, wts = ref_tables(nq)
-    for kk in range(rows.shape[0]):
-        e = rows[kk]
-        for g in range(wts.shape[0]):
-            x = 0.0; y = 0.0; z = 0.0
-            for a in range(20):
-                p = pos[nodes[e, a]]
-                x += shp[g, a] * p[0]; y += shp[g, a] * p[1]; z += shp[g, a] * p[2]
-            out[e, g, 0] = x
-            out[e, g, 1] = y
-            out[e, g, 2] = z
-
-
-@njit(cache=True)
-def _slave_weights():
-    """N_a at the 7 slave nodes: (7, 20)."""
-    w = np.empty((7, 20))
-    dn = np.empty((20, 3))
-    for s in range(7):
-        shape20(YSLAVE[s, 0], YSLAVE[s, 1], YSLAVE[s, 2], w[s], dn)
-    return w
-
-
-@njit(cache=True)
-def feb_slave_interp(nodes, slaves, rows, arr):
-    """Slave nodes follow the masters (text, "Element Implementation"): arr[slaves[e, s]] =
-    sum_a N_a(y_s) arr[nodes[e, a]] for every slave s >= 0 (slaves (ne, 7) rows, -1 none) of the
-    elements in rows; arr (nv, 3): positions, velocities or displacements. Modifies arr."""
-    w = _slave_weights()
-    for kk in range(rows.shape[0]):
-        e = rows[kk]
-        for s in range(7):
-            r = slaves[e, s]
-            if r < 0:
-                continue
-            x = 0.0; y = 0.0; z = 0.0
-            for a in range(20):
-                p = arr[nodes[e, a]]
-                x += w[s, a] * p[0]; y += w[s, a] * p[1]; z += w[s, a] * p[2]
-            arr[r, 0] = x
-            arr[r, 1] = y
-            arr[r, 2] = z
-
-
-@njit(cache=True)
-def feb_slave_forces(nodes, slaves, rows, force):
-    """Forces on slave nodes (contact, boundary loads) go to the masters by the text's Eq. (9),
-    F_I = N_I(y_s) P; the slave's own force is then zero. Force and moment about any point are
-    kept when the slave sits where the masters' interpolation puts it (``feb_slave_interp``).
-    Modifies force."""
-    w = _slave_weights()
-    for kk in range(rows.shape[0]):
-        e = rows[kk]
-        for s in range(7):
-            r = slaves[e, s]
-            if r < 0:
-                continue
-            px = force[r, 0]; py = force[r, 1]; pz = force[r, 2]
-            for a in range(20):
-                m = nodes[e, a]
-                force[m, 0] += w[s, a] * px
-                force[m, 1] += w[s, a] * py
-                force[m, 2] += w[s, a] * pz
-            force[r, 0] = 0.0
-            force[r, 1] = 0.0
-            force[r, 2] = 0.0

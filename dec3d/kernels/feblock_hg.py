@@ -32,6 +32,8 @@ not an element stress: it is left out of ``stress`` and of the output.
 """
 from numba import njit
 
+from .feblock_jac import jac_inv
+
 #: eps_h: the hourglass stiffness as a fraction of the elastic moduli (0 switches control off)
 HOURGLASS = 0.1
 
@@ -42,30 +44,11 @@ HG_ROW = 8
 @njit(cache=True)
 def hg_jacobians(xe, dface, jf):
     """Inverse Jacobians jf (6, 3, 3) (jf[p, k, j] = dy_k/dx_j) at the six face centres from the
-    master derivatives dface (6, 20, 3) and the node coordinates xe (20, 3). False (jf partly
-    written) when det J is not positive at one of them."""
+    master derivatives dface (6, 20, 3) and the node coordinates xe (20, 3) (``feblock_jac.jac_inv``
+    at each). False (jf partly written) when det J is not positive at one of them."""
     for p in range(6):
-        d = dface[p]
-        j00 = 0.0; j01 = 0.0; j02 = 0.0
-        j10 = 0.0; j11 = 0.0; j12 = 0.0
-        j20 = 0.0; j21 = 0.0; j22 = 0.0
-        for a in range(20):
-            x0 = xe[a, 0]; x1 = xe[a, 1]; x2 = xe[a, 2]
-            d0 = d[a, 0]; d1 = d[a, 1]; d2 = d[a, 2]
-            j00 += x0 * d0; j01 += x0 * d1; j02 += x0 * d2
-            j10 += x1 * d0; j11 += x1 * d1; j12 += x1 * d2
-            j20 += x2 * d0; j21 += x2 * d1; j22 += x2 * d2
-        c00 = j11 * j22 - j12 * j21
-        c01 = j12 * j20 - j10 * j22
-        c02 = j10 * j21 - j11 * j20
-        det = j00 * c00 + j01 * c01 + j02 * c02
-        if not det > 0.0:
+        if not jac_inv(xe, dface[p], jf[p]) > 0.0:
             return False
-        r = 1.0 / det
-        ji = jf[p]
-        ji[0, 0] = c00 * r; ji[0, 1] = (j02 * j21 - j01 * j22) * r; ji[0, 2] = (j01 * j12 - j02 * j11) * r
-        ji[1, 0] = c01 * r; ji[1, 1] = (j00 * j22 - j02 * j20) * r; ji[1, 2] = (j02 * j10 - j00 * j12) * r
-        ji[2, 0] = c02 * r; ji[2, 1] = (j01 * j20 - j00 * j21) * r; ji[2, 2] = (j00 * j11 - j01 * j10) * r
     return True
 
 
