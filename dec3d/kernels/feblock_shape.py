@@ -158,6 +158,54 @@ def hg_tables():
     return dface, wpg
 
 
+#: master coordinates (s, t) of the nodes of an element face in the layout of ``FACES``: the 4
+#: corners counter-clockwise seen from outside, then the mid-edge nodes of edges 01 12 23 30
+QNODE = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0],
+                  [0.0, -1.0], [1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])
+
+
+@njit(cache=True)
+def quad_shape(s, t, nn, n, ds, dt):
+    """Shape functions n (nn,) and their derivatives ds, dt (nn,) at (s, t) of a quadrilateral
+    face with nn = 4 (bilinear: N = 1/4 (1 + a1 s)(1 + a2 t)) or 8 nodes (serendipity: the
+    brick's functions restricted to a face, corners N = 1/4 (1 + a1 s)(1 + a2 t)(a1 s + a2 t - 1),
+    mid-edge nodes N = 1/2 (1 - s^2)(1 + a2 t) or 1/2 (1 - t^2)(1 + a1 s)), nodes at QNODE[:nn]."""
+    for a in range(nn):
+        a1 = QNODE[a, 0]
+        a2 = QNODE[a, 1]
+        if nn == 4:
+            n[a] = 0.25 * (1.0 + a1 * s) * (1.0 + a2 * t)
+            ds[a] = 0.25 * a1 * (1.0 + a2 * t)
+            dt[a] = 0.25 * a2 * (1.0 + a1 * s)
+        elif a < 4:
+            n[a] = 0.25 * (1.0 + a1 * s) * (1.0 + a2 * t) * (a1 * s + a2 * t - 1.0)
+            ds[a] = 0.25 * a1 * (1.0 + a2 * t) * (2.0 * a1 * s + a2 * t)
+            dt[a] = 0.25 * a2 * (1.0 + a1 * s) * (2.0 * a2 * t + a1 * s)
+        elif a1 == 0.0:
+            n[a] = 0.5 * (1.0 - s * s) * (1.0 + a2 * t)
+            ds[a] = -s * (1.0 + a2 * t)
+            dt[a] = 0.5 * a2 * (1.0 - s * s)
+        else:
+            n[a] = 0.5 * (1.0 - t * t) * (1.0 + a1 * s)
+            ds[a] = 0.5 * a1 * (1.0 - t * t)
+            dt[a] = -t * (1.0 + a1 * s)
+
+
+@njit(cache=True)
+def _face_point(pos, quad, f, s, t, n, ds, dt):
+    """Face functions n, ds, dt (``quad_shape``) at (s, t) of face quad[f] (nn = quad.shape[1]
+    node rows) and its area vector dx/ds x dx/dt there (outward for nodes counter-clockwise
+    seen from outside), returned as (cx, cy, cz)."""
+    nn = quad.shape[1]
+    quad_shape(s, t, nn, n, ds, dt)
+    t1x = 0.0; t1y = 0.0; t1z = 0.0; t2x = 0.0; t2y = 0.0; t2z = 0.0
+    for a in range(nn):
+        p = pos[quad[f, a]]
+        t1x += ds[a] * p[0]; t1y += ds[a] * p[1]; t1z += ds[a] * p[2]
+        t2x += dt[a] * p[0]; t2y += dt[a] * p[1]; t2z += dt[a] * p[2]
+    return t1y * t2z - t1z * t2y, t1z * t2x - t1x * t2z, t1x * t2y - t1y * t2x
+
+
 @njit(cache=True)
 def quad8_traction_loads(pos, quad, traction, force):
     """Consistent nodal forces of a uniform traction on 8-node element faces:
@@ -171,40 +219,13 @@ def quad8_traction_loads(pos, quad, traction, force):
     r = np.sqrt(0.6)
     x = np.array([-r, 0.0, r])
     wq = np.array([5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0])
-    # master coordinates (s, t) of the 8 face nodes
-    cs = np.array([-1.0, 1.0, 1.0, -1.0, 0.0, 1.0, 0.0, -1.0])
-    ct = np.array([-1.0, -1.0, 1.0, 1.0, -1.0, 0.0, 1.0, 0.0])
     n = np.empty(8)
     ds = np.empty(8)
     dt = np.empty(8)
     for f in range(quad.shape[0]):
         for i in range(3):
             for j in range(3):
-                s = x[i]
-                t = x[j]
-                for a in range(8):
-                    a1 = cs[a]
-                    a2 = ct[a]
-                    if a < 4:
-                        n[a] = 0.25 * (1.0 + a1 * s) * (1.0 + a2 * t) * (a1 * s + a2 * t - 1.0)
-                        ds[a] = 0.25 * a1 * (1.0 + a2 * t) * (2.0 * a1 * s + a2 * t)
-                        dt[a] = 0.25 * a2 * (1.0 + a1 * s) * (2.0 * a2 * t + a1 * s)
-                    elif a1 == 0.0:
-                        n[a] = 0.5 * (1.0 - s * s) * (1.0 + a2 * t)
-                        ds[a] = -s * (1.0 + a2 * t)
-                        dt[a] = 0.5 * a2 * (1.0 - s * s)
-                    else:
-                        n[a] = 0.5 * (1.0 - t * t) * (1.0 + a1 * s)
-                        ds[a] = 0.5 * a1 * (1.0 - t * t)
-                        dt[a] = -t * (1.0 + a1 * s)
-                t1x = 0.0; t1y = 0.0; t1z = 0.0; t2x = 0.0; t2y = 0.0; t2z = 0.0
-                for a in range(8):
-                    p = pos[quad[f, a]]
-                    t1x += ds[a] * p[0]; t1y += ds[a] * p[1]; t1z += ds[a] * p[2]
-                    t2x += dt[a] * p[0]; t2y += dt[a] * p[1]; t2z += dt[a] * p[2]
-                cx = t1y * t2z - t1z * t2y
-                cy = t1z * t2x - t1x * t2z
-                cz = t1x * t2y - t1y * t2x
+                cx, cy, cz = _face_point(pos, quad, f, x[i], x[j], n, ds, dt)
                 da = np.sqrt(cx * cx + cy * cy + cz * cz) * wq[i] * wq[j]
                 for a in range(8):
                     rr = quad[f, a]
@@ -212,6 +233,42 @@ def quad8_traction_loads(pos, quad, traction, force):
                     force[rr, 0] += w * traction[f, 0]
                     force[rr, 1] += w * traction[f, 1]
                     force[rr, 2] += w * traction[f, 2]
+
+
+@njit(cache=True)
+def face_stress_loads(pos, quad, stress, force):
+    """Consistent nodal forces of a uniform stress on quadrilateral element faces (``block face
+    apply stress`` on FE blocks): force[quad[f, a]] += int N_a sigma_f . n dA, n the outward unit
+    normal, the text's Eq. (8)/(9) F_I = int N_I t dA applied to a surface traction t = sigma n.
+
+    quad (k, nn): nn = 8 (an element face: corners counter-clockwise seen from outside, then the
+    mid-edge nodes of edges 01 12 23 30, the layout of ``FACES``) or nn = 4 (corners only,
+    bilinear); stress (k, 6) [Pa] xx yy zz xy xz yz, tension positive. n dA = dx/ds x dx/dt ds dt,
+    so warped or curved faces take the normal of each point; 3 x 3 Gauss rule, exact for flat
+    parallelogram faces, where a face of area A under a traction t gets -A t/12 at each corner
+    and A t/3 at each mid-edge node (nn = 8), A t/4 at each corner (nn = 4). Modifies force."""
+    r = np.sqrt(0.6)
+    x = np.array([-r, 0.0, r])
+    wq = np.array([5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0])
+    nn = quad.shape[1]
+    n = np.empty(nn)
+    ds = np.empty(nn)
+    dt = np.empty(nn)
+    for f in range(quad.shape[0]):
+        sxx = stress[f, 0]; syy = stress[f, 1]; szz = stress[f, 2]
+        sxy = stress[f, 3]; sxz = stress[f, 4]; syz = stress[f, 5]
+        for i in range(3):
+            for j in range(3):
+                cx, cy, cz = _face_point(pos, quad, f, x[i], x[j], n, ds, dt)
+                w = wq[i] * wq[j]
+                tx = (sxx * cx + sxy * cy + sxz * cz) * w
+                ty = (sxy * cx + syy * cy + syz * cz) * w
+                tz = (sxz * cx + syz * cy + szz * cz) * w
+                for a in range(nn):
+                    rr = quad[f, a]
+                    force[rr, 0] += n[a] * tx
+                    force[rr, 1] += n[a] * ty
+                    force[rr, 2] += n[a] * tz
 
 
 @njit(cache=True)

@@ -16,8 +16,17 @@ the thirds of the two splits (A/4 per corner of a flat parallelogram; thirds of 
 would give A/3 at the diagonal's ends and A/6 at the others, and zone stresses would spread).
 The pairs are found from the zones: two loaded triangles of one block on one source face that
 are faces of tetrahedra of the same hexahedral zone and share two gridpoints.
+A face of a 20-node element of an FE block is on the surface as eight triangles fanned around its
+mid-face slave node; when all eight carry the same stress the face is loaded as the 8-node
+element face with the consistent loads of ``kernels.feblock_shape.face_stress_loads`` (the
+integral of N_a sigma n over the face: -A/12 at each corner and A/3 at each mid-edge node of a
+flat parallelogram face), which a 20-node mesh needs to carry a uniform stress exactly; thirds of
+the eight triangles, the slave's share sent to the masters by the text's Eq. (9), give 0 at the
+corners and A/4 at the mid-edge nodes: a bar of 4 x 1 x 1 elements pulled by a face stress
+then ended 0.8 to 15 % beyond sigma L / E over its end face (exact with the consistent loads). Faces loaded in part (a range that cuts an element face) keep the thirds.
 Only triangles on the outside of a joined continuum take loads: a triangle whose gridpoints
-(resolved to their link masters) are also a triangle of another block is interior.
+(resolved to their link masters; FE slave nodes to the lowest slave row at the same position) are
+also a triangle of another block is interior.
 """
 from __future__ import annotations
 
@@ -52,6 +61,15 @@ def loadable_faces(model) -> np.ndarray:
         return out
     link = v["link"]
     master = np.where(link >= 0, link, np.arange(v.n))
+    if "feslave" in v:
+        # slave nodes are never linked (they follow their element): coincident ones are one point
+        sr = np.flatnonzero(v["feslave"])
+        if len(sr):
+            _, inv = np.unique(v["pos"][sr], axis=0, return_inverse=True)
+            inv = inv.ravel()
+            low = np.full(int(inv.max()) + 1, np.iinfo(np.int64).max)
+            np.minimum.at(low, inv, sr)
+            master[sr] = low[inv]
     keys = np.sort(master[_triangle_nodes(model, cand)], axis=1)
     _, inv, cnt = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
     out[cand[cnt[inv.ravel()] == 1]] = True
@@ -84,6 +102,11 @@ def recompute_fface(model) -> None:
         unit = a6 / np.linalg.norm(a6, axis=1)[:, None]
         trac = np.ascontiguousarray(np.einsum("kij,kj->ki", sig[members[:, 0]], unit))
         tri6_traction_loads(v["pos"], np.ascontiguousarray(tri6), trac, v["fface"])
+    quads, fmem = _fe_faces(model, nodes, s)
+    if len(quads):
+        from dec3d.kernels.feblock_shape import face_stress_loads
+        thirds[fmem.ravel()] = False
+        face_stress_loads(v["pos"], quads, np.ascontiguousarray(s[fmem[:, 0]]), v["fface"])
     rest = np.flatnonzero(thirds)
     pairs = _hex_quads(model, rows[rest], nodes[rest], s[rest])
     weight = np.ones(len(rows))
@@ -108,6 +131,37 @@ def recompute_fface(model) -> None:
     force = weight[thirds, None] * np.einsum("kij,kj->ki", sig[thirds], an[thirds]) / 3.0
     for k in range(3):
         np.add.at(v["fface"], nodes[thirds, k], force)
+
+
+def _fe_faces(model, nodes: np.ndarray, fstress: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The 8-node faces of FE elements whose eight surface triangles (fanned around the face's
+    slave node) are all among the loaded ones (``nodes`` (k, 3), their stresses ``fstress``) with
+    one stress: (g, 8) node rows in the layout of ``kernels.feblock_shape.FACES`` and (g, 8)
+    indices into ``nodes`` of their triangles."""
+    v = model.vertices
+    empty = (np.zeros((0, 8), np.int64), np.zeros((0, 8), np.int64))
+    if "feslave" not in v or "feblocks" not in model.stores or not len(nodes):
+        return empty
+    from dec3d.kernels.feblock_shape import FACES
+    es = model.store("feblocks")
+    sl = v["feslave"][nodes]
+    tri = np.flatnonzero(sl.sum(axis=1) == 1)
+    if not len(tri):
+        return empty
+    slave = nodes[tri][sl[tri]]
+    # element face of each slave row: 6 e + s
+    e, s = np.nonzero(es["slaves"][:, :6] >= 0)
+    owner = np.full(v.n, -1, np.int64)
+    owner[es["slaves"][e, s]] = 6 * e + s
+    order = np.lexsort((tri, slave))
+    slave, tri = slave[order], tri[order]
+    uniq, start, cnt = np.unique(slave, return_index=True, return_counts=True)
+    full = (cnt == 8) & (owner[uniq] >= 0)
+    mem = tri[start[full][:, None] + np.arange(8)[None, :]]
+    same = np.all(fstress[mem] == fstress[mem[:, :1]], axis=(1, 2))
+    ef = owner[uniq[full][same]]
+    quads = es["nodes"][(ef // 6)[:, None], FACES[ef % 6]]
+    return np.ascontiguousarray(quads, np.int64), mem[same]
 
 
 def _hex_quads(model, frows: np.ndarray, nodes: np.ndarray, fstress: np.ndarray) -> np.ndarray:
