@@ -44,7 +44,9 @@ def _need_configured(session, call, what: str) -> None:
                  "mesh one element across in two directions) have zero-energy modes; they get a small "
                  "stiffness-based hourglass control (0.1 of the elastic moduli on the strain the eight points "
                  "miss, at the six face centres), which leaves uniform, linear and bilinear strain fields alone. "
-                 "`feblock change hourglass` sets it per element.",
+                 "`feblock change hourglass` sets it per element. FE blocks of one joined set (`block join`, "
+                 "before or after meshing) share their coincident nodes and carry no contact between them: "
+                 "one body, as joined zoned blocks.",
          examples=["feblock generate 1 1 1", "feblock generate 20 2.5 20 range group 'liner'",
                    "feblock generate 0.5 0.5 0.5 integration 3"])
 def feblock_generate(session, call):
@@ -90,6 +92,9 @@ def feblock_generate(session, call):
         sl = install_feblock_mesh(model, row, points, elems, slaves, tris, src, nmaster, nq)
         if (model.store("feblocks")["hourglass"][sl] > 0).any():
             thin.append(bid)
+    if plans:
+        from ..model.zone_mesh import relink
+        relink(model)       # FE blocks joined before they were meshed share their coincident nodes
     if thin:
         session.write(f"note: {call.location}: blocks {', '.join(str(i) for i in thin[:10])} are one element "
                       "thick in two directions: with 2x2x2 integration their cross-sections have a zero-energy "

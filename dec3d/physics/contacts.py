@@ -161,7 +161,7 @@ def zoned_side_carries(sc_contact, kind, area, za, zb) -> None:
 
 
 def joined_zoned_inert(sc_c, area, zoned, leader, ra, rb) -> None:
-    """Contacts between two zoned blocks of one joined set (``block join``) carry no force: the
+    """Contacts between two zoned (or two FE) blocks of one joined set (``block join``) carry no force: the
     blocks share their gridpoints there (linked rows), so their sub-contacts get area 0 (dropped
     by the caller), in place. sc_c (ns,) contact index of each sub-contact; area (ns,) [m²];
     zoned (nb,) bool; leader (nb,) row of the leader (-1 or itself: not joined); ra, rb (nc,) rows."""
@@ -372,6 +372,8 @@ class ContactDetection:
         if deform.any():
             zoned_side_carries(sc_c, kind, area, deform[f_ra], deform[f_rb])
             joined_zoned_inert(sc_c, area, zoned, b["leader"], f_ra, f_rb)
+            # two FE blocks of one joined set share their nodes as well (``zone_mesh.relink``)
+            joined_zoned_inert(sc_c, area, b["kind"] == KIND_FE, b["leader"], f_ra, f_rb)
         live = area > 0.0
         if not live.all():
             sc_c, kind, key0, key1, pos, area = (x[live] for x in (sc_c, kind, key0, key1, pos, area))

@@ -87,6 +87,10 @@ class FeStepper:
         self.density = np.ascontiguousarray(p[:, ZP_DENSITY])
         self.nodes = np.ascontiguousarray(es["nodes"])
         self.slaves = np.ascontiguousarray(es["slaves"])
+        # node rows resolved to their link masters (joined blocks share nodes): what slave nodes pass
+        # on (Eq. 9) arrives after the linked rows were summed onto their masters, so it goes there
+        link = v["link"][np.maximum(self.nodes, 0)]
+        self.mnodes = np.ascontiguousarray(np.where(link >= 0, link, self.nodes))
         nq = es["nq"][el]
         hg = es["hourglass"][el] if "hourglass" in es else np.zeros(len(el))
         hg = np.where(nq == 2, hg, 0.0)
@@ -158,8 +162,8 @@ class FeStepper:
         return first
 
     def slave_stiffness(self, k: np.ndarray) -> None:
-        """Move stiffness put on slave rows (contacts, Eq. 85) to the masters, weighted by
-        |N_a| at the slave (a bound of what Eq. 9 carries to each)."""
+        """Move stiffness put on slave rows (contacts, Eq. 85) to the masters (their link
+        masters), weighted by |N_a| at the slave (a bound of what Eq. 9 carries to each)."""
         w = np.abs(_slave_weights())
         for s in range(7):
             r = self.slaves[self.erows, s]
@@ -167,12 +171,13 @@ class FeStepper:
             if not on.any():
                 continue
             ks = k[r[on]]
-            np.add.at(k, self.nodes[self.erows[on]], ks[:, None] * w[s][None, :])
+            np.add.at(k, self.mnodes[self.erows[on]], ks[:, None] * w[s][None, :])
             k[r[on]] = 0.0
 
     def slave_forces(self, facc) -> None:
-        """Forces on slave nodes (contacts, face loads) to the masters by Eq. (9)."""
-        feb_slave_forces(self.nodes, self.slaves, self.erows, facc)
+        """Forces on slave nodes (contacts, face loads) to the masters by Eq. (9) (to the link
+        masters of linked nodes)."""
+        feb_slave_forces(self.mnodes, self.slaves, self.erows, facc)
 
     def follow(self, *arrays) -> None:
         """Slave nodes take the masters' interpolated values of each (nv, 3) array given
