@@ -211,6 +211,11 @@ def relink(model) -> int:
         gp = np.concatenate([np.arange(b["vert_start"][r], b["vert_start"][r] + b["vert_count"][r]) for r in rows])
         gp = gp[free[gp]]
         pos = v["pos"][gp] + 0.0
+        if fe[rows].any():
+            # FE blocks are meshed one by one, not snapped to their neighbours: nodes that coincide
+            # can differ by round-off (1e-15 m at the joints of a ring of FE liner blocks)
+            h = 1e-9 * max(float(np.ptp(pos, axis=0).max()), 1e-12)
+            pos = np.round(pos / h) * h + 0.0
         _, inv = np.unique(pos, axis=0, return_inverse=True)
         inv = inv.ravel()
         master = np.full(inv.max() + 1, np.iinfo(np.int64).max)
