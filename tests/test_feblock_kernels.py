@@ -13,6 +13,7 @@ from feblock_twin import (CORNERS, EDGES, ERRATA_MID, TABLE, b_matrix, brick, di
 from dec3d.kernels.feblock import (FACES, feb_body_force, feb_forces, feb_gauss_positions,
                                    feb_lumped_mass, feb_slave_forces, feb_slave_interp, feb_step,
                                    feb_stiffness, feb_volume, quad8_traction_loads, shape20)
+from dec3d.kernels.feblock_jac import grad_n, jac_inv
 
 
 # ----------------------------------------------------------------------------- shape functions
@@ -106,6 +107,31 @@ def test_inverted_element_is_skipped_and_reported():
     assert not gs.any() and not f.any()
     assert feb_volume(pos, nodes, rows, np.zeros(1)) == 0
     assert feb_lumped_mass(pos, nodes, rows, np.ones(1), np.zeros(20)) == 0
+
+
+def test_jacobian_kernels_match_numpy_on_the_twin():
+    """``feblock_jac``: det J, J^-1 and the Cartesian derivatives at points of a distorted element
+    against numpy (J = x^T dN/dy from the twin's complex-step derivatives, numpy's det and inv);
+    an inverted element gives det J <= 0 and leaves the outputs untouched."""
+    x = distorted(seed=4, amp=0.1)
+    for y in ([0.3, -0.7, 0.1], [-1.0, 0.0, 1.0], [0.77, 0.77, -0.77]):
+        d = twin_dn(np.array(y))
+        J = x.T @ d
+        ji = np.zeros((3, 3))
+        dn = np.zeros((20, 3))
+        det = jac_inv(x, d, ji)
+        assert abs(det - np.linalg.det(J)) < 1e-13 * abs(det)
+        assert np.allclose(ji, np.linalg.inv(J), rtol=0, atol=1e-12 * np.abs(ji).max())
+        assert grad_n(x, d, dn) == det
+        assert np.allclose(dn, d @ np.linalg.inv(J), rtol=0, atol=1e-12 * np.abs(dn).max())
+    xi = brick()
+    xi[[0, 6]] = xi[[6, 0]]
+    d = twin_dn(np.array([-0.9, -0.9, -0.9]))
+    assert np.linalg.det(xi.T @ d) < 0
+    ji = np.full((3, 3), 7.0)
+    dn = np.full((20, 3), 7.0)
+    assert jac_inv(xi, d, ji) <= 0 and grad_n(xi, d, dn) <= 0
+    assert (ji == 7.0).all() and (dn == 7.0).all()
 
 
 # ----------------------------------------------------------------------------- patch tests, balance
