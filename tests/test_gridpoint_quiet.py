@@ -97,3 +97,12 @@ def test_properties_lost_later_stop_the_run(session):
     session.model.store("zones")["prop"][:] = 0.0
     with pytest.raises(QuietError, match="no positive density"):
         quiet_dashpots(session.model)
+
+
+def test_save_restore_keeps_the_quiet_gridpoints(session):
+    session.run_items(session.load_text(BLOCK + "block gridpoint apply quiet-x range position-z 0\nmodel save 'q'\n"
+                                        "model new\nmodel restore 'q'\n"))
+    rows, c = quiet_dashpots(session.model)
+    assert len(rows) == 9
+    assert c.sum(axis=0)[0, 0] == pytest.approx(2.0 * np.sqrt(2500.0 * 3e9), rel=1e-12)
+    assert np.abs(c[:, 1:, :]).max() == 0.0
