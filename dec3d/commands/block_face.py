@@ -108,7 +108,7 @@ def _no_fish_history(call):
                  "for the incident velocity v, e.g. `stress-xz` with a table (on a base whose outward normal is "
                  "−z, `stress-xz −2ρC_s v` pushes +x). Faces of rigid blocks take neither. (3DEC 7 lists no `quiet` "
                  "for `block face apply` and sets viscous boundaries on gridpoints, `block gridpoint apply quiet`, "
-                 "which dec3d does not have yet; `quiet` here is FLAC3D's `zone face apply quiet`.)",
+                 "which dec3d has too; `quiet` here is FLAC3D's `zone face apply quiet`.)",
          examples=["block face apply stress-normal -1e6 range position-z 1",
                    "block face apply stress -1e6 -2e6 -1e6 0 0 0 range group 'hole'",
                    "block face apply quiet range position-z 0",

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import BindError
+from ..errors import BindError, CommandError
 from ..model.zones import zone_stores
 from ..physics.dynamic import add_timefn, load_time, remove_timefns, timefn_factor
 from .block_apply import _TIMEFN, check_timefn, timefn_source, where_text
@@ -11,6 +11,7 @@ from .registry import command
 from .values import FLAG, Num, Nums, P
 
 _AX = ("x", "y", "z")
+_QUIET = ("quiet", "quiet_x", "quiet_y", "quiet_z")
 
 
 def _gridpoints(session, call, what: str) -> np.ndarray:
@@ -31,6 +32,9 @@ def _gridpoints(session, call, what: str) -> np.ndarray:
                    *[P(f"velocity-{a}", Num(), f"the {a} component held", units="m/s") for a in _AX],
                    P("force", Nums(3, 3), "fx fy fz applied force", units="N"),
                    *[P(f"force-{a}", Num(), f"the {a} component of the applied force", units="N") for a in _AX],
+                   P("quiet", FLAG, "a quiet (viscous, Lysmer–Kuhlemeyer) boundary in all three directions",
+                     bare=True),
+                   *[P(f"quiet-{a}", FLAG, f"a quiet boundary acting along {a} only", bare=True) for a in _AX],
                    P("table", _TIMEFN, "time function: the value is multiplied by table <id> at the current time"),
                    P("fish", _TIMEFN, "time function: the value is multiplied by FISH function <s> at the current "
                      "time")],
@@ -42,8 +46,15 @@ def _gridpoints(session, call, what: str) -> np.ndarray:
                  "or `fish <name>` the value is multiplied at every step by the table at the current time (linear "
                  "interpolation) or the FISH function's value (as `block apply`: the dynamic time in dynamic "
                  "mode, else the model's time; a velocity at the middle of the step, a force at its start; such a "
-                 "force adds to the constant one).",
+                 "force adds to the constant one). `quiet` (or `quiet-x|-y|-z`, one direction) makes the "
+                 "gridpoints a viscous boundary (Lysmer and Kuhlemeyer, as `block face apply quiet`): every "
+                 "boundary face whose gridpoints are all quiet takes normal and shear dashpots ρC_p and ρC_s of "
+                 "its zone (C_p = ((K + 4G/3)/ρ)^½, C_s = (G/ρ)^½) per unit area, shared to its gridpoints as an "
+                 "applied stress is; a gridpoint quiet along some axes only keeps the dashpot forces along "
+                 "them from the velocity along them. `quiet` takes no value, table or fish and no other keyword.",
          examples=["block gridpoint apply velocity-z 0 range position-z 0",
+                   "block gridpoint apply quiet range position-z 0",
+                   "block gridpoint apply quiet-x range position-x 0",
                    "block gridpoint apply velocity 0 0 0 range position-x 0",
                    "block gridpoint apply force 0 0 -1e3 range position 0 0 1",
                    "block gridpoint apply velocity-y 1 table 1 range position-z 0"])
@@ -51,8 +62,12 @@ def block_gridpoint_apply(session, call):
     a = call.args
     given = [k for k in ("velocity", "velocity_x", "velocity_y", "velocity_z", "force", "force_x", "force_y",
                          "force_z") if a[k] is not None]
+    quiet = [k for k in _QUIET if a[k]]
+    if quiet:
+        return _apply_quiet(session, call, quiet, given)
     if not given:
-        raise BindError("`block gridpoint apply` needs velocity[-x|-y|-z] or force[-x|-y|-z]", call.location)
+        raise BindError("`block gridpoint apply` needs velocity[-x|-y|-z], force[-x|-y|-z] or quiet[-x|-y|-z]",
+                        call.location)
     for k in given:
         if not np.isfinite(np.asarray(a[k], float)).all():
             raise BindError(f"`{k.replace('_', '-')}` must be finite", call.locations.get(k, call.location))
@@ -96,21 +111,63 @@ def block_gridpoint_apply(session, call):
             v["fapp"][rows, i] = a[f"force_{ax}"]
 
 
+def _apply_quiet(session, call, keys, given) -> None:
+    """`block gridpoint apply quiet[-x|-y|-z]` (``dec3d.model.quiet``): the gridpoints in range become
+    quiet in those directions, checked to make quiet some boundary face (with those quiet before) whose
+    zone has an impedance."""
+    from ..model.face_loads import _triangle_nodes
+    from ..model.quiet import face_impedances, quiet_bits, quiet_gridpoint_faces
+
+    other = list(given) + [k for k in ("table", "fish") if call.args[k] is not None]
+    if other:
+        k = other[0]
+        raise BindError(f"`quiet` cannot be combined with `{k.replace('_', '-')}` in one `block gridpoint apply`",
+                        call.locations.get(k, call.location))
+    m = session.model
+    rows = _gridpoints(session, call, "block gridpoint apply quiet")
+    if not len(rows):
+        return
+    bits = quiet_bits(m)
+    flag = bits != 0
+    flag[rows] = True
+    faces = quiet_gridpoint_faces(m, flag)
+    if len(faces):
+        mine = np.zeros(len(flag), bool)
+        mine[rows] = True
+        faces = faces[mine[_triangle_nodes(m, faces)].any(axis=1)]
+    if not len(faces):
+        raise CommandError("`block gridpoint apply quiet`: the gridpoints in range make no boundary face of a zoned "
+                           "or FE block quiet (a face is quiet when its three gridpoints are: select whole faces, "
+                           "e.g. `range position-z 0` for a base)", call.location)
+    _, problems = face_impedances(m, faces)
+    if problems:
+        raise CommandError("`block gridpoint apply quiet`: " + "; ".join(problems), call.location)
+    bits[rows] |= np.uint8(7 if "quiet" in keys else sum(1 << "xyz".index(k[-1]) for k in keys))
+
+
 @command("block gridpoint apply-remove",
          keywords=[P("velocity", FLAG, "all velocity conditions", bare=True),
                    *[P(f"velocity-{a}", FLAG, f"the {a} velocity condition", bare=True) for a in _AX],
                    P("force", FLAG, "the applied force", bare=True),
-                   *[P(f"force-{a}", FLAG, f"the {a} component of the applied force", bare=True) for a in _AX]],
+                   *[P(f"force-{a}", FLAG, f"the {a} component of the applied force", bare=True) for a in _AX],
+                   P("quiet", FLAG, "the quiet boundary in all directions", bare=True),
+                   *[P(f"quiet-{a}", FLAG, f"the quiet boundary along {a}", bare=True) for a in _AX]],
          range="gridpoint",
          doc="Remove gridpoint conditions (all of them when no keyword is given) in range.",
-         examples=["block gridpoint apply-remove", "block gridpoint apply-remove velocity-z range position-z 0"])
+         examples=["block gridpoint apply-remove", "block gridpoint apply-remove velocity-z range position-z 0",
+                   "block gridpoint apply-remove quiet range position-z 0"])
 def block_gridpoint_apply_remove(session, call):
     a = call.args
     keys = [k for k in ("velocity", "velocity_x", "velocity_y", "velocity_z", "force", "force_x", "force_y",
-                        "force_z") if a[k]]
+                        "force_z", *_QUIET) if a[k]]
     everything = not keys
     rows = _gridpoints(session, call, "block gridpoint apply-remove")
     v = session.model.vertices
+    quiet = [k for k in _QUIET if a[k]]
+    if everything or quiet:
+        from ..model.quiet import quiet_bits
+        drop = 7 if everything or "quiet" in quiet else sum(1 << "xyz".index(k[-1]) for k in quiet)
+        quiet_bits(session.model)[rows] &= np.uint8(~drop & 0xFF)
     for i, ax in enumerate(_AX):
         if everything or a["velocity"] or a[f"velocity_{ax}"]:
             remove_timefns(session.model, "gridpoint", rows, {("velocity", i)})
@@ -163,6 +220,9 @@ def _conditions(v, r) -> str:
             out.append(f"f{ax}={v['fapp'][r, i]:.4g}")
     if np.any(v["fface"][r] != 0.0):
         out.append("face-stress")
+    q = int(v["gquiet"][r]) if "gquiet" in v else 0
+    if q:
+        out.append("quiet" if q == 7 else "quiet-" + "".join(ax for i, ax in enumerate(_AX) if q & (1 << i)))
     if v["link"][r] >= 0:
         out.append(f"linked-to={int(v['link'][r]) + 1}")
     return " ".join(out)

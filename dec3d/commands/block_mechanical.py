@@ -91,8 +91,8 @@ def _alpha(mode, value, where) -> float:
                  "equations), `rayleigh <fraction> <frequency> [mass|stiffness]` (Rayleigh damping C = αM + βK "
                  "with the damping ratio `fraction` least at `frequency` Hz: α = ξω, β = ξ/ω, ω = 2π f; one "
                  "term alone is doubled so that the ratio at f stays ξ; the mass term damps body and gridpoint "
-                 "velocities, the stiffness term the sub-contacts of rigid blocks and the 4-node zones (damping "
-                 "stress β D ε̇), and lowers the time step; "
+                 "velocities, the stiffness term every sub-contact (rigid, zoned and FE sides), the zones (4-node, "
+                 "hexahedral, 10-node) and the FE elements (damping stress β D ε̇), and lowers the time step; "
                  "real masses and full inertia, as with `none`; see dec3d.physics.dynamic). In dynamic mode "
                  "(`model dynamic active on`) only rayleigh damping is applied. `maxwell` is known and not "
                  "supported yet.",

@@ -1,4 +1,4 @@
-"""The stiffness-proportional term of Rayleigh damping on the sub-contacts of rigid blocks.
+"""The stiffness-proportional term of Rayleigh damping on the sub-contacts (rigid, zoned and FE sides).
 
 Itasca's 3DEC "Dynamic Analysis" pages (Damping): stiffness-proportional damping "applies a force,
 which is proportional to the incremental stiffness matrix multiplied by relative velocities [...], to
@@ -53,3 +53,77 @@ def contact_stiffness_damping(beta, bpos, bvel, bspin, ca, cb, cn, cprop, sc_con
         sg[s, 0] -= kn * vn * n0 + ks * (v0 - vn * n0)
         sg[s, 1] -= kn * vn * n1 + ks * (v1 - vn * n1)
         sg[s, 2] -= kn * vn * n2 + ks * (v2 - vn * n2)
+
+
+@njit(cache=True)
+def mixed_stiffness_damping(beta, bpos, bvel, bspin, bforce, bmoment, gvel, gforce, ca, cb, cn, cprop,
+                            sc_contact, sc_pos, sc_area, sc_fn, sc_state, nodes_a, w_a, nodes_b, w_b):
+    """The damping force of the module text on every sub-contact of a model where zoned (or FE) and
+    rigid blocks touch (``gpcontact.mixed_subcontact_forces`` arrays): V from each side's rigid
+    motion or its gridpoints' velocities interpolated with the weights (node -1: rigid side), the
+    force on B (−Fᵈ on A) to a rigid side's centroid with its moment, or to a zoned side's gridpoints
+    in proportion to their weights (added to gforce (nv, 3)). Serial: sub-contacts share blocks and
+    gridpoints. The same rules as ``contact_stiffness_damping`` (closed, not slipping for the shear)."""
+    for s in range(sc_contact.shape[0]):
+        if not sc_fn[s] > 0.0:
+            continue
+        c = sc_contact[s]
+        n0 = cn[c, 0]
+        n1 = cn[c, 1]
+        n2 = cn[c, 2]
+        x0 = sc_pos[s, 0]
+        x1 = sc_pos[s, 1]
+        x2 = sc_pos[s, 2]
+        v0 = 0.0
+        v1 = 0.0
+        v2 = 0.0
+        for side in range(2):
+            blk = ca[c] if side == 0 else cb[c]
+            nodes = nodes_a if side == 0 else nodes_b
+            w = w_a if side == 0 else w_b
+            sg = -1.0 if side == 0 else 1.0
+            if nodes[s, 0] < 0:
+                r0 = x0 - bpos[blk, 0]
+                r1 = x1 - bpos[blk, 1]
+                r2 = x2 - bpos[blk, 2]
+                v0 += sg * (bvel[blk, 0] + bspin[blk, 1] * r2 - bspin[blk, 2] * r1)
+                v1 += sg * (bvel[blk, 1] + bspin[blk, 2] * r0 - bspin[blk, 0] * r2)
+                v2 += sg * (bvel[blk, 2] + bspin[blk, 0] * r1 - bspin[blk, 1] * r0)
+            else:
+                for j in range(3):
+                    g = nodes[s, j]
+                    if g >= 0:
+                        v0 += sg * w[s, j] * gvel[g, 0]
+                        v1 += sg * w[s, j] * gvel[g, 1]
+                        v2 += sg * w[s, j] * gvel[g, 2]
+        vn = v0 * n0 + v1 * n1 + v2 * n2
+        kn = beta * cprop[c, P_KN] * sc_area[s]
+        ks = 0.0 if (sc_state[s] & ST_SLIP) else beta * cprop[c, P_KS] * sc_area[s]
+        d0 = -(kn * vn * n0 + ks * (v0 - vn * n0))
+        d1 = -(kn * vn * n1 + ks * (v1 - vn * n1))
+        d2 = -(kn * vn * n2 + ks * (v2 - vn * n2))
+        for side in range(2):
+            blk = cb[c] if side == 0 else ca[c]
+            nodes = nodes_b if side == 0 else nodes_a
+            w = w_b if side == 0 else w_a
+            sg = 1.0 if side == 0 else -1.0
+            g0 = sg * d0
+            g1 = sg * d1
+            g2 = sg * d2
+            if nodes[s, 0] < 0:
+                r0 = x0 - bpos[blk, 0]
+                r1 = x1 - bpos[blk, 1]
+                r2 = x2 - bpos[blk, 2]
+                bforce[blk, 0] += g0
+                bforce[blk, 1] += g1
+                bforce[blk, 2] += g2
+                bmoment[blk, 0] += r1 * g2 - r2 * g1
+                bmoment[blk, 1] += r2 * g0 - r0 * g2
+                bmoment[blk, 2] += r0 * g1 - r1 * g0
+            else:
+                for j in range(3):
+                    g = nodes[s, j]
+                    if g >= 0:
+                        gforce[g, 0] += w[s, j] * g0
+                        gforce[g, 1] += w[s, j] * g1
+                        gforce[g, 2] += w[s, j] * g2

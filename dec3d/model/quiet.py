@@ -12,6 +12,14 @@ as its quadrilateral, a 10-node zone's face as a 6-node triangle); summed per gr
 symmetric 3×3 dashpot matrix C, and the force −C v is added every step from the gridpoint's
 velocity (``physics.zones.ZoneStepper``).
 
+Quiet gridpoints (``block gridpoint apply quiet|quiet-x|quiet-y|quiet-z``, 3DEC's spelling: its
+`block gridpoint apply` lists `quiet[-x|-y|-z]`): each gridpoint keeps the directions it is quiet in
+(``vertices.gquiet``, bits 1 x, 2 y, 4 z; 0 none). While cycling, the boundary faces whose three
+gridpoints are all quiet (and that are not quiet faces already) load their gridpoints as quiet faces
+do, with the impedances of their zones taken at that time; a gridpoint quiet in some directions only
+keeps the part P C P of its matrix (P the projection on those axes: `quiet-x` damps v_x by a force
+along x). A face is quiet once, whichever command made it so.
+
 Table-driven stress (``block face apply stress-xz … table <id>``): a stress whose value is
 multiplied by a table of time (linear interpolation, end values held outside, as FISH's
 ``table(t, x)``) at the model time of each step. The face keeps the stress (``faces.fdyn``) and the
@@ -25,6 +33,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from dec3d.errors import Dec3dError
+
 from .face_loads import _TRI6, _hex_quads, _lookup, _triangle_nodes, _tri6_faces, loadable_faces
 from .model import KIND_FE
 from .store import Field
@@ -32,6 +42,10 @@ from .zones import ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
 
 _F = np.float64
 _I = np.int64
+
+
+class QuietError(Dec3dError):
+    """A quiet boundary cannot be set up (a zone without density or moduli under quiet gridpoints)."""
 
 
 def _ensure(model) -> None:
@@ -43,6 +57,8 @@ def _ensure(model) -> None:
         f.add_field("fdyn", Field((6,), _F, 0.0))
     if "fdyn_tab" not in f:
         f.add_field("fdyn_tab", Field((), _I, -1))
+    if "gquiet" not in model.vertices:
+        model.vertices.add_field("gquiet", Field((), np.uint8, 0))
 
 
 # ------------------------------------------------------------------ area shares
@@ -193,17 +209,9 @@ def remove_quiet(model, mask: np.ndarray) -> int:
     return len(rows)
 
 
-def quiet_dashpots(model) -> tuple[np.ndarray, np.ndarray] | None:
-    """The dashpot matrices of the quiet faces: (vertex rows (g,), C (g, 3, 3) [N·s/m]) with the
-    gridpoint force −C v; None when no face is quiet. C = Σ a (ρC_s I + (ρC_p − ρC_s) n nᵀ) over
-    the shares a n of the quiet faces at the gridpoint."""
-    f = model.faces
-    if "fquiet" not in f or not f.n:
-        return None
-    rows = np.flatnonzero(f["fquiet"][: f.n, 0] > 0)
-    if not len(rows):
-        return None
-    key = f["fquiet"][rows]
+def _dashpots(model, rows: np.ndarray, key: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(vertex rows, C (g, 3, 3)) of the faces ``rows`` with impedances ``key`` (k, 2):
+    C = Σ a (ρC_s I + (ρC_p − ρC_s) n nᵀ) over the shares a n of the faces at each gridpoint."""
     fi, node, s = face_shares(model, rows, key)
     a = np.sqrt((s * s).sum(axis=1))
     keep = a > 0
@@ -212,6 +220,53 @@ def quiet_dashpots(model) -> tuple[np.ndarray, np.ndarray] | None:
     zp, zs = key[fi, 0], key[fi, 1]
     c = (a * zs)[:, None, None] * np.eye(3)[None] + (a * (zp - zs))[:, None, None] * (n[:, :, None] * n[:, None, :])
     return _per_node(node, c)
+
+
+def quiet_bits(model) -> np.ndarray:
+    """The quiet directions of every vertex row (``vertices.gquiet``, a view: bits 1 x, 2 y, 4 z)."""
+    _ensure(model)
+    return model.vertices["gquiet"][: model.vertices.n]
+
+
+def quiet_gridpoint_faces(model, flagged: np.ndarray | None = None) -> np.ndarray:
+    """Rows of the boundary faces (not quiet faces themselves) whose three gridpoints are quiet
+    gridpoints (``flagged``: a mask over vertex rows to use instead of ``gquiet``)."""
+    _ensure(model)
+    f, v = model.faces, model.vertices
+    on = (v["gquiet"][: v.n] != 0) if flagged is None else flagged
+    if not f.n or not on.any():
+        return np.zeros(0, _I)
+    cand = np.flatnonzero(loadable_faces(model) & (f["fquiet"][: f.n, 0] <= 0))
+    if not len(cand):
+        return cand
+    return cand[on[_triangle_nodes(model, cand)].all(axis=1)]
+
+
+def quiet_dashpots(model) -> tuple[np.ndarray, np.ndarray] | None:
+    """The dashpot matrices of the quiet faces and quiet gridpoints: (vertex rows (g,), C (g, 3, 3)
+    [N·s/m]) with the gridpoint force −C v; None when nothing is quiet. Raises ``QuietError`` when a
+    face of quiet gridpoints has no impedance (its zone lost its properties since)."""
+    f = model.faces
+    if "fquiet" not in f or not f.n:
+        return None
+    parts = []
+    rows = np.flatnonzero(f["fquiet"][: f.n, 0] > 0)
+    if len(rows):
+        parts.append(_dashpots(model, rows, f["fquiet"][rows]))
+    grow = quiet_gridpoint_faces(model)
+    if len(grow):
+        imp, problems = face_impedances(model, grow)
+        if problems:
+            raise QuietError("quiet gridpoints (`block gridpoint apply quiet`): " + "; ".join(problems))
+        node, c = _dashpots(model, grow, imp)
+        bits = model.vertices["gquiet"][node].astype(_I)
+        p = np.stack([(bits >> i) & 1 for i in range(3)], axis=1).astype(_F)
+        parts.append((node, c * p[:, :, None] * p[:, None, :]))
+    if not parts:
+        return None
+    if len(parts) == 1:
+        return parts[0]
+    return _per_node(np.concatenate([q[0] for q in parts]), np.concatenate([q[1] for q in parts]))
 
 
 # ------------------------------------------------------------------ table-driven stresses

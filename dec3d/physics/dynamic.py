@@ -19,9 +19,9 @@ Everything is kept in ``model.settings.mechanical`` (plain JSON, so `model save|
   large (α = 2ξω, or β = 2ξ/ω), so that the damping ratio at f is still ξ (dec3d's reading: the
   page could not be checked for this detail). The mass term is viscous damping of the body,
   gridpoint and node velocities (``kernels.motion`` mode 4, ``kernels.zonestep.gp_motion`` mode 4);
-  the stiffness term acts on the sub-contacts of rigid blocks (``kernels.rayleigh``) and on the 4-node
-  zones as a damping stress β D ε̇ (``zone_stiffness_damping``; not yet on 10-node zones, FE blocks, nor
-  on contacts between rigid and zoned blocks). Stiffness damping lowers the stable step: Δt = Δt₀ (√(1 + λ²) − λ), λ = β / Δt₀ (the central-difference limit 2/ω (√(1 + ξ²) − ξ)
+  the stiffness term acts on the sub-contacts (``kernels.rayleigh``: between rigid blocks, and
+  where a zoned or FE block takes part, its share going to the gridpoints) and on the zones (4-node,
+  hexahedral, 10-node) and FE elements as a damping stress β D ε̇ (``zone_stiffness_damping``). Stiffness damping lowers the stable step: Δt = Δt₀ (√(1 + λ²) − λ), λ = β / Δt₀ (the central-difference limit 2/ω (√(1 + ξ²) − ξ)
   for the highest mode Δt₀ allows, ω = 2/Δt₀, ξ = β ω / 2).
 - ``timefns``: the time functions of `block apply … table|fish` and `block gridpoint apply … table|fish`
   (``TimeFunctions``).
@@ -109,11 +109,13 @@ def damping_text(model) -> str:
 
 
 def zone_stiffness_damping(zst, beta: float, pos, vel, facc) -> None:
-    """Add the gridpoint forces of the damping stresses β D ε̇ of the 4-node zones to ``facc``: the zone
-    step's own kernel, run on zero stresses with the strain increment of the current velocities over a
-    unit time (so it returns −K v, the forces being linear in the stresses and the strains in the
-    velocities), with Mohr-Coulomb zones taken as elastic (the damping stress is not limited by their
-    strength; null zones stay null), times β. ``zst`` is the ``physics.zones.ZoneStepper``."""
+    """Add the gridpoint forces of the damping stresses β D ε̇ of the zones and FE elements to ``facc``:
+    each element kind's own step kernel, run on zero stresses with the strain increment of the current
+    velocities over a unit time (so it returns −K v, the forces being linear in the stresses and the
+    strains in the velocities), times β — the 4-node zones (``zonestep``/``zone_plastic``, Mohr-Coulomb
+    zones taken as elastic: the damping stress is not limited by their strength; null zones stay null),
+    the 10-node zones (``zones_ho.tet10_step``) and the FE elements with their hourglass control
+    (``FeStepper.stiffness_damping``). ``zst`` is the ``physics.zones.ZoneStepper``."""
     from dec3d.kernels.zone_plastic import zone_forces_plastic
     from dec3d.kernels.zonestep import zone_forces
     from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_MOHR
@@ -123,18 +125,25 @@ def zone_stiffness_damping(zst, beta: float, pos, vel, facc) -> None:
     if sc is None or sc[0].shape != zs["stress"].shape or sc[2].shape != facc.shape:
         cm = np.where(zs["cmodel"] == ZMODEL_MOHR, ZMODEL_ELASTIC, zs["cmodel"]).astype(zs["cmodel"].dtype)
         sc = zst._rayleigh_scratch = (np.zeros_like(zs["stress"]), np.zeros_like(zs["state"]), np.zeros_like(facc),
-                                      np.zeros(facc.shape[0]), cm)
-    stress, state, f, fm, cm = sc
+                                      np.zeros(facc.shape[0]), cm,
+                                      np.zeros_like(zs["gstress"]) if len(zst.rows10) else None)
+    stress, state, f, fm, cm, gstress = sc
     stress[:] = 0.0
     state[:] = 0
     f[:] = 0.0
     fm[:] = 0.0
-    if zst.plastic:
+    if len(zst.rows4) and zst.plastic:
         zone_forces_plastic(pos, vel, zs["gp"], zst.rows4, zst.zset, zst.weight, zst.nset, zst.node, cm, zs["prop"],
                             1.0, False, zst.nmd, stress, state, f, fm)
-    else:
+    elif len(zst.rows4):
         zone_forces(pos, vel, zs["gp"], zst.rows4, zst.zset, zst.weight, zst.nset, zst.bulk, zst.shear, 1.0, False,
                     stress, f, fm)
+    if gstress is not None:
+        from dec3d.kernels.zones_ho import tet10_step
+        gstress[zst.rows10] = 0.0
+        tet10_step(pos, vel, zs["gp"], zst.rows10, zst.bulk, zst.shear, 1.0, gstress, stress, f)
+    if zst.fe is not None:
+        zst.fe.stiffness_damping(pos, vel, f)
     facc[zst.rows] += beta * f[zst.rows]
 
 

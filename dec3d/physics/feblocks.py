@@ -161,6 +161,23 @@ class FeStepper:
             mag[self.masters] += np.abs(w) * float(np.sqrt(g @ g))
         return first
 
+    def stiffness_damping(self, pos, vel, f) -> None:
+        """Add −K v of the elastic elements (hourglass control included) to f (nv, 3): the element
+        pass on zero stresses with the strain increment of ``vel`` over a unit time (for Rayleigh
+        damping's stiffness term, ``physics.dynamic.zone_stiffness_damping``); the element stresses
+        are not touched."""
+        es = self.model.store("feblocks")
+        sc = getattr(self, "_damp_scratch", None)
+        if sc is None or sc[0].shape != es["gstress"].shape or len(sc[2]) != len(f):
+            sc = self._damp_scratch = (np.zeros_like(es["gstress"]), np.zeros_like(es["stress"]), np.zeros(len(f)))
+        gs, st, mag = sc
+        for (q, h, rows), (fe, ok, nstart, nent) in zip(self.groups, self.scratch):
+            gs[rows] = 0.0
+            par = len(rows) > PARALLEL_MIN
+            (feb_element_pass if par else feb_element_pass_serial)(pos, vel, self.nodes, rows, self.bulk,
+                                                                  self.shear, 1.0, gs, st, fe, ok, q, h)
+            (feb_node_sums_mag if par else feb_node_sums_mag_serial)(f, mag, fe, ok, nstart, nent)
+
     def slave_stiffness(self, k: np.ndarray) -> None:
         """Move stiffness put on slave rows (contacts, Eq. 85) to the masters (their link
         masters), weighted by |N_a| at the slave (a bound of what Eq. 9 carries to each)."""

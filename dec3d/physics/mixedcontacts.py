@@ -12,6 +12,7 @@ from dec3d.kernels.gpcontact import (mixed_move_points, mixed_subcontact_forces,
                                     take_contact_forces, vertex_sides)
 from dec3d.kernels.joints import P_KN, P_KS
 from dec3d.kernels.motion import rigid_motion_groups
+from dec3d.kernels.rayleigh import mixed_stiffness_damping
 from dec3d.model.model import KIND_DEFORMABLE, KIND_FE
 
 _I = np.int64
@@ -103,6 +104,10 @@ class MixedContactSteps:
                                     cs["a"], cs["b"], cs["normal"], cs["jmodel"], cs["prop"], ss["contact"], ss["pos"],
                                     ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"],
                                     *wsub)
+            if zst.beta > 0.0:          # Rayleigh damping's stiffness term (physics.dynamic)
+                mixed_stiffness_damping(zst.beta, b["centroid"], b["velocity"], b["spin"], b["force"], b["moment"],
+                                        gvel, gc, cs["a"], cs["b"], cs["normal"], cs["prop"], ss["contact"],
+                                        ss["pos"], ss["area"], ss["fn"], ss["state"], *wsub)
             take_contact_forces(touched, gc, facc, zst.fmag)
             if len(gmember):
                 gbad = rigid_motion_groups(dt, g, full, damping, groups, bodies, vmax, out)

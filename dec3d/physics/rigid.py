@@ -163,13 +163,33 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         jm = JOINT_MODELS[s["jmodel"]]
         drow = jm.row(s["props"])
         kn = max(drow[P_KN], drow[P_KS])
+        # Eqs. (87)-(88) over the blocks that move: a block whose six velocity components are all
+        # held (`block fix`, `block apply velocity …`, or those of the leader it is joined to) takes
+        # no force-driven step, so neither its mass nor its faces (a large fixed base) bound Δt
+        live = (b["mass"] > 0) & ~b["hidden"]
+        moving = live & ~self._held_still()
+        if moving.any():
+            live = moving
         c = self.contacts
         if c.n:
-            kn = max(kn, float(c["prop"][:, [P_KN, P_KS]].max()))
-        area = float(self.model.faces["area"].max()) if self.model.faces.n else 1.0
-        live = (b["mass"] > 0) & ~b["hidden"]
+            on = live[c["a"]] | live[c["b"]]
+            if on.any():
+                kn = max(kn, float(c["prop"][on][:, [P_KN, P_KS]].max()))
+        f = self.model.faces
+        fb = f["block"]
+        fa = f["area"][(fb >= 0) & live[np.maximum(fb, 0)]]
+        area = float(fa.max()) if len(fa) else 1.0
         mmin = float(b["mass"][live].min()) if live.any() else 1.0
         return block_timestep(mmin, kn * area, float(s["frac"])) or 1e-3
+
+    def _held_still(self) -> np.ndarray:
+        """Per block: all six velocity components held (bits 0-5 of ``fixity | apply_fix``, of the
+        block or of the leader of its joined group)."""
+        b = self.model.blocks
+        held = (b["fixity"] | b["apply_fix"]).astype(_I)
+        lead = b["leader"]
+        held = np.where(lead >= 0, held[np.maximum(lead, 0)], held)
+        return (held & 63) == 63
 
     def damping(self) -> tuple[int, float]:
         """(damping mode code, α) for the motion kernel (Rayleigh: α is its mass term's viscous

@@ -481,9 +481,10 @@ model cycle 1500
     v = values(s.model)
     assert v["body"] > 1000.0 and v["contact-slip"] > 0.0
     # not round-off here: during the impact the arms of the spinning bodies turn within a step, and the
-    # joint law's increment (arms at t) and the work with the mid velocity differ by O(Δt) (0.02 % without
-    # damping; 0.3 % with density scaling, whose masses change at every detection)
-    assert v["error-relative"] < (1e-3 if damping == "none" else 1e-2)
+    # joint law's increment (arms at t) and the work with the mid velocity differ by O(Δt) (0.23 % without
+    # damping, at the step of the moving L alone — 0.02 % when the fixed base's 49 m² face still made it 5
+    # times smaller; 0.3 % with density scaling, whose masses change at every detection)
+    assert v["error-relative"] < (5e-3 if damping == "none" else 1e-2)
     if damping == "none":
         assert abs(v["damping"]) < 1e-3 * v["body"]
     else:
