@@ -56,7 +56,9 @@ MECH_DEFAULTS = {
     "servo": [],               # adaptive global damping state (kernels.motion, first NSERVO entries)
     "servo_ratio": 0.5,        # its target ratio
     "scale_timestep": None,    # Δt wanted with density scaling [s] (None: Eq. 87, median body)
-    "scaling": "eq87",         # density scaling: eq87 (Eq. 87, masses only raised) | body (stiffness row sums)
+    "scaling": "auto",         # density scaling: eq87 (Eq. 87, masses only raised) | body (stiffness row sums)
+                               # | raised (body, no mass lowered) | auto (raised in static runs with local or
+                               # combined damping, else eq87: RigidEngine.scaling)
     "safety": None,            # body scaling: ω_max Δt ≤ 2 × safety (None: SAFETY by damping mode)
     "dt_run": [],              # [Δt, step]: the step the last rigid run ended on and the Δt it was using
     **DYN_DEFAULTS,            # dynamic mode, dynamic time, Rayleigh damping, time functions (physics.dynamic)
@@ -117,6 +119,8 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         self._zstep = None
         #: the steps of the last run's cycle, in order (``_Run``: RigidBatch, Clock, Hooks, ...)
         self.steps: list = []
+        #: the last detection kept every contact as it was (``ContactDetection.detect``)
+        self.detect_kept_all = False
         contact_stores(model)
 
     # ------------------------------------------------------------ model-backed state
@@ -195,6 +199,23 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         s = self.settings()
         return s["mass_scale"] == "on" or (s["mass_scale"] == "auto" and not self._dynamic_style())
 
+    def scaling(self) -> str:
+        """The density scaling in effect when it is on: ``body`` (``mass-scale body``: every body
+        at the same critical step, masses raised or lowered), ``raised`` (the same, but no mass
+        below its real value) or ``eq87``. The default (setting ``auto``) of a static run with
+        local or combined damping is ``raised``: "Density scaling is the default mode for static
+        analysis with 3DEC", "inertial densities may be increased" and scaling "is only effective
+        ... if the natural timesteps differ for different parts of the model" (3DEC theory text,
+        "Mass (Density) Scaling"). Eq. (87) when scaling is forced on (``mass-scale on``, or a
+        ``mass-scale timestep`` for the partial scaling of a dynamic run) and with adaptive global
+        damping, with which the larger steps of the body scaling left a spring 1 % short of its
+        static closure and let a block that friction holds slide off (dec3d's measurements,
+        bench/README.md)."""
+        s = self.settings()
+        if s["scaling"] != "auto":
+            return s["scaling"]
+        return "raised" if s["mass_scale"] == "auto" and s["damping"] in ("local", "combined") else "eq87"
+
     def full_inertia(self) -> bool:
         s = self.settings()
         return s["inertia"] == "full" or (s["inertia"] == "auto" and self._dynamic_style())
@@ -232,7 +253,7 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         if not self.mass_scaling() or not len(gmass):
             dt = dt_fixed if dt_fixed is not None else stiffness_timestep(self.timestep(), self.rayleigh_beta())
             return dt, gmass.copy(), giscalar.copy()
-        if s["scaling"] == "body":
+        if self.scaling() in ("body", "raised"):
             return self._body_masses(gstart, gmember, gmass, giscalar, dt_fixed)
         kg = self._stiffness_sums(gstart, gmember)
         if dt_fixed is None and s["scale_timestep"]:
@@ -289,6 +310,12 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         f = (dt / (2.0 * safety)) ** 2
         im = np.where(on, rt * f, gmass)
         isc = np.where(rr > 0, rr * f, giscalar)
+        if self.scaling() == "raised":
+            # the default of static runs: densities only increased (3DEC theory text, "Mass
+            # (Density) Scaling"), so no body is lighter than it is; a block that loses most of
+            # its contact stiffness (tipping onto an edge, sliding off) keeps its real inertia
+            im = np.maximum(im, gmass)
+            isc = np.maximum(isc, giscalar)
         if self.full_inertia():
             ratio = np.maximum(im / gmass, isc / giscalar)
             im, isc = gmass * ratio, giscalar * ratio

@@ -149,6 +149,16 @@ class _Run:
             if msg:
                 warn(msg)
         self.scaled = eng.mass_scaling()
+        # density scaling by body works its masses out from the geometry, which moves between
+        # detections: a run that starts on the step where the last one ended takes that run's
+        # masses and Δt back (block fields ``scaled_mass``, ``scaled_inertia``) unless what they
+        # depend on besides the geometry changed, so a split run takes exactly the steps of one run
+        self.by_body = self.scaled and eng.scaling() in ("body", "raised") and self.ng > 0
+        self.scale_key = self._scale_key() if self.by_body else ""
+        resume = (self.by_body and not fresh and len(last) == 2 and int(last[1]) == m.step
+                  and s.get("dt_mode", self.dt_mode) == self.dt_mode and s.get("scale_key") == self.scale_key
+                  and bool(np.all(b["scaled_mass"][gmember] > 0)))
+        between = between or (resume and self.dt_fixed is None)
         dt_last = float(last[0]) if self.dt_fixed is None and between else None
         if self.zoned:
             if dt_last is not None and not self.scaled and getattr(self.zst, "cdash", None) is not None:
@@ -157,6 +167,10 @@ class _Run:
             self.zst.set_masses(dt, self.scaled)
             if self.ng:
                 self.masses(dt)
+        elif resume:
+            lead = gmember[gstart[:-1]]
+            self.gimass, self.gisc = b["scaled_mass"][lead].copy(), b["scaled_inertia"][lead].copy()
+            dt = dt_last if dt_last is not None else self.dt_fixed
         else:
             dt = self.masses(dt_last if dt_last is not None else self.dt_fixed)
         self.dt = eng.dt = dt
@@ -183,7 +197,30 @@ class _Run:
     def masses(self, dt):
         """Inertial masses of the rigid groups for Δt ``dt`` (None: Δt from the stiffnesses); returns Δt."""
         dt, self.gimass, self.gisc = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, dt)
+        if self.by_body:
+            counts = np.diff(self.gstart)
+            self.b["scaled_mass"][self.gmember] = np.repeat(self.gimass, counts)
+            self.b["scaled_inertia"][self.gmember] = np.repeat(self.gisc, counts)
         return dt
+
+    def _scale_key(self) -> str:
+        """What density scaling by body depends on besides the geometry and the contacts: its
+        settings and the bodies (membership, fixity, masses), as a short digest."""
+        import hashlib
+
+        s = self.s
+        h = hashlib.sha1(repr((self.eng.scaling(), s["safety"], s["scale_timestep"], s["damping"],
+                               self.full)).encode())
+        for a in (self.gstart, self.gmember, self.fixity, self.gmass, self.giscalar):
+            h.update(np.ascontiguousarray(a).tobytes())
+        return h.hexdigest()[:16]
+
+    def _keeps_masses(self) -> bool:
+        """A detection that kept every contact as it was leaves density scaling by body as it is
+        (as a detection left out does, ``quiet``), unless a callback could have changed the bodies."""
+        eng = self.eng
+        return (self.by_body and eng.detect_kept_all and self.gimass is not None and not eng.pre_steps
+                and all(isinstance(h, HistorySet) for h in eng.step_hooks))
 
     def _zoned_dt(self) -> float:
         """Δt of a model with zoned blocks for the contacts as they are now."""
@@ -244,6 +281,8 @@ class _Run:
         for st in self.steps:
             st.prepare()
         if not self.zoned:
+            if self._keeps_masses():
+                return
             if self.dt_fixed is None:
                 # the contacts made or lost change the stiffness each body feels
                 self.dt = eng.dt = self.masses(None)
@@ -268,6 +307,7 @@ class _Run:
             self.zst.finish(self.large)
         s["dt_run"] = [float(eng.dt), int(m.step)]
         s["dt_mode"] = self.dt_mode
+        s["scale_key"] = self.scale_key
         if self.ng or not self.zoned:
             # keep each block's principal axes turning with its body
             gstart, gmember, gaxes = self.gstart, self.gmember, self.gaxes
