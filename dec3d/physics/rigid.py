@@ -83,6 +83,10 @@ def _has_gridpoints(m) -> bool:
 #: adaptive damping settles there (dec3d's measurements, bench/README.md)
 SAFETY = {"local": 0.7, "combined": 0.7, "global": 0.8, "none": 0.8}
 
+#: density scaling by body: the Δt in use is kept at a detection while the stiffnesses ask for
+#: one within these factors of it (``RigidEngine._body_masses``)
+KEEP_DT = (0.8, 1.25)
+
 #: local/maximum ratios are scaled by this so that they mean about the same as the average
 #: (Itasca, ``zone ratio`` / ``structure ratio`` command pages, see ``RigidEngine.criteria``)
 RATIO_SCALE = 0.1
@@ -208,13 +212,16 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         ... if the natural timesteps differ for different parts of the model" (3DEC theory text,
         "Mass (Density) Scaling"). Eq. (87) when scaling is forced on (``mass-scale on``, or a
         ``mass-scale timestep`` for the partial scaling of a dynamic run) and with adaptive global
-        damping, with which the larger steps of the body scaling left a spring 1 % short of its
-        static closure and let a block that friction holds slide off (dec3d's measurements,
-        bench/README.md)."""
+        damping, with which the larger steps of the body scaling let a block that friction holds
+        slide off an incline (dec3d's measurements, bench/README.md); and in models with zoned or
+        FE blocks."""
         s = self.settings()
         if s["scaling"] != "auto":
             return s["scaling"]
-        return "raised" if s["mass_scale"] == "auto" and s["damping"] in ("local", "combined") else "eq87"
+        static = s["mass_scale"] == "auto" and s["damping"] in ("local", "combined")
+        # (models with zoned or FE blocks keep Eq. 87 for their rigid blocks: their gridpoints have
+        # their own scaling, and the mixed energy balance measured 5e-9 instead of < 1e-9)
+        return "raised" if static and not _has_gridpoints(self.model) else "eq87"
 
     def full_inertia(self) -> bool:
         s = self.settings()
@@ -246,15 +253,17 @@ class RigidEngine(ContactDetection, MixedContactSteps):
             kb += np.bincount(cs["a"][c], k, minlength=b.n) + np.bincount(cs["b"][c], k, minlength=b.n)
         return np.add.reduceat(kb[gmember], gstart[:-1]) if len(gmember) else np.zeros(0)
 
-    def _masses(self, gstart, gmember, gmass, giscalar, dt_fixed):
-        """(Δt, inertial masses, scaled scalar inertias) of the groups; density scaling when on."""
+    def _masses(self, gstart, gmember, gmass, giscalar, dt_fixed, near=None):
+        """(Δt, inertial masses, scaled scalar inertias) of the groups; density scaling when on.
+        ``near``: by body, the Δt in use, kept when the one the stiffnesses ask for is within
+        ``KEEP_DT`` of it (``_body_masses``)."""
         s = self.settings()
         frac = float(s["frac"])
         if not self.mass_scaling() or not len(gmass):
             dt = dt_fixed if dt_fixed is not None else stiffness_timestep(self.timestep(), self.rayleigh_beta())
             return dt, gmass.copy(), giscalar.copy()
         if self.scaling() in ("body", "raised"):
-            return self._body_masses(gstart, gmember, gmass, giscalar, dt_fixed)
+            return self._body_masses(gstart, gmember, gmass, giscalar, dt_fixed, near)
         kg = self._stiffness_sums(gstart, gmember)
         if dt_fixed is None and s["scale_timestep"]:
             dt_fixed = float(s["scale_timestep"])
@@ -269,7 +278,7 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         im, isc = inertial_masses(gmass, giscalar, kg, dt, frac)
         return dt, im, isc
 
-    def _body_masses(self, gstart, gmember, gmass, giscalar, dt_fixed):
+    def _body_masses(self, gstart, gmember, gmass, giscalar, dt_fixed, near=None):
         """Density scaling by body (``mass-scale body``): every body's inertial mass and scalar
         inertia set from the Gershgorin row sums of the contact stiffness around it (kernel
         ``bodyscale.body_row_sums``) so that each body has the same critical step, and the
@@ -305,6 +314,12 @@ class RigidEngine(ContactDetection, MixedContactSteps):
             dt = dt_fixed
         elif on.any():
             dt = 2.0 * safety * float(np.median(np.sqrt(gmass[on] / rt[on])))
+            # the joint law takes each step's displacement as velocity × the Δt in use, so a Δt that
+            # changes while blocks move leaves the contact's closure off the geometry by v ΔΔt (a
+            # block on a spring settled 0.17 % short); the masses below keep any Δt stable, so the
+            # one in use stays unless the stiffnesses ask for a clearly different one
+            if near is not None and near > 0 and KEEP_DT[0] <= dt / near <= KEEP_DT[1]:
+                dt = near
         else:
             dt = self.timestep()
         f = (dt / (2.0 * safety)) ** 2

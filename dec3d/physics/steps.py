@@ -194,9 +194,11 @@ class _Run:
         return Bodies(b["mass"], self.fixity, b["force"], b["moment"], b["fapp"], b["mapp"], b["velocity"], b["spin"],
                       b["centroid"], b["disp"], b["vert_start"], b["vert_count"], self.m.vertices["pos"])
 
-    def masses(self, dt):
-        """Inertial masses of the rigid groups for Δt ``dt`` (None: Δt from the stiffnesses); returns Δt."""
-        dt, self.gimass, self.gisc = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, dt)
+    def masses(self, dt, near=None):
+        """Inertial masses of the rigid groups for Δt ``dt`` (None: Δt from the stiffnesses, or
+        ``near`` when it is close, by body); returns Δt."""
+        dt, self.gimass, self.gisc = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, dt,
+                                                      near)
         if self.by_body:
             counts = np.diff(self.gstart)
             self.b["scaled_mass"][self.gmember] = np.repeat(self.gimass, counts)
@@ -227,7 +229,9 @@ class _Run:
         if self.dt_fixed is not None:
             return self.dt_fixed
         ng = self.ng
-        dt_r = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, None)[0] if ng else math.inf
+        near = getattr(self, "dt", None) if self.by_body else None
+        dt_r = (self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, None, near)[0] if ng
+                else math.inf)
         d = ((dt_r if ng else float(self.s["scale_timestep"] or 1.0)) if self.scaled
              else min(dt_r, stiffness_timestep(self.zst.natural_timestep(), self.beta)))
         return d if math.isfinite(d) and d > 0 else 1.0
@@ -285,7 +289,7 @@ class _Run:
                 return
             if self.dt_fixed is None:
                 # the contacts made or lost change the stiffness each body feels
-                self.dt = eng.dt = self.masses(None)
+                self.dt = eng.dt = self.masses(None, self.dt if self.by_body else None)
             elif eng.mass_scaling():
                 self.masses(self.dt)
             return
