@@ -204,17 +204,12 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         return s["mass_scale"] == "on" or (s["mass_scale"] == "auto" and not self._dynamic_style())
 
     def scaling(self) -> str:
-        """The density scaling in effect when it is on: ``body`` (``mass-scale body``: every body
-        at the same critical step, masses raised or lowered), ``raised`` (the same, but no mass
-        below its real value) or ``eq87``. The default (setting ``auto``) of a static run with
-        local or combined damping is ``raised``: "Density scaling is the default mode for static
-        analysis with 3DEC", "inertial densities may be increased" and scaling "is only effective
-        ... if the natural timesteps differ for different parts of the model" (3DEC theory text,
-        "Mass (Density) Scaling"). Eq. (87) when scaling is forced on (``mass-scale on``, or a
-        ``mass-scale timestep`` for the partial scaling of a dynamic run) and with adaptive global
-        damping, with which the larger steps of the body scaling let a block that friction holds
-        slide off an incline (dec3d's measurements, bench/README.md); and in models with zoned or
-        FE blocks."""
+        """Density scaling in effect when on: ``body`` (every body at the same critical step),
+        ``raised`` (the same, no mass below its real value) or ``eq87``. Default (``auto``) of a
+        static run with local or combined damping on rigid blocks only: ``raised`` (3DEC theory
+        text, "Mass (Density) Scaling": "Density scaling is the default mode for static analysis",
+        "inertial densities may be increased", effective "if the natural timesteps differ");
+        otherwise Eq. (87) (``mass-scale on``/``timestep``, global damping: see the command page)."""
         s = self.settings()
         if s["scaling"] != "auto":
             return s["scaling"]

@@ -125,6 +125,8 @@ def test_mass_scale_body_settings_and_bad_input(session):
     _run(session, "block mechanical mass-scale automatic\n")
     assert (m["scaling"], m["mass_scale"]) == ("auto", "auto")
     assert engine(session.model).scaling() == "raised"    # the default of static runs with local damping
+    _run(session, "model dynamic list\n")
+    assert "density scaling     : on (by body, masses only raised)" in session.output.getvalue()
     _run(session, "block mechanical damping global\n")
     assert engine(session.model).scaling() == "eq87"
     _run(session, "block mechanical damping local\n")
