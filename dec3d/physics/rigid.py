@@ -79,13 +79,15 @@ def _has_gridpoints(m) -> bool:
 
 #: default ``safety`` of density scaling by body, per damping mode: local (and combined) damping
 #: takes the sign of a half-step-old velocity, which at ω Δt near 1.6 lags enough to sustain a
-#: rocking cycle (a joined column failed to settle at 0.8, settled at 0.75); the viscous
-#: adaptive damping settles there (dec3d's measurements, bench/README.md)
+#: rocking cycle (a joined column failed to settle at 0.8, settled at 0.75); the viscous adaptive
+#: damping settles there (dec3d's measurements, bench/README.md)
 SAFETY = {"local": 0.7, "combined": 0.7, "global": 0.8, "none": 0.8}
 
-#: density scaling by body: the Δt in use is kept at a detection while the stiffnesses ask for
-#: one within these factors of it (``RigidEngine._body_masses``)
-KEEP_DT = (0.8, 1.25)
+#: by body, the Δt in use stays at a detection unless the stiffnesses ask for less than this part
+KEEP_DT = 0.8
+
+#: ... for the default scaling (masses only raised); at 0.7 DY5's slide ran 2 % fast after its settle
+SAFETY_RAISED = 0.5
 
 #: local/maximum ratios are scaled by this so that they mean about the same as the average
 #: (Itasca, ``zone ratio`` / ``structure ratio`` command pages, see ``RigidEngine.criteria``)
@@ -214,8 +216,7 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         if s["scaling"] != "auto":
             return s["scaling"]
         static = s["mass_scale"] == "auto" and s["damping"] in ("local", "combined")
-        # (models with zoned or FE blocks keep Eq. 87 for their rigid blocks: their gridpoints have
-        # their own scaling, and the mixed energy balance measured 5e-9 instead of < 1e-9)
+        # (zoned or FE blocks: Eq. 87, the mixed energy balance measured 5e-9 instead of < 1e-9)
         return "raised" if static and not _has_gridpoints(self.model) else "eq87"
 
     def full_inertia(self) -> bool:
@@ -250,7 +251,7 @@ class RigidEngine(ContactDetection, MixedContactSteps):
 
     def _masses(self, gstart, gmember, gmass, giscalar, dt_fixed, near=None):
         """(Δt, inertial masses, scaled scalar inertias) of the groups; density scaling when on.
-        ``near``: by body, the Δt in use, kept when the one the stiffnesses ask for is within
+        ``near``: by body, the Δt in use, kept unless the stiffnesses ask for less than
         ``KEEP_DT`` of it (``_body_masses``)."""
         s = self.settings()
         frac = float(s["frac"])
@@ -288,7 +289,8 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         that every part of the model has the same step. With full inertia (Euler's equations) the
         principal moments take the larger of the two ratios m_i / m, I_i / I."""
         s = self.settings()
-        safety = float(s["safety"] or SAFETY.get(s["damping"], 0.7))
+        raised = self.scaling() == "raised"
+        safety = float(s["safety"] or (SAFETY_RAISED if raised else SAFETY.get(s["damping"], 0.7)))
         b = self.model.blocks
         cs, ss = self.contacts, self.subcontacts
         ng = len(gstart) - 1
@@ -305,22 +307,24 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         if dt_fixed is None and s["scale_timestep"]:
             dt_fixed = float(s["scale_timestep"])
         on = rt > 0
+        #: whether the last body scaling had contacts to set Δt from (``steps._Run.masses``)
+        self.body_dt_from_contacts = bool(on.any())
         if dt_fixed is not None:
             dt = dt_fixed
         elif on.any():
             dt = 2.0 * safety * float(np.median(np.sqrt(gmass[on] / rt[on])))
-            # the joint law takes each step's displacement as velocity × the Δt in use, so a Δt that
-            # changes while blocks move leaves the contact's closure off the geometry by v ΔΔt (a
-            # block on a spring settled 0.17 % short); the masses below keep any Δt stable, so the
-            # one in use stays unless the stiffnesses ask for a clearly different one
-            if near is not None and near > 0 and KEEP_DT[0] <= dt / near <= KEEP_DT[1]:
+            # the masses below keep any Δt stable, so in a run Δt never grows (a block sliding or tipping
+            # off its contacts got ever longer steps: R1, F1 blew up) and falls only when clearly asked:
+            # the joint law takes velocity × the Δt in use, a changing Δt leaves closures v ΔΔt off the
+            # geometry (a block on a spring settled 0.17 % short)
+            if near is not None and near > 0 and dt >= KEEP_DT * near:
                 dt = near
         else:
             dt = self.timestep()
         f = (dt / (2.0 * safety)) ** 2
         im = np.where(on, rt * f, gmass)
         isc = np.where(rr > 0, rr * f, giscalar)
-        if self.scaling() == "raised":
+        if raised:
             # the default of static runs: densities only increased (3DEC theory text, "Mass
             # (Density) Scaling"), so no body is lighter than it is; a block that loses most of
             # its contact stiffness (tipping onto an edge, sliding off) keeps its real inertia

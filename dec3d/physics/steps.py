@@ -155,6 +155,7 @@ class _Run:
         # depend on besides the geometry changed, so a split run takes exactly the steps of one run
         self.by_body = self.scaled and eng.scaling() in ("body", "raised") and self.ng > 0
         self.scale_key = self._scale_key() if self.by_body else ""
+        self.body_dt_set = False
         resume = (self.by_body and not fresh and len(last) == 2 and int(last[1]) == m.step
                   and s.get("dt_mode", self.dt_mode) == self.dt_mode and s.get("scale_key") == self.scale_key
                   and bool(np.all(b["scaled_mass"][gmember] > 0)))
@@ -170,6 +171,7 @@ class _Run:
         elif resume:
             lead = gmember[gstart[:-1]]
             self.gimass, self.gisc = b["scaled_mass"][lead].copy(), b["scaled_inertia"][lead].copy()
+            self.body_dt_set = True
             dt = dt_last if dt_last is not None else self.dt_fixed
         else:
             dt = self.masses(dt_last if dt_last is not None else self.dt_fixed)
@@ -200,6 +202,8 @@ class _Run:
         dt, self.gimass, self.gisc = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, dt,
                                                       near)
         if self.by_body:
+            # (Δt set from contacts: from now on it never grows in this run, ``_body_masses``)
+            self.body_dt_set = self.body_dt_set or self.eng.body_dt_from_contacts
             counts = np.diff(self.gstart)
             self.b["scaled_mass"][self.gmember] = np.repeat(self.gimass, counts)
             self.b["scaled_inertia"][self.gmember] = np.repeat(self.gisc, counts)
@@ -229,7 +233,7 @@ class _Run:
         if self.dt_fixed is not None:
             return self.dt_fixed
         ng = self.ng
-        near = getattr(self, "dt", None) if self.by_body else None
+        near = getattr(self, "dt", None) if self.by_body and self.body_dt_set else None
         dt_r = (self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, None, near)[0] if ng
                 else math.inf)
         d = ((dt_r if ng else float(self.s["scale_timestep"] or 1.0)) if self.scaled
@@ -289,7 +293,7 @@ class _Run:
                 return
             if self.dt_fixed is None:
                 # the contacts made or lost change the stiffness each body feels
-                self.dt = eng.dt = self.masses(None, self.dt if self.by_body else None)
+                self.dt = eng.dt = self.masses(None, self.dt if self.by_body and self.body_dt_set else None)
             elif eng.mass_scaling():
                 self.masses(self.dt)
             return
