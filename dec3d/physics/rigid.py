@@ -210,8 +210,7 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         ``raised`` (the same, no mass below its real value) or ``eq87``. Default (``auto``) of a
         static run with local or combined damping on rigid blocks only: ``raised`` (3DEC theory
         text, "Mass (Density) Scaling": "Density scaling is the default mode for static analysis",
-        "inertial densities may be increased", effective "if the natural timesteps differ");
-        otherwise Eq. (87) (``mass-scale on``/``timestep``, global damping: see the command page)."""
+        "inertial densities may be increased"); else Eq. (87) (see the command page)."""
         s = self.settings()
         if s["scaling"] != "auto":
             return s["scaling"]
