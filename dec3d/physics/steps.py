@@ -223,10 +223,8 @@ class _Run:
 
     def _keeps_masses(self) -> bool:
         """A detection that kept every contact as it was leaves density scaling by body as it is
-        (as a detection left out does, ``quiet``), unless a callback could have changed the bodies."""
-        eng = self.eng
-        return (self.by_body and eng.detect_kept_all and self.gimass is not None and not eng.pre_steps
-                and all(isinstance(h, HistorySet) for h in eng.step_hooks))
+        (as a detection left out does, ``quiet``: a run resumed there then agrees with one run)."""
+        return self.by_body and self.eng.detect_kept_all and self.gimass is not None
 
     def _zoned_dt(self) -> float:
         """Δt of a model with zoned blocks for the contacts as they are now."""
