@@ -229,7 +229,7 @@ def main() -> int:
     if args.equilibrium:
         print(f"machine: {machine()}")
         setup = "".join(line.strip() + "\n" for line in args.setup.split(";") if line.strip())
-        print(f"setup: {args.setup or '(scene as is: local damping 0.8, Eq. 87 density scaling)'}; "
+        print(f"setup: {args.setup or '(scene as is: local damping 0.8, default density scaling: by body, masses raised)'}; "
               f"load average before: {os.getloadavg()[0]:.2f}")
         for n in args.n:
             runs = [equilibrium(n, args.jmodel, solve=setup) for _ in range(args.repeat)]

@@ -47,7 +47,8 @@ def dynamic_list(session, call):
     session.write(f"dynamic mode        : {'on' if on else 'off'}")
     session.write(f"dynamic time-total  : {dynamic_time(m):.6g} s")
     session.write(f"damping             : {damping_text(m)}")
-    session.write(f"density scaling     : {'on' if eng.mass_scaling() else 'off (real masses)'}")
+    kind = {"raised": "by body, masses only raised", "body": "by body", "eq87": "Eq. 87"}[eng.scaling()]
+    session.write(f"density scaling     : {f'on ({kind})' if eng.mass_scaling() else 'off (real masses)'}")
     session.write(f"inertia             : {'full (Euler equations)' if eng.full_inertia() else 'scalar'}")
     session.write(f"time step           : {eng.dt:.6g} s" + (" (last cycle)" if eng.dt else " (not cycled yet)"))
 

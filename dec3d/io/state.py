@@ -382,7 +382,7 @@ def _settings_problem(d: dict) -> str | None:
     if not isinstance(m, dict):
         return "the mechanical settings are not an object"
     choices = {"damping": ("local", "combined", "global", "none", "rayleigh"), "mass_scale": ("on", "off", "auto"),
-               "scaling": ("eq87", "body"),
+               "scaling": ("eq87", "body", "raised", "auto"),
                "inertia": ("full", "scalar", "auto"), "jmodel": tuple(sorted(_known()["joint_models"]))}
     for k, options in choices.items():
         if k in m and m[k] not in options:

@@ -65,6 +65,10 @@ def _block_fields() -> dict[str, Field]:
         "principal_moment": Field((3,), _F, 0.0),
         "principal_axes": Field((3, 3), _F, 0.0),
         "inertia_approx": Field((), _F, 0.0),
+        # density scaling by body: the inertial mass and scalar inertia of the block's body at the
+        # last detection (0: not worked out), so a run split into several commands goes on with them
+        "scaled_mass": Field((), _F, 0.0),
+        "scaled_inertia": Field((), _F, 0.0),
         "velocity": Field((3,), _F, 0.0),
         "spin": Field((3,), _F, 0.0),
         "force": Field((3,), _F, 0.0),

@@ -415,6 +415,10 @@ class ContactDetection:
                     "state": (ss["state"], state)}
             sub = {key: np.concatenate(pair)[src] for key, pair in pool.items()}
         self.timings["subcontacts"] += _time.perf_counter() - t1
+        #: whether this detection kept every contact and sub-contact as it was, with the same
+        #: properties (density scaling by body then keeps its masses: ``steps._Run.detected``)
+        self.detect_kept_all = (not full and k == 0 and same and nc == cs.n and np.array_equal(prev_c, np.arange(nc))
+                                and np.array_equal(prop, cs["prop"], equal_nan=True) and np.array_equal(jcode, cs["jmodel"]))
         # install
         cs.clear()
         cs.append(nc)

@@ -56,7 +56,9 @@ MECH_DEFAULTS = {
     "servo": [],               # adaptive global damping state (kernels.motion, first NSERVO entries)
     "servo_ratio": 0.5,        # its target ratio
     "scale_timestep": None,    # Δt wanted with density scaling [s] (None: Eq. 87, median body)
-    "scaling": "eq87",         # density scaling: eq87 (Eq. 87, masses only raised) | body (stiffness row sums)
+    "scaling": "auto",         # density scaling: eq87 (Eq. 87, masses only raised) | body (stiffness row sums)
+                               # | raised (body, no mass lowered) | auto (raised in static runs with local or
+                               # combined damping, else eq87: RigidEngine.scaling)
     "safety": None,            # body scaling: ω_max Δt ≤ 2 × safety (None: SAFETY by damping mode)
     "dt_run": [],              # [Δt, step]: the step the last rigid run ended on and the Δt it was using
     **DYN_DEFAULTS,            # dynamic mode, dynamic time, Rayleigh damping, time functions (physics.dynamic)
@@ -77,9 +79,15 @@ def _has_gridpoints(m) -> bool:
 
 #: default ``safety`` of density scaling by body, per damping mode: local (and combined) damping
 #: takes the sign of a half-step-old velocity, which at ω Δt near 1.6 lags enough to sustain a
-#: rocking cycle (a joined column failed to settle at 0.8, settled at 0.75); the viscous
-#: adaptive damping settles there (dec3d's measurements, bench/README.md)
+#: rocking cycle (a joined column failed to settle at 0.8, settled at 0.75); the viscous adaptive
+#: damping settles there (dec3d's measurements, bench/README.md)
 SAFETY = {"local": 0.7, "combined": 0.7, "global": 0.8, "none": 0.8}
+
+#: by body, the Δt in use stays at a detection unless the stiffnesses ask for less than this part
+KEEP_DT = 0.8
+
+#: ... for the default scaling (masses only raised); at 0.7 DY5's slide ran 2 % fast after its settle
+SAFETY_RAISED = 0.5
 
 #: local/maximum ratios are scaled by this so that they mean about the same as the average
 #: (Itasca, ``zone ratio`` / ``structure ratio`` command pages, see ``RigidEngine.criteria``)
@@ -117,6 +125,8 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         self._zstep = None
         #: the steps of the last run's cycle, in order (``_Run``: RigidBatch, Clock, Hooks, ...)
         self.steps: list = []
+        #: the last detection kept every contact as it was (``ContactDetection.detect``)
+        self.detect_kept_all = False
         contact_stores(model)
 
     # ------------------------------------------------------------ model-backed state
@@ -215,6 +225,19 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         s = self.settings()
         return s["mass_scale"] == "on" or (s["mass_scale"] == "auto" and not self._dynamic_style())
 
+    def scaling(self) -> str:
+        """Density scaling in effect when on: ``body`` (every body at the same critical step),
+        ``raised`` (the same, no mass below its real value) or ``eq87``. Default (``auto``) of a
+        static run with local or combined damping on rigid blocks only: ``raised`` (3DEC theory
+        text, "Mass (Density) Scaling": "Density scaling is the default mode for static analysis",
+        "inertial densities may be increased"); else Eq. (87) (see the command page)."""
+        s = self.settings()
+        if s["scaling"] != "auto":
+            return s["scaling"]
+        static = s["mass_scale"] == "auto" and s["damping"] in ("local", "combined")
+        # (zoned or FE blocks: Eq. 87, the mixed energy balance measured 5e-9 instead of < 1e-9)
+        return "raised" if static and not _has_gridpoints(self.model) else "eq87"
+
     def full_inertia(self) -> bool:
         s = self.settings()
         return s["inertia"] == "full" or (s["inertia"] == "auto" and self._dynamic_style())
@@ -245,15 +268,17 @@ class RigidEngine(ContactDetection, MixedContactSteps):
             kb += np.bincount(cs["a"][c], k, minlength=b.n) + np.bincount(cs["b"][c], k, minlength=b.n)
         return np.add.reduceat(kb[gmember], gstart[:-1]) if len(gmember) else np.zeros(0)
 
-    def _masses(self, gstart, gmember, gmass, giscalar, dt_fixed):
-        """(Δt, inertial masses, scaled scalar inertias) of the groups; density scaling when on."""
+    def _masses(self, gstart, gmember, gmass, giscalar, dt_fixed, near=None):
+        """(Δt, inertial masses, scaled scalar inertias) of the groups; density scaling when on.
+        ``near``: by body, the Δt in use, kept unless the stiffnesses ask for less than
+        ``KEEP_DT`` of it (``_body_masses``)."""
         s = self.settings()
         frac = float(s["frac"])
         if not self.mass_scaling() or not len(gmass):
             dt = dt_fixed if dt_fixed is not None else stiffness_timestep(self.timestep(), self.rayleigh_beta())
             return dt, gmass.copy(), giscalar.copy()
-        if s["scaling"] == "body":
-            return self._body_masses(gstart, gmember, gmass, giscalar, dt_fixed)
+        if self.scaling() in ("body", "raised"):
+            return self._body_masses(gstart, gmember, gmass, giscalar, dt_fixed, near)
         kg = self._stiffness_sums(gstart, gmember)
         if dt_fixed is None and s["scale_timestep"]:
             dt_fixed = float(s["scale_timestep"])
@@ -268,7 +293,7 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         im, isc = inertial_masses(gmass, giscalar, kg, dt, frac)
         return dt, im, isc
 
-    def _body_masses(self, gstart, gmember, gmass, giscalar, dt_fixed):
+    def _body_masses(self, gstart, gmember, gmass, giscalar, dt_fixed, near=None):
         """Density scaling by body (``mass-scale body``): every body's inertial mass and scalar
         inertia set from the Gershgorin row sums of the contact stiffness around it (kernel
         ``bodyscale.body_row_sums``) so that each body has the same critical step, and the
@@ -283,7 +308,8 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         that every part of the model has the same step. With full inertia (Euler's equations) the
         principal moments take the larger of the two ratios m_i / m, I_i / I."""
         s = self.settings()
-        safety = float(s["safety"] or SAFETY.get(s["damping"], 0.7))
+        raised = self.scaling() == "raised"
+        safety = float(s["safety"] or (SAFETY_RAISED if raised else SAFETY.get(s["damping"], 0.7)))
         b = self.model.blocks
         cs, ss = self.contacts, self.subcontacts
         ng = len(gstart) - 1
@@ -300,15 +326,29 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         if dt_fixed is None and s["scale_timestep"]:
             dt_fixed = float(s["scale_timestep"])
         on = rt > 0
+        #: whether the last body scaling had contacts to set Δt from (``steps._Run.masses``)
+        self.body_dt_from_contacts = bool(on.any())
         if dt_fixed is not None:
             dt = dt_fixed
         elif on.any():
             dt = 2.0 * safety * float(np.median(np.sqrt(gmass[on] / rt[on])))
+            # the masses below keep any Δt stable, so in a run Δt never grows (a block sliding or tipping
+            # off its contacts got ever longer steps: R1, F1 blew up) and falls only when clearly asked:
+            # the joint law takes velocity × the Δt in use, a changing Δt leaves closures v ΔΔt off the
+            # geometry (a block on a spring settled 0.17 % short)
+            if near is not None and near > 0 and dt >= KEEP_DT * near:
+                dt = near
         else:
             dt = self.timestep()
         f = (dt / (2.0 * safety)) ** 2
         im = np.where(on, rt * f, gmass)
         isc = np.where(rr > 0, rr * f, giscalar)
+        if raised:
+            # the default of static runs: densities only increased (3DEC theory text, "Mass
+            # (Density) Scaling"), so no body is lighter than it is; a block that loses most of
+            # its contact stiffness (tipping onto an edge, sliding off) keeps its real inertia
+            im = np.maximum(im, gmass)
+            isc = np.maximum(isc, giscalar)
         if self.full_inertia():
             ratio = np.maximum(im / gmass, isc / giscalar)
             im, isc = gmass * ratio, giscalar * ratio

@@ -149,6 +149,17 @@ class _Run:
             if msg:
                 warn(msg)
         self.scaled = eng.mass_scaling()
+        # density scaling by body works its masses out from the geometry, which moves between
+        # detections: a run that starts on the step where the last one ended takes that run's
+        # masses and Δt back (block fields ``scaled_mass``, ``scaled_inertia``) unless what they
+        # depend on besides the geometry changed, so a split run takes exactly the steps of one run
+        self.by_body = self.scaled and eng.scaling() in ("body", "raised") and self.ng > 0
+        self.scale_key = self._scale_key() if self.by_body else ""
+        self.body_dt_set = False
+        resume = (self.by_body and not fresh and len(last) == 2 and int(last[1]) == m.step
+                  and s.get("dt_mode", self.dt_mode) == self.dt_mode and s.get("scale_key") == self.scale_key
+                  and bool(np.all(b["scaled_mass"][gmember] > 0)))
+        between = between or (resume and self.dt_fixed is None)
         dt_last = float(last[0]) if self.dt_fixed is None and between else None
         if self.zoned:
             if dt_last is not None and not self.scaled and getattr(self.zst, "cdash", None) is not None:
@@ -157,6 +168,11 @@ class _Run:
             self.zst.set_masses(dt, self.scaled)
             if self.ng:
                 self.masses(dt)
+        elif resume:
+            lead = gmember[gstart[:-1]]
+            self.gimass, self.gisc = b["scaled_mass"][lead].copy(), b["scaled_inertia"][lead].copy()
+            self.body_dt_set = True
+            dt = dt_last if dt_last is not None else self.dt_fixed
         else:
             dt = self.masses(dt_last if dt_last is not None else self.dt_fixed)
         self.dt = eng.dt = dt
@@ -180,17 +196,44 @@ class _Run:
         return Bodies(b["mass"], self.fixity, b["force"], b["moment"], b["fapp"], b["mapp"], b["velocity"], b["spin"],
                       b["centroid"], b["disp"], b["vert_start"], b["vert_count"], self.m.vertices["pos"])
 
-    def masses(self, dt):
-        """Inertial masses of the rigid groups for Δt ``dt`` (None: Δt from the stiffnesses); returns Δt."""
-        dt, self.gimass, self.gisc = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, dt)
+    def masses(self, dt, near=None):
+        """Inertial masses of the rigid groups for Δt ``dt`` (None: Δt from the stiffnesses, or
+        ``near`` when it is close, by body); returns Δt."""
+        dt, self.gimass, self.gisc = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, dt,
+                                                      near)
+        if self.by_body:
+            # (Δt set from contacts: from now on it never grows in this run, ``_body_masses``)
+            self.body_dt_set = self.body_dt_set or self.eng.body_dt_from_contacts
+            counts = np.diff(self.gstart)
+            self.b["scaled_mass"][self.gmember] = np.repeat(self.gimass, counts)
+            self.b["scaled_inertia"][self.gmember] = np.repeat(self.gisc, counts)
         return dt
+
+    def _scale_key(self) -> str:
+        """What density scaling by body depends on besides the geometry and the contacts: its
+        settings and the bodies (membership, fixity, masses), as a short digest."""
+        import hashlib
+
+        s = self.s
+        h = hashlib.sha1(repr((self.eng.scaling(), s["safety"], s["scale_timestep"], s["damping"],
+                               self.full)).encode())
+        for a in (self.gstart, self.gmember, self.fixity, self.gmass, self.giscalar):
+            h.update(np.ascontiguousarray(a).tobytes())
+        return h.hexdigest()[:16]
+
+    def _keeps_masses(self) -> bool:
+        """A detection that kept every contact as it was leaves density scaling by body as it is
+        (as a detection left out does, ``quiet``: a run resumed there then agrees with one run)."""
+        return self.by_body and self.eng.detect_kept_all and self.gimass is not None
 
     def _zoned_dt(self) -> float:
         """Δt of a model with zoned blocks for the contacts as they are now."""
         if self.dt_fixed is not None:
             return self.dt_fixed
         ng = self.ng
-        dt_r = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, None)[0] if ng else math.inf
+        near = getattr(self, "dt", None) if self.by_body and self.body_dt_set else None
+        dt_r = (self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, None, near)[0] if ng
+                else math.inf)
         d = ((dt_r if ng else float(self.s["scale_timestep"] or 1.0)) if self.scaled
              else min(dt_r, stiffness_timestep(self.zst.natural_timestep(), self.beta)))
         return d if math.isfinite(d) and d > 0 else 1.0
@@ -244,9 +287,11 @@ class _Run:
         for st in self.steps:
             st.prepare()
         if not self.zoned:
+            if self._keeps_masses():
+                return
             if self.dt_fixed is None:
                 # the contacts made or lost change the stiffness each body feels
-                self.dt = eng.dt = self.masses(None)
+                self.dt = eng.dt = self.masses(None, self.dt if self.by_body and self.body_dt_set else None)
             elif eng.mass_scaling():
                 self.masses(self.dt)
             return
@@ -268,6 +313,7 @@ class _Run:
             self.zst.finish(self.large)
         s["dt_run"] = [float(eng.dt), int(m.step)]
         s["dt_mode"] = self.dt_mode
+        s["scale_key"] = self.scale_key
         if self.ng or not self.zoned:
             # keep each block's principal axes turning with its body
             gstart, gmember, gaxes = self.gstart, self.gmember, self.gaxes

@@ -46,16 +46,19 @@ def _run(session, text):
     return session.model
 
 
-@pytest.mark.parametrize("damping", ["local 0.8", "global"])
-def test_left_out_detections_change_no_bit(session, monkeypatch, damping):
-    """Eq. (87) scaling: a settling stack with and without the quiet rule ends bit for bit the
-    same (a detection that looks at no pair again keeps every contact, Δt and mass), in a run
-    split over two commands too; the rule leaves out most of the detections."""
+@pytest.mark.parametrize("damping,scaling", [("local 0.8", "on"), ("global", "on"), ("local 0.8", "automatic"),
+                                             ("global", "automatic")])
+def test_left_out_detections_change_no_bit(session, monkeypatch, damping, scaling):
+    """Eq. (87) scaling (`mass-scale on`) and the default, by body: a settling stack with and
+    without the quiet rule ends bit for bit the same (a detection that looks at no pair again
+    keeps every contact, Δt and mass), in a run split over two commands too; the rule leaves out
+    most of the detections."""
     out = {}
     for skip in (False, True):
         monkeypatch.setattr(steps, "SKIP_QUIET", skip)
         n = _counted(monkeypatch)
-        m = _run(session, STACK + f"block mechanical damping {damping}\nmodel cycle 250\nmodel cycle 250\n")
+        m = _run(session, STACK + f"block mechanical damping {damping}\nblock mechanical mass-scale {scaling}\n"
+                                  "model cycle 250\nmodel cycle 250\n")
         ss = engine(m).subcontacts
         out[skip] = (n, m.blocks["centroid"].copy(), m.blocks["velocity"].copy(), ss["fn"].copy(), ss["fs"].copy())
         monkeypatch.undo()
