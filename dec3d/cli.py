@@ -13,7 +13,7 @@ def _run(args) -> int:
     from . import warmup
 
     session = None
-    helper = warmup.start()          # cold cache: the cycle kernels compile on the other core
+    helper = warmup.start()          # cold cache: half of the kernels compile on the other core
     try:
         from .errors import Dec3dError
         from .session import Session

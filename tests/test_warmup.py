@@ -37,3 +37,67 @@ def test_warmup_fills_a_cold_cache_with_the_cycle_kernels(tmp_path):
     probe = "from dec3d import kcache; print(kcache.COLD)"
     assert subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, env=env,
                           timeout=300).stdout.strip() == "False"
+
+
+def test_recorder_runs_kernels_as_python_and_keeps_the_calls_from_python():
+    """Inside ``_Recorder`` a kernel of the package runs as plain Python (nothing compiled) and
+    each call made from Python is kept once with its argument types; the kernels it calls are
+    not kept; a kernel outside the package compiles as usual."""
+    import numpy as np
+    from numba import njit, types
+
+    def inner(x):
+        return x * 2.0
+
+    inner.__module__ = "dec3d.kernels.fake"
+    inner_k = njit(inner)
+
+    def outer(a):
+        s = 0.0
+        for v in a:
+            s += inner_k(v)
+        return s
+
+    def other(x):
+        return x + 1
+
+    outer.__module__ = "dec3d.kernels.fake"
+    outer_k = njit(outer)
+    other_k = njit(other)
+    with warmup._Recorder() as rec:
+        assert outer_k(np.arange(4.0)) == 12.0
+        assert outer_k(np.arange(3.0)) == 6.0
+        assert inner_k(1.5) == 3.0
+        assert other_k(1) == 2
+    assert [(d.py_func.__name__, s) for d, s in rec.calls] == [
+        ("outer", (types.float64[::1],)), ("inner", (types.float64,))]
+    assert outer_k.signatures == [] and inner_k.signatures == []
+    assert len(other_k.signatures) == 1
+    assert outer_k(np.arange(4.0)) == 12.0 and len(outer_k.signatures) == 1     # compiles after
+
+
+class _FakeKernel:
+    """Stands in for a dispatcher: ``compile`` notes the order, a cache hit when ``cached``."""
+
+    def __init__(self, name, log, cached=False):
+        from collections import Counter
+        from types import SimpleNamespace
+
+        self.name, self.log, self.cached = name, log, cached
+        self.stats = SimpleNamespace(cache_hits=Counter())
+
+    def compile(self, sig):
+        self.log.append(self.name)
+        if self.cached:
+            self.stats.cache_hits[sig] += 1
+
+
+def test_plan_reverses_the_deck_stage_and_compiling_stops_where_the_deck_has_got_to():
+    log = []
+    a, b, c, d = (_FakeKernel(n, log) for n in "abcd")
+    order = warmup.plan([[(a, (1,)), (d, (1,))], [(a, (1,)), (b, (1,)), (c, (1,))]])
+    assert [k.name for k, _ in order] == ["c", "b", "a", "d"]
+    assert warmup.compile_plan(order) == 4 and log == ["c", "b", "a", "d"]
+    log.clear()
+    b.cached = True                      # the deck's process compiled b: it has done a too
+    assert warmup.compile_plan(order) == 1 and log == ["c", "b"]

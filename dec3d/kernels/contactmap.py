@@ -24,10 +24,16 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import get_num_threads, njit, prange
 
 from .commonplane import common_plane, contact_type
 from .joints import ST_NEW
+
+#: detection kernels with a parallel loop (``cp_batch``, ``subcontact_gaps``) are compiled serial
+#: (their ``prange`` runs as ``range``), with a parallel twin (``*_parallel``) for at least this many
+#: items on more than one thread (``threaded``): a small model's pass is over before the other
+#: threads wake up, and a parallel kernel takes about three times as long to compile (a cold start)
+PARALLEL_FROM = 512
 
 
 @njit(cache=True)
@@ -47,7 +53,7 @@ def match_sorted(old0, old1, new0, new1):
     return out
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def cp_batch(ra, rb, prev, vpos, bvstart, bvcount, centroid, old_n, old_c, reach,
              out_n, out_c, out_gap, out_type):
     """Common plane of every candidate pair (rows ra[i], rb[i]; A → B).
@@ -59,7 +65,7 @@ def cp_batch(ra, rb, prev, vpos, bvstart, bvcount, centroid, old_n, old_c, reach
     a contact when its gap is at most this (CTOL, plus the blocks' step motion when fast).
     Writes out_n/out_c (k, 3), out_gap (k,) m, out_type (k,) contact type (CT_*, 0 if apart).
     """
-    for i in prange(ra.shape[0]):          # pairs in parallel: each writes only its own row
+    for i in prange(ra.shape[0]):          # pairs (in parallel in the twin): each writes only its own row
         n0 = np.empty(3)
         nn = np.empty(3)
         cc = np.empty(3)
@@ -102,7 +108,7 @@ def newell(vpos, fverts, start, m):
     return nx, ny, nz
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def subcontact_gaps(sc_contact, pos, ca, cb, cn, cgap, centroid, vpos, bfstart, bfcount, fvstart,
                     fnvert, fverts, out):
     """Gap [m] of each sub-contact: along the contact normal n (A → B) through its point x,
@@ -117,7 +123,7 @@ def subcontact_gaps(sc_contact, pos, ca, cb, cn, cgap, centroid, vpos, bfstart, 
     such face (degenerate). sc_contact (ns,), pos (ns, 3) [m]; ca, cb (nc,) block rows;
     cn (nc, 3); centroid (nb, 3); faces as in ``subgeom.subcontacts_batch``; writes out (ns,).
     """
-    for s in prange(sc_contact.shape[0]):      # in parallel: each writes only out[s]
+    for s in prange(sc_contact.shape[0]):      # (in parallel in the twin) each writes only out[s]
         c = sc_contact[s]
         n0 = cn[c, 0]
         n1 = cn[c, 1]
@@ -164,6 +170,28 @@ def subcontact_gaps(sc_contact, pos, ca, cb, cn, cgap, centroid, vpos, bfstart, 
             out[s] = cgap[c]
         else:
             out[s] = tb - ta
+
+
+def _parallel_twin(kernel, name):
+    """``kernel`` compiled with ``parallel`` under its own name (numba caches it in its own file)."""
+    f = getattr(kernel, "py_func", kernel)         # (a plain function when the JIT is disabled)
+    g = type(f)(f.__code__, f.__globals__, name, f.__defaults__, f.__closure__)
+    g.__qualname__ = name
+    g.__module__ = f.__module__
+    g.__doc__ = f"``{f.__name__}`` with its ``prange`` loop in parallel."
+    return njit(cache=True, parallel=True)(g)
+
+
+cp_batch_parallel = _parallel_twin(cp_batch, "cp_batch_parallel")
+subcontact_gaps_parallel = _parallel_twin(subcontact_gaps, "subcontact_gaps_parallel")
+
+
+def threaded(kernel, n):
+    """The kernel to run on ``n`` items: its parallel twin for ``PARALLEL_FROM`` items or more on
+    more than one thread, else ``kernel`` (the same numbers: each item writes only its own row)."""
+    if n >= PARALLEL_FROM and get_num_threads() > 1:
+        return cp_batch_parallel if kernel is cp_batch else subcontact_gaps_parallel
+    return kernel
 
 
 @njit(cache=True)

@@ -96,12 +96,6 @@ def _emit(k, out_contact, out_kind, out_key0, out_key1, out_pos, out_area,
     return k + 1
 
 
-def make_scratch(maxv, maxf, maxfv):
-    """Scratch buffers of ``subcontacts_one`` for blocks of at most maxv vertices, maxf
-    faces and maxfv face-loop entries (plain numpy; also called inside the batch kernel)."""
-    return _scratch(maxv, maxf, maxfv, maxfv * maxfv)
-
-
 @njit(cache=True)
 def _scratch(maxv, maxf, maxfv, ncr):
     """ncr: room for edge-edge crossings, at most the product of the two blocks' face-loop
@@ -128,101 +122,6 @@ def _scratch(maxv, maxf, maxfv, ncr):
             np.zeros(16, np.int64),            # 17 small ints: nt, nsf, nord, ne, vs, what, e0, e1
             np.zeros((3, 3)),                  # 18 p, q
             np.zeros((2, maxv), np.int64))     # 19 touching flag
-
-
-@njit(cache=True)
-def subcontacts_one(ci, ca, cb, n, c, ctol, point_area, vpos, bvstart, bvcount, bfstart,
-                    bfcount, fvstart, fnvert, fverts, scratch, k,
-                    out_contact, out_kind, out_key0, out_key1, out_pos, out_area):
-    """Sub-contacts of contact ci between block rows ca (A) and cb (B), c-p unit normal n (3,)
-    A → B and reference point c (3,) [m]; written from out row k on (nothing beyond the
-    capacity). Returns k + the number of sub-contacts. See the module docstring for the rule.
-    scratch: ``make_scratch(maxv, maxf, maxfv)`` sized for both blocks."""
-    (sxy, tv, sfaces, sord, smark, hull, share, sin, vcnt, edges, cxy, cedge, cshare,
-     b1, b2, loop, order, ints, pqv, touch) = scratch
-    p = pqv[0]
-    q = pqv[1]
-    basis(n, p, q)
-    nt = ints[0:2]
-    nsf = ints[2:4]
-    nord = ints[4:6]
-    ne = ints[6:8]
-    vs = ints[8:10]
-    vs[0] = bvstart[ca]
-    vs[1] = bvstart[cb]
-    blk = (ca, cb)
-    nh0 = np.int64(0)   # np.int64, not a literal: a literal argument compiles the callee twice
-    nh1 = np.int64(0)
-    for s in range(2):
-        b = blk[s]
-        nv = bvcount[b]
-        # touching vertices (ERRATA Eqs. 6-8) and their c-p coordinates
-        ext = -1e300 if s == 0 else 1e300
-        for i in range(nv):
-            r = vs[s] + i
-            d = n[0] * (vpos[r, 0] - c[0]) + n[1] * (vpos[r, 1] - c[1]) + n[2] * (vpos[r, 2] - c[2])
-            if (s == 0 and d > ext) or (s == 1 and d < ext):
-                ext = d
-            sxy[s, i, 0] = (p[0] * (vpos[r, 0] - c[0]) + p[1] * (vpos[r, 1] - c[1]) +
-                            p[2] * (vpos[r, 2] - c[2]))
-            sxy[s, i, 1] = (q[0] * (vpos[r, 0] - c[0]) + q[1] * (vpos[r, 1] - c[1]) +
-                            q[2] * (vpos[r, 2] - c[2]))
-            smark[s, i] = 0
-            share[s, i] = 0.0
-            vcnt[s, i] = 0
-            sin[s, i] = 0
-        m = 0
-        for i in range(nv):
-            r = vs[s] + i
-            d = n[0] * (vpos[r, 0] - c[0]) + n[1] * (vpos[r, 1] - c[1]) + n[2] * (vpos[r, 2] - c[2])
-            touch[s, i] = 0
-            if (s == 0 and d >= ext - ctol) or (s == 1 and d <= ext + ctol):
-                touch[s, i] = 1
-                tv[s, m] = i
-                m += 1
-        nt[s] = m
-        # touching faces, their vertices in loop order and their distinct edges
-        nsf[s] = 0
-        nord[s] = 0
-        ne[s] = 0
-        for f in range(bfstart[b], bfstart[b] + bfcount[b]):
-            ok = True
-            for j in range(fvstart[f], fvstart[f] + fnvert[f]):
-                if touch[s, fverts[j] - vs[s]] == 0:
-                    ok = False
-                    break
-            if not ok:
-                continue
-            sfaces[s, nsf[s]] = f
-            nsf[s] += 1
-            mf = fnvert[f]
-            for j in range(mf):
-                v0 = fverts[fvstart[f] + j] - vs[s]
-                v1 = fverts[fvstart[f] + (j + 1) % mf] - vs[s]
-                if smark[s, v0] == 0:
-                    smark[s, v0] = 1
-                    sord[s, nord[s]] = v0
-                    nord[s] += 1
-                dup = False
-                for e in range(ne[s]):
-                    if ((edges[s, e, 0] == v0 and edges[s, e, 1] == v1) or
-                            (edges[s, e, 0] == v1 and edges[s, e, 1] == v0)):
-                        dup = True
-                        break
-                if not dup:
-                    edges[s, ne[s], 0] = v0
-                    edges[s, ne[s], 1] = v1
-                    ne[s] += 1
-        h = convex_hull(sxy[s], tv[s], nt[s], order, hull[s])
-        if s == 0:
-            nh0 = h
-        else:
-            nh1 = h
-    if nsf[0] > 0 and nsf[1] > 0 and nh0 >= 3 and nh1 >= 3:
-        return _face_face(ci, n, c, p, q, ctol, vs, fvstart, fnvert, fverts, scratch, nh0, nh1,
-                          k, out_contact, out_kind, out_key0, out_key1, out_pos, out_area)
-    return _points(ci, c, p, q, ctol, point_area, vs, fvstart, fnvert, fverts, scratch, nh0, nh1,
-                   k, out_contact, out_kind, out_key0, out_key1, out_pos, out_area)
 
 
 @njit(cache=True)
@@ -482,9 +381,112 @@ def subcontacts_batch(vpos, bvstart, bvcount, bfstart, bfcount, fvstart, fnvert,
             maxfv = max(maxfv, nfv[b])
         ncr = max(ncr, nfv[ca[i]] * nfv[cb[i]])
     scratch = _scratch(maxv, maxf, maxfv, ncr)
+    (sxy, tv, sfaces, sord, smark, hull, share, sin, vcnt, edges, cxy, cedge, cshare,
+     b1, b2, loop, order, ints, pqv, touch) = scratch
+    p = pqv[0]
+    q = pqv[1]
     k = np.int64(0)
-    for i in range(ca.shape[0]):
-        k = subcontacts_one(i, ca[i], cb[i], cn[i], cc[i], ctol, point_area, vpos, bvstart,
-                            bvcount, bfstart, bfcount, fvstart, fnvert, fverts, scratch, k,
-                            out_contact, out_kind, out_key0, out_key1, out_pos, out_area)
+    # (one loop: a kernel per contact called from here had its code compiled twice, in its own
+    # right and again inside this one, a second more of a cold start)
+    for ci in range(ca.shape[0]):
+        # contact ci: block rows ca[ci] (A), cb[ci] (B), c-p unit normal n A → B, point c
+        n = cn[ci]
+        c = cc[ci]
+        basis(n, p, q)
+        nt = ints[0:2]
+        nsf = ints[2:4]
+        nord = ints[4:6]
+        ne = ints[6:8]
+        vs = ints[8:10]
+        vs[0] = bvstart[ca[ci]]
+        vs[1] = bvstart[cb[ci]]
+        blk = (ca[ci], cb[ci])
+        nh0 = np.int64(0)   # np.int64, not a literal: a literal argument compiles a callee twice
+        nh1 = np.int64(0)
+        for s in range(2):
+            b = blk[s]
+            nv = bvcount[b]
+            # touching vertices (ERRATA Eqs. 6-8) and their c-p coordinates
+            ext = -1e300 if s == 0 else 1e300
+            for i in range(nv):
+                r = vs[s] + i
+                d = n[0] * (vpos[r, 0] - c[0]) + n[1] * (vpos[r, 1] - c[1]) + n[2] * (vpos[r, 2] - c[2])
+                if (s == 0 and d > ext) or (s == 1 and d < ext):
+                    ext = d
+                sxy[s, i, 0] = (p[0] * (vpos[r, 0] - c[0]) + p[1] * (vpos[r, 1] - c[1]) +
+                                p[2] * (vpos[r, 2] - c[2]))
+                sxy[s, i, 1] = (q[0] * (vpos[r, 0] - c[0]) + q[1] * (vpos[r, 1] - c[1]) +
+                                q[2] * (vpos[r, 2] - c[2]))
+                smark[s, i] = 0
+                share[s, i] = 0.0
+                vcnt[s, i] = 0
+                sin[s, i] = 0
+            m = 0
+            for i in range(nv):
+                r = vs[s] + i
+                d = n[0] * (vpos[r, 0] - c[0]) + n[1] * (vpos[r, 1] - c[1]) + n[2] * (vpos[r, 2] - c[2])
+                touch[s, i] = 0
+                if (s == 0 and d >= ext - ctol) or (s == 1 and d <= ext + ctol):
+                    touch[s, i] = 1
+                    tv[s, m] = i
+                    m += 1
+            nt[s] = m
+            # touching faces, their vertices in loop order and their distinct edges
+            nsf[s] = 0
+            nord[s] = 0
+            ne[s] = 0
+            for f in range(bfstart[b], bfstart[b] + bfcount[b]):
+                ok = True
+                for j in range(fvstart[f], fvstart[f] + fnvert[f]):
+                    if touch[s, fverts[j] - vs[s]] == 0:
+                        ok = False
+                        break
+                if not ok:
+                    continue
+                sfaces[s, nsf[s]] = f
+                nsf[s] += 1
+                mf = fnvert[f]
+                for j in range(mf):
+                    v0 = fverts[fvstart[f] + j] - vs[s]
+                    v1 = fverts[fvstart[f] + (j + 1) % mf] - vs[s]
+                    if smark[s, v0] == 0:
+                        smark[s, v0] = 1
+                        sord[s, nord[s]] = v0
+                        nord[s] += 1
+                    dup = False
+                    for e in range(ne[s]):
+                        if ((edges[s, e, 0] == v0 and edges[s, e, 1] == v1) or
+                                (edges[s, e, 0] == v1 and edges[s, e, 1] == v0)):
+                            dup = True
+                            break
+                    if not dup:
+                        edges[s, ne[s], 0] = v0
+                        edges[s, ne[s], 1] = v1
+                        ne[s] += 1
+            h = convex_hull(sxy[s], tv[s], nt[s], order, hull[s])
+            if s == 0:
+                nh0 = h
+            else:
+                nh1 = h
+        if nsf[0] > 0 and nsf[1] > 0 and nh0 >= 3 and nh1 >= 3:
+            k = _face_face(ci, n, c, p, q, ctol, vs, fvstart, fnvert, fverts, scratch, nh0, nh1,
+                           k, out_contact, out_kind, out_key0, out_key1, out_pos, out_area)
+        else:
+            k = _points(ci, c, p, q, ctol, point_area, vs, fvstart, fnvert, fverts, scratch, nh0, nh1,
+                        k, out_contact, out_kind, out_key0, out_key1, out_pos, out_area)
     return k
+
+
+def subcontacts_one(ci, ca, cb, n, c, ctol, point_area, vpos, bvstart, bvcount, bfstart,
+                    bfcount, fvstart, fnvert, fverts, k,
+                    out_contact, out_kind, out_key0, out_key1, out_pos, out_area):
+    """Sub-contacts of contact ci alone, between block rows ca (A) and cb (B), c-p unit normal n
+    (3,) A → B and reference point c (3,) [m]: ``subcontacts_batch`` on that one contact (plain
+    Python), written from out row k on (nothing beyond the capacity). Returns k + their number."""
+    one = lambda x: np.array([x], np.int64)  # noqa: E731
+    outs = tuple(o[k:] for o in (out_contact, out_kind, out_key0, out_key1, out_pos, out_area))
+    m = subcontacts_batch(vpos, bvstart, bvcount, bfstart, bfcount, fvstart, fnvert, fverts, one(ca), one(cb),
+                          np.array(n, float).reshape(1, 3), np.array(c, float).reshape(1, 3), float(ctol),
+                          float(point_area), *outs)
+    outs[0][:m] = ci
+    return k + int(m)

@@ -29,7 +29,7 @@ import numpy as np
 
 from dec3d.kernels.cellmap import cell_grid, cell_pairs, outside_grid
 from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, match_sorted,
-                                      subcontact_gaps, vertex_point_areas)
+                                      subcontact_gaps, threaded, vertex_point_areas)
 from dec3d.kernels.joints import NPROP
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.groups import group_field
@@ -315,8 +315,8 @@ class ContactDetection:
         # one step: fast blocks get their contact (still open) before they meet
         step = self._step_motion()
         reach = ctol + step[ra[need]] + step[rb[need]]
-        cp_batch(ra[need], rb[need], prev[need], vpos, b["vert_start"], b["vert_count"], b["centroid"],
-                 cs["normal"], cs["pos"], reach, nn, cc, gap, ctype)
+        threaded(cp_batch, k)(ra[need], rb[need], prev[need], vpos, b["vert_start"], b["vert_count"],
+                              b["centroid"], cs["normal"], cs["pos"], reach, nn, cc, gap, ctype)
         # the contacts: quiet old contacts as they were, looked-at pairs with gap ≤ CTOL
         is_new = np.zeros(len(ra), bool)
         is_new[need[ctype > 0]] = True
@@ -379,8 +379,8 @@ class ContactDetection:
             sc_c, kind, key0, key1, pos, area = (x[live] for x in (sc_c, kind, key0, key1, pos, area))
         ns = len(sc_c)
         sgap = np.empty(ns)
-        subcontact_gaps(sc_c, pos, f_ra, f_rb, f_n, f_gap, b["centroid"], vpos, b["face_start"],
-                        b["face_count"], f["vstart"], f["nvert"], fv["vertex"], sgap)
+        threaded(subcontact_gaps, ns)(sc_c, pos, f_ra, f_rb, f_n, f_gap, b["centroid"], vpos, b["face_start"],
+                                      b["face_count"], f["vstart"], f["nvert"], fv["vertex"], sgap)
         fs = np.empty((ns, 3))
         un = np.empty(ns)
         udil = np.empty(ns)

@@ -9,7 +9,7 @@ from scipy.spatial import ConvexHull, QhullError
 import dec3d
 from dec3d.geometry.cutting import cut_by_planes
 from dec3d.geometry.polyhedron import brick, tetrahedron
-from dec3d.kernels.subgeom import subcontacts_batch, subcontacts_one, make_scratch
+from dec3d.kernels.subgeom import subcontacts_batch, subcontacts_one
 from reference.subgeom_ref import subcontacts_ref
 
 Z = np.array([0.0, 0.0, 1.0])
@@ -325,7 +325,7 @@ def test_one_contact_entry_matches_the_batch():
     cap = 16
     o = (np.zeros(cap, np.int64), np.zeros(cap, np.int64), np.zeros(cap, np.int64),
          np.zeros(cap, np.int64), np.zeros((cap, 3)), np.zeros(cap))
-    k = subcontacts_one(3, a, b, n, c, 1e-6, 0.01, *arrays, make_scratch(8, 6, 24), 0, *o)
+    k = subcontacts_one(3, a, b, n, c, 1e-6, 0.01, *arrays, 0, *o)
     sel = out[0] == 3
     assert k == sel.sum()
     for got, want in zip(o, out):
