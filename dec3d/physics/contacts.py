@@ -287,6 +287,7 @@ class ContactDetection:
         pair is looked at.
         """
         t0 = _time.perf_counter()
+        self.detections += 1
         m = self.model
         b, f, fv = m.blocks, m.faces, m.face_vertices
         cs, ss = self.contacts, self.subcontacts
