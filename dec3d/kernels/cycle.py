@@ -25,12 +25,10 @@ number of threads (``dec3d.config.set_threads``), and equal to those of one seri
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 from numba import get_num_threads, njit, prange
 from numba.core.cpu import ParallelOptions
-from numba.core.errors import NumbaPerformanceWarning
 
 from .bundles import Fused
 from .jointlaw import block_lists, block_sum, update_one
@@ -225,9 +223,7 @@ def run_steps(nsteps, dt, gravity, full_inertia, damping, groups, bodies, contac
 #: (an options object, not a dict: numba empties an options dict as it reads it, at every compile)
 _SERIAL = ParallelOptions(dict(comprehension=False, reduction=False, inplace_binop=False, setitem=False,
                                numpy=False, stencil=False, fusion=False, prange=False))
-# (numba warns that such a kernel was asked to be parallel but has nothing parallel: by design)
-warnings.filterwarnings("ignore", message=r"(?s).*no transformation for parallel execution was possible"
-                        r".*dec3d[/\\]kernels", category=NumbaPerformanceWarning)
+# (numba's warning that such a kernel has nothing parallel is left out: ``config.init_threads``)
 
 
 def _serial_twin(kernel, name, **swap):

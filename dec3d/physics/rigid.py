@@ -113,7 +113,8 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         #: seconds per phase; "hooks" covers histories and periodic VTK snapshots
         self.timings = {"detect": 0.0, "search": 0.0, "subcontacts": 0.0, "cycle": 0.0, "hooks": 0.0}
         self._cand = None             # candidate pairs (rows A, rows B) of the last cell map
-        #: detections so far (what was made from the contacts is made again when it changes)
+        #: detections that installed the contacts anew (what was made from the contact and
+        #: sub-contact rows, e.g. the cycle kernel's lists, is made again when it changes)
         self.detections = 0
         #: the deformable step of the last run on a model with zones (``physics.zones``), or None
         self._zstep = None

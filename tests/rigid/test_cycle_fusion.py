@@ -214,3 +214,32 @@ def test_a_batch_split_anywhere_takes_the_same_steps(state, threads, restore_thr
     split = run(copy.deepcopy(state), [5, 1, 6])
     assert _same(one, split) == []
     assert not np.array_equal(one["s"]["pos"], state["s"]["pos"])
+
+
+# ------------------------------------------------------------------ the serial part of a run
+def test_a_detection_with_nothing_to_look_at_keeps_the_rows_and_takes_new_defaults(tmp_path, monkeypatch):
+    """A quiet model's first detection of a run (nothing moved, every contact kept) only makes the
+    contacts that follow the defaults take them: the same arrays as the full install, which the
+    second model is forced through."""
+    from dec3d.physics.contacts import ContactDetection
+    from dec3d.session import Session
+
+    deck = "\n".join(DECK[:-3] + ["model gravity 0 0 -9.81", "block mechanical damping local 0.8", "model cycle 5",
+                                  "block contact material-table default property friction 33",
+                                  "model cycle 12"]) + "\n"
+    states = []
+    for fast in (True, False):
+        if not fast:
+            monkeypatch.setattr(ContactDetection, "_as_they_are", lambda *a: False)
+        s = Session(out_dir=tmp_path, stdout=io.StringIO())
+        s.command(deck)
+        e = s.model.rigid_engine
+        states.append(({k: np.array(a) for k, a in e.contacts.to_arrays().items()},
+                       {k: np.array(a) for k, a in e.subcontacts.to_arrays().items()},
+                       np.array(s.model.blocks["velocity"]), e.detections))
+    (c1, s1, v1, n1), (c2, s2, v2, n2) = states
+    assert _same(c1, c2) == [] and _same(s1, s2) == [] and np.array_equal(v1, v2)
+    assert n1 < n2                                  # the first model left the rows as they were
+    from dec3d.kernels.joints.mohr import P_TANF
+
+    assert np.allclose(c1["prop"][:, P_TANF], np.tan(np.radians(33.0)), rtol=1e-12)      # the new default
