@@ -81,7 +81,15 @@ def init_threads(environ=None) -> str | None:
     the thread count from ``DEC3D_THREADS`` when set. Returns a warning for a value of
     ``DEC3D_THREADS`` that cannot be used (the count is then left as it was), else None."""
     import os
+    import warnings
 
+    from numba.core.errors import NumbaPerformanceWarning
+
+    # the serial twins of the parallel kernels (``kernels.cycle._serial_twin``) go through numba's
+    # parallel pipeline with every transformation off, by design: numba's warning that they have
+    # nothing parallel is left out, for dec3d's kernels only
+    warnings.filterwarnings("ignore", message=r"(?s).*no transformation for parallel execution was possible"
+                            r".*dec3d[/\\]kernels", category=NumbaPerformanceWarning)
     env = os.environ if environ is None else environ
     if "NUMBA_THREADING_LAYER" not in env and "NUMBA_THREADING_LAYER_PRIORITY" not in env:
         from numba.core import config

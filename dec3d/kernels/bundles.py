@@ -39,6 +39,12 @@ motion calls. The model saves the fields in this order (``settings.mechanical.se
 ``Bounds``: the motion bound that ends a batch for a detection: radius (nb,) m largest
 centroid-to-vertex distance, acc (nb,) m motion summed since the last detection, trigger m,
 motion (2,) as ``cycle._run_steps`` documents.
+
+``Fused``: what ``motion.rigid_motion_groups`` does besides the motion when the cycle kernel hands
+it over (one parallel loop per step instead of three): start (nb+1,), ent (2 ns,) the sub-contacts
+of every block (``jointlaw.block_lists``), pos (ns, 3) the sub-contact points, sg (ns, 3) the force
+on B of each sub-contact (the block sums, ``jointlaw.block_sum``, before the motion); radius (nb,) m
+as in ``Bounds`` and step (nb,) m, filled with each member's step motion |v| Δt + |ω| Δt r.
 """
 from __future__ import annotations
 
@@ -53,6 +59,7 @@ SubContacts = namedtuple("SubContacts", "contact pos area fn fs un udil us state
 Servo = namedtuple("Servo", "alpha work dek nwin ratio window factor lastr hist calls")
 Damping = namedtuple("Damping", "mode alpha servo prev")
 Bounds = namedtuple("Bounds", "radius acc trigger motion")
+Fused = namedtuple("Fused", "start ent pos sg radius step")
 
 #: the number of servo entries a model saves (``Servo``'s fields, in order)
 NSERVO = len(Servo._fields)

@@ -2,14 +2,19 @@
 
 Per step, with the contacts and sub-contacts fixed between two detection passes:
   1. sub-contact relative velocities → displacement increments → joint law → forces
-     (``jointlaw.subcontact_update``, in parallel over sub-contacts), then the forces and
-     moments on every block summed in a fixed order (``jointlaw.block_sums``, in parallel
-     over blocks);
-  2. motion of every group of joined blocks (a lone block is a group of one), Eqs. (44)-(52)
+     (``jointlaw.update_one``, in parallel over contacts, each doing its own sub-contacts:
+     ``_contact_pass``);
+  2. the forces and moments on every block summed in a fixed order (``jointlaw.block_sum``), then
+     the motion of every group of joined blocks (a lone block is a group of one), Eqs. (44)-(52)
      with damping and Euler's equations as chosen (``motion.rigid_motion_groups``, in parallel
-     over groups);
+     over groups, the sums of a group's members inside its own iteration);
   3. the contact reference points and the sub-contact points move with the mean
-     displacement of the two blocks at that point, Eq. (11) (rotation included).
+     displacement of the two blocks at that point, Eq. (11) (rotation included) — done at the
+     start of the next step's loop over contacts (the same numbers: nothing moves in between),
+     and once more at the end of the call.
+So a step wakes the threads twice (each parallel loop costs a fork and a join, and every pass
+over the sub-contact arrays streams them from memory: on a large model the step is bound by
+memory traffic, not arithmetic).
 The host (``dec3d.physics.rigid``) calls this between detection passes, histories and
 solve checks, so Python runs once per batch, not once per step.
 
@@ -23,8 +28,10 @@ import math
 
 import numpy as np
 from numba import get_num_threads, njit, prange
+from numba.core.cpu import ParallelOptions
 
-from .jointlaw import block_lists, block_sums, subcontact_update
+from .bundles import Fused
+from .jointlaw import block_lists, block_sum, update_one
 from .motion import rigid_motion_groups
 from .rayleigh import contact_stiffness_damping
 
@@ -36,37 +43,84 @@ from .rayleigh import contact_stiffness_damping
 SERIAL_BELOW = 4000
 
 
+@njit(cache=True, inline="always")
+def _move_point(dt, a, b, pts, i, centroid, vel, spin):
+    """Eq. (11) for point pts[i] between blocks a and b, in place."""
+    d0 = 0.0
+    d1 = 0.0
+    d2 = 0.0
+    for side in range(2):
+        x = a if side == 0 else b
+        r0 = pts[i, 0] - centroid[x, 0] + vel[x, 0] * dt
+        r1 = pts[i, 1] - centroid[x, 1] + vel[x, 1] * dt
+        r2 = pts[i, 2] - centroid[x, 2] + vel[x, 2] * dt
+        w0 = spin[x, 0] * dt
+        w1 = spin[x, 1] * dt
+        w2 = spin[x, 2] * dt
+        d0 += vel[x, 0] * dt + w1 * r2 - w2 * r1
+        d1 += vel[x, 1] * dt + w2 * r0 - w0 * r2
+        d2 += vel[x, 2] * dt + w0 * r1 - w1 * r0
+    pts[i, 0] += 0.5 * d0
+    pts[i, 1] += 0.5 * d1
+    pts[i, 2] += 0.5 * d2
+
+
 @njit(cache=True, parallel=True)
 def _move_points(dt, ca, cb, owner, pts, centroid, vel, spin):
     """Eq. (11) for points pts (k, 3) of contacts owner (k,), in place, without scratch
     (in parallel: each point is its own)."""
     for i in prange(pts.shape[0]):
         c = owner[i]
-        d0 = 0.0
-        d1 = 0.0
-        d2 = 0.0
-        for side in range(2):
-            b = ca[c] if side == 0 else cb[c]
-            r0 = pts[i, 0] - centroid[b, 0] + vel[b, 0] * dt
-            r1 = pts[i, 1] - centroid[b, 1] + vel[b, 1] * dt
-            r2 = pts[i, 2] - centroid[b, 2] + vel[b, 2] * dt
-            w0 = spin[b, 0] * dt
-            w1 = spin[b, 1] * dt
-            w2 = spin[b, 2] * dt
-            d0 += vel[b, 0] * dt + w1 * r2 - w2 * r1
-            d1 += vel[b, 1] * dt + w2 * r0 - w0 * r2
-            d2 += vel[b, 2] * dt + w0 * r1 - w1 * r0
-        pts[i, 0] += 0.5 * d0
-        pts[i, 1] += 0.5 * d1
-        pts[i, 2] += 0.5 * d2
+        _move_point(dt, ca[c], cb[c], pts, i, centroid, vel, spin)
+
+
+@njit(cache=True, parallel=True)
+def _contact_pass(move, dt, centroid, vel, spin, ca, cb, cn, cc, cmodel, cprop, cstart,
+                  sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg):
+    """One parallel loop over the contacts: when ``move``, first Eq. (11) for the contact point and
+    the sub-contact points (the motion of the step before), then the joint law of each sub-contact
+    (``jointlaw.update_one``; force on B to sg). The sub-contacts of contact c are rows
+    cstart[c]:cstart[c + 1] (``contact_ranges``). Each contact writes only its own rows."""
+    for c in prange(ca.shape[0]):
+        a = ca[c]
+        b = cb[c]
+        if move:
+            _move_point(dt, a, b, cc, c, centroid, vel, spin)
+        for s in range(cstart[c], cstart[c + 1]):
+            if move:
+                _move_point(dt, a, b, sc_pos, s, centroid, vel, spin)
+            update_one(s, c, a, b, dt, centroid, vel, spin, cn, cmodel, cprop,
+                       sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg)
 
 
 @njit(cache=True)
-def _run_steps(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies, contacts, subs, bounds, vmax, out):
+def contact_ranges(nc, sc_contact):
+    """cstart (nc + 1,) int64 with the sub-contacts of contact c at rows cstart[c]:cstart[c + 1],
+    for sub-contact rows grouped by contact in contact order (as detection installs them);
+    raises ValueError if they are not."""
+    cstart = np.zeros(nc + 1, dtype=np.int64)
+    last = 0
+    for s in range(sc_contact.shape[0]):
+        c = sc_contact[s]
+        if c < last or c >= nc:
+            raise ValueError("sub-contact rows are not grouped by contact in contact order")
+        last = c
+        cstart[c + 1] += 1
+    for c in range(nc):
+        cstart[c + 1] += cstart[c]
+    return cstart
+
+
+@njit(cache=True)
+def _run_steps(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies, contacts, subs, bounds, vmax, out,
+               bstart, bent, cstart, orphans):
     """Take up to ``nsteps`` steps of Δt = dt [s]. Bundles (``kernels.bundles``): damping, groups,
     bodies as ``rigid_motion_groups`` takes them; contacts (``Contacts``: pos (nc, 3) the contact
     reference points, own (nc,) = arange(nc)) and subs (``SubContacts``) as
     ``jointlaw.subcontact_update`` reads them; bounds (``Bounds``) the detection trigger.
+    bstart, bent: the sub-contacts of every block (``jointlaw.block_lists``); cstart: those of
+    every contact (``contact_ranges``); orphans: rows of blocks with sub-contacts that are in no
+    group (their forces are summed too).
 
     out (4,): as ``rigid_motion_groups`` fills it, for the last step.
     Motion bound for contact detection: each block's step motion |v| Δt + |ω| Δt r (bounds.radius
@@ -79,6 +133,11 @@ def _run_steps(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies,
     ``rayleigh.contact_stiffness_damping``).
     Returns (steps done, first unstable block row or −1). An unstable step is not finished:
     the caller reports it and the arrays hold the state at that step.
+
+    Per step two parallel loops: over contacts (Eq. 11 for the points of the step before, then
+    the joint law, ``_contact_pass``) and over groups (block sums, motion, clearing the forces,
+    step motion: ``rigid_motion_groups`` with ``Fused``); the points of the last step move
+    before returning.
     """
     gstart, gmember = groups.start, groups.member
     centroid, vel, spin, force, moment = bodies.centroid, bodies.vel, bodies.spin, bodies.force, bodies.moment
@@ -88,28 +147,29 @@ def _run_steps(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies,
     done = 0
     bad = -1
     motion[1] = 0.0
-    # the sub-contacts of every block in a fixed order, for the forces' fixed-order sums
-    bstart, bent = block_lists(centroid.shape[0], ca, cb, sc_contact)
     sg = np.empty((sc_contact.shape[0], 3))
+    step = np.zeros(centroid.shape[0])
+    fused = Fused(bstart, bent, sc_pos, sg, radius, step)
+    pending = False             # the points still have to move with the last step's motion
     for _ in range(nsteps):
-        subcontact_update(dt, centroid, vel, spin, ca, cb, cn, cmodel, cprop,
-                          sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg)
+        _contact_pass(pending, dt, centroid, vel, spin, ca, cb, cn, cc, cmodel, cprop, cstart,
+                      sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg)
+        pending = False
         if beta > 0.0:
             contact_stiffness_damping(beta, centroid, vel, spin, ca, cb, cn, cprop, sc_contact, sc_pos, sc_area,
                                       sc_fn, sc_state, sg)
-        block_sums(centroid, force, moment, sc_pos, sg, bstart, bent)
-        g = rigid_motion_groups(dt, gravity, full_inertia, damping, groups, bodies, vmax, out)
+        for k in range(orphans.shape[0]):
+            block_sum(orphans[k], centroid, force, moment, sc_pos, sg, bstart, bent)
+        g = rigid_motion_groups(dt, gravity, full_inertia, damping, groups, bodies, vmax, out, fused)
         done += 1
         if g >= 0 or not math.isfinite(out[0]):
             bad = gmember[gstart[g]] if g >= 0 else (gmember[0] if gmember.shape[0] else 0)
             break
-        _move_points(dt, ca, cb, cown, cc, centroid, vel, spin)
-        _move_points(dt, ca, cb, sc_contact, sc_pos, centroid, vel, spin)
+        pending = True
         hit = False
         for k in range(gmember.shape[0]):
             b = gmember[k]
-            d = dt * (math.sqrt(vel[b, 0] ** 2 + vel[b, 1] ** 2 + vel[b, 2] ** 2)
-                      + radius[b] * math.sqrt(spin[b, 0] ** 2 + spin[b, 1] ** 2 + spin[b, 2] ** 2))
+            d = step[b]
             if d > motion[0]:
                 motion[0] = d
             if d > radius[b] and bad < 0:
@@ -123,31 +183,60 @@ def _run_steps(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies,
         if hit:
             motion[1] = 1.0
             break
+    if pending:
+        _move_points(dt, ca, cb, cown, cc, centroid, vel, spin)
+        _move_points(dt, ca, cb, sc_contact, sc_pos, centroid, vel, spin)
     return done, bad
 
 
+def cycle_lists(nb, contacts, subs, gmember):
+    """What ``_run_steps`` needs besides the bundles, made once per detection (the host keeps it
+    while the contacts stay): (bstart, bent) the sub-contacts of every block, cstart those of
+    every contact, orphans the rows of blocks with sub-contacts in no group."""
+    bstart, bent = block_lists(nb, contacts.a, contacts.b, subs.contact)
+    cstart = contact_ranges(contacts.a.shape[0], subs.contact)
+    grouped = np.zeros(nb, dtype=bool)
+    grouped[gmember] = True
+    orphans = np.flatnonzero((np.diff(bstart) > 0) & ~grouped).astype(np.int64)
+    return bstart, bent, cstart, orphans
+
+
 def run_steps(nsteps, dt, gravity, full_inertia, damping, groups, bodies, contacts, subs, bounds, vmax, out,
-              beta=0.0):
+              beta=0.0, lists=None):
     """``_run_steps`` (the kernel, documented there); a small model (``SERIAL_BELOW``), or any
     model on one thread, runs its serial twin ``_run_steps_1`` (the same numbers: every sum has a
-    fixed order)."""
+    fixed order). ``lists``: ``cycle_lists`` of these contacts (made here when None)."""
+    if lists is None:
+        lists = cycle_lists(bodies.centroid.shape[0], contacts, subs, groups.member)
     args = (nsteps, dt, gravity, bool(full_inertia), float(beta), damping, groups, bodies, contacts, subs,
-            bounds, vmax, out)
+            bounds, vmax, out) + tuple(lists)
     if subs.contact.shape[0] + 4 * groups.member.shape[0] >= SERIAL_BELOW and get_num_threads() > 1:
         return _run_steps(*args)
     return _run_steps_1(*args)
 
 
+#: numba's parallel pipeline with every transformation off: ``prange`` runs as ``range`` and
+#: nothing is handed to the threading layer, but the loop bodies are simplified as in a parallel
+#: kernel. Compiled plainly (``njit`` without ``parallel``), the helpers inlined into a loop
+#: (``inline="always"``) keep reference counting of their array arguments inside the loop: the
+#: serial sub-contact pass ran 7x slower (4.7 vs 0.65 ms for 52 632 sub-contacts)
+#: (an options object, not a dict: numba empties an options dict as it reads it, at every compile)
+_SERIAL = ParallelOptions(dict(comprehension=False, reduction=False, inplace_binop=False, setitem=False,
+                               numpy=False, stencil=False, fusion=False, prange=False))
+# (numba's warning that such a kernel has nothing parallel is left out: ``config.init_threads``)
+
+
 def _serial_twin(kernel, name, **swap):
-    """The same kernel compiled without ``parallel`` (its ``prange`` loops run as ``range``), under
-    its own name (so numba caches it in its own file); ``swap`` replaces globals it calls."""
+    """The same kernel compiled without parallel loops (``_SERIAL``: its ``prange`` loops run as
+    ``range``), under its own name (so numba caches it in its own file); ``swap`` replaces globals
+    it calls."""
     f = getattr(kernel, "py_func", kernel)         # (a plain function when the JIT is disabled)
     glb = dict(f.__globals__, **swap) if swap else f.__globals__
     g = type(f)(f.__code__, glb, name, f.__defaults__, f.__closure__)      # (a FunctionType)
     g.__qualname__ = name
     g.__module__ = f.__module__
     g.__doc__ = f"``{f.__name__}`` on one thread, without parallel loops."
-    return njit(cache=True)(g)
+    return njit(cache=True, parallel=_SERIAL)(g)
 
 
 # a small model's steps: no parallel loop at all. Waking the other threads costs more than such a
@@ -155,8 +244,7 @@ def _serial_twin(kernel, name, **swap):
 # hands its work to a worker thread of numba's workqueue)
 _run_steps_1 = _serial_twin(
     _run_steps, "_run_steps_1",
-    subcontact_update=_serial_twin(subcontact_update, "_subcontact_update_1"),
-    block_sums=_serial_twin(block_sums, "_block_sums_1"),
+    _contact_pass=_serial_twin(_contact_pass, "_contact_pass_1"),
     rigid_motion_groups=_serial_twin(rigid_motion_groups, "_rigid_motion_groups_1"),
     _move_points=_serial_twin(_move_points, "_move_points_1"),
     contact_stiffness_damping=_serial_twin(contact_stiffness_damping, "_contact_stiffness_damping_1"))

@@ -26,6 +26,63 @@ from numba import njit, prange
 from .joints import ST_NEW, joint_law
 
 
+@njit(cache=True, inline="always")   # (inlined into each caller's loop: the call costs as much as the work)
+def update_one(s, c, a, b, dt, bpos, bvel, bspin, cn, cmodel, cprop,
+               sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg):
+    """The joint law of sub-contact s of contact c (blocks a = A, b = B): its rows of sc_* updated,
+    the force on B to sg[s] [N] (``subcontact_update`` for one sub-contact)."""
+    n0 = cn[c, 0]
+    n1 = cn[c, 1]
+    n2 = cn[c, 2]
+    x0 = sc_pos[s, 0]
+    x1 = sc_pos[s, 1]
+    x2 = sc_pos[s, 2]
+    ra0 = x0 - bpos[a, 0]
+    ra1 = x1 - bpos[a, 1]
+    ra2 = x2 - bpos[a, 2]
+    rb0 = x0 - bpos[b, 0]
+    rb1 = x1 - bpos[b, 1]
+    rb2 = x2 - bpos[b, 2]
+    wa0 = bspin[a, 0]
+    wa1 = bspin[a, 1]
+    wa2 = bspin[a, 2]
+    wb0 = bspin[b, 0]
+    wb1 = bspin[b, 1]
+    wb2 = bspin[b, 2]
+    # Eq. (15)
+    v0 = bvel[b, 0] + wb1 * rb2 - wb2 * rb1 - bvel[a, 0] - (wa1 * ra2 - wa2 * ra1)
+    v1 = bvel[b, 1] + wb2 * rb0 - wb0 * rb2 - bvel[a, 1] - (wa2 * ra0 - wa0 * ra2)
+    v2 = bvel[b, 2] + wb0 * rb1 - wb1 * rb0 - bvel[a, 2] - (wa0 * ra1 - wa1 * ra0)
+    du0 = v0 * dt
+    du1 = v1 * dt
+    du2 = v2 * dt
+    dun = du0 * n0 + du1 * n1 + du2 * n2
+    st0 = sc_state[s]
+    if st0 & ST_NEW:
+        du0 = 0.0
+        du1 = 0.0
+        du2 = 0.0
+        dun = 0.0
+        st0 &= ~ST_NEW
+    fn, f0, f1, f2, un, ud, u0, u1, u2, st = joint_law(
+        cmodel[c], cprop, c, sc_area[s], dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s],
+        sc_udil[s], sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
+    sc_fn[s] = fn
+    sc_fs[s, 0] = f0
+    sc_fs[s, 1] = f1
+    sc_fs[s, 2] = f2
+    sc_un[s] = un
+    sc_udil[s] = ud
+    sc_us[s, 0] = u0
+    sc_us[s, 1] = u1
+    sc_us[s, 2] = u2
+    sc_state[s] = st
+    # force on B (ERRATA Eqs. 28-32)
+    sg[s, 0] = fn * n0 + f0
+    sg[s, 1] = fn * n1 + f1
+    sg[s, 2] = fn * n2 + f2
+
+
 @njit(cache=True, parallel=True)
 def subcontact_update(dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
                       sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg):
@@ -33,58 +90,8 @@ def subcontact_update(dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
     force on B of sub-contact s goes to sg (ns, 3) [N] for ``block_sums``."""
     for s in prange(sc_contact.shape[0]):
         c = sc_contact[s]
-        a = ca[c]
-        b = cb[c]
-        n0 = cn[c, 0]
-        n1 = cn[c, 1]
-        n2 = cn[c, 2]
-        x0 = sc_pos[s, 0]
-        x1 = sc_pos[s, 1]
-        x2 = sc_pos[s, 2]
-        ra0 = x0 - bpos[a, 0]
-        ra1 = x1 - bpos[a, 1]
-        ra2 = x2 - bpos[a, 2]
-        rb0 = x0 - bpos[b, 0]
-        rb1 = x1 - bpos[b, 1]
-        rb2 = x2 - bpos[b, 2]
-        wa0 = bspin[a, 0]
-        wa1 = bspin[a, 1]
-        wa2 = bspin[a, 2]
-        wb0 = bspin[b, 0]
-        wb1 = bspin[b, 1]
-        wb2 = bspin[b, 2]
-        # Eq. (15)
-        v0 = bvel[b, 0] + wb1 * rb2 - wb2 * rb1 - bvel[a, 0] - (wa1 * ra2 - wa2 * ra1)
-        v1 = bvel[b, 1] + wb2 * rb0 - wb0 * rb2 - bvel[a, 1] - (wa2 * ra0 - wa0 * ra2)
-        v2 = bvel[b, 2] + wb0 * rb1 - wb1 * rb0 - bvel[a, 2] - (wa0 * ra1 - wa1 * ra0)
-        du0 = v0 * dt
-        du1 = v1 * dt
-        du2 = v2 * dt
-        dun = du0 * n0 + du1 * n1 + du2 * n2
-        st0 = sc_state[s]
-        if st0 & ST_NEW:
-            du0 = 0.0
-            du1 = 0.0
-            du2 = 0.0
-            dun = 0.0
-            st0 &= ~ST_NEW
-        fn, f0, f1, f2, un, ud, u0, u1, u2, st = joint_law(
-            cmodel[c], cprop, c, sc_area[s], dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s],
-            sc_udil[s], sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
-        sc_fn[s] = fn
-        sc_fs[s, 0] = f0
-        sc_fs[s, 1] = f1
-        sc_fs[s, 2] = f2
-        sc_un[s] = un
-        sc_udil[s] = ud
-        sc_us[s, 0] = u0
-        sc_us[s, 1] = u1
-        sc_us[s, 2] = u2
-        sc_state[s] = st
-        # force on B (ERRATA Eqs. 28-32)
-        sg[s, 0] = fn * n0 + f0
-        sg[s, 1] = fn * n1 + f1
-        sg[s, 2] = fn * n2 + f2
+        update_one(s, c, ca[c], cb[c], dt, bpos, bvel, bspin, cn, cmodel, cprop,
+                   sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg)
 
 
 @njit(cache=True)
@@ -115,7 +122,7 @@ def block_lists(nb, ca, cb, sc_contact):
 
 
 @njit(cache=True, inline="always")   # (a call with this many arrays costs more than the work)
-def _block_sum(x, bpos, bforce, bmoment, sc_pos, sg, bstart, bent):
+def block_sum(x, bpos, bforce, bmoment, sc_pos, sg, bstart, bent):
     """``block_sums`` for block x."""
     e0 = bstart[x]
     e1 = bstart[x + 1]
@@ -168,7 +175,7 @@ def block_sums(bpos, bforce, bmoment, sc_pos, sg, bstart, bent):
     block sums its own list (``block_lists``) in its fixed order, so the sums do not depend on
     the number of threads (and equal a serial scatter over s)."""
     for x in prange(bstart.shape[0] - 1):
-        _block_sum(x, bpos, bforce, bmoment, sc_pos, sg, bstart, bent)
+        block_sum(x, bpos, bforce, bmoment, sc_pos, sg, bstart, bent)
 
 
 @njit(cache=True)

@@ -111,6 +111,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from .jointlaw import block_sum
+
 
 @njit(cache=True)
 def _sgn(x):
@@ -179,7 +181,7 @@ def _jmul(ax, p0, p1, p2, x0, x1, x2):
 
 
 @njit(cache=True, parallel=True)
-def rigid_motion_groups(dt, gravity, full_inertia, damping, groups, bodies, vmax, out):
+def rigid_motion_groups(dt, gravity, full_inertia, damping, groups, bodies, vmax, out, fused=None):
     """Advance every group of joined blocks by one step Δt [s] (see the module docstring).
 
     gravity (3,) m/s²; full_inertia bool (Euler's equations); damping a ``bundles.Damping``
@@ -188,6 +190,10 @@ def rigid_motion_groups(dt, gravity, full_inertia, damping, groups, bodies, vmax
     groups a ``bundles.Groups`` (axes and centroid updated); bodies a ``bundles.Bodies`` (every
     motion field and the vertices updated). vmax [m/s] the speed of a blow-up. out (4,) float64
     filled as documented.
+    fused: None, or a ``bundles.Fused`` from the cycle kernel: then each group first adds the
+    sub-contact forces to its members (``jointlaw.block_sum``, each member its own fixed-order
+    list) and afterwards clears their forces and writes their step motion to fused.step, inside
+    the one parallel loop (the same numbers as separate loops: every row is its own group's).
     Returns the first unstable group index or −1.
     """
     damp_mode, alpha, servo, prev = damping
@@ -221,12 +227,19 @@ def rigid_motion_groups(dt, gravity, full_inertia, damping, groups, bodies, vmax
     gdek = np.empty(ng)
     gok = np.empty(ng, dtype=np.bool_)
     gon = np.empty(ng, dtype=np.bool_)
+    if fused is not None:
+        # (taken out of the bundle here: numba 0.68 drops writes to a namedtuple's array made
+        # inside a prange loop)
+        fstart, fent, fpos, fsg, frad, fstep = fused
     for g in prange(ng):
         j0 = gstart[g]
         j1 = gstart[g + 1]
         gon[g] = j1 > j0
         gok[g] = True
         if j1 > j0:
+            if fused is not None:
+                for j in range(j0, j1):
+                    block_sum(gmember[j], centroid, force, moment, fpos, fsg, fstart, fent)
             lead = gmember[j0]
             fx = fixity[lead]
             C0 = gcentroid[g, 0]
@@ -440,6 +453,14 @@ def rigid_motion_groups(dt, gravity, full_inertia, damping, groups, bodies, vmax
                 gcentroid[g, 0] = C0 + dx0
                 gcentroid[g, 1] = C1 + dx1
                 gcentroid[g, 2] = C2 + dx2
+            if fused is not None:
+                for j in range(j0, j1):
+                    b = gmember[j]
+                    for i in range(3):
+                        force[b, i] = 0.0
+                        moment[b, i] = 0.0
+                    fstep[b] = dt * (math.sqrt(vel[b, 0] ** 2 + vel[b, 1] ** 2 + vel[b, 2] ** 2)
+                                     + frad[b] * math.sqrt(spin[b, 0] ** 2 + spin[b, 1] ** 2 + spin[b, 2] ** 2))
     fmax = 0.0
     fsum = 0.0
     ke = 0.0
@@ -460,11 +481,12 @@ def rigid_motion_groups(dt, gravity, full_inertia, damping, groups, bodies, vmax
         ke += gke[g]
         if not gok[g] and bad < 0:
             bad = g
-    for j in prange(gstart[0], gstart[ng]):
-        b = gmember[j]
-        for i in range(3):
-            force[b, i] = 0.0
-            moment[b, i] = 0.0
+    if fused is None:
+        for j in prange(gstart[0], gstart[ng]):
+            b = gmember[j]
+            for i in range(3):
+                force[b, i] = 0.0
+                moment[b, i] = 0.0
     if damp_mode == 2:
         servo.hist[0] = 1.0
     if damp_mode == 3:

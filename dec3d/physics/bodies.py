@@ -43,12 +43,18 @@ def group_properties(gstart, gmember, mass, centroid, inertia, inertia_approx, p
     np.add.at(ginertia, gid, ib)
     giscalar = np.bincount(gid, np.asarray(inertia_approx, np.float64)[gmember] + m * d2, minlength=ng)
     ginertia = 0.5 * (ginertia + ginertia.transpose(0, 2, 1))
-    gprin, gaxes = np.linalg.eigh(ginertia)
-    flip = np.linalg.det(gaxes) < 0
-    gaxes[flip, :, 2] *= -1.0
-    if prin is not None and axes is not None:
-        lone = gmember[gstart[:-1][one]]
-        gprin[one], gaxes[one] = np.asarray(prin)[lone], np.asarray(axes)[lone]
+    # (the eigen-decomposition only where the blocks' own frames are not taken: it is most of
+    # the time of a model of lone blocks, and of the serial part of a short run on two cores)
+    own = one if (prin is not None and axes is not None) else np.zeros(ng, bool)
+    gprin = np.empty((ng, 3))
+    gaxes = np.empty((ng, 3, 3))
+    if not own.all():
+        p, a = np.linalg.eigh(ginertia[~own])
+        a[np.linalg.det(a) < 0, :, 2] *= -1.0
+        gprin[~own], gaxes[~own] = p, a
+    if own.any():
+        lone = gmember[gstart[:-1][own]]
+        gprin[own], gaxes[own] = np.asarray(prin)[lone], np.asarray(axes)[lone]
     return gmass, gc, ginertia, gprin, np.ascontiguousarray(gaxes), giscalar
 
 

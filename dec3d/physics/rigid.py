@@ -121,6 +121,9 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         #: seconds per phase; "hooks" covers histories and periodic VTK snapshots
         self.timings = {"detect": 0.0, "search": 0.0, "subcontacts": 0.0, "cycle": 0.0, "hooks": 0.0}
         self._cand = None             # candidate pairs (rows A, rows B) of the last cell map
+        #: detections that installed the contacts anew (what was made from the contact and
+        #: sub-contact rows, e.g. the cycle kernel's lists, is made again when it changes)
+        self.detections = 0
         #: the deformable step of the last run on a model with zones (``physics.zones``), or None
         self._zstep = None
         #: the steps of the last run's cycle, in order (``_Run``: RigidBatch, Clock, Hooks, ...)
@@ -442,11 +445,16 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         cs = self.contacts
         if cs.n == 0:
             return None
+        follow = cs["own_props"] == 0             # these take the defaults at the next detection
+        codes = [int(code) for code in np.unique(cs["jmodel"][follow])]
+        rows = {code: default_row(self.settings(), code) for code in codes}
+        if (all(r[P_KN] > 0.0 and r[P_KS] > 0.0 for r in rows.values())
+                and (cs["prop"][:, P_KN] > 0.0).all() and (cs["prop"][:, P_KS] > 0.0).all()):
+            return None                           # (every stiffness set: no copy of the table)
         used = cs["sub_count"] > 0
         prop = cs["prop"].copy()
-        follow = cs["own_props"] == 0             # these take the defaults at the next detection
-        for code in np.unique(cs["jmodel"][follow]):
-            prop[follow & (cs["jmodel"] == code)] = default_row(self.settings(), int(code))
+        for code, row in rows.items():
+            prop[follow & (cs["jmodel"] == code)] = row
         bad = used & ((prop[:, P_KN] <= 0.0) | (prop[:, P_KS] <= 0.0))
         if not bad.any():
             return None

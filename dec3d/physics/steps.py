@@ -22,7 +22,7 @@ from dec3d.io.vtk import periodic_vtk
 from dec3d.kernels.bundles import (NSERVO, Bodies, Bounds, Contacts, Groups, SubContacts, load_servo, new_damping,
                                    new_servo, servo_values)
 from dec3d.kernels.contactmap import blocks_moved
-from dec3d.kernels.cycle import run_steps
+from dec3d.kernels.cycle import cycle_lists, run_steps
 from dec3d.kernels.motion import DAMP_ADAPTIVE
 
 from . import contacts as _contacts
@@ -317,16 +317,22 @@ class _Run:
         if self.ng or not self.zoned:
             # keep each block's principal axes turning with its body
             gstart, gmember, gaxes = self.gstart, self.gmember, self.gaxes
-            turn = np.einsum("gij,gkj->gik", gaxes, self.axes0)
-            gid = np.repeat(np.arange(self.ng), np.diff(gstart))
             pa = b["principal_axes"]
-            # re-orthonormalised (polar factor): a slightly skew frame would grow threefold per
-            # call (Q A Aᵀ A), and after ~30 `model cycle` commands Euler's equations blow up
-            pa[gmember] = _orthonormal(np.einsum("bij,bjk->bik", turn[gid], pa[gmember]))
+            lone = np.diff(gstart) == 1
+            joined = np.flatnonzero(~lone)
+            if len(joined):
+                # the members of joined groups turn with their group; re-orthonormalised (polar
+                # factor): a slightly skew frame would grow threefold per call (Q A Aᵀ A), and
+                # after ~30 `model cycle` commands Euler's equations blow up
+                turn = np.einsum("gij,gkj->gik", gaxes[joined], self.axes0[joined])
+                gid = np.repeat(np.arange(self.ng), np.diff(gstart))
+                sel = ~lone[gid]
+                rows = gmember[sel]
+                k = (np.cumsum(~lone) - 1)[gid[sel]]          # each member's row of ``turn``
+                pa[rows] = _orthonormal(np.einsum("bij,bjk->bik", turn[k], pa[rows]))
             # a lone block takes back the kernel's own frame unchanged: the next run starts from
             # exactly the axes this one ended with, so splitting a run into several `model cycle`
             # commands (or save/restore between them) changes no bit
-            lone = np.diff(gstart) == 1
             pa[gmember[gstart[:-1][lone]]] = gaxes[lone]
             b["inertia"][gmember] = np.einsum("bij,bj,bkj->bik", pa[gmember], b["principal_moment"][gmember],
                                               pa[gmember])
@@ -378,6 +384,9 @@ class RigidBatch(_Step):
         super().__init__(run)
         self.chunked = chunked
         self.chunk = 10                  # steps per kernel call, adapted to CHUNK_SECONDS
+        #: ``cycle.cycle_lists`` of the contacts as last detected, and that detection's number
+        self.lists = None
+        self.listed = -1
 
     def advance(self, k: int) -> int:
         r = self.run
@@ -389,13 +398,16 @@ class RigidBatch(_Step):
                             cs["prop"])
         subs = SubContacts(*(ss[k] for k in SubContacts._fields))
         bounds = Bounds(r.radius, r.acc, r.trigger, r.motion)
+        if self.listed != eng.detections:        # (made once per detection, not per kernel call)
+            self.lists = cycle_lists(r.b.n, contacts, subs, r.gmember)
+            self.listed = eng.detections
         n_ok = 0
         bad = -1
         while n_ok < k:
             kk = min(k - n_ok, self.chunk) if self.chunked else k
             t0 = _time.perf_counter()
             c_ok, bad = run_steps(kk, r.dt, r.g, r.full, r.damping, r.groups(), r.bodies(), contacts, subs, bounds,
-                                  r.vmax, r.out, r.beta)
+                                  r.vmax, r.out, r.beta, self.lists)
             spent = _time.perf_counter() - t0
             n_ok += c_ok
             if bad >= 0 or r.motion[1] > 0.0 or c_ok < kk or not self.chunked:
