@@ -173,8 +173,9 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         if s["timestep"]:
             return float(s["timestep"])
         b = self.model.blocks
-        jm = JOINT_MODELS[s["jmodel"]]
-        drow = jm.row(s["props"])
+        # the defaults this model has (a table may hold another model's properties, e.g. friction
+        # set for mohr before `jmodel assign elastic`)
+        drow = default_row(s, JOINT_MODELS[s["jmodel"]].code)
         kn = max(drow[P_KN], drow[P_KS])
         # Eqs. (87)-(88) over the blocks that move: a block whose six velocity components are all
         # held (`block fix`, `block apply velocity …`, or those of the leader it is joined to) takes

@@ -45,3 +45,15 @@ def test_all_blocks_fixed_falls_back_to_all_blocks(session):
     """Nothing moves: Δt from every block, as before (no division by an empty set)."""
     dt = _model(session, "block fix\n")
     assert dt == pytest.approx(FRAC * 2.0 * math.sqrt(RHO / (KN * 64.0)), rel=1e-12)
+
+
+def test_defaults_of_another_joint_model_are_left_out(session):
+    """Material-table defaults set for mohr (friction) and then `jmodel assign elastic`: the elastic
+    step uses the stiffnesses and ignores the friction it has no column for (this raised a KeyError)."""
+    session.command("model new\nblock create brick -8 8 -2 2 -1 0\nblock create brick 0 1 0 1 0 1\n"
+                    f"block property density {RHO:g}\nblock contact jmodel assign mohr\n"
+                    "block contact material-table default property stiffness-normal 1e9 stiffness-shear 1e9 friction 30\n"
+                    "block contact jmodel assign elastic\n"
+                    f"block contact material-table default property stiffness-normal {KN:g} stiffness-shear {KN:g}\n"
+                    "block fix range position-z -1 0\nmodel dynamic active on\nmodel cycle 2")
+    assert session.model.rigid_engine.dt == pytest.approx(FRAC * 2.0 * math.sqrt(RHO / KN), rel=1e-12)
