@@ -272,7 +272,7 @@ class RigidEngine(ContactDetection, MixedContactSteps):
             kb += np.bincount(cs["a"][c], k, minlength=b.n) + np.bincount(cs["b"][c], k, minlength=b.n)
         return np.add.reduceat(kb[gmember], gstart[:-1]) if len(gmember) else np.zeros(0)
 
-    def _masses(self, gstart, gmember, gmass, giscalar, dt_fixed, near=None):
+    def _masses(self, gstart, gmember, gmass, giscalar, dt_fixed, near=None, gprin=None):
         """(Δt, inertial masses, scaled scalar inertias) of the groups; density scaling when on.
         ``near``: by body, the Δt in use, kept unless the stiffnesses ask for less than
         ``KEEP_DT`` of it (``_body_masses``)."""
@@ -282,7 +282,7 @@ class RigidEngine(ContactDetection, MixedContactSteps):
             dt = dt_fixed if dt_fixed is not None else stiffness_timestep(self.timestep(), self.rayleigh_beta())
             return dt, gmass.copy(), giscalar.copy()
         if self.scaling() in ("body", "raised"):
-            return self._body_masses(gstart, gmember, gmass, giscalar, dt_fixed, near)
+            return self._body_masses(gstart, gmember, gmass, giscalar, dt_fixed, near, gprin)
         kg = self._stiffness_sums(gstart, gmember)
         if dt_fixed is None and s["scale_timestep"]:
             dt_fixed = float(s["scale_timestep"])
@@ -297,7 +297,7 @@ class RigidEngine(ContactDetection, MixedContactSteps):
         im, isc = inertial_masses(gmass, giscalar, kg, dt, frac)
         return dt, im, isc
 
-    def _body_masses(self, gstart, gmember, gmass, giscalar, dt_fixed, near=None):
+    def _body_masses(self, gstart, gmember, gmass, giscalar, dt_fixed, near=None, gprin=None):
         """Density scaling by body (``mass-scale body``): every body's inertial mass and scalar
         inertia set from the Gershgorin row sums of the contact stiffness around it (kernel
         ``bodyscale.body_row_sums``) so that each body has the same critical step, and the
@@ -354,7 +354,12 @@ class RigidEngine(ContactDetection, MixedContactSteps):
             im = np.maximum(im, gmass)
             isc = np.maximum(isc, giscalar)
         if self.full_inertia():
-            ratio = np.maximum(im / gmass, isc / giscalar)
+            # Euler's equations turn the body with its principal moments × im / m (kernels.motion):
+            # the smallest of them must reach the scalar bound isc, else ω_max Δt exceeds 2s (a
+            # 10 × 10 × 5 m block on an incline, I_min = 0.46 of the scalar inertia, ran at
+            # ω_max Δt = 2.1 with s = 0.8 and fell through its base)
+            imin = giscalar if gprin is None else np.minimum(giscalar, np.asarray(gprin).min(axis=1))
+            ratio = np.maximum(im / gmass, isc / imin)
             im, isc = gmass * ratio, giscalar * ratio
         return dt, im, isc
 

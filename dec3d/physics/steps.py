@@ -200,7 +200,7 @@ class _Run:
         """Inertial masses of the rigid groups for Δt ``dt`` (None: Δt from the stiffnesses, or
         ``near`` when it is close, by body); returns Δt."""
         dt, self.gimass, self.gisc = self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, dt,
-                                                      near)
+                                                      near, self.gprin)
         if self.by_body:
             # (Δt set from contacts: from now on it never grows in this run, ``_body_masses``)
             self.body_dt_set = self.body_dt_set or self.eng.body_dt_from_contacts
@@ -232,7 +232,7 @@ class _Run:
             return self.dt_fixed
         ng = self.ng
         near = getattr(self, "dt", None) if self.by_body and self.body_dt_set else None
-        dt_r = (self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, None, near)[0] if ng
+        dt_r = (self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, None, near, self.gprin)[0] if ng
                 else math.inf)
         d = ((dt_r if ng else float(self.s["scale_timestep"] or 1.0)) if self.scaled
              else min(dt_r, stiffness_timestep(self.zst.natural_timestep(), self.beta)))
