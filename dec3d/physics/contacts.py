@@ -311,7 +311,11 @@ class ContactDetection:
             # nothing to look at again and every contact kept in place: all the install below would
             # change is the properties of contacts that follow the defaults (a quiet model's
             # first detection of a run; on a large model the gathers cost ~2 % of a short run)
+            before = (cs["prop"].copy(), cs["jmodel"].copy())
             self.follow_defaults()
+            # (as the full install below says it: every contact kept, with the same properties)
+            self.detect_kept_all = bool(np.array_equal(before[0], cs["prop"], equal_nan=True)
+                                        and np.array_equal(before[1], cs["jmodel"]))
             self.timings["detect"] += _time.perf_counter() - t0
             return
         nn = np.empty((k, 3))
