@@ -5,12 +5,19 @@ from conftest import ROOT
 from dec3d.cli import main
 
 # decks called by another example are run through their caller
-EXAMPLES = sorted(p for p in (ROOT / "examples").rglob("*.dat") if p.name != "settings.dat")
+# the slow decks whose own tests below run them through `dec3d run` as well are not run again here
+RUN_BY_THEIR_TESTS = {"deformable/tunnel_mc.dat", "deformable/tunnel_jointed_mc.dat", "feblock/tunnel_liner.dat"}
+EXAMPLES = sorted(p for p in (ROOT / "examples").rglob("*.dat")
+                  if p.name != "settings.dat" and p.relative_to(ROOT / "examples").as_posix() not in RUN_BY_THEIR_TESTS)
+
+
+def _cli_run(deck, out):
+    assert main(["run", str(deck), "--out", str(out), "-q"]) == 0
 
 
 @pytest.mark.parametrize("deck", EXAMPLES, ids=lambda p: str(p.relative_to(ROOT / "examples")))
 def test_example_runs(deck, tmp_path):
-    assert main(["run", str(deck), "--out", str(tmp_path), "-q"]) == 0
+    _cli_run(deck, tmp_path)
 
 
 def test_language_example_results(tmp_path):
@@ -57,9 +64,7 @@ def test_tunnel_mc_stages_show_the_plastic_zone(tmp_path):
     import meshio
     import numpy as np
 
-    from dec3d.session import run_deck
-
-    run_deck(ROOT / "examples" / "deformable" / "tunnel_mc.dat", out_dir=tmp_path)
+    _cli_run(ROOT / "examples" / "deformable" / "tunnel_mc.dat", tmp_path)
     assert all((tmp_path / f"{n}.sav").exists() for n in ("initial", "heading", "staged"))
     got = {}
     for name in ("heading", "staged", "full_face"):
@@ -144,20 +149,20 @@ def test_tunnel_liner_carries_the_rest_of_the_load(tmp_path):
     vhoop = tt[:, 0] ** 2 * st[:, 0] + 2 * tt[:, 0] * tt[:, 1] * st[:, 5] + tt[:, 1] ** 2 * st[:, 2]
     np.testing.assert_allclose(np.sort(vhoop), np.sort(hoop), rtol=1e-9, atol=1e-9)
     again = tmp_path / "again"
-    run_deck(deck, out_dir=again)
+    _cli_run(deck, again)                                   # and as `dec3d run` runs it
     assert (again / "roof.csv").read_bytes() == (tmp_path / "roof.csv").read_bytes()
 
 
 @pytest.fixture(scope="module")
 def jointed_tunnel_runs(tmp_path_factory):
-    """examples/deformable/tunnel_jointed_mc.dat run twice, each into its own folder."""
+    """examples/deformable/tunnel_jointed_mc.dat run twice, each into its own folder (the first
+    as `dec3d run` runs it)."""
     from dec3d.session import run_deck
 
-    outs = []
-    for k in range(2):
-        out = tmp_path_factory.mktemp(f"tunnel_jointed_{k}")
-        run_deck(ROOT / "examples" / "deformable" / "tunnel_jointed_mc.dat", out_dir=out)
-        outs.append(out)
+    deck = ROOT / "examples" / "deformable" / "tunnel_jointed_mc.dat"
+    outs = [tmp_path_factory.mktemp(f"tunnel_jointed_{k}") for k in range(2)]
+    _cli_run(deck, outs[0])
+    run_deck(deck, out_dir=outs[1])
     return outs
 
 

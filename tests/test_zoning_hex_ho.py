@@ -7,7 +7,7 @@ import pytest
 
 from dec3d.errors import Dec3dError
 from dec3d.geometry.errors import GeometryError
-from dec3d.geometry.zoning import mesh_hex
+from dec3d.geometry.zoning_hex import mesh_hex
 from dec3d.model.zone_mesh import conformity
 
 

@@ -12,7 +12,8 @@ from ..errors import BindError, CommandError
 from ..io.history import write_csv, write_png
 from ..physics.history import (BLOCK_QUANTITIES, CONTACT_QUANTITIES, GRIDPOINT_QUANTITIES, MODEL_QUANTITIES,
                                POINT_QUANTITIES, RIGID_QUANTITIES, ROTATION_QUANTITIES, ZONE_QUANTITIES, figures,
-                               histories, nearest_block_id, nearest_gridpoint, zone_at)
+                               histories)
+from ..physics.history_lookup import nearest_block_id, nearest_gridpoint, zone_at
 from ..model.model import KIND_DEFORMABLE, KIND_FE
 from .registry import REGISTRY, command
 from .values import NUMBERISH, VEC3, Choice, Num, OutPath, P, Text, ValueType, _number_literal

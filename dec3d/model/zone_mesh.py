@@ -15,8 +15,8 @@ import numpy as np
 
 from dec3d.geometry.assemble import block_poly
 from dec3d.geometry.errors import GeometryError
-from dec3d.geometry.zoning import (face_planes, hex_corners, imprint_segments, inside, mesh_convex, mesh_hex,
-                                   to_high_order)
+from dec3d.geometry.zoning import face_planes, imprint_segments, inside, mesh_convex
+from dec3d.geometry.zoning_hex import hex_corners, mesh_hex, to_high_order
 from .model import KIND_FE
 from .store import Field
 from .zones import install_block_mesh, zone_stores

@@ -13,7 +13,7 @@ Every input goes to a Session with a temporary output folder (bind, then run), a
 bind-only path of `dec3d check`. Any exception that is not a Dec3dError fails, and so does a
 non-finite number in any float array of the model. Model sizes stay tiny: the session's block
 budget is lowered (`model budget` in the harness), cycle counts are small, and a mutated deck's
-`model cycle|solve` lines that ask for more than MAX_STEPS steps are left out of the run.
+`model cycle|solve|factor-of-safety` lines that ask for more than MAX_STEPS steps are left out of the run.
 """
 from __future__ import annotations
 
@@ -41,6 +41,9 @@ from dec3d.kernels.joints.mohr import P_TANF_RES
 from dec3d.session import Session
 
 MAX_STEPS = 30
+#: commands whose `cycles` keyword bounds the steps they take (a factor-of-safety trial defaults to
+#: 10000 steps, and a search runs several: left unbounded, a few such lines took most of the fuzz time)
+CYCLING = (("model", "solve"), ("model", "factor-of-safety"))
 #: examples per test are multiplied by DEC3D_FUZZ_SCALE (default 1, for CI); a longer local hunt:
 #: DEC3D_FUZZ_SCALE=50 DEC3D_FUZZ_RANDOM=1 python -m pytest tests/robustness/test_fuzz.py
 SCALE = max(1, int(os.environ.get("DEC3D_FUZZ_SCALE", "1")))
@@ -149,8 +152,8 @@ def command_line(draw):
                     toks += [p.name] + draw(value_for(p.value))
             if draw(st.booleans()):
                 toks.append("not")
-    if cmd.path == ("model", "solve"):
-        toks += ["cycles", str(MAX_STEPS)]              # a solve never runs long here
+    if cmd.path in CYCLING:
+        toks += ["cycles", str(MAX_STEPS)]              # a solve (or a strength-reduction trial) never runs long here
     return " ".join(toks)
 
 
@@ -179,7 +182,7 @@ def _small(item) -> bool:
     if item.command.path == ("model", "cycle"):
         n = item.args.get("n")
         return isinstance(n, int) and n <= MAX_STEPS
-    if item.command.path == ("model", "solve"):
+    if item.command.path in CYCLING:
         n = item.args.get("cycles")
         return isinstance(n, int) and n <= MAX_STEPS
     return True
@@ -303,8 +306,9 @@ def test_mutated_save_files_are_refused_or_restored_cleanly(data):
 def test_the_harness_refuses_a_long_run_and_keeps_blocks_few(tmp_path):
     # the guards the fuzz relies on: a long cycle is left out, the budget stops a big cut
     s = _session(str(tmp_path))
-    items = s.load_text("model cycle 1000000000\nmodel cycle 3\n", "<t>", tmp_path)
-    assert [_small(it) for it in items] == [False, True]
+    items = s.load_text("model cycle 1000000000\nmodel cycle 3\nmodel factor-of-safety\n"
+                        "model factor-of-safety cycles 30\n", "<t>", tmp_path)
+    assert [_small(it) for it in items] == [False, True, False, True]
     s.command("block create brick 0 10 0 10 0 10")
     with pytest.raises(Dec3dError, match="400 blocks"):
         s.command("block cut joint-set spacing 0.01")
