@@ -45,6 +45,7 @@ import numpy as np
 
 from dec3d.errors import Dec3dError
 from dec3d.kernels.zone_elastic import ElasticPlan, elastic_zone_step
+from dec3d.kernels.zone_mohr_step import mohr_zone_step
 from dec3d.kernels.zone_plastic import node_lists4, zone_forces_plastic, zone_forces_plastic_parallel_ws, zone_scratch
 from dec3d.kernels.zonestep import gp_externals, gp_motion, gp_motion_ws, zone_mass_stiffness
 from dec3d.model.feblocks import has_feblocks
@@ -69,6 +70,9 @@ PARALLEL_MIN_ZONES = 20000
 #: step zones with ``zone_elastic.elastic_zone_step`` when none is Mohr-Coulomb (False: always
 #: the plastic kernels, which give the same bits; for tests)
 ELASTIC_KERNEL = True
+#: step zones with ``zone_mohr_step.mohr_zone_step`` when some are Mohr-Coulomb (False: the
+#: plastic kernels of ``zone_plastic``, which give the same bits; for tests)
+MOHR_KERNEL = True
 
 
 def _ids(model, rows) -> str:
@@ -167,11 +171,16 @@ class ZoneStepper:
         #: no Mohr-Coulomb zone: the elastic step (``zone_elastic.elastic_zone_step``, the bits of
         #: the plastic step) on one part of the zones per thread from PARALLEL_MIN_ZONES zones on
         self.fast = None
-        if ELASTIC_KERNEL and not len(mo) and len(self.rows4):
+        #: some Mohr-Coulomb zones: ``zone_mohr_step.mohr_zone_step`` (the same plan, and the
+        #: scratch of its plastic corrections: per zone entry and per averaging node)
+        self.fastmc = None
+        if ((ELASTIC_KERNEL and not len(mo)) or (MOHR_KERNEL and len(mo))) and len(self.rows4):
             import numba
 
             nch = numba.get_num_threads() if len(self.rows4) >= PARALLEL_MIN_ZONES else 1
             self.fast = ElasticPlan(zs["gp"], self.rows4, self.node, self.zset, self.weight, v.n, nch)
+            if len(mo):
+                self.fastmc = (np.empty(len(self.rows4)), np.empty(v.n))
         elif self.plastic and len(self.rows4) >= PARALLEL_MIN_ZONES:
             nv = v.n
             fstart, fent = node_lists4(nv, np.arange(nv, dtype=_I), zs["gp"], self.rows4)
@@ -419,7 +428,11 @@ class ZoneStepper:
             self.begin()
         pos, vel = v["pos"], v["velocity"]
         fast = self.fast
-        if fast is not None:
+        if self.fastmc is not None:
+            mohr_zone_step(pos, vel, fast.g4, fast.n4, fast.rows, fast.zset, fast.weight, self.nset, zs["cmodel"],
+                           zs["prop"], self.bulk, self.shear, dt, large, self.nmd, zs["stress"], zs["state"], facc,
+                           fmag, *fast.args(), *self.fastmc)
+        elif fast is not None:
             elastic_zone_step(pos, vel, fast.g4, fast.n4, fast.rows, fast.zset, fast.weight, self.nset, self.bulk,
                               self.shear, dt, large, self.nmd, zs["stress"], facc, fmag, *fast.args())
         elif self.par is not None:
