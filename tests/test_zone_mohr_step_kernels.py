@@ -164,7 +164,7 @@ def test_mohr_scalar_is_mohr_return():
         lam_ = K - 2 * G / 3
         tr[:3] += lam_ * de[:3].sum() + 2 * G * de[:3]
         tr[3:] += 2 * G * de[3:]
-        code, *t6, d = zm.mohr_scalar(*tr, K, G, c, tf, ten, td)
+        code, *t6, d = zm.mohr_scalar(*tr, c, *zm.mohr_constants(K, G, c, tf, ten, td))
         if code >= 0:
             settled[code] += 1
             assert code == bits and np.array_equal(np.array(t6), s_k) and d == dsp

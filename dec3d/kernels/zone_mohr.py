@@ -205,12 +205,15 @@ def mohr_work():
             np.empty(3, np.int64), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3))
 
 
+_THIRD = 1.0 / 3.0
+
+
 @njit(cache=True, inline="always")
 def _deviator(s0, s1, s2):
     """Diagonal of the deviator from differences of the diagonal ((s0 - s1) + (s0 - s2)) / 3, not
     s0 - m: exact differences when the mean stress is far above the deviator."""
     a = s0 - s1; b = s1 - s2; c = s2 - s0
-    return (a - c) / 3.0, (b - a) / 3.0, (c - b) / 3.0
+    return (a - c) * _THIRD, (b - a) * _THIRD, (c - b) * _THIRD
 
 
 @njit(cache=True, inline="always")
@@ -226,13 +229,16 @@ def _dev_principal(s0, s1, s2, s3, s4, s5):
     if j2 <= 0.0:
         return m, 0.0, 0.0, 0.0
     j3 = d0 * (d1 * d2 - s5 * s5) - s3 * (s3 * d2 - s5 * s4) + s4 * (s3 * s5 - d1 * s4)
-    r = math.sqrt(j2 / 3.0)
-    cs = j3 / (2.0 * r * r * r)
+    # (multiplications by 1/3, and cos 3θ = (J3/2) u u^½ with u = 3/J2 beside r: the divisions
+    # and the square root lie on the path to acos, and their latency is most of the cost)
+    r = math.sqrt(j2 * _THIRD)
+    u = 3.0 / j2
+    cs = 0.5 * j3 * u * math.sqrt(u)
     if cs > 1.0:
         cs = 1.0
     elif cs < -1.0:
         cs = -1.0
-    th = math.acos(cs) / 3.0
+    th = math.acos(cs) * _THIRD
     hi = 2.0 * r * math.cos(th)
     lo = 2.0 * r * math.cos(th + 2.0 * math.pi / 3.0)
     return m, lo, -lo - hi, hi
@@ -349,32 +355,41 @@ def mohr_trial(s, de, bulk, shear, coh, tanfric, ten):
 
 
 @njit(cache=True, inline="always")
-def _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, bulk, shear, coh, npf, csn, ft, tandil):
+def mohr_constants(bulk, shear, coh, tanfric, ten, tandil):
+    """What the single-plane returns take from a zone's properties: (N_phi, 2 c sqrt(N_phi),
+    sigma_t capped, N_psi, alpha1, alpha2, sigma_P, alpha_P, the shear return's denominator);
+    a tuple hot loops can keep while the properties stay the same."""
+    npf, csn, ft = _strength(coh, tanfric, ten)
+    spsi = tandil / math.sqrt(1.0 + tandil * tandil)
+    nps = (1.0 + spsi) / (1.0 - spsi)
+    a1 = bulk + 4.0 * shear / 3.0
+    a2 = bulk - 2.0 * shear / 3.0
+    sp = ft * npf - csn
+    ap = math.sqrt(1.0 + npf * npf) + npf
+    return npf, csn, ft, nps, a1, a2, sp, ap, a1 * (1.0 + npf * nps) - a2 * (npf + nps)
+
+
+@njit(cache=True, inline="always")
+def _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, coh, npf, csn, ft, nps, a1, a2, sp, ap, den):
     """``mohr_plastic`` in scalars for the common case: principal values well apart (closed
     form, ``GAP_REL``) and Itasca's single plane giving an admissible stress. The trial stress
     s0..s5 with its deviatoric principal values l1 <= l2 <= l3 about the mean m
-    (``_dev_principal``). Returns (code, t0..t5, dsp): code 0 elastic (t = s, dsp = 0), SHEAR_NOW
-    or TENSION_NOW (t the returned stress, dsp as ``mohr_return``), -1 not settled here (t = s:
-    ``mohr_plastic``'s general path must do it). The same operations as ``mohr_plastic``'s array
-    path, so the same bits."""
+    (``_dev_principal``), the zone's cohesion and ``mohr_constants``. Returns (code, t0..t5,
+    dsp): code 0 elastic (t = s, dsp = 0), SHEAR_NOW or TENSION_NOW (t the returned stress, dsp
+    as ``mohr_return``), -1 not settled here (t = s: ``mohr_plastic``'s general path must do it).
+    The same operations as ``mohr_plastic``'s array path, so the same bits."""
     if not (l3 - l1 > 0.0 and min(l2 - l1, l3 - l2) >= GAP_REL * (l3 - l1)):
         return -1, s0, s1, s2, s3, s4, s5, 0.0
     p1 = m + l1; p2 = m + l2; p3 = m + l3
-    spsi = tandil / math.sqrt(1.0 + tandil * tandil)
-    nps = (1.0 + spsi) / (1.0 - spsi)
     scale = abs(p1) + abs(p3) + abs(p2) + coh + abs(ft)
     tol = 1e-10 * scale
     fs13 = p3 * npf - p1 - csn
     ft3 = p3 - ft
     if fs13 <= tol and ft3 <= tol:
         return 0, s0, s1, s2, s3, s4, s5, 0.0
-    a1 = bulk + 4.0 * shear / 3.0
-    a2 = bulk - 2.0 * shear / 3.0
-    sp = ft * npf - csn
-    ap = math.sqrt(1.0 + npf * npf) + npf
     h = p3 - ft + ap * (p1 - sp)
     if fs13 > tol and (h <= 0.0 or ft3 <= tol):
-        ls = fs13 / (a1 * (1.0 + npf * nps) - a2 * (npf + nps))
+        ls = fs13 / den
         n1 = p1 + ls * (a1 - a2 * nps)
         n2 = p2 + ls * a2 * (1.0 - nps)
         n3 = p3 + ls * (a2 - a1 * nps)
@@ -410,51 +425,45 @@ def _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, bulk, shear, coh, npf, c
 
 
 @njit(cache=True, inline="always")
-def mohr_scalar(s0, s1, s2, s3, s4, s5, bulk, shear, coh, tanfric, ten, tandil):
+def mohr_scalar(s0, s1, s2, s3, s4, s5, coh, npf, csn, ft, nps, a1, a2, sp, ap, den):
     """``mohr_trial``'s test and ``mohr_plastic``'s common case on the trial stress s0..s5 in
-    scalars (no arrays, for hot loops): (code, t0..t5, dsp) as ``_fast_return``; code -1: the
-    caller runs ``mohr_plastic`` on the trial stress. The bits of mohr_trial + mohr_plastic."""
-    npf, csn, ft = _strength(coh, tanfric, ten)
+    scalars (no arrays, for hot loops), with the zone's cohesion and ``mohr_constants``: (code,
+    t0..t5, dsp) as ``_fast_return``; code -1: the caller runs ``mohr_plastic`` on the trial
+    stress. The bits of mohr_trial + mohr_plastic."""
     if _bounds_elastic(s0, s1, s2, s3, s4, s5, coh, npf, csn, ft):
         return 0, s0, s1, s2, s3, s4, s5, 0.0
     m, l1, l2, l3 = _dev_principal(s0, s1, s2, s3, s4, s5)
     if _values_elastic(m, l1, l3, coh, npf, csn, ft):
         return 0, s0, s1, s2, s3, s4, s5, 0.0
-    return _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, bulk, shear, coh, npf, csn, ft, tandil)
+    return _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, coh, npf, csn, ft, nps, a1, a2, sp, ap, den)
 
 
 @njit(cache=True)
 def mohr_plastic(s, bulk, shear, coh, tanfric, ten, tandil, work):
     """Second half of ``mohr_core``: the return of the trial stress s (in place); (bits, dsp).
     The common case in scalars (``_fast_return``), the rest on the arrays of ``work``."""
-    npf, csn, ft = _strength(coh, tanfric, ten)
+    npf, csn, ft, nps, a1, a2, sp, ap, den = mohr_constants(bulk, shear, coh, tanfric, ten, tandil)
     m, l1, l2, l3 = _dev_principal(s[0], s[1], s[2], s[3], s[4], s[5])
-    code, t0, t1, t2, t3, t4, t5, dsp = _fast_return(s[0], s[1], s[2], s[3], s[4], s[5], m, l1, l2, l3, bulk, shear,
-                                                     coh, npf, csn, ft, tandil)
+    code, t0, t1, t2, t3, t4, t5, dsp = _fast_return(s[0], s[1], s[2], s[3], s[4], s[5], m, l1, l2, l3, coh, npf, csn,
+                                                     ft, nps, a1, a2, sp, ap, den)
     if code >= 0:
         s[0] = t0; s[1] = t1; s[2] = t2; s[3] = t3; s[4] = t4; s[5] = t5
         return code, dsp
     lam, pr, nn, dm, rr, act, mm, bb, x, sn = work
     principal_axes(s, lam, pr, mm)
     s1 = lam[0]; s3 = lam[2]
-    spsi = tandil / math.sqrt(1.0 + tandil * tandil)
-    nps = (1.0 + spsi) / (1.0 - spsi)
     scale = abs(s1) + abs(s3) + abs(lam[1]) + coh + abs(ft)
     tol = 1e-10 * scale
     fs13 = s3 * npf - s1 - csn          # = -f_s (Itasca), > 0 violated
     ft3 = s3 - ft
     if fs13 <= tol and ft3 <= tol:
         return 0, 0.0
-    a1 = bulk + 4.0 * shear / 3.0
-    a2 = bulk - 2.0 * shear / 3.0
     # Itasca's choice of the plane: h decides between shear and tension
-    sp = ft * npf - csn
-    ap = math.sqrt(1.0 + npf * npf) + npf
     h = s3 - ft + ap * (s1 - sp)
     first = 0 if (fs13 > tol and (h <= 0.0 or ft3 <= tol)) else 8
     # fast path: Itasca's single-plane return in closed form, kept when it violates no plane
     if first == 0:
-        ls = fs13 / (a1 * (1.0 + npf * nps) - a2 * (npf + nps))
+        ls = fs13 / den
         n1 = s1 + ls * (a1 - a2 * nps)
         n2 = lam[1] + ls * a2 * (1.0 - nps)
         n3 = s3 + ls * (a2 - a1 * nps)

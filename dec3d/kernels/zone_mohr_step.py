@@ -27,8 +27,8 @@ import numpy as np
 from numba import njit, prange
 
 from .zone_elastic import _add, _faces, _force, _strain
-from .zone_mohr import (ZMODEL_MOHR, ZP_COHESION, ZP_TANDIL, ZP_TANFRIC, ZP_TENSION, merge_state, mohr_plastic,
-                        mohr_scalar, mohr_work)
+from .zone_mohr import (ZMODEL_MOHR, ZP_COHESION, ZP_TANDIL, ZP_TANFRIC, ZP_TENSION, merge_state, mohr_constants,
+                        mohr_plastic, mohr_scalar, mohr_work)
 
 
 @njit(cache=True, parallel=True)
@@ -89,6 +89,9 @@ def mohr_zone_step(pos, vel, g4, n4, rows, zset, weight, nset, cmodel, prop, bul
     for c in prange(nch):
         j = nbase[c]
         work = mohr_work()
+        # (the constants of the last Mohr-Coulomb zone's properties: neighbours mostly share them)
+        kb = -1.0; kg = -1.0; kc = -1.0; kt = -1.0; kn = -1.0; kd = -1.0
+        npf, csn, ft, nps, a1, a2, sp, ap, den = mohr_constants(1.0, 1.0, 1.0, 1.0, 1.0, 0.0)
         for q in range(pstart[c], pstart[c + 1]):
             k = pk[q]
             i0 = g4[k, 0]; i1 = g4[k, 1]; i2 = g4[k, 2]; i3 = g4[k, 3]
@@ -136,7 +139,11 @@ def mohr_zone_step(pos, vel, g4, n4, rows, zset, weight, nset, cmodel, prop, bul
             if cmodel[z] == ZMODEL_MOHR:
                 coh = prop[z, ZP_COHESION]; tf = prop[z, ZP_TANFRIC]
                 ten = prop[z, ZP_TENSION]; td = prop[z, ZP_TANDIL]
-                code, s0, s1, s2, s3, s4, s5, dp = mohr_scalar(s0, s1, s2, s3, s4, s5, K, G, coh, tf, ten, td)
+                if K != kb or G != kg or coh != kc or tf != kt or ten != kn or td != kd:
+                    npf, csn, ft, nps, a1, a2, sp, ap, den = mohr_constants(K, G, coh, tf, ten, td)
+                    kb = K; kg = G; kc = coh; kt = tf; kn = ten; kd = td
+                code, s0, s1, s2, s3, s4, s5, dp = mohr_scalar(s0, s1, s2, s3, s4, s5, coh, npf, csn, ft, nps, a1, a2,
+                                                               sp, ap, den)
                 if code < 0:
                     stress[z, 0] = s0; stress[z, 1] = s1; stress[z, 2] = s2
                     stress[z, 3] = s3; stress[z, 4] = s4; stress[z, 5] = s5
