@@ -22,9 +22,10 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
 4. each step (``step``): zone forces of the 4-node zones (mixed discretization in hexahedral
    sets and nodal mixed discretization, NMD, for the other tetrahedra when
    ``settings.mechanical["nmd"]`` is on, the default, ``block zone nodal-mixed-discretization``):
-   with no Mohr-Coulomb zone ``zone_elastic.elastic_zone_step`` (threads from PARALLEL_MIN_ZONES
-   zones on), otherwise ``zone_plastic.zone_forces_plastic`` (``zone_forces_plastic_parallel_ws``
-   from PARALLEL_MIN_ZONES zones on), all with the same bits for the same zones; 10-node zones
+   with no Mohr-Coulomb zone ``zone_elastic.elastic_zone_step``, otherwise
+   ``zone_mohr_step.mohr_zone_step`` (both on threads from PARALLEL_MIN_ZONES zones on; with
+   ELASTIC_KERNEL / MOHR_KERNEL off ``zone_plastic.zone_forces_plastic`` or
+   ``zone_forces_plastic_parallel_ws``), all with the same bits for the same zones; 10-node zones
    by ``zones_ho.tet10_step``), gravity (m g
    on the gridpoints of 4-node zones, the consistent loads of ``zones_ho.tet10_body_force`` on
    those of 10-node zones, both counted in the applied-force magnitudes of the equilibrium
