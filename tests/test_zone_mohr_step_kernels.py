@@ -169,3 +169,55 @@ def test_mohr_scalar_is_mohr_return():
             settled[code] += 1
             assert code == bits and np.array_equal(np.array(t6), s_k) and d == dsp
     assert min(settled.values()) >= 40, settled
+
+
+#: a small Mohr-Coulomb model that yields: tetrahedra and hexahedral (mixed-discretization) zones,
+#: large strain, gravity, a held base, a side load, in-situ stress beyond the strength
+_DECK = """model new
+block create brick 0 1 0 1 0 1
+block create brick 2 3 0 1 0 1
+block zone generate edgelength 0.3 range position-x 0 1
+block zone generate hexahedra divisions 3 2 3 range position-x 2 3
+block zone cmodel assign mohr-coulomb
+block zone property bulk 5e8 shear 3e8 density 2000 cohesion 1e4 friction 30 dilation 5 tension 5e3
+block insitu stress -1e4 -4e4 -8e4 0 0 0
+block gridpoint apply velocity 0 0 0 range position-z 0
+block gridpoint apply force-x 2e5 range position-z 1
+model gravity 0 0 -10
+model large-strain on
+"""
+
+
+def _model_run(tmp_path, monkeypatch, threads, fast, steps=40):
+    import io
+
+    import dec3d
+    import dec3d.physics.zones as pz
+
+    monkeypatch.setattr(pz, "MOHR_KERNEL", fast)
+    monkeypatch.setattr(pz, "PARALLEL_MIN_ZONES", 0)          # the threaded kernels on this small model
+    keep = numba.get_num_threads()
+    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    try:
+        s = dec3d.Session(out_dir=tmp_path, stdout=io.StringIO())
+        s.command(_DECK + f"model cycle {steps}\n")
+    finally:
+        numba.set_num_threads(keep)
+    m = s.model
+    zst = m.rigid_engine._zstep
+    assert (zst.fastmc is not None) == fast and zst.nset > 0
+    zs = m.store("zones")
+    return (zs["stress"].copy(), zs["state"].copy(), m.vertices["disp"].copy(), m.vertices["velocity"].copy(),
+            np.array([m.rigid_engine.kinetic, m.rigid_engine.criteria()["unbalanced-maximum"]]))
+
+
+def test_model_runs_give_the_same_bits_with_either_kernel_and_thread_count(tmp_path, monkeypatch):
+    """A whole Mohr-Coulomb run (40 steps, large strain, tetrahedra and hexahedral sets, zones
+    yielding): ``mohr_zone_step`` on 1 and 2 threads and the plastic kernels give the same
+    stresses, plastic states, displacements, velocities, kinetic energy and unbalanced force."""
+    ref = _model_run(tmp_path, monkeypatch, 1, False)
+    assert (ref[1] & zm.SHEAR_PAST).sum() > 0 and np.abs(ref[2]).max() > 1e-7
+    for nt in (1, 2):
+        got = _model_run(tmp_path, monkeypatch, nt, True)
+        for a, b in zip(ref, got):
+            assert np.array_equal(a, b), nt
