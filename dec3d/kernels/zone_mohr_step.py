@@ -19,7 +19,9 @@ repeated principal values). A step is three sweeps over the zones:
     sweep C (per zone): the stress corrected by dsp minus its average (set mean, Eqs. 64-67, or
                         the mean of the nodal averages, Eqs. 74-76), nodal forces scattered.
 
-Sums onto gridpoints and averaging nodes follow the plans of ``ElasticPlan`` (a target's terms in
+Each averaging node's quotient (Σ Δε_v V / Σ V, Σ dsp V / Σ V) is made once per node after its
+sums rather than by each of its zones (the same quotient, so the same bits). Sums onto gridpoints
+and averaging nodes follow the plans of ``ElasticPlan`` (a target's terms in
 ascending zone-entry order, foreign entries through slots), hexahedral-set sums are made
 serially between the sweeps: the serial order, so the serial kernel's bits for any thread count.
 """
@@ -78,6 +80,10 @@ def mohr_zone_step(pos, vel, g4, n4, rows, zset, weight, nset, cmodel, prop, bul
                 for q in range(npstart[i], npstart[i + 1]):
                     nodesum[t] += sa[npslot[q], 0]
                     nodevol[t] += sa[npslot[q], 1]
+            # each node's average once (the quotient the zones would each work out: same bits)
+            for t in prange(nodesum.shape[0]):
+                if nodevol[t] > 0.0:
+                    nodesum[t] = nodesum[t] / nodevol[t]
     sv = np.zeros(nset)
     ss = np.zeros(nset)
     for k in range(zset.shape[0] if nset > 0 else 0):
@@ -106,10 +112,10 @@ def mohr_zone_step(pos, vel, g4, n4, rows, zset, weight, nset, cmodel, prop, bul
                     bar = sv[h] / ss[h]
             elif nmd:
                 acc = 0.0
-                acc += nodesum[n4[k, 0]] / nodevol[n4[k, 0]]
-                acc += nodesum[n4[k, 1]] / nodevol[n4[k, 1]]
-                acc += nodesum[n4[k, 2]] / nodevol[n4[k, 2]]
-                acc += nodesum[n4[k, 3]] / nodevol[n4[k, 3]]
+                acc += nodesum[n4[k, 0]]
+                acc += nodesum[n4[k, 1]]
+                acc += nodesum[n4[k, 2]]
+                acc += nodesum[n4[k, 3]]
                 bar = 0.25 * acc
             shift = (bar - e) / 3.0
             d0 += shift; d1 += shift; d2 += shift
@@ -168,6 +174,9 @@ def mohr_zone_step(pos, vel, g4, n4, rows, zset, weight, nset, cmodel, prop, bul
             t = nptgt[i]
             for q in range(npstart[i], npstart[i + 1]):
                 nodedsp[t] += sa[npslot[q], 0]
+        for t in prange(nodedsp.shape[0]):
+            if nodevol[t] > 0.0:
+                nodedsp[t] = nodedsp[t] / nodevol[t]
     # (zone_plastic.md_stress_average: the set sums in entry order)
     sd = np.zeros(nset)
     for k in range(zset.shape[0] if nset > 0 else 0):
@@ -191,10 +200,10 @@ def mohr_zone_step(pos, vel, g4, n4, rows, zset, weight, nset, cmodel, prop, bul
                     s0 += cc; s1 += cc; s2 += cc
             elif nmd:
                 acc = 0.0
-                acc += nodedsp[n4[k, 0]] / nodevol[n4[k, 0]]
-                acc += nodedsp[n4[k, 1]] / nodevol[n4[k, 1]]
-                acc += nodedsp[n4[k, 2]] / nodevol[n4[k, 2]]
-                acc += nodedsp[n4[k, 3]] / nodevol[n4[k, 3]]
+                acc += nodedsp[n4[k, 0]]
+                acc += nodedsp[n4[k, 1]]
+                acc += nodedsp[n4[k, 2]]
+                acc += nodedsp[n4[k, 3]]
                 cc = dsp[k] - 0.25 * acc
                 s0 += cc; s1 += cc; s2 += cc
             stress[z, 0] = s0; stress[z, 1] = s1; stress[z, 2] = s2
