@@ -210,8 +210,8 @@ _THIRD = 1.0 / 3.0
 
 @njit(cache=True, inline="always")
 def _deviator(s0, s1, s2):
-    """Diagonal of the deviator from differences of the diagonal ((s0 - s1) + (s0 - s2)) / 3, not
-    s0 - m: exact differences when the mean stress is far above the deviator."""
+    """Diagonal of the deviator as ((s0 - s1) - (s2 - s0)) / 3, not s0 - m: exact differences
+    when the mean stress is far above the deviator."""
     a = s0 - s1; b = s1 - s2; c = s2 - s0
     return (a - c) * _THIRD, (b - a) * _THIRD, (c - b) * _THIRD
 
@@ -244,9 +244,8 @@ def _dev_principal(s0, s1, s2, s3, s4, s5):
     return m, lo, -lo - hi, hi
 
 
-#: the closed-form principal axes (``principal_axes``) are used when both gaps between the
-#: deviatoric principal values are at least this fraction of their spread; closer values (a
-#: nearly repeated root, where the closed-form values lose accuracy) go to the Jacobi rotations
+#: closed-form principal axes (``principal_axes``) when both gaps between the principal values are
+#: at least this fraction of their spread; closer (nearly repeated) values go to Jacobi
 GAP_REL = 0.02
 
 
