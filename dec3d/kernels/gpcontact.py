@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from numba import njit, prange
 
 from .joints import ST_NEW, joint_law
 
@@ -143,7 +143,7 @@ def vertex_sides(kind, key0, ca, cb, sc_contact, zoned, nodes_a, w_a, nodes_b, w
         w[s, 2] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce,
                             ca, cb, cn, cmodel, cprop,
                             sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
@@ -153,8 +153,10 @@ def mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce
     gridpoints (gvel (nv, 3)) and its force shared to them (added to gforce (nv, 3)).
 
     (Both sides are written out in one loop over ``side`` rather than through a helper that
-    returns a tuple: numba compiled that form some 40 times slower.)"""
-    for s in range(sc_contact.shape[0]):
+    returns a tuple: numba compiled that form some 40 times slower.) The joint laws run on
+    threads (each sub-contact's own numbers); the forces are then added to the gridpoints and
+    blocks in sub-contact order, as before: the same bits for any thread count."""
+    for s in prange(sc_contact.shape[0]):
         c = sc_contact[s]
         n0 = cn[c, 0]
         n1 = cn[c, 1]
@@ -209,6 +211,18 @@ def mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce
         sc_us[s, 1] = u1
         sc_us[s, 2] = u2
         sc_state[s] = st
+    for s in range(sc_contact.shape[0]):
+        c = sc_contact[s]
+        n0 = cn[c, 0]
+        n1 = cn[c, 1]
+        n2 = cn[c, 2]
+        x0 = sc_pos[s, 0]
+        x1 = sc_pos[s, 1]
+        x2 = sc_pos[s, 2]
+        fn = sc_fn[s]
+        f0 = sc_fs[s, 0]
+        f1 = sc_fs[s, 1]
+        f2 = sc_fs[s, 2]
         # force on B: + (Fn n + Fs), on A: - (ERRATA Eqs. 28-32); B first, then A
         for side in range(2):
             blk = cb[c] if side == 0 else ca[c]
@@ -237,11 +251,14 @@ def mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce
                         gforce[g, 2] += w[s, j] * g2
 
 
-@njit(cache=True)
+
+
+@njit(cache=True, parallel=True)
 def mixed_move_points(dt, ca, cb, owner, pts, bpos, bvel, bspin, gvel, nodes_a, w_a, nodes_b, w_b):
     """Eq. (11) with zoned sides: each point moves by the mean of the two sides' displacement
-    at it (a rigid side's rigid motion, a zoned side's interpolated gridpoint velocity) × Δt."""
-    for i in range(owner.shape[0]):
+    at it (a rigid side's rigid motion, a zoned side's interpolated gridpoint velocity) × Δt.
+    (Each point its own numbers: on threads.)"""
+    for i in prange(owner.shape[0]):
         c = owner[i]
         x0 = pts[i, 0]
         x1 = pts[i, 1]

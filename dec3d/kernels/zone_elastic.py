@@ -269,6 +269,10 @@ def elastic_zone_step(pos, vel, g4, n4, rows, zset, weight, nset, bulk, shear, d
                 for q in range(npstart[i], npstart[i + 1]):
                     nodesum[t] += sa[npslot[q], 0]
                     nodevol[t] += sa[npslot[q], 1]
+            # each node's average once (the quotient its zones would each work out: same bits)
+            for t in prange(nodesum.shape[0]):
+                if nodevol[t] > 0.0:
+                    nodesum[t] = nodesum[t] / nodevol[t]
     sv = np.zeros(nset)
     ss = np.zeros(nset)
     for k in range(zset.shape[0] if nset > 0 else 0):
@@ -293,10 +297,10 @@ def elastic_zone_step(pos, vel, g4, n4, rows, zset, weight, nset, bulk, shear, d
                     bar = sv[h] / ss[h]
             elif nmd:
                 acc = 0.0
-                acc += nodesum[n4[k, 0]] / nodevol[n4[k, 0]]
-                acc += nodesum[n4[k, 1]] / nodevol[n4[k, 1]]
-                acc += nodesum[n4[k, 2]] / nodevol[n4[k, 2]]
-                acc += nodesum[n4[k, 3]] / nodevol[n4[k, 3]]
+                acc += nodesum[n4[k, 0]]
+                acc += nodesum[n4[k, 1]]
+                acc += nodesum[n4[k, 2]]
+                acc += nodesum[n4[k, 3]]
                 bar = 0.25 * acc
             shift = (bar - e) / 3.0
             d0 += shift; d1 += shift; d2 += shift

@@ -201,30 +201,90 @@ def _try_planes(act, na, nn, dm, rr, lam, tol, mm, bb, x, sn):
 @njit(cache=True)
 def mohr_work():
     """Scratch arrays of ``mohr_core`` (allocate once per batch, not per zone)."""
-    return (np.empty(3), np.empty((3, 3)), np.empty((9, 3)), np.empty((9, 3)), np.empty(9),
+    return (np.empty(3), np.empty(12), np.empty((9, 3)), np.empty((9, 3)), np.empty(9),
             np.empty(3, np.int64), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3))
 
 
-@njit(cache=True)
-def _principal_values(s):
-    """Principal values (ascending) of the symmetric tensor s (6,) in closed form (the
-    trigonometric solution of the characteristic cubic); used only to skip clearly elastic zones."""
-    m = (s[0] + s[1] + s[2]) / 3.0
-    d0 = s[0] - m; d1 = s[1] - m; d2 = s[2] - m
-    j2 = 0.5 * (d0 * d0 + d1 * d1 + d2 * d2) + s[3] * s[3] + s[4] * s[4] + s[5] * s[5]
+_THIRD = 1.0 / 3.0
+
+
+@njit(cache=True, inline="always")
+def _deviator(s0, s1, s2):
+    """Diagonal of the deviator as ((s0 - s1) - (s2 - s0)) / 3, not s0 - m: exact differences
+    when the mean stress is far above the deviator."""
+    a = s0 - s1; b = s1 - s2; c = s2 - s0
+    return (a - c) * _THIRD, (b - a) * _THIRD, (c - b) * _THIRD
+
+
+@njit(cache=True, inline="always")
+def _dev_principal(s0, s1, s2, s3, s4, s5):
+    """(m, lo, mid, hi): mean stress and the principal values of the deviator of the symmetric
+    tensor (s0 s1 s2 s3 s4 s5) = (xx yy zz xy xz yz), ascending, in closed form (the
+    trigonometric solution of the characteristic cubic λ³ - J2 λ - J3 = 0: λ = 2 r cos(θ + 2πk/3),
+    r = (J2/3)^½, cos 3θ = J3 / (2 r³)). The two values nearest each other are accurate to about
+    eps r² / gap, the isolated one to eps r."""
+    m = (s0 + s1 + s2) / 3.0
+    d0, d1, d2 = _deviator(s0, s1, s2)
+    j2 = 0.5 * (d0 * d0 + d1 * d1 + d2 * d2) + s3 * s3 + s4 * s4 + s5 * s5
     if j2 <= 0.0:
-        return m, m, m
-    j3 = d0 * (d1 * d2 - s[5] * s[5]) - s[3] * (s[3] * d2 - s[5] * s[4]) + s[4] * (s[3] * s[5] - d1 * s[4])
-    r = math.sqrt(j2 / 3.0)
-    cs = j3 / (2.0 * r * r * r)
+        return m, 0.0, 0.0, 0.0
+    j3 = d0 * (d1 * d2 - s5 * s5) - s3 * (s3 * d2 - s5 * s4) + s4 * (s3 * s5 - d1 * s4)
+    # (multiplications by 1/3, and cos 3θ = (J3/2) u u^½ with u = 3/J2 beside r: the divisions
+    # and the square root lie on the path to acos, and their latency is most of the cost)
+    r = math.sqrt(j2 * _THIRD)
+    u = 3.0 / j2
+    cs = 0.5 * j3 * u * math.sqrt(u)
     if cs > 1.0:
         cs = 1.0
     elif cs < -1.0:
         cs = -1.0
-    th = math.acos(cs) / 3.0
-    hi = m + 2.0 * r * math.cos(th)
-    lo = m + 2.0 * r * math.cos(th + 2.0 * math.pi / 3.0)
-    return lo, 3.0 * m - lo - hi, hi
+    th = math.acos(cs) * _THIRD
+    hi = 2.0 * r * math.cos(th)
+    lo = 2.0 * r * math.cos(th + 2.0 * math.pi / 3.0)
+    return m, lo, -lo - hi, hi
+
+
+#: closed-form principal axes (``principal_axes``) when both gaps between the principal values are
+#: at least this fraction of their spread; closer (nearly repeated) values go to Jacobi
+GAP_REL = 0.02
+
+
+@njit(cache=True)
+def principal_axes(s, lam, pr, vec):
+    """Principal values lam (3,) ascending and the projectors onto the axes of the least and the
+    greatest, pr (12,) = P1 (xx yy zz xy xz yz), P3 (same order), of the symmetric tensor s (6,).
+    Closed form when the values are well apart (``GAP_REL``): values by ``_dev_principal``,
+    projectors by Sylvester's formula P1 = (D - l2 I)(D - l3 I) / ((l1 - l2)(l1 - l3)) on the
+    deviator D (likewise P3), no eigenvectors; otherwise cyclic Jacobi (``sym_eig3``) and
+    P_k = v_k v_k^T (vec (3, 3): scratch of the rotations). Returns True when the closed form was
+    used."""
+    m, l1, l2, l3 = _dev_principal(s[0], s[1], s[2], s[3], s[4], s[5])
+    if l3 - l1 > 0.0 and min(l2 - l1, l3 - l2) >= GAP_REL * (l3 - l1):
+        d0, d1, d2 = _deviator(s[0], s[1], s[2])
+        a3 = s[3]; a4 = s[4]; a5 = s[5]
+        # Q = D²
+        q0 = d0 * d0 + a3 * a3 + a4 * a4
+        q1 = a3 * a3 + d1 * d1 + a5 * a5
+        q2 = a4 * a4 + a5 * a5 + d2 * d2
+        q3 = d0 * a3 + a3 * d1 + a4 * a5
+        q4 = d0 * a4 + a3 * a5 + a4 * d2
+        q5 = a3 * a4 + d1 * a5 + a5 * d2
+        # P1 = (Q - (l2 + l3) D + l2 l3 I) / ((l1 - l2)(l1 - l3)), P3 likewise
+        b = l2 + l3; c = l2 * l3; f = 1.0 / ((l1 - l2) * (l1 - l3))
+        pr[0] = (q0 - b * d0 + c) * f; pr[1] = (q1 - b * d1 + c) * f; pr[2] = (q2 - b * d2 + c) * f
+        pr[3] = (q3 - b * a3) * f; pr[4] = (q4 - b * a4) * f; pr[5] = (q5 - b * a5) * f
+        b = l1 + l2; c = l1 * l2; f = 1.0 / ((l3 - l1) * (l3 - l2))
+        pr[6] = (q0 - b * d0 + c) * f; pr[7] = (q1 - b * d1 + c) * f; pr[8] = (q2 - b * d2 + c) * f
+        pr[9] = (q3 - b * a3) * f; pr[10] = (q4 - b * a4) * f; pr[11] = (q5 - b * a5) * f
+        lam[0] = m + l1; lam[1] = m + l2; lam[2] = m + l3
+        return True
+    sym_eig3(s, lam, vec)
+    for h in range(2):
+        c = 0 if h == 0 else 2
+        o = 6 * h
+        pr[o] = vec[0, c] * vec[0, c]; pr[o + 1] = vec[1, c] * vec[1, c]; pr[o + 2] = vec[2, c] * vec[2, c]
+        pr[o + 3] = vec[0, c] * vec[1, c]; pr[o + 4] = vec[0, c] * vec[2, c]; pr[o + 5] = vec[1, c] * vec[2, c]
+    return False
 
 
 @njit(cache=True)
@@ -246,7 +306,7 @@ def mohr_core(s, de, bulk, shear, coh, tanfric, ten, tandil, work):
     return mohr_plastic(s, bulk, shear, coh, tanfric, ten, tandil, work)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _strength(coh, tanfric, ten):
     """(N_phi, 2 c sqrt(N_phi), sigma_t capped at the apex c / tan phi)."""
     sphi = tanfric / math.sqrt(1.0 + tanfric * tanfric)
@@ -257,6 +317,27 @@ def _strength(coh, tanfric, ten):
     return npf, 2.0 * coh * math.sqrt(npf), ft
 
 
+@njit(cache=True, inline="always")
+def _bounds_elastic(s0, s1, s2, s3, s4, s5, coh, npf, csn, ft):
+    """Clearly elastic from the bounds m - 2r <= s1, s3 <= m + 2r (r = sqrt(J2 / 3))."""
+    m = (s0 + s1 + s2) / 3.0
+    d0 = s0 - m; d1 = s1 - m; d2 = s2 - m
+    r2 = 2.0 * math.sqrt((0.5 * (d0 * d0 + d1 * d1 + d2 * d2) + s3 * s3 + s4 * s4 + s5 * s5) / 3.0)
+    bscale = 3.0 * (abs(m) + r2) + coh + abs(ft)
+    return (m + r2) * npf - (m - r2) - csn < -1e-7 * bscale and m + r2 - ft < -1e-7 * bscale
+
+
+@njit(cache=True, inline="always")
+def _values_elastic(m, l1, l3, coh, npf, csn, ft):
+    """Clearly elastic from the principal values m + l1 <= m + l3 (``_dev_principal``), with a
+    margin far above their round-off."""
+    q1 = m + l1
+    q3 = m + l3
+    q2 = 3.0 * m - q1 - q3
+    qscale = abs(q1) + abs(q2) + abs(q3) + coh + abs(ft)
+    return q3 * npf - q1 - csn < -1e-7 * qscale and q3 - ft < -1e-7 * qscale
+
+
 @njit(cache=True)
 def mohr_trial(s, de, bulk, shear, coh, tanfric, ten):
     """First half of ``mohr_core``: s += D:de (the elastic trial); True when the trial is clearly
@@ -265,44 +346,123 @@ def mohr_trial(s, de, bulk, shear, coh, tanfric, ten):
     than this test) only for the zones near or at yield."""
     hooke_increment(s, de, bulk, shear)
     npf, csn, ft = _strength(coh, tanfric, ten)
-    # clearly elastic: first from the bounds m - 2r <= s1, s3 <= m + 2r (r = sqrt(J2 / 3)), then
-    # from the closed-form principal values (margin far above their round-off); no eigenvectors
-    m = (s[0] + s[1] + s[2]) / 3.0
-    d0 = s[0] - m; d1 = s[1] - m; d2 = s[2] - m
-    r2 = 2.0 * math.sqrt((0.5 * (d0 * d0 + d1 * d1 + d2 * d2) + s[3] * s[3] + s[4] * s[4] + s[5] * s[5]) / 3.0)
-    bscale = 3.0 * (abs(m) + r2) + coh + abs(ft)
-    if (m + r2) * npf - (m - r2) - csn < -1e-7 * bscale and m + r2 - ft < -1e-7 * bscale:
+    # clearly elastic: first from bounds, then from the closed-form principal values; no axes
+    if _bounds_elastic(s[0], s[1], s[2], s[3], s[4], s[5], coh, npf, csn, ft):
         return True
-    q1, q2, q3 = _principal_values(s)
-    qscale = abs(q1) + abs(q2) + abs(q3) + coh + abs(ft)
-    return q3 * npf - q1 - csn < -1e-7 * qscale and q3 - ft < -1e-7 * qscale
+    m, l1, _l2, l3 = _dev_principal(s[0], s[1], s[2], s[3], s[4], s[5])
+    return _values_elastic(m, l1, l3, coh, npf, csn, ft)
+
+
+@njit(cache=True, inline="always")
+def mohr_constants(bulk, shear, coh, tanfric, ten, tandil):
+    """What the single-plane returns take from a zone's properties: (N_phi, 2 c sqrt(N_phi),
+    sigma_t capped, N_psi, alpha1, alpha2, sigma_P, alpha_P, the shear return's denominator);
+    a tuple hot loops can keep while the properties stay the same."""
+    npf, csn, ft = _strength(coh, tanfric, ten)
+    spsi = tandil / math.sqrt(1.0 + tandil * tandil)
+    nps = (1.0 + spsi) / (1.0 - spsi)
+    a1 = bulk + 4.0 * shear / 3.0
+    a2 = bulk - 2.0 * shear / 3.0
+    sp = ft * npf - csn
+    ap = math.sqrt(1.0 + npf * npf) + npf
+    return npf, csn, ft, nps, a1, a2, sp, ap, a1 * (1.0 + npf * nps) - a2 * (npf + nps)
+
+
+@njit(cache=True, inline="always")
+def _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, coh, npf, csn, ft, nps, a1, a2, sp, ap, den):
+    """``mohr_plastic`` in scalars for the common case: principal values well apart (closed
+    form, ``GAP_REL``) and Itasca's single plane giving an admissible stress. The trial stress
+    s0..s5 with its deviatoric principal values l1 <= l2 <= l3 about the mean m
+    (``_dev_principal``), the zone's cohesion and ``mohr_constants``. Returns (code, t0..t5,
+    dsp): code 0 elastic (t = s, dsp = 0), SHEAR_NOW or TENSION_NOW (t the returned stress, dsp
+    as ``mohr_return``), -1 not settled here (t = s: ``mohr_plastic``'s general path must do it).
+    The same operations as ``mohr_plastic``'s array path, so the same bits."""
+    if not (l3 - l1 > 0.0 and min(l2 - l1, l3 - l2) >= GAP_REL * (l3 - l1)):
+        return -1, s0, s1, s2, s3, s4, s5, 0.0
+    p1 = m + l1; p2 = m + l2; p3 = m + l3
+    scale = abs(p1) + abs(p3) + abs(p2) + coh + abs(ft)
+    tol = 1e-10 * scale
+    fs13 = p3 * npf - p1 - csn
+    ft3 = p3 - ft
+    if fs13 <= tol and ft3 <= tol:
+        return 0, s0, s1, s2, s3, s4, s5, 0.0
+    h = p3 - ft + ap * (p1 - sp)
+    if fs13 > tol and (h <= 0.0 or ft3 <= tol):
+        ls = fs13 / den
+        n1 = p1 + ls * (a1 - a2 * nps)
+        n2 = p2 + ls * a2 * (1.0 - nps)
+        n3 = p3 + ls * (a2 - a1 * nps)
+        code = SHEAR_NOW
+    else:
+        lt = ft3 / a1
+        n1 = p1 - lt * a2
+        n2 = p2 - lt * a2
+        n3 = ft
+        code = TENSION_NOW
+    lo = min(n1, min(n2, n3))
+    hi = max(n1, max(n2, n3))
+    if not (hi * npf - lo - csn <= tol and hi - ft <= tol):
+        return -1, s0, s1, s2, s3, s4, s5, 0.0
+    # projectors P1, P3 (``principal_axes``' formulas) and the rotation back (``_rotate_back``)
+    d0, d1, d2 = _deviator(s0, s1, s2)
+    q0 = d0 * d0 + s3 * s3 + s4 * s4
+    q1 = s3 * s3 + d1 * d1 + s5 * s5
+    q2 = s4 * s4 + s5 * s5 + d2 * d2
+    q3 = d0 * s3 + s3 * d1 + s4 * s5
+    q4 = d0 * s4 + s3 * s5 + s4 * d2
+    q5 = s3 * s4 + d1 * s5 + s5 * d2
+    b = l2 + l3; c = l2 * l3; f = 1.0 / ((l1 - l2) * (l1 - l3))
+    u0 = (q0 - b * d0 + c) * f; u1 = (q1 - b * d1 + c) * f; u2 = (q2 - b * d2 + c) * f
+    u3 = (q3 - b * s3) * f; u4 = (q4 - b * s4) * f; u5 = (q5 - b * s5) * f
+    b = l1 + l2; c = l1 * l2; f = 1.0 / ((l3 - l1) * (l3 - l2))
+    v0 = (q0 - b * d0 + c) * f; v1 = (q1 - b * d1 + c) * f; v2 = (q2 - b * d2 + c) * f
+    v3 = (q3 - b * s3) * f; v4 = (q4 - b * s4) * f; v5 = (q5 - b * s5) * f
+    e1 = n1 - p1; e2 = n2 - p2; e3 = n3 - p3
+    g1 = e1 - e2; g3 = e3 - e2
+    return (code, s0 + (e2 + g1 * u0 + g3 * v0), s1 + (e2 + g1 * u1 + g3 * v1), s2 + (e2 + g1 * u2 + g3 * v2),
+            s3 + (g1 * u3 + g3 * v3), s4 + (g1 * u4 + g3 * v4), s5 + (g1 * u5 + g3 * v5), -(e1 + e2 + e3) / 3.0)
+
+
+@njit(cache=True, inline="always")
+def mohr_scalar(s0, s1, s2, s3, s4, s5, coh, npf, csn, ft, nps, a1, a2, sp, ap, den):
+    """``mohr_trial``'s test and ``mohr_plastic``'s common case on the trial stress s0..s5 in
+    scalars (no arrays, for hot loops), with the zone's cohesion and ``mohr_constants``: (code,
+    t0..t5, dsp) as ``_fast_return``; code -1: the caller runs ``mohr_plastic`` on the trial
+    stress. The bits of mohr_trial + mohr_plastic."""
+    if _bounds_elastic(s0, s1, s2, s3, s4, s5, coh, npf, csn, ft):
+        return 0, s0, s1, s2, s3, s4, s5, 0.0
+    m, l1, l2, l3 = _dev_principal(s0, s1, s2, s3, s4, s5)
+    if _values_elastic(m, l1, l3, coh, npf, csn, ft):
+        return 0, s0, s1, s2, s3, s4, s5, 0.0
+    return _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, coh, npf, csn, ft, nps, a1, a2, sp, ap, den)
 
 
 @njit(cache=True)
 def mohr_plastic(s, bulk, shear, coh, tanfric, ten, tandil, work):
-    """Second half of ``mohr_core``: the return of the trial stress s (in place); (bits, dsp)."""
-    npf, csn, ft = _strength(coh, tanfric, ten)
-    lam, vec, nn, dm, rr, act, mm, bb, x, sn = work
-    sym_eig3(s, lam, vec)
+    """Second half of ``mohr_core``: the return of the trial stress s (in place); (bits, dsp).
+    The common case in scalars (``_fast_return``), the rest on the arrays of ``work``."""
+    npf, csn, ft, nps, a1, a2, sp, ap, den = mohr_constants(bulk, shear, coh, tanfric, ten, tandil)
+    m, l1, l2, l3 = _dev_principal(s[0], s[1], s[2], s[3], s[4], s[5])
+    code, t0, t1, t2, t3, t4, t5, dsp = _fast_return(s[0], s[1], s[2], s[3], s[4], s[5], m, l1, l2, l3, coh, npf, csn,
+                                                     ft, nps, a1, a2, sp, ap, den)
+    if code >= 0:
+        s[0] = t0; s[1] = t1; s[2] = t2; s[3] = t3; s[4] = t4; s[5] = t5
+        return code, dsp
+    lam, pr, nn, dm, rr, act, mm, bb, x, sn = work
+    principal_axes(s, lam, pr, mm)
     s1 = lam[0]; s3 = lam[2]
-    spsi = tandil / math.sqrt(1.0 + tandil * tandil)
-    nps = (1.0 + spsi) / (1.0 - spsi)
     scale = abs(s1) + abs(s3) + abs(lam[1]) + coh + abs(ft)
     tol = 1e-10 * scale
     fs13 = s3 * npf - s1 - csn          # = -f_s (Itasca), > 0 violated
     ft3 = s3 - ft
     if fs13 <= tol and ft3 <= tol:
         return 0, 0.0
-    a1 = bulk + 4.0 * shear / 3.0
-    a2 = bulk - 2.0 * shear / 3.0
     # Itasca's choice of the plane: h decides between shear and tension
-    sp = ft * npf - csn
-    ap = math.sqrt(1.0 + npf * npf) + npf
     h = s3 - ft + ap * (s1 - sp)
     first = 0 if (fs13 > tol and (h <= 0.0 or ft3 <= tol)) else 8
     # fast path: Itasca's single-plane return in closed form, kept when it violates no plane
     if first == 0:
-        ls = fs13 / (a1 * (1.0 + npf * nps) - a2 * (npf + nps))
+        ls = fs13 / den
         n1 = s1 + ls * (a1 - a2 * nps)
         n2 = lam[1] + ls * a2 * (1.0 - nps)
         n3 = s3 + ls * (a2 - a1 * nps)
@@ -317,7 +477,7 @@ def mohr_plastic(s, bulk, shear, coh, tanfric, ten, tandil, work):
     hi = max(n1, max(n2, n3))
     if hi * npf - lo - csn <= tol and hi - ft <= tol:
         sn[0] = n1; sn[1] = n2; sn[2] = n3
-        return _rotate_back(s, lam, vec, sn, fast)
+        return _rotate_back(s, lam, pr, sn, fast)
     # the nine planes: n (normal of F), dm (D times the flow direction), r
     nn[:, :] = 0.0
     for k in range(6):
@@ -386,19 +546,21 @@ def mohr_plastic(s, bulk, shear, coh, tanfric, ten, tandil, work):
         bits = SHEAR_NOW
         if piso == ft:
             bits |= TENSION_NOW
-    return _rotate_back(s, lam, vec, sn, bits)
+    return _rotate_back(s, lam, pr, sn, bits)
 
 
 @njit(cache=True)
-def _rotate_back(s, lam, vec, sn, bits):
-    """s (6,) += sum_k (sn_k - lam_k) v_k v_k^T (principal directions kept); returns (bits, dsp)."""
+def _rotate_back(s, lam, pr, sn, bits):
+    """s (6,) += sum_k (sn_k - lam_k) P_k (principal directions kept), with P2 = I - P1 - P3 and
+    the projectors P1, P3 of ``principal_axes`` in pr; returns (bits, dsp)."""
     d0 = sn[0] - lam[0]; d1 = sn[1] - lam[1]; d2 = sn[2] - lam[2]
-    s[0] += d0 * vec[0, 0] * vec[0, 0] + d1 * vec[0, 1] * vec[0, 1] + d2 * vec[0, 2] * vec[0, 2]
-    s[1] += d0 * vec[1, 0] * vec[1, 0] + d1 * vec[1, 1] * vec[1, 1] + d2 * vec[1, 2] * vec[1, 2]
-    s[2] += d0 * vec[2, 0] * vec[2, 0] + d1 * vec[2, 1] * vec[2, 1] + d2 * vec[2, 2] * vec[2, 2]
-    s[3] += d0 * vec[0, 0] * vec[1, 0] + d1 * vec[0, 1] * vec[1, 1] + d2 * vec[0, 2] * vec[1, 2]
-    s[4] += d0 * vec[0, 0] * vec[2, 0] + d1 * vec[0, 1] * vec[2, 1] + d2 * vec[0, 2] * vec[2, 2]
-    s[5] += d0 * vec[1, 0] * vec[2, 0] + d1 * vec[1, 1] * vec[2, 1] + d2 * vec[1, 2] * vec[2, 2]
+    e0 = d0 - d1; e2 = d2 - d1
+    s[0] += d1 + e0 * pr[0] + e2 * pr[6]
+    s[1] += d1 + e0 * pr[1] + e2 * pr[7]
+    s[2] += d1 + e0 * pr[2] + e2 * pr[8]
+    s[3] += e0 * pr[3] + e2 * pr[9]
+    s[4] += e0 * pr[4] + e2 * pr[10]
+    s[5] += e0 * pr[5] + e2 * pr[11]
     return bits, -(d0 + d1 + d2) / 3.0
 
 

@@ -75,6 +75,9 @@ class MixedContactSteps:
                 st["gw_b"][:] = wb
         out = [tuple(st[key] for key in ("gp_a", "gw_a", "gp_b", "gw_b")) for st, _ in stores]
         na, wa, nb, wb = out[0]
+        # the gridpoints the sub-contacts load (``_mixed_steps``), made once per detection
+        touched = np.unique(np.concatenate((na.ravel(), nb.ravel())))
+        self._mixed_touched = (out[0], np.ascontiguousarray(touched[touched >= 0]))
         c = ss["contact"]
         kk = np.maximum(cs["prop"][c, P_KN], cs["prop"][c, P_KS]) * ss["area"]
         rows = np.concatenate((na.ravel(), nb.ravel()))
@@ -94,8 +97,12 @@ class MixedContactSteps:
         cs, ss = self.contacts, self.subcontacts
         gvel = v["velocity"]
         gc = np.zeros((v.n, 3))
-        touched = np.unique(np.concatenate((wsub[0].ravel(), wsub[2].ravel())))
-        touched = np.ascontiguousarray(touched[touched >= 0])
+        kept = getattr(self, "_mixed_touched", None)
+        if kept is not None and all(x is y for x, y in zip(kept[0], wsub)):
+            touched = kept[1]
+        else:
+            touched = np.unique(np.concatenate((wsub[0].ravel(), wsub[2].ravel())))
+            touched = np.ascontiguousarray(touched[touched >= 0])
         cown = np.arange(cs.n, dtype=_I)
         gstart, gmember = groups.start, groups.member
         for _ in range(k):

@@ -22,9 +22,10 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
 4. each step (``step``): zone forces of the 4-node zones (mixed discretization in hexahedral
    sets and nodal mixed discretization, NMD, for the other tetrahedra when
    ``settings.mechanical["nmd"]`` is on, the default, ``block zone nodal-mixed-discretization``):
-   with no Mohr-Coulomb zone ``zone_elastic.elastic_zone_step`` (threads from PARALLEL_MIN_ZONES
-   zones on), otherwise ``zone_plastic.zone_forces_plastic`` (``zone_forces_plastic_parallel_ws``
-   from PARALLEL_MIN_ZONES zones on), all with the same bits for the same zones; 10-node zones
+   with no Mohr-Coulomb zone ``zone_elastic.elastic_zone_step``, otherwise
+   ``zone_mohr_step.mohr_zone_step`` (both on threads from PARALLEL_MIN_ZONES zones on; with
+   ELASTIC_KERNEL / MOHR_KERNEL off ``zone_plastic.zone_forces_plastic`` or
+   ``zone_forces_plastic_parallel_ws``), all with the same bits for the same zones; 10-node zones
    by ``zones_ho.tet10_step``), gravity (m g
    on the gridpoints of 4-node zones, the consistent loads of ``zones_ho.tet10_body_force`` on
    those of 10-node zones, both counted in the applied-force magnitudes of the equilibrium
@@ -45,6 +46,7 @@ import numpy as np
 
 from dec3d.errors import Dec3dError
 from dec3d.kernels.zone_elastic import ElasticPlan, elastic_zone_step
+from dec3d.kernels.zone_mohr_step import mohr_zone_step
 from dec3d.kernels.zone_plastic import node_lists4, zone_forces_plastic, zone_forces_plastic_parallel_ws, zone_scratch
 from dec3d.kernels.zonestep import gp_externals, gp_motion, gp_motion_ws, zone_mass_stiffness
 from dec3d.model.feblocks import has_feblocks
@@ -69,6 +71,9 @@ PARALLEL_MIN_ZONES = 20000
 #: step zones with ``zone_elastic.elastic_zone_step`` when none is Mohr-Coulomb (False: always
 #: the plastic kernels, which give the same bits; for tests)
 ELASTIC_KERNEL = True
+#: step zones with ``zone_mohr_step.mohr_zone_step`` when some are Mohr-Coulomb (False: the
+#: plastic kernels of ``zone_plastic``, which give the same bits; for tests)
+MOHR_KERNEL = True
 
 
 def _ids(model, rows) -> str:
@@ -167,11 +172,16 @@ class ZoneStepper:
         #: no Mohr-Coulomb zone: the elastic step (``zone_elastic.elastic_zone_step``, the bits of
         #: the plastic step) on one part of the zones per thread from PARALLEL_MIN_ZONES zones on
         self.fast = None
-        if ELASTIC_KERNEL and not len(mo) and len(self.rows4):
+        #: some Mohr-Coulomb zones: ``zone_mohr_step.mohr_zone_step`` (the same plan, and the
+        #: scratch of its plastic corrections: per zone entry and per averaging node)
+        self.fastmc = None
+        if ((ELASTIC_KERNEL and not len(mo)) or (MOHR_KERNEL and len(mo))) and len(self.rows4):
             import numba
 
             nch = numba.get_num_threads() if len(self.rows4) >= PARALLEL_MIN_ZONES else 1
             self.fast = ElasticPlan(zs["gp"], self.rows4, self.node, self.zset, self.weight, v.n, nch)
+            if len(mo):
+                self.fastmc = (np.empty(len(self.rows4)), np.empty(v.n))
         elif self.plastic and len(self.rows4) >= PARALLEL_MIN_ZONES:
             nv = v.n
             fstart, fent = node_lists4(nv, np.arange(nv, dtype=_I), zs["gp"], self.rows4)
@@ -419,7 +429,11 @@ class ZoneStepper:
             self.begin()
         pos, vel = v["pos"], v["velocity"]
         fast = self.fast
-        if fast is not None:
+        if self.fastmc is not None:
+            mohr_zone_step(pos, vel, fast.g4, fast.n4, fast.rows, fast.zset, fast.weight, self.nset, zs["cmodel"],
+                           zs["prop"], self.bulk, self.shear, dt, large, self.nmd, zs["stress"], zs["state"], facc,
+                           fmag, *fast.args(), *self.fastmc)
+        elif fast is not None:
             elastic_zone_step(pos, vel, fast.g4, fast.n4, fast.rows, fast.zset, fast.weight, self.nset, self.bulk,
                               self.shear, dt, large, self.nmd, zs["stress"], facc, fmag, *fast.args())
         elif self.par is not None:

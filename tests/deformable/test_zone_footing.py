@@ -76,17 +76,22 @@ def test_footing_pressure_of_a_uniform_stress(tmp_path):
 
 
 def test_threaded_plastic_step_gives_the_serial_bits(tmp_path, monkeypatch):
-    """Big models take the threaded plastic step (``zone_forces_plastic_parallel_ws``); forced on
-    for this small one it gives the serial run's stresses, states and displacements bit for bit."""
+    """The plastic kernels (``MOHR_KERNEL`` off): big models take the threaded plastic step
+    (``zone_forces_plastic_parallel_ws``); forced on for this small one it gives the serial run's
+    stresses, states and displacements bit for bit; and so does the engine's Mohr-Coulomb step
+    (``zone_mohr_step.mohr_zone_step``, threaded)."""
 
     import dec3d.physics.zones as pz
     runs = []
-    for threshold in (10**12, 0):
+    for threshold, fast in ((10**12, False), (0, False), (0, True)):
         monkeypatch.setattr(pz, "PARALLEL_MIN_ZONES", threshold)
+        monkeypatch.setattr(pz, "MOHR_KERNEL", fast)
         s, _ = _footing(tmp_path, "on", steps=1500)
-        assert (s.model.rigid_engine._zstep.par is not None) == (threshold == 0)
+        zst = s.model.rigid_engine._zstep
+        assert (zst.par is not None) == (threshold == 0 and not fast) and (zst.fastmc is not None) == fast
         zs = s.model.store("zones")
         runs.append((zs["stress"].copy(), zs["state"].copy(), s.model.vertices["disp"].copy()))
     assert ((runs[0][1] & 1) != 0).any()
-    for a, b in zip(*runs):
-        np.testing.assert_array_equal(a, b)
+    for other in runs[1:]:
+        for a, b in zip(runs[0], other):
+            np.testing.assert_array_equal(a, b)
