@@ -67,7 +67,7 @@ def _counts(session) -> tuple:
 
 
 def one(n: int, steps: int, jmodel: str, full: bool = False, threads: int | None = None,
-        dynamic: bool = False) -> dict:
+        dynamic: bool = False, setup: str = "") -> dict:
     """Build, warm up and time in this process. ``full``: every pair is looked at again at
     every detection (the engine's incremental rule off: the worst case, a model in which
     every block keeps moving)."""
@@ -93,7 +93,7 @@ def one(n: int, steps: int, jmodel: str, full: bool = False, threads: int | None
     with tempfile.TemporaryDirectory() as d:
         s = dec3d.Session(out_dir=d, stdout=io.StringIO())
         t0 = time.perf_counter()
-        s.command(deck(n, jmodel, dynamic))
+        s.command(deck(n, jmodel, dynamic) + setup)
         t1 = time.perf_counter()
         s.command(f"model cycle {WARMUP}")
         t2 = time.perf_counter()
@@ -222,13 +222,13 @@ def main() -> int:
                     help="every block keeps moving (the stack slides on the base; with "
                          "--full-detection: detection at every step)")
     ap.add_argument("--setup", default="",
-                    help="with --equilibrium: extra command lines after the scene, separated by ';' "
+                    help="extra command lines after the scene, separated by ';' "
                          "(e.g. 'block mechanical mass-scale body; block mechanical damping global')")
     ap.add_argument("--child", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args()
+    setup = "".join(line.strip() + "\n" for line in args.setup.split(";") if line.strip())
     if args.equilibrium:
         print(f"machine: {machine()}")
-        setup = "".join(line.strip() + "\n" for line in args.setup.split(";") if line.strip())
         print(f"setup: {args.setup or '(scene as is: local damping 0.8, default density scaling: by body, masses raised)'}; "
               f"load average before: {os.getloadavg()[0]:.2f}")
         for n in args.n:
@@ -244,13 +244,14 @@ def main() -> int:
         return 0
     if args.child:
         print(json.dumps(one(args.child, args.steps, args.jmodel, args.full_detection,
-                             args.threads, args.dynamic)))
+                             args.threads, args.dynamic, setup)))
         return 0
     print(f"machine: {machine()}")
     print(f"scene: n^3 unit cubes on a fixed base, jmodel {args.jmodel}, kn = ks = 1e9 Pa/m, "
           f"{WARMUP} warm-up + {args.steps} timed steps, median of {args.repeat}"
           + (", full detection" if args.full_detection else "")
-          + (", dynamic (sliding, no damping)" if args.dynamic else ""))
+          + (", dynamic (sliding, no damping)" if args.dynamic else "")
+          + (f", setup: {args.setup}" if setup else ""))
     print(f"{'n':>3} {'blocks':>7} {'contacts':>8} {'subcont':>8} {'build s':>8} {'warmup s':>8} "
           f"{'seconds':>8} {'min..max':>15} {'blk-cyc/s':>10} {'subc-upd/s':>11} {'peak MiB':>9}")
     for n in args.n:
@@ -258,7 +259,8 @@ def main() -> int:
                              "--steps", str(args.steps), "--jmodel", args.jmodel]
                             + (["--full-detection"] if args.full_detection else [])
                             + (["--threads", str(args.threads)] if args.threads else [])
-                            + (["--dynamic"] if args.dynamic else []),
+                            + (["--dynamic"] if args.dynamic else [])
+                            + (["--setup", args.setup] if setup else []),
                             args.repeat, f"n = {n}")
         sec = [r["seconds"] for r in runs]
         t = statistics.median(sec)
