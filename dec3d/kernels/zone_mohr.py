@@ -216,32 +216,76 @@ def _deviator(s0, s1, s2):
     return (a - c) * _THIRD, (b - a) * _THIRD, (c - b) * _THIRD
 
 
+#: x(u) = cos(2 arccos(u) / 3) on 0 <= u <= 1 as a polynomial in t = 2u - 1 (``_root``): the
+#: Chebyshev interpolant of degree 18 at 600 Chebyshev nodes of 40-digit values (mpmath),
+#: written as monomial coefficients c0 ... c18, with c0 and c1 then moved by 8e-16 and 1e-16 so
+#: that the exact polynomial meets x(0) = 1/2 and x(1) = 1; largest error 1.1e-15 in double
+#: precision, a unit in the last place at the ends (x itself lies in [1/2, 1]). x(u) is analytic on the whole interval: arccos(u) has its branch
+#: point at u = 1, but cos(2 arccos(u) / 3) is even in arccos(u) there.
+_XC = (0.7660444431189777, 0.24740906632285423, -0.015509188436501056,
+       0.002466352815026528, -0.0005041246908393405, 0.00011642545390407192,
+       -2.8919938766347355e-05, 7.541071632329256e-06, -2.035859516600697e-06,
+       5.641781102042346e-07, -1.595665547802857e-07, 4.579921583679578e-08,
+       -1.3318192881031793e-08, 4.0122241520328296e-09, -1.2070097655119283e-09,
+       2.9158240048239817e-10, -8.479376924224957e-11, 5.545024435052661e-11,
+       -1.680310434864443e-11)
+
+
+@njit(cache=True, inline="always")
+def _root(u):
+    """cos(2 arccos(u) / 3) for 0 <= u <= 1 (``_XC``, Estrin's scheme: a few products deep
+    instead of eighteen)."""
+    t = 2.0 * u - 1.0
+    t2 = t * t
+    t4 = t2 * t2
+    t8 = t4 * t4
+    p0 = _XC[0] + _XC[1] * t; p1 = _XC[2] + _XC[3] * t; p2 = _XC[4] + _XC[5] * t
+    p3 = _XC[6] + _XC[7] * t; p4 = _XC[8] + _XC[9] * t; p5 = _XC[10] + _XC[11] * t
+    p6 = _XC[12] + _XC[13] * t; p7 = _XC[14] + _XC[15] * t; p8 = _XC[16] + _XC[17] * t
+    q0 = p0 + t2 * p1; q1 = p2 + t2 * p3; q2 = p4 + t2 * p5; q3 = p6 + t2 * p7; q4 = p8 + t2 * _XC[18]
+    r0 = q0 + t4 * q1; r1 = q2 + t4 * q3
+    return (r0 + t8 * r1) + (t8 * t8) * q4
+
+
 @njit(cache=True, inline="always")
 def _dev_principal(s0, s1, s2, s3, s4, s5):
     """(m, lo, mid, hi): mean stress and the principal values of the deviator of the symmetric
-    tensor (s0 s1 s2 s3 s4 s5) = (xx yy zz xy xz yz), ascending, in closed form (the
-    trigonometric solution of the characteristic cubic λ³ - J2 λ - J3 = 0: λ = 2 r cos(θ + 2πk/3),
-    r = (J2/3)^½, cos 3θ = J3 / (2 r³)). The two values nearest each other are accurate to about
+    tensor (s0 s1 s2 s3 s4 s5) = (xx yy zz xy xz yz), ascending, in closed form: the
+    trigonometric solution of the characteristic cubic λ³ - J2 λ - J3 = 0, λ = 2 r cos(θ + 2πk/3),
+    r = (J2/3)^½, cos 3θ = J3 / (2 r³). With c = cos 3θ, cos θ = x(((1 + c)/2)^½) and
+    cos(θ + 2π/3) = -x(((1 - c)/2)^½) for x(u) = cos(2 arccos(u) / 3) (half-angle formula:
+    cos 3θ = 2u² - 1 with u = cos(3θ/2)), and x is a polynomial (``_root``): no arccos and cosines
+    on the path of a yielding zone. The two values nearest each other are accurate to about
     eps r² / gap, the isolated one to eps r."""
+    m, d0, d1, d2, j2, r = _invariants(s0, s1, s2, s3, s4, s5)
+    lo, mid, hi = _values(d0, d1, d2, s3, s4, s5, j2, r)
+    return m, lo, mid, hi
+
+
+@njit(cache=True, inline="always")
+def _invariants(s0, s1, s2, s3, s4, s5):
+    """(m, d0, d1, d2, J2, r): mean stress, deviator diagonal, J2 and r = (J2/3)^½."""
     m = (s0 + s1 + s2) / 3.0
     d0, d1, d2 = _deviator(s0, s1, s2)
     j2 = 0.5 * (d0 * d0 + d1 * d1 + d2 * d2) + s3 * s3 + s4 * s4 + s5 * s5
+    return m, d0, d1, d2, j2, math.sqrt(j2 * _THIRD)
+
+
+@njit(cache=True, inline="always")
+def _values(d0, d1, d2, s3, s4, s5, j2, r):
+    """The principal values (lo, mid, hi) of the deviator (d0 d1 d2 s3 s4 s5) with J2 and r
+    (``_dev_principal``)."""
     if j2 <= 0.0:
-        return m, 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0
     j3 = d0 * (d1 * d2 - s5 * s5) - s3 * (s3 * d2 - s5 * s4) + s4 * (s3 * s5 - d1 * s4)
-    # (multiplications by 1/3, and cos 3θ = (J3/2) u u^½ with u = 3/J2 beside r: the divisions
-    # and the square root lie on the path to acos, and their latency is most of the cost)
-    r = math.sqrt(j2 * _THIRD)
-    u = 3.0 / j2
-    cs = 0.5 * j3 * u * math.sqrt(u)
+    cs = 0.5 * j3 / (r * (j2 * _THIRD))        # J3 / (2 r³)
     if cs > 1.0:
         cs = 1.0
     elif cs < -1.0:
         cs = -1.0
-    th = math.acos(cs) * _THIRD
-    hi = 2.0 * r * math.cos(th)
-    lo = 2.0 * r * math.cos(th + 2.0 * math.pi / 3.0)
-    return m, lo, -lo - hi, hi
+    hi = 2.0 * r * _root(math.sqrt(0.5 + 0.5 * cs))
+    lo = -2.0 * r * _root(math.sqrt(0.5 - 0.5 * cs))
+    return lo, -lo - hi, hi
 
 
 #: closed-form principal axes (``principal_axes``) when both gaps between the principal values are
@@ -318,13 +362,23 @@ def _strength(coh, tanfric, ten):
 
 
 @njit(cache=True, inline="always")
-def _bounds_elastic(s0, s1, s2, s3, s4, s5, coh, npf, csn, ft):
+def _bounds_elastic(m, r, coh, npf, csn, ft):
     """Clearly elastic from the bounds m - 2r <= s1, s3 <= m + 2r (r = sqrt(J2 / 3))."""
-    m = (s0 + s1 + s2) / 3.0
-    d0 = s0 - m; d1 = s1 - m; d2 = s2 - m
-    r2 = 2.0 * math.sqrt((0.5 * (d0 * d0 + d1 * d1 + d2 * d2) + s3 * s3 + s4 * s4 + s5 * s5) / 3.0)
+    r2 = 2.0 * r
     bscale = 3.0 * (abs(m) + r2) + coh + abs(ft)
     return (m + r2) * npf - (m - r2) - csn < -1e-7 * bscale and m + r2 - ft < -1e-7 * bscale
+
+
+@njit(cache=True, inline="always")
+def _yield_test(s0, s1, s2, s3, s4, s5, coh, npf, csn, ft):
+    """(clearly elastic, m, l1, l2, l3): the bounds test (``_bounds_elastic``), then, when it
+    cannot tell, the principal values (``_dev_principal``'s, from the same invariants) and
+    ``_values_elastic``; l1..l3 are 0 when the bounds sufficed."""
+    m, d0, d1, d2, j2, r = _invariants(s0, s1, s2, s3, s4, s5)
+    if _bounds_elastic(m, r, coh, npf, csn, ft):
+        return True, m, 0.0, 0.0, 0.0
+    l1, l2, l3 = _values(d0, d1, d2, s3, s4, s5, j2, r)
+    return _values_elastic(m, l1, l3, coh, npf, csn, ft), m, l1, l2, l3
 
 
 @njit(cache=True, inline="always")
@@ -347,10 +401,7 @@ def mohr_trial(s, de, bulk, shear, coh, tanfric, ten):
     hooke_increment(s, de, bulk, shear)
     npf, csn, ft = _strength(coh, tanfric, ten)
     # clearly elastic: first from bounds, then from the closed-form principal values; no axes
-    if _bounds_elastic(s[0], s[1], s[2], s[3], s[4], s[5], coh, npf, csn, ft):
-        return True
-    m, l1, _l2, l3 = _dev_principal(s[0], s[1], s[2], s[3], s[4], s[5])
-    return _values_elastic(m, l1, l3, coh, npf, csn, ft)
+    return _yield_test(s[0], s[1], s[2], s[3], s[4], s[5], coh, npf, csn, ft)[0]
 
 
 @njit(cache=True, inline="always")
@@ -376,7 +427,8 @@ def _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, coh, npf, csn, ft, nps, 
     (``_dev_principal``), the zone's cohesion and ``mohr_constants``. Returns (code, t0..t5,
     dsp): code 0 elastic (t = s, dsp = 0), SHEAR_NOW or TENSION_NOW (t the returned stress, dsp
     as ``mohr_return``), -1 not settled here (t = s: ``mohr_plastic``'s general path must do it).
-    The same operations as ``mohr_plastic``'s array path, so the same bits."""
+    The formulas of ``mohr_plastic``'s array path (``principal_axes``' projectors, ``_rotate_back``),
+    arranged for one division instead of three; a stress takes one path or the other, never both."""
     if not (l3 - l1 > 0.0 and min(l2 - l1, l3 - l2) >= GAP_REL * (l3 - l1)):
         return -1, s0, s1, s2, s3, s4, s5, 0.0
     p1 = m + l1; p2 = m + l2; p3 = m + l3
@@ -411,16 +463,19 @@ def _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, coh, npf, csn, ft, nps, 
     q3 = d0 * s3 + s3 * d1 + s4 * s5
     q4 = d0 * s4 + s3 * s5 + s4 * d2
     q5 = s3 * s4 + d1 * s5 + s5 * d2
-    b = l2 + l3; c = l2 * l3; f = 1.0 / ((l1 - l2) * (l1 - l3))
+    # (both denominators from one division: it is on the path of every yielding zone)
+    e1 = n1 - p1; e2 = n2 - p2; e3 = n3 - p3
+    den1 = (l1 - l2) * (l1 - l3)
+    den3 = (l3 - l1) * (l3 - l2)
+    inv = 1.0 / (den1 * den3)
+    b = l2 + l3; c = l2 * l3; f = (e1 - e2) * (den3 * inv)
     u0 = (q0 - b * d0 + c) * f; u1 = (q1 - b * d1 + c) * f; u2 = (q2 - b * d2 + c) * f
     u3 = (q3 - b * s3) * f; u4 = (q4 - b * s4) * f; u5 = (q5 - b * s5) * f
-    b = l1 + l2; c = l1 * l2; f = 1.0 / ((l3 - l1) * (l3 - l2))
+    b = l1 + l2; c = l1 * l2; f = (e3 - e2) * (den1 * inv)
     v0 = (q0 - b * d0 + c) * f; v1 = (q1 - b * d1 + c) * f; v2 = (q2 - b * d2 + c) * f
     v3 = (q3 - b * s3) * f; v4 = (q4 - b * s4) * f; v5 = (q5 - b * s5) * f
-    e1 = n1 - p1; e2 = n2 - p2; e3 = n3 - p3
-    g1 = e1 - e2; g3 = e3 - e2
-    return (code, s0 + (e2 + g1 * u0 + g3 * v0), s1 + (e2 + g1 * u1 + g3 * v1), s2 + (e2 + g1 * u2 + g3 * v2),
-            s3 + (g1 * u3 + g3 * v3), s4 + (g1 * u4 + g3 * v4), s5 + (g1 * u5 + g3 * v5), -(e1 + e2 + e3) / 3.0)
+    return (code, s0 + (e2 + u0 + v0), s1 + (e2 + u1 + v1), s2 + (e2 + u2 + v2),
+            s3 + (u3 + v3), s4 + (u4 + v4), s5 + (u5 + v5), -(e1 + e2 + e3) * _THIRD)
 
 
 @njit(cache=True, inline="always")
@@ -429,10 +484,8 @@ def mohr_scalar(s0, s1, s2, s3, s4, s5, coh, npf, csn, ft, nps, a1, a2, sp, ap, 
     scalars (no arrays, for hot loops), with the zone's cohesion and ``mohr_constants``: (code,
     t0..t5, dsp) as ``_fast_return``; code -1: the caller runs ``mohr_plastic`` on the trial
     stress. The bits of mohr_trial + mohr_plastic."""
-    if _bounds_elastic(s0, s1, s2, s3, s4, s5, coh, npf, csn, ft):
-        return 0, s0, s1, s2, s3, s4, s5, 0.0
-    m, l1, l2, l3 = _dev_principal(s0, s1, s2, s3, s4, s5)
-    if _values_elastic(m, l1, l3, coh, npf, csn, ft):
+    elastic, m, l1, l2, l3 = _yield_test(s0, s1, s2, s3, s4, s5, coh, npf, csn, ft)
+    if elastic:
         return 0, s0, s1, s2, s3, s4, s5, 0.0
     return _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, coh, npf, csn, ft, nps, a1, a2, sp, ap, den)
 
