@@ -2,7 +2,7 @@
 plastic step it stands in for (``zone_plastic.zone_forces_plastic``, itself checked against the
 slow twins of tests/test_zone_mohr_kernels.py) for any number of parts and threads, with zones
 yielding in shear, in tension and at corners, hexahedral sets, linked gridpoints, large strain,
-NMD on and off; and the closed-form principal axes of ``zone_mohr.principal_axes`` against
+NMD on and off; and the closed-form principal axes of ``principal.principal_axes`` against
 numpy's eigh."""
 import math
 
