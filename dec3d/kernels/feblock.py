@@ -22,7 +22,7 @@ import numpy as np
 from numba import njit, prange
 
 from .feblock_hg import hg_jacobians, hg_step
-from .feblock_jac import grad_n, jac_inv
+from .feblock_jac import gauss_force, grad_n, jac_inv, strain_increment
 from .feblock_shape import (FACES, NGMAX, YNODE, YSLAVE, _slave_weights, feb_gauss_positions, feb_slave_forces,
                             feb_slave_interp, gauss_rule, hg_tables, quad8_traction_loads, ref_tables, shape20)
 from .gather import node_lists, node_sums, scatter
@@ -79,25 +79,6 @@ def _elem_force(dng, wd, sg, fe):
             fe[a, 2] -= w * (s[4] * dn[a, 0] + s[5] * dn[a, 1] + s[2] * dn[a, 2])
 
 
-@njit(cache=True, inline='always')
-def _gauss_force(sxx, syy, szz, sxy, sxz, syz, ji, d, fe):
-    """fe[a] -= (S J^-T) dN_a/dy for the weighted stress S (w det J sigma) of one point."""
-    p00 = sxx * ji[0, 0] + sxy * ji[0, 1] + sxz * ji[0, 2]
-    p01 = sxx * ji[1, 0] + sxy * ji[1, 1] + sxz * ji[1, 2]
-    p02 = sxx * ji[2, 0] + sxy * ji[2, 1] + sxz * ji[2, 2]
-    p10 = sxy * ji[0, 0] + syy * ji[0, 1] + syz * ji[0, 2]
-    p11 = sxy * ji[1, 0] + syy * ji[1, 1] + syz * ji[1, 2]
-    p12 = sxy * ji[2, 0] + syy * ji[2, 1] + syz * ji[2, 2]
-    p20 = sxz * ji[0, 0] + syz * ji[0, 1] + szz * ji[0, 2]
-    p21 = sxz * ji[1, 0] + syz * ji[1, 1] + szz * ji[1, 2]
-    p22 = sxz * ji[2, 0] + syz * ji[2, 1] + szz * ji[2, 2]
-    for a in range(20):
-        n0 = d[a, 0]; n1 = d[a, 1]; n2 = d[a, 2]
-        fe[a, 0] -= p00 * n0 + p01 * n1 + p02 * n2
-        fe[a, 1] -= p10 * n0 + p11 * n1 + p12 * n2
-        fe[a, 2] -= p20 * n0 + p21 * n1 + p22 * n2
-
-
 @njit(cache=True)
 def _elem_step(xe, ve, dref, wts, lam, g2, dt, sg, se, fe, jinv, wd, hg, dface, wpg, jf, eg, tg):
     """Stress update and nodal forces of one element (node coordinates xe, velocities ve
@@ -126,31 +107,8 @@ def _elem_step(xe, ve, dref, wts, lam, g2, dt, sg, se, fe, jinv, wd, hg, dface, 
         se[c] = 0.0
     for g in range(ng):
         d = dref[g]
-        # master velocity gradient m[i, k] = sum_a v_ai dN_a/dy_k
-        m00 = 0.0; m01 = 0.0; m02 = 0.0
-        m10 = 0.0; m11 = 0.0; m12 = 0.0
-        m20 = 0.0; m21 = 0.0; m22 = 0.0
-        for a in range(20):
-            v0 = ve[a, 0]; v1 = ve[a, 1]; v2 = ve[a, 2]
-            n0 = d[a, 0]; n1 = d[a, 1]; n2 = d[a, 2]
-            m00 += v0 * n0; m01 += v0 * n1; m02 += v0 * n2
-            m10 += v1 * n0; m11 += v1 * n1; m12 += v1 * n2
-            m20 += v2 * n0; m21 += v2 * n1; m22 += v2 * n2
         ji = jinv[g]
-        # L = m J^-1
-        l00 = m00 * ji[0, 0] + m01 * ji[1, 0] + m02 * ji[2, 0]
-        l01 = m00 * ji[0, 1] + m01 * ji[1, 1] + m02 * ji[2, 1]
-        l02 = m00 * ji[0, 2] + m01 * ji[1, 2] + m02 * ji[2, 2]
-        l10 = m10 * ji[0, 0] + m11 * ji[1, 0] + m12 * ji[2, 0]
-        l11 = m10 * ji[0, 1] + m11 * ji[1, 1] + m12 * ji[2, 1]
-        l12 = m10 * ji[0, 2] + m11 * ji[1, 2] + m12 * ji[2, 2]
-        l20 = m20 * ji[0, 0] + m21 * ji[1, 0] + m22 * ji[2, 0]
-        l21 = m20 * ji[0, 1] + m21 * ji[1, 1] + m22 * ji[2, 1]
-        l22 = m20 * ji[0, 2] + m21 * ji[1, 2] + m22 * ji[2, 2]
-        exx = l00 * dt; eyy = l11 * dt; ezz = l22 * dt
-        exy = 0.5 * (l01 + l10) * dt
-        exz = 0.5 * (l02 + l20) * dt
-        eyz = 0.5 * (l12 + l21) * dt
+        exx, eyy, ezz, exy, exz, eyz = strain_increment(ve, d, ji, dt)
         ev = exx + eyy + ezz
         s = sg[g]
         s[0] += lam * ev + g2 * exx
@@ -167,14 +125,14 @@ def _elem_step(xe, ve, dref, wts, lam, g2, dt, sg, se, fe, jinv, wd, hg, dface, 
             e = eg[g]
             e[0] = exx; e[1] = eyy; e[2] = ezz; e[3] = exy; e[4] = exz; e[5] = eyz
         else:
-            _gauss_force(s[0] * w, s[1] * w, s[2] * w, s[3] * w, s[4] * w, s[5] * w, ji, d, fe)
+            gauss_force(s[0] * w, s[1] * w, s[2] * w, s[3] * w, s[4] * w, s[5] * w, ji, d, fe)
     if ctl:
         hg_step(ve, dface, jf, wpg, vol, lam, g2, hg, dt, eg, sg, tg, fe)
         for g in range(8):
             s = sg[g]
             w = wd[g]
             t = tg[g]
-            _gauss_force(s[0] * w - t[0], s[1] * w - t[1], s[2] * w - t[2], s[3] * w - t[3], s[4] * w - t[4],
+            gauss_force(s[0] * w - t[0], s[1] * w - t[1], s[2] * w - t[2], s[3] * w - t[3], s[4] * w - t[4],
                          s[5] * w - t[5], jinv[g], dref[g], fe)
     return True
 

@@ -32,7 +32,7 @@ not an element stress: it is left out of ``stress`` and of the output.
 """
 from numba import njit
 
-from .feblock_jac import jac_inv
+from .feblock_jac import gauss_force, jac_inv, strain_increment
 
 #: eps_h: the hourglass stiffness as a fraction of the elastic moduli (0 switches control off)
 HOURGLASS = 0.1
@@ -68,28 +68,7 @@ def hg_step(ve, dface, jf, wpg, vol, lam, g2, hg, dt, eg, sg, tg, fe):
     for p in range(6):
         d = dface[p]
         ji = jf[p]
-        m00 = 0.0; m01 = 0.0; m02 = 0.0
-        m10 = 0.0; m11 = 0.0; m12 = 0.0
-        m20 = 0.0; m21 = 0.0; m22 = 0.0
-        for a in range(20):
-            v0 = ve[a, 0]; v1 = ve[a, 1]; v2 = ve[a, 2]
-            n0 = d[a, 0]; n1 = d[a, 1]; n2 = d[a, 2]
-            m00 += v0 * n0; m01 += v0 * n1; m02 += v0 * n2
-            m10 += v1 * n0; m11 += v1 * n1; m12 += v1 * n2
-            m20 += v2 * n0; m21 += v2 * n1; m22 += v2 * n2
-        l00 = m00 * ji[0, 0] + m01 * ji[1, 0] + m02 * ji[2, 0]
-        l01 = m00 * ji[0, 1] + m01 * ji[1, 1] + m02 * ji[2, 1]
-        l02 = m00 * ji[0, 2] + m01 * ji[1, 2] + m02 * ji[2, 2]
-        l10 = m10 * ji[0, 0] + m11 * ji[1, 0] + m12 * ji[2, 0]
-        l11 = m10 * ji[0, 1] + m11 * ji[1, 1] + m12 * ji[2, 1]
-        l12 = m10 * ji[0, 2] + m11 * ji[1, 2] + m12 * ji[2, 2]
-        l20 = m20 * ji[0, 0] + m21 * ji[1, 0] + m22 * ji[2, 0]
-        l21 = m20 * ji[0, 1] + m21 * ji[1, 1] + m22 * ji[2, 1]
-        l22 = m20 * ji[0, 2] + m21 * ji[1, 2] + m22 * ji[2, 2]
-        exx = l00 * dt; eyy = l11 * dt; ezz = l22 * dt
-        exy = 0.5 * (l01 + l10) * dt
-        exz = 0.5 * (l02 + l20) * dt
-        eyz = 0.5 * (l12 + l21) * dt
+        exx, eyy, ezz, exy, exz, eyz = strain_increment(ve, d, ji, dt)
         for g in range(8):
             w = wpg[p, g]
             exx -= w * eg[g, 0]; eyy -= w * eg[g, 1]; ezz -= w * eg[g, 2]
@@ -106,19 +85,4 @@ def hg_step(ve, dface, jf, wpg, vol, lam, g2, hg, dt, eg, sg, tg, fe):
             w = wv * wpg[p, g]
             for c in range(6):
                 tg[g, c] += w * s[c]
-        sxx = s[0] * wv; syy = s[1] * wv; szz = s[2] * wv
-        sxy = s[3] * wv; sxz = s[4] * wv; syz = s[5] * wv
-        p00 = sxx * ji[0, 0] + sxy * ji[0, 1] + sxz * ji[0, 2]
-        p01 = sxx * ji[1, 0] + sxy * ji[1, 1] + sxz * ji[1, 2]
-        p02 = sxx * ji[2, 0] + sxy * ji[2, 1] + sxz * ji[2, 2]
-        p10 = sxy * ji[0, 0] + syy * ji[0, 1] + syz * ji[0, 2]
-        p11 = sxy * ji[1, 0] + syy * ji[1, 1] + syz * ji[1, 2]
-        p12 = sxy * ji[2, 0] + syy * ji[2, 1] + syz * ji[2, 2]
-        p20 = sxz * ji[0, 0] + syz * ji[0, 1] + szz * ji[0, 2]
-        p21 = sxz * ji[1, 0] + syz * ji[1, 1] + szz * ji[1, 2]
-        p22 = sxz * ji[2, 0] + syz * ji[2, 1] + szz * ji[2, 2]
-        for a in range(20):
-            n0 = d[a, 0]; n1 = d[a, 1]; n2 = d[a, 2]
-            fe[a, 0] -= p00 * n0 + p01 * n1 + p02 * n2
-            fe[a, 1] -= p10 * n0 + p11 * n1 + p12 * n2
-            fe[a, 2] -= p20 * n0 + p21 * n1 + p22 * n2
+        gauss_force(s[0] * wv, s[1] * wv, s[2] * wv, s[3] * wv, s[4] * wv, s[5] * wv, ji, d, fe)
