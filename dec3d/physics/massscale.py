@@ -30,6 +30,11 @@ SAFETY_RAISED = 0.5
 
 
 class DensityScaling:
+    def body_safety(self) -> float:
+        """The safety s of density scaling by body: ω_max Δt ≤ 2 s (``_body_masses``)."""
+        s = self.settings()
+        return float(s["safety"] or (SAFETY_RAISED if self.scaling() == "raised" else SAFETY.get(s["damping"], 0.7)))
+
     def _stiffness_sums(self, gstart, gmember) -> np.ndarray:
         """Per group, Σ over its sub-contacts of max(kn, ks)·area [N/m] (Eq. 87's K)."""
         b = self.model.blocks
@@ -81,8 +86,7 @@ class DensityScaling:
         that every part of the model has the same step. With full inertia (Euler's equations) the
         principal moments take the larger of the two ratios m_i / m, I_i / I."""
         s = self.settings()
-        raised = self.scaling() == "raised"
-        safety = float(s["safety"] or (SAFETY_RAISED if raised else SAFETY.get(s["damping"], 0.7)))
+        safety = self.body_safety()
         b = self.model.blocks
         cs, ss = self.contacts, self.subcontacts
         ng = len(gstart) - 1
@@ -116,7 +120,7 @@ class DensityScaling:
         f = (dt / (2.0 * safety)) ** 2
         im = np.where(on, rt * f, gmass)
         isc = np.where(rr > 0, rr * f, giscalar)
-        if raised:
+        if self.scaling() == "raised":
             # the default of static runs: densities only increased (3DEC theory text, "Mass
             # (Density) Scaling"), so no body is lighter than it is; a block that loses most of
             # its contact stiffness (tipping onto an edge, sliding off) keeps its real inertia

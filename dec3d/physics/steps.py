@@ -176,6 +176,13 @@ class _Run:
         else:
             dt = self.masses(dt_last if dt_last is not None else self.dt_fixed)
         self.dt = eng.dt = dt
+        servo = self.damping.servo
+        if self.mode == DAMP_ADAPTIVE and self.by_body and not servo.alpha[0] > 0.0:
+            # a fresh servo starts where it aims for the fastest mode density scaling by body lets
+            # through, ω = 2 s / Δt: R = π α_v / (2ω) = ratio (``kernels.motion``). The 0.02/Δt
+            # the kernel starts from otherwise left a block set down on an incline ringing at
+            # ω Δt ≈ 1 for some 300 steps, sliding 65 mm where it then held (1.4 mm with Eq. 87)
+            servo.alpha[0] = 2.0 * float(s["servo_ratio"]) * (2.0 * eng.body_safety() / dt) / math.pi
         # detection also runs as soon as a block has moved CTOL/2 since the last one, so
         # that two blocks approaching each other cannot close more than CTOL unseen
         self.radius = eng._radii()
