@@ -22,6 +22,7 @@ identity when its vertex moves onto another face of the opposing block (relocati
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 from numba import get_num_threads, njit, prange
@@ -194,6 +195,31 @@ def threaded(kernel, n):
     return kernel
 
 
+def in_threads(work, nitems: int, nthreads: int) -> None:
+    """Call ``work(j)`` for j = 0 .. nitems-1 on ``nthreads`` threads (this one and nthreads-1
+    started here), each taking the next j when it is free. ``work`` calls kernels compiled with
+    ``nogil`` (they run side by side, outside numba's threading layer, and need no parallel
+    twin: nothing compiles again) and writes only its own results; the first error is raised."""
+    items = iter(range(nitems))     # (next() on a range iterator is atomic under the GIL)
+    errors = []
+
+    def loop():
+        try:
+            for j in items:
+                work(j)
+        except BaseException as exc:  # noqa: BLE001 - re-raised in the calling thread below
+            errors.append(exc)
+
+    extra = [threading.Thread(target=loop, daemon=True) for _ in range(min(nthreads, nitems) - 1)]
+    for t in extra:
+        t.start()
+    loop()
+    for t in extra:
+        t.join()
+    if errors:
+        raise errors[0]
+
+
 @njit(cache=True)
 def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, sgap,
                old_start, old_count, old_kind, old_key0, old_key1, old_area,
@@ -274,6 +300,53 @@ def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, sg
             fs[s, d] = rot[d] / atot * new_area[s]
         udil[s] = mdil / atot
         state[s] = st | ST_NEW
+
+
+@njit(cache=True, nogil=True)
+def gather_subcontacts(lo, hi, base, starts, counts, nold, old, new, out):
+    """The sub-contacts of contacts lo .. hi-1 of a detection, each taken from the old rows or the
+    new ones: contact c has counts[c] sub-contacts, written from row starts[c] of ``out`` and
+    read from row base[c] of the old rows followed by the new ones (base[c] ≥ nold: row
+    base[c] − nold of the new). Its rows in order, one contact after the other.
+
+    old: (kind, key0, key1, pos, area, fn, fs, un, udil, us, state), the old sub-contact arrays
+    (nold rows); new: the same without fn (a new sub-contact starts with fn 0); out: (contact,
+    kind, key0, key1, pos, area, fn, fs, un, udil, us, state), ``out[0][i]`` the contact of row i."""
+    o_kind, o_key0, o_key1, o_pos, o_area, o_fn, o_fs, o_un, o_udil, o_us, o_state = old
+    n_kind, n_key0, n_key1, n_pos, n_area, n_fs, n_un, n_udil, n_us, n_state = new
+    w_c, w_kind, w_key0, w_key1, w_pos, w_area, w_fn, w_fs, w_un, w_udil, w_us, w_state = out
+    for c in range(lo, hi):
+        for j in range(counts[c]):
+            i = starts[c] + j
+            r = base[c] + j
+            w_c[i] = c
+            if r < nold:
+                w_kind[i] = o_kind[r]
+                w_key0[i] = o_key0[r]
+                w_key1[i] = o_key1[r]
+                w_area[i] = o_area[r]
+                w_fn[i] = o_fn[r]
+                w_un[i] = o_un[r]
+                w_udil[i] = o_udil[r]
+                w_state[i] = o_state[r]
+                for d in range(3):
+                    w_pos[i, d] = o_pos[r, d]
+                    w_fs[i, d] = o_fs[r, d]
+                    w_us[i, d] = o_us[r, d]
+            else:
+                r -= nold
+                w_kind[i] = n_kind[r]
+                w_key0[i] = n_key0[r]
+                w_key1[i] = n_key1[r]
+                w_area[i] = n_area[r]
+                w_fn[i] = 0.0
+                w_un[i] = n_un[r]
+                w_udil[i] = n_udil[r]
+                w_state[i] = n_state[r]
+                for d in range(3):
+                    w_pos[i, d] = n_pos[r, d]
+                    w_fs[i, d] = n_fs[r, d]
+                    w_us[i, d] = n_us[r, d]
 
 
 @njit(cache=True)

@@ -26,10 +26,12 @@ from __future__ import annotations
 import time as _time
 
 import numpy as np
+from numba import get_num_threads
 
 from dec3d.kernels.cellmap import cell_grid, cell_pairs, outside_grid
-from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, match_sorted,
-                                      subcontact_gaps, threaded, vertex_point_areas)
+from dec3d.kernels import contactmap as _cm
+from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, gather_subcontacts,
+                                      in_threads, match_sorted, subcontact_gaps, threaded, vertex_point_areas)
 from dec3d.kernels.joints import NPROP
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.groups import group_field
@@ -92,6 +94,8 @@ SUBCONTACT_FIELDS = {
 #: since it was last looked at (dec3d's choice; areas and planes change by ~QUIET·CTOL/size)
 QUIET = 0.1
 
+#: the sub-contact fields a detection writes (``contactmap.gather_subcontacts``), in its order
+_GATHERED = ("contact", "kind", "key0", "key1", "pos", "area", "fn", "fs", "un", "udil", "us", "state")
 
 
 def contact_stores(model) -> tuple[Store, Store]:
@@ -110,8 +114,9 @@ def contact_stores(model) -> tuple[Store, Store]:
     return model.store("contacts"), model.store("subcontacts")
 
 
-def _subcontacts(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea):
-    """Sub-contacts of every contact (kernel ``subgeom.subcontacts_batch``, grown until it fits)."""
+def _subcontacts_chunk(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea):
+    """Sub-contacts of the contacts (ra, rb, cn, cc) (kernel ``subgeom.subcontacts_batch``, its
+    output grown until it fits); contact indices local to these contacts."""
     cap = max(16, 8 * len(ra))
     while True:
         out = (np.empty(cap, _I), np.empty(cap, _I), np.empty(cap, _I), np.empty(cap, _I),
@@ -121,6 +126,35 @@ def _subcontacts(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea):
         if k <= cap:
             return tuple(a[:k] for a in out)
         cap = int(k)
+
+
+#: contacts per chunk are at least this many; a pass has about CHUNKS_PER_THREAD chunks per thread
+#: (threads that finish early take the next chunk: a busy core holds up less)
+CHUNK_MIN = 128
+CHUNKS_PER_THREAD = 4
+
+
+def _subcontacts(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea, nthreads=None):
+    """Sub-contacts of every contact, ordered by contact: from ``contactmap.PARALLEL_FROM`` contacts on
+    more than one thread the contacts are cut into chunks, each chunk's sub-contacts found on
+    its own (``_subcontacts_chunk``: the kernel keeps no state from one contact to the next) on
+    the threads side by side, and the chunks joined in their order: the same rows as one pass."""
+    n = len(ra)
+    nt = get_num_threads() if nthreads is None else nthreads
+    if n < _cm.PARALLEL_FROM or nt < 2:
+        return _subcontacts_chunk(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea)
+    nchunk = int(min(nt * CHUNKS_PER_THREAD, max(nt, n // CHUNK_MIN)))
+    bounds = np.linspace(0, n, nchunk + 1).astype(_I)
+    parts = [None] * nchunk
+
+    def work(j):
+        lo, hi = bounds[j], bounds[j + 1]
+        parts[j] = _subcontacts_chunk(vpos, b, f, fv, ra[lo:hi], rb[lo:hi], cn[lo:hi], cc[lo:hi], ctol, parea)
+
+    in_threads(work, nchunk, nt)
+    for j in range(1, nchunk):
+        parts[j][0][...] += bounds[j]
+    return tuple(np.concatenate([p[i] for p in parts]) for i in range(6))
 
 
 def zoned_side_carries(sc_contact, kind, area, za, zb) -> None:
@@ -413,18 +447,19 @@ class ContactDetection:
         counts[~kept_c], base[~kept_c] = f_count[fi[~kept_c]], ss.n + f_start[fi[~kept_c]]
         starts = (np.cumsum(counts) - counts).astype(_I)
         total = int(counts.sum())
-        owner = np.repeat(np.arange(nc, dtype=_I), counts)
         # nothing recomputed and every old sub-contact kept in place (a quiet model): the rows
         # stay as they are (the gather below would copy each of them onto itself)
         same = nf == 0 and total == ss.n and np.array_equal(base, starts)
-        sub = {}
         if not same:
-            src = np.repeat(base - starts, counts) + np.arange(total, dtype=_I)
-            pool = {"kind": (ss["kind"], kind), "key0": (ss["key0"], key0), "key1": (ss["key1"], key1),
-                    "pos": (ss["pos"], pos), "area": (ss["area"], area), "fn": (ss["fn"], np.zeros(ns)),
-                    "fs": (ss["fs"], fs), "un": (ss["un"], un), "udil": (ss["udil"], udil), "us": (ss["us"], us),
-                    "state": (ss["state"], state)}
-            sub = {key: np.concatenate(pair)[src] for key, pair in pool.items()}
+            # straight into new arrays (the old rows are read from the store's own), installed below
+            gathered = ss.blank(total, _GATHERED)
+            old_rows = tuple(ss[key] for key in _GATHERED[1:])
+            new_rows = (kind, key0, key1, pos, area, fs, un, udil, us, state)
+            out = tuple(gathered[key] for key in _GATHERED)
+            nt = get_num_threads() if total >= _cm.PARALLEL_FROM else 1
+            cut = np.linspace(0, nc, nt + 1).astype(_I)
+            in_threads(lambda j: gather_subcontacts(cut[j], cut[j + 1], base, starts, counts, ss.n, old_rows, new_rows,
+                                                    out), nt, nt)
         self.timings["subcontacts"] += _time.perf_counter() - t1
         #: whether this detection kept every contact and sub-contact as it was, with the same
         #: properties (density scaling by body then keeps its masses: ``steps._Run.detected``)
@@ -438,12 +473,10 @@ class ContactDetection:
                          ("normal", normal), ("gap", cgap), ("type", ctyp), ("jmodel", jcode), ("prop", prop),
                          ("own_props", own), ("sub_start", starts), ("sub_count", counts), ("group", group)):
             cs[key][...] = val
-        if not same:
-            ss.clear()
-            ss.append(total)
-        ss["contact"][...] = owner
-        for key, val in sub.items():
-            ss[key][...] = val
+        if same:
+            ss["contact"][...] = np.repeat(np.arange(nc, dtype=_I), counts)
+        else:
+            ss.install(total, gathered)
         # the blocks looked at are the new reference for "moved"
         if full:
             look[...] = vpos
