@@ -467,12 +467,13 @@ class ContactDetection:
                                 and np.array_equal(prop, cs["prop"], equal_nan=True) and np.array_equal(jcode, cs["jmodel"]))
         # install
         self.detections += 1
-        cs.clear()
-        cs.append(nc)
-        for key, val in (("ida", ids[ra_c]), ("idb", ids[rb_c]), ("a", ra_c), ("b", rb_c), ("pos", cpos),
-                         ("normal", normal), ("gap", cgap), ("type", ctyp), ("jmodel", jcode), ("prop", prop),
-                         ("own_props", own), ("sub_start", starts), ("sub_count", counts), ("group", group)):
-            cs[key][...] = val
+        values = {"ida": ids[ra_c], "idb": ids[rb_c], "a": ra_c, "b": rb_c, "pos": cpos, "normal": normal,
+                  "gap": cgap, "type": ctyp, "jmodel": jcode, "prop": prop, "own_props": own, "sub_start": starts,
+                  "sub_count": counts, "group": group}
+        rows_new = cs.blank(nc, values)         # (the other fields get their fill value)
+        for key, val in values.items():
+            rows_new[key][:nc] = val
+        cs.install(nc, rows_new)
         if same:
             ss["contact"][...] = np.repeat(np.arange(nc, dtype=_I), counts)
         else:
