@@ -124,13 +124,28 @@ def subcontact_gaps(sc_contact, pos, ca, cb, cn, cgap, centroid, vpos, bfstart, 
     such face (degenerate). sc_contact (ns,), pos (ns, 3) [m]; ca, cb (nc,) block rows;
     cn (nc, 3); centroid (nb, 3); faces as in ``subgeom.subcontacts_batch``; writes out (ns,).
     """
-    for s in prange(sc_contact.shape[0]):      # (in parallel in the twin) each writes only out[s]
-        c = sc_contact[s]
+    # the face planes of a contact's two blocks are worked out once for its run of sub-contacts
+    # (consecutive rows of one contact: the sub-contacts come ordered by contact)
+    ns = sc_contact.shape[0]
+    nrun = 0
+    for s in range(ns):
+        if s == 0 or sc_contact[s] != sc_contact[s - 1]:
+            nrun += 1
+    first = np.empty(nrun + 1, np.int64)
+    r = 0
+    for s in range(ns):
+        if s == 0 or sc_contact[s] != sc_contact[s - 1]:
+            first[r] = s
+            r += 1
+    first[nrun] = ns
+    for r in prange(nrun):                  # (in parallel in the twin) each writes only its own rows
+        c = sc_contact[first[r]]
         n0 = cn[c, 0]
         n1 = cn[c, 1]
         n2 = cn[c, 2]
-        ta = math.inf
-        tb = -math.inf
+        nfa = bfcount[ca[c]]
+        plane = np.empty((nfa + bfcount[cb[c]], 7))   # m (outward unit normal), f (face centre), m·n
+        npl = np.zeros(2, np.int64)
         for side in range(2):
             b = ca[c] if side == 0 else cb[c]
             for f in range(bfstart[b], bfstart[b] + bfcount[b]):
@@ -160,17 +175,33 @@ def subcontact_gaps(sc_contact, pos, ca, cb, cn, cgap, centroid, vpos, bfstart, 
                     my = -my
                     mz = -mz
                 mn = mx * n0 + my * n1 + mz * n2
-                if abs(mn) <= 1e-9:
+                if abs(mn) <= 1e-9 or (side == 0 and mn <= 0.0) or (side == 1 and mn >= 0.0):
                     continue
-                t = (mx * (fx - pos[s, 0]) + my * (fy - pos[s, 1]) + mz * (fz - pos[s, 2])) / mn
-                if side == 0 and mn > 0.0 and t < ta:
-                    ta = t
-                if side == 1 and mn < 0.0 and t > tb:
-                    tb = t
-        if ta == math.inf or tb == -math.inf:
-            out[s] = cgap[c]
-        else:
-            out[s] = tb - ta
+                k = npl[side] + (0 if side == 0 else nfa)
+                plane[k, 0] = mx
+                plane[k, 1] = my
+                plane[k, 2] = mz
+                plane[k, 3] = fx
+                plane[k, 4] = fy
+                plane[k, 5] = fz
+                plane[k, 6] = mn
+                npl[side] += 1
+        for s in range(first[r], first[r + 1]):
+            ta = math.inf
+            tb = -math.inf
+            for side in range(2):
+                k0 = 0 if side == 0 else nfa
+                for k in range(k0, k0 + npl[side]):
+                    t = (plane[k, 0] * (plane[k, 3] - pos[s, 0]) + plane[k, 1] * (plane[k, 4] - pos[s, 1]) +
+                         plane[k, 2] * (plane[k, 5] - pos[s, 2])) / plane[k, 6]
+                    if side == 0 and t < ta:
+                        ta = t
+                    if side == 1 and t > tb:
+                        tb = t
+            if ta == math.inf or tb == -math.inf:
+                out[s] = cgap[c]
+            else:
+                out[s] = tb - ta
 
 
 def _parallel_twin(kernel, name):
