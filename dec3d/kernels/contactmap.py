@@ -22,7 +22,6 @@ identity when its vertex moves onto another face of the opposing block (relocati
 from __future__ import annotations
 
 import math
-import threading
 
 import numpy as np
 from numba import get_num_threads, njit, prange
@@ -224,31 +223,6 @@ def threaded(kernel, n):
     if n >= PARALLEL_FROM and get_num_threads() > 1:
         return cp_batch_parallel if kernel is cp_batch else subcontact_gaps_parallel
     return kernel
-
-
-def in_threads(work, nitems: int, nthreads: int) -> None:
-    """Call ``work(j)`` for j = 0 .. nitems-1 on ``nthreads`` threads (this one and nthreads-1
-    started here), each taking the next j when it is free. ``work`` calls kernels compiled with
-    ``nogil`` (they run side by side, outside numba's threading layer, and need no parallel
-    twin: nothing compiles again) and writes only its own results; the first error is raised."""
-    items = iter(range(nitems))     # (next() on a range iterator is atomic under the GIL)
-    errors = []
-
-    def loop():
-        try:
-            for j in items:
-                work(j)
-        except BaseException as exc:  # noqa: BLE001 - re-raised in the calling thread below
-            errors.append(exc)
-
-    extra = [threading.Thread(target=loop, daemon=True) for _ in range(min(nthreads, nitems) - 1)]
-    for t in extra:
-        t.start()
-    loop()
-    for t in extra:
-        t.join()
-    if errors:
-        raise errors[0]
 
 
 @njit(cache=True)

@@ -17,12 +17,16 @@ steps, default 10, and as soon as a block has moved CTOL/2 since the last one):
      a twin starts from its own gap (kernel ``contactmap.subcontact_gaps``).
   Pairs whose blocks have both moved less than QUIET·CTOL since they were last looked at
   keep their contact and sub-contacts as they are.
+On more than one thread (``model configure threads``) the sub-contacts are found chunk by
+chunk and gathered piece by piece on Python threads (``in_threads``, kernels compiled
+``nogil``), joined in their order: the same rows, bit for bit, as one thread.
 
 Contacts are oriented from the block with the lower id (A) to the higher (B) and sorted
 by (id A, id B); that key finds a contact again after blocks are deleted or cut.
 """
 from __future__ import annotations
 
+import threading
 import time as _time
 
 import numpy as np
@@ -31,7 +35,7 @@ from numba import get_num_threads
 from dec3d.kernels.cellmap import cell_grid, cell_pairs, outside_grid
 from dec3d.kernels import contactmap as _cm
 from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, gather_subcontacts,
-                                      in_threads, match_sorted, subcontact_gaps, threaded, vertex_point_areas)
+                                      match_sorted, subcontact_gaps, threaded, vertex_point_areas)
 from dec3d.kernels.joints import NPROP
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.groups import group_field
@@ -112,6 +116,31 @@ def contact_stores(model) -> tuple[Store, Store]:
     if "map_reach" not in model.blocks:
         model.blocks.add_field("map_reach", Field((), _F, 0.0))
     return model.store("contacts"), model.store("subcontacts")
+
+
+def in_threads(work, nitems: int, nthreads: int) -> None:
+    """Call ``work(j)`` for j = 0 .. nitems-1 on ``nthreads`` threads (this one and nthreads-1
+    started here), each taking the next j when it is free. ``work`` calls kernels compiled with
+    ``nogil`` (they run side by side, outside numba's threading layer, and need no parallel
+    twin: nothing compiles again) and writes only its own results; the first error is raised."""
+    items = iter(range(nitems))     # (next() on a range iterator is atomic under the GIL)
+    errors = []
+
+    def loop():
+        try:
+            for j in items:
+                work(j)
+        except BaseException as exc:  # noqa: BLE001 - re-raised in the calling thread below
+            errors.append(exc)
+
+    extra = [threading.Thread(target=loop, daemon=True) for _ in range(min(nthreads, nitems) - 1)]
+    for t in extra:
+        t.start()
+    loop()
+    for t in extra:
+        t.join()
+    if errors:
+        raise errors[0]
 
 
 def _subcontacts_chunk(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea):

@@ -1,5 +1,5 @@
 """Contact detection on several threads (``physics.contacts._subcontacts`` in chunks,
-``contactmap.gather_subcontacts`` in pieces, ``contactmap.in_threads``) and the store's
+``contactmap.gather_subcontacts`` in pieces, ``contacts.in_threads``) and the store's
 ``blank``/``install``: the same rows, bit for bit, as one serial pass, whatever the thread count."""
 import io
 import threading
@@ -10,9 +10,10 @@ import pytest
 from dec3d import config
 from dec3d.geometry.cutting import cut_by_planes
 from dec3d.kernels import contactmap
-from dec3d.kernels.contactmap import gather_subcontacts, in_threads
+from dec3d.kernels.contactmap import gather_subcontacts
 from dec3d.model.store import Field, Store
 from dec3d.physics import contacts as detection
+from dec3d.physics.contacts import in_threads
 from dec3d.session import Session
 
 TWO = pytest.mark.skipif(config.max_threads() < 2, reason="numba may use only one thread here")
@@ -199,3 +200,33 @@ def test_a_detection_on_two_threads_installs_the_rows_of_one(monkeypatch, restor
         states.append(out)
     assert len(states[0]["subcontacts/area"]) > 2 * len(states[0]["contacts/a"]) > 1000
     assert [k for k in states[0] if not np.array_equal(states[0][k], states[1][k], equal_nan=True)] == []
+
+
+def test_subcontact_gaps_by_runs_of_a_contact_equal_each_row_alone():
+    """``subcontact_gaps`` works a contact's face planes out once for its run of sub-contacts: on
+    the cut model's sub-contacts, in contact order and shuffled (runs of one), each gap equals the
+    kernel's on that row alone, bit for bit (the gaps against an independent twin:
+    ``test_contact_fixes.test_subcontact_gaps_against_hull_twin``)."""
+    from dec3d.kernels.contactmap import subcontact_gaps
+    model = _cut_model(2)
+    cs, ss = model.store("contacts"), model.store("subcontacts")
+    b, f = model.blocks, model.faces
+    geo = (b["centroid"], model.vertices["pos"], b["face_start"], b["face_count"], f["vstart"], f["nvert"],
+           model.face_vertices["vertex"])
+    con = (cs["a"], cs["b"], cs["normal"], cs["gap"])
+    sc, pos = ss["contact"].copy(), ss["pos"].copy()
+    ns = len(sc)
+    assert ns > 50 and len(np.unique(sc)) > 20
+    together = np.empty(ns)
+    subcontact_gaps(sc, pos, *con, *geo, together)
+    alone = np.empty(ns)
+    for s in range(ns):
+        one = np.empty(1)
+        subcontact_gaps(sc[s:s + 1], pos[s:s + 1], *con, *geo, one)
+        alone[s] = one[0]
+    np.testing.assert_array_equal(together, alone)
+    perm = np.random.default_rng(0).permutation(ns)
+    shuffled = np.empty(ns)
+    subcontact_gaps(sc[perm], pos[perm], *con, *geo, shuffled)
+    np.testing.assert_array_equal(shuffled, together[perm])
+    assert np.median(np.abs(together)) < 1e-9        # pieces cut from one box: most points touch
