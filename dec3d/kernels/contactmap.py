@@ -225,7 +225,7 @@ def threaded(kernel, n):
     return kernel
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, sgap,
                old_start, old_count, old_kind, old_key0, old_key1, old_area,
                old_fs, old_un, old_udil, old_us, old_state, old_n, new_n,

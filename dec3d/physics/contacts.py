@@ -460,9 +460,12 @@ class ContactDetection:
         udil = np.empty(ns)
         us = np.empty((ns, 3))
         state = np.empty(ns, _I)
-        carry_over(f_prev, sc_c, kind, key0, key1, area, sgap, cs["sub_start"], cs["sub_count"], ss["kind"],
-                   ss["key0"], ss["key1"], ss["area"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"],
-                   cs["normal"], f_n, fs, un, udil, us, state)
+        olds = (cs["sub_start"], cs["sub_count"], ss["kind"], ss["key0"], ss["key1"], ss["area"], ss["fs"], ss["un"],
+                ss["udil"], ss["us"], ss["state"], cs["normal"], f_n)
+        nt = get_num_threads() if ns >= _cm.PARALLEL_FROM else 1
+        cut = np.linspace(0, ns, nt + 1).astype(_I)       # (each sub-contact's state is its own: rows apart)
+        in_threads(lambda j: carry_over(f_prev, *(x[cut[j]:cut[j + 1]] for x in (sc_c, kind, key0, key1, area, sgap)),
+                                        *olds, *(x[cut[j]:cut[j + 1]] for x in (fs, un, udil, us, state))), nt, nt)
         nf = len(fresh)
         f_count = np.bincount(sc_c, minlength=nf).astype(_I) if nf else np.zeros(0, _I)
         f_start = (np.cumsum(f_count) - f_count).astype(_I)
