@@ -124,7 +124,7 @@ class Store:
         for key in keys:
             spec = self._fields[key]
             old, dirty = self._retired.pop(key, (None, 0))
-            if old is not None and old.shape[0] == cap:
+            if old is not None and old.shape == (cap, *spec.shape) and old.dtype == spec.dtype:
                 out[key] = old
             else:
                 out[key] = np.empty((cap, *spec.shape), dtype=spec.dtype)

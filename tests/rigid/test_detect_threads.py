@@ -172,6 +172,15 @@ def test_store_blank_and_install_are_clear_then_append_without_the_fill():
         assert s.n == ref.n == n and s.capacity == ref.capacity
         for k in fields:                          # spare rows hold the fill value too
             np.testing.assert_array_equal(s.full(k), ref.full(k), err_msg=k)
+    new = s.blank(2, ("g",))
+    new["g"][:2] = 3
+    s.install(2, new)                             # the replaced (16, 2) array kept for the next blank
+    s.resize_field("g", (3,))                     # (a group slot more): no array of the old shape handed out
+    new = s.blank(2, ("g",))
+    assert new["g"].shape == (s.capacity, 3)
+    new["g"][:2] = 4
+    s.install(2, new)
+    np.testing.assert_array_equal(s["g"], 4)
     wrong = {"a": np.zeros(3, np.int64)}
     with pytest.raises(ValueError, match="field 'a' needs shape"):
         s.install(2, wrong)
