@@ -123,13 +123,28 @@ def subcontact_gaps(sc_contact, pos, ca, cb, cn, cgap, centroid, vpos, bfstart, 
     such face (degenerate). sc_contact (ns,), pos (ns, 3) [m]; ca, cb (nc,) block rows;
     cn (nc, 3); centroid (nb, 3); faces as in ``subgeom.subcontacts_batch``; writes out (ns,).
     """
-    for s in prange(sc_contact.shape[0]):      # (in parallel in the twin) each writes only out[s]
-        c = sc_contact[s]
+    # the face planes of a contact's two blocks are worked out once for its run of sub-contacts
+    # (consecutive rows of one contact: the sub-contacts come ordered by contact)
+    ns = sc_contact.shape[0]
+    nrun = 0
+    for s in range(ns):
+        if s == 0 or sc_contact[s] != sc_contact[s - 1]:
+            nrun += 1
+    first = np.empty(nrun + 1, np.int64)
+    r = 0
+    for s in range(ns):
+        if s == 0 or sc_contact[s] != sc_contact[s - 1]:
+            first[r] = s
+            r += 1
+    first[nrun] = ns
+    for r in prange(nrun):                  # (in parallel in the twin) each writes only its own rows
+        c = sc_contact[first[r]]
         n0 = cn[c, 0]
         n1 = cn[c, 1]
         n2 = cn[c, 2]
-        ta = math.inf
-        tb = -math.inf
+        nfa = bfcount[ca[c]]
+        plane = np.empty((nfa + bfcount[cb[c]], 7))   # m (outward unit normal), f (face centre), m·n
+        npl = np.zeros(2, np.int64)
         for side in range(2):
             b = ca[c] if side == 0 else cb[c]
             for f in range(bfstart[b], bfstart[b] + bfcount[b]):
@@ -159,17 +174,33 @@ def subcontact_gaps(sc_contact, pos, ca, cb, cn, cgap, centroid, vpos, bfstart, 
                     my = -my
                     mz = -mz
                 mn = mx * n0 + my * n1 + mz * n2
-                if abs(mn) <= 1e-9:
+                if abs(mn) <= 1e-9 or (side == 0 and mn <= 0.0) or (side == 1 and mn >= 0.0):
                     continue
-                t = (mx * (fx - pos[s, 0]) + my * (fy - pos[s, 1]) + mz * (fz - pos[s, 2])) / mn
-                if side == 0 and mn > 0.0 and t < ta:
-                    ta = t
-                if side == 1 and mn < 0.0 and t > tb:
-                    tb = t
-        if ta == math.inf or tb == -math.inf:
-            out[s] = cgap[c]
-        else:
-            out[s] = tb - ta
+                k = npl[side] + (0 if side == 0 else nfa)
+                plane[k, 0] = mx
+                plane[k, 1] = my
+                plane[k, 2] = mz
+                plane[k, 3] = fx
+                plane[k, 4] = fy
+                plane[k, 5] = fz
+                plane[k, 6] = mn
+                npl[side] += 1
+        for s in range(first[r], first[r + 1]):
+            ta = math.inf
+            tb = -math.inf
+            for side in range(2):
+                k0 = 0 if side == 0 else nfa
+                for k in range(k0, k0 + npl[side]):
+                    t = (plane[k, 0] * (plane[k, 3] - pos[s, 0]) + plane[k, 1] * (plane[k, 4] - pos[s, 1]) +
+                         plane[k, 2] * (plane[k, 5] - pos[s, 2])) / plane[k, 6]
+                    if side == 0 and t < ta:
+                        ta = t
+                    if side == 1 and t > tb:
+                        tb = t
+            if ta == math.inf or tb == -math.inf:
+                out[s] = cgap[c]
+            else:
+                out[s] = tb - ta
 
 
 def _parallel_twin(kernel, name):
@@ -194,7 +225,7 @@ def threaded(kernel, n):
     return kernel
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, sgap,
                old_start, old_count, old_kind, old_key0, old_key1, old_area,
                old_fs, old_un, old_udil, old_us, old_state, old_n, new_n,
@@ -274,6 +305,53 @@ def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, sg
             fs[s, d] = rot[d] / atot * new_area[s]
         udil[s] = mdil / atot
         state[s] = st | ST_NEW
+
+
+@njit(cache=True, nogil=True)
+def gather_subcontacts(lo, hi, base, starts, counts, nold, old, new, out):
+    """The sub-contacts of contacts lo .. hi-1 of a detection, each taken from the old rows or the
+    new ones: contact c has counts[c] sub-contacts, written from row starts[c] of ``out`` and
+    read from row base[c] of the old rows followed by the new ones (base[c] ≥ nold: row
+    base[c] − nold of the new). Its rows in order, one contact after the other.
+
+    old: (kind, key0, key1, pos, area, fn, fs, un, udil, us, state), the old sub-contact arrays
+    (nold rows); new: the same without fn (a new sub-contact starts with fn 0); out: (contact,
+    kind, key0, key1, pos, area, fn, fs, un, udil, us, state), ``out[0][i]`` the contact of row i."""
+    o_kind, o_key0, o_key1, o_pos, o_area, o_fn, o_fs, o_un, o_udil, o_us, o_state = old
+    n_kind, n_key0, n_key1, n_pos, n_area, n_fs, n_un, n_udil, n_us, n_state = new
+    w_c, w_kind, w_key0, w_key1, w_pos, w_area, w_fn, w_fs, w_un, w_udil, w_us, w_state = out
+    for c in range(lo, hi):
+        for j in range(counts[c]):
+            i = starts[c] + j
+            r = base[c] + j
+            w_c[i] = c
+            if r < nold:
+                w_kind[i] = o_kind[r]
+                w_key0[i] = o_key0[r]
+                w_key1[i] = o_key1[r]
+                w_area[i] = o_area[r]
+                w_fn[i] = o_fn[r]
+                w_un[i] = o_un[r]
+                w_udil[i] = o_udil[r]
+                w_state[i] = o_state[r]
+                for d in range(3):
+                    w_pos[i, d] = o_pos[r, d]
+                    w_fs[i, d] = o_fs[r, d]
+                    w_us[i, d] = o_us[r, d]
+            else:
+                r -= nold
+                w_kind[i] = n_kind[r]
+                w_key0[i] = n_key0[r]
+                w_key1[i] = n_key1[r]
+                w_area[i] = n_area[r]
+                w_fn[i] = 0.0
+                w_un[i] = n_un[r]
+                w_udil[i] = n_udil[r]
+                w_state[i] = n_state[r]
+                for d in range(3):
+                    w_pos[i, d] = n_pos[r, d]
+                    w_fs[i, d] = n_fs[r, d]
+                    w_us[i, d] = n_us[r, d]
 
 
 @njit(cache=True)

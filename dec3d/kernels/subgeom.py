@@ -347,7 +347,7 @@ def _points(ci, c, p, q, ctol, point_area, vs, fvstart, fnvert, fverts, scratch,
     return k
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def subcontacts_batch(vpos, bvstart, bvcount, bfstart, bfcount, fvstart, fnvert, fverts,
                       ca, cb, cn, cc, ctol, point_area,
                       out_contact, out_kind, out_key0, out_key1, out_pos, out_area):

@@ -34,6 +34,8 @@ class Store:
         self._fields: dict[str, Field] = {}
         self._data: dict[str, np.ndarray] = {}
         self._capacity = max(1, int(capacity))
+        self._retired: dict[str, tuple[np.ndarray, int]] = {}   # arrays ``install`` replaced (and their rows in use)
+        self._dirty: dict[str, int] = {}
         for key, spec in fields.items():
             self.add_field(key, spec)
 
@@ -109,6 +111,54 @@ class Store:
             self._data[key][start:start + count] = spec.fill
         self.n = start + count
         return slice(start, start + count)
+
+    def blank(self, count: int, keys) -> dict[str, np.ndarray]:
+        """Arrays, not filled, for the fields ``keys`` of a store of ``count`` rows (the capacity
+        doubled as ``grow`` would until they fit), to be written and handed to ``install``: a
+        caller can build the new rows from the old ones without a copy. The arrays an earlier
+        ``install`` replaced are handed out again when their capacity fits (no new memory)."""
+        cap = self._capacity
+        while cap < count:
+            cap *= 2
+        out = {}
+        for key in keys:
+            spec = self._fields[key]
+            old, dirty = self._retired.pop(key, (None, 0))
+            if old is not None and old.shape == (cap, *spec.shape) and old.dtype == spec.dtype:
+                out[key] = old
+            else:
+                out[key] = np.empty((cap, *spec.shape), dtype=spec.dtype)
+                dirty = cap
+            self._dirty[key] = dirty        # rows from which on all are the fill value
+        return out
+
+    def install(self, count: int, arrays: dict[str, np.ndarray]) -> None:
+        """Make ``count`` rows live, the fields in ``arrays`` (from ``blank``, their first ``count``
+        rows written) taking those arrays; the other fields' rows and every spare row get the fill
+        value (as ``clear`` then ``append(count)``, without filling the rows given). The arrays
+        replaced are kept for the next ``blank``."""
+        count = int(count)
+        cap = self._capacity
+        while cap < count:
+            cap *= 2
+        for key, spec in self._fields.items():
+            arr = arrays.get(key)
+            if arr is None:
+                if cap == self._capacity:
+                    arr = self._data[key]
+                    arr[: max(count, self.n)] = spec.fill
+                else:
+                    arr = np.empty((cap, *spec.shape), dtype=spec.dtype)
+                    arr[...] = spec.fill
+            else:
+                if arr.shape != (cap, *spec.shape) or arr.dtype != spec.dtype:
+                    raise ValueError(f"store '{self.name}': field '{key}' needs shape {(cap, *spec.shape)} "
+                                     f"{np.dtype(spec.dtype)}, got {arr.shape} {arr.dtype}")
+                arr[count:self._dirty.pop(key, cap)] = spec.fill
+                self._retired[key] = (self._data[key], self.n)
+            self._data[key] = arr
+        self._capacity = cap
+        self.n = count
 
     def compact(self, keep: np.ndarray) -> np.ndarray:
         """Drop the live rows where ``keep`` is False, keeping order.

@@ -17,19 +17,25 @@ steps, default 10, and as soon as a block has moved CTOL/2 since the last one):
      a twin starts from its own gap (kernel ``contactmap.subcontact_gaps``).
   Pairs whose blocks have both moved less than QUIET·CTOL since they were last looked at
   keep their contact and sub-contacts as they are.
+On more than one thread (``model configure threads``) the sub-contacts are found chunk by
+chunk and gathered piece by piece on Python threads (``in_threads``, kernels compiled
+``nogil``), joined in their order: the same rows, bit for bit, as one thread.
 
 Contacts are oriented from the block with the lower id (A) to the higher (B) and sorted
 by (id A, id B); that key finds a contact again after blocks are deleted or cut.
 """
 from __future__ import annotations
 
+import threading
 import time as _time
 
 import numpy as np
+from numba import get_num_threads
 
 from dec3d.kernels.cellmap import cell_grid, cell_pairs, outside_grid
-from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, match_sorted,
-                                      subcontact_gaps, threaded, vertex_point_areas)
+from dec3d.kernels import contactmap as _cm
+from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, gather_subcontacts,
+                                      match_sorted, subcontact_gaps, threaded, vertex_point_areas)
 from dec3d.kernels.joints import NPROP
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.groups import group_field
@@ -92,6 +98,8 @@ SUBCONTACT_FIELDS = {
 #: since it was last looked at (dec3d's choice; areas and planes change by ~QUIET·CTOL/size)
 QUIET = 0.1
 
+#: the sub-contact fields a detection writes (``contactmap.gather_subcontacts``), in its order
+_GATHERED = ("contact", "kind", "key0", "key1", "pos", "area", "fn", "fs", "un", "udil", "us", "state")
 
 
 def contact_stores(model) -> tuple[Store, Store]:
@@ -110,8 +118,34 @@ def contact_stores(model) -> tuple[Store, Store]:
     return model.store("contacts"), model.store("subcontacts")
 
 
-def _subcontacts(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea):
-    """Sub-contacts of every contact (kernel ``subgeom.subcontacts_batch``, grown until it fits)."""
+def in_threads(work, nitems: int, nthreads: int) -> None:
+    """Call ``work(j)`` for j = 0 .. nitems-1 on ``nthreads`` threads (this one and nthreads-1
+    started here), each taking the next j when it is free. ``work`` calls kernels compiled with
+    ``nogil`` (they run side by side, outside numba's threading layer, and need no parallel
+    twin: nothing compiles again) and writes only its own results; the first error is raised."""
+    items = iter(range(nitems))     # (next() on a range iterator is atomic under the GIL)
+    errors = []
+
+    def loop():
+        try:
+            for j in items:
+                work(j)
+        except BaseException as exc:  # noqa: BLE001 - re-raised in the calling thread below
+            errors.append(exc)
+
+    extra = [threading.Thread(target=loop, daemon=True) for _ in range(min(nthreads, nitems) - 1)]
+    for t in extra:
+        t.start()
+    loop()
+    for t in extra:
+        t.join()
+    if errors:
+        raise errors[0]
+
+
+def _subcontacts_chunk(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea):
+    """Sub-contacts of the contacts (ra, rb, cn, cc) (kernel ``subgeom.subcontacts_batch``, its
+    output grown until it fits); contact indices local to these contacts."""
     cap = max(16, 8 * len(ra))
     while True:
         out = (np.empty(cap, _I), np.empty(cap, _I), np.empty(cap, _I), np.empty(cap, _I),
@@ -121,6 +155,35 @@ def _subcontacts(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea):
         if k <= cap:
             return tuple(a[:k] for a in out)
         cap = int(k)
+
+
+#: contacts per chunk are at least this many; a pass has about CHUNKS_PER_THREAD chunks per thread
+#: (threads that finish early take the next chunk: a busy core holds up less)
+CHUNK_MIN = 128
+CHUNKS_PER_THREAD = 4
+
+
+def _subcontacts(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea, nthreads=None):
+    """Sub-contacts of every contact, ordered by contact: from ``contactmap.PARALLEL_FROM`` contacts on
+    more than one thread the contacts are cut into chunks, each chunk's sub-contacts found on
+    its own (``_subcontacts_chunk``: the kernel keeps no state from one contact to the next) on
+    the threads side by side, and the chunks joined in their order: the same rows as one pass."""
+    n = len(ra)
+    nt = get_num_threads() if nthreads is None else nthreads
+    if n < _cm.PARALLEL_FROM or nt < 2:
+        return _subcontacts_chunk(vpos, b, f, fv, ra, rb, cn, cc, ctol, parea)
+    nchunk = int(min(nt * CHUNKS_PER_THREAD, max(nt, n // CHUNK_MIN)))
+    bounds = np.linspace(0, n, nchunk + 1).astype(_I)
+    parts = [None] * nchunk
+
+    def work(j):
+        lo, hi = bounds[j], bounds[j + 1]
+        parts[j] = _subcontacts_chunk(vpos, b, f, fv, ra[lo:hi], rb[lo:hi], cn[lo:hi], cc[lo:hi], ctol, parea)
+
+    in_threads(work, nchunk, nt)
+    for j in range(1, nchunk):
+        parts[j][0][...] += bounds[j]
+    return tuple(np.concatenate([p[i] for p in parts]) for i in range(6))
 
 
 def zoned_side_carries(sc_contact, kind, area, za, zb) -> None:
@@ -397,9 +460,12 @@ class ContactDetection:
         udil = np.empty(ns)
         us = np.empty((ns, 3))
         state = np.empty(ns, _I)
-        carry_over(f_prev, sc_c, kind, key0, key1, area, sgap, cs["sub_start"], cs["sub_count"], ss["kind"],
-                   ss["key0"], ss["key1"], ss["area"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"],
-                   cs["normal"], f_n, fs, un, udil, us, state)
+        olds = (cs["sub_start"], cs["sub_count"], ss["kind"], ss["key0"], ss["key1"], ss["area"], ss["fs"], ss["un"],
+                ss["udil"], ss["us"], ss["state"], cs["normal"], f_n)
+        nt = get_num_threads() if ns >= _cm.PARALLEL_FROM else 1
+        cut = np.linspace(0, ns, nt + 1).astype(_I)       # (each sub-contact's state is its own: rows apart)
+        in_threads(lambda j: carry_over(f_prev, *(x[cut[j]:cut[j + 1]] for x in (sc_c, kind, key0, key1, area, sgap)),
+                                        *olds, *(x[cut[j]:cut[j + 1]] for x in (fs, un, udil, us, state))), nt, nt)
         nf = len(fresh)
         f_count = np.bincount(sc_c, minlength=nf).astype(_I) if nf else np.zeros(0, _I)
         f_start = (np.cumsum(f_count) - f_count).astype(_I)
@@ -413,18 +479,19 @@ class ContactDetection:
         counts[~kept_c], base[~kept_c] = f_count[fi[~kept_c]], ss.n + f_start[fi[~kept_c]]
         starts = (np.cumsum(counts) - counts).astype(_I)
         total = int(counts.sum())
-        owner = np.repeat(np.arange(nc, dtype=_I), counts)
         # nothing recomputed and every old sub-contact kept in place (a quiet model): the rows
         # stay as they are (the gather below would copy each of them onto itself)
         same = nf == 0 and total == ss.n and np.array_equal(base, starts)
-        sub = {}
         if not same:
-            src = np.repeat(base - starts, counts) + np.arange(total, dtype=_I)
-            pool = {"kind": (ss["kind"], kind), "key0": (ss["key0"], key0), "key1": (ss["key1"], key1),
-                    "pos": (ss["pos"], pos), "area": (ss["area"], area), "fn": (ss["fn"], np.zeros(ns)),
-                    "fs": (ss["fs"], fs), "un": (ss["un"], un), "udil": (ss["udil"], udil), "us": (ss["us"], us),
-                    "state": (ss["state"], state)}
-            sub = {key: np.concatenate(pair)[src] for key, pair in pool.items()}
+            # straight into new arrays (the old rows are read from the store's own), installed below
+            gathered = ss.blank(total, _GATHERED)
+            old_rows = tuple(ss[key] for key in _GATHERED[1:])
+            new_rows = (kind, key0, key1, pos, area, fs, un, udil, us, state)
+            out = tuple(gathered[key] for key in _GATHERED)
+            nt = get_num_threads() if total >= _cm.PARALLEL_FROM else 1
+            cut = np.linspace(0, nc, nt + 1).astype(_I)
+            in_threads(lambda j: gather_subcontacts(cut[j], cut[j + 1], base, starts, counts, ss.n, old_rows, new_rows,
+                                                    out), nt, nt)
         self.timings["subcontacts"] += _time.perf_counter() - t1
         #: whether this detection kept every contact and sub-contact as it was, with the same
         #: properties (density scaling by body then keeps its masses: ``steps._Run.detected``)
@@ -432,18 +499,17 @@ class ContactDetection:
                                 and np.array_equal(prop, cs["prop"], equal_nan=True) and np.array_equal(jcode, cs["jmodel"]))
         # install
         self.detections += 1
-        cs.clear()
-        cs.append(nc)
-        for key, val in (("ida", ids[ra_c]), ("idb", ids[rb_c]), ("a", ra_c), ("b", rb_c), ("pos", cpos),
-                         ("normal", normal), ("gap", cgap), ("type", ctyp), ("jmodel", jcode), ("prop", prop),
-                         ("own_props", own), ("sub_start", starts), ("sub_count", counts), ("group", group)):
-            cs[key][...] = val
-        if not same:
-            ss.clear()
-            ss.append(total)
-        ss["contact"][...] = owner
-        for key, val in sub.items():
-            ss[key][...] = val
+        values = {"ida": ids[ra_c], "idb": ids[rb_c], "a": ra_c, "b": rb_c, "pos": cpos, "normal": normal,
+                  "gap": cgap, "type": ctyp, "jmodel": jcode, "prop": prop, "own_props": own, "sub_start": starts,
+                  "sub_count": counts, "group": group}
+        rows_new = cs.blank(nc, values)         # (the other fields get their fill value)
+        for key, val in values.items():
+            rows_new[key][:nc] = val
+        cs.install(nc, rows_new)
+        if same:
+            ss["contact"][...] = np.repeat(np.arange(nc, dtype=_I), counts)
+        else:
+            ss.install(total, gathered)
         # the blocks looked at are the new reference for "moved"
         if full:
             look[...] = vpos
