@@ -53,7 +53,7 @@ def body_row_sums(gid, gcen, rho, held, ca, cb, cn, kn, ks, sc_contact, sc_pos, 
     Two loops (``prange``; each item writes only its own rows, every sum in a fixed order): over
     the contacts, the row sums of the coupling block on either side; over the bodies, the
     diagonal block from the body's contacts in contact order. The blocks come in closed form from
-    the moments of each contact's sub-contact areas (``_moments``, ``_block``). (The per-item
+    the moments of each contact's sub-contact areas (``_moments``; ``_block``, ``_diag_add``). (The per-item
     code is written out in the loops: a helper taking a dozen arrays cost three times the work.)"""
     ng = gcen.shape[0]
     nc = ca.shape[0]
@@ -132,7 +132,6 @@ def body_row_sums(gid, gcen, rho, held, ca, cb, cn, kn, ks, sc_contact, sc_pos, 
         mom = np.empty(13)
         dx = np.empty(3)
         p = np.empty((3, 3))
-        blk = np.empty((6, 6))
         diag = np.empty((6, 6))
         orow = np.empty(6)
         for g in range(t * CHUNK, min(ng, (t + 1) * CHUNK)):
@@ -146,12 +145,13 @@ def body_row_sums(gid, gcen, rho, held, ca, cb, cn, kn, ks, sc_contact, sc_pos, 
                 _moments(s0, cstart[c + 1], sc_pos, sc_area, mom)
                 for i in range(3):
                     dx[i] = sc_pos[s0, i] - gcen[g, i]
-                _block(cn[c], kn[c], ks[c], mom, dx, dx, p, blk)
+                _diag_add(cn[c], kn[c], ks[c], mom, dx, p, diag)
                 side = 0 if gid[ca[c]] == g else 6
                 for i in range(6):
                     orow[i] += off[c, side + i]
-                    for j in range(6):
-                        diag[i, j] += blk[i, j]
+            for i in range(6):
+                for j in range(i):
+                    diag[i, j] = diag[j, i]
             tmax = 0.0
             rmax = 0.0
             for i in range(6):
@@ -273,6 +273,61 @@ def _block(n, kn, ks, mom, dx, dy, p, out):
                 vji = vij
             out[3 + i, 3 + j] = -vij
             out[3 + j, 3 + i] = -vji
+
+
+@njit(cache=True)
+def _diag_add(n, kn, ks, mom, d, p, diag):
+    """``_block`` with dx = dy = d added to diag (6, 6), on and above its diagonal only (the block
+    is symmetric: [u]× K₀ = (−K₀ [u]×)ᵀ, S and [n]× S [n]× symmetric). p (3, 3): scratch."""
+    A = mom[0]
+    e = kn - ks
+    u0 = mom[1] + A * d[0]
+    u1 = mom[2] + A * d[1]
+    u2 = mom[3] + A * d[2]
+    for i in range(3):
+        for j in range(i, 3):
+            diag[i, j] += A * (e * n[i] * n[j] + (ks if i == j else 0.0))
+    c0 = n[1] * u2 - n[2] * u1
+    c1 = n[2] * u0 - n[0] * u2
+    c2 = n[0] * u1 - n[1] * u0
+    diag[0, 3] -= e * n[0] * c0
+    diag[0, 4] -= -ks * u2 + e * n[0] * c1
+    diag[0, 5] -= ks * u1 + e * n[0] * c2
+    diag[1, 3] -= ks * u2 + e * n[1] * c0
+    diag[1, 4] -= e * n[1] * c1
+    diag[1, 5] -= -ks * u0 + e * n[1] * c2
+    diag[2, 3] -= -ks * u1 + e * n[2] * c0
+    diag[2, 4] -= ks * u0 + e * n[2] * c1
+    diag[2, 5] -= e * n[2] * c2
+    # S (symmetric) into p, then P = [n]× S column by column, then the upper part of P [n]×
+    s00 = mom[4] + 2.0 * mom[1] * d[0] + A * d[0] * d[0]
+    s01 = mom[5] + mom[1] * d[1] + d[0] * mom[2] + A * d[0] * d[1]
+    s02 = mom[6] + mom[1] * d[2] + d[0] * mom[3] + A * d[0] * d[2]
+    s11 = mom[8] + 2.0 * mom[2] * d[1] + A * d[1] * d[1]
+    s12 = mom[9] + mom[2] * d[2] + d[1] * mom[3] + A * d[1] * d[2]
+    s22 = mom[12] + 2.0 * mom[3] * d[2] + A * d[2] * d[2]
+    tr = s00 + s11 + s22
+    p[0, 0] = n[1] * s02 - n[2] * s01
+    p[1, 0] = n[2] * s00 - n[0] * s02
+    p[2, 0] = n[0] * s01 - n[1] * s00
+    p[0, 1] = n[1] * s12 - n[2] * s11
+    p[1, 1] = n[2] * s01 - n[0] * s12
+    p[2, 1] = n[0] * s11 - n[1] * s01
+    p[0, 2] = n[1] * s22 - n[2] * s12
+    p[1, 2] = n[2] * s02 - n[0] * s22
+    p[2, 2] = n[0] * s12 - n[1] * s02
+    q00 = p[0, 1] * n[2] - p[0, 2] * n[1]
+    q01 = p[0, 2] * n[0] - p[0, 0] * n[2]
+    q02 = p[0, 0] * n[1] - p[0, 1] * n[0]
+    q11 = p[1, 2] * n[0] - p[1, 0] * n[2]
+    q12 = p[1, 0] * n[1] - p[1, 1] * n[0]
+    q22 = p[2, 0] * n[1] - p[2, 1] * n[0]
+    diag[3, 3] -= ks * (s00 - tr) + e * q00
+    diag[3, 4] -= ks * s01 + e * q01
+    diag[3, 5] -= ks * s02 + e * q02
+    diag[4, 4] -= ks * (s11 - tr) + e * q11
+    diag[4, 5] -= ks * s12 + e * q12
+    diag[5, 5] -= ks * (s22 - tr) + e * q22
 
 
 def _parallel_twin(kernel, name):
