@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dec3d.kernels.bodyscale import body_row_sums
+from dec3d.kernels import bodyscale
 from dec3d.kernels.joints import P_KN, P_KS
 from dec3d.kernels.motion import block_timestep
 
@@ -98,8 +98,9 @@ class DensityScaling:
         held = (b["fixity"] | b["apply_fix"])[gmember[gstart[:-1]]].astype(_I)
         rt = np.zeros(ng)
         rr = np.zeros(ng)
-        body_row_sums(gid, gcen, rho, held, cs["a"], cs["b"], cs["normal"], np.ascontiguousarray(cs["prop"][:, P_KN]),
-                      np.ascontiguousarray(cs["prop"][:, P_KS]), ss["contact"], ss["pos"], ss["area"], rt, rr)
+        bodyscale.threaded(cs.n)(gid, gcen, rho, held, cs["a"], cs["b"], cs["normal"],
+                                 np.ascontiguousarray(cs["prop"][:, P_KN]), np.ascontiguousarray(cs["prop"][:, P_KS]),
+                                 ss["contact"], ss["pos"], ss["area"], rt, rr)
         if dt_fixed is None and s["scale_timestep"]:
             dt_fixed = float(s["scale_timestep"])
         on = rt > 0

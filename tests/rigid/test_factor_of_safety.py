@@ -147,12 +147,14 @@ def test_command_finds_the_incline_factor_and_stores_it(session, tmp_path):
     assert "model factor-of-safety: FS = " in session.output.getvalue()
     vtu = (tmp_path / "fos_mechanism.vtu").read_text()
     assert 'Name="velocity"' in vtu
-    # the mechanism is the block sliding downslope (+x)
+    # the mechanism is the block sliding downslope (+x); its out-of-plane part grows from round-off
+    # as the block rocks: one-ulp changes of the body scaling's row sums gave |v_y| / v_x from 4e-6
+    # to 1.9e-3 (14 trials), hence 1e-2
     import meshio
 
     mesh = meshio.read(tmp_path / "fos_mechanism.vtu")
     v = mesh.point_data["velocity"]
-    assert v[:, 0].max() > 1e-3 and abs(v[:, 1]).max() < 1e-3 * v[:, 0].max()
+    assert v[:, 0].max() > 1e-3 and abs(v[:, 1]).max() < 1e-2 * v[:, 0].max()
     # a second search is fos.2; the model is as before the first
     step = session.model.step
     _run(session, "model factor-of-safety bracket 1.3 1.6 resolution 0.05 cycles 3000\n")
