@@ -203,3 +203,18 @@ def test_zone_bench_mohr_coulomb_case_runs_beside_the_elastic_one():
     assert ratio.startswith("MC / elastic zone-cycles/s:") and "target >= 0.5" in ratio
     got = float(ratio.split(":")[1].split()[0])
     assert got == pytest.approx(float(mc[6]) / float(el[6]), abs=0.01 + 1e-3 * got)
+
+
+def test_static_scenes_bench_reaches_the_static_answer_of_a_small_scene():
+    """bench/static_scenes.py on the 0.1 m cube on a 1 m cube, default and Eq. 87 scaling: both
+    converge, and the small cube's centroid ends where the joints' elastic closure puts it
+    (z = 1.05 m less the two contacts' closures, ρ g h / kn each: well under 0.1 mm)."""
+    sys.path.insert(0, str(ROOT / "bench"))
+    try:
+        import static_scenes as ss
+    finally:
+        sys.path.pop(0)
+    for setup in ("default", "eq87"):
+        r = ss.run("mix", setup, 1e-5)
+        assert r["converged"] and 0 < r["steps"] < 20000
+        assert r["z"][1] == pytest.approx(1.05, abs=1e-4) and r["z"][0] == pytest.approx(0.5, abs=1e-4)
