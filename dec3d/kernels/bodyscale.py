@@ -31,6 +31,8 @@ from __future__ import annotations
 import numpy as np
 from numba import get_num_threads, njit, prange
 
+from .contactmap import parallel_twin
+
 #: the parallel twin (``body_row_sums_parallel``) from this many contacts on more than one thread
 #: (``threaded``): below, the pass is over before the other threads wake up, and the serial kernel
 #: alone is compiled (a cold start: a parallel kernel takes about three times as long)
@@ -330,17 +332,7 @@ def _diag_add(n, kn, ks, mom, d, p, diag):
     diag[5, 5] -= ks * (s22 - tr) + e * q22
 
 
-def _parallel_twin(kernel, name):
-    """``kernel`` compiled with ``parallel`` under its own name (numba caches it in its own file)."""
-    f = getattr(kernel, "py_func", kernel)         # (a plain function when the JIT is disabled)
-    g = type(f)(f.__code__, f.__globals__, name, f.__defaults__, f.__closure__)
-    g.__qualname__ = name
-    g.__module__ = f.__module__
-    g.__doc__ = f"``{f.__name__}`` with its ``prange`` loops in parallel."
-    return njit(cache=True, parallel=True)(g)
-
-
-body_row_sums_parallel = _parallel_twin(body_row_sums, "body_row_sums_parallel")
+body_row_sums_parallel = parallel_twin(body_row_sums, "body_row_sums_parallel")
 
 
 def threaded(nc):

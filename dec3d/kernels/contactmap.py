@@ -203,18 +203,19 @@ def subcontact_gaps(sc_contact, pos, ca, cb, cn, cgap, centroid, vpos, bfstart, 
                 out[s] = tb - ta
 
 
-def _parallel_twin(kernel, name):
-    """``kernel`` compiled with ``parallel`` under its own name (numba caches it in its own file)."""
+def parallel_twin(kernel, name):
+    """``kernel`` compiled with ``parallel`` under its own name (numba caches it in its own file;
+    also ``bodyscale``'s)."""
     f = getattr(kernel, "py_func", kernel)         # (a plain function when the JIT is disabled)
     g = type(f)(f.__code__, f.__globals__, name, f.__defaults__, f.__closure__)
     g.__qualname__ = name
     g.__module__ = f.__module__
-    g.__doc__ = f"``{f.__name__}`` with its ``prange`` loop in parallel."
+    g.__doc__ = f"``{f.__name__}`` with its ``prange`` loops in parallel."
     return njit(cache=True, parallel=True)(g)
 
 
-cp_batch_parallel = _parallel_twin(cp_batch, "cp_batch_parallel")
-subcontact_gaps_parallel = _parallel_twin(subcontact_gaps, "subcontact_gaps_parallel")
+cp_batch_parallel = parallel_twin(cp_batch, "cp_batch_parallel")
+subcontact_gaps_parallel = parallel_twin(subcontact_gaps, "subcontact_gaps_parallel")
 
 
 def threaded(kernel, n):

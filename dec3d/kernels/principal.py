@@ -160,6 +160,13 @@ def _values(d0, d1, d2, s3, s4, s5, j2, r):
     return lo, -lo - hi, hi
 
 
+@njit(cache=True, inline="always")
+def dev_square(d0, d1, d2, a3, a4, a5):
+    """Q = D² of the symmetric tensor D = (d0 d1 d2 a3 a4 a5) (xx yy zz xy xz yz), same order."""
+    return (d0 * d0 + a3 * a3 + a4 * a4, a3 * a3 + d1 * d1 + a5 * a5, a4 * a4 + a5 * a5 + d2 * d2,
+            d0 * a3 + a3 * d1 + a4 * a5, d0 * a4 + a3 * a5 + a4 * d2, a3 * a4 + d1 * a5 + a5 * d2)
+
+
 #: closed-form principal axes (``principal_axes``) when both gaps between the principal values are
 #: at least this fraction of their spread; closer (nearly repeated) values go to Jacobi
 GAP_REL = 0.02
@@ -178,13 +185,7 @@ def principal_axes(s, lam, pr, vec):
     if l3 - l1 > 0.0 and min(l2 - l1, l3 - l2) >= GAP_REL * (l3 - l1):
         d0, d1, d2 = _deviator(s[0], s[1], s[2])
         a3 = s[3]; a4 = s[4]; a5 = s[5]
-        # Q = D²
-        q0 = d0 * d0 + a3 * a3 + a4 * a4
-        q1 = a3 * a3 + d1 * d1 + a5 * a5
-        q2 = a4 * a4 + a5 * a5 + d2 * d2
-        q3 = d0 * a3 + a3 * d1 + a4 * a5
-        q4 = d0 * a4 + a3 * a5 + a4 * d2
-        q5 = a3 * a4 + d1 * a5 + a5 * d2
+        q0, q1, q2, q3, q4, q5 = dev_square(d0, d1, d2, a3, a4, a5)
         # P1 = (Q - (l2 + l3) D + l2 l3 I) / ((l1 - l2)(l1 - l3)), P3 likewise
         b = l2 + l3; c = l2 * l3; f = 1.0 / ((l1 - l2) * (l1 - l3))
         pr[0] = (q0 - b * d0 + c) * f; pr[1] = (q1 - b * d1 + c) * f; pr[2] = (q2 - b * d2 + c) * f

@@ -44,7 +44,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .principal import _THIRD, GAP_REL, _deviator, _dev_principal, _invariants, _values, principal_axes
+from .principal import _THIRD, GAP_REL, _deviator, _dev_principal, _invariants, _values, dev_square, principal_axes
 from .zones import hooke_increment, tet_add_forces, tet_kinematics
 
 # mirrors of dec3d.model.zones
@@ -263,12 +263,7 @@ def _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, coh, npf, csn, ft, nps, 
         return -1, s0, s1, s2, s3, s4, s5, 0.0
     # projectors P1, P3 (``principal_axes``' formulas) and the rotation back (``_rotate_back``)
     d0, d1, d2 = _deviator(s0, s1, s2)
-    q0 = d0 * d0 + s3 * s3 + s4 * s4
-    q1 = s3 * s3 + d1 * d1 + s5 * s5
-    q2 = s4 * s4 + s5 * s5 + d2 * d2
-    q3 = d0 * s3 + s3 * d1 + s4 * s5
-    q4 = d0 * s4 + s3 * s5 + s4 * d2
-    q5 = s3 * s4 + d1 * s5 + s5 * d2
+    q0, q1, q2, q3, q4, q5 = dev_square(d0, d1, d2, s3, s4, s5)
     # (both denominators from one division: it is on the path of every yielding zone)
     e1 = n1 - p1; e2 = n2 - p2; e3 = n3 - p3
     den1 = (l1 - l2) * (l1 - l3)
