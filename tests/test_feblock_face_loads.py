@@ -169,3 +169,31 @@ model solve ratio 1e-8""")
     assert len(top) == 21
     ref = 1e6 * (2 / 1.2e9 + 1 / 1e10)
     assert np.abs(-v["disp"][top, 2] / ref - 1).max() < 0.01
+
+
+def test_table_driven_face_stress_loads_an_fe_face_as_the_fixed_one(tmp_path):
+    """`block face apply stress … table` on an FE face takes the consistent face loads too: at
+    multiplier 1 the table-driven nodal forces (``quiet.dynamic_face_loads``) are those of the
+    same fixed stress (-A sigma/12 at the corners, A sigma/3 at the mid-edge nodes), not thirds of
+    the eight triangles (0 at the corners, A/4 at the mid-edge nodes)."""
+    from dec3d.model.quiet import dynamic_face_loads
+
+    s = _session(tmp_path)
+    s.command("""model configure feblock
+block create brick 0 2 0 1 0 1
+feblock generate 2 1 1
+table 1 add (0, 1) (10, 1)
+block face apply stress -1e5 0 0 2e4 0 0 table 1 range position-x 2""")
+    v = s.model.vertices
+    (_x, _y, rows, force), = dynamic_face_loads(s.model)
+    got = np.zeros((v.n, 3))
+    got[rows] = force
+    t = np.array([-1e5, 2e4, 0.0])
+    on = np.abs(v["pos"][:, 0] - 2) < 1e-9
+    master = on & ~v["feslave"]
+    corner = master & (np.abs(v["pos"][:, 1] - 0.5) > 0.25) & (np.abs(v["pos"][:, 2] - 0.5) > 0.25)
+    mid = master & ~corner
+    assert np.allclose(got[corner], -t / 12, atol=1e-9) and np.allclose(got[mid], t / 3, atol=1e-9)
+    assert not got[~master].any()
+    s.command("block face apply stress -1e5 0 0 2e4 0 0 range position-x 2")
+    assert np.allclose(got, v["fface"], atol=1e-9)

@@ -27,7 +27,10 @@ index of its table (``faces.fdyn_tab``, −1 none) in ``settings.mechanical["fac
 of ``{"id", "x", "y"}``: the table's points as they were when the command ran, so a save file
 holds everything the run needs. A face carries one table-driven stress (more of the same table
 add). The input stress of a wave on a quiet base is 2ρC_s v (shear) or 2ρC_p v (normal) for an
-incident velocity v (3DEC 7 documentation, "Application of Dynamic Input", Eqs. 1-2).
+incident velocity v (3DEC 7 documentation, "Application of Dynamic Input", Eqs. 1-2). On an FE
+element face it loads the nodes as a fixed stress does (``face_shares(consistent_fe=True)``, the
+8-node face's ∫ N_a σ n dA); a quiet FE face keeps the thirds of its triangles: the consistent
+shares are negative at the corners of a flat face, and a dashpot there would push.
 """
 from __future__ import annotations
 
@@ -35,7 +38,7 @@ import numpy as np
 
 from dec3d.errors import Dec3dError
 
-from .face_loads import _TRI6, _hex_quads, _lookup, _triangle_nodes, _tri6_faces, loadable_faces
+from .face_loads import _TRI6, _fe_faces, _hex_quads, _lookup, _triangle_nodes, _tri6_faces, loadable_faces
 from .model import KIND_FE
 from .store import Field
 from .zones import ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
@@ -63,18 +66,33 @@ def _ensure(model) -> None:
 
 # ------------------------------------------------------------------ area shares
 
-def face_shares(model, rows: np.ndarray, key: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def face_shares(model, rows: np.ndarray, key: np.ndarray,
+                consistent_fe: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """How the faces ``rows`` (triangles) load their gridpoints: (face index into ``rows`` (k,),
     vertex row (k,), area-vector share (k, 3)); a uniform stress σ on the faces gives the nodal
     forces σ·share (what ``face_loads.recompute_fface`` does). Faces are taken together as a
     hexahedral zone's quadrilateral or a 10-node zone's 6-node triangle only when their rows of
-    ``key`` (k, m) are equal."""
+    ``key`` (k, m) are equal; with ``consistent_fe`` (stresses), the eight triangles of an FE
+    element face as that face, shares ∫ N_a n dA (``feblock_shape.face_stress_loads`` with σ = I;
+    −A/12 at the corners of a flat parallelogram face, so not for dashpots)."""
     v = model.vertices
     nodes = _triangle_nodes(model, rows)
     p = v["pos"][nodes]
     an = 0.5 * np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])          # outward normal times area
     fi, nd, sh = [], [], []
     thirds = np.ones(len(rows), bool)
+    quads, fmem = _fe_faces(model, nodes, key) if consistent_fe else (np.zeros((0, 8), _I), None)
+    if len(quads):
+        from dec3d.kernels.feblock_shape import face_stress_loads
+        thirds[fmem.ravel()] = False
+        g = len(quads)
+        share = np.zeros((8 * g, 3))
+        face_stress_loads(np.ascontiguousarray(v["pos"][quads].reshape(-1, 3)), np.arange(8 * g, dtype=_I).reshape(g, 8),
+                          np.tile(np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0]), (g, 1)), share)
+        for a in range(8):
+            fi.append(fmem[:, 0])
+            nd.append(quads[:, a])
+            sh.append(share[a::8])
     tri6, members = _tri6_faces(model, nodes, key)
     if len(tri6):
         thirds[members.ravel()] = False
@@ -321,7 +339,7 @@ def dynamic_face_loads(model) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, 
             continue
         rows = np.flatnonzero(f["fdyn_tab"][: f.n] == j)
         s = f["fdyn"][rows]
-        fi, node, share = face_shares(model, rows, s)
+        fi, node, share = face_shares(model, rows, s, consistent_fe=True)
         sig = np.empty((len(rows), 3, 3))
         sig[:, 0, 0], sig[:, 1, 1], sig[:, 2, 2] = s[:, 0], s[:, 1], s[:, 2]
         sig[:, 0, 1] = sig[:, 1, 0] = s[:, 3]
