@@ -324,12 +324,13 @@ class ContactDetection:
         v = m.vertices
         vpos, mpos = v["pos"], v["map_pos"]
         have = s.get("grid") is not None and len(vpos) > 0
+        if have and not force and self._cand is None:    # after a restore: the same pairs from the saved map
+            g = s["grid"]
+            self._cand, _ = self._pairs(mpos, ctol, (np.array(g[0]), float(g[1]), np.array(g[2], _I)))
         if have and not force and float(np.abs(vpos - mpos).max()) <= 0.5 * ctol:
-            if self._cand is None:       # after a restore: the same pairs from the saved map
-                g = s["grid"]
-                self._cand, _ = self._pairs(mpos, ctol, (np.array(g[0]), float(g[1]), np.array(g[2], _I)))
             return self._cand, False
         t0 = _time.perf_counter()
+        self._cand_before = self._cand           # (detect looks at the pairs that are new candidates)
         g = s.get("grid")
         grid = None if (g is None or force) else (np.array(g[0]), float(g[1]), np.array(g[2], _I))
         m.blocks["map_reach"][...] = self._step_motion()
@@ -346,8 +347,8 @@ class ContactDetection:
         ``QUIET`` × CTOL (largest vertex displacement) since they were last looked at keeps
         its contact and sub-contacts as they are (their points still follow Eq. 11 every
         step); every other pair gets a new common plane and new sub-contacts. After a
-        remap of the cell space, a change of the blocks, or with ``force_search``, every
-        pair is looked at.
+        remap of the cell space the pairs that were not candidates before are looked at
+        too; after a change of the blocks, or with ``force_search``, every pair is.
         """
         t0 = _time.perf_counter()
         m = self.model
@@ -359,17 +360,28 @@ class ContactDetection:
         ctol = self.tolerance()
         vpos = m.vertices["pos"]
         look = m.vertices["look_pos"]
-        (ra, rb), remapped = self._search(ctol, force_search or changed)
-        full = force_search or changed or remapped
+        geometry = force_search or changed
+        self._cand_before = None
+        (ra, rb), remapped = self._search(ctol, geometry)
+        ids = b["id"]
+        # after a remap alone (the blocks as they were) only the pairs that are new candidates are
+        # looked at besides those of moved blocks: a pair that was a candidate before was looked at
+        # when its blocks were last, and those have moved less than QUIET·CTOL since
+        before = self._cand_before
+        full = geometry or (remapped and before is None)
         if full:
             moved = np.ones(b.n, bool)
         else:
             moved = np.zeros(b.n, bool)
             blocks_moved(vpos, look, b["vert_start"], b["vert_count"], QUIET * ctol, moved)
-        ids = b["id"]
         prev = match_sorted(cs["ida"], cs["idb"], ids[ra], ids[rb])
-        need = np.flatnonzero(moved[ra] | moved[rb])
+        look_at = moved[ra] | moved[rb]
+        if remapped and not full:
+            look_at |= match_sorted(ids[before[0]], ids[before[1]], ids[ra], ids[rb]) < 0
+        need = np.flatnonzero(look_at)
         k = len(need)
+        #: candidate pairs the last detection looked at again (common plane and sub-contacts anew)
+        self.looked_at = k
         if not full and k == 0 and self._as_they_are(ra, rb, prev):
             # nothing to look at again and every contact kept in place: all the install below would
             # change is the properties of contacts that follow the defaults (a quiet model's
@@ -394,7 +406,7 @@ class ContactDetection:
         # the contacts: quiet old contacts as they were, looked-at pairs with gap ≤ CTOL
         is_new = np.zeros(len(ra), bool)
         is_new[need[ctype > 0]] = True
-        kept = (prev >= 0) & ~(moved[ra] | moved[rb])
+        kept = (prev >= 0) & ~look_at
         rows = np.flatnonzero(kept | is_new)
         local = np.full(len(ra), -1, _I)
         local[need] = np.arange(k)
