@@ -26,6 +26,7 @@ by (id A, id B); that key finds a contact again after blocks are deleted or cut.
 """
 from __future__ import annotations
 
+import os
 import threading
 import time as _time
 
@@ -34,12 +35,12 @@ from numba import get_num_threads
 
 from dec3d.kernels.cellmap import cell_grid, cell_pairs, outside_grid
 from dec3d.kernels import contactmap as _cm
-from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, gather_subcontacts,
+from dec3d.kernels.contactmap import (add_turns, blocks_moved, carry_over, cp_batch, envelopes, gather_subcontacts,
                                       match_sorted, subcontact_gaps, threaded, vertex_point_areas)
 from dec3d.kernels.joints import NPROP
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.groups import group_field
-from dec3d.model.model import KIND_DEFORMABLE, KIND_FE
+from dec3d.model.model import KIND_DEFORMABLE, KIND_FE, KIND_RIGID
 from dec3d.model.ranges import pairs_in_groups
 from dec3d.model.store import Field, Store
 
@@ -69,6 +70,11 @@ CONTACT_FIELDS = {
     "gp_b": Field((3,), _I, -1),
     "gw_b": Field((3,), _F, 0.0),
     "group": group_field(),
+    # when the contact was last computed: its blocks' centroids [m] and turns (block field ``turn``) [m]
+    "ref_ca": Field((3,), _F, 0.0),
+    "ref_cb": Field((3,), _F, 0.0),
+    "ref_ta": Field((), _F, 0.0),
+    "ref_tb": Field((), _F, 0.0),
 }
 
 SUBCONTACT_FIELDS = {
@@ -98,23 +104,28 @@ SUBCONTACT_FIELDS = {
 #: since it was last looked at (dec3d's choice; areas and planes change by ~QUIET·CTOL/size)
 QUIET = 0.1
 
+#: rigid-rigid contacts follow the relative rule (``detect``); off for now (a settling stack then keeps all
+#: its contacts: test_detect_threads' gather check gets one detection), on with DEC3D_DETECT_RELATIVE=1
+RELATIVE = os.environ.get("DEC3D_DETECT_RELATIVE", "0") == "1"
+
 #: the sub-contact fields a detection writes (``contactmap.gather_subcontacts``), in its order
 _GATHERED = ("contact", "kind", "key0", "key1", "pos", "area", "fn", "fs", "un", "udil", "us", "state")
 
 
 def contact_stores(model) -> tuple[Store, Store]:
-    """The ``contacts`` and ``subcontacts`` stores, made on first use, with the detection
-    bookkeeping fields of vertices (``map_pos``, ``look_pos``) and blocks (``map_reach``)."""
+    """The ``contacts`` and ``subcontacts`` stores, made on first use, with the detection bookkeeping
+    fields of vertices (``map_pos``, ``look_pos``, ``turn_pos``), blocks (``map_reach``, ``turn[_cen]``)."""
     stores = model.stores
     if "contacts" not in stores:
         model.add_store(Store("contacts", CONTACT_FIELDS, capacity=64))
     if "subcontacts" not in stores:
         model.add_store(Store("subcontacts", SUBCONTACT_FIELDS, capacity=256))
-    for key in ("map_pos", "look_pos"):
+    for key in ("map_pos", "look_pos", "turn_pos"):
         if key not in model.vertices:
             model.vertices.add_field(key, Field((3,), _F, 0.0))
-    if "map_reach" not in model.blocks:
-        model.blocks.add_field("map_reach", Field((), _F, 0.0))
+    for key, shape in (("map_reach", ()), ("turn", ()), ("turn_cen", (3,))):
+        if key not in model.blocks:
+            model.blocks.add_field(key, Field(shape, _F, 0.0))
     return model.store("contacts"), model.store("subcontacts")
 
 
@@ -324,12 +335,13 @@ class ContactDetection:
         v = m.vertices
         vpos, mpos = v["pos"], v["map_pos"]
         have = s.get("grid") is not None and len(vpos) > 0
+        if have and not force and self._cand is None:    # after a restore: the same pairs from the saved map
+            g = s["grid"]
+            self._cand, _ = self._pairs(mpos, ctol, (np.array(g[0]), float(g[1]), np.array(g[2], _I)))
         if have and not force and float(np.abs(vpos - mpos).max()) <= 0.5 * ctol:
-            if self._cand is None:       # after a restore: the same pairs from the saved map
-                g = s["grid"]
-                self._cand, _ = self._pairs(mpos, ctol, (np.array(g[0]), float(g[1]), np.array(g[2], _I)))
             return self._cand, False
         t0 = _time.perf_counter()
+        self._cand_before = self._cand           # (detect looks at the pairs that are new candidates)
         g = s.get("grid")
         grid = None if (g is None or force) else (np.array(g[0]), float(g[1]), np.array(g[2], _I))
         m.blocks["map_reach"][...] = self._step_motion()
@@ -339,15 +351,29 @@ class ContactDetection:
         self.timings["search"] += _time.perf_counter() - t0
         return self._cand, True
 
+    def _turned(self, changed: bool) -> np.ndarray:
+        """Block field ``turn`` [m] brought up to now (``contactmap.add_turns``; blocks changed: only
+        the references are set)."""
+        b, v = self.model.blocks, self.model.vertices
+        if not changed:
+            add_turns(b["turn"], v["turn_pos"], b["turn_cen"], v["pos"], b["centroid"], v["block"])
+        v["turn_pos"][...] = v["pos"]
+        b["turn_cen"][...] = b["centroid"]
+        return b["turn"]
+
     def detect(self, force_search: bool = False) -> None:
         """Find the contacts and their sub-contacts again, keeping the force history.
 
         Incremental: a candidate pair whose two blocks have each moved less than
         ``QUIET`` × CTOL (largest vertex displacement) since they were last looked at keeps
         its contact and sub-contacts as they are (their points still follow Eq. 11 every
-        step); every other pair gets a new common plane and new sub-contacts. After a
-        remap of the cell space, a change of the blocks, or with ``force_search``, every
-        pair is looked at.
+        step); every other pair gets a new common plane and new sub-contacts. With ``RELATIVE``
+        a contact between two rigid blocks follows the relative rule instead: it is kept while
+        |Δc_B − Δc_A| + Δturn_A + Δturn_B < QUIET × CTOL since it was computed (centroid
+        displacements and turns, ``_turned``: the normal is not turned between detections,
+        so blocks turning together have theirs recomputed). After a
+        remap of the cell space the pairs that were not candidates before are looked at
+        too; after a change of the blocks, or with ``force_search``, every pair is.
         """
         t0 = _time.perf_counter()
         m = self.model
@@ -359,17 +385,35 @@ class ContactDetection:
         ctol = self.tolerance()
         vpos = m.vertices["pos"]
         look = m.vertices["look_pos"]
-        (ra, rb), remapped = self._search(ctol, force_search or changed)
-        full = force_search or changed or remapped
+        geometry, self._cand_before = force_search or changed, None
+        (ra, rb), remapped = self._search(ctol, geometry)
+        turn = self._turned(changed)
+        cen = b["centroid"]
+        ids = b["id"]
+        # after a remap alone, the pairs that were candidates before follow the rules below as well
+        before = self._cand_before
+        full = geometry or (remapped and before is None)
         if full:
             moved = np.ones(b.n, bool)
         else:
             moved = np.zeros(b.n, bool)
             blocks_moved(vpos, look, b["vert_start"], b["vert_count"], QUIET * ctol, moved)
-        ids = b["id"]
         prev = match_sorted(cs["ida"], cs["idb"], ids[ra], ids[rb])
-        need = np.flatnonzero(moved[ra] | moved[rb])
+        look_at = moved[ra] | moved[rb]
+        if RELATIVE and not full:
+            # contacts between rigid blocks: kept while their blocks moved little relative to each other
+            rigid = b["kind"] == KIND_RIGID
+            rel = np.flatnonzero((prev >= 0) & rigid[ra] & rigid[rb])
+            p, a_, b_ = prev[rel], ra[rel], rb[rel]
+            drift = (np.linalg.norm((cen[b_] - cs["ref_cb"][p]) - (cen[a_] - cs["ref_ca"][p]), axis=1)
+                     + (turn[a_] - cs["ref_ta"][p]) + (turn[b_] - cs["ref_tb"][p]))
+            look_at[rel] = ~(drift < QUIET * ctol)
+        if remapped and not full:
+            look_at |= match_sorted(ids[before[0]], ids[before[1]], ids[ra], ids[rb]) < 0
+        need = np.flatnonzero(look_at)
         k = len(need)
+        #: candidate pairs the last detection looked at again (common plane and sub-contacts anew)
+        self.looked_at = k
         if not full and k == 0 and self._as_they_are(ra, rb, prev):
             # nothing to look at again and every contact kept in place: all the install below would
             # change is the properties of contacts that follow the defaults (a quiet model's
@@ -394,7 +438,7 @@ class ContactDetection:
         # the contacts: quiet old contacts as they were, looked-at pairs with gap ≤ CTOL
         is_new = np.zeros(len(ra), bool)
         is_new[need[ctype > 0]] = True
-        kept = (prev >= 0) & ~(moved[ra] | moved[rb])
+        kept = (prev >= 0) & ~look_at
         rows = np.flatnonzero(kept | is_new)
         local = np.full(len(ra), -1, _I)
         local[need] = np.arange(k)
@@ -410,6 +454,9 @@ class ContactDetection:
         ctyp = np.empty(nc, _I)
         normal[kept_c], cpos[kept_c], cgap[kept_c], ctyp[kept_c] = (cs["normal"][p_k], cs["pos"][p_k],
                                                                    cs["gap"][p_k], cs["type"][p_k])
+        ref_ca, ref_cb, ref_ta, ref_tb = cen[ra_c], cen[rb_c], turn[ra_c], turn[rb_c]
+        ref_ca[kept_c], ref_cb[kept_c], ref_ta[kept_c], ref_tb[kept_c] = (cs["ref_ca"][p_k], cs["ref_cb"][p_k],
+                                                                          cs["ref_ta"][p_k], cs["ref_tb"][p_k])
         lf = lc[~kept_c]
         normal[~kept_c], cpos[~kept_c], cgap[~kept_c], ctyp[~kept_c] = nn[lf], cc[lf], gap[lf], ctype[lf]
         # contact data carried by the pair key, or the defaults for a new contact
@@ -501,7 +548,8 @@ class ContactDetection:
         self.detections += 1
         values = {"ida": ids[ra_c], "idb": ids[rb_c], "a": ra_c, "b": rb_c, "pos": cpos, "normal": normal,
                   "gap": cgap, "type": ctyp, "jmodel": jcode, "prop": prop, "own_props": own, "sub_start": starts,
-                  "sub_count": counts, "group": group}
+                  "sub_count": counts, "group": group, "ref_ca": ref_ca, "ref_cb": ref_cb, "ref_ta": ref_ta,
+                  "ref_tb": ref_tb}
         rows_new = cs.blank(nc, values)         # (the other fields get their fill value)
         for key, val in values.items():
             rows_new[key][:nc] = val

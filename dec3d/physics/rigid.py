@@ -394,7 +394,7 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
         b, v = m.blocks, m.vertices
         hs = getattr(m, "history_set", None)
         return {"blocks": {k: b[k].copy() for k in b.fields},
-                "vertices": {k: v[k].copy() for k in ("pos", "map_pos", "look_pos")
+                "vertices": {k: v[k].copy() for k in ("pos", "map_pos", "look_pos", "turn_pos")
                              + (_GP_STATE if _has_gridpoints(m) else ()) if k in v},
                 "zones": ({k: m.store("zones")[k].copy() for k in ("stress", "gstress", "volume", "state")}
                           if has_zones(m) else {}),
