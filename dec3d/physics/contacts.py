@@ -26,7 +26,6 @@ by (id A, id B); that key finds a contact again after blocks are deleted or cut.
 """
 from __future__ import annotations
 
-import os
 import threading
 import time as _time
 
@@ -104,9 +103,9 @@ SUBCONTACT_FIELDS = {
 #: since it was last looked at (dec3d's choice; areas and planes change by ~QUIET·CTOL/size)
 QUIET = 0.1
 
-#: rigid-rigid contacts follow the relative rule (``detect``); off for now (a settling stack then keeps all
-#: its contacts: test_detect_threads' gather check gets one detection), on with DEC3D_DETECT_RELATIVE=1
-RELATIVE = os.environ.get("DEC3D_DETECT_RELATIVE", "0") == "1"
+#: contacts between rigid blocks follow the relative rule (``detect``): kept while their blocks have
+#: moved (and turned) less than QUIET·CTOL relative to each other (a stack settling or sliding as one)
+RELATIVE = True
 
 #: the sub-contact fields a detection writes (``contactmap.gather_subcontacts``), in its order
 _GATHERED = ("contact", "kind", "key0", "key1", "pos", "area", "fn", "fs", "un", "udil", "us", "state")

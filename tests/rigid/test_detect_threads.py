@@ -188,9 +188,10 @@ def test_store_blank_and_install_are_clear_then_append_without_the_fill():
 
 @TWO
 def test_a_detection_on_two_threads_installs_the_rows_of_one(monkeypatch, restore_threads):
-    """The 6 x 6 x 6 stack cycled 60 steps (detections with old and new sub-contacts to gather)
-    on one thread and on two with every chunk and piece small: every contact and sub-contact
-    array and every vertex equal bit for bit."""
+    """The 6 x 6 x 6 stack cycled 60 steps sliding on its base (set off at 0.5 m/s along x):
+    detections with old (kept: the stack's blocks move together) and new (the
+    base contacts) sub-contacts to gather; on one thread and on two with every chunk and piece
+    small: every contact and sub-contact array and every vertex equal bit for bit."""
     states = []
     for threads in (1, 2):
         config.set_threads(threads)
@@ -200,7 +201,7 @@ def test_a_detection_on_two_threads_installs_the_rows_of_one(monkeypatch, restor
         lines = ["model new", "block create brick 0 6 0 6 -1 0"] + [
             f"block create brick {i} {i + 1} {j} {j + 1} {k} {k + 1}"
             for i in range(6) for j in range(6) for k in range(6)]
-        s.command("\n".join(lines + PROPS + ["model cycle 60"]) + "\n")
+        s.command("\n".join(lines + PROPS + ["block initialize velocity-x 0.5 range position-z 0 6", "model cycle 60"]) + "\n")
         m = s.model
         out = {"pos": np.array(m.vertices["pos"])}
         for st in ("contacts", "subcontacts"):
