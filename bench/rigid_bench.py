@@ -228,7 +228,17 @@ def main() -> int:
     args = ap.parse_args()
     setup = "".join(line.strip() + "\n" for line in args.setup.split(";") if line.strip())
     if args.equilibrium:
-        print(f"machine: {machine()}")
+        import importlib
+
+        root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+        if os.path.isdir(os.path.join(root, "dec3d")) and root not in sys.path:
+            sys.path.insert(0, root)
+        importlib.import_module("dec3d")          # (first: it chooses numba's threading layer)
+        import numba
+
+        if args.threads:
+            numba.set_num_threads(args.threads)
+        print(f"machine: {machine()}; threads {numba.get_num_threads()}")
         print(f"setup: {args.setup or '(scene as is: local damping 0.8, default density scaling: by body, masses raised)'}; "
               f"load average before: {os.getloadavg()[0]:.2f}")
         for n in args.n:
