@@ -36,7 +36,7 @@ from .contactmap import parallel_twin
 #: the parallel twin (``body_row_sums_parallel``) from this many contacts on more than one thread
 #: (``threaded``): below, the pass is over before the other threads wake up, and the serial kernel
 #: alone is compiled (a cold start: a parallel kernel takes about three times as long)
-PARALLEL_FROM = 2048
+PARALLEL_FROM = 40000
 
 #: contacts or bodies per work item of the kernel's two loops (temporaries allocated per item)
 CHUNK = 64

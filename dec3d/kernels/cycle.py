@@ -38,9 +38,12 @@ from .rayleigh import contact_stiffness_damping
 
 #: a model with less work per step than this (sub-contacts + 4 × bodies) runs the serial twin of
 #: the kernel (``_run_steps_1``): each parallel loop costs a wake-up of the other threads
-#: (microseconds on a quiet machine, up to a scheduler time slice on a busy one), more than a
-#: small model's whole step
-SERIAL_BELOW = 4000
+#: (microseconds on a quiet machine, up to a scheduler time slice on a busy one). Measured on the
+#: 2-core VM of bench/README.md (numba's workqueue layer), the two loops of a step cost about
+#: 0.28 ms more than the serial twin: the 10-layer cube stack (34 000 units, 0.69 ms a step
+#: serial) ran 0.64 ms a step on two threads in the kernel alone and slower in a run; the 20-layer
+#: one (287 000) 1.9 times faster
+SERIAL_BELOW = 60000
 
 
 @njit(cache=True, inline="always")

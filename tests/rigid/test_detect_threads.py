@@ -197,6 +197,7 @@ def test_a_detection_on_two_threads_installs_the_rows_of_one(monkeypatch, restor
         config.set_threads(threads)
         if threads == 2:
             monkeypatch.setattr(detection, "CHUNK_MIN", 16)
+            monkeypatch.setattr(contactmap, "PARALLEL_FROM", 1)       # (the stack has ~2000 contacts)
         s = Session(stdout=io.StringIO())
         lines = ["model new", "block create brick 0 6 0 6 -1 0"] + [
             f"block create brick {i} {i + 1} {j} {j + 1} {k} {k + 1}"
