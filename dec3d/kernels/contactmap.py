@@ -381,20 +381,6 @@ def envelopes(vpos, bvstart, bvcount, active, pad, lo, hi):
             hi[b, d] += pad
 
 
-def add_turns(turn, tpos, tcen, vpos, cen, vblock) -> None:
-    """Accumulated turn of each block [m], in place (numpy): ``turn`` grows by the largest
-    displacement of a vertex besides its block's centroid since the references (vertex positions
-    ``tpos``, centroids ``tcen``): |(R − I) r| of the rotation R since then, plus any deformation.
-    Summed over detections it bounds how far the rotation since any earlier one has moved the
-    vertices (R₂R₁ − I = (R₂ − I)R₁ + (R₁ − I)). vblock (nv,) block row of each vertex."""
-    if not len(vpos):
-        return
-    d = np.sqrt((((vpos - tpos) - (cen - tcen)[vblock]) ** 2).sum(axis=1))
-    most = np.zeros(len(turn))
-    np.maximum.at(most, vblock, d)
-    turn += most
-
-
 @njit(cache=True)
 def blocks_moved(vpos, snap, bvstart, bvcount, tol, out):
     """out[b] = True where a vertex of block b is more than ``tol`` [m] (in any coordinate)

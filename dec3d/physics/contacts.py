@@ -34,8 +34,9 @@ from numba import get_num_threads
 
 from dec3d.kernels.cellmap import cell_grid, cell_pairs, outside_grid
 from dec3d.kernels import contactmap as _cm
-from dec3d.kernels.contactmap import (add_turns, blocks_moved, carry_over, cp_batch, envelopes, gather_subcontacts,
-                                      match_sorted, subcontact_gaps, threaded, vertex_point_areas)
+from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, gather_subcontacts, match_sorted,
+                                      subcontact_gaps, threaded, vertex_point_areas)
+from dec3d.kernels.kept import add_turns, as_they_are, pairs_to_look_at, take_defaults
 from dec3d.kernels.joints import NPROP
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.groups import group_field
@@ -351,13 +352,15 @@ class ContactDetection:
         return self._cand, True
 
     def _turned(self, changed: bool) -> np.ndarray:
-        """Block field ``turn`` [m] brought up to now (``contactmap.add_turns``; blocks changed: only
+        """Block field ``turn`` [m] brought up to now (``kept.add_turns``; blocks changed: only
         the references are set)."""
         b, v = self.model.blocks, self.model.vertices
-        if not changed:
-            add_turns(b["turn"], v["turn_pos"], b["turn_cen"], v["pos"], b["centroid"], v["block"])
-        v["turn_pos"][...] = v["pos"]
-        b["turn_cen"][...] = b["centroid"]
+        if changed:
+            v["turn_pos"][...] = v["pos"]
+            b["turn_cen"][...] = b["centroid"]
+        else:
+            add_turns(b["turn"], v["turn_pos"], b["turn_cen"], v["pos"], b["centroid"], b["vert_start"],
+                      b["vert_count"])
         return b["turn"]
 
     def detect(self, force_search: bool = False) -> None:
@@ -398,15 +401,11 @@ class ContactDetection:
             moved = np.zeros(b.n, bool)
             blocks_moved(vpos, look, b["vert_start"], b["vert_count"], QUIET * ctol, moved)
         prev = match_sorted(cs["ida"], cs["idb"], ids[ra], ids[rb])
-        look_at = moved[ra] | moved[rb]
-        if RELATIVE and not full:
-            # contacts between rigid blocks: kept while their blocks moved little relative to each other
-            rigid = b["kind"] == KIND_RIGID
-            rel = np.flatnonzero((prev >= 0) & rigid[ra] & rigid[rb])
-            p, a_, b_ = prev[rel], ra[rel], rb[rel]
-            drift = (np.linalg.norm((cen[b_] - cs["ref_cb"][p]) - (cen[a_] - cs["ref_ca"][p]), axis=1)
-                     + (turn[a_] - cs["ref_ta"][p]) + (turn[b_] - cs["ref_tb"][p]))
-            look_at[rel] = ~(drift < QUIET * ctol)
+        look_at = np.empty(len(ra), bool)
+        # contacts between rigid blocks (``RELATIVE``): kept while their blocks moved little relative to each other
+        relative = (b["kind"] == KIND_RIGID) if RELATIVE and not full else np.zeros(b.n, bool)
+        pairs_to_look_at(ra, rb, prev, moved, relative, cen, cs["ref_ca"], cs["ref_cb"], turn, cs["ref_ta"],
+                         cs["ref_tb"], QUIET * ctol, look_at)
         if remapped and not full:
             look_at |= match_sorted(ids[before[0]], ids[before[1]], ids[ra], ids[rb]) < 0
         need = np.flatnonzero(look_at)
@@ -417,11 +416,8 @@ class ContactDetection:
             # nothing to look at again and every contact kept in place: all the install below would
             # change is the properties of contacts that follow the defaults (a quiet model's
             # first detection of a run; on a large model the gathers cost ~2 % of a short run)
-            before = (cs["prop"].copy(), cs["jmodel"].copy())
-            self.follow_defaults()
             # (as the full install below says it: every contact kept, with the same properties)
-            self.detect_kept_all = bool(np.array_equal(before[0], cs["prop"], equal_nan=True)
-                                        and np.array_equal(before[1], cs["jmodel"]))
+            self.detect_kept_all = not self.follow_defaults()
             self.timings["detect"] += _time.perf_counter() - t0
             return
         nn = np.empty((k, 3))
@@ -569,25 +565,20 @@ class ContactDetection:
         """Whether the candidate pairs (ra, rb) with old contact rows prev (−1: none) hold every
         contact, in its row, on its blocks' rows, with the sub-contacts in contact order."""
         cs = self.contacts
-        old = np.flatnonzero(prev >= 0)
-        if len(old) != cs.n:
-            return False
-        count = cs["sub_count"]
-        return bool(np.array_equal(prev[old], np.arange(cs.n)) and np.array_equal(ra[old], cs["a"])
-                    and np.array_equal(rb[old], cs["b"]) and int(count.sum()) == self.subcontacts.n
-                    and np.array_equal(cs["sub_start"], np.cumsum(count) - count))
+        return bool(as_they_are(prev, ra, rb, cs["a"], cs["b"], cs["sub_start"], cs["sub_count"], self.subcontacts.n))
 
-    def follow_defaults(self) -> None:
+    def follow_defaults(self) -> bool:
         """Contacts that follow the material-table defaults (``own_props`` 0) take them now, as a
-        detection would (for runs in which no detection is due: zoned blocks alone in small strain)."""
+        detection would (for runs in which no detection is due: zoned blocks alone in small strain).
+        Returns whether a property changed."""
         cs = self.contacts
         if not cs.n:
-            return
+            return False
         s = self.settings()
-        follow = cs["own_props"] == 0
-        for code in np.unique(cs["jmodel"][follow]):
-            sel = follow & (cs["jmodel"] == code)
-            cs["prop"][sel] = default_row(s, int(code))
+        table = np.zeros((max(MODEL_BY_CODE) + 1, NPROP))
+        for code in MODEL_BY_CODE:
+            table[code] = default_row(s, code)
+        return take_defaults(cs["own_props"], cs["jmodel"], cs["prop"], table) > 0
 
     def ensure_contacts(self) -> None:
         """Detect now if the blocks changed since the last detection (3DEC keeps contacts
