@@ -116,14 +116,15 @@ def contact_ranges(nc, sc_contact):
 
 @njit(cache=True)
 def _run_steps(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies, contacts, subs, bounds, vmax, out,
-               bstart, bent, cstart, orphans):
+               bstart, bent, cstart, orphans, sg, step):
     """Take up to ``nsteps`` steps of Δt = dt [s]. Bundles (``kernels.bundles``): damping, groups,
     bodies as ``rigid_motion_groups`` takes them; contacts (``Contacts``: pos (nc, 3) the contact
     reference points, own (nc,) = arange(nc)) and subs (``SubContacts``) as
     ``jointlaw.subcontact_update`` reads them; bounds (``Bounds``) the detection trigger.
     bstart, bent: the sub-contacts of every block (``jointlaw.block_lists``); cstart: those of
     every contact (``contact_ranges``); orphans: rows of blocks with sub-contacts that are in no
-    group (their forces are summed too).
+    group (their forces are summed too); sg (ns, 3), step (nb,): scratch, overwritten (kept by the
+    host from call to call: fresh arrays of this size are new pages to the kernel at every call).
 
     out (4,): as ``rigid_motion_groups`` fills it, for the last step.
     Motion bound for contact detection: each block's step motion |v| Δt + |ω| Δt r (bounds.radius
@@ -150,8 +151,6 @@ def _run_steps(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies,
     done = 0
     bad = -1
     motion[1] = 0.0
-    sg = np.empty((sc_contact.shape[0], 3))
-    step = np.zeros(centroid.shape[0])
     fused = Fused(bstart, bent, sc_pos, sg, radius, step)
     pending = False             # the points still have to move with the last step's motion
     for _ in range(nsteps):
@@ -195,13 +194,14 @@ def _run_steps(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies,
 def cycle_lists(nb, contacts, subs, gmember):
     """What ``_run_steps`` needs besides the bundles, made once per detection (the host keeps it
     while the contacts stay): (bstart, bent) the sub-contacts of every block, cstart those of
-    every contact, orphans the rows of blocks with sub-contacts in no group."""
+    every contact, orphans the rows of blocks with sub-contacts in no group, and the kernel's
+    scratch sg (ns, 3), step (nb,)."""
     bstart, bent = block_lists(nb, contacts.a, contacts.b, subs.contact)
     cstart = contact_ranges(contacts.a.shape[0], subs.contact)
     grouped = np.zeros(nb, dtype=bool)
     grouped[gmember] = True
     orphans = np.flatnonzero((np.diff(bstart) > 0) & ~grouped).astype(np.int64)
-    return bstart, bent, cstart, orphans
+    return bstart, bent, cstart, orphans, np.empty((subs.contact.shape[0], 3)), np.zeros(nb)
 
 
 def run_steps(nsteps, dt, gravity, full_inertia, damping, groups, bodies, contacts, subs, bounds, vmax, out,

@@ -124,10 +124,10 @@ def test_cycle_lists_name_the_blocks_with_sub_contacts_in_no_group(state):
     subs = SubContacts(*(s[k] for k in SubContacts._fields))
     nb = len(state["b"]["mass"])
     member = state["g"]["member"]
-    _, _, _, none = cycle.cycle_lists(nb, contacts, subs, member)
+    _, _, _, none, _, _ = cycle.cycle_lists(nb, contacts, subs, member)
     assert len(none) == 0
     # a group of blocks that leaves out the base (row 0, touched by four contacts) and one cube
-    _, _, _, orphans = cycle.cycle_lists(nb, contacts, subs, member[(member != 0) & (member != 3)])
+    _, _, _, orphans, _, _ = cycle.cycle_lists(nb, contacts, subs, member[(member != 0) & (member != 3)])
     assert list(orphans) == [0, 3]
 
 
