@@ -11,7 +11,7 @@ def _init_threads():
 
     from .config import init_threads
 
-    msg = init_threads()     # fork-safe threading layer; DEC3D_THREADS
+    msg = init_threads()     # numba threading layers in dec3d's order; DEC3D_THREADS
     if msg:
         sys.stderr.write(msg + "\n")
 

@@ -22,13 +22,19 @@ SAVE_FORMAT_VERSION = 1
 
 #: environment variable with the number of threads of the parallel kernels (read at import)
 THREADS_ENV = "DEC3D_THREADS"
-#: numba threading layers in the order dec3d wants them: numba's own workqueue first. GNU OpenMP
-#: is not fork-safe on Linux (a process forked after a parallel kernel ran, as the
-#: factor-of-safety pool does, aborts; numba documentation, "The Threading Layers"), and TBB hung
-#: here in numba's before-fork handler (``tbb::finalize`` spinning on ``sched_yield``, numba issue
-#: #5983) when a later test forked; its idle workers also spin on a busy machine. The workqueue is
-#: fork-safe; it is not thread-safe (dec3d runs kernels from one thread only)
-LAYER_PRIORITY = ("workqueue", "tbb", "omp")
+#: numba threading layers in the order dec3d wants them: GNU OpenMP first where the system has
+#: libgomp, numba's own workqueue otherwise. A step of the cycle kernel is two parallel loops of a
+#: few milliseconds each; OpenMP's idle workers wait spinning for a moment and start at once, the
+#: workqueue's sleep and are woken for every loop, and on a virtual machine that wake-up is slow
+#: and uneven: the 20-layer cube stack took 1.9x less time on two threads than on one with OpenMP,
+#: 1.4x with the workqueue (bench/README.md, session 9). GNU OpenMP is not fork-safe (a process
+#: forked after a parallel kernel ran aborts in its first parallel kernel; numba documentation,
+#: "The Threading Layers"): dec3d's own worker processes are spawned (the factor-of-safety pool,
+#: batch runs), never forked. TBB hung here in numba's before-fork handler (``tbb::finalize``
+#: spinning on ``sched_yield``, numba issue #5983) when a later test forked, so it comes last.
+#: Neither the workqueue nor OpenMP here is thread-safe: dec3d runs parallel kernels from one
+#: thread only (``in_threads`` runs serial ``nogil`` kernels)
+LAYER_PRIORITY = ("omp", "workqueue", "tbb")
 
 
 def max_threads() -> int:
@@ -76,7 +82,7 @@ def thread_report() -> str:
 
 
 def init_threads(environ=None) -> str | None:
-    """Run once at ``import dec3d``: prefer the fork-safe threading layers (``LAYER_PRIORITY``)
+    """Run once at ``import dec3d``: put numba's threading layers in dec3d's order (``LAYER_PRIORITY``)
     unless the user chose one (NUMBA_THREADING_LAYER or NUMBA_THREADING_LAYER_PRIORITY), and take
     the thread count from ``DEC3D_THREADS`` when set. Returns a warning for a value of
     ``DEC3D_THREADS`` that cannot be used (the count is then left as it was), else None."""

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 from numba import get_num_threads, njit, prange
 from numba.core.cpu import ParallelOptions
@@ -37,13 +38,35 @@ from .rayleigh import contact_stiffness_damping
 
 
 #: a model with less work per step than this (sub-contacts + 4 × bodies) runs the serial twin of
-#: the kernel (``_run_steps_1``): each parallel loop costs a wake-up of the other threads
-#: (microseconds on a quiet machine, up to a scheduler time slice on a busy one). Measured on the
-#: 2-core VM of bench/README.md (numba's workqueue layer), the two loops of a step cost about
-#: 0.28 ms more than the serial twin: the 10-layer cube stack (34 000 units, 0.69 ms a step
-#: serial) ran 0.64 ms a step on two threads in the kernel alone and slower in a run; the 20-layer
-#: one (287 000) 1.9 times faster
-SERIAL_BELOW = 60000
+#: the kernel (``_run_steps_1``); None: the threshold of the threading layer in use
+#: (``SERIAL_BY_LAYER``, ``serial_below``)
+SERIAL_BELOW = None
+#: each parallel loop costs a start of the other threads. Measured on the 2-core VM of
+#: bench/README.md: with numba's workqueue (idle workers sleep and are woken for every loop) the two
+#: loops of a step cost about 0.28 ms more than the serial twin: the 10-layer cube stack (34 000
+#: units, 0.69 ms a step serial) ran 0.64 ms a step on two threads in the kernel alone and slower in
+#: a run; the 20-layer one (287 000) 1.9 times faster. With GNU OpenMP (idle workers spin a moment)
+#: two threads already win at 4 × 4 × 4 cubes (1 000 units: 0.030 against 0.042 ms a step), tie at
+#: 3 × 3 × 3 (400 units) and lose at 2 × 2 × 2; the 10-layer stack runs 0.48 against 0.79 ms a step
+SERIAL_BY_LAYER = {"omp": 1000, "workqueue": 60000}
+
+
+def serial_below() -> int:
+    """``SERIAL_BELOW``, or when None the threshold of numba's threading layer (started here if no
+    parallel kernel has run yet; a layer not in ``SERIAL_BY_LAYER`` takes the workqueue's)."""
+    if SERIAL_BELOW is not None:
+        return SERIAL_BELOW
+    try:
+        layer = numba.threading_layer()
+    except ValueError:                      # (not started: an empty parallel loop starts it)
+        none = np.zeros(0, np.int64)
+        _move_points(0.0, none, none, none, np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
+                     np.zeros((0, 3)))
+        try:
+            layer = numba.threading_layer()
+        except ValueError:                  # (numba's JIT off: nothing runs in parallel)
+            layer = "workqueue"
+    return SERIAL_BY_LAYER.get(layer, SERIAL_BY_LAYER["workqueue"])
 
 
 @njit(cache=True, inline="always")
@@ -213,7 +236,7 @@ def run_steps(nsteps, dt, gravity, full_inertia, damping, groups, bodies, contac
         lists = cycle_lists(bodies.centroid.shape[0], contacts, subs, groups.member)
     args = (nsteps, dt, gravity, bool(full_inertia), float(beta), damping, groups, bodies, contacts, subs,
             bounds, vmax, out) + tuple(lists)
-    if subs.contact.shape[0] + 4 * groups.member.shape[0] >= SERIAL_BELOW and get_num_threads() > 1:
+    if get_num_threads() > 1 and subs.contact.shape[0] + 4 * groups.member.shape[0] >= serial_below():
         return _run_steps(*args)
     return _run_steps_1(*args)
 

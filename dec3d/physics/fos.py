@@ -262,8 +262,12 @@ class FileTrials:
                 import multiprocessing
                 from concurrent.futures import ProcessPoolExecutor
 
-                self._pool = ProcessPoolExecutor(max_workers=self.workers,
-                                                 mp_context=multiprocessing.get_context("fork"))
+                from dec3d.config import set_threads
+
+                # spawned, not forked: a process forked after GNU OpenMP ran aborts in its first
+                # parallel kernel (``config.LAYER_PRIORITY``); a worker is one thread of work
+                self._pool = ProcessPoolExecutor(max_workers=self.workers, initializer=set_threads, initargs=(1,),
+                                                 mp_context=multiprocessing.get_context("spawn"))
             futures = [self._pool.submit(_trial_from_file, self.path, *self.args, f) for f in fs]
             out = [fu.result() for fu in futures]
         else:

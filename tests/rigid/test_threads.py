@@ -1,6 +1,7 @@
 """Two cores (issue 9): the parallel kernels give bit-identical results whatever the number of
 threads; the thread count is set by `model configure threads n` or DEC3D_THREADS and reported;
-a process forked after parallel kernels ran (the factor-of-safety pool) still runs them."""
+dec3d's worker processes are spawned (GNU OpenMP, the first threading layer, aborts a forked child)
+and run the kernels after the parent did."""
 import io
 import multiprocessing
 import os
@@ -169,6 +170,12 @@ def test_more_threads_than_cores_is_a_command_error(session, restore_threads):
     assert config.threads() == n
 
 
+def _omp_loads() -> bool:
+    """Whether numba's OpenMP layer loads here (it needs the system's libgomp)."""
+    r = subprocess.run([sys.executable, "-c", "import numba.np.ufunc.omppool"], capture_output=True, timeout=600)
+    return r.returncode == 0
+
+
 def _fresh(env_extra: dict) -> subprocess.CompletedProcess:
     env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_THREADING_LAYER")}
     env.update(env_extra, PYTHONPATH=str(ROOT))
@@ -187,7 +194,8 @@ def test_dec3d_threads_environment_variable(tmp_path):
     assert r.returncode == 0, r.stderr
     n, layer = r.stdout.split()
     assert n == "1"
-    assert layer == "workqueue"          # fork-safe (GNU OpenMP is not; TBB hung in numba's fork handler)
+    # GNU OpenMP where the system has libgomp, else numba's workqueue (TBB hung in numba's fork handler)
+    assert layer == ("omp" if _omp_loads() else "workqueue")
     r = _fresh({"DEC3D_THREADS": "two"})
     assert r.returncode == 0 and "DEC3D_THREADS='two' is not a whole number" in r.stderr
     r = _fresh({"DEC3D_THREADS": "999"})
@@ -202,22 +210,57 @@ def test_init_threads_reads_the_variable_and_keeps_a_chosen_layer(restore_thread
     assert "NUMBA_THREADING_LAYER_PRIORITY" not in env          # the user's choice is left alone
     env = {"DEC3D_THREADS": "0"}
     assert "not a whole number ≥ 1" in config.init_threads(env)
-    assert env["NUMBA_THREADING_LAYER_PRIORITY"].split()[0] == "workqueue"
+    assert env["NUMBA_THREADING_LAYER_PRIORITY"].split() == ["omp", "workqueue", "tbb"]
     assert config.init_threads({}) is None
 
 
 def _child_run(scene: str, out: str) -> dict:
     from pathlib import Path
 
+    cycle.SERIAL_BELOW = 0                  # the parallel kernels, however small the model
     return _state(scene, 2, Path(out))
 
 
 @TWO
-def test_a_forked_process_runs_the_kernels_after_the_parent_did(tmp_path, restore_threads, monkeypatch):
-    """The factor-of-safety pool forks the process after parallel kernels ran in it: with GNU
-    OpenMP the child aborted. The child's run gives the parent's numbers."""
-    monkeypatch.setattr(cycle, "SERIAL_BELOW", 0)          # the parallel kernels (the child inherits it)
+def test_a_spawned_worker_runs_the_kernels_after_the_parent_did(tmp_path, restore_threads, monkeypatch):
+    """dec3d's worker processes are spawned, not forked: a child forked after GNU OpenMP ran aborts
+    in its first parallel kernel. The factor-of-safety pool says so, and a spawned child's run, after
+    the parent's parallel kernels, gives the parent's numbers."""
+    from dec3d.physics import fos
+
+    monkeypatch.setattr(cycle, "SERIAL_BELOW", 0)          # the parallel kernels
     mine = _state("sliding", 2, tmp_path)
-    with ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork")) as pool:
+    import concurrent.futures as cf
+
+    made = []
+
+    class Made(Exception):
+        pass
+
+    def pool(**kw):
+        made.append(kw)
+        raise Made
+
+    monkeypatch.setattr(cf, "ProcessPoolExecutor", pool)
+    trials = fos.FileTrials.__new__(fos.FileTrials)
+    trials.path, trials.args, trials.workers, trials.log, trials._pool = "x", (), 2, [], None
+    with pytest.raises(Made):
+        trials([1.0, 2.0])
+    assert made[0]["mp_context"].get_start_method() == "spawn"
+    with ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn")) as pool:
         theirs = pool.submit(_child_run, "sliding", str(tmp_path)).result(timeout=600)
     assert [k for k in mine if not np.array_equal(mine[k], theirs[k], equal_nan=True)] == []
+
+
+def test_the_serial_threshold_follows_the_threading_layer(monkeypatch):
+    """OpenMP's spinning workers start a loop at once, the workqueue's are woken for each: a small
+    model runs its parallel kernel from 1 000 units of work with OpenMP, 60 000 with the workqueue;
+    a threshold set by hand wins."""
+    import numba
+
+    monkeypatch.setattr(cycle, "SERIAL_BELOW", None)
+    below = cycle.serial_below()                    # (starts the layer if nothing parallel ran yet)
+    layer = numba.threading_layer()
+    assert below == {"omp": 1000}.get(layer, 60000)
+    monkeypatch.setattr(cycle, "SERIAL_BELOW", 7)
+    assert cycle.serial_below() == 7
