@@ -32,8 +32,8 @@ THREADS_ENV = "DEC3D_THREADS"
 #: "The Threading Layers"): dec3d's own worker processes are spawned (the factor-of-safety pool,
 #: batch runs), never forked. TBB hung here in numba's before-fork handler (``tbb::finalize``
 #: spinning on ``sched_yield``, numba issue #5983) when a later test forked, so it comes last.
-#: Neither the workqueue nor OpenMP here is thread-safe: dec3d runs parallel kernels from one
-#: thread only (``in_threads`` runs serial ``nogil`` kernels)
+#: GNU OpenMP is thread-safe, the workqueue is not (numba documentation); dec3d runs parallel
+#: kernels from one thread only either way (``in_threads`` runs serial ``nogil`` kernels)
 LAYER_PRIORITY = ("omp", "workqueue", "tbb")
 
 
