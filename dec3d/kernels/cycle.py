@@ -26,10 +26,11 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 from numba import get_num_threads, njit, prange
 from numba.core.cpu import ParallelOptions
+
+from dec3d.config import threading_layer
 
 from .bundles import Fused
 from .jointlaw import block_lists, block_sum, update_one
@@ -56,16 +57,12 @@ def serial_below() -> int:
     parallel kernel has run yet; a layer not in ``SERIAL_BY_LAYER`` takes the workqueue's)."""
     if SERIAL_BELOW is not None:
         return SERIAL_BELOW
-    try:
-        layer = numba.threading_layer()
-    except ValueError:                      # (not started: an empty parallel loop starts it)
-        none = np.zeros(0, np.int64)
+    layer = threading_layer()
+    if layer == "not started yet":          # (an empty parallel loop starts it; with numba's JIT off
+        none = np.zeros(0, np.int64)        # nothing does, and the workqueue's threshold is taken)
         _move_points(0.0, none, none, none, np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
                      np.zeros((0, 3)))
-        try:
-            layer = numba.threading_layer()
-        except ValueError:                  # (numba's JIT off: nothing runs in parallel)
-            layer = "workqueue"
+        layer = threading_layer()
     return SERIAL_BY_LAYER.get(layer, SERIAL_BY_LAYER["workqueue"])
 
 
