@@ -341,8 +341,6 @@ def _check_geometry(path: str, model: Model) -> None:
 def _check_zones(path: str, model: Model) -> None:
     """The ``zones`` store (dec3d.model.zones): gridpoint rows within the vertices, block rows
     within the blocks, gridpoint links valid, 4- or 10-node zones, known constitutive codes."""
-    from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_MOHR, ZMODEL_NULL
-
     v, nb = model.vertices, model.blocks.n
 
     def need(ok, what):
@@ -366,7 +364,7 @@ def _check_zones(path: str, model: Model) -> None:
     used = np.arange(10)[None, :] < nn[:, None].astype(np.int64)
     need(((gp[used] >= 0) & (gp[used] < v.n)).all(), "zone gridpoint rows point outside the vertices")
     need((gp[~used] == -1).all(), "a zone has gridpoint rows past its node count")
-    need(np.isin(zs["cmodel"], (ZMODEL_NULL, ZMODEL_ELASTIC, ZMODEL_MOHR)).all(),
+    need(np.isin(zs["cmodel"], [0] + sorted(_known()["zone_model_codes"])).all(),
          "a zone has an unknown constitutive model code")
 
 

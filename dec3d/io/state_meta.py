@@ -127,12 +127,13 @@ def register_known(**entries) -> None:
 
 
 def _known() -> dict:
-    if not {"joint_models", "joint_model_codes", "histories", "energy_problem"} <= KNOWN.keys():
+    if not {"joint_models", "joint_model_codes", "zone_model_codes", "histories", "energy_problem"} <= KNOWN.keys():
         # a restore called before anything imported the physics layer (e.g. ``dec3d.io.state``
         # used on its own): load the registering modules by name, which keeps the import arrows
         # of the layers (physics -> io) as they are
         import importlib
-        for name in ("dec3d.physics.jmodels", "dec3d.physics.history", "dec3d.physics.energy"):
+        for name in ("dec3d.physics.jmodels", "dec3d.physics.cmodels", "dec3d.physics.history",
+                     "dec3d.physics.energy"):
             importlib.import_module(name)
     return KNOWN
 

@@ -91,3 +91,19 @@ def new_damping(mode: int, alpha: float, ng: int, servo: Servo | None = None) ->
     """A damping bundle for ``ng`` groups (a fresh servo unless one is given; no force history)."""
     return Damping(int(mode), float(alpha), servo if servo is not None else new_servo(),
                    np.zeros((int(ng), 6)))
+
+# --- the 4-node zone step (``kernels/zone_step.zone_step``) ---------------------------------
+#: ``ZoneMesh``: the zone entries of the step, nr of them: g4 (nr, 4) int32 gridpoint rows of
+#: each entry's zone, n4 (nr, 4) int32 their averaging nodes (NMD), rows (nr,) zone rows (empty:
+#: entry k is zone row k), zset (nr,) the entry's mixed-discretization set or -1 (empty when there
+#: is none), weight (nr,) overlay weight (empty: all 1), nset the number of sets.
+ZoneMesh = namedtuple("ZoneMesh", "g4 n4 rows zset weight nset")
+#: ``ZonePlan``: chunks and scatter plans (``zone_elastic.ElasticPlan``): pstart, pk the chunks of
+#: entries; fbits … fpslot the gridpoint-force plan, nbits … npslot the averaging-node plan.
+ZonePlan = namedtuple("ZonePlan", "pstart pk fbits fbase fpstart fptgt fpslot nbits nbase npstart nptgt npslot")
+#: ``ZoneMaterial``: per zone row cmodel (int8 model codes), prop (nz, NZPROP), hist (nz, NZHIST),
+#: bulk, shear (nz,) Pa, stress (nz, 6) Pa, state (nz,) plastic bits; tab the ``Tables`` bundle.
+ZoneMaterial = namedtuple("ZoneMaterial", "cmodel prop hist bulk shear stress state tab")
+#: ``ZoneScratch``: nodesum, nodevol, nodedsp (nvert,); sa (slots, 2), sb (slots, 4); evs, vols
+#: (entries in sets); dsp (nr,).
+ZoneScratch = namedtuple("ZoneScratch", "nodesum nodevol nodedsp sa sb evs vols dsp")
