@@ -95,14 +95,17 @@ def twin_hb(s0, de, K, G, mb, s, a, sci, psi_deg=0.0, flag=0.0):
                 continue
             if admissible(p, 1e-10 * scale):
                 bits = 0
+                nshear = 0
                 for b in range(n):
                     if mu[b] > 1e-12 * np.abs(mu).max():
                         bits |= 1 if surfaces[act[b]][0] == "s" else 2
-                found.append((p, bits))
+                        nshear += surfaces[act[b]][0] == "s"
+                found.append((p, bits, nshear))
     assert found, "twin: no consistent return"
-    p, bits = found[0]
+    p, bits, nshear = found[0]
     ambiguous = any(np.abs(f[0] - p).max() > 1e-9 * scale for f in found[1:])
     new = v @ np.diag(p) @ v.T
+    twin_hb.edge = nshear > 1
     return _vec6(new), bits, (w.sum() - p.sum()) / 3, ambiguous
 
 
@@ -160,6 +163,7 @@ def test_kernel_matches_twin_on_random_states():
     compared = 0
     worst = 0.0
     skipped = 0
+    edges = 0
     while compared < 400:
         s0, de, K, G, mb, s, a, sci, psi, flag = _random_case(rng)
         st, bits_t, dsp_t, ambiguous = twin_hb(s0, de, K, G, mb, s, a, sci, psi, flag)
@@ -177,10 +181,12 @@ def test_kernel_matches_twin_on_random_states():
         if bits_t & 1 and not bits_t & 2:
             assert abs(fs) <= 1e-9 * scale                 # on the nonlinear surface itself
         seen[bits_t] += 1
+        edges += twin_hb.edge
         compared += 1
     assert seen[0] >= 40 and seen[1] >= 100 and seen[2] >= 20 and seen[3] >= 5, seen
+    assert edges >= 20, edges               # returns to an edge (two shear surfaces active)
     assert skipped <= 20, skipped           # (the twin found more than one consistent return)
-    print("worst relative difference", worst, seen, "skipped", skipped)
+    print("worst relative difference", worst, seen, "edges", edges, "skipped", skipped)
 
 
 def _triaxial(mb, s, a, sci, sig3, K=10e9, G=6e9, steps=400, dz=-5e-5):
@@ -267,6 +273,18 @@ def test_hostile_inputs_stay_finite_and_admissible(mb, s, a, psi, flag):
             if bits and s == 0:
                 w = np.linalg.eigvalsh(_tensor(sk))
                 assert w[2] <= 1e-9 * scale                       # cut-off at σ3 = 0
+
+
+def test_dispatch_chain_calls_the_model_by_its_code():
+    from dec3d.kernels.zmodels import CODES, PLASTIC_CODES, zone_update
+    assert CODES["hoek-brown"] == 4 and 4 in PLASTIC_CODES
+    p = _rows(10.0, 1.0, 0.5, 100e6)
+    s0 = np.array([-10e6, -10e6, -10e6, 0.0, 0.0, 0.0])
+    de = np.array([2e-3, 1e-3, -5e-2, 1e-4, 0.0, -3e-4])       # yields
+    wf = np.full(NWORK, np.nan)
+    r = zone_update(4, p, _H, 0, 10e9, 6e9, *de, *s0, _TAB, wf, _MW)
+    sk, bits, dsp = kernel(p, 10e9, 6e9, s0, de)
+    assert r[0] == bits == 1 and np.array_equal(np.array(r[1:7]), sk) and r[7] == dsp
 
 
 def test_host_refuses_out_of_range_properties():
