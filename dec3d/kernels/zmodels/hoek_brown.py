@@ -48,7 +48,7 @@ import math
 
 from numba import njit
 
-from ..principal import principal_axes
+from ..principal import _dev_principal, principal_axes
 from ..zone_mohr import SHEAR_NOW, mohr_plastic
 from ._common import P_OWN, hooke
 
@@ -124,6 +124,14 @@ def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, w
     if not (mb > 0.0 and sci > 0.0 and a > 0.0 and s >= 0.0):
         return 0, s0, s1, s2, s3, s4, s5, 0.0          # (refused by the host; never cycled)
     st = s * sci / mb
+    # clearly elastic from the closed-form principal values (no arrays), with a margin far above
+    # their round-off; what this cannot tell goes to the exact test below
+    m, l1, _l2, l3 = _dev_principal(s0, s1, s2, s3, s4, s5)
+    margin = 1e-7 * (3.0 * abs(m) + abs(l1) + abs(l3) + sci)
+    if m + l3 - st < -margin:
+        q, _n = hb_strength(-(m + l3), mb, s, a, sci)
+        if -(m + l1) - q < -margin:
+            return 0, s0, s1, s2, s3, s4, s5, 0.0
     # the chunk scratch: trial t = wf[0:6], working copy wf[6:12], projectors wf[12:24],
     # principal values wf[24:27]; wf[0] is left NaN so that no cache of another model matches
     t = wf[0:6]
