@@ -21,14 +21,14 @@ from dec3d.physics.cmodels import ELASTIC, Prop, angle, which_zones, zmodel
 _K = kernel
 
 PROPS = ELASTIC + [
-    Prop("constant-mb", _K.C_MB, "Hoek-Brown constant mb", None, lo=0.0, lo_open=True),
-    Prop("constant-s", _K.C_S, "Hoek-Brown constant s", None, lo=0.0, hi=1.0),
-    Prop("constant-a", _K.C_A, "Hoek-Brown exponent a", None, lo=0.0, lo_open=True, hi=1.0),
+    Prop("constant-mb", _K.C_MB, "Hoek-Brown constant mb", "", lo=0.0, lo_open=True),
+    Prop("constant-s", _K.C_S, "Hoek-Brown constant s", "", lo=0.0, hi=1.0),
+    Prop("constant-a", _K.C_A, "Hoek-Brown exponent a", "", lo=0.0, lo_open=True, hi=1.0),
     Prop("constant-sci", _K.C_SCI, "unconfined compressive strength of the intact rock σci", "Pa",
          lo=0.0, lo_open=True),
     angle("constant-dilation", _K.C_TANDIL, "dilation angle ψ (capped at the local friction angle)"),
     Prop("flag-dilation", _K.C_FLAGDIL, "dilation rule: 0 constant-dilation; < 0 ψ = φc; > 0 ψ = flag × φc",
-         None, lo=None),
+         "", lo=None),
 ]
 
 
