@@ -27,8 +27,13 @@ The envelope is concave, so every tangent lies outside it: each iterate stays ou
 surface and the multiplier grows monotonically to the root (quadratically). The dilation,
 and so the flow direction, is fixed from the trial state (σ3 of the trial, as Itasca takes it).
 
-Properties (own columns; keyword names as in Itasca's model, whose property list reads
-constant-mb, constant-s, constant-a, constant-sci, flag-dilation, constant-dilation):
+The property keywords, the dilation rule and the trial-state tangent are taken from Itasca's
+published source of the model (``modelhoek.cpp``: ``ModelHoek::getProperties`` lists
+constant-mb, constant-s, constant-a, constant-sci, flag-dilation, constant-dilation …;
+``ModelHoek::run`` computes φc, c_c and ψ at the trial σ3, its compressive part); the search tool
+returned only the opening part of the documentation page, not its property table.
+
+Properties (own columns):
 column P_OWN     mb         (``constant-mb`` > 0)
        P_OWN+1   s          (``constant-s``, 0..1)
        P_OWN+2   a          (``constant-a``, 0 < a <= 1)
@@ -41,8 +46,9 @@ column P_OWN     mb         (``constant-mb`` > 0)
 Not implemented: Itasca's table-* properties and softening (flag-evolution, strain-plastic,
 length-calibration), its optional Mohr-Coulomb ``tension`` cap below s σci/mb, and its
 factor-of-safety option (``flag-fos``; see the host for strength reduction). Where s = 0 the
-curve is vertical at σ3 = 0; N_φc is capped at 1e6 there (φc ≈ 89.9°), so within about
-1e-12 σci of that apex the stress is returned to the capped tangent, not the curve.
+curve is vertical at σ3 = 0: slopes N_φc (and N0) are capped at 1e6 (φc ≈ 89.9°), so for
+σ3 below (σci/mb) (1e-6 a mb)^(1/(1-a)) (2.5e-12 σci for mb = 10, a = 0.5) the stress is
+returned to the capped line, not the curve.
 """
 import math
 

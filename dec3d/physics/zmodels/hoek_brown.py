@@ -10,9 +10,9 @@ Itasca's model, so mb, a and σci must be given (the range check refuses the zon
 
 Strength reduction (``model factor-of-safety``): not provided (``reduce`` is None). Itasca's
 page says the model "can be used to perform factor of safety calculations" as the Mohr-Coulomb
-model is; in its model the reduction acts on the instantaneous tangent c_c and tan φc at each
-stress level (or on σci alone, its flag-fos option), which no change of the constant columns
-can express. It would need the kernel to read a factor per zone (as table strengths read
+model is; in its model source (``ModelHoek::run``, ``scaleProperties``) the reduction acts on the
+instantaneous tangent c_c and tan φc at each stress level (or on σci alone, its flag-fos
+option), which no change of the constant columns can express. It would need the kernel to read a factor per zone (as table strengths read
 P_SRF), a change of the plug-in contract left to the engine's owner.
 """
 from dec3d.kernels.zmodels import hoek_brown as kernel
