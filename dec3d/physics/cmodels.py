@@ -150,9 +150,11 @@ class ZoneModel:
         property in its range (in user units), then the model's own ``check``; ``ids`` the zone
         ids, ``blocks`` their block ids (named in the messages when given)."""
         out: list[str] = []
+        seen = set()
         for p in self.props.values():
-            if p.kind == "table":
+            if p.kind == "table" or p.column in seen:       # (a second name of a column: checked once)
                 continue
+            seen.add(p.column)
             col = prop_rows[:, p.column]
             with np.errstate(all="ignore"):
                 v = np.array([p.from_column(x) for x in col]) if p.kind == "angle" else col
