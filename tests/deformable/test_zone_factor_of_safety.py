@@ -174,3 +174,12 @@ def test_nothing_to_reduce_is_refused(session):
     msg = str(err.value)
     assert "nothing to reduce" in msg and "no zone has a constitutive model with a strength" in msg
     assert "fos" not in session.results
+
+
+def test_rounds_of_trials_from_a_state_file_reduce_the_zones_too(session):
+    """`trials-per-round`: each trial runs on the model read from a state file (here in this process,
+    one worker); the zones read back are reduced as in the serial search."""
+    _run(session, COLUMN + "model factor-of-safety bracket 1.0 2.1 resolution 0.005 cycles 3000 "
+                           "trials-per-round 3 workers 1\n")
+    fs, un = session.results["fos"], session.results["fos.unstable"]
+    assert fs <= FS_COLUMN < un + 1e-12 and un - fs <= 0.005
