@@ -1,0 +1,50 @@
+"""Host of zone model ``anisotropic`` (transversely isotropic elasticity; kernel:
+``dec3d/kernels/zmodels/anisotropic.py``, where the law, the axes and their sources are).
+
+Keywords (Itasca, "Anisotropic (Transversely) Elastic Model" page and its property list,
+http://docs.itascacg.com/flac3d700/common/models/aniso/doc/modelaniso.html): ``young-plane`` E
+and ``young-normal`` E' (> 0), ``poisson-plane`` ν and ``poisson-normal`` ν', ``shear-normal``
+G' (> 0), ``dip`` and ``dip-direction`` of the plane of isotropy (degrees); ``density``.
+G = E / (2 (1 + ν)) is worked out. Itasca's ``normal``/``normal-x|y|z`` alternatives are not
+taken.
+
+Check and ``moduli`` as for ``orthotropic`` (its host's text: the compliance must be positive
+definite; K + 4G/3 is the largest eigenvalue of the stiffness in Mandel form).
+"""
+import numpy as np
+
+from dec3d.kernels.zmodels import anisotropic as kernel
+from dec3d.physics.cmodels import ELASTIC, Prop, zmodel
+from dec3d.physics.zmodels.orthotropic import bound_moduli, compliance_check, orientation_props
+
+k = kernel
+
+PROPS = [q for q in ELASTIC if q.name == "density"] + [
+    Prop("young-plane", k.P_E, "Young's modulus E in the plane of isotropy", "Pa", lo=0.0, lo_open=True),
+    Prop("young-normal", k.P_EN, "Young's modulus E' normal to the plane of isotropy", "Pa", lo=0.0, lo_open=True),
+    Prop("poisson-plane", k.P_NU, "Poisson's ratio ν: contraction in the plane under tension in the plane",
+         None, lo=None, hi=None),
+    Prop("poisson-normal", k.P_NUN, "Poisson's ratio ν': contraction in the plane under tension normal to it",
+         None, lo=None, hi=None),
+    Prop("shear-normal", k.P_GN, "shear modulus G' of the planes normal to the plane of isotropy", "Pa",
+         lo=0.0, lo_open=True),
+] + orientation_props(k.P_DIP, k.P_DD, plane="the plane of isotropy")
+
+
+def ti_constants(p):
+    e, en, nu, nun, gn = p[:, k.P_E], p[:, k.P_EN], p[:, k.P_NU], p[:, k.P_NUN], p[:, k.P_GN]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        g12 = np.where(nu > -1.0, e / (2.0 * (1.0 + nu)), 0.0)
+    return e, e, en, nu, nun, nun, g12, gn, gn
+
+
+def ti_check(p, ids):
+    return compliance_check(ti_constants(p), ids), []
+
+
+def ti_moduli(p):
+    return bound_moduli(*ti_constants(p))
+
+
+zmodel(kernel, "transversely isotropic linear elasticity, plane of isotropy by dip and dip-direction "
+       "(Itasca's model)", PROPS, check=ti_check, moduli=ti_moduli)
