@@ -193,6 +193,18 @@ def test_uniaxial_tension_reaches_cutoff_before_shear():
     np.testing.assert_allclose(axial[first:], 3 * ten, rtol=1e-9)
 
 
+def test_degenerate_input_stays_finite():
+    """Zero moduli or strengths (refused before cycling, but a kernel never makes NaN or inf)."""
+    rng = np.random.default_rng(1)
+    for K, G, qphi, kphi, ten in ((0.0, 0.0, 0.5, 1e6, 1e5), (1e9, 0.0, 0.0, 0.0, 0.0), (0.0, 1e9, 0.0, 0.0, 0.0),
+                                  (1e9, 1e9, 1e-300, 1e6, 1e6)):
+        for _ in range(50):
+            bits, new, dsp = _kernel(_rows(qphi, kphi, 0.3, ten), K, G, rng.normal(0, 1e-3, 6), rng.normal(0, 1e6, 6))
+            assert np.isfinite(new).all() and math.isfinite(dsp)
+        _, new, _ = _kernel(_rows(qphi, kphi, 0.3, ten), K, G, np.zeros(6), np.zeros(6))
+        assert np.isfinite(new).all()
+
+
 def test_host_check_and_ranges():
     m = cmodels.ZONE_MODELS["drucker-prager"]
     rows = np.zeros((3, NZPROP))

@@ -73,9 +73,8 @@ def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, w
         taup = 0.0
     ap = math.sqrt(1.0 + qf * qf) - qf
     if tau - taup - ap * (sig - st) > 0.0:
-        lam = fs / (G + K * qf * qp)
-        if lam < 0.0:
-            lam = 0.0
+        den = G + K * qf * qp
+        lam = fs / den if den > 0.0 and fs > 0.0 else 0.0
         tn = tau - G * lam
         sn = sig - K * qp * lam
         code = SHEAR_NOW
