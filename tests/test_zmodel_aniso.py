@@ -2,7 +2,9 @@
 (dec3d/kernels/zmodels/anisotropic.py, orthotropic.py): uniaxial stresses in several directions
 against the compliance of Itasca's pages, the stiffness against numpy's inverse of the rotated
 compliance, the orientation convention on hand-worked cases, isotropic constants against Hooke's
-law, a slow numpy twin on random states, the host's check and its bound for the mass scaling."""
+law, a slow numpy twin on random states (stress and the dsp that symmetrizes NMD), the host's
+check and its bound for the mass scaling, and cubes of zones through the whole zone step with NMD
+on (stable, and the uniaxial strains of the compliance)."""
 import math
 
 import numpy as np
@@ -62,11 +64,12 @@ def global_compliance(S, R):
     return out
 
 
-def run(model, p, d, s=None):
+def run(model, p, d, s=None, dsp=False):
+    """The new stress (and the returned dsp) of one update; the bits are always 0."""
     s = np.zeros(6) if s is None else s
     out = model.update(p, np.zeros((1, NZHIST)), 0, 1e9, 1e9, *d, *s, TAB, np.full(NWORK, np.nan), MW)
-    assert out[0] == 0 and out[7] == 0.0
-    return np.array(out[1:7])
+    assert out[0] == 0
+    return (np.array(out[1:7]), out[7]) if dsp else np.array(out[1:7])
 
 
 def ortho_rows(E1, E2, E3, n12, n13, n23, G12, G13, G23, dip, ddir, rot):
@@ -91,7 +94,7 @@ TI = (30e9, 12e9, 0.22, 0.3, 5e9)
 
 def test_registered():
     assert CODES["anisotropic"] == 7 and CODES["orthotropic"] == 8
-    assert not ({7, 8} & PLASTIC_CODES)
+    assert {7, 8} <= PLASTIC_CODES             # for the step's averaging sweep (NMD), not for yield
     o = cmodels.ZONE_MODELS["orthotropic"]
     a = cmodels.ZONE_MODELS["anisotropic"]
     assert set(o.props) == {"density", "young-1", "young-2", "young-3", "poisson-12", "poisson-13", "poisson-23",
@@ -192,20 +195,27 @@ def test_isotropic_constants_reduce_to_hooke():
         s = rng.normal(0, 1e6, 6)
         want = np.array(hooke(K, G, *d, *s))
         scale = np.abs(want - s).max()
-        got = run(ti, ti_rows(E, E, nu, nu, G, dip, ddir), d, s)
+        got, dsp = run(ti, ti_rows(E, E, nu, nu, G, dip, ddir), d, s, dsp=True)
         np.testing.assert_allclose(got - s, want - s, rtol=0, atol=1e-12 * scale)
-        got = run(ort, ortho_rows(E, E, E, nu, nu, nu, G, G, G, dip, ddir, rot), d, s)
+        assert abs(dsp) <= 1e-12 * scale            # no mean stress from the deviator: the elastic step
+        got, dsp = run(ort, ortho_rows(E, E, E, nu, nu, nu, G, G, G, dip, ddir, rot), d, s, dsp=True)
         np.testing.assert_allclose(got - s, want - s, rtol=0, atol=1e-12 * scale)
+        assert abs(dsp) <= 1e-12 * scale
 
 
 def twin(consts, orient, d, s):
     """Slow twin: numpy inverse of the local compliance, strain rotated to the local axes as a
-    tensor, stress rotated back."""
+    tensor, stress rotated back; and dsp = −(mean stress of C applied to the deviator of d)."""
     R = axes(*orient)
     C = np.linalg.inv(local_compliance(*consts))
-    el = R @ tensor(d) @ R.T
-    sl = C @ np.concatenate([vec(el)[:3], 2 * vec(el)[3:]])
-    return s + vec(R.T @ tensor(sl) @ R)
+
+    def stress(dd):
+        el = R @ tensor(dd) @ R.T
+        sl = C @ np.concatenate([vec(el)[:3], 2 * vec(el)[3:]])
+        return vec(R.T @ tensor(sl) @ R)
+    dev = np.array(d, float)
+    dev[:3] -= dev[:3].sum() / 3
+    return s + stress(d), -stress(dev)[:3].mean()
 
 
 def _random_ortho(rng):
@@ -228,7 +238,7 @@ def test_twin_random_states():
         orient = (rng.uniform(0, 90), rng.uniform(-360, 720), rng.uniform(-200, 200))
         if i % 2:
             c = _random_ortho(rng)
-            got = run(ort, ortho_rows(*c, *orient), d, s)
+            got, dsp = run(ort, ortho_rows(*c, *orient), d, s, dsp=True)
         else:
             while True:
                 E, En = rng.uniform(1e9, 8e10, 2)
@@ -238,9 +248,10 @@ def test_twin_random_states():
                 if nu > -1 and np.linalg.eigvalsh(local_compliance(*c)).min() > 0:
                     break
             orient = (orient[0], orient[1], 0.0)
-            got = run(ti, ti_rows(E, En, nu, nun, Gn, orient[0], orient[1]), d, s)
-        want = twin(c, orient, d, s)
+            got, dsp = run(ti, ti_rows(E, En, nu, nun, Gn, orient[0], orient[1]), d, s, dsp=True)
+        want, wdsp = twin(c, orient, d, s)
         np.testing.assert_allclose(got - s, want - s, rtol=0, atol=1e-10 * np.abs(want - s).max())
+        assert abs(dsp - wdsp) <= 1e-10 * np.abs(want - s).max()
 
 
 def test_inadmissible_constants_keep_stress():
@@ -312,3 +323,71 @@ def test_moduli_bound_the_acoustic_tensor():
     K, G = cmodels.ZONE_MODELS["anisotropic"].bulk_shear(ti_rows(E, E, nu, nu, G0, 30, 60))
     assert K[0] + 4 * G[0] / 3 == pytest.approx(max(3 * K0, 2 * G0), rel=1e-12)
     assert G[0] == pytest.approx(G0, rel=1e-12)
+
+
+# ---- through the zone step ---------------------------------------------------------------------
+
+def _assembled_stiffness(symmetrize):
+    """The 4-node zone step's stiffness on a jittered lattice of orthotropic zones (one set of
+    constants and axes), NMD on: column j the nodal forces of a unit velocity on freedom j over a
+    unit step from zero stress. ``symmetrize`` False runs the step without its averaging sweep
+    (the dsp ignored), as a non-plastic model would be stepped."""
+    from dec3d.physics.zones import zone_bundles
+    from tests.test_zone_elastic_kernels import _case
+    from tests.zone_step_run import Stepper
+
+    pos, _, gp, rows, zset, weight, node, prop, _ = _case(5, plain=True)
+    nz, nv = len(gp), len(pos)
+    prop[:] = ortho_rows(*ORTHO, 35, 120, 25)[0]
+    cm = np.full(nz, CODES["orthotropic"], np.int8)
+    zs = Stepper(gp, rows, zset, weight, node, nv, cm, prop)
+    assert zs.plastic
+    if not symmetrize:
+        zs.plastic = False
+        zs.mesh, zs.zplan, zs.scr = zone_bundles(zs.plan, 0, False)
+    Kmat = np.zeros((3 * nv, 3 * nv))
+    for j in range(3 * nv):
+        vel = np.zeros((nv, 3))
+        vel[j // 3, j % 3] = 1.0
+        f, fm = np.zeros((nv, 3)), np.zeros(nv)
+        zs.step(pos, vel, np.zeros((nz, 6)), np.zeros(nz, np.int32), f, fm, 1.0, False, True)
+        Kmat[:, j] = -f.ravel()
+    return Kmat
+
+
+def test_nmd_stiffness_symmetric():
+    """With NMD on, the returned dsp (the mean stress of the deviatoric strain, averaged by the
+    step's sweep) makes the assembled stiffness symmetric (to 1e-12 of its largest entry); without
+    the sweep it is not (the flutter that blew up anisotropic cubes): more than 1e-3 off."""
+    K = _assembled_stiffness(True)
+    scale = np.abs(K).max()
+    assert np.abs(K - K.T).max() <= 1e-12 * scale
+    assert np.linalg.eigvalsh(0.5 * (K + K.T)).min() > -1e-9 * scale      # six rigid modes, none negative
+    K0 = _assembled_stiffness(False)
+    assert np.abs(K0 - K0.T).max() > 1e-3 * scale
+
+
+def test_cube_through_engine_nmd_on():
+    """A 1 m cube of tetrahedral orthotropic zones (dip 0, dip-direction 0, rotation 90: 1' = −x,
+    2' = −y, 3' = z) on rollers under 1 MPa on its top face, NMD on, solved: stable, and the
+    strains of the compliance, εzz = σ/E3, εxx = −ν13 σ/E3, εyy = −ν23 σ/E3, to 1e-6."""
+    from dec3d.session import Session
+
+    s = Session()
+    for line in ("model new", "block create brick 0 1 0 1 0 1", "block zone generate edgelength 0.5",
+                 "block zone cmodel assign orthotropic", "block zone property density 2500"):
+        s.command(line)
+    zs = s.model.store("zones")
+    zs["prop"][:, ort.P_OWN:ort.P_OWN + 12] = ortho_rows(*ORTHO, 0, 0, 90)[0, ort.P_OWN:ort.P_OWN + 12]
+    for line in ("block gridpoint apply velocity-z 0 range position-z 0",
+                 "block gridpoint apply velocity-y 0 range position-y 0",
+                 "block gridpoint apply velocity-x 0 range position-x 0",
+                 "block face apply stress-zz -1e6 range position-z 1", "model solve ratio 1e-9"):
+        s.command(line)
+    E1, E2, E3, n12, n13, n23 = ORTHO[:6]
+    v = s.model.vertices
+    gp = np.flatnonzero(v["zoned"])
+    p, u = v["pos"][gp], v["disp"][gp]
+    for axis, want in ((0, n13 * 1e6 / E3), (1, n23 * 1e6 / E3), (2, -1e6 / E3)):
+        slope = np.polyfit(p[:, axis], u[:, axis], 1)[0]
+        assert slope == pytest.approx(want, rel=1e-6)

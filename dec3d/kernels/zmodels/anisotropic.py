@@ -13,7 +13,9 @@ the orthotropic one (``orthotropic.py``, whose law and axes this uses) with
 
 The plane of isotropy is the plane of the dip and dip direction (rotation 0: any in-plane
 rotation gives the same law), so 3' is its upward normal (sin δ sin α, sin δ cos α, cos δ):
-dip 90, dip direction 90 makes x the axis of symmetry.
+dip 90, dip direction 90 makes x the axis of symmetry. Like the orthotropic model it returns
+dsp = −tr(C : dev d)/3 so that the step's averaging sweep keeps the stiffness symmetric under
+nodal mixed discretization (``orthotropic.py``'s text).
 """
 from numba import njit
 
@@ -32,7 +34,7 @@ P_DD = P_OWN + 6      # dip-direction [deg]
 NCOLS = P_OWN + 7
 NHIST = 0
 HIST_NAMES = ()
-PLASTIC = False
+PLASTIC = True    # see orthotropic.py: the averaging sweep makes NMD symmetric
 
 
 @njit(cache=True)
@@ -42,6 +44,6 @@ def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, w
     nun = p[z, P_NUN]
     gn = p[z, P_GN]
     g12 = e / (2.0 * (1.0 + nu)) if nu > -1.0 else 0.0       # 0: refused by ortho_increment
-    s0, s1, s2, s3, s4, s5 = ortho_increment(e, e, p[z, P_EN], nu, nun, nun, g12, gn, gn, p[z, P_DIP], p[z, P_DD],
+    s0, s1, s2, s3, s4, s5, q = ortho_increment(e, e, p[z, P_EN], nu, nun, nun, g12, gn, gn, p[z, P_DIP], p[z, P_DD],
                                              0.0, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5)
-    return 0, s0, s1, s2, s3, s4, s5, 0.0
+    return 0, s0, s1, s2, s3, s4, s5, -q

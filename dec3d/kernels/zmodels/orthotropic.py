@@ -32,6 +32,21 @@ local axes in global components), applies the local stiffness, rotates the stres
 back (Δσ = Rᵀ Δσ' R) and adds it. The rotation and the stiffness are worked out on every call
 (the 12 own columns hold the nine constants and three angles, in degrees). A zone whose
 compliance is not positive definite (the host refuses it before cycling) keeps its stress.
+
+Nodal mixed discretization. The step hands the update a strain increment whose volumetric part
+ē is averaged over the zones around each gridpoint (NMD, or a hexahedral set's mean). For an
+isotropic law that keeps the assembled stiffness symmetric (the mean stress K ē acts on the
+zone's own volumetric strain; volume times averaging is a symmetric operator), but an
+anisotropic C couples the two parts: the deviatoric stress takes the averaged ē while the mean
+stress would take the zone's own deviatoric strain unaveraged, a non-symmetric stiffness under
+which the damped explicit scheme grows oscillations (a cube of these zones under a face load
+blew up after some 1500 steps with NMD on, and was exact with it off). The cure used here: the
+mean stress made by the deviatoric part of d, q = tr(C : dev d)/3, is averaged as the plastic
+mean-stress correction is (3DEC theory text, NMD Eqs. 74-76): the update returns dsp = −q, and the
+step's averaging sweep replaces q in the zone's mean stress by its average. The transposed
+couplings then match, the stiffness is symmetric again, and for isotropic constants q = 0, the
+step of the elastic model. So the model declares PLASTIC (it needs that sweep) though its bits
+stay 0. With NMD off and outside hexahedral sets the sweep changes nothing.
 """
 import math
 
@@ -56,7 +71,7 @@ P_ROT = P_OWN + 11    # rotation [deg]
 NCOLS = P_OWN + 12
 NHIST = 0
 HIST_NAMES = ()
-PLASTIC = False
+PLASTIC = True    # not plastic: the step's averaging sweep symmetrizes NMD (module text)
 
 
 @njit(cache=True)
@@ -100,10 +115,11 @@ def _sandwich(a1x, a1y, a1z, a2x, a2y, a2z, a3x, a3y, a3z, t0, t1, t2, t3, t4, t
 @njit(cache=True)
 def ortho_increment(e1, e2, e3, n12, n13, n23, g12, g13, g23, dip, ddir, rot,
                     d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5):
-    """s + C : d for the orthotropic constants in the local axes of (dip, ddir, rot) [deg]
-    (the module's text); s unchanged when the constants are not admissible."""
+    """(s + C : d, q) for the orthotropic constants in the local axes of (dip, ddir, rot)
+    [deg] (the module's text), q the mean of C : dev(d), the mean stress the deviatoric part of d
+    makes; s unchanged and q = 0 when the constants are not admissible."""
     if not (e1 > 0.0 and e2 > 0.0 and e3 > 0.0 and g12 > 0.0 and g13 > 0.0 and g23 > 0.0):
-        return s0, s1, s2, s3, s4, s5
+        return s0, s1, s2, s3, s4, s5, 0.0
     # normal block of the local compliance and its inverse by cofactors
     c11 = 1.0 / e1; c22 = 1.0 / e2; c33 = 1.0 / e3
     c12 = -n12 / e2; c13 = -n13 / e3; c23 = -n23 / e3
@@ -115,7 +131,7 @@ def ortho_increment(e1, e2, e3, n12, n13, n23, g12, g13, g23, dip, ddir, rot,
     k23 = c12 * c13 - c11 * c23
     det = c11 * k11 + c12 * k12 + c13 * k13
     if not (det > 0.0 and k11 > 0.0 and k33 > 0.0):
-        return s0, s1, s2, s3, s4, s5
+        return s0, s1, s2, s3, s4, s5, 0.0
     k11 /= det; k22 /= det; k33 /= det; k12 /= det; k13 /= det; k23 /= det
     a1x, a1y, a1z, a2x, a2y, a2z, a3x, a3y, a3z = local_axes(dip, ddir, rot)
     l0, l1, l2, l3, l4, l5 = _sandwich(a1x, a1y, a1z, a2x, a2y, a2z, a3x, a3y, a3z, d0, d1, d2, d3, d4, d5)
@@ -127,13 +143,16 @@ def ortho_increment(e1, e2, e3, n12, n13, n23, g12, g13, g23, dip, ddir, rot,
     q5 = 2.0 * g23 * l5
     # back to global axes: the columns of R are the rows of Rᵀ
     r0, r1, r2, r3, r4, r5 = _sandwich(a1x, a2x, a3x, a1y, a2y, a3y, a1z, a2z, a3z, q0, q1, q2, q3, q4, q5)
-    return s0 + r0, s1 + r1, s2 + r2, s3 + r3, s4 + r4, s5 + r5
+    # mean of C:d less the mean of C:(ev/3) I (traces are the same in both axes)
+    ksum = k11 + k22 + k33 + 2.0 * (k12 + k13 + k23)
+    qd = (q0 + q1 + q2) / 3.0 - (l0 + l1 + l2) * ksum / 9.0
+    return s0 + r0, s1 + r1, s2 + r2, s3 + r3, s4 + r4, s5 + r5, qd
 
 
 @njit(cache=True)
 def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
-    s0, s1, s2, s3, s4, s5 = ortho_increment(p[z, P_E1], p[z, P_E2], p[z, P_E3], p[z, P_NU12], p[z, P_NU13],
+    s0, s1, s2, s3, s4, s5, q = ortho_increment(p[z, P_E1], p[z, P_E2], p[z, P_E3], p[z, P_NU12], p[z, P_NU13],
                                              p[z, P_NU23], p[z, P_G12], p[z, P_G13], p[z, P_G23], p[z, P_DIP],
                                              p[z, P_DD], p[z, P_ROT], d0, d1, d2, d3, d4, d5,
                                              s0, s1, s2, s3, s4, s5)
-    return 0, s0, s1, s2, s3, s4, s5, 0.0
+    return 0, s0, s1, s2, s3, s4, s5, -q
