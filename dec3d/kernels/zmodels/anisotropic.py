@@ -5,7 +5,7 @@ Source: Itasca, FLAC3D/3DEC documentation, "Anisotropic (Transversely) Elastic M
 Theory and Background, Constitutive Models),
 http://docs.itascacg.com/flac3d700/common/models/aniso/doc/modelaniso.html: the axis of symmetry,
 normal to the plane of isotropy, is the local 3' axis; 1', 2' lie in the plane, and the model is
-the orthotropic one (``orthotropic.py``, whose law and axes this uses) with
+the orthotropic law (``_elastic_aniso.py``, whose law, axes and update this uses) with
 
     E1 = E2 = E (young-plane),  E3 = E' (young-normal),  ν12 = ν (poisson-plane),
     ν13 = ν23 = ν' (poisson-normal: lateral contraction in the plane under tension normal to it),
@@ -15,12 +15,12 @@ The plane of isotropy is the plane of the dip and dip direction (rotation 0: any
 rotation gives the same law), so 3' is its upward normal (sin δ sin α, sin δ cos α, cos δ):
 dip 90, dip direction 90 makes x the axis of symmetry. Like the orthotropic model it returns
 dsp = −tr(C : dev d)/3 so that the step's averaging sweep keeps the stiffness symmetric under
-nodal mixed discretization (``orthotropic.py``'s text).
+nodal mixed discretization (``_elastic_aniso.py``'s text).
 """
 from numba import njit
 
 from ._common import P_OWN
-from .orthotropic import ortho_increment
+from ._elastic_aniso import ortho_increment
 
 NAME = "anisotropic"
 CODE = 7          # kept in save files: never renumber
@@ -34,7 +34,7 @@ P_DD = P_OWN + 6      # dip-direction [deg]
 NCOLS = P_OWN + 7
 NHIST = 0
 HIST_NAMES = ()
-PLASTIC = True    # see orthotropic.py: the averaging sweep makes NMD symmetric
+PLASTIC = True    # for the step's averaging sweep (symmetric NMD), not for yield: bits stay 0
 
 
 @njit(cache=True)

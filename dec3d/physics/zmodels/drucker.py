@@ -29,9 +29,10 @@ P_QPHI, P_KPHI, P_QPSI = kernel.P_QPHI, kernel.P_KPHI, kernel.P_QPSI
 _TENSION = [q for q in MOHR_STRENGTH if q.name == "tension"]
 
 PROPS = ELASTIC + [
-    Prop("friction-drucker", P_QPHI, "material constant q_φ: f_s = τ + q_φ σ − k_φ (τ = √J2, σ mean stress)"),
+    Prop("friction-drucker", P_QPHI, "material constant q_φ of f_s = τ + q_φ σ − k_φ (τ = √J2, σ mean stress)",
+         ""),
     Prop("cohesion-drucker", P_KPHI, "material constant k_φ of the shear criterion", "Pa"),
-    Prop("dilation-drucker", P_QPSI, "material constant q_ψ of the shear potential g_s = τ + q_ψ σ"),
+    Prop("dilation-drucker", P_QPSI, "material constant q_ψ of the shear potential g_s = τ + q_ψ σ", ""),
 ] + _TENSION
 
 

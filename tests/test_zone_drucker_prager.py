@@ -217,3 +217,41 @@ def test_host_check_and_ranges():
     rows[0, dp.P_QPSI] = -0.1
     probs, _ = m.problems(rows, np.array([1, 2, 3]))
     assert len(probs) == 1 and probs[0].startswith("dilation-drucker")
+
+
+@pytest.mark.parametrize("line, message", [
+    ("block zone property friction-drucker -0.1", r"`friction-drucker` must be ≥ 0, got"),
+    ("block zone property cohesion-drucker -1", r"`cohesion-drucker` must be ≥ 0, got"),
+    ("block zone property dilation-drucker -0.2", r"`dilation-drucker` must be ≥ 0, got"),
+    ("block zone property tension -5", r"`tension` must be ≥ 0, got"),
+])
+def test_out_of_range_keywords_refused_with_location(tmp_path, line, message):
+    import io
+
+    from dec3d.errors import Dec3dError
+    from dec3d.session import Session
+
+    s = Session(out_dir=tmp_path, stdout=io.StringIO())
+    s.command("model new\nblock create brick 0 1 0 1 0 1\nblock zone generate edgelength 1\n"
+              "block zone cmodel assign drucker-prager")
+    before = s.model.store("zones")["prop"].copy()
+    with pytest.raises(Dec3dError, match=message) as e:
+        s.command(line)
+    loc = e.value.location
+    assert loc is not None and loc.line == 1 and loc.column == line.rindex(line.split()[4]) + 1
+    np.testing.assert_array_equal(s.model.store("zones")["prop"], before)
+
+
+def test_keywords_reach_their_columns(tmp_path):
+    import io
+
+    from dec3d.session import Session
+
+    s = Session(out_dir=tmp_path, stdout=io.StringIO())
+    s.command("model new\nblock create brick 0 1 0 1 0 1\nblock zone generate edgelength 1\n"
+              "block zone cmodel assign drucker-prager\nblock zone property young 1e9 poisson 0.25 density 2000 "
+              "friction-drucker 0.4 cohesion-drucker 2e5 dilation-drucker 0.1 tension 1e4")
+    p = s.model.store("zones")["prop"]
+    n = s.model.store("zones").n
+    assert (p[:n, dp.P_QPHI] == 0.4).all() and (p[:n, dp.P_KPHI] == 2e5).all()
+    assert (p[:n, dp.P_QPSI] == 0.1).all() and (p[:n, TENSION_COLUMN] == 1e4).all()

@@ -391,3 +391,58 @@ def test_cube_through_engine_nmd_on():
     for axis, want in ((0, n13 * 1e6 / E3), (1, n23 * 1e6 / E3), (2, -1e6 / E3)):
         slope = np.polyfit(p[:, axis], u[:, axis], 1)[0]
         assert slope == pytest.approx(want, rel=1e-6)
+
+
+def test_ti_positive_definite_condition():
+    """The host's refusal agrees with the closed-form condition it states: ν > −1 and
+    1 − ν − 2 ν'² E/E' > 0."""
+    a = cmodels.ZONE_MODELS["anisotropic"]
+    rng = np.random.default_rng(4)
+    for _ in range(300):
+        E, En = rng.uniform(1e9, 5e10, 2)
+        nu, nun = rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5)
+        rows = ti_rows(E, En, nu, nun, 3e9, 0, 0)
+        rows[0, 2] = 2000.0
+        probs, _ = a.problems(rows, np.array([1]))
+        ok = nu > -1 and 1 - nu - 2 * nun ** 2 * E / En > 0
+        assert (probs == []) == ok, (E, En, nu, nun, probs)
+
+
+@pytest.mark.parametrize("model, line, message", [
+    ("orthotropic", "block zone property young-1 0", r"`young-1` must be > 0"),
+    ("orthotropic", "block zone property shear-23 -1e9", r"`shear-23` must be > 0"),
+    ("orthotropic", "block zone property dip 95", r"`dip` must be in \[0, 90\]"),
+    ("anisotropic", "block zone property young-normal -2", r"`young-normal` must be > 0"),
+    ("anisotropic", "block zone property dip -1", r"`dip` must be in \[0, 90\]"),
+])
+def test_out_of_range_keywords_refused_with_location(tmp_path, model, line, message):
+    import io
+
+    from dec3d.errors import Dec3dError
+    from dec3d.session import Session
+
+    s = Session(out_dir=tmp_path, stdout=io.StringIO())
+    s.command("model new\nblock create brick 0 1 0 1 0 1\nblock zone generate edgelength 1\n"
+              f"block zone cmodel assign {model}")
+    before = s.model.store("zones")["prop"].copy()
+    with pytest.raises(Dec3dError, match=message) as e:
+        s.command(line)
+    loc = e.value.location
+    value = line.split()[4]
+    assert loc is not None and loc.line == 1 and loc.column == line.rindex(value) + 1      # the value's place
+    np.testing.assert_array_equal(s.model.store("zones")["prop"], before)
+
+
+def test_cycling_refuses_a_bad_compliance_naming_zones(tmp_path):
+    import io
+
+    from dec3d.errors import Dec3dError
+    from dec3d.session import Session
+
+    s = Session(out_dir=tmp_path, stdout=io.StringIO())
+    s.command("model new\nblock create brick 0 1 0 1 0 1\nblock zone generate edgelength 1\n"
+              "block zone cmodel assign orthotropic\nblock zone property density 2000 young-1 10e9 young-2 10e9 "
+              "young-3 10e9 poisson-12 0.2 poisson-13 0.2 poisson-23 0.2 shear-12 4e9 shear-13 4e9 shear-23 4e9\n"
+              "block zone property poisson-12 1.5 range id 1")
+    with pytest.raises(Dec3dError, match=r"orthotropic zones: compliance not positive definite .*: 1 zone\(s\) \(1\)"):
+        s.command("model cycle 1")
