@@ -65,7 +65,7 @@ def twin(s, d, K, G, qphi, kphi, qpsi, ten):
     corner = np.linalg.solve(np.array(n), np.array(r))        # where both lines meet
     corner[1] = max(corner[1], 0.0)
     w = n[0] / np.linalg.norm(n[0]) - n[1] / np.linalg.norm(n[1])
-    act = 0 if (x - corner) @ w > 0 else 1
+    act = 0 if (x - corner) @ w >= 0 else 1
     lam = np.linalg.solve(np.array([[n[act] @ m[act]]]), np.array([F[act]]))[0]
     y = x - max(lam, 0.0) * m[act]
     bits = 1 if act == 0 else 2

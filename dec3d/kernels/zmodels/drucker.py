@@ -17,13 +17,16 @@ A trial stress violating a criterion returns along the flow of one of them, chos
 through the corner (σ^t, τ^P) that bisects the outward normals of the two criteria there:
 
     h = τ − τ^P − α^P (σ − σ^t),  τ^P = k_φ − q_φ σ^t,  α^P = sqrt(1 + q_φ²) − q_φ;
-    h > 0: shear return,  λ = f_s / (G + K q_φ q_ψ),  τ_N = τ − G λ,  σ_N = σ − K q_ψ λ,
+    h ≥ 0: shear return,  λ = f_s / (G + K q_φ q_ψ),  τ_N = τ − G λ,  σ_N = σ − K q_ψ λ,
            the deviator scaled by τ_N / τ;
-    h ≤ 0: tension return, σ_N = σ^t, the deviator kept.
+    h < 0: tension return, σ_N = σ^t, the deviator kept.
 
 (In the (σ, τ) plane the normals are (q_φ, 1)/sqrt(1 + q_φ²) and (1, 0); their bisector at the
 corner has slope 1 / (q_φ + sqrt(1 + q_φ²)) = α^P. Where f_s > 0 the trial lies above it, where
-f_t > 0 below it, so one test picks the criterion, as Itasca's h does for Mohr-Coulomb.)
+f_t > 0 below it, so one test picks the criterion, as Itasca's h does for Mohr-Coulomb. Since
+f_s / sqrt(1 + q_φ²) and f_t are the distances past the two lines, h / sqrt(1 + q_φ²) is their
+difference: the return is to the line the trial is farther past, the test of Itasca's published
+model source, ties to shear as there.)
 
 dec3d's completion: where the chosen return lands beyond the other criterion (a shear return
 to σ_N > σ^t or τ_N < 0, a tension return with τ > τ^P: trial stresses near the corner), the
@@ -72,7 +75,7 @@ def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, w
     if taup < 0.0:                       # (round-off when σ^t is the apex)
         taup = 0.0
     ap = math.sqrt(1.0 + qf * qf) - qf
-    if tau - taup - ap * (sig - st) > 0.0:
+    if tau - taup - ap * (sig - st) >= 0.0:
         den = G + K * qf * qp
         lam = fs / den if den > 0.0 and fs > 0.0 else 0.0
         tn = tau - G * lam
