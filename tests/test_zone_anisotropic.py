@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from dec3d.kernels.zmodels import CODES, NWORK, NZHIST, NZPROP, PLASTIC_CODES, no_tables
+from dec3d.kernels.zmodels import CODES, CORRECTING_CODES, NWORK, NZHIST, NZPROP, PLASTIC_CODES, no_tables
 from dec3d.kernels.zmodels import anisotropic as ti
 from dec3d.kernels.zmodels import orthotropic as ort
 from dec3d.kernels.zmodels._common import hooke
@@ -94,7 +94,7 @@ TI = (30e9, 12e9, 0.22, 0.3, 5e9)
 
 def test_registered():
     assert CODES["anisotropic"] == 7 and CODES["orthotropic"] == 8
-    assert {7, 8} <= PLASTIC_CODES             # for the step's averaging sweep (NMD), not for yield
+    assert {7, 8} <= CORRECTING_CODES and not {7, 8} & PLASTIC_CODES    # the averaging sweep (NMD), no yield
     o = cmodels.ZONE_MODELS["orthotropic"]
     a = cmodels.ZONE_MODELS["anisotropic"]
     assert set(o.props) == {"density", "young-1", "young-2", "young-3", "poisson-12", "poisson-13", "poisson-23",

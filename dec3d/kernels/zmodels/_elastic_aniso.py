@@ -50,8 +50,8 @@ mean stress made by the deviatoric part of d, q = tr(C : dev d)/3, is averaged a
 mean-stress correction is (3DEC theory text, NMD Eqs. 74-76): the update returns dsp = −q, and the
 step's averaging sweep replaces q in the zone's mean stress by its average. The transposed
 couplings then match, the stiffness is symmetric again, and for isotropic constants q = 0, the
-step of the elastic model. So the model declares PLASTIC (it needs that sweep) though its bits
-stay 0. With NMD off and outside hexahedral sets the sweep changes nothing.
+step of the elastic model. So the models declare CORRECTS (they need that sweep) and not PLASTIC
+(they never yield: their bits stay 0). With NMD off and outside hexahedral sets the sweep changes nothing.
 
 Mass scaling and time step (``bound_moduli``, the hosts' ``moduli``): the engine scales masses
 with the P-wave modulus M = K + 4G/3 of an isotropic zone, which bounds u·Q(n)·u for unit vectors

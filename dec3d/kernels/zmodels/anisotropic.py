@@ -34,7 +34,8 @@ P_DD = P_OWN + 6      # dip-direction [deg]
 NCOLS = P_OWN + 7
 NHIST = 0
 HIST_NAMES = ()
-PLASTIC = True    # for the step's averaging sweep (symmetric NMD), not for yield: bits stay 0
+PLASTIC = False   # never yields (bits stay 0)
+CORRECTS = True   # its dsp needs the step's averaging sweep (symmetric NMD)
 
 
 @njit(cache=True)

@@ -6,7 +6,7 @@ https://docs.itascacg.com/pfc700/common/models/ortho/doc/modelortho.html. The la
 update and the mean-stress correction that keeps nodal mixed discretization symmetric are in
 ``_elastic_aniso.py`` (shared with the transversely isotropic model ``anisotropic``). The 12 own
 columns hold the nine constants and the three angles (degrees). The update returns bits 0 and
-dsp = −tr(C : dev d)/3; PLASTIC is declared for the step's averaging sweep, not for yield.
+dsp = −tr(C : dev d)/3; CORRECTS is declared for the step's averaging sweep (it never yields).
 """
 from numba import njit
 
@@ -30,7 +30,8 @@ P_ROT = P_OWN + 11    # rotation [deg]
 NCOLS = P_OWN + 12
 NHIST = 0
 HIST_NAMES = ()
-PLASTIC = True    # for the step's averaging sweep (symmetric NMD), not for yield: bits stay 0
+PLASTIC = False   # never yields (bits stay 0)
+CORRECTS = True   # its dsp needs the step's averaging sweep (symmetric NMD)
 
 
 @njit(cache=True)
