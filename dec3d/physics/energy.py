@@ -126,14 +126,23 @@ def value(model, quantity: str) -> float:
 
 
 def refuse_unsupported(run, error) -> None:
-    """Energy tracking covers rigid blocks and zoned blocks of 4-node zones: FE blocks and 10-node zones
-    are refused with ``error`` (the engine's RunError) before anything cycles."""
+    """Energy tracking covers rigid blocks and zoned blocks of 4-node zones of isotropic elasticity: FE
+    blocks, 10-node zones and anisotropic zones are refused with ``error`` (the engine's RunError)
+    before anything cycles."""
     zst = run.zst
     what = None
     if zst is not None and zst.fe is not None:
         what = "FE blocks"
     elif zst is not None and len(zst.rows10):
         what = "10-node zones"
+    elif zst is not None and len(zst.rows4):
+        from dec3d.physics.cmodels import MODEL_BY_CODE
+
+        # the strain energy here is that of isotropic elasticity, from the stress and K, G
+        codes = np.unique(run.m.store("zones")["cmodel"][zst.rows4])
+        own = sorted(MODEL_BY_CODE[int(c)].name for c in codes if MODEL_BY_CODE[int(c)].moduli is not None)
+        if own:
+            what = f"zones of the anisotropic models {', '.join(own)}"
     if what:
         raise error(f"energy tracking (`model energy active on`) covers rigid blocks and 4-node zones; {what} "
                     "are not supported yet: switch it off with `model energy active off`")
