@@ -1,0 +1,179 @@
+"""Zone model ``strain-softening``: Itasca's strain-softening/strain-hardening Mohr-Coulomb model.
+
+Source: Itasca, FLAC3D/3DEC documentation, "Strain-Softening/Hardening Mohr-Coulomb (SSoft)
+Model", https://docs.itascacg.com/itasca900/common/models/ssoft/doc/modelssoft.html (and its
+property page: ``table-cohesion``, ``table-friction``, ``table-dilation``, ``table-tension``; the
+hardening parameters are read as ``strain-shear-plastic`` and ``strain-tension-plastic``).
+
+The yield and potential functions, flow rules and stress corrections are those of the
+Mohr-Coulomb model (``dec3d/kernels/zone_mohr.py``, used here as is); what differs is that the
+cohesion c, friction φ and dilation ψ may be piecewise-linear functions (tables) of the shear
+hardening parameter κs, and the tensile strength σt a function of the tensile hardening
+parameter κt, both sums over the steps of plastic strain increments:
+
+    Δκs = ( ½ [ (Δε1ps − Δεmps)² + (Δεmps)² + (Δε3ps − Δεmps)² ] )^½,   Δεmps = (Δε1ps + Δε3ps)/3,
+
+the page's "measure of the second invariant of the plastic shear-strain increment tensor" for a
+shear return on one plane, whose intermediate principal plastic strain is 0
+(Δεps = λs (−1, 0, N_ψ) in the principal axes of ``zone_mohr``, s1 the most compressive);
+dec3d takes that invariant, (J2' of Δεps)^½, for every shear return (one plane, edge, corner), so
+it is Itasca's value for the one-plane return and the same measure for the others; and
+
+    Δκt = Δε3pt, the plastic tensile strain (the sum of the tensile multipliers when two or
+    three principal stresses are cut off, as Itasca's code adds them).
+
+Per step (Itasca's order): the properties of the step come from κ at the start of the step
+(tables at κs, κt; a property without a table keeps its column value), then the elastic trial
+and the Mohr-Coulomb return, then κ grows by this step's increments, so the next step sees the
+new properties. The plastic strain increment is worked out from the return in principal space,
+Δεp = D⁻¹ (σ_trial − σ_new) (the return keeps the principal axes): for a shear return its
+deviatoric part gives Δκs = (J2 of σ_trial − σ_new)^½ / 2G, for a tension return its trace
+Δκt = (mean(σ_trial) − mean(σ_new)) / K; when both act (the shear-tension corner) the principal
+plastic strains e1 <= e2 <= e3 are split as shear λs (−1, 0, N_ψ) with λs = −e1 and tension
+λt = e3 − λs N_ψ on the least compressive axis (the corner's flow rule; other mixed returns,
+which the tests do not meet, are split the same way).
+
+Table values: c and σt in Pa (taken >= 0), φ and ψ in degrees (kept in [0°, 89.99°]); σt is
+capped at the apex c/tan φ by the return (as Itasca). Strength reduction (``model
+factor-of-safety``): strengths from tables are divided by F = column P_SRF when F > 0 (c/F,
+tan φ/F, σt/F, and tan ψ kept at most the reduced tan φ); constant strengths come already
+reduced in their columns (the host's ``reduce``).
+
+Columns: the shared ones (bulk, shear, density, cohesion, tan friction, tension, tan dilation,
+P_SRF) and from P_OWN on the table references (table index + 1; 0: none) of cohesion,
+friction, dilation and tension. History: h[z, 0] = κs, h[z, 1] = κt.
+
+The chunk scratch ``wf`` holds what ``mohr.py`` keeps there, with the same meaning (wf[0:6] the
+K, G, c, tan φ, σt, tan ψ the Mohr-Coulomb constants wf[6:15] were made from; wf[16:22] the
+trial handed to the general return), so zones of either model may follow each other in a chunk.
+"""
+import math
+
+from numba import njit
+
+from ..principal import _invariants, _values
+from ..zone_mohr import mohr_constants, mohr_plastic, mohr_scalar
+from ._common import (P_COHESION, P_OWN, P_SRF, P_TANDIL, P_TANFRIC, P_TENSION, SHEAR_NOW, TENSION_NOW, hooke,
+                      table_value)
+
+NAME = "strain-softening"
+CODE = 3          # kept in save files: never renumber
+#: own columns: table references (table index + 1, 0 none)
+P_TABLE_COHESION = P_OWN
+P_TABLE_FRICTION = P_OWN + 1
+P_TABLE_DILATION = P_OWN + 2
+P_TABLE_TENSION = P_OWN + 3
+NCOLS = P_OWN + 4
+NHIST = 2
+HIST_NAMES = ("strain-shear-plastic", "strain-tension-plastic")     # κs, κt (Itasca's names)
+PLASTIC = True
+
+#: largest friction or dilation angle a table may give [degrees]: tan and N_φ stay finite
+MAX_ANGLE = 89.99
+_RAD = math.pi / 180.0
+
+
+@njit(cache=True, inline="always")
+def _table(tab, col, kappa):
+    """(has a table, its value at kappa) for the table reference ``col`` (index + 1; 0 none; a
+    reference past the tables bundle counts as none)."""
+    t = int(col)
+    if t <= 0 or t > tab.count.shape[0]:
+        return False, 0.0
+    return True, table_value(tab, t - 1, kappa)
+
+
+@njit(cache=True, inline="always")
+def _tan_deg(v):
+    if v < 0.0:
+        v = 0.0
+    elif v > MAX_ANGLE:
+        v = MAX_ANGLE
+    return math.tan(v * _RAD)
+
+
+@njit(cache=True)
+def strengths(p, h, z, tab):
+    """(c, tan φ, σt, tan ψ) of zone z for this step: tables at κs = h[z, 0] (c, φ, ψ) and
+    κt = h[z, 1] (σt), divided by F = p[z, P_SRF] when F > 0; the columns where there is no
+    table."""
+    ks = h[z, 0]
+    kt = h[z, 1]
+    f = p[z, P_SRF]
+    red = f > 0.0
+    coh = p[z, P_COHESION]
+    tf = p[z, P_TANFRIC]
+    ten = p[z, P_TENSION]
+    td = p[z, P_TANDIL]
+    has, v = _table(tab, p[z, P_TABLE_COHESION], ks)
+    if has:
+        coh = max(v, 0.0)
+        if red:
+            coh /= f
+    has, v = _table(tab, p[z, P_TABLE_FRICTION], ks)
+    if has:
+        tf = _tan_deg(v)
+        if red:
+            tf /= f
+    has, v = _table(tab, p[z, P_TABLE_DILATION], ks)
+    if has:
+        td = _tan_deg(v)
+    has, v = _table(tab, p[z, P_TABLE_TENSION], kt)
+    if has:
+        ten = max(v, 0.0)
+        if red:
+            ten /= f
+    if red and td > tf:
+        td = tf
+    return coh, tf, ten, td
+
+
+@njit(cache=True)
+def hardening_increments(bits, a0, a1, a2, a3, a4, a5, K, G, nps):
+    """(Δκs, Δκt) of a return with bits ``bits`` (SHEAR_NOW, TENSION_NOW or both) from
+    a = σ_trial − σ_new (xx yy zz xy xz yz), the moduli K, G and N_ψ (see the module text)."""
+    if K <= 0.0 or G <= 0.0:
+        return 0.0, 0.0
+    m, d0, d1, d2, j2, r = _invariants(a0, a1, a2, a3, a4, a5)
+    if bits & TENSION_NOW == 0:
+        return math.sqrt(max(j2, 0.0)) / (2.0 * G), 0.0
+    if bits & SHEAR_NOW == 0:
+        return 0.0, max(m / K, 0.0)
+    lo, mid, hi = _values(d0, d1, d2, a3, a4, a5, j2, r)
+    ev = m / (3.0 * K)
+    e1 = lo / (2.0 * G) + ev
+    e2 = mid / (2.0 * G) + ev
+    e3 = hi / (2.0 * G) + ev
+    ls = max(-e1, 0.0)
+    lt = e3 - ls * nps
+    if lt < 0.0:
+        lt = 0.0
+    elif lt > max(e3, 0.0):
+        lt = max(e3, 0.0)
+    x3 = e3 - lt
+    em = (e1 + e2 + x3) / 3.0
+    dks = math.sqrt(0.5 * ((e1 - em) ** 2 + (e2 - em) ** 2 + (x3 - em) ** 2))
+    return dks, lt
+
+
+@njit(cache=True)
+def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
+    coh, tf, ten, td = strengths(p, h, z, tab)
+    e0, e1, e2, e3, e4, e5 = hooke(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5)
+    if K != wf[0] or G != wf[1] or coh != wf[2] or tf != wf[3] or ten != wf[4] or td != wf[5]:
+        npf, csn, ft, nps, a1, a2, sp, ap, den = mohr_constants(K, G, coh, tf, ten, td)
+        wf[0] = K; wf[1] = G; wf[2] = coh; wf[3] = tf; wf[4] = ten; wf[5] = td
+        wf[6] = npf; wf[7] = csn; wf[8] = ft; wf[9] = nps; wf[10] = a1; wf[11] = a2
+        wf[12] = sp; wf[13] = ap; wf[14] = den
+    code, t0, t1, t2, t3, t4, t5, dp = mohr_scalar(e0, e1, e2, e3, e4, e5, coh, wf[6], wf[7], wf[8], wf[9],
+                                                   wf[10], wf[11], wf[12], wf[13], wf[14])
+    if code < 0:
+        s = wf[16:22]
+        s[0] = e0; s[1] = e1; s[2] = e2; s[3] = e3; s[4] = e4; s[5] = e5
+        code, dp = mohr_plastic(s, K, G, coh, tf, ten, td, mw)
+        t0 = s[0]; t1 = s[1]; t2 = s[2]; t3 = s[3]; t4 = s[4]; t5 = s[5]
+    if code != 0:
+        dks, dkt = hardening_increments(code, e0 - t0, e1 - t1, e2 - t2, e3 - t3, e4 - t4, e5 - t5, K, G, wf[9])
+        h[z, 0] += dks
+        h[z, 1] += dkt
+    return code, t0, t1, t2, t3, t4, t5, dp
