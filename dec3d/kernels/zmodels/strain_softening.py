@@ -29,9 +29,14 @@ new properties. The plastic strain increment is worked out from the return in pr
 Δεp = D⁻¹ (σ_trial − σ_new) (the return keeps the principal axes): for a shear return its
 deviatoric part gives Δκs = (J2 of σ_trial − σ_new)^½ / 2G, for a tension return its trace
 Δκt = (mean(σ_trial) − mean(σ_new)) / K; when both act (the shear-tension corner) the principal
-plastic strains e1 <= e2 <= e3 are split as shear λs (−1, 0, N_ψ) with λs = −e1 and tension
-λt = e3 − λs N_ψ on the least compressive axis (the corner's flow rule; other mixed returns,
-which the tests do not meet, are split the same way).
+plastic strains e1 <= e2 <= e3 are split into shear and tension by the flow rules: the
+compressive plastic strain is all shear, λs = −Σ min(e_k, 0) (each shear flow is −1 on its more
+compressive axis, +N_ψ on the other), the trace is λs (N_ψ − 1) + λt, so Δκt = λt = Σ e_k −
+λs (N_ψ − 1), and the shear part is e minus λt on the least compressive axis (exact for the
+shear-tension corner and for an edge of two shear planes with the cut-off on the least compressive
+axis; where two or three axes are cut off besides shear, a return whose split into planes is not
+unique anyway, the tension is taken from the least compressive axis down, each axis giving at most
+its plastic strain).
 
 Table values: c and σt in Pa (taken >= 0), φ and ψ in degrees (kept in [0°, 89.99°]); σt is
 capped at the apex c/tan φ by the return (as Itasca). Strength reduction (``model
@@ -144,15 +149,18 @@ def hardening_increments(bits, a0, a1, a2, a3, a4, a5, K, G, nps):
     e1 = lo / (2.0 * G) + ev
     e2 = mid / (2.0 * G) + ev
     e3 = hi / (2.0 * G) + ev
-    ls = max(-e1, 0.0)
-    lt = e3 - ls * nps
-    if lt < 0.0:
-        lt = 0.0
-    elif lt > max(e3, 0.0):
-        lt = max(e3, 0.0)
-    x3 = e3 - lt
-    em = (e1 + e2 + x3) / 3.0
-    dks = math.sqrt(0.5 * ((e1 - em) ** 2 + (e2 - em) ** 2 + (x3 - em) ** 2))
+    # the compressive plastic strain is all shear (flows −1 on their more compressive axis), the
+    # trace is λs (N_ψ − 1) + λt
+    ls = -(min(e1, 0.0) + min(e2, 0.0) + min(e3, 0.0))
+    lt = max((e1 + e2 + e3) - ls * (nps - 1.0), 0.0)
+    # the tensile part from the least compressive axis down, each axis at most its strain
+    t3 = min(lt, max(e3, 0.0))
+    t2 = min(lt - t3, max(e2, 0.0))
+    x1 = e1 - (lt - t3 - t2)
+    x2 = e2 - t2
+    x3 = e3 - t3
+    em = (x1 + x2 + x3) / 3.0
+    dks = math.sqrt(0.5 * ((x1 - em) ** 2 + (x2 - em) ** 2 + (x3 - em) ** 2))
     return dks, lt
 
 
