@@ -1,7 +1,8 @@
-"""The elastic 4-node zone step (``kernels/zone_elastic.py``): against a numpy twin written from
-the text's formulas (shape-function gradients, not the kernel's face vectors), bit for bit
-against the plastic step it stands in for (``zone_plastic.zone_forces_plastic``) for any number
-of parts and threads, and its scatter bookkeeping."""
+"""The 4-node zone step (``kernels/zone_step.py``) on elastic zones: against a numpy twin written
+from the text's formulas (shape-function gradients, not the kernel's face vectors), bit for bit
+against the serial twin in passes (``tests/zone_plastic_twin.py``) for any number of parts and
+threads and through either of its paths (two sweeps, or the plastic three), and the scatter
+bookkeeping of ``kernels/zone_elastic.py``."""
 import itertools
 
 import numba
@@ -9,8 +10,9 @@ import numpy as np
 import pytest
 
 from dec3d.kernels import zone_elastic as ze
-from dec3d.kernels import zone_plastic as zp
 from dec3d.model import zones as mz
+from tests import zone_plastic_twin as zp
+from tests.zone_step_run import Stepper
 
 K, G = 5e9, 3e9
 
@@ -106,16 +108,18 @@ def _case(seed, n=3, plain=False):
     return pos, vel, gp, rows, zset, weight, node, prop, stress
 
 
-def _run(case, large, nmd, nparts, identity_node=False):
+def _run(case, large, nmd, nparts, identity_node=False, plastic=False):
     pos, vel, gp, rows, zset, weight, node, prop, stress = case
     nv = len(pos)
     if identity_node:
         node = np.arange(nv, dtype=np.int64)
-    plan = ze.ElasticPlan(gp, rows, node, zset, weight, nv, nparts)
+    zs = Stepper(gp, rows, zset, weight, node, nv, np.full(len(gp), mz.ZMODEL_ELASTIC, np.int8), prop, nparts)
+    if plastic:                           # the three-sweep path, its correction zero on elastic zones
+        from dec3d.physics.zones import zone_bundles
+        zs.plastic = True
+        zs.mesh, zs.zplan, zs.scr = zone_bundles(zs.plan, int(zset.max()) + 1, True)
     st, f, fm = stress.copy(), np.ones((nv, 3)), np.full(nv, 0.5)
-    ze.elastic_zone_step(pos, vel, plan.g4, plan.n4, plan.rows, plan.zset, plan.weight, int(zset.max()) + 1,
-                         np.ascontiguousarray(prop[:, mz.ZP_BULK]), np.ascontiguousarray(prop[:, mz.ZP_SHEAR]),
-                         0.7, large, nmd, st, f, fm, *plan.args())
+    zs.step(pos, vel, st, np.zeros(len(gp), np.int32), f, fm, 0.7, large, nmd)
     return st, f, fm
 
 
@@ -152,9 +156,10 @@ def test_elastic_step_gives_the_plastic_steps_bits_for_any_parts_and_threads(lar
         for nt in (1, 2):
             numba.set_num_threads(min(nt, numba.config.NUMBA_NUM_THREADS))
             for parts in (1, 2, 3, 5, 16):
-                st, f, fm = _run(case, large, nmd, parts)
-                for a, b in zip((ref[0], ref[2], ref[3]), (st, f, fm)):
-                    assert np.array_equal(a, b), (nt, parts)
+                for plastic in (False, True):
+                    st, f, fm = _run(case, large, nmd, parts, plastic=plastic)
+                    for a, b in zip((ref[0], ref[2], ref[3]), (st, f, fm)):
+                        assert np.array_equal(a, b), (nt, parts, plastic)
     finally:
         numba.set_num_threads(keep)
 
@@ -269,14 +274,14 @@ model large-strain on
 """
 
 
-def _model_run(tmp_path, monkeypatch, threads, elastic, nmd="on", steps=60):
+def _model_run(tmp_path, monkeypatch, threads, chunked, nmd="on", steps=60):
     import io
 
     import dec3d
     import dec3d.physics.zones as pz
 
-    monkeypatch.setattr(pz, "ELASTIC_KERNEL", elastic)
-    monkeypatch.setattr(pz, "PARALLEL_MIN_ZONES", 0)          # the threaded kernels on this small model
+    if chunked:
+        monkeypatch.setattr(pz, "PARALLEL_MIN_ZONES", 0)      # one chunk per thread on this small model
     keep = numba.get_num_threads()
     numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     try:
@@ -286,15 +291,15 @@ def _model_run(tmp_path, monkeypatch, threads, elastic, nmd="on", steps=60):
         numba.set_num_threads(keep)
     m = s.model
     zst = m.rigid_engine._zstep
-    assert (zst.fast is not None) == elastic and zst.nset > 0
+    assert zst.nset > 0 and (len(zst.fast.pstart) > 2) == (chunked and threads > 1)
     return (m.store("zones")["stress"].copy(), m.vertices["disp"].copy(), m.vertices["velocity"].copy(),
             np.array([m.rigid_engine.kinetic, m.rigid_engine.criteria()["unbalanced-maximum"]]))
 
 
 @pytest.mark.parametrize("nmd", ["on", "off"])
 def test_model_runs_give_the_same_bits_with_either_kernel_and_thread_count(tmp_path, monkeypatch, nmd):
-    """A whole run (60 steps, large strain, tetrahedra and hexahedral sets): the elastic kernel
-    on 1 and 2 threads and the plastic kernels give the same stresses, displacements,
+    """A whole run (60 steps, large strain, tetrahedra and hexahedral sets): the zone step in one
+    chunk and in one chunk per thread on 1 and 2 threads gives the same stresses, displacements,
     velocities, kinetic energy and unbalanced force, bit for bit."""
     ref = _model_run(tmp_path, monkeypatch, 1, False, nmd)
     assert np.abs(ref[1]).max() > 1e-7                             # it moved

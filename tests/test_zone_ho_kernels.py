@@ -293,8 +293,8 @@ def test_patch_test_linear_velocity_uniform_strain():
 def test_same_convention_as_the_4_node_kernel():
     """Under a linear velocity field a straight-edged 10-node zone and the 4-node zone of its
     corners get the same stress, and their forces the same resultant moment tensor
-    sum_a x_a (x) f_a = -V sigma: same signs and units as kernels/zones.tet_elastic_step."""
-    from dec3d.kernels.zones import tet_elastic_step
+    sum_a x_a (x) f_a = -V sigma: same signs and units as the 4-node zone step (kernels/zone_step.py)."""
+    from tests.zone_step_run import elastic_tets as tet_elastic_step
     rng = np.random.default_rng(15)
     pos, gp = random_tets(rng, 2)
     A = rng.normal(size=(3, 3))

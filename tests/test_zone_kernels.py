@@ -1,7 +1,8 @@
-"""Twin test of kernels/zones.tet_elastic_step against a shape-function (matrix) implementation."""
+"""The engine's 4-node zone step (``kernels/zone_step.py``) on plain elastic tetrahedra against a
+shape-function (matrix) twin."""
 import numpy as np
 
-from dec3d.kernels.zones import tet_elastic_step
+from tests.zone_step_run import elastic_tets as tet_elastic_step
 
 
 def twin_tet_step(pos, vel, gp, bulk, shear, dt, stress, force):

@@ -7,11 +7,12 @@ import math
 import numpy as np
 import pytest
 
-from dec3d.errors import Dec3dError
 from dec3d.kernels import zone_mohr as zm
-from dec3d.kernels import zone_plastic as zp
 from dec3d.model import zones as mz
-from dec3d.model.zone_mohr import angle_to_tangent, mohr_props_check, tangent_to_angle
+from dec3d.physics.cmodels import ZONE_MODELS
+from tests.zone_step_run import Stepper
+
+MOHR = ZONE_MODELS["mohr-coulomb"].code
 
 K, G = 2e9, 1e9
 A1, A2 = K + 4 * G / 3, K - 2 * G / 3
@@ -33,11 +34,9 @@ def _cube_step(stress, state, prop, rate, nmd):
     s, st, f = stress.copy(), state.copy(), np.zeros((8, 3))
     vel = CUBE * np.asarray(rate)
     rows = np.arange(5, dtype=np.int64)
-    if nmd:
-        zp.tet_zone_step(CUBE, vel, CUBE5, rows, np.arange(8, dtype=np.int64),
-                         np.full(5, mz.ZMODEL_MOHR, np.int8), prop, 1.0, True, s, st, f)
-    else:
-        zm.tet_mohr_step(CUBE, vel, CUBE5, rows, prop, 1.0, s, st, f)
+    stepper = Stepper(CUBE5, rows, np.full(5, -1, np.int64), np.ones(5), np.arange(8, dtype=np.int64), 8,
+                      np.full(5, MOHR, np.int8), prop)
+    stepper.step(CUBE, vel, s, st, f, np.zeros(8), 1.0, False, nmd)
     return s, st
 
 
@@ -155,44 +154,40 @@ def _prow(c=1e6, fric=30.0, ten=0.5e6, dil=0.0):
     return p
 
 
+_MC = ZONE_MODELS["mohr-coulomb"]
+
+
 def test_angle_conversions():
-    assert angle_to_tangent(45.0) == pytest.approx(1.0, rel=1e-15)
-    assert np.allclose(tangent_to_angle(angle_to_tangent(np.array([0., 12.5, 89.0]))), [0, 12.5, 89.0])
-    for bad in (-1.0, 90.0, float("nan"), 120.0):
-        with pytest.raises(ValueError, match="less than 90 degrees"):
-            angle_to_tangent(bad)
+    fr = _MC.props["friction"]
+    assert fr.to_column(45.0) == pytest.approx(1.0, rel=1e-15)
+    assert np.allclose([fr.from_column(fr.to_column(a)) for a in (0., 12.5, 89.0)], [0, 12.5, 89.0])
 
 
 def test_mohr_props_check_accepts_good_rows_and_warns_at_the_apex():
-    assert mohr_props_check(np.array([_prow(), _prow(c=0, fric=0, ten=0), _prow(dil=30.0)])) == []
-    w = mohr_props_check(np.array([_prow(), _prow(c=1e6, fric=45.0, ten=2e6)]), ids=[7, 9])
-    assert len(w) == 1 and "1 zone(s) (9)" in w[0] and "apex" in w[0]
+    assert _MC.problems(np.array([_prow(), _prow(c=0, fric=0, ten=0), _prow(dil=30.0)]), [1, 2, 3]) == ([], [])
+    bad, w = _MC.problems(np.array([_prow(), _prow(c=1e6, fric=45.0, ten=2e6)]), [7, 9])
+    assert not bad and len(w) == 1 and "1 zone(s) (9)" in w[0] and "apex" in w[0]
 
 
 @pytest.mark.parametrize("row, words", [
-    (_prow(c=-1.0), "cohesion must be a finite value >= 0 Pa: 1 zone(s) (4)"),
-    (_prow(ten=-5.0), "tension must be a finite value >= 0 Pa"),
+    (_prow(c=-1.0), "cohesion must be >= 0 Pa: 1 zone(s) (4)"),
+    (_prow(ten=-5.0), "tension must be >= 0 Pa"),
     (_prow(dil=35.0), "dilation must not exceed friction: 1 zone(s) (4)"),
-    (_prow(c=float("nan")), "cohesion must be a finite value"),
-    (np.where(np.arange(mz.NZPROP) == mz.ZP_SHEAR, 0.0, _prow()), "shear must be > 0: 1 zone(s) (4)"),
+    (_prow(c=float("nan")), "cohesion must be >= 0 Pa"),
+    (np.where(np.arange(mz.NZPROP) == mz.ZP_SHEAR, 0.0, _prow()), "shear must be > 0 Pa: 1 zone(s) (4)"),
     (np.where(np.arange(mz.NZPROP) == mz.ZP_DENSITY, -1.0, _prow()), "density must be > 0"),
 ])
 def test_mohr_props_check_errors(row, words):
-    class RunError(Dec3dError):
-        pass
-    rows = np.array([_prow(), row])
-    with pytest.raises(RunError, match="Mohr-Coulomb zone properties") as e:
-        mohr_props_check(rows, ids=[3, 4], error=RunError)
-    assert words in str(e.value)
+    bad, _ = _MC.problems(np.array([_prow(), row]), [3, 4])
+    assert any(words in b for b in bad), bad
 
 
 def test_mohr_props_check_bad_friction_tangent():
     p = _prow(); p[mz.ZP_TANFRIC] = np.inf
-    with pytest.raises(Dec3dError, match="friction must be at least 0 and less than 90 degrees"):
-        mohr_props_check(p[None, :])
+    bad, _ = _MC.problems(p[None, :], [1])
+    assert any(b.startswith("friction must be >= 0 and < 90 deg") for b in bad), bad
     p[mz.ZP_TANFRIC] = -0.1
-    with pytest.raises(Dec3dError, match="friction"):
-        mohr_props_check(p[None, :])
+    assert any("friction" in b for b in _MC.problems(p[None, :], [1])[0])
 
 
 # --------------------------------------------------------------------------------------------
@@ -219,8 +214,9 @@ def _footing_pressure(nmd, nx=16, nz=8, h=0.5, half_width=1.0, steps=10000, v0=2
     Kf, Gf, c = 2e8, 1e8, 1e5
     prop = np.zeros((nzn, mz.NZPROP))
     prop[:, mz.ZP_BULK], prop[:, mz.ZP_SHEAR], prop[:, mz.ZP_COHESION], prop[:, mz.ZP_TENSION] = Kf, Gf, c, 1e12
-    cm = np.full(nzn, mz.ZMODEL_MOHR, np.int8)
+    cm = np.full(nzn, MOHR, np.int8)
     rows, node = np.arange(nzn, dtype=np.int64), np.arange(nv, dtype=np.int64)
+    stepper = Stepper(gp, rows, np.full(nzn, -1, np.int64), np.ones(nzn), node, nv, cm, prop)
     stress, state = np.zeros((nzn, 6)), np.zeros(nzn, np.int32)
     mass = np.zeros(nv)
     np.add.at(mass, gp.ravel(), (8 / 3) * (Kf + 4 * Gf / 3) * 2 * h * h / (h / math.sqrt(3)) / 4)
@@ -236,7 +232,7 @@ def _footing_pressure(nmd, nx=16, nz=8, h=0.5, half_width=1.0, steps=10000, v0=2
     p = []
     for it in range(steps):
         f = np.zeros((nv, 3))
-        zp.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 1.0, nmd, stress, state, f)
+        stepper.step(pos, vel, stress, state, f, np.zeros(nv), 1.0, False, nmd)
         if (it + 1) % (steps // 10) == 0:
             p.append(f[foot, 2].sum() / (half_width * h) / c)
         vel += np.where(fix, 0.0, (f - 0.8 * np.abs(f) * np.sign(vel)) / mass[:, None])

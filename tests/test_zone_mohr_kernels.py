@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 
 from dec3d.kernels import zone_mohr as zm
-from dec3d.kernels import zone_plastic as zp
-from dec3d.kernels.zones import tet_elastic_step
 from dec3d.model import zones as mz
+from dec3d.physics.cmodels import ZONE_MODELS
+from tests import zone_plastic_twin as zp
+from tests.zone_step_run import Stepper
 
 K, G = 2e9, 1e9
 A1, A2 = K + 4 * G / 3, K - 2 * G / 3
@@ -143,12 +144,13 @@ def _yield_values(s, c, tanphi, ten):
     return w[0] - w[2] * nphi + 2 * c * math.sqrt(nphi), w[2] - st
 
 
-def test_constants_mirror_the_model():
-    assert (zm.ZP_BULK, zm.ZP_SHEAR, zm.ZP_COHESION, zm.ZP_TANFRIC, zm.ZP_TENSION, zm.ZP_TANDIL) == \
+def test_the_twins_reading_of_the_store_is_the_models():
+    """tests/zone_plastic_twin.py writes its codes, columns and bits down itself (it shares no
+    constant with the kernels): they must be the model's."""
+    assert (zp.ZP_BULK, zp.ZP_SHEAR, zp.ZP_COHESION, zp.ZP_TANFRIC, zp.ZP_TENSION, zp.ZP_TANDIL) == \
         (mz.ZP_BULK, mz.ZP_SHEAR, mz.ZP_COHESION, mz.ZP_TANFRIC, mz.ZP_TENSION, mz.ZP_TANDIL)
-    assert (zm.ZMODEL_ELASTIC, zm.ZMODEL_MOHR) == (mz.ZMODEL_ELASTIC, mz.ZMODEL_MOHR)
-    assert (zm.SHEAR_NOW, zm.TENSION_NOW, zm.SHEAR_PAST, zm.TENSION_PAST) == \
-        (mz.ZSTATE_SHEAR_NOW, mz.ZSTATE_TENSION_NOW, mz.ZSTATE_SHEAR_PAST, mz.ZSTATE_TENSION_PAST)
+    assert (zp.ZMODEL_ELASTIC, zp.ZMODEL_MOHR) == (ZONE_MODELS["elastic"].code, ZONE_MODELS["mohr-coulomb"].code)
+    assert (zp.SHEAR_PAST, zp.TENSION_PAST) == (mz.ZSTATE_SHEAR_PAST, mz.ZSTATE_TENSION_PAST)
 
 
 def test_mohr_return_matches_twin_on_random_states():
@@ -221,10 +223,12 @@ def test_tension_return_is_associated_and_hits_the_cut_off():
 
 
 def test_state_bits_now_and_past():
-    assert zm.merge_state(0, 1) == 1 | 4
-    assert zm.merge_state(1 | 4, 0) == 4
-    assert zm.merge_state(4, 2) == 4 | 2 | 8
-    assert zm.merge_state(2 | 8 | 4, 0) == 12
+    from dec3d.kernels.zmodels import merge_state
+    assert merge_state(0, 1) == 1 | 4
+    assert merge_state(1 | 4, 0) == 4
+    assert merge_state(4, 2) == 4 | 2 | 8
+    assert merge_state(2 | 8 | 4, 0) == 12
+    assert merge_state(16 | 64 | 1, 32) == 32 | 64 | 128          # the weak plane's bits alike
 
 
 # --------------------------------------------------------------------------------------------
@@ -278,6 +282,20 @@ def _props(n, rng):
     return prop
 
 
+def _mohr_step(pos, vel, gp, prop, stress, state, force, dt, nmd=False, cm=None, node=None, zset=None, weight=None,
+               parts=1, large=False):
+    """The engine's zone step on every zone of gp (Mohr-Coulomb unless ``cm`` says otherwise)."""
+    nz, nv = len(gp), len(pos)
+    rows = np.arange(nz, dtype=np.int64)
+    cm = np.full(nz, ZONE_MODELS["mohr-coulomb"].code, np.int8) if cm is None else cm
+    node = np.arange(nv, dtype=np.int64) if node is None else node
+    zset = np.full(nz, -1, np.int64) if zset is None else zset
+    weight = np.ones(nz) if weight is None else weight
+    st = Stepper(gp, rows, zset, weight, node, nv, cm, prop, parts)
+    st.step(pos, vel, stress, state, force, np.zeros(nv), dt, large, nmd)
+    return st
+
+
 def test_tet_mohr_step_matches_twin():
     rng = np.random.default_rng(3)
     pos, gp = _two_cubes(rng)
@@ -285,10 +303,9 @@ def test_tet_mohr_step_matches_twin():
     vel = rng.normal(size=(len(pos), 3)) * 1e-3
     prop = _props(nz, rng)
     s0 = np.array([_vec6(np.diag([-1e6, -1.5e6, -2e6]))] * nz) + rng.normal(size=(nz, 6)) * 2e5
-    rows = np.arange(nz, dtype=np.int64)
     sk, fk, stk = s0.copy(), np.zeros((len(pos), 3)), np.array([0, 4, 8, 12] * 2 + [0, 0], np.int32)
     st0 = stk.copy()
-    zm.tet_mohr_step(pos, vel, gp, rows, prop, 1.0, sk, stk, fk)
+    _mohr_step(pos, vel, gp, prop, sk, stk, fk, 1.0)
     ft = np.zeros_like(fk)
     nyield = 0
     for z in range(nz):
@@ -361,21 +378,21 @@ def test_tet_zone_step_elastic_and_mohr_paths():
     node = np.arange(len(pos), dtype=np.int64)
     prop = _props(nz, rng)
     s0 = rng.normal(size=(nz, 6)) * 1e5
-    # all elastic, no NMD: the same as tet_elastic_step
-    cm = np.full(nz, mz.ZMODEL_ELASTIC, np.int8)
+    # all elastic, no NMD: the engine's zone step (forces in the order of its scatter plan)
+    cm = np.full(nz, zp.ZMODEL_ELASTIC, np.int8)
     sa, fa, st = s0.copy(), np.zeros((len(pos), 3)), np.zeros(nz, np.int32)
     zp.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 0.5, False, sa, st, fa)
     sb, fb = s0.copy(), np.zeros_like(fa)
-    tet_elastic_step(pos, vel, gp, prop[:, 0].copy(), prop[:, 1].copy(), 0.5, sb, fb)
+    _mohr_step(pos, vel, gp, prop, sb, np.zeros(nz, np.int32), fb, 0.5, cm=cm)
     assert np.allclose(sa, sb, rtol=1e-12, atol=1e-6) and np.allclose(fa, fb, rtol=1e-12, atol=1e-6)
-    # all Mohr-Coulomb, no NMD: the same as tet_mohr_step
-    cm[:] = mz.ZMODEL_MOHR
+    # all Mohr-Coulomb, no NMD: the same stresses and states
+    cm[:] = zp.ZMODEL_MOHR
     vel *= 30
     sa, fa, sta = s0.copy(), np.zeros_like(fa), np.zeros(nz, np.int32)
     zp.tet_zone_step(pos, vel, gp, rows, node, cm, prop, 1.0, False, sa, sta, fa)
     sb, fb, stb = s0.copy(), np.zeros_like(fa), np.zeros(nz, np.int32)
-    zm.tet_mohr_step(pos, vel, gp, rows, prop, 1.0, sb, stb, fb)
-    assert np.array_equal(sa, sb) and np.array_equal(fa, fb) and np.array_equal(sta, stb)
+    _mohr_step(pos, vel, gp, prop, sb, stb, fb, 1.0, cm=cm)
+    assert np.array_equal(sa, sb) and np.allclose(fa, fb, rtol=1e-12, atol=1e-6) and np.array_equal(sta, stb)
     assert (sta > 0).sum() >= 3
     # with NMD: twin of the whole sequence (strain average, return, stress correction, forces)
     sa, fa, sta = s0.copy(), np.zeros_like(fa), np.zeros(nz, np.int32)
@@ -518,6 +535,8 @@ def test_limiting_properties_match_twin_and_stay_finite(c, phi, ten, psi):
 
 
 def test_parallel_step_is_bit_identical_to_serial():
+    """The engine's zone step in 1, 2, 3 chunks on 1 and 2 threads gives the twin's bits, with a
+    mixed-discretization set, a linked gridpoint, elastic and Mohr-Coulomb zones."""
     import numba
     rng = np.random.default_rng(23)
     pos, gp = _two_cubes(rng)
@@ -530,28 +549,29 @@ def test_parallel_step_is_bit_identical_to_serial():
     prop = _props(nzn, rng)
     cm = np.array([2, 1, 2, 2, 1, 2, 1, 2, 2, 2], np.int8)
     s0 = rng.normal(size=(nzn, 6)) * 2e5 + np.array([-1e6, -1e6, -1e6, 0, 0, 0])
-    fstart, fent = zp.node_lists4(nv, np.arange(nv, dtype=np.int64), gp, rows)
-    nstart, nent = zp.node_lists4(nv, node, gp, rows)
-    assert np.array_equal(np.bincount(gp.ravel(), minlength=nv), np.diff(fstart))
-    for large, nmd in ((False, False), (True, True)):
-        ref = [s0.copy(), np.zeros(nzn, np.int32), rng.normal(size=(nv, 3)), np.zeros(nv)]
-        ref[3][:] = 1.0
-        par = [a.copy() for a in ref]
-        zp.zone_forces_plastic(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd, *ref)
-        for nt in (1, 2):
-            out = [a.copy() for a in par]
-            numba.set_num_threads(min(nt, numba.config.NUMBA_NUM_THREADS))
-            zp.zone_forces_plastic_parallel(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd,
-                                            *out, fstart, fent, nstart, nent)
-            for a, b in zip(ref, out):
-                assert np.array_equal(a, b), (large, nmd, nt)
-        assert (ref[1] > 0).sum() >= 2
+    keep = numba.get_num_threads()
+    try:
+        for large, nmd in ((False, False), (True, True)):
+            ref = [s0.copy(), np.zeros(nzn, np.int32), rng.normal(size=(nv, 3)), np.zeros(nv)]
+            ref[3][:] = 1.0
+            par = [a.copy() for a in ref]
+            zp.zone_forces_plastic(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd, *ref)
+            for nt in (1, 2):
+                numba.set_num_threads(min(nt, numba.config.NUMBA_NUM_THREADS))
+                for parts in (1, 2, 3):
+                    out = [a.copy() for a in par]
+                    st = Stepper(gp, rows, zset, weight, node, nv, cm, prop, parts)
+                    st.step(pos, vel, *out, 1.0, large, nmd)
+                    for a, b in zip(ref, out):
+                        assert np.array_equal(a, b), (large, nmd, nt, parts)
+            assert (ref[1] > 0).sum() >= 2
+    finally:
+        numba.set_num_threads(keep)
 
 
 def test_step_with_kept_scratch_ignores_what_the_scratch_held():
-    """The stepper's kernels (``zone_forces_plastic_ws``, ``zone_forces_plastic_parallel_ws``)
-    reuse scratch from step to step: scratch full of NaN gives the bits of the allocating
-    kernel, elastic-only (forces in the constitutive sweep) and with Mohr-Coulomb zones."""
+    """The stepper keeps the zone step's scratch from step to step: scratch full of NaN gives the
+    twin's bits, elastic-only (forces in the second sweep) and with Mohr-Coulomb zones."""
     rng = np.random.default_rng(29)
     pos, gp = _two_cubes(rng)
     nzn, nv = len(gp), len(pos)
@@ -562,23 +582,16 @@ def test_step_with_kept_scratch_ignores_what_the_scratch_held():
     node = np.arange(nv, dtype=np.int64); node[8] = 1
     prop = _props(nzn, rng)
     s0 = rng.normal(size=(nzn, 6)) * 2e5 + np.array([-1e6, -1e6, -1e6, 0, 0, 0])
-    fstart, fent = zp.node_lists4(nv, np.arange(nv, dtype=np.int64), gp, rows)
-    nstart, nent = zp.node_lists4(nv, node, gp, rows)
     for cm in (np.ones(nzn, np.int8), np.array([2, 1, 2, 2, 1, 2, 1, 2, 2, 2], np.int8)):
         for large, nmd in ((False, True), (True, True), (True, False)):
             ref = [s0.copy(), np.zeros(nzn, np.int32), np.zeros((nv, 3)), np.zeros(nv)]
             zp.zone_forces_plastic(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large, nmd, *ref)
             assert np.abs(ref[2]).max() > 0.0
-            for par in (False, True):
-                ws = zp.zone_scratch(nzn, nv, par)
-                for a in ws:
+            for parts in (1, 2):
+                st = Stepper(gp, rows, zset, weight, node, nv, cm, prop, parts)
+                for a in st.scr:
                     a[...] = np.nan
                 out = [s0.copy(), np.zeros(nzn, np.int32), np.zeros((nv, 3)), np.zeros(nv)]
-                if par:
-                    zp.zone_forces_plastic_parallel_ws(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0,
-                                                       large, nmd, *out, fstart, fent, nstart, nent, *ws)
-                else:
-                    zp.zone_forces_plastic_ws(pos, vel, gp, rows, zset, weight, 1, node, cm, prop, 1.0, large,
-                                              nmd, *out, *ws[:7])
+                st.step(pos, vel, *out, 1.0, large, nmd)
                 for a, b in zip(ref, out):
-                    assert np.array_equal(a, b), (cm[0], large, nmd, par)
+                    assert np.array_equal(a, b), (cm[0], large, nmd, parts)

@@ -1,6 +1,7 @@
-"""The Mohr-Coulomb 4-node zone step (``kernels/zone_mohr_step.py``) bit for bit against the
-plastic step it stands in for (``zone_plastic.zone_forces_plastic``, itself checked against the
-slow twins of tests/test_zone_mohr_kernels.py) for any number of parts and threads, with zones
+"""The 4-node zone step (``kernels/zone_step.py``) with Mohr-Coulomb zones, bit for bit against the
+serial twin in passes (``tests/zone_plastic_twin.py``, the engine's plastic step before the
+plug-in models, its return checked against the slow twins of tests/test_zone_mohr_kernels.py)
+for any number of parts and threads, with zones
 yielding in shear, in tension and at corners, hexahedral sets, linked gridpoints, large strain,
 NMD on and off; and the closed-form principal axes of ``principal.principal_axes`` against
 numpy's eigh."""
@@ -10,12 +11,14 @@ import numba
 import numpy as np
 import pytest
 
-from dec3d.kernels import zone_elastic as ze
 from dec3d.kernels import zone_mohr as zm
-from dec3d.kernels import zone_mohr_step as zms
-from dec3d.kernels import zone_plastic as zp
 from dec3d.model import zones as mz
-from tests.test_zone_elastic_kernels import _case
+from dec3d.physics.cmodels import ZONE_MODELS
+from tests import zone_plastic_twin as zp
+from tests.test_zone_elastic_kernels import _case, _run
+from tests.zone_step_run import Stepper
+
+MOHR = ZONE_MODELS["mohr-coulomb"].code
 
 
 def _mohr_case(seed, plain=False, frac=0.7):
@@ -24,7 +27,7 @@ def _mohr_case(seed, plain=False, frac=0.7):
     pos, vel, gp, rows, zset, weight, node, prop, stress = _case(seed, plain=plain)
     rng = np.random.default_rng(seed + 100)
     nz = len(gp)
-    cm = np.where(rng.uniform(size=nz) < frac, mz.ZMODEL_MOHR, mz.ZMODEL_ELASTIC).astype(np.int8)
+    cm = np.where(rng.uniform(size=nz) < frac, MOHR, mz.ZMODEL_ELASTIC).astype(np.int8)
     prop[:, mz.ZP_COHESION] = rng.uniform(0.2e5, 1e5, nz)
     prop[:, mz.ZP_TANFRIC] = np.tan(np.radians(rng.uniform(15, 40, nz)))
     prop[:, mz.ZP_TENSION] = rng.uniform(0.0, 0.5e5, nz)
@@ -48,12 +51,10 @@ def _plain_run(case, large, nmd, steps):
 def _fast_run(case, large, nmd, steps, parts):
     pos, vel, gp, rows, zset, weight, node, prop, stress, cm = case
     nv = len(pos)
-    plan = ze.ElasticPlan(gp, rows, node, zset, weight, nv, parts)
+    zs = Stepper(gp, rows, zset, weight, node, nv, cm, prop, parts)
     st, state, f, fm = stress.copy(), np.zeros(len(gp), np.int8), np.ones((nv, 3)), np.full(nv, 0.5)
     for _ in range(steps):
-        zms.mohr_zone_step(pos, vel, plan.g4, plan.n4, plan.rows, plan.zset, plan.weight, int(zset.max()) + 1, cm,
-                           prop, np.ascontiguousarray(prop[:, mz.ZP_BULK]), np.ascontiguousarray(prop[:, mz.ZP_SHEAR]),
-                           0.7, large, nmd, st, state, f, fm, *plan.args(), np.empty(len(rows)), np.empty(nv))
+        zs.step(pos, vel, st, state, f, fm, 0.7, large, nmd)
     return st, state, f, fm
 
 
@@ -64,9 +65,9 @@ def test_mohr_step_gives_the_plastic_steps_bits_for_any_parts_and_threads(large,
     ref = _plain_run(case, large, nmd, 3)
     state = ref[1]
     rows = case[3]
-    on = case[-1][rows] == mz.ZMODEL_MOHR
+    on = case[-1][rows] == MOHR
     # the case is what it says: shear and tension yield, elastic Mohr-Coulomb zones too
-    assert ((state[rows] & zm.SHEAR_PAST) != 0).sum() > 10 and ((state[rows] & zm.TENSION_PAST) != 0).sum() > 3
+    assert ((state[rows] & mz.ZSTATE_SHEAR_PAST) != 0).sum() > 10 and ((state[rows] & mz.ZSTATE_TENSION_PAST) != 0).sum() > 3
     assert (on & (state[rows] == 0)).any()
     keep = numba.get_num_threads()
     try:
@@ -82,13 +83,7 @@ def test_mohr_step_gives_the_plastic_steps_bits_for_any_parts_and_threads(large,
 
 def test_mohr_step_without_mohr_zones_is_the_elastic_step():
     case = _mohr_case(8, frac=0.0)
-    pos, vel, gp, rows, zset, weight, node, prop, stress, cm = case
-    nv = len(pos)
-    plan = ze.ElasticPlan(gp, rows, node, zset, weight, nv, 2)
-    st, f, fm = stress.copy(), np.ones((nv, 3)), np.full(nv, 0.5)
-    ze.elastic_zone_step(pos, vel, plan.g4, plan.n4, plan.rows, plan.zset, plan.weight, int(zset.max()) + 1,
-                         np.ascontiguousarray(prop[:, mz.ZP_BULK]), np.ascontiguousarray(prop[:, mz.ZP_SHEAR]),
-                         0.7, True, True, st, f, fm, *plan.args())
+    st, f, fm = _run(case[:-1], True, True, 2)
     got = _fast_run(case, True, True, 1, 2)
     assert np.array_equal(got[0], st) and np.array_equal(got[2], f) and np.array_equal(got[3], fm)
     assert not got[1].any()
@@ -188,14 +183,14 @@ model large-strain on
 """
 
 
-def _model_run(tmp_path, monkeypatch, threads, fast, steps=40):
+def _model_run(tmp_path, monkeypatch, threads, chunked, steps=40):
     import io
 
     import dec3d
     import dec3d.physics.zones as pz
 
-    monkeypatch.setattr(pz, "MOHR_KERNEL", fast)
-    monkeypatch.setattr(pz, "PARALLEL_MIN_ZONES", 0)          # the threaded kernels on this small model
+    if chunked:
+        monkeypatch.setattr(pz, "PARALLEL_MIN_ZONES", 0)      # one chunk per thread on this small model
     keep = numba.get_num_threads()
     numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     try:
@@ -205,7 +200,7 @@ def _model_run(tmp_path, monkeypatch, threads, fast, steps=40):
         numba.set_num_threads(keep)
     m = s.model
     zst = m.rigid_engine._zstep
-    assert (zst.fastmc is not None) == fast and zst.nset > 0
+    assert zst.nset > 0 and zst.plastic
     zs = m.store("zones")
     return (zs["stress"].copy(), zs["state"].copy(), m.vertices["disp"].copy(), m.vertices["velocity"].copy(),
             np.array([m.rigid_engine.kinetic, m.rigid_engine.criteria()["unbalanced-maximum"]]))
@@ -213,10 +208,10 @@ def _model_run(tmp_path, monkeypatch, threads, fast, steps=40):
 
 def test_model_runs_give_the_same_bits_with_either_kernel_and_thread_count(tmp_path, monkeypatch):
     """A whole Mohr-Coulomb run (40 steps, large strain, tetrahedra and hexahedral sets, zones
-    yielding): ``mohr_zone_step`` on 1 and 2 threads and the plastic kernels give the same
-    stresses, plastic states, displacements, velocities, kinetic energy and unbalanced force."""
+    yielding): the zone step in one chunk, and in one chunk per thread on 1 and 2 threads, give the
+    same stresses, plastic states, displacements, velocities, kinetic energy and unbalanced force."""
     ref = _model_run(tmp_path, monkeypatch, 1, False)
-    assert (ref[1] & zm.SHEAR_PAST).sum() > 0 and np.abs(ref[2]).max() > 1e-7
+    assert (ref[1] & mz.ZSTATE_SHEAR_PAST).sum() > 0 and np.abs(ref[2]).max() > 1e-7
     for nt in (1, 2):
         got = _model_run(tmp_path, monkeypatch, nt, True)
         for a, b in zip(ref, got):

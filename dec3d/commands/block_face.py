@@ -8,7 +8,7 @@ from ..errors import BindError, CommandError, NotSupportedError
 from ..geometry.triangulate import triangulate_blocks
 from ..lang.abbrev import matches
 from ..model.blocks import group_faces
-from .fish_cmds import _TableId
+from .values import TableId
 from .registry import command
 from .values import FLAG, Num, Nums, P, Text, ValueType
 
@@ -69,7 +69,7 @@ class _History(ValueType):
             return ("fish", str(nt)), i + 2
         if nt.type not in ("NUMBER", "STRING", "WORD"):
             raise BindError("a table id is an integer or a name", binder.where(nt))
-        return ("table", _TableId().literal(nt)), i + 2
+        return ("table", TableId().literal(nt)), i + 2
 
 
 def _no_fish_history(call):
@@ -87,7 +87,7 @@ def _no_fish_history(call):
                    *[P(k, Num(), f"the {k[-2:]} component alone", units="Pa") for k in _STRESS_KEYS],
                    P("stress-normal", Num(), "normal stress (tension positive)", units="Pa"),
                    P("quiet", FLAG, "a quiet (viscous, Lysmer–Kuhlemeyer) boundary on the faces", bare=True),
-                   P("table", _TableId(), "multiply the stress by this table of time (model time, linear)"),
+                   P("table", TableId(), "multiply the stress by this table of time (model time, linear)"),
                    P("history", _History(), "3DEC's spelling of the same: `history table <id>`")],
          range="face", check=_no_fish_history,
          doc="Apply a stress, or a quiet boundary, to the boundary triangles of zoned blocks in range "

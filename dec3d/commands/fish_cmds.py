@@ -18,7 +18,7 @@ from ..errors import BindError, CommandError, Dec3dError, NotSupportedError
 from ..fish import contact_intrinsics, intrinsics
 from ..lang.abbrev import matches
 from .registry import command
-from .values import FLAG, INT, NUMBERISH, ONOFF, InPath, Nums, P, Text, ValueType
+from .values import FLAG, INT, NUMBERISH, ONOFF, InPath, Nums, P, TableId, Text, ValueType
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 
@@ -394,35 +394,12 @@ def program_list_cycle_sequence(session, call):
 
 # ------------------------------------------------------------------ table
 
-class _TableId(ValueType):
-    """A table id: an integer or a name."""
-
-    label = "<i|s>"
-    fits_types = ("NUMBER", "STRING", "WORD", "EXPR", "ATNAME")
-
-    def literal(self, tok):
-        s = str(tok)
-        if tok.type == "NUMBER":
-            try:
-                return int(s)
-            except ValueError:
-                raise BindError(f"a table id is an integer or a name, not {s}") from None
-        return s[1:-1] if tok.type == "STRING" else s
-
-    def convert(self, value, where):
-        if isinstance(value, float) and value == int(value):
-            value = int(value)
-        if isinstance(value, bool) or not isinstance(value, (int, str)) or value == "":
-            raise BindError(f"a table id is an integer or a name, not {value!r}", where)
-        return value
-
-
 TABLE_FILE = InPath(exts=(".txt", ".tab", ".dat"))
 #: largest table file read (bytes)
 TABLE_MAX_BYTES = 64 * 2**20
 
 
-@command("table", positional=[P("id", _TableId(), "table id (integer) or name", required=True)],
+@command("table", positional=[P("id", TableId(), "table id (integer) or name", required=True)],
          keywords=[P("add", Nums(2, 10**7, multiple_of=2), "points x y x y … (or (x,y) (x,y) …)", repeat=True),
                    P("insert", Nums(2, 10**7, multiple_of=2), "points x y …; the same as add (points are kept "
                      "in increasing x)", repeat=True),

@@ -358,3 +358,27 @@ class InPath(Text):
 
     label: str = "<file>"
     exts: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class TableId(ValueType):
+    """A table id: an integer or a name."""
+
+    label = "<i|s>"
+    fits_types = ("NUMBER", "STRING", "WORD", "EXPR", "ATNAME")
+
+    def literal(self, tok):
+        s = str(tok)
+        if tok.type == "NUMBER":
+            try:
+                return int(s)
+            except ValueError:
+                raise BindError(f"a table id is an integer or a name, not {s}") from None
+        return s[1:-1] if tok.type == "STRING" else s
+
+    def convert(self, value, where):
+        if isinstance(value, float) and value == int(value):
+            value = int(value)
+        if isinstance(value, bool) or not isinstance(value, (int, str)) or value == "":
+            raise BindError(f"a table id is an integer or a name, not {value!r}", where)
+        return value

@@ -34,6 +34,7 @@ import numpy as np
 from dec3d.config import SAVE_FORMAT_VERSION
 from dec3d.errors import Dec3dError
 from dec3d.io.finite import require_finite
+from dec3d.kernels.zmodels import NZPROP
 from dec3d.io.state_meta import (_HIST, _NPY_HEADER_MAX, _expected_arrays, _known, _meta_problem, _settings_problem,
                                   register_known)
 from dec3d.model.groups import GroupTable
@@ -272,6 +273,10 @@ def _build(path: str, meta: dict, blobs: dict[str, bytes]) -> Model:
                                      f"{np.dtype(store.fields[key].dtype).str}")
             arrays[key] = arr
         store.load_arrays(arrays)
+        if sname in ("zones", "feblocks") and "prop" in store and store.fields["prop"].shape[0] < NZPROP:
+            # a file from before the zone-model library (8 property columns): the models' own
+            # columns are added empty
+            store.resize_field("prop", (NZPROP,))
     if "origin" not in meta["stores"].get("vertices", {}).get("fields", {"origin": 0}):
         # a file from before vertices had an origin: take each vertex as having moved with its block's centroid
         v = model.vertices
@@ -371,7 +376,7 @@ def _check_zones(path: str, model: Model) -> None:
 def _check_feblocks(path: str, model: Model) -> None:
     """The ``feblocks`` store (dec3d.model.feblocks): node and slave rows within the vertices,
     block rows within the blocks, Gauss rule 2 or 3, known constitutive codes."""
-    from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_MOHR, ZMODEL_NULL
+    from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_NULL
 
     if "feblocks" not in model.stores or not model.store("feblocks").n:
         return
@@ -388,7 +393,7 @@ def _check_feblocks(path: str, model: Model) -> None:
     s = es["slaves"]
     need(((s == -1) | ((s >= 0) & (s < nv))).all(), "FE element slave rows point outside the vertices")
     need(np.isin(es["nq"], (2, 3)).all(), "an FE element has a Gauss rule other than 2 or 3")
-    need(np.isin(es["cmodel"], (ZMODEL_NULL, ZMODEL_ELASTIC, ZMODEL_MOHR)).all(),
+    need(np.isin(es["cmodel"], (ZMODEL_NULL, ZMODEL_ELASTIC)).all(),
          "an FE element has an unknown constitutive model code")
 
 

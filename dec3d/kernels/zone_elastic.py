@@ -1,40 +1,29 @@
-"""The step of 4-node zones when none of them is Mohr-Coulomb (elastic zones, the common case):
-the numbers of ``zone_plastic.zone_forces_plastic`` bit for bit (strain increment, mixed
-discretization of hexahedral sets, nodal mixed discretization, stress rotation in large strain,
-incremental Hooke, nodal forces), in two sweeps over the zones and no per-zone scratch.
+"""Geometry and bookkeeping of the 4-node zone step (``kernels/zone_step.py``): the per-zone
+face vectors, volume and strain increment in scalars (``_faces``, ``_strain``), the nodal force of
+a face and its scatter (``_force``, ``_add``), and the plan that lets threads share the scatter
+without changing a bit (``partition_entries``, ``scatter_plan``, ``node_table``, ``ElasticPlan``).
 
-Formulas: 3DEC theory text (deformable blocks, Eqs. 53-59; mixed discretization Eqs. 60-63; NMD
-Eqs. 68-71), as in ``kernels/zones.py`` and ``kernels/zone_plastic.py``; with elastic zones the
-stress averaging of Eqs. 64-67 and 74-76 has nothing to average (no plastic correction), so a
-step is:
+Formulas: 3DEC theory text (deformable blocks, Eqs. 53-59). Sums onto gridpoints are scattered in
+ascending zone-entry order, as a serial loop does. Threads take parts of the zone entries
+(``partition_entries``: by the zones' smallest gridpoint row, so a part is a compact region when
+gridpoints are numbered in space), each part in ascending entry order. A target (gridpoint or
+averaging node) gets the leading run of its entries that lie in one part straight from that
+part's thread, in order; its other entries ("foreign" ones, near the borders between parts) are
+written to slots and added after the sweep, in ascending entry order. Every target therefore gets
+its terms in the serial order: the same bits for any part count and any thread count
+(``scatter_plan`` makes this bookkeeping once per mesh; at 1e6 zones and two parts about 5 % of
+the entries are foreign).
 
-    sweep A (per zone): volume and strain increment; Σ Δε_v V and Σ V onto the averaging nodes
-                        (zones outside hexahedral sets, when NMD is on) or the set sums;
-    sweep B (per zone): strain increment again (the same formulas, so the same bits: cheaper
-                        than storing it), averaged volumetric part, stress rotated (large
-                        strain), Hooke, nodal forces scattered onto the gridpoints.
-
-Sums onto gridpoints are scattered in ascending zone-entry order, as the serial kernel does.
-Threads take parts of the zone entries (``partition_entries``: by the zones' smallest gridpoint
-row, so a part is a compact region when gridpoints are numbered in space), each part in
-ascending entry order. A target (gridpoint or averaging node) gets the leading run of its
-entries that lie in one part straight from that part's thread, in order; its other entries
-("foreign" ones, near the borders between parts) are written to slots and added after the
-sweep, in ascending entry order. Every target therefore gets its terms in the serial order: the
-same bits for any part count and any thread count (``scatter_plan`` makes this bookkeeping once
-per mesh; at 1e6 zones and two parts about 5 % of the entries are foreign).
-
-Why this is faster than the plastic kernels on elastic zones (1e6 zones, one thread, CPU time;
-bench/README.md): ``zone_forces_plastic`` stores per-zone strain and face vectors between its
-passes (221 ms), ``zone_forces_plastic_ws`` carries the untaken Mohr-Coulomb branch in its
-fused loop (339 ms), the threaded ``*_parallel_ws`` gathers 128 B of per-zone forces through
-memory (~150 ms); here every value is a scalar local, the strain is recomputed in sweep B rather
-than stored (storing it measured no faster) and the forces go straight to the gridpoints (~70 ms).
+Why scalars (1e6 elastic zones, one thread, measured when the step had several copies; bench/README.md):
+a step in passes that stores per-zone strain and face vectors between them took 221 ms, a fused
+loop over per-zone scratch 339 ms, a threaded gather of 128 B of per-zone forces ~150 ms; with
+every value a scalar local, the strain recomputed in a later sweep rather than stored and the
+forces scattered straight to the gridpoints, ~70 ms.
 """
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 
 @njit(cache=True, inline="always")
@@ -215,137 +204,6 @@ def scatter_plan(tgt, ntarget, pstart, pk, sel):
     return bits, sbase, tstart, ptgt, pslot
 
 
-@njit(cache=True, parallel=True)
-def elastic_zone_step(pos, vel, g4, n4, rows, zset, weight, nset, bulk, shear, dt, large, nmd, stress, force,
-                      fmag, pstart, pk, fbits, fbase, fpstart, fptgt, fpslot, nbits, nbase, npstart, nptgt, npslot,
-                      nodesum, nodevol, sa, sb, evs, vols):
-    """One step of the elastic 4-node zones ``rows`` (the numbers of
-    ``zone_plastic.zone_forces_plastic`` with only elastic zones, any thread count).
-
-    g4 (nr, 4) int32: gridpoint rows of each entry's zone (gp[rows, :4]); n4 (nr, 4) int32:
-    their averaging nodes (node[g4]; g4 itself without linked gridpoints); zset, weight, nset,
-    large, nmd as ``zone_forces_plastic``, except that rows may be empty (entry k is zone row k),
-    zset empty when nset is 0 and weight empty when every weight is 1 (``ElasticPlan`` passes
-    them so: fewer streams through memory); bulk, shear per zone row; stress (nzones, 6) updated;
-    force (nvert, 3) and fmag (nvert,) added to. Parts pstart, pk: ``partition_entries``; fbits
-    … fpslot: ``scatter_plan(g4, nvert, pstart, pk, all entries)``; nbits … npslot:
-    ``scatter_plan(n4, nvert, pstart, pk, zset < 0)`` (read when ``nmd``). Scratch: nodesum,
-    nodevol (nvert,); sa (slots of nbase, 2), sb (slots of fbase, 4); evs, vols (nr,) (read
-    when nset > 0)."""
-    nch = pstart.shape[0] - 1
-    if nmd:
-        for t in prange(nodesum.shape[0]):
-            nodesum[t] = 0.0
-            nodevol[t] = 0.0
-    # sweep A: volumetric strain increments onto the averaging nodes / set entries
-    if nmd or nset > 0:
-        for c in prange(nch):
-            j = nbase[c]
-            for q in range(pstart[c], pstart[c + 1]):
-                k = pk[q]
-                i0 = g4[k, 0]; i1 = g4[k, 1]; i2 = g4[k, 2]; i3 = g4[k, 3]
-                a0x, a0y, a0z, a1x, a1y, a1z, a2x, a2y, a2z, a3x, a3y, a3z, vol = _faces(pos, i0, i1, i2, i3)
-                d0, d1, d2, d3, d4, d5, w0, w1, w2 = _strain(vel, i0, i1, i2, i3, a0x, a0y, a0z, a1x, a1y, a1z,
-                                                             a2x, a2y, a2z, a3x, a3y, a3z, vol, dt)
-                e = d0 + d1 + d2
-                if nset > 0 and zset[k] >= 0:
-                    evs[k] = e
-                    vols[k] = vol
-                elif nmd:
-                    x = e * vol
-                    b = nbits[k]
-                    for a in range(4):
-                        if b & (1 << a):
-                            sa[j, 0] = x
-                            sa[j, 1] = vol
-                            j += 1
-                        else:
-                            t = n4[k, a]
-                            nodesum[t] += x
-                            nodevol[t] += vol
-        if nmd:
-            for i in prange(nptgt.shape[0]):
-                t = nptgt[i]
-                for q in range(npstart[i], npstart[i + 1]):
-                    nodesum[t] += sa[npslot[q], 0]
-                    nodevol[t] += sa[npslot[q], 1]
-            # each node's average once (the quotient its zones would each work out: same bits)
-            for t in prange(nodesum.shape[0]):
-                if nodevol[t] > 0.0:
-                    nodesum[t] = nodesum[t] / nodevol[t]
-    sv = np.zeros(nset)
-    ss = np.zeros(nset)
-    for k in range(zset.shape[0] if nset > 0 else 0):
-        h = zset[k]
-        if h >= 0:
-            sv[h] += evs[k] * vols[k]
-            ss[h] += vols[k]
-    # sweep B: averaged strain, stress, nodal forces
-    for c in prange(nch):
-        j = fbase[c]
-        for q in range(pstart[c], pstart[c + 1]):
-            k = pk[q]
-            i0 = g4[k, 0]; i1 = g4[k, 1]; i2 = g4[k, 2]; i3 = g4[k, 3]
-            a0x, a0y, a0z, a1x, a1y, a1z, a2x, a2y, a2z, a3x, a3y, a3z, vol = _faces(pos, i0, i1, i2, i3)
-            d0, d1, d2, d3, d4, d5, w01, w02, w12 = _strain(vel, i0, i1, i2, i3, a0x, a0y, a0z, a1x, a1y, a1z,
-                                                            a2x, a2y, a2z, a3x, a3y, a3z, vol, dt)
-            e = d0 + d1 + d2
-            bar = e
-            h = zset[k] if nset > 0 else -1
-            if h >= 0:
-                if ss[h] > 0.0:
-                    bar = sv[h] / ss[h]
-            elif nmd:
-                acc = 0.0
-                acc += nodesum[n4[k, 0]]
-                acc += nodesum[n4[k, 1]]
-                acc += nodesum[n4[k, 2]]
-                acc += nodesum[n4[k, 3]]
-                bar = 0.25 * acc
-            shift = (bar - e) / 3.0
-            d0 += shift; d1 += shift; d2 += shift
-            z = rows[k] if rows.shape[0] > 0 else k
-            s0 = stress[z, 0]; s1 = stress[z, 1]; s2 = stress[z, 2]
-            s3 = stress[z, 3]; s4 = stress[z, 4]; s5 = stress[z, 5]
-            if large:
-                # (zone_plastic.jaumann_rotate)
-                r0 = s0 + 2.0 * (w01 * s3 + w02 * s4)
-                r1 = s1 + 2.0 * (-w01 * s3 + w12 * s5)
-                r2 = s2 + 2.0 * (-w02 * s4 - w12 * s5)
-                r3 = s3 + w01 * (s1 - s0) + w02 * s5 + w12 * s4
-                r4 = s4 + w02 * (s2 - s0) + w01 * s5 - w12 * s3
-                r5 = s5 + w12 * (s2 - s1) - w01 * s4 - w02 * s3
-                s0 = r0; s1 = r1; s2 = r2; s3 = r3; s4 = r4; s5 = r5
-            # incremental Hooke (zones.hooke_increment)
-            K = bulk[z]; G = shear[z]
-            ev = d0 + d1 + d2
-            lam = K - 2.0 * G / 3.0
-            s0 += lam * ev + 2.0 * G * d0
-            s1 += lam * ev + 2.0 * G * d1
-            s2 += lam * ev + 2.0 * G * d2
-            s3 += 2.0 * G * d3
-            s4 += 2.0 * G * d4
-            s5 += 2.0 * G * d5
-            stress[z, 0] = s0; stress[z, 1] = s1; stress[z, 2] = s2
-            stress[z, 3] = s3; stress[z, 4] = s4; stress[z, 5] = s5
-            w = weight[k] / 3.0 if weight.shape[0] > 0 else 1.0 / 3.0
-            b = fbits[k]
-            fx, fy, fz, fm = _force(s0, s1, s2, s3, s4, s5, a0x, a0y, a0z, w)
-            j = _add(force, fmag, i0, fx, fy, fz, fm, b & 1, sb, j)
-            fx, fy, fz, fm = _force(s0, s1, s2, s3, s4, s5, a1x, a1y, a1z, w)
-            j = _add(force, fmag, i1, fx, fy, fz, fm, b & 2, sb, j)
-            fx, fy, fz, fm = _force(s0, s1, s2, s3, s4, s5, a2x, a2y, a2z, w)
-            j = _add(force, fmag, i2, fx, fy, fz, fm, b & 4, sb, j)
-            fx, fy, fz, fm = _force(s0, s1, s2, s3, s4, s5, a3x, a3y, a3z, w)
-            j = _add(force, fmag, i3, fx, fy, fz, fm, b & 8, sb, j)
-    for i in prange(fptgt.shape[0]):
-        t = fptgt[i]
-        for q in range(fpstart[i], fpstart[i + 1]):
-            sl = fpslot[q]
-            force[t, 0] += sb[sl, 0]; force[t, 1] += sb[sl, 1]; force[t, 2] += sb[sl, 2]
-            fmag[t] += sb[sl, 3]
-
-
 @njit(cache=True)
 def node_table(gp, rows, node):
     """(g4, n4, same): int32 gridpoint rows gp[rows, :4] and their averaging nodes node[g4]
@@ -369,14 +227,14 @@ def node_table(gp, rows, node):
 
 
 class ElasticPlan:
-    """What ``elastic_zone_step`` needs besides the model's arrays, made once per mesh (the
+    """What ``zone_step.zone_step`` needs besides the model's arrays, made once per mesh (the
     zone stepper keeps it): compact int32 node lists, chunks, scatter plans and the scratch.
     ``nchunk``: chunks of zone entries (any count gives the same bits; one per thread keeps
     the foreign entries few)."""
 
     def __init__(self, gp, rows, node, zset, weight, nvert, nchunk):
         nr = len(rows)
-        #: rows, zset and weight as ``elastic_zone_step`` takes them (empty when they say nothing)
+        #: rows, zset and weight as ``zone_step`` takes them (empty when they say nothing)
         self.rows = np.zeros(0, np.int64) if np.array_equal(rows, np.arange(nr)) else rows
         self.zset = zset if (zset >= 0).any() else np.zeros(0, np.int64)
         self.weight = weight if (weight != 1.0).any() else np.zeros(0)
@@ -394,8 +252,3 @@ class ElasticPlan:
         nsr = nr if (zset >= 0).any() else 0
         self.evs = np.empty(nsr)
         self.vols = np.empty(nsr)
-
-    def args(self):
-        """The plan's arguments of ``elastic_zone_step``, from ``pstart`` on."""
-        return (self.pstart, self.pk, *self.fplan, *self.nplan, self.nodesum, self.nodevol, self.sa, self.sb, self.evs,
-                self.vols)

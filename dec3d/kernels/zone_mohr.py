@@ -1,5 +1,6 @@
 """Mohr-Coulomb zones: the constitutive update of a 4-node tetrahedron (the zone step that runs
-it, with mixed discretization and NMD, is ``kernels/zone_plastic.py``).
+it, with mixed discretization and NMD, is ``kernels/zone_step.py``; the model's plug-in is
+``kernels/zmodels/mohr.py``).
 
 Mohr-Coulomb (Itasca's formulation: FLAC3D/3DEC documentation, "Mohr-Coulomb Model",
 https://docs.itascacg.com/itasca920/common/models/mohr/doc/modelmohr.html; the 3DEC theory
@@ -36,8 +37,8 @@ consistent, which the tests never meet, the stress goes to the isotropic admissi
 Plastic state bits (``zones.state``): 1 shear now, 2 tension now, 4 shear in the past,
 8 tension in the past; the "now" bits are those of the last step.
 
-Kernels may not import dec3d.model: the property columns and model codes below mirror
-``dec3d.model.zones`` (a test checks they agree).
+The plastic-state bits are ``kernels/zones.py``'s (one definition for the store, the models and
+the step).
 """
 import math
 
@@ -45,21 +46,7 @@ import numpy as np
 from numba import njit
 
 from .principal import _THIRD, GAP_REL, _deviator, _dev_principal, _invariants, _values, dev_square, principal_axes
-from .zones import hooke_increment, tet_add_forces, tet_kinematics
-
-# mirrors of dec3d.model.zones
-ZP_BULK = 0
-ZP_SHEAR = 1
-ZP_COHESION = 3
-ZP_TANFRIC = 4
-ZP_TENSION = 5
-ZP_TANDIL = 6
-ZMODEL_ELASTIC = 1
-ZMODEL_MOHR = 2
-SHEAR_NOW = 1
-TENSION_NOW = 2
-SHEAR_PAST = 4
-TENSION_PAST = 8
+from .zones import SHEAR_NOW, TENSION_NOW, hooke_increment
 
 #: shear planes: (i, j) = (more compressive, less compressive) principal index; planes 6-8: tension
 _SH_I = np.array([0, 0, 1, 1, 2, 2], np.int64)
@@ -424,30 +411,3 @@ def mohr_update(stress6, de6, bulk, shear, coh, tanfric, ten, tandil):
     s = stress6.copy()
     bits, dsp = mohr_return(s, de6, bulk, shear, coh, tanfric, ten, tandil)
     return s, bits, dsp
-
-
-@njit(cache=True)
-def merge_state(old, now):
-    """New ``zones.state``: the now bits of this step, the past bits of before and of now."""
-    return (old & (SHEAR_PAST | TENSION_PAST)) | now | (now << 2)
-
-
-@njit(cache=True)
-def tet_mohr_step(pos, vel, gp, rows, prop, dt, stress, state, force):
-    """One step of the Mohr-Coulomb 4-node zones ``rows`` without NMD: strain increment
-    (``kernels.zones.tet_kinematics``), ``mohr_return`` with the zone's ``prop`` columns,
-    ``state`` updated (``merge_state``), nodal forces added to ``force``."""
-    av = np.empty((4, 3))
-    de = np.empty(6)
-    w = np.empty(3)
-    work = mohr_work()
-    for k in range(rows.shape[0]):
-        z = rows[k]
-        tet_kinematics(pos, vel, gp, z, dt, av, de, w)
-        bits = 0
-        if not mohr_trial(stress[z], de, prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
-                          prop[z, ZP_TANFRIC], prop[z, ZP_TENSION]):
-            bits, _dsp = mohr_plastic(stress[z], prop[z, ZP_BULK], prop[z, ZP_SHEAR], prop[z, ZP_COHESION],
-                                      prop[z, ZP_TANFRIC], prop[z, ZP_TENSION], prop[z, ZP_TANDIL], work)
-        state[z] = merge_state(state[z], bits)
-        tet_add_forces(gp, z, av, stress[z], 1.0, force)

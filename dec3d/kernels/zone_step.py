@@ -1,8 +1,9 @@
 """The step of 4-node zones, any constitutive model: strain increment, mixed discretization of
 hexahedral sets, nodal mixed discretization (NMD) of the volumetric strain and of the plastic
 mean-stress correction, stress rotation in large strain, the zone model's update
-(``kernels/zmodels``), nodal forces. The one 4-node step of the engine; its slow twin is
-``kernels/zone_plastic.tet_zone_step`` in passes, kept for the tests.
+(``kernels/zmodels``), nodal forces. The one 4-node step of the engine; its serial twin in
+passes is ``tests/zone_plastic_twin.py`` (elastic and Mohr-Coulomb), the models' own twins are
+beside their tests.
 
 Formulas: 3DEC theory text (deformable blocks, Eqs. 53-59; mixed discretization Eqs. 60-67;
 NMD Eqs. 68-76, with the three-term Δε_v of ``shared/seeds/ERRATA.md``). The step is two sweeps
@@ -24,7 +25,7 @@ serial order, so one thread's bits for any thread count.
 import numpy as np
 from numba import njit, prange
 
-from .zmodels import NWORK, merge_state, zone_update
+from .zmodels import NWORK, Tables, merge_state, zone_update
 from .zone_elastic import _add, _faces, _force, _strain
 from .zone_mohr import mohr_work
 
@@ -53,6 +54,9 @@ def zone_step(pos, vel, mesh, mat, plan, scr, dt, large, nmd, plastic, force, fm
     fmag (nvert,) added to (Σ |zone force contributions| for the equilibrium ratio)."""
     g4 = mesh.g4; n4 = mesh.n4; rows = mesh.rows; zset = mesh.zset; weight = mesh.weight; nset = mesh.nset
     stress = mat.stress; state = mat.state; cmodel = mat.cmodel; bulk = mat.bulk; shear = mat.shear
+    prop = mat.prop; hist = mat.hist
+    # (parallel loops take arrays and scalars, not tuples: the tables go in as their arrays)
+    tx = mat.tab.x; ty = mat.tab.y; tstart = mat.tab.start; tcount = mat.tab.count
     pstart = plan.pstart; pk = plan.pk; fbits = plan.fbits; fbase = plan.fbase
     nbits = plan.nbits; nbase = plan.nbase
     nodesum = scr.nodesum; nodevol = scr.nodevol; nodedsp = scr.nodedsp; sa = scr.sa; sb = scr.sb
@@ -114,6 +118,7 @@ def zone_step(pos, vel, mesh, mat, plan, scr, dt, large, nmd, plastic, force, fm
         j = fbase[c] if not plastic else nbase[c]
         mw = mohr_work()
         wf = np.full(NWORK, np.nan)
+        tab = Tables(tx, ty, tstart, tcount)
         for q in range(pstart[c], pstart[c + 1]):
             k = pk[q]
             i0 = g4[k, 0]; i1 = g4[k, 1]; i2 = g4[k, 2]; i3 = g4[k, 3]
@@ -139,7 +144,7 @@ def zone_step(pos, vel, mesh, mat, plan, scr, dt, large, nmd, plastic, force, fm
             s0 = stress[z, 0]; s1 = stress[z, 1]; s2 = stress[z, 2]
             s3 = stress[z, 3]; s4 = stress[z, 4]; s5 = stress[z, 5]
             if large:
-                # Jaumann rotation (zone_plastic.jaumann_rotate)
+                # Jaumann rotation: σ += ωσ − σω
                 r0 = s0 + 2.0 * (w01 * s3 + w02 * s4)
                 r1 = s1 + 2.0 * (-w01 * s3 + w12 * s5)
                 r2 = s2 + 2.0 * (-w02 * s4 - w12 * s5)
@@ -147,9 +152,9 @@ def zone_step(pos, vel, mesh, mat, plan, scr, dt, large, nmd, plastic, force, fm
                 r4 = s4 + w02 * (s2 - s0) + w01 * s5 - w12 * s3
                 r5 = s5 + w12 * (s2 - s1) - w01 * s4 - w02 * s3
                 s0 = r0; s1 = r1; s2 = r2; s3 = r3; s4 = r4; s5 = r5
-            code, s0, s1, s2, s3, s4, s5, dp = zone_update(cmodel[z], mat.prop, mat.hist, z, bulk[z], shear[z],
+            code, s0, s1, s2, s3, s4, s5, dp = zone_update(cmodel[z], prop, hist, z, bulk[z], shear[z],
                                                            d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5,
-                                                           mat.tab, wf, mw)
+                                                           tab, wf, mw)
             stress[z, 0] = s0; stress[z, 1] = s1; stress[z, 2] = s2
             stress[z, 3] = s3; stress[z, 4] = s4; stress[z, 5] = s5
             if not plastic:
@@ -197,7 +202,7 @@ def _correction_sweep(pos, mesh, mat, plan, scr, nmd, force, fmag):
         for t in prange(nodedsp.shape[0]):
             if nodevol[t] > 0.0:
                 nodedsp[t] = nodedsp[t] / nodevol[t]
-    # (zone_plastic.md_stress_average: the set sums in entry order)
+    # the set sums in entry order (Eqs. 64-67)
     sd = np.zeros(nset)
     ss = np.zeros(nset)
     for k in range(zset.shape[0] if nset > 0 else 0):

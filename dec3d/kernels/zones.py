@@ -1,14 +1,25 @@
-"""Elastic 4-node tetrahedral zones: strain increment, stress update, nodal forces.
+"""Per-zone pieces of 4-node tetrahedral zones: strain increment, Hooke, nodal forces (used by the
+Mohr-Coulomb return's callers and the tests' twin of the zone step; the engine's step is
+``kernels/zone_step.py``).
 
 3DEC theory text, deformable blocks (000_*, "zone strain rates and stresses", "nodal forces"):
 the velocity gradient of a constant-strain tetrahedron follows from Gauss's divergence theorem,
 grad v = -(1/3V) sum_n v^n n^(n) S^(n), where face (n) is the face opposite node n, n^(n) its unit
 outward normal and S^(n) its area; the nodal force of a zone is the contour integral
 f^n = (1/3) sigma . n^(n) S^(n). Stresses are tension positive, order xx yy zz xy xz yz.
-Partial: mixed discretization, 10-node tetrahedra, masses and the motion loop are not here yet.
 """
-import numpy as np
 from numba import njit
+
+#: plastic-state bits of ``zones.state``: the "now" bits a zone model's update returns, the "past"
+#: bits the step keeps (now << 2); 16/32 (64/128) are a ubiquitous-joint zone's weak plane
+SHEAR_NOW = 1
+TENSION_NOW = 2
+SHEAR_PAST = 4
+TENSION_PAST = 8
+JOINT_SHEAR_NOW = 16
+JOINT_TENSION_NOW = 32
+JOINT_SHEAR_PAST = 64
+JOINT_TENSION_PAST = 128
 
 
 @njit(cache=True)
@@ -25,49 +36,9 @@ def _face_vector(a, b, c, opp):
     return nx, ny, nz
 
 
-@njit(cache=True)
-def tet_elastic_step(pos, vel, gp, bulk, shear, dt, stress, force):
-    """One elastic step for every 4-node zone: stress += D : (sym grad v) dt, then
-    force[gp] += (1/3) sigma . n S per face opposite each node. Returns nothing."""
-    nz = gp.shape[0]
-    fv = np.empty((4, 3))
-    for z in range(nz):
-        vol = 0.0
-        for n in range(4):
-            i1 = gp[z, (n + 1) % 4]; i2 = gp[z, (n + 2) % 4]; i3 = gp[z, (n + 3) % 4]
-            ax, ay, az = _face_vector(pos[i1], pos[i2], pos[i3], pos[gp[z, n]])
-            fv[n, 0] = ax; fv[n, 1] = ay; fv[n, 2] = az
-        p0 = pos[gp[z, 0]]; p1 = pos[gp[z, 1]]; p2 = pos[gp[z, 2]]; p3 = pos[gp[z, 3]]
-        vol = abs((p1[0] - p0[0]) * ((p2[1] - p0[1]) * (p3[2] - p0[2]) - (p2[2] - p0[2]) * (p3[1] - p0[1]))
-                  - (p1[1] - p0[1]) * ((p2[0] - p0[0]) * (p3[2] - p0[2]) - (p2[2] - p0[2]) * (p3[0] - p0[0]))
-                  + (p1[2] - p0[2]) * ((p2[0] - p0[0]) * (p3[1] - p0[1]) - (p2[1] - p0[1]) * (p3[0] - p0[0]))) / 6.0
-        g = np.zeros((3, 3))   # g[i, j] = d v_i / d x_j
-        for n in range(4):
-            for i in range(3):
-                for j in range(3):
-                    g[i, j] -= vel[gp[z, n], i] * fv[n, j]
-        g /= 3.0 * vol
-        e = np.array([g[0, 0], g[1, 1], g[2, 2], 0.5 * (g[0, 1] + g[1, 0]),
-                      0.5 * (g[0, 2] + g[2, 0]), 0.5 * (g[1, 2] + g[2, 1])]) * dt
-        ev = e[0] + e[1] + e[2]
-        lam = bulk[z] - 2.0 * shear[z] / 3.0
-        for k in range(3):
-            stress[z, k] += lam * ev + 2.0 * shear[z] * e[k]
-        for k in range(3, 6):
-            stress[z, k] += 2.0 * shear[z] * e[k]
-        s = stress[z]
-        for n in range(4):
-            r = gp[z, n]
-            force[r, 0] += (s[0] * fv[n, 0] + s[3] * fv[n, 1] + s[4] * fv[n, 2]) / 3.0
-            force[r, 1] += (s[3] * fv[n, 0] + s[1] * fv[n, 1] + s[5] * fv[n, 2]) / 3.0
-            force[r, 2] += (s[4] * fv[n, 0] + s[5] * fv[n, 1] + s[2] * fv[n, 2]) / 3.0
-
-
-# --- per-zone pieces shared by the constitutive kernels (kernels/zone_mohr.py) ---------------
-
 @njit(cache=True, inline="always")
 def tet_kinematics(pos, vel, gp, z, dt, av, de, w):
-    """Strain increment of 4-node zone ``z`` (same formulas as ``tet_elastic_step``): fills
+    """Strain increment of 4-node zone ``z`` (the face vectors of Gauss's theorem above): fills
     ``av`` (4, 3) with the area vectors n^(n) S^(n) of the faces opposite nodes 0-3 (outward),
     ``de`` (6,) with sym(grad v) dt in the order xx yy zz xy xz yz and ``w`` (3,) with the spin
     increment skw(grad v) dt, components 01 02 12 (Eq. 58's rotation rate times dt). Returns
@@ -99,7 +70,7 @@ def tet_kinematics(pos, vel, gp, z, dt, av, de, w):
 def tet_add_forces(gp, z, av, s, w, force):
     """Add the nodal forces w (1/3) sigma . n^(n) S^(n) of zone ``z`` with stress ``s`` (6,)
     and face area vectors ``av`` (4, 3) (from ``tet_kinematics``) to ``force`` (sign as
-    ``tet_elastic_step``)."""
+    the text's contour integral)."""
     w3 = w / 3.0
     for n in range(4):
         r = gp[z, n]

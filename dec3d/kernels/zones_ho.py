@@ -22,7 +22,7 @@ sqrt 5)/20, b = (5 - sqrt 5)/20), weight 1/24 each in the reference volume 1/6. 
 is the one nearest corner g; ``gstress[z, g]`` is its stress (xx yy zz xy xz yz, tension
 positive) and ``stress[z]`` the mean of the four.
 
-Sign convention as ``kernels/zones.tet_elastic_step``: ``force[r]`` accumulates the force the
+Sign convention as ``kernels/zone_step.zone_step``: ``force[r]`` accumulates the force the
 zone exerts on gridpoint r, the negative of the internal-force vector, -int B^T sigma dV.
 
 Zones must be positively oriented (corners 0-3 right-handed, as the mesher makes them). Every

@@ -1,5 +1,5 @@
-"""The deformable-block step: gridpoint masses and stiffness, zone forces with mixed
-discretization, and the gridpoint equations of motion with damping.
+"""The deformable-block step besides the zone forces (``kernels/zone_step.py``): gridpoint masses
+and stiffness, and the gridpoint equations of motion with damping.
 
 Sources: the 3DEC theory text (/work/shared/seeds/000_b8ba745952e0c537.txt), sections
 "Deformable Block Motion" (Eqs. 53-59, ERRATA: Δε_v has three terms), "Accurate Modeling of
@@ -18,19 +18,6 @@ and "Mass (Density) Scaling".
     10-node zone four times the corner-tetrahedron value, dec3d's conservative choice, since its
     nodes are twice as close).
 
-``zone_forces`` (4-node zones)
-    Velocity gradient from Gauss's theorem, ∂v_i/∂x_j = −(1/3V) Σ_n v_i^n n_j^(n) S^(n) (face (n)
-    opposite node n, outward normal, area S); strain increment Δε = sym(∇v) Δt. In a mixed set
-    (both overlays of one hexahedral zone, as the text does mixed discretization "over the
-    combination of two overlays") the volumetric part is replaced by the volume-weighted mean of
-    the set (Eqs. 60-63). In large strain the stress is first turned with the material by the
-    spin increment ω Δt, ω = ½(∇v − ∇vᵀ) (the rotation rate of Eq. 58): σ += ωσ − σω (Jaumann,
-    dec3d's choice of objective rate). Incremental Hooke (Eq. 59, three-term Δε_v) updates the stress; the
-    zone's nodal force is f^n = (1/3) σ·n^(n) S^(n) (Eq. 55 for a constant-stress tetrahedron),
-    times the zone's weight (½ for an overlay zone: the nodal force is the average of the two).
-    ``force[r]`` accumulates the force zones exert on gridpoint r; ``fmag[r]`` the sum of the
-    magnitudes of those contributions (Itasca's "applied force magnitude" of the ratio).
-
 ``gp_externals``  gravity (real mass), applied and face forces per row, then linked rows summed
     onto their master.
 
@@ -43,7 +30,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit, prange
 
 from .motion import _sgn
@@ -111,83 +97,6 @@ def zone_mass_stiffness(pos, gp, nnode, overlay, rows, bulk, shear, density, mas
             for n in range(4):
                 mass[gp[z, n]] += 0.25 * mz
                 stiff[gp[z, n]] += kz
-
-
-@njit(cache=True)
-def _rotate(stress, z, w01, w02, w12):
-    """σ += W σ − σ W for the spin increment W (W01 = w01, W02 = w02, W12 = w12, antisymmetric)."""
-    s00 = stress[z, 0]; s11 = stress[z, 1]; s22 = stress[z, 2]
-    s01 = stress[z, 3]; s02 = stress[z, 4]; s12 = stress[z, 5]
-    stress[z, 0] = s00 + 2.0 * (w01 * s01 + w02 * s02)
-    stress[z, 1] = s11 + 2.0 * (-w01 * s01 + w12 * s12)
-    stress[z, 2] = s22 + 2.0 * (-w02 * s02 - w12 * s12)
-    stress[z, 3] = s01 + w01 * (s11 - s00) + w02 * s12 + w12 * s02
-    stress[z, 4] = s02 + w02 * (s22 - s00) + w01 * s12 - w12 * s01
-    stress[z, 5] = s12 + w12 * (s22 - s11) - w01 * s02 - w02 * s01
-
-
-@njit(cache=True)
-def zone_forces(pos, vel, gp, rows, zset, weight, nset, bulk, shear, dt, large, stress, force, fmag):
-    """One step of 4-node elastic zones ``rows``: strain increment (mixed discretization over
-    the sets ``zset`` (per entry of rows: set index 0..nset-1, or -1)), stress update (in large
-    strain after rotating the stress by the spin increment), nodal forces times ``weight`` (per
-    entry of rows) added to ``force``, their magnitudes to ``fmag``."""
-    nz = rows.shape[0]
-    de = np.empty((nz, 6))
-    rot = np.zeros((nz, 3))
-    vols = np.empty(nz)
-    av = np.empty((nz, 4, 3))
-    sv = np.zeros(nset)
-    ss = np.zeros(nset)
-    for k in range(nz):
-        z = rows[k]
-        for n in range(4):
-            ax, ay, az = _area_vec(pos, gp[z, (n + 1) % 4], gp[z, (n + 2) % 4], gp[z, (n + 3) % 4], gp[z, n])
-            av[k, n, 0] = ax; av[k, n, 1] = ay; av[k, n, 2] = az
-        vol = _tet_volume(pos, gp[z, 0], gp[z, 1], gp[z, 2], gp[z, 3])
-        vols[k] = vol
-        g00 = 0.0; g01 = 0.0; g02 = 0.0; g10 = 0.0; g11 = 0.0; g12 = 0.0; g20 = 0.0; g21 = 0.0; g22 = 0.0
-        for n in range(4):
-            r = gp[z, n]
-            v0 = vel[r, 0]; v1 = vel[r, 1]; v2 = vel[r, 2]
-            s0 = av[k, n, 0]; s1 = av[k, n, 1]; s2 = av[k, n, 2]
-            g00 -= v0 * s0; g01 -= v0 * s1; g02 -= v0 * s2
-            g10 -= v1 * s0; g11 -= v1 * s1; g12 -= v1 * s2
-            g20 -= v2 * s0; g21 -= v2 * s1; g22 -= v2 * s2
-        f = dt / (3.0 * vol)
-        de[k, 0] = g00 * f; de[k, 1] = g11 * f; de[k, 2] = g22 * f
-        de[k, 3] = 0.5 * (g01 + g10) * f; de[k, 4] = 0.5 * (g02 + g20) * f; de[k, 5] = 0.5 * (g12 + g21) * f
-        rot[k, 0] = 0.5 * (g01 - g10) * f; rot[k, 1] = 0.5 * (g02 - g20) * f; rot[k, 2] = 0.5 * (g12 - g21) * f
-        h = zset[k]
-        if h >= 0:
-            sv[h] += (de[k, 0] + de[k, 1] + de[k, 2]) * vol
-            ss[h] += vol
-    for k in range(nz):
-        z = rows[k]
-        h = zset[k]
-        if h >= 0 and ss[h] > 0.0:
-            shift = (sv[h] / ss[h] - (de[k, 0] + de[k, 1] + de[k, 2])) / 3.0
-            de[k, 0] += shift; de[k, 1] += shift; de[k, 2] += shift
-        if large:
-            _rotate(stress, z, rot[k, 0], rot[k, 1], rot[k, 2])
-        ev = de[k, 0] + de[k, 1] + de[k, 2]
-        lam = bulk[z] - 2.0 * shear[z] / 3.0
-        g2 = 2.0 * shear[z]
-        for i in range(3):
-            stress[z, i] += lam * ev + g2 * de[k, i]
-        for i in range(3, 6):
-            stress[z, i] += g2 * de[k, i]
-        sxx = stress[z, 0]; syy = stress[z, 1]; szz = stress[z, 2]
-        sxy = stress[z, 3]; sxz = stress[z, 4]; syz = stress[z, 5]
-        w = weight[k] / 3.0
-        for n in range(4):
-            r = gp[z, n]
-            s0 = av[k, n, 0]; s1 = av[k, n, 1]; s2 = av[k, n, 2]
-            fx = (sxx * s0 + sxy * s1 + sxz * s2) * w
-            fy = (sxy * s0 + syy * s1 + syz * s2) * w
-            fz = (sxz * s0 + syz * s1 + szz * s2) * w
-            force[r, 0] += fx; force[r, 1] += fy; force[r, 2] += fz
-            fmag[r] += math.sqrt(fx * fx + fy * fy + fz * fz)
 
 
 @njit(cache=True, parallel=True)

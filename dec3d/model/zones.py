@@ -27,9 +27,11 @@ block still owns a contiguous vertex range (which the contact code relies on).
     volume ()        m³     volume (reference configuration; updated in large strain)
     stress (6,)      Pa     xx yy zz xy xz yz, tension positive (3DEC sign convention)
     gstress (4, 6)   Pa     Gauss-point stresses of a 10-node tetrahedron (zone stress = their mean)
-    cmodel ()        int8   constitutive model code (``ZMODEL_*``); 0: none assigned (null)
-    prop (NZPROP,)   SI     constitutive properties by ``ZP_*`` column
-    state ()         int32  plastic state bits (issue "deformable blocks II")
+    cmodel ()        int8   constitutive model code (``kernels/zmodels``: each model's ``CODE``); 0: null
+    prop (NZPROP,)   SI     constitutive properties: columns 0-7 shared (``ZP_*``), from 8 on the model's own
+    hist (NZHIST,)   -      the model's history (strain-softening's hardening parameters, …): the first
+                            ``NHIST`` entries of the zone's model, zeroed when a model is assigned
+    state ()         int32  plastic state bits (``ZSTATE_*``; a model's update returns the "now" bits)
     group (nslots,)  int32  group codes per slot, -1 none
 
 Gridpoint fields added to ``vertices`` (rigid-block vertices leave them at their fill):
@@ -55,34 +57,43 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..kernels.zmodels import CODES, NZHIST, NZPROP
+from ..kernels.zmodels._common import (JOINT_SHEAR_NOW, JOINT_SHEAR_PAST, JOINT_TENSION_NOW, JOINT_TENSION_PAST,
+                                       P_BULK, P_COHESION, P_DENSITY, P_SHEAR, P_TANDIL, P_TANFRIC, P_TENSION,
+                                       SHEAR_NOW, SHEAR_PAST, TENSION_NOW, TENSION_PAST)
 from .groups import group_field
 from .store import Field, Store
 
 _F = np.float64
 _I = np.int64
 
-#: constitutive model codes of zones
+#: constitutive model code of null zones (no stress, no mass); the models' codes are their
+#: kernels' (``dec3d.kernels.zmodels.CODES``)
 ZMODEL_NULL = 0
-ZMODEL_ELASTIC = 1
-ZMODEL_MOHR = 2          # Mohr-Coulomb, issue "deformable blocks II"
+#: the elastic model's code: FE elements take elastic or null only
+ZMODEL_ELASTIC = CODES["elastic"]
 
-#: property columns of ``zones.prop``
-ZP_BULK = 0
-ZP_SHEAR = 1
-ZP_DENSITY = 2
-ZP_COHESION = 3
-ZP_TANFRIC = 4
-ZP_TENSION = 5
-ZP_TANDIL = 6
-NZPROP = 8
+#: shared property columns of ``zones.prop`` (``kernels/zmodels/_common``); the models' own
+#: columns start at ``P_OWN``
+ZP_BULK = P_BULK
+ZP_SHEAR = P_SHEAR
+ZP_DENSITY = P_DENSITY
+ZP_COHESION = P_COHESION
+ZP_TANFRIC = P_TANFRIC
+ZP_TENSION = P_TENSION
+ZP_TANDIL = P_TANDIL
 
-#: plastic state bits of ``zones.state`` (Itasca's shear-n, tension-n, shear-p, tension-p):
-#: "now" bits are set by the step that yielded and cleared by the next step that does not,
-#: "past" bits stay once set
-ZSTATE_SHEAR_NOW = 1
-ZSTATE_TENSION_NOW = 2
-ZSTATE_SHEAR_PAST = 4
-ZSTATE_TENSION_PAST = 8
+#: plastic state bits of ``zones.state`` (Itasca's shear-n, tension-n, shear-p, tension-p, and
+#: the weak plane's of ubiquitous-joint zones): "now" bits are set by the step that yielded and
+#: cleared by the next step that does not, "past" bits stay once set
+ZSTATE_SHEAR_NOW = SHEAR_NOW
+ZSTATE_TENSION_NOW = TENSION_NOW
+ZSTATE_SHEAR_PAST = SHEAR_PAST
+ZSTATE_TENSION_PAST = TENSION_PAST
+ZSTATE_BITS = (("shear-now", SHEAR_NOW), ("tension-now", TENSION_NOW), ("shear-past", SHEAR_PAST),
+               ("tension-past", TENSION_PAST), ("joint-shear-now", JOINT_SHEAR_NOW),
+               ("joint-tension-now", JOINT_TENSION_NOW), ("joint-shear-past", JOINT_SHEAR_PAST),
+               ("joint-tension-past", JOINT_TENSION_PAST))
 
 #: stress components in store order
 STRESS_COMPONENTS = ("xx", "yy", "zz", "xy", "xz", "yz")
@@ -101,6 +112,7 @@ def _zone_fields() -> dict[str, Field]:
         "gstress": Field((4, 6), _F, 0.0),
         "cmodel": Field((), np.int8, ZMODEL_NULL),
         "prop": Field((NZPROP,), _F, 0.0),
+        "hist": Field((NZHIST,), _F, 0.0),
         "state": Field((), np.int32, 0),
         "group": group_field(),
     }

@@ -112,18 +112,19 @@ def zone_stiffness_damping(zst, beta: float, pos, vel, facc) -> None:
     """Add the gridpoint forces of the damping stresses β D ε̇ of the zones and FE elements to ``facc``:
     each element kind's own step kernel, run on zero stresses with the strain increment of the current
     velocities over a unit time (so it returns −K v, the forces being linear in the stresses and the
-    strains in the velocities), times β — the 4-node zones (``zonestep``/``zone_plastic``, Mohr-Coulomb
-    zones taken as elastic: the damping stress is not limited by their strength; null zones stay null),
-    the 10-node zones (``zones_ho.tet10_step``) and the FE elements with their hourglass control
-    (``FeStepper.stiffness_damping``). ``zst`` is the ``physics.zones.ZoneStepper``."""
-    from dec3d.kernels.zone_plastic import zone_forces_plastic
-    from dec3d.kernels.zonestep import zone_forces
-    from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_MOHR
+    strains in the velocities), times β — the 4-node zones (``zone_step`` with each plastic model's zones
+    taken as elastic: the damping stress is not limited by their strength; null zones stay null; other
+    elastic models, anisotropic ones, keep theirs), the 10-node zones (``zones_ho.tet10_step``) and the FE
+    elements with their hourglass control (``FeStepper.stiffness_damping``). ``zst`` is the
+    ``physics.zones.ZoneStepper``."""
+    from dec3d.kernels.zmodels import CODES, PLASTIC_CODES
+    from dec3d.kernels.zone_step import zone_step
 
     zs = zst.model.store("zones")
     sc = getattr(zst, "_rayleigh_scratch", None)
     if sc is None or sc[0].shape != zs["stress"].shape or sc[2].shape != facc.shape:
-        cm = np.where(zs["cmodel"] == ZMODEL_MOHR, ZMODEL_ELASTIC, zs["cmodel"]).astype(zs["cmodel"].dtype)
+        plastic = np.isin(zs["cmodel"], sorted(PLASTIC_CODES))
+        cm = np.where(plastic, CODES["elastic"], zs["cmodel"]).astype(zs["cmodel"].dtype)
         sc = zst._rayleigh_scratch = (np.zeros_like(zs["stress"]), np.zeros_like(zs["state"]), np.zeros_like(facc),
                                       np.zeros(facc.shape[0]), cm,
                                       np.zeros_like(zs["gstress"]) if len(zst.rows10) else None)
@@ -132,12 +133,9 @@ def zone_stiffness_damping(zst, beta: float, pos, vel, facc) -> None:
     state[:] = 0
     f[:] = 0.0
     fm[:] = 0.0
-    if len(zst.rows4) and zst.plastic:
-        zone_forces_plastic(pos, vel, zs["gp"], zst.rows4, zst.zset, zst.weight, zst.nset, zst.node, cm, zs["prop"],
-                            1.0, False, zst.nmd, stress, state, f, fm)
-    elif len(zst.rows4):
-        zone_forces(pos, vel, zs["gp"], zst.rows4, zst.zset, zst.weight, zst.nset, zst.bulk, zst.shear, 1.0, False,
-                    stress, f, fm)
+    if zst.fast is not None:
+        zone_step(pos, vel, zst.zmesh, zst.material(stress, state, cm), zst.zplan, zst.zscratch, 1.0, False, zst.nmd,
+                  False, f, fm)
     if gstress is not None:
         from dec3d.kernels.zones_ho import tet10_step
         gstress[zst.rows10] = 0.0

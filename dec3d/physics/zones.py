@@ -4,10 +4,10 @@
 model with zones (state is the model's: ``zones`` store and the gridpoint fields of
 ``vertices``, see ``dec3d.model.zones``; the stepper holds only what it can rebuild):
 
-1. checks: every zoned block has zones with a model, every elastic zone its bulk, shear and
-   density (``RunError`` naming the blocks otherwise); Mohr-Coulomb zones by
-   ``model.zone_mohr.mohr_props_check`` (errors stop the run, warnings go to the engine's
-   ``warn``); Mohr-Coulomb on 10-node zones is refused;
+1. checks: every zoned block has zones with a model (``RunError`` naming the blocks otherwise);
+   the zones of each model by its registry entry (``physics.cmodels``: every property in its
+   range, then the model's own check; errors stop the run naming the zones, warnings go to the
+   engine's ``warn``); 10-node zones cycle elastic only;
 2. lumped masses and the node stiffness of Eq. (86) (kernel ``zonestep.zone_mass_stiffness``)
    of the 4-node zones; for 10-node zones HRZ lumped masses (``zones_ho.tet10_lumped_mass``) and
    twice the Gershgorin row-sum stiffness (``zones_ho.tet10_stiffness``); summed onto link masters
@@ -22,10 +22,8 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
 4. each step (``step``): zone forces of the 4-node zones (mixed discretization in hexahedral
    sets and nodal mixed discretization, NMD, for the other tetrahedra when
    ``settings.mechanical["nmd"]`` is on, the default, ``block zone nodal-mixed-discretization``):
-   with no Mohr-Coulomb zone ``zone_elastic.elastic_zone_step``, otherwise
-   ``zone_mohr_step.mohr_zone_step`` (both on threads from PARALLEL_MIN_ZONES zones on; with
-   ELASTIC_KERNEL / MOHR_KERNEL off ``zone_plastic.zone_forces_plastic`` or
-   ``zone_forces_plastic_parallel_ws``), all with the same bits for the same zones; 10-node zones
+   by ``zone_step.zone_step`` (each zone's model update from ``kernels/zmodels``; one chunk per
+   thread from PARALLEL_MIN_ZONES zones on, the same bits for any chunk count); 10-node zones
    by ``zones_ho.tet10_step``), gravity (m g
    on the gridpoints of 4-node zones, the consistent loads of ``zones_ho.tet10_body_force`` on
    those of 10-node zones, both counted in the applied-force magnitudes of the equilibrium
@@ -45,14 +43,15 @@ import math
 import numpy as np
 
 from dec3d.errors import Dec3dError
-from dec3d.kernels.zone_elastic import ElasticPlan, elastic_zone_step
-from dec3d.kernels.zone_mohr_step import mohr_zone_step
-from dec3d.kernels.zone_plastic import node_lists4, zone_forces_plastic, zone_forces_plastic_parallel_ws, zone_scratch
+from dec3d.kernels.bundles import ZoneMaterial, ZoneMesh, ZonePlan, ZoneScratch
+from dec3d.kernels.zmodels import PLASTIC_CODES, make_tables, no_tables
+from dec3d.kernels.zone_elastic import ElasticPlan
+from dec3d.kernels.zone_step import zone_step
 from dec3d.kernels.zonestep import gp_externals, gp_motion, gp_motion_ws, zone_mass_stiffness
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.model import KIND_DEFORMABLE
-from dec3d.model.zone_mohr import mohr_props_check
-from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_MOHR, ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
+from dec3d.model.zones import ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
+from dec3d.physics.cmodels import MODEL_BY_CODE
 
 _F = np.float64
 _I = np.int64
@@ -62,18 +61,39 @@ _I = np.int64
 #: spare; the D3 10-node hole deck went unstable at step 130 with it and runs with twice it
 TET10_STIFFNESS_MARGIN = 2.0
 
-#: 4-node zones from which the zone step runs on threads (``elastic_zone_step`` in one part
-#: per thread, ``zone_forces_plastic_parallel_ws``; both bit-identical to the serial kernel, so
-#: the choice never changes a result)
+#: 4-node zones from which the zone step runs in one chunk per thread (``zone_step`` gives the
+#: same bits for any chunk count, so the choice never changes a result)
 PARALLEL_MIN_ZONES = 20000
 
 
-#: step zones with ``zone_elastic.elastic_zone_step`` when none is Mohr-Coulomb (False: always
-#: the plastic kernels, which give the same bits; for tests)
-ELASTIC_KERNEL = True
-#: step zones with ``zone_mohr_step.mohr_zone_step`` when some are Mohr-Coulomb (False: the
-#: plastic kernels of ``zone_plastic``, which give the same bits; for tests)
-MOHR_KERNEL = True
+def zone_bundles(plan: ElasticPlan, nset: int, plastic: bool):
+    """(``ZoneMesh``, ``ZonePlan``, ``ZoneScratch``) of ``zone_step`` from a plan (scratch of the
+    plastic correction only when ``plastic``)."""
+    nr = plan.g4.shape[0]
+    nv = plan.nodesum.shape[0]
+    mesh = ZoneMesh(plan.g4, plan.n4, plan.rows, plan.zset, plan.weight, int(nset))
+    zplan = ZonePlan(plan.pstart, plan.pk, *plan.fplan, *plan.nplan)
+    scratch = ZoneScratch(plan.nodesum, plan.nodevol, np.empty(nv if plastic else 0), plan.sa, plan.sb, plan.evs,
+                          plan.vols, np.empty(nr if plastic else 0))
+    return mesh, zplan, scratch
+
+
+def zone_tables(model, error=Dec3dError):
+    """The ``Tables`` bundle of the tables zone properties name (``settings.mechanical
+    ["zone_tables"]``, table t + 1 in a table column is its entry t), read from the FISH tables
+    as they are now; a table that is gone stops the run."""
+    ids = model.settings.mechanical.get("zone_tables", [])
+    if not ids:
+        return no_tables()
+    get = getattr(model, "fish_table", None)
+    points = []
+    for tid in ids:
+        tab = get(tid) if get is not None else None
+        if tab is None:
+            raise error(f"zone properties name table {tid!r}, which does not exist (any more): make it with "
+                             "`table` before cycling")
+        points.append((list(tab.xs), list(tab.ys)))
+    return make_tables(points)
 
 
 def _ids(model, rows) -> str:
@@ -112,9 +132,9 @@ class ZoneStepper:
         zs = zone_stores(model)
         b, v = model.blocks, model.vertices
         self.blocks = zoned_blocks(model)
-        on, zrow, cm = block_elements(model, zs, self.blocks, (ZMODEL_NULL, ZMODEL_ELASTIC, ZMODEL_MOHR), error,
-                                      "zones", "(only elastic, mohr-coulomb and null)")
-        act = (cm == ZMODEL_ELASTIC) | (cm == ZMODEL_MOHR)
+        on, zrow, cm = block_elements(model, zs, self.blocks, [ZMODEL_NULL] + list(MODEL_BY_CODE), error,
+                                      "zones", "(unknown model code)")
+        act = cm != ZMODEL_NULL
         live = np.zeros(b.n, bool)
         live[zs["block"][zrow[act]]] = True
         none = self.blocks[~live[self.blocks]]
@@ -123,31 +143,39 @@ class ZoneStepper:
                         "`block zone cmodel assign elastic` (and `block zone property`) before cycling")
         el = zrow[act]
         p = zs["prop"]
-        ela = zrow[cm == ZMODEL_ELASTIC]
-        miss = (p[ela, ZP_BULK] <= 0) | (p[ela, ZP_SHEAR] <= 0) | (p[ela, ZP_DENSITY] <= 0)
-        if miss.any():
-            what = "; ".join(f"{name} in blocks {_ids(model, zs['block'][ela[p[ela, c] <= 0]])}"
-                             for name, c in (("bulk", ZP_BULK), ("shear", ZP_SHEAR), ("density", ZP_DENSITY))
-                             if (p[ela, c] <= 0).any())
-            raise error(f"{int(miss.sum())} elastic zones lack properties ({what}): set them with "
-                        "`block zone property` before cycling")
-        mo = zrow[cm == ZMODEL_MOHR]
-        #: warnings of the property check (also given to ``warn`` when there is one)
-        self.warnings = mohr_props_check(p[mo], ids=zs["id"][mo], error=error) if len(mo) else []
+        #: warnings of the property checks (also given to ``warn`` when there is one)
+        self.warnings = []
+        problems = []
+        #: the zone moduli the mass scaling and time step take (each model's ``moduli``)
+        self.bulk = np.ascontiguousarray(p[:, ZP_BULK])
+        self.shear = np.ascontiguousarray(p[:, ZP_SHEAR])
+        self.density = np.ascontiguousarray(p[:, ZP_DENSITY])
+        nn = zs["nnode"]
+        for code in np.unique(cm[act]):
+            zm = MODEL_BY_CODE[int(code)]
+            mine = zrow[cm == code]
+            bad, warns = zm.problems(p[mine], zs["id"][mine])
+            problems += [f"{zm.name}: {x}" for x in bad]
+            self.warnings += [f"{zm.name}: {x}" for x in warns]
+            if zm.moduli is not None and not bad:
+                self.bulk[mine], self.shear[mine] = zm.bulk_shear(p[mine])
+            if zm.name != "elastic" and (nn[mine] == 10).any():
+                ho = mine[nn[mine] == 10]
+                problems.append(f"{len(ho)} {zm.name} zones of blocks {_ids(model, zs['block'][ho])} are 10-node "
+                                "tetrahedra: 10-node zones cycle elastic only (use `block zone generate "
+                                "edgelength` or `hexahedra` for these blocks, or an elastic model)")
+        if problems:
+            raise error("zone properties: " + "; ".join(problems)
+                        + " (set them with `block zone property` before cycling)")
         if warn is not None:
             for w in self.warnings:
                 warn(w)
-        nn = zs["nnode"][el]
-        if len(mo) and (zs["nnode"][mo] == 10).any():
-            ho = mo[zs["nnode"][mo] == 10]
-            raise error(f"{len(ho)} Mohr-Coulomb zones of blocks {_ids(model, zs['block'][ho])} are 10-node "
-                        "tetrahedra: Mohr-Coulomb cycles on 4-node zones only (use `block zone generate "
-                        "edgelength` or `hexahedra` for these blocks, or an elastic model)")
+        nn = nn[el]
         self.rows4 = np.ascontiguousarray(el[nn == 4])
         self.rows10 = np.ascontiguousarray(el[nn == 10])
-        #: the plastic-capable zone step: with Mohr-Coulomb zones or nodal mixed discretization
         self.nmd = bool(model.settings.mechanical.get("nmd", True))
-        self.plastic = bool(len(mo)) or (self.nmd and bool(len(self.rows4)))
+        #: some 4-node zone has a plastic model (the step's third sweep, the plastic correction)
+        self.plastic = bool(np.isin(zs["cmodel"][self.rows4], sorted(PLASTIC_CODES)).any())
         link0 = v["link"]
         #: NMD averaging node of each vertex row: its link master (one gridpoint of a joined set) or itself
         self.node = np.ascontiguousarray(np.where(link0 >= 0, link0, np.arange(v.n, dtype=_I)))
@@ -157,10 +185,6 @@ class ZoneStepper:
         if len(self.rows10):
             from dec3d.kernels import zones_ho
             self.ho = zones_ho.tet10_step
-        #: gather lists of the threaded plastic step (same bits as the serial one), big models only;
-        #: taken on one thread too: its zone sweeps and gathers beat the serial scatter there as well
-        #: (``bench/zone_bench.py``)
-        self.par = None
         # mixed-discretization sets of the 4-node zones: compact set numbers
         hx = zs["hex"][self.rows4]
         self.weight = np.where(zs["overlay"][self.rows4] >= 0, 0.5, 1.0)
@@ -169,29 +193,17 @@ class ZoneStepper:
             _, inv = np.unique(hx[hx >= 0], return_inverse=True)
             self.zset[hx >= 0] = inv.ravel()
         self.nset = int(self.zset.max()) + 1 if len(self.zset) else 0
-        #: no Mohr-Coulomb zone: the elastic step (``zone_elastic.elastic_zone_step``, the bits of
-        #: the plastic step) on one part of the zones per thread from PARALLEL_MIN_ZONES zones on
+        #: the 4-node step (``zone_step.zone_step``): chunks (one per thread from PARALLEL_MIN_ZONES
+        #: zones on; any count gives the same bits), plans and scratch, made once per stepper
         self.fast = None
-        #: some Mohr-Coulomb zones: ``zone_mohr_step.mohr_zone_step`` (the same plan, and the
-        #: scratch of its plastic corrections: per zone entry and per averaging node)
-        self.fastmc = None
-        if ((ELASTIC_KERNEL and not len(mo)) or (MOHR_KERNEL and len(mo))) and len(self.rows4):
+        if len(self.rows4):
             import numba
 
             nch = numba.get_num_threads() if len(self.rows4) >= PARALLEL_MIN_ZONES else 1
             self.fast = ElasticPlan(zs["gp"], self.rows4, self.node, self.zset, self.weight, v.n, nch)
-            if len(mo):
-                self.fastmc = (np.empty(len(self.rows4)), np.empty(v.n))
-        elif self.plastic and len(self.rows4) >= PARALLEL_MIN_ZONES:
-            nv = v.n
-            fstart, fent = node_lists4(nv, np.arange(nv, dtype=_I), zs["gp"], self.rows4)
-            nstart, nent = node_lists4(nv, self.node, zs["gp"], self.rows4)
-            self.par = (fstart, fent, nstart, nent)
-        #: scratch of the plastic step, allocated once (``zone_plastic.zone_scratch``)
-        self.ws = zone_scratch(len(self.rows4), v.n, True) if self.par is not None else None
-        self.bulk = np.ascontiguousarray(p[:, ZP_BULK])
-        self.shear = np.ascontiguousarray(p[:, ZP_SHEAR])
-        self.density = np.ascontiguousarray(p[:, ZP_DENSITY])
+            self.zmesh, self.zplan, self.zscratch = zone_bundles(self.fast, self.nset, self.plastic)
+        #: the tables the zone models read (``table`` ids named by table properties)
+        self.tables = zone_tables(model, error)
         # FE blocks (issue 12): their nodes move with the gridpoints; forces, masses and slave
         # nodes come from dec3d.physics.feblocks.FeStepper
         self.fe = None
@@ -406,6 +418,13 @@ class ZoneStepper:
         self.ktot = self.kzone + kj
 
     # ------------------------------------------------------------ one step
+    def material(self, stress=None, state=None, cmodel=None) -> ZoneMaterial:
+        """The zones' ``ZoneMaterial`` (stress, state, model codes as given, else the store's)."""
+        zs = self.model.store("zones")
+        return ZoneMaterial(zs["cmodel"] if cmodel is None else cmodel, zs["prop"], zs["hist"], self.bulk, self.shear,
+                            zs["stress"] if stress is None else stress, zs["state"] if state is None else state,
+                            self.tables)
+
     def begin(self) -> np.ndarray:
         """Start a step: the gridpoint force accumulator zeroed and returned (contact forces
         may be added to it before ``step(…, begun=True)``)."""
@@ -428,21 +447,9 @@ class ZoneStepper:
         if not begun:
             self.begin()
         pos, vel = v["pos"], v["velocity"]
-        fast = self.fast
-        if self.fastmc is not None:
-            mohr_zone_step(pos, vel, fast.g4, fast.n4, fast.rows, fast.zset, fast.weight, self.nset, zs["cmodel"],
-                           zs["prop"], self.bulk, self.shear, dt, large, self.nmd, zs["stress"], zs["state"], facc,
-                           fmag, *fast.args(), *self.fastmc)
-        elif fast is not None:
-            elastic_zone_step(pos, vel, fast.g4, fast.n4, fast.rows, fast.zset, fast.weight, self.nset, self.bulk,
-                              self.shear, dt, large, self.nmd, zs["stress"], facc, fmag, *fast.args())
-        elif self.par is not None:
-            zone_forces_plastic_parallel_ws(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset,
-                                            self.node, zs["cmodel"], zs["prop"], dt, large, self.nmd, zs["stress"],
-                                            zs["state"], facc, fmag, *self.par, *self.ws)
-        elif len(self.rows4):
-            zone_forces_plastic(pos, vel, zs["gp"], self.rows4, self.zset, self.weight, self.nset, self.node,
-                                zs["cmodel"], zs["prop"], dt, large, self.nmd, zs["stress"], zs["state"], facc, fmag)
+        if self.fast is not None:
+            zone_step(pos, vel, self.zmesh, self.material(), self.zplan, self.zscratch, dt, large, self.nmd,
+                      self.plastic, facc, fmag)
         if self.ho is not None:
             self.ho(pos, vel, zs["gp"], self.rows10, self.bulk, self.shear, dt, zs["gstress"], zs["stress"], facc)
         if self.beta > 0.0:             # Rayleigh damping's stiffness term (physics.dynamic)

@@ -6,8 +6,9 @@ import itertools
 import numpy as np
 import pytest
 
-from dec3d.kernels.zones import tet_elastic_step
-from dec3d.kernels.zonestep import gp_externals, gp_motion, zone_forces, zone_mass_stiffness
+from dec3d.kernels.zonestep import gp_externals, gp_motion, zone_mass_stiffness
+from tests.zone_step_run import elastic_forces as zone_forces
+from tests.zone_step_run import elastic_tets as tet_elastic_step
 
 
 # ------------------------------------------------------------------ twins

@@ -12,6 +12,9 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
+from ..zones import (JOINT_SHEAR_NOW, JOINT_SHEAR_PAST, JOINT_TENSION_NOW, JOINT_TENSION_PAST,  # noqa: F401
+                     SHEAR_NOW, SHEAR_PAST, TENSION_NOW, TENSION_PAST)
+
 #: shared property columns of ``zones.prop`` (SI; angles kept as tangents)
 P_BULK = 0
 P_SHEAR = 1
@@ -32,16 +35,8 @@ NZHIST = 4
 #: per-chunk float scratch handed to ``update`` (``wf``): kept between the zones of one chunk
 NWORK = 32
 
-#: plastic-state bits (``zones.state``): a model's update returns "now" bits; the step keeps
-#: the "past" bits (now << 2) as well (``merge_state``)
-SHEAR_NOW = 1
-TENSION_NOW = 2
-SHEAR_PAST = 4
-TENSION_PAST = 8
-JOINT_SHEAR_NOW = 16      # ubiquitous-joint: the weak plane yields in shear
-JOINT_TENSION_NOW = 32    # the weak plane yields in tension
-JOINT_SHEAR_PAST = 64
-JOINT_TENSION_PAST = 128
+#: plastic-state bits (``zones.state``, defined in ``kernels/zones.py``): a model's update returns
+#: "now" bits; the step keeps the "past" bits (now << 2) as well (``merge_state``)
 PAST = SHEAR_PAST | TENSION_PAST | JOINT_SHEAR_PAST | JOINT_TENSION_PAST
 
 #: the tables a model may read (``table`` command), flattened: table t has points
