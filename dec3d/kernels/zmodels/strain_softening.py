@@ -13,30 +13,33 @@ parameter κt, both sums over the steps of plastic strain increments:
 
     Δκs = ( ½ [ (Δε1ps − Δεmps)² + (Δεmps)² + (Δε3ps − Δεmps)² ] )^½,   Δεmps = (Δε1ps + Δε3ps)/3,
 
-the page's "measure of the second invariant of the plastic shear-strain increment tensor" for a
-shear return on one plane, whose intermediate principal plastic strain is 0
-(Δεps = λs (−1, 0, N_ψ) in the principal axes of ``zone_mohr``, s1 the most compressive);
-dec3d takes that invariant, (J2' of Δεps)^½, for every shear return (one plane, edge, corner), so
-it is Itasca's value for the one-plane return and the same measure for the others; and
+the page's measure of the plastic shear-strain increment of a shear return on one plane, whose
+principal plastic strains are Δεps = λs (−1, 0, N_ψ) (principal axes of ``zone_mohr``, s1 the
+most compressive): Δκs = f(N_ψ) λs, f(N) = (½ [(1 + m)² + m² + (N − m)²])^½, m = (N − 1)/3
+(f = 1 when ψ = 0: Δκs is then the compressive plastic strain); and
 
     Δκt = Δε3pt, the plastic tensile strain (the sum of the tensile multipliers when two or
     three principal stresses are cut off, as Itasca's code adds them).
 
+Itasca's correction is always on one plane (and the apex); dec3d's return also goes to an edge of
+two shear planes, or a corner of shear and the cut-off (``zone_mohr``). There dec3d sums
+Itasca's increment over the shear planes, Δκs = f(N_ψ) Σ λs (so a triaxial specimen whose two
+lateral stresses are equal, an edge return, hardens by its compressive plastic strain as one
+whose lateral stresses differ slightly, a one-plane return, does, instead of by the 13 % smaller
+(J2')^½ of its symmetric plastic strain), and Δκt = Σ λt.
+
 Per step (Itasca's order): the properties of the step come from κ at the start of the step
 (tables at κs, κt; a property without a table keeps its column value), then the elastic trial
 and the Mohr-Coulomb return, then κ grows by this step's increments, so the next step sees the
-new properties. The plastic strain increment is worked out from the return in principal space,
-Δεp = D⁻¹ (σ_trial − σ_new) (the return keeps the principal axes): for a shear return its
-deviatoric part gives Δκs = (J2 of σ_trial − σ_new)^½ / 2G, for a tension return its trace
-Δκt = (mean(σ_trial) − mean(σ_new)) / K; when both act (the shear-tension corner) the principal
-plastic strains e1 <= e2 <= e3 are split into shear and tension by the flow rules: the
-compressive plastic strain is all shear, λs = −Σ min(e_k, 0) (each shear flow is −1 on its more
-compressive axis, +N_ψ on the other), the trace is λs (N_ψ − 1) + λt, so Δκt = λt = Σ e_k −
-λs (N_ψ − 1), and the shear part is e minus λt on the least compressive axis (exact for the
-shear-tension corner and for an edge of two shear planes with the cut-off on the least compressive
-axis; where two or three axes are cut off besides shear, a return whose split into planes is not
-unique anyway, the tension is taken from the least compressive axis down, each axis giving at most
-its plastic strain).
+new properties. The multipliers are worked out from the return in principal space: the plastic
+strain increment is Δεp = D⁻¹ (σ_trial − σ_new) (the return keeps the principal axes), with
+principal values e_k from those of σ_trial − σ_new; each shear flow is −1 on its more compressive
+axis and tension flows are >= 0, so Σ λs = −Σ min(e_k, 0), and the trace is Σ λs (N_ψ − 1) +
+Σ λt, so Σ λt = Σ e_k − Σ λs (N_ψ − 1) (for a tension return alone the trace, (mean(σ_trial) −
+mean(σ_new)) / K). These hold for the returns to a face, an edge of two shear planes, and the
+shear-tension corner, where the split of Δεp into planes is unique; at the apex, and where two
+axes are cut off on the shear pyramid, four or more planes meet, the split is not unique, and
+dec3d's is the one these formulas give.
 
 Table values: c and σt in Pa (taken >= 0), φ and ψ in degrees (kept in [0°, 89.99°]); σt is
 capped at the apex c/tan φ by the return (as Itasca). Strength reduction (``model
@@ -133,6 +136,13 @@ def strengths(p, h, z, tab):
     return coh, tf, ten, td
 
 
+@njit(cache=True, inline="always")
+def shear_factor(nps):
+    """f(N_ψ): Itasca's Δκs of a one-plane shear return per unit multiplier (module text)."""
+    m = (nps - 1.0) / 3.0
+    return math.sqrt(0.5 * ((1.0 + m) ** 2 + m * m + (nps - m) ** 2))
+
+
 @njit(cache=True)
 def hardening_increments(bits, a0, a1, a2, a3, a4, a5, K, G, nps):
     """(Δκs, Δκt) of a return with bits ``bits`` (SHEAR_NOW, TENSION_NOW or both) from
@@ -140,8 +150,6 @@ def hardening_increments(bits, a0, a1, a2, a3, a4, a5, K, G, nps):
     if K <= 0.0 or G <= 0.0:
         return 0.0, 0.0
     m, d0, d1, d2, j2, r = _invariants(a0, a1, a2, a3, a4, a5)
-    if bits & TENSION_NOW == 0:
-        return math.sqrt(max(j2, 0.0)) / (2.0 * G), 0.0
     if bits & SHEAR_NOW == 0:
         return 0.0, max(m / K, 0.0)
     lo, mid, hi = _values(d0, d1, d2, a3, a4, a5, j2, r)
@@ -149,19 +157,11 @@ def hardening_increments(bits, a0, a1, a2, a3, a4, a5, K, G, nps):
     e1 = lo / (2.0 * G) + ev
     e2 = mid / (2.0 * G) + ev
     e3 = hi / (2.0 * G) + ev
-    # the compressive plastic strain is all shear (flows −1 on their more compressive axis), the
-    # trace is λs (N_ψ − 1) + λt
     ls = -(min(e1, 0.0) + min(e2, 0.0) + min(e3, 0.0))
-    lt = max((e1 + e2 + e3) - ls * (nps - 1.0), 0.0)
-    # the tensile part from the least compressive axis down, each axis at most its strain
-    t3 = min(lt, max(e3, 0.0))
-    t2 = min(lt - t3, max(e2, 0.0))
-    x1 = e1 - (lt - t3 - t2)
-    x2 = e2 - t2
-    x3 = e3 - t3
-    em = (x1 + x2 + x3) / 3.0
-    dks = math.sqrt(0.5 * ((x1 - em) ** 2 + (x2 - em) ** 2 + (x3 - em) ** 2))
-    return dks, lt
+    lt = 0.0
+    if bits & TENSION_NOW:
+        lt = max((e1 + e2 + e3) - ls * (nps - 1.0), 0.0)
+    return shear_factor(nps) * ls, lt
 
 
 @njit(cache=True)
