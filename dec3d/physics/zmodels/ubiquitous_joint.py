@@ -55,8 +55,8 @@ zmodel(kernel, "Mohr-Coulomb matrix with one weak plane of Coulomb strength with
            angle("joint-friction", JTF, "friction angle φ_j of the weak plane"),
            Prop("joint-tension", JT, "tensile strength σ_t^j of the weak plane (capped at c_j/tan φ_j)", "Pa"),
            angle("joint-dilation", JTD, "dilation angle ψ_j ≤ φ_j of the weak plane"),
-           Prop("dip", kernel.P_DIP, "dip of the weak plane, down from the horizontal", "deg", hi=90.0),
+           Prop("dip", kernel.P_DIP, "dip of the weak plane, down from the horizontal", "degrees", hi=90.0),
            Prop("dip-direction", kernel.P_DIPDIR, "dip direction of the weak plane, clockwise from +y (north)",
-                "deg", hi=360.0, hi_open=True),
+                "degrees", hi=360.0, hi_open=True),
        ],
        check=ubiquitous_check, reduce=ubiquitous_reduce)
