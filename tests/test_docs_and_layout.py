@@ -145,7 +145,8 @@ def test_the_layer_check_catches_upward_imports(tmp_path):
 
 #: the kernel modules with one more standard-library import: the one that lists its folder (the
 #: joint-law plug-ins, kernels/joints) and the named bundles of arrays (namedtuple)
-FINDS_PLUGINS = {"joints/__init__.py": {"importlib", "pkgutil"}, "bundles.py": {"collections"}}
+FINDS_PLUGINS = {"joints/__init__.py": {"importlib", "pkgutil"}, "zmodels/__init__.py": {"importlib", "pkgutil"},
+                 "bundles.py": {"collections"}, "zmodels/_common.py": {"collections"}}
 
 
 def test_kernels_import_only_numpy_numba_math_config():

@@ -324,17 +324,22 @@ def block_insitu(session, call):
 
 # ----------------------------------------------------------------------------- listing
 def _plastic_counts(session, zs, rows) -> None:
-    """Zones of the rows in each plastic state (``zones.state`` bits), when some are Mohr-Coulomb:
-    a line of output and the session results ``zones_shear_now`` … ``zones_tension_past``."""
-    from ..model.zones import (ZMODEL_MOHR, ZSTATE_SHEAR_NOW, ZSTATE_SHEAR_PAST, ZSTATE_TENSION_NOW,
-                               ZSTATE_TENSION_PAST)
-    if not (zs["cmodel"][rows] == ZMODEL_MOHR).any():
+    """Zones of the rows in each plastic state (``zones.state`` bits), when some have a plastic model:
+    a line of output and the session results ``zones_shear_now`` … ``zones_tension_past`` (and the weak
+    plane's ``zones_joint_shear_now`` … when a zone in range has such bits)."""
+    from ..kernels.zmodels import PLASTIC_CODES
+    from ..model.zones import ZSTATE_BITS
+
+    if not np.isin(zs["cmodel"][rows], sorted(PLASTIC_CODES)).any():
         return
     st = zs["state"][rows]
-    counts = {name: int(((st & bit) != 0).sum()) for name, bit in
-              (("shear-now", ZSTATE_SHEAR_NOW), ("tension-now", ZSTATE_TENSION_NOW),
-               ("shear-past", ZSTATE_SHEAR_PAST), ("tension-past", ZSTATE_TENSION_PAST))}
-    elastic = int(((st & (ZSTATE_SHEAR_PAST | ZSTATE_TENSION_PAST)) == 0).sum())
+    counts = {name: int(((st & bit) != 0).sum()) for name, bit in ZSTATE_BITS
+              if not name.startswith("joint") or (st >= 16).any()}
+    past = 0
+    for name, bit in ZSTATE_BITS:
+        if name.endswith("past"):
+            past |= bit
+    elastic = int(((st & past) == 0).sum())
     session.write("plastic state: " + ", ".join(f"{k} {n}" for k, n in counts.items())
                   + f", never yielded {elastic}")
     session.results.update({"zones_" + k.replace("-", "_"): float(n) for k, n in counts.items()})
@@ -347,7 +352,7 @@ def _plastic_counts(session, zs, rows) -> None:
                  "once), smallest and largest edge, smallest dihedral angle (70.53° for a regular tetrahedron, "
                  "near 0 for a sliver), smallest and total volume. These go into the session results as "
                  "`zones`, `gridpoints`, `zone_edge_min`, `zone_edge_max`, `zone_dihedral_min` (degrees), "
-                 "`zone_volume_min` and `zone_volume`. With Mohr-Coulomb zones in range, both forms also count the "
+                 "`zone_volume_min` and `zone_volume`. With zones of a plastic model in range, both forms also count the "
                  "zones by plastic state (shear-now, tension-now, shear-past, tension-past, never yielded), "
                  "kept as results `zones_shear_now` … `zones_tension_past`.",
          examples=["block zone list", "block zone list information", "block zone list range position-z 0 1"])

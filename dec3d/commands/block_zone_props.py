@@ -134,7 +134,8 @@ _PROPS = [n for n in ALL_PROPS if n not in _ELASTIC_KEYS]
                    "block zone property young 1e9 poisson 0.25 density 2000 range position-z 0 1",
                    "block zone property cohesion 1e6 friction 30 tension 1e7 table-cohesion 'coh'"])
 def block_zone_property(session, call):
-    a = call.args
+    a = {k.replace("_", "-"): v for k, v in call.args.items()}        # the keywords' own names
+    loc = {k.replace("_", "-"): v for k, v in call.locations.items()}
     keys = [k for k in ("bulk", "shear", "young", "poisson", "density", *_PROPS) if a.get(k) is not None]
     if not keys:
         raise BindError("`block zone property` needs a property: " + ", ".join(("young", "poisson", *ALL_PROPS)),
@@ -142,7 +143,7 @@ def block_zone_property(session, call):
     kg = a["bulk"] is not None or a["shear"] is not None
     ev = a["young"] is not None or a["poisson"] is not None
     if kg and ev:
-        where = call.locations.get("young" if a["young"] is not None else "poisson", call.location)
+        where = loc.get("young" if a["young"] is not None else "poisson", call.location)
         raise BindError("`block zone property`: give bulk/shear or young/poisson, not both pairs in one command",
                         where)
     fe = _fe_rows(session, call)
@@ -152,7 +153,7 @@ def block_zone_property(session, call):
         except ValueError as exc:
             given = "young" if a["young"] is not None else "poisson"
             raise BindError(f"`block zone property {given}` needs the other too: {exc}",
-                            call.locations.get(given, call.location)) from None
+                            loc.get(given, call.location)) from None
     rows = _zones(session, call, "block zone property", fe)
     zs = session.model.store("zones")
     prop = zs["prop"]
@@ -161,7 +162,7 @@ def block_zone_property(session, call):
     cm = zs["cmodel"][rows]
     writes = []
     for k in own:
-        where = call.locations.get(k, call.location)
+        where = loc.get(k, call.location)
         hit = False
         for m in models_with(k):
             sel = rows[cm == m.code]
@@ -181,7 +182,7 @@ def block_zone_property(session, call):
             z = int(zs["id"][rows[~have][0]])
             raise BindError(f"`block zone property {given}` needs {other} too: {int((~have).sum())} zone(s) in "
                             f"range have no elastic moduli yet (the first is zone {z})",
-                            call.locations.get(given, call.location))
+                            loc.get(given, call.location))
         with np.errstate(divide="ignore", invalid="ignore"):
             E = a["young"] if a["young"] is not None else 9.0 * K * G / (3.0 * K + G)
             nu = a["poisson"] if a["poisson"] is not None else (3.0 * K - 2.0 * G) / (2.0 * (3.0 * K + G))
@@ -197,7 +198,7 @@ def block_zone_property(session, call):
         prop[rows, ZP_DENSITY] = a["density"]
     for k in _PROPS:
         if a.get(k) is not None and ALL_PROPS[k].column < P_OWN:
-            writes.append((rows, ALL_PROPS[k], a[k], call.locations.get(k, call.location)))
+            writes.append((rows, ALL_PROPS[k], a[k], loc.get(k, call.location)))
     for sel, p, value, where in writes:
         prop[sel, p.column] = _column_value(session, p, value, where)
 

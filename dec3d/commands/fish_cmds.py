@@ -15,7 +15,7 @@ import re
 from functools import reduce
 
 from ..errors import BindError, CommandError, Dec3dError, NotSupportedError
-from ..fish import contact_intrinsics, intrinsics
+from ..fish import contact_intrinsics, intrinsics, zone_intrinsics
 from ..lang.abbrev import matches
 from .registry import command
 from .values import FLAG, INT, NUMBERISH, ONOFF, InPath, Nums, P, TableId, Text, ValueType
@@ -176,8 +176,15 @@ def _joint_model(code):
     return MODEL_BY_CODE.get(code)
 
 
+def _zone_model(code):
+    from ..physics.cmodels import MODEL_BY_CODE
+
+    return MODEL_BY_CODE.get(code)
+
+
 contact_intrinsics.CONTACTS[0] = _current_contacts
 contact_intrinsics.JMODELS[0] = _joint_model
+zone_intrinsics.ZMODELS[0] = _zone_model
 intrinsics.ENGINE[0] = _engine
 
 

@@ -3,7 +3,9 @@
 A zone is handed to FISH as its id (an integer from 1, what `block.zone.list` holds and
 `block.zone.find` returns; 0, FISH's null, when no zone has it), as blocks are. Names follow
 Itasca's 3DEC 7 FISH reference: block.zone.list, .num, .find, .id, .block, .vol, .pos,
-.stress and its six components (tension positive), .state (plastic state bits), .gp(z, i) (the gridpoint at node i, from 1).
+.stress and its six components (tension positive), .state (plastic state bits), .gp(z, i) (the gridpoint at node i, from 1),
+.model (the model's name), .prop(z, name) (a property of the zone's model in the units `block zone property`
+takes, or a history value of the model by its name).
 
 A gridpoint is handed to FISH as its index: its row in the ``vertices`` store + 1 (gridpoints are
 vertices, dec3d.model.zones; the vertices of rigid blocks are gridpoints too, as in 3DEC). The
@@ -114,6 +116,41 @@ def _state(rt, z):
     2 tension-now, 4 shear-past, 8 tension-past; 0 never yielded (elastic zones are always 0)."""
     _, st, r = _row(rt, z, "block.zone.state")
     return int(st["state"][r])
+
+
+#: ``ZMODELS[0](code)`` -> the zone model of that code (``physics.cmodels.ZoneModel``: ``name``, ``props``,
+#: ``value(row, name)``, ``hist_names``), or None for null; set by dec3d.commands.fish_cmds (FISH imports no
+#: physics)
+ZMODELS: list = [None]
+
+
+@intrinsic("block.zone.model", 1)
+def _model(rt, z):
+    """The name of the zone's constitutive model ('null' when none is assigned)."""
+    _, st, r = _row(rt, z, "block.zone.model")
+    m = ZMODELS[0](int(st["cmodel"][r])) if ZMODELS[0] is not None else None
+    return "null" if m is None else m.name
+
+
+@intrinsic("block.zone.prop", 2)
+def _zprop(rt, z, name):
+    """A property of the zone's model by the name `block zone property` uses, in its units (angles in
+    degrees), or one of the model's history values by name (strain-softening's plastic strains …)."""
+    fname = "block.zone.prop"
+    if type(name) is not str:
+        raise FishValueError(f"`{fname}` takes a property name (a string), not a {type_name(name)}")
+    _, st, r = _row(rt, z, fname)
+    m = ZMODELS[0](int(st["cmodel"][r])) if ZMODELS[0] is not None else None
+    if m is None:
+        raise FishValueError(f"`{fname}`: zone {z} has no constitutive model (null)")
+    key = name.lower()
+    if key in m.props:
+        return float(m.value(st["prop"][r], key))
+    hist = [h.lower() for h in m.hist_names]
+    if key in hist:
+        return float(st["hist"][r, hist.index(key)])
+    have = sorted(m.props) + list(m.hist_names)
+    raise FishValueError(f"`{fname}`: zone model `{m.name}` has no property '{name}' (it has {', '.join(have)})")
 
 
 @intrinsic("block.zone.gp", 2)

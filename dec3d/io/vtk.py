@@ -152,9 +152,32 @@ def _zone_cell_data(model, zrows, npoly: int) -> dict:
 
     overlay = np.full(npoly + len(zrows), -1, dtype=np.int8)
     overlay[npoly:] = zs["overlay"][zrows]
-    return {"zone_id": pad(zs["id"][zrows]), "overlay": overlay, "stress": pad(st[:, VTK_TENSOR_ORDER]),
-            "mean_stress": pad(mean_stress(st)), "principal_stress": pad(principal_stresses(st)),
-            "von_mises": pad(von_mises(st)), "plastic_state": pad(zs["state"][zrows])}
+    out = {"zone_id": pad(zs["id"][zrows]), "overlay": overlay, "stress": pad(st[:, VTK_TENSOR_ORDER]),
+           "mean_stress": pad(mean_stress(st)), "principal_stress": pad(principal_stresses(st)),
+           "von_mises": pad(von_mises(st)), "plastic_state": pad(zs["state"][zrows]),
+           "cmodel": pad(zs["cmodel"][zrows])}
+    out.update(_zone_history(zs, zrows, pad))
+    return out
+
+
+def _zone_history(zs, zrows, pad) -> dict:
+    """The zone models' history entries as cell arrays named as each model names them
+    (``HIST_NAMES`` of ``kernels/zmodels``), 0 on the cells of other models; a name two models
+    share is one array."""
+    from dec3d.kernels.zmodels import MODELS
+    cm = zs["cmodel"][zrows]
+    hist = zs["hist"][zrows]
+    out: dict = {}
+    for k in MODELS:
+        mine = cm == k.CODE
+        if not k.NHIST or not mine.any():
+            continue
+        for j, name in enumerate(k.HIST_NAMES):
+            col = out.get(name)
+            if col is None:
+                col = out[name] = np.zeros(len(zrows))
+            col[mine] = hist[mine, j]
+    return {name: pad(col) for name, col in out.items()}
 
 
 def write_vtu(model, path: str | os.PathLike, cells: str = "all", point_data: dict | None = None,

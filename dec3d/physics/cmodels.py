@@ -88,12 +88,17 @@ MOHR_STRENGTH = [Prop("cohesion", P_COHESION, "cohesion c", "Pa"),
                  angle("dilation", P_TANDIL, "dilation angle ψ ≤ φ")]
 
 
-def which_zones(ids, bad: np.ndarray) -> str:
-    """'n zone(s) (id, id, … and k more)' for the rows where ``bad`` holds."""
+def which_zones(ids, bad: np.ndarray, blocks=None) -> str:
+    """'n zone(s) (id, id, … and k more)' for the rows where ``bad`` holds, with 'of blocks …'
+    when the zones' block ids ``blocks`` are given."""
     rows = np.flatnonzero(bad)
     shown = ", ".join(str(int(ids[r])) for r in rows[:5])
     more = f" and {len(rows) - 5} more" if len(rows) > 5 else ""
-    return f"{len(rows)} zone(s) ({shown}{more})"
+    where = ""
+    if blocks is not None:
+        bs = sorted(set(int(b) for b in np.asarray(blocks)[rows]))
+        where = " of blocks " + ", ".join(str(b) for b in bs[:10]) + (f" … ({len(bs)} blocks)" if len(bs) > 10 else "")
+    return f"{len(rows)} zone(s){where} ({shown}{more})"
 
 
 @dataclass
@@ -140,13 +145,16 @@ class ZoneModel:
             return self.moduli(prop_rows)
         return prop_rows[:, P_BULK], prop_rows[:, P_SHEAR]
 
-    def problems(self, prop_rows: np.ndarray, ids) -> tuple[list[str], list[str]]:
+    def problems(self, prop_rows: np.ndarray, ids, blocks=None) -> tuple[list[str], list[str]]:
         """(problems, warnings) of the zones ``prop_rows`` of this model before cycling: every
-        property in its range (in user units), then the model's own ``check``."""
+        property in its range (in user units), then the model's own ``check``; ``ids`` the zone
+        ids, ``blocks`` their block ids (named in the messages when given)."""
         out: list[str] = []
+        seen = set()
         for p in self.props.values():
-            if p.kind == "table":
+            if p.kind == "table" or p.column in seen:       # (a second name of a column: checked once)
                 continue
+            seen.add(p.column)
             col = prop_rows[:, p.column]
             with np.errstate(all="ignore"):
                 v = np.array([p.from_column(x) for x in col]) if p.kind == "angle" else col
@@ -156,7 +164,8 @@ class ZoneModel:
                 if p.hi is not None:
                     bad |= (v >= p.hi) if p.hi_open else (v > p.hi)
             if bad.any():
-                out.append(f"{p.name} {_range_text(p)}: {which_zones(ids, bad)}")
+                unset = " (not set)" if p.default == 0.0 and (col[bad] == 0.0).all() else ""
+                out.append(f"{p.name} {_range_text(p)}{unset}: {which_zones(ids, bad, blocks)}")
         warns: list[str] = []
         if not out and self.check is not None:
             more, warns = self.check(prop_rows, ids)

@@ -151,19 +151,22 @@ class ZoneStepper:
         self.shear = np.ascontiguousarray(p[:, ZP_SHEAR])
         self.density = np.ascontiguousarray(p[:, ZP_DENSITY])
         nn = zs["nnode"]
+        bid = model.blocks["id"]
         for code in np.unique(cm[act]):
             zm = MODEL_BY_CODE[int(code)]
             mine = zrow[cm == code]
-            bad, warns = zm.problems(p[mine], zs["id"][mine])
-            problems += [f"{zm.name}: {x}" for x in bad]
-            self.warnings += [f"{zm.name}: {x}" for x in warns]
-            if zm.moduli is not None and not bad:
-                self.bulk[mine], self.shear[mine] = zm.bulk_shear(p[mine])
             if zm.name != "elastic" and (nn[mine] == 10).any():
                 ho = mine[nn[mine] == 10]
-                problems.append(f"{len(ho)} {zm.name} zones of blocks {_ids(model, zs['block'][ho])} are 10-node "
-                                "tetrahedra: 10-node zones cycle elastic only (use `block zone generate "
-                                "edgelength` or `hexahedra` for these blocks, or an elastic model)")
+                raise error(f"{len(ho)} {zm.name} zones of blocks {_ids(model, zs['block'][ho])} are 10-node "
+                            "tetrahedra: 10-node zones cycle elastic only (use `block zone generate edgelength` "
+                            "or `hexahedra` for these blocks, or an elastic model)")
+            bad, warns = zm.problems(p[mine], zs["id"][mine], bid[zs["block"][mine]])
+            problems += [f"{x}" for x in bad]
+            self.warnings += [f"{zm.name} zones: {x}" for x in warns]
+            if zm.moduli is not None and not bad:
+                self.bulk[mine], self.shear[mine] = zm.bulk_shear(p[mine])
+            if bad:
+                problems[-len(bad):] = [f"{zm.name} zones: {x}" for x in bad]
         if problems:
             raise error("zone properties: " + "; ".join(problems)
                         + " (set them with `block zone property` before cycling)")

@@ -57,7 +57,8 @@ def test_missing_properties_at_cycle_time_name_blocks_and_the_cycle_line(tmp_pat
                     "block zone property young 1e9 poisson 0.2 density 2000 range position-x 0 1\n"
                     "model cycle 3\n")
     s = Session(out_dir=tmp_path)
-    with pytest.raises(Dec3dError, match=r"lack properties \(bulk in blocks 2; shear in blocks 2; density in blocks 2\)") as exc:
+    with pytest.raises(Dec3dError, match=r"bulk must be > 0 Pa \(not set\): 43 zone\(s\) of blocks 2 .*density must be > 0 kg/m³ \(not set\): "
+                       r"43 zone\(s\) of blocks 2") as exc:
         s.call(deck)
     loc = exc.value.location
     assert loc is not None and loc.line == 6                 # the `model cycle` line

@@ -58,7 +58,7 @@ def test_cmodel_null_clears_stress_and_group_range_reaches_zones_of_the_block(s)
 
 
 @pytest.mark.parametrize("line,msg", [
-    ("block zone property", "needs bulk, shear, young, poisson, density, cohesion, friction, tension or dilation"),
+    ("block zone property", "needs a property: young, poisson, bulk, shear, density, cohesion, friction, tension, dilation"),
     ("block zone property bulk -1e9", "`bulk` must be > 0"),
     ("block zone property shear 0", "`shear` must be > 0"),
     ("block zone property young -5", "`young` must be > 0"),

@@ -115,11 +115,13 @@ def test_missing_zone_properties_name_the_blocks(tmp_path):
     s = _run(tmp_path, ["block create brick 0 1 0 1 0 1", "block create brick 2 3 0 1 0 1",
                         "block zone generate edgelength 0.5", "block zone cmodel assign elastic",
                         "block zone property young 1e9 poisson 0.2 range position-x 0 1"])
-    with pytest.raises(Dec3dError, match=r"elastic zones lack properties \(bulk in blocks 2; shear in blocks 2; "
-                                         r"density in blocks 1, 2\).*block zone property"):
+    with pytest.raises(Dec3dError, match=r"elastic zones: bulk must be > 0 Pa \(not set\): 43 zone\(s\) of blocks 2 .*"
+                                         r"shear must be > 0 Pa \(not set\): 43 zone\(s\) of blocks 2 .*density must be "
+                                         r"> 0 kg/m³ \(not set\): 87 zone\(s\) of blocks 1, 2 .*block zone property"):
         s.command("model cycle 5")
     s.command("block zone property density 2000")
-    with pytest.raises(Dec3dError, match=r"lack properties \(bulk in blocks 2; shear in blocks 2\)"):
+    with pytest.raises(Dec3dError, match=r"bulk must be > 0 Pa \(not set\): 43 zone\(s\) of blocks 2 .*shear must be "
+                                         r"> 0 Pa \(not set\): 43 zone\(s\) of blocks 2 \([^;]*\) \(set them"):
         s.command("model cycle 5")
     assert s.model.step == 0
 

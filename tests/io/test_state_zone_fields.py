@@ -30,6 +30,7 @@ def _model():
     zs["cmodel"][:] = ZMODEL_ELASTIC
     zs["prop"][:] = rng.uniform(1, 2, size=(zs.n, NZPROP)) * 1e9
     zs["state"][:] = rng.integers(0, 8, size=zs.n)
+    zs["hist"][:] = rng.normal(size=zs["hist"].shape)           # the zone models' history
     gp = np.flatnonzero(v["zoned"])
     for key, shape in (("imass", ()), ("fapp", (3,)), ("fface", (3,)), ("vapp", (3,)), ("disp", (3,)),
                        ("velocity", (3,)), ("force", (3,)), ("mass", ())):

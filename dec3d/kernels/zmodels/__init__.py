@@ -17,7 +17,9 @@ A model's kernel file (any ``<name>.py`` here not starting with ``_``) declares
   the volumetric part already averaged by the mixed discretization), the stress s0..s5 at the
   start of the step (rotated in large strain; tension positive, Pa), the ``Tables`` bundle ``tab``,
   a float scratch ``wf`` (NWORK,) kept between the zones of one chunk of the step (NaN at the start
-  of each chunk) and the Mohr-Coulomb return's scratch ``mw`` (``zone_mohr.mohr_work``);
+  of each chunk; ``mohr-coulomb`` keeps the constants of its return there, keyed by wf[0:6], so any
+  other model that writes ``wf`` leaves wf[0] NaN when it returns) and the Mohr-Coulomb return's
+  scratch ``mw`` (``zone_mohr.mohr_work``);
   returning ``(bits, t0..t5, dsp)``: the "now" plastic bits (``_common``: 1 shear, 2 tension,
   16/32 the weak plane; 0 elastic), the new stress, and dsp = mean(trial) − mean(new), the
   trial being s + D:d with K and G (K times the plastic volumetric strain increment; 0 elastic).
