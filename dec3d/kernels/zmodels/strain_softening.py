@@ -51,9 +51,9 @@ Columns: the shared ones (bulk, shear, density, cohesion, tan friction, tension,
 P_SRF) and from P_OWN on the table references (table index + 1; 0: none) of cohesion,
 friction, dilation and tension. History: h[z, 0] = κs, h[z, 1] = κt.
 
-The chunk scratch ``wf`` holds what ``mohr.py`` keeps there, with the same meaning (wf[0:6] the
-K, G, c, tan φ, σt, tan ψ the Mohr-Coulomb constants wf[6:15] were made from; wf[16:22] the
-trial handed to the general return), so zones of either model may follow each other in a chunk.
+The chunk scratch ``wf``: only wf[16:22], the trial handed to the general return (as ``mohr.py``
+uses it); the Mohr-Coulomb constants are made for every zone (its strengths follow κ), and
+``mohr.py``'s cache in wf[0:15] is left as it was (the zone-model contract).
 """
 import math
 
@@ -168,20 +168,17 @@ def hardening_increments(bits, a0, a1, a2, a3, a4, a5, K, G, nps):
 def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
     coh, tf, ten, td = strengths(p, h, z, tab)
     e0, e1, e2, e3, e4, e5 = hooke(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5)
-    if K != wf[0] or G != wf[1] or coh != wf[2] or tf != wf[3] or ten != wf[4] or td != wf[5]:
-        npf, csn, ft, nps, a1, a2, sp, ap, den = mohr_constants(K, G, coh, tf, ten, td)
-        wf[0] = K; wf[1] = G; wf[2] = coh; wf[3] = tf; wf[4] = ten; wf[5] = td
-        wf[6] = npf; wf[7] = csn; wf[8] = ft; wf[9] = nps; wf[10] = a1; wf[11] = a2
-        wf[12] = sp; wf[13] = ap; wf[14] = den
-    code, t0, t1, t2, t3, t4, t5, dp = mohr_scalar(e0, e1, e2, e3, e4, e5, coh, wf[6], wf[7], wf[8], wf[9],
-                                                   wf[10], wf[11], wf[12], wf[13], wf[14])
+    # (the constants are made here, not kept in wf[0:15]: that is mohr-coulomb's cache)
+    npf, csn, ft, nps, a1, a2, sp, ap, den = mohr_constants(K, G, coh, tf, ten, td)
+    code, t0, t1, t2, t3, t4, t5, dp = mohr_scalar(e0, e1, e2, e3, e4, e5, coh, npf, csn, ft, nps, a1, a2, sp,
+                                                   ap, den)
     if code < 0:
         s = wf[16:22]
         s[0] = e0; s[1] = e1; s[2] = e2; s[3] = e3; s[4] = e4; s[5] = e5
         code, dp = mohr_plastic(s, K, G, coh, tf, ten, td, mw)
         t0 = s[0]; t1 = s[1]; t2 = s[2]; t3 = s[3]; t4 = s[4]; t5 = s[5]
     if code != 0:
-        dks, dkt = hardening_increments(code, e0 - t0, e1 - t1, e2 - t2, e3 - t3, e4 - t4, e5 - t5, K, G, wf[9])
+        dks, dkt = hardening_increments(code, e0 - t0, e1 - t1, e2 - t2, e3 - t3, e4 - t4, e5 - t5, K, G, nps)
         h[z, 0] += dks
         h[z, 1] += dkt
     return code, t0, t1, t2, t3, t4, t5, dp

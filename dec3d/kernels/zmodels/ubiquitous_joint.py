@@ -43,8 +43,10 @@ n = (sin δ sin α, sin δ cos α, cos δ).
 
 Columns: the shared Mohr-Coulomb ones, and from P_OWN on joint cohesion, tan joint friction,
 joint tension, tan joint dilation, dip [degrees], dip direction [degrees]. Chunk scratch ``wf``:
-wf[0:22] as ``mohr.py`` (same meaning, so zones of both models may share a chunk); wf[22] = CODE
-when wf[23:25] hold the dip and dip direction that the normal wf[25:28] was made from.
+wf[16:22] the trial handed to the general Mohr-Coulomb return (as ``mohr.py``); wf[22] = CODE
+when wf[23:25] hold the dip and dip direction that the normal wf[25:28] was made from (CODE = 5
+is no value another model's scratch there takes by chance: hoek-brown keeps projector entries,
+within ±1, in wf[12:24]); ``mohr.py``'s cache wf[0:15] is left as it was (the zone-model contract).
 """
 import math
 
@@ -166,13 +168,10 @@ def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, w
     tf = p[z, P_TANFRIC]
     ten = p[z, P_TENSION]
     td = p[z, P_TANDIL]
-    if K != wf[0] or G != wf[1] or coh != wf[2] or tf != wf[3] or ten != wf[4] or td != wf[5]:
-        npf, csn, ft, nps, a1, a2, sp, ap, den = mohr_constants(K, G, coh, tf, ten, td)
-        wf[0] = K; wf[1] = G; wf[2] = coh; wf[3] = tf; wf[4] = ten; wf[5] = td
-        wf[6] = npf; wf[7] = csn; wf[8] = ft; wf[9] = nps; wf[10] = a1; wf[11] = a2
-        wf[12] = sp; wf[13] = ap; wf[14] = den
-    code, s0, s1, s2, s3, s4, s5, dp = mohr_scalar(s0, s1, s2, s3, s4, s5, coh, wf[6], wf[7], wf[8], wf[9],
-                                                   wf[10], wf[11], wf[12], wf[13], wf[14])
+    # (the constants are made here, not kept in wf[0:15]: that is mohr-coulomb's cache)
+    npf, csn, ft, nps, a1, a2, sp, ap, den = mohr_constants(K, G, coh, tf, ten, td)
+    code, s0, s1, s2, s3, s4, s5, dp = mohr_scalar(s0, s1, s2, s3, s4, s5, coh, npf, csn, ft, nps, a1, a2, sp,
+                                                   ap, den)
     if code < 0:
         s = wf[16:22]
         s[0] = s0; s[1] = s1; s[2] = s2; s[3] = s3; s[4] = s4; s[5] = s5
