@@ -11,7 +11,7 @@ from dec3d.kernels.zmodels import NWORK, NZHIST, NZPROP, make_tables, no_tables
 from dec3d.kernels.zmodels import strain_softening as ss
 from dec3d.kernels.zmodels._common import P_SRF
 from dec3d.kernels.zone_mohr import mohr_work
-from zmodel_twins import nfac, tensor, twin_hooke, twin_mc, triaxial_path, vec6
+from zmodel_twins import twin_hooke, twin_mc, triaxial_path, vec6
 
 K, G = 2e9, 1e9
 E = 9 * K * G / (3 * K + G)

@@ -12,7 +12,7 @@ from dec3d.geometry.planes import dip_normal
 from dec3d.kernels.zmodels import NWORK, NZHIST, NZPROP, no_tables
 from dec3d.kernels.zmodels import ubiquitous_joint as uj
 from dec3d.kernels.zone_mohr import mohr_work
-from zmodel_twins import tensor, twin_hooke, twin_mc, triaxial_path, vec6
+from zmodel_twins import twin_hooke, twin_mc, triaxial_path, vec6
 
 K, G = 2e9, 1e9
 A1, A2 = K + 4 * G / 3, K - 2 * G / 3
@@ -182,7 +182,8 @@ def test_matches_twin_on_random_states():
         phij = rng.uniform(0, 35) if rng.random() < 0.9 else 0.0
         cj = rng.uniform(0, 1e6) if rng.random() < 0.9 else 0.0
         strong = rng.random() < 0.5                    # (a matrix that mostly holds)
-        args = dict(c=rng.uniform(5e5, 3e6) * (10 if strong else 1), phi=phi, ten=rng.uniform(0, 2e6), psi=rng.uniform(0, phi),
+        args = dict(c=rng.uniform(5e5, 3e6) * (10 if strong else 1), phi=phi, ten=rng.uniform(0, 2e6),
+                    psi=rng.uniform(0, phi),
                     cj=cj, phij=phij, tenj=rng.uniform(0, 1e6), psij=rng.uniform(0, phij),
                     dip=rng.uniform(0, 90), dd=rng.uniform(0, 360))
         p = _row(**args)

@@ -11,7 +11,7 @@ cohesion c, friction φ and dilation ψ may be piecewise-linear functions (table
 hardening parameter κs, and the tensile strength σt a function of the tensile hardening
 parameter κt, both sums over the steps of plastic strain increments:
 
-    Δκs = ( ½ [ (Δε1ps − Δεmps)² + (Δεmps)² + (Δε3ps − Δεmps)² ] )^½,   Δεmps = (Δε1ps + Δε3ps)/3,
+    Δκs = (½ [(Δε1ps − Δεmps)² + (Δεmps)² + (Δε3ps − Δεmps)²])^½,  Δεmps = (Δε1ps + Δε3ps)/3,
 
 the page's measure of the plastic shear-strain increment of a shear return on one plane, whose
 principal plastic strains are Δεps = λs (−1, 0, N_ψ) (principal axes of ``zone_mohr``, s1 the

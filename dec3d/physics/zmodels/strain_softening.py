@@ -6,9 +6,9 @@ properties, and ``table-cohesion``, ``table-friction``, ``table-dilation`` (c, �
 functions of the plastic shear strain κs, ``strain-shear-plastic``) and ``table-tension`` (σt as a
 function of the plastic tensile strain κt, ``strain-tension-plastic``). A property with a table
 follows the table; one without keeps its constant value. Rules as ``mohr-coulomb``'s for the
-constant values (dilation <= friction where neither has a table). Strength reduction (``model factor-of-safety``): the constant strengths as
-``mohr-coulomb`` (c/F, tan φ/F, σt/F), and F kept in the zone's P_SRF column, by which the kernel
-divides the strengths it reads from tables.
+constant values (dilation <= friction where neither has a table). Strength reduction (``model
+factor-of-safety``): the constant strengths as ``mohr-coulomb`` (c/F, tan φ/F, σt/F), and F kept in
+the zone's P_SRF column, by which the kernel divides the strengths it reads from tables.
 """
 import numpy as np
 
@@ -56,6 +56,7 @@ zmodel(kernel, "Mohr-Coulomb whose cohesion, friction, dilation soften or harden
                  "table of friction angle [degrees] vs plastic shear strain κs"),
            table("table-dilation", kernel.P_TABLE_DILATION,
                  "table of dilation angle [degrees] vs plastic shear strain κs"),
-           table("table-tension", kernel.P_TABLE_TENSION, "table of tensile strength [Pa] vs plastic tensile strain κt"),
+           table("table-tension", kernel.P_TABLE_TENSION,
+                 "table of tensile strength [Pa] vs plastic tensile strain κt"),
        ],
        check=ssoft_check, reduce=ssoft_reduce)
