@@ -19,7 +19,7 @@ a fresh process (``--child``); the median of ``--repeat`` runs is printed, with 
 /proc/loadavg before and after (the machine is shared: read the figures with the load).
 
     python bench/zone_bench.py [--zones 1e4 1e5 1e6] [--steps 50] [--repeat 3] [--threads 1 2] [--jointed]
-                               [--cmodel elastic mohr-coulomb mohr-coulomb-strong]
+                               [--cmodel elastic mohr-coulomb mohr-coulomb-strong hoek-brown strain-softening]
 
 ``--cmodel``: the constitutive models to time, one after the other for each thread count and size
 (back to back, so the ratio is read at one load). ``mohr-coulomb`` gives the same elastic
@@ -30,7 +30,10 @@ test: the worst case for the Mohr-Coulomb cycle (the count of zones that have yi
 The Mohr-Coulomb rate is also printed as a ratio to the elastic one when both are asked for
 (issue 11 target: MC at least half the elastic zone-cycles/s). ``mohr-coulomb-strong``: the same
 with cohesion and tension 1 GPa, so no zone yields (the Mohr-Coulomb cycle of zones in their
-elastic range: yield test, no return).
+elastic range: yield test, no return). ``hoek-brown`` (mb 1, s 0.001, a 0.5, σci 100 kPa) and
+``strain-softening`` (the Mohr-Coulomb strength with the cohesion softening from 10 to 2 kPa over
+κs = 0.01) yield under the same in-situ stress; their time per zone-cycle is printed as a ratio to
+Mohr-Coulomb's (issue 26 target: at most 2).
 
 ``--jointed``: the cube cut by three orthogonal joint sets (spacing 0.25 m) into 64 blocks, each
 zoned, Coulomb joints (kn = ks = 1e11 Pa/m, friction 30°) between them (contacts between
@@ -70,12 +73,21 @@ MOHR = "block zone property cohesion 1e4 friction 30 dilation 0 tension 5e3"
 INSITU = "block insitu stress -1e4 -4e4 -8e4 0 0 0"
 #: Mohr-Coulomb zones far from yield (``--cmodel mohr-coulomb-strong``): the yield test only
 MOHR_STRONG = "block zone property cohesion 1e9 friction 30 dilation 0 tension 1e9"
-_STRENGTH = {"mohr-coulomb": MOHR, "mohr-coulomb-strong": MOHR_STRONG}
+#: Hoek-Brown zones that yield under the same in-situ stress (strength at σ3 = 10 kPa:
+#: 10 kPa + σci (mb σ3/σci + s)^a = 41.8 kPa < 80 kPa), each return a few tangent iterations
+HOEK = "block zone property constant-mb 1 constant-s 0.001 constant-a 0.5 constant-sci 1e5"
+#: strain-softening zones: Mohr-Coulomb above with the cohesion softening along a table of κs
+SOFT = "table 'zb-coh' add (0,1e4) (0.01,2e3)\n" + MOHR + " table-cohesion 'zb-coh'"
+_STRENGTH = {"mohr-coulomb": MOHR, "mohr-coulomb-strong": MOHR_STRONG, "hoek-brown": HOEK,
+             "strain-softening": SOFT}
+#: the model each --cmodel choice assigns
+_MODEL = {"elastic": "elastic", "mohr-coulomb": "mohr-coulomb", "mohr-coulomb-strong": "mohr-coulomb",
+          "hoek-brown": "hoek-brown", "strain-softening": "strain-softening"}
 
 
 def _cmodel_lines(cmodel: str) -> list:
     """The `cmodel assign` and strength lines of a --cmodel choice (elastic constants apart)."""
-    return [f"block zone cmodel assign {'elastic' if cmodel == 'elastic' else 'mohr-coulomb'}"]
+    return [f"block zone cmodel assign {_MODEL[cmodel]}"]
 
 
 def deck(length: float, cmodel: str = "elastic") -> str:
@@ -241,7 +253,7 @@ def main(argv=None) -> int:
                     help="numba thread counts to run (numba.set_num_threads); 0: numba's own")
     ap.add_argument("--jointed", action="store_true", help="the cube in 64 jointed zoned blocks")
     ap.add_argument("--cmodel", nargs="+", default=["elastic"],
-                    choices=["elastic", "mohr-coulomb", "mohr-coulomb-strong"],
+                    choices=list(_MODEL),
                     help="constitutive models to time back to back (default elastic)")
     ap.add_argument("--child", type=float, help=argparse.SUPPRESS)
     ap.add_argument("--child-threads", type=int, default=0, help=argparse.SUPPRESS)
@@ -270,6 +282,10 @@ def main(argv=None) -> int:
                 if "elastic" in rates and mc in rates:
                     print(f"MC / elastic zone-cycles/s: {rates[mc] / rates['elastic']:.2f} ({mc}; "
                           f"target >= 0.5); loadavg {loadavg()}", flush=True)
+            for other in ("hoek-brown", "strain-softening"):
+                if "mohr-coulomb" in rates and other in rates:
+                    print(f"{other} / mohr-coulomb time per zone-cycle: {rates['mohr-coulomb'] / rates[other]:.2f} "
+                          f"(target <= 2); loadavg {loadavg()}", flush=True)
     print(f"loadavg after: {loadavg()}")
     return 0
 

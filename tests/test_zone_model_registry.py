@@ -106,10 +106,12 @@ def test_out_of_range_own_property_is_refused_with_its_location(tmp_path):
     with pytest.raises(Dec3dError, match=r"`constant-a` must be in \(0, 1\], got 1.5") as e:
         s.command("block zone property constant-a 1.5")
     assert e.value.location is not None and e.value.location.line == 1
-    with pytest.raises(Dec3dError, match="unknown keyword `constant-mz`"):
+    with pytest.raises(Dec3dError, match="unknown keyword `constant-mz`") as e:
         s.command("block zone property constant-mz 1")
-    with pytest.raises(Dec3dError, match="hoek-brown"):
+    assert "`constant-mb`" in e.value.hint and e.value.location.column == len("block zone property ") + 1
+    with pytest.raises(Dec3dError, match="needs model") as e:
         s.command("block zone cmodel assign hoek-brwn")
+    assert e.value.hint == "did you mean `hoek-brown`?" and e.value.location.column == len("block zone cmodel assign ") + 1
 
 
 def test_assigning_a_model_resets_its_own_columns_and_history_and_keeps_the_stress(tmp_path):

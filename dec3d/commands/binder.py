@@ -329,8 +329,11 @@ class Binder:
                     given.append(p.key)
                     continue
                 if p.required:
+                    opts = getattr(p.value, "options", ())
+                    close = suggest(str(tok), opts) if opts and tok.type == "WORD" else []
                     raise BindError(f"{what} needs {p.name} {p.value.describe()} here, got `{_shown(tok)}`",
-                                    self.where(tok), hint=p.doc or None)
+                                    self.where(tok), hint=(f"did you mean {' or '.join(f'`{c}`' for c in close)}?"
+                                                           if close else p.doc or None))
                 pos.pop(0)
                 continue
             hits = matches(str(tok), names) if tok.type == "WORD" else []

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..errors import BindError
-from ..lang.abbrev import matches
+from ..lang.abbrev import matches, suggest
 from ..lang.deferred import Deferred  # noqa: F401  (commands and FISH share it)
 
 NUMBERISH = ("NUMBER", "EXPR", "ATNAME")
@@ -261,7 +261,9 @@ class Choice(ValueType):
         hits = matches(str(value), self.options)
         if len(hits) != 1:
             what = "ambiguous" if hits else "not one of"
-            raise BindError(f"`{value}` is {what} {', '.join(hits or self.options)}", where)
+            close = [] if hits else suggest(str(value), self.options)
+            raise BindError(f"`{value}` is {what} {', '.join(hits or self.options)}", where,
+                            hint=f"did you mean {' or '.join(f'`{c}`' for c in close)}?" if close else None)
         return hits[0]
 
 
