@@ -27,7 +27,7 @@ def test_every_verification_problem_is_there():
                                          "D8_jointed_deformable", "D9_wedge_deformable",
                                          "E1_eigenmodes", "DY1_rayleigh_block_on_spring", "DY2_newmark_sliding_block",
                                          "DY3_shear_wave_quiet_base", "DY5_energy", "FE1_cantilever",
-                                         "FE2_fe_deformable_contacts"}
+                                         "FE2_fe_deformable_contacts", "F2_griffiths_lane_slope", "F3_vertical_cut"}
 
 
 def _demo(tmp_path, expects: str):

@@ -4,7 +4,7 @@ rows stepped, sets, weights, averaging nodes, model codes, properties), as the e
 import numpy as np
 
 from dec3d.kernels.bundles import ZoneMaterial
-from dec3d.kernels.zmodels import NZHIST, PLASTIC_CODES, no_tables
+from dec3d.kernels.zmodels import CORRECTING_CODES, NZHIST, no_tables
 from dec3d.kernels.zone_elastic import ElasticPlan
 from dec3d.kernels.zone_step import zone_step
 from dec3d.model import zones as mz
@@ -17,7 +17,7 @@ class Stepper:
     def __init__(self, gp, rows, zset, weight, node, nv, cm, prop, parts=1, hist=None, tab=None):
         nset = int(zset.max()) + 1 if len(zset) else 0
         self.plan = ElasticPlan(gp, rows, node, zset, weight, nv, parts)
-        self.plastic = bool(np.isin(cm[rows], sorted(PLASTIC_CODES)).any())
+        self.plastic = bool(np.isin(cm[rows], sorted(CORRECTING_CODES)).any())
         self.mesh, self.zplan, self.scr = zone_bundles(self.plan, nset, self.plastic)
         self.cm = np.ascontiguousarray(cm)
         self.prop = np.ascontiguousarray(prop)

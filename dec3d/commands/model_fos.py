@@ -1,4 +1,4 @@
-"""`model factor-of-safety`: the factor of safety of the joints by strength reduction
+"""`model factor-of-safety`: the factor of safety of the joints and zones by strength reduction
 (dec3d.physics.fos; Itasca's procedure, FLAC3D/3DEC manual "Strength Reduction Procedure in
 FLAC3D and 3DEC" and the `model factor-of-safety` command page, docs.itascacg.com)."""
 from __future__ import annotations
@@ -9,7 +9,8 @@ import time as _time
 from ..errors import BindError, CommandError
 from ..io.vtk import write_vtu
 from ..io.state import StateFileError, save_state
-from ..physics.fos import (DEFAULT_RESOLUTION, DEFAULT_TRIAL_STEPS, STABLE_RATIO, ContactStrengthTrials, FileTrials,
+from ..model.zones import has_zones
+from ..physics.fos import (DEFAULT_RESOLUTION, DEFAULT_TRIAL_STEPS, STABLE_RATIO, FileTrials, StrengthTrials,
                            FosError, bracket_fos)
 from ..physics.rigid import RunError, engine
 from .registry import command
@@ -40,7 +41,8 @@ def _check(call):
                      "processes that run the trials of a round (dec3d; default: the trials per round, at most "
                      "the number of CPUs)")],
          range="contact", check=_check,
-         doc="Find the factor of safety of the `mohr` joints by strength reduction (bisection on the factor).",
+         doc="Find the factor of safety of the `mohr` joints and the zones by strength reduction (bisection on "
+             "the factor).",
          details="Each trial factor F divides the cohesion, the tensile strength and tan φ of the `mohr` contacts "
                  "in range (peak and residual values; without a range the material-table defaults too, so that "
                  "contacts made during a trial are reduced as well): c/F, T/F, φ = atan(tan φ / F) (Itasca, "
@@ -48,6 +50,11 @@ def _check(call):
                  "docs.itascacg.com). Dilation as 3DEC's command page says: with `associated` the dilation angle "
                  "is the reduced friction angle; without it the dilation angle is kept but never above the reduced "
                  "friction angle.\n\n"
+                 "The zones are reduced together with the joints, as in 3DEC and FLAC3D: every zone whose "
+                 "constitutive model has a strength to reduce (`mohr-coulomb`: c/F, tan φ/F, σt/F, the dilation "
+                 "angle kept at most the reduced friction angle; see each model's page) takes the reduced "
+                 "strengths for the trial; `elastic` zones are left as they are. The range selects contacts "
+                 "only: every zone with a reducible model is reduced.\n\n"
                  f"Every trial starts from the model as it is when the command is given (stresses, contacts, "
                  f"velocities, time). A trial is **stable** when the mechanical ratio of `model solve` falls to "
                  f"{STABLE_RATIO:g} (Itasca's equilibrium ratio) within `cycles` steps (default "
@@ -67,8 +74,9 @@ def _check(call):
                  "it is printed with the trials, put in the results as `fos` (with `fos.unstable`, `fos.trials`) "
                  "and as `fos.<n>` for the n-th search of the run, and kept on the model. The first unstable trial's state at its end (vertex and block velocities: "
                  f"the failure mechanism) is written to `{MECHANISM_FILE}` in the output folder. Afterwards the "
-                 "model is put back exactly to its state before the command (dec3d's choice; histories and "
-                 "periodic VTK snapshots are not sampled during the trials).",
+                 "model is put back exactly to its state before the command (zone stresses, plastic states, histories "
+                 "and properties, gridpoint positions and velocities included; dec3d's choice; `history` "
+                 "records and periodic VTK snapshots are not sampled during the trials).",
          examples=["model factor-of-safety", "model factor-of-safety bracket 0.5 2 resolution 0.001",
                    "model factor-of-safety associated", "model factor-of-safety range group 'joints'"])
 def model_factor_of_safety(session, call):
@@ -86,12 +94,13 @@ def model_factor_of_safety(session, call):
         write_vtu(session.model, vtk_path)
         session.write(f"  failure mechanism (F = {factor:.6g}) written to {MECHANISM_FILE}")
 
-    trials = ContactStrengthTrials(e, mask, associated=a["associated"], steps=int(a["cycles"]),
-                                   on_unstable=mechanism)
-    if trials.rows.size == 0:
+    trials = StrengthTrials(e, mask, associated=a["associated"], steps=int(a["cycles"]), on_unstable=mechanism)
+    if trials.empty:
         trials.finish()
-        raise CommandError("model factor-of-safety: no contact " + ("in range " if mask is not None else "")
-                           + "has the `mohr` joint model (nothing to reduce)", call.location)
+        raise CommandError("model factor-of-safety: nothing to reduce: no contact "
+                           + ("in range " if mask is not None else "") + "has the `mohr` joint model"
+                           + (" and no zone has a constitutive model with a strength (e.g. `block zone cmodel "
+                              "assign mohr-coulomb`)" if has_zones(session.model) else ""), call.location)
     points = int(a["trials_per_round"])
     workers = int(a["workers"]) if a["workers"] is not None else min(points, os.cpu_count() or 1)
     t0 = _time.perf_counter()
@@ -109,8 +118,8 @@ def model_factor_of_safety(session, call):
             res = bracket_fos(None, lo, hi, float(a["resolution"]), points=points, run_many=runner)
             bad = next((f for f, ok, _, _ in log if not ok), None)
             if bad is not None:                   # the failure mechanism: the first unstable trial again, here
-                trials = ContactStrengthTrials(e, mask, associated=a["associated"], steps=int(a["cycles"]),
-                                               on_unstable=mechanism)
+                trials = StrengthTrials(e, mask, associated=a["associated"], steps=int(a["cycles"]),
+                                        on_unstable=mechanism)
                 trials(bad)
     except FosError as exc:
         raise CommandError(f"model factor-of-safety: {exc}", call.location)

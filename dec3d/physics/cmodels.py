@@ -20,13 +20,13 @@ those columns to its defaults and zeroes the zone's history (the stress is kept)
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
 
 from dec3d.io.state import register_known
+from dec3d.physics.modelprops import ModelProp, atan_deg, tan_deg
 from dec3d.kernels.zmodels import MODELS as KERNELS
 from dec3d.kernels.zmodels import NZPROP, P_OWN
 from dec3d.kernels.zmodels._common import (P_BULK, P_COHESION, P_DENSITY, P_SHEAR, P_SRF, P_TANDIL, P_TANFRIC,
@@ -37,30 +37,10 @@ __all__ = ["ALL_PROPS", "MODEL_BY_CODE", "Prop", "ZONE_MODELS", "ZoneModel", "an
            "P_TANDIL", "P_SRF", "P_OWN", "NZPROP", "which_zones"]
 
 
-def _tan_deg(v: float) -> float:
-    return math.tan(math.radians(v))
-
-
-def _atan_deg(v: float) -> float:
-    return math.degrees(math.atan(v))
-
-
 @dataclass(frozen=True)
-class Prop:
-    """One property keyword of a zone model: ``block zone property <name> <value>``."""
-    name: str
-    column: int
-    doc: str
-    units: str | None = None
-    to_column: Callable[[float], float] = float
-    from_column: Callable[[float], float] = float
-    #: column value when the model is assigned (own columns only; shared ones are kept)
-    default: float = 0.0
-    #: valid user values [lo, hi] (``lo_open``/``hi_open`` exclude the ends); None: unbounded
-    lo: float | None = 0.0
-    hi: float | None = None
-    lo_open: bool = False
-    hi_open: bool = False
+class Prop(ModelProp):
+    """One property keyword of a zone model: ``block zone property <name> <value>`` (``ModelProp``;
+    ``default`` is the column value when the model is assigned, own columns only)."""
     #: "number", "angle" (degrees kept as a tangent) or "table" (a table's name or number,
     #: kept as its index + 1 in the model's list of zone tables; 0 none)
     kind: str = "number"
@@ -68,7 +48,7 @@ class Prop:
 
 def angle(name, column, doc, hi=90.0, hi_open=True, **kw) -> Prop:
     """An angle in degrees in [0, hi), kept as its tangent."""
-    return Prop(name, column, doc, "deg", _tan_deg, _atan_deg, hi=hi, hi_open=hi_open, kind="angle", **kw)
+    return Prop(name, column, doc, "deg", tan_deg, atan_deg, hi=hi, hi_open=hi_open, kind="angle", **kw)
 
 
 def table(name, column, doc) -> Prop:

@@ -113,8 +113,8 @@ def zone_stiffness_damping(zst, beta: float, pos, vel, facc) -> None:
     each element kind's own step kernel, run on zero stresses with the strain increment of the current
     velocities over a unit time (so it returns −K v, the forces being linear in the stresses and the
     strains in the velocities), times β — the 4-node zones (``zone_step`` with each plastic model's zones
-    taken as elastic: the damping stress is not limited by their strength; null zones stay null; other
-    elastic models, anisotropic ones, keep theirs), the 10-node zones (``zones_ho.tet10_step``) and the FE
+    taken as elastic: the damping stress is not limited by their strength; null zones stay null; the
+    anisotropic elastic models keep theirs), the 10-node zones (``zones_ho.tet10_step``) and the FE
     elements with their hourglass control (``FeStepper.stiffness_damping``). ``zst`` is the
     ``physics.zones.ZoneStepper``."""
     from dec3d.kernels.zmodels import CODES, PLASTIC_CODES
@@ -134,8 +134,10 @@ def zone_stiffness_damping(zst, beta: float, pos, vel, facc) -> None:
     f[:] = 0.0
     fm[:] = 0.0
     if zst.fast is not None:
+        # (the anisotropic models' mean-stress correction is linear in the strain too: their zones
+        # keep the step's averaging sweep, the plastic ones, taken as elastic, give it nothing)
         zone_step(pos, vel, zst.zmesh, zst.material(stress, state, cm), zst.zplan, zst.zscratch, 1.0, False, zst.nmd,
-                  False, f, fm)
+                  zst.plastic, f, fm)
     if gstress is not None:
         from dec3d.kernels.zones_ho import tet10_step
         gstress[zst.rows10] = 0.0

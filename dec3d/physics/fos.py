@@ -7,9 +7,16 @@ joint strengths, c/F, tan φ/F (and the tensile strength T/F); each trial is sol
 initial state and is *stable* when it reaches equilibrium, *unstable* otherwise; the bracket
 [stable F, unstable F] is halved until it is narrower than the resolution.
 
+Zones are reduced together with the joints, as FLAC3D and 3DEC do (same page: the method "is applied
+automatically" to the Mohr-Coulomb, ubiquitous-joint and Hoek-Brown zone strengths, and to the joint
+cohesion and friction of `block contact property`): every zone whose constitutive model declares a
+``reduce`` in the registry (``dec3d.physics.cmodels``; e.g. `mohr-coulomb`: c/F, tan φ/F, σt/F) gets
+its property row from that ``reduce`` for the trial, and the strength-reduction column ``P_SRF`` set
+to F (the factor a kernel applies to strengths it reads from tables).
+
 This module holds the bracketing logic (``bracket_fos``, independent of the engine: a trial is any
-callable F -> bool) and the rigid-block trial (``ContactStrengthTrials``): reduce the `mohr`
-contacts' strengths, cycle, judge, put the model back exactly.
+callable F -> bool) and the trial on a model (``StrengthTrials``): reduce the `mohr` contacts' and
+the zones' strengths, cycle, judge, put the model back exactly.
 """
 from __future__ import annotations
 
@@ -20,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from dec3d.kernels.joints.mohr import CODE as MODEL_MOHR
+from dec3d.kernels.zmodels._common import P_SRF
 from dec3d.kernels.joints.mohr import P_COH, P_COH_RES, P_TANDIL, P_TANF, P_TANF_RES, P_TEN, P_TEN_RES
 
 #: equilibrium ratio of a stable trial (Itasca's equilibrium ratio, "Reaching Equilibrium": 1e-5)
@@ -156,10 +164,61 @@ def reduce_defaults(props: dict, factor: float, associated: bool) -> dict:
     return out
 
 
-class ContactStrengthTrials:
-    """Trials of the rigid-block model ``engine`` with the `mohr` contacts selected by ``mask``
-    (a bool array over the contacts; None: all, and the material-table defaults too, so contacts
-    made during a trial are reduced as well).
+def reducible_zones(model) -> np.ndarray:
+    """Rows of the ``zones`` store whose constitutive model declares a strength ``reduce`` in the
+    registry (``dec3d.physics.cmodels.MODEL_BY_CODE``); empty without zones."""
+    from dec3d.model.zones import has_zones
+    from dec3d.physics.cmodels import MODEL_BY_CODE
+
+    if not has_zones(model):
+        return np.zeros(0, dtype=np.int64)
+    codes = model.store("zones")["cmodel"]
+    ok = np.zeros(len(codes), dtype=bool)
+    for code in np.unique(codes):
+        m = MODEL_BY_CODE.get(int(code))
+        if m is not None and m.reduce is not None:
+            ok |= codes == code
+    return np.flatnonzero(ok)
+
+
+def reduce_zone_rows(prop: np.ndarray, cmodel: np.ndarray, factor: float) -> np.ndarray:
+    """The property rows ``prop`` (k, ncols) of zones of models ``cmodel`` (k,) with their strengths
+    divided by ``factor``: each model's own ``reduce(rows, F)`` (a new array; ``prop`` is not
+    changed), then the strength-reduction column ``P_SRF`` = F where the rows have it (the factor
+    a kernel divides the strengths it reads from tables by). Rows of a model without ``reduce``
+    are returned as they are."""
+    from dec3d.physics.cmodels import MODEL_BY_CODE
+
+    out = np.array(prop, dtype=np.float64, copy=True)
+    for code in np.unique(cmodel):
+        m = MODEL_BY_CODE.get(int(code))
+        if m is None or m.reduce is None:
+            continue
+        sel = np.flatnonzero(cmodel == code)
+        rows = np.asarray(m.reduce(out[sel].copy(), float(factor)), dtype=np.float64)
+        if rows.shape != (len(sel), out.shape[1]):
+            raise FosError(f"zone model '{m.name}': its strength reduction gave rows of shape {rows.shape}, "
+                           f"expected {(len(sel), out.shape[1])}")
+        if out.shape[1] > P_SRF:
+            rows[:, P_SRF] = float(factor)
+        out[sel] = rows
+    return out
+
+
+def _store_snapshot(store) -> dict:
+    return {k: store[k].copy() for k in store.fields}
+
+
+def _store_restore(store, snap: dict) -> None:
+    for k, a in snap.items():
+        store.full(k)[: len(a)] = a
+
+
+class StrengthTrials:
+    """Trials of the model of ``engine`` with the strengths of the `mohr` contacts selected by
+    ``mask`` (a bool array over the contacts; None: all, and the material-table defaults too, so
+    contacts made during a trial are reduced as well) and of every zone whose model declares a
+    ``reduce`` (``reducible_zones``) divided by the trial factor.
 
     ``__call__(F)`` puts the model back to the state it had when this object was made, divides
     the strengths by F, cycles until the equilibrium ratio (the mechanical ratio of `model
@@ -167,6 +226,12 @@ class ContactStrengthTrials:
     whether it was stable. ``finish()`` puts the model back (bit-identical arrays) and gives the
     engine its step hooks (histories, periodic VTK) again; they are not run during trials.
     ``on_unstable(F)`` is called with the model in the state at the end of the first unstable trial.
+
+    The model is put back with the engine's own snapshot (the one a failed ``cycle`` is put back
+    with: blocks, vertex motion, contacts, settings, time) and, because a trial may change any zone
+    or gridpoint field (stress, Gauss-point stress, plastic state, history, the reduced properties;
+    positions, velocities, displacements, reference positions), a copy of *every* field of the
+    ``zones`` and ``vertices`` stores.
     """
 
     def __init__(self, engine, mask=None, associated: bool = False, steps: int = DEFAULT_TRIAL_STEPS,
@@ -179,15 +244,25 @@ class ContactStrengthTrials:
         self.failed_once = False
         self.log: list[tuple[float, bool, int, float]] = []   # (F, stable, steps, ratio)
         engine.ensure_contacts()
+        m = engine.model
         c = engine.contacts
         sel = c["jmodel"] == MODEL_MOHR
         if mask is not None:
             sel &= np.asarray(mask, dtype=bool)
         self.rows = np.flatnonzero(sel)
         self.all_contacts = mask is None
+        #: rows of the zones whose strengths are reduced
+        self.zone_rows = reducible_zones(m)
         self.snap = engine._snapshot()
+        self.zsnap = _store_snapshot(m.store("zones")) if "zones" in m.stores else None
+        self.vsnap = _store_snapshot(m.vertices)
         self.hooks = engine.step_hooks
         engine.step_hooks = []
+
+    @property
+    def empty(self) -> bool:
+        """Nothing to reduce: no `mohr` contact selected and no zone with a reducible model."""
+        return self.rows.size == 0 and self.zone_rows.size == 0
 
     def _reset(self) -> None:
         # the engine's own snapshot (the one a failed `model cycle` is put back with); its settings
@@ -195,18 +270,27 @@ class ContactStrengthTrials:
         snap = dict(self.snap)
         snap["mech"] = copy.deepcopy(self.snap["mech"])
         self.e._restore(snap)
+        m = self.e.model
+        if self.zsnap is not None:
+            _store_restore(m.store("zones"), self.zsnap)
+        _store_restore(m.vertices, self.vsnap)
 
     def __call__(self, factor: float) -> bool:
         e = self.e
         self._reset()
         c = e.contacts
-        block = c["prop"][self.rows]
-        reduce_rows(block, factor, self.associated)
-        c["prop"][self.rows] = block
-        c["own_props"][self.rows] = 1          # kept through re-detection during the trial
+        if self.rows.size:
+            block = c["prop"][self.rows]
+            reduce_rows(block, factor, self.associated)
+            c["prop"][self.rows] = block
+            c["own_props"][self.rows] = 1          # kept through re-detection during the trial
         if self.all_contacts:
             s = e.settings()
             s["props"] = reduce_defaults(s["props"], factor, self.associated)
+        if self.zone_rows.size:
+            zs = e.model.store("zones")
+            r = self.zone_rows
+            zs["prop"][r] = reduce_zone_rows(zs["prop"][r], zs["cmodel"][r], factor)
         done = e.cycle(self.steps, lambda en: en.criteria()["ratio"] <= self.ratio)
         r = e.criteria()["ratio"]
         stable = bool(r <= self.ratio)
@@ -220,6 +304,10 @@ class ContactStrengthTrials:
     def finish(self) -> None:
         self._reset()
         self.e.step_hooks = self.hooks
+
+
+#: the name of the joints-only days (kept for callers)
+ContactStrengthTrials = StrengthTrials
 
 
 def _trial_from_file(path: str, rows: np.ndarray, all_contacts: bool, associated: bool, steps: int,
@@ -236,7 +324,7 @@ def _trial_from_file(path: str, rows: np.ndarray, all_contacts: bool, associated
     if not all_contacts:
         mask = np.zeros(e.contacts.n, dtype=bool)
         mask[rows] = True
-    t = ContactStrengthTrials(e, mask, associated=associated, steps=steps, ratio=ratio)
+    t = StrengthTrials(e, mask, associated=associated, steps=steps, ratio=ratio)
     ok = t(factor)
     _, _, done, r = t.log[-1]
     return ok, done, r
@@ -247,9 +335,9 @@ class FileTrials:
     (``dec3d.io.state.save_state``), by ``workers`` processes (1: in this process, one after the
     other). Every trial, whichever process runs it, starts from the same file, so the answers do
     not depend on the number of workers. ``log`` gets (F, stable, steps, ratio) like
-    ``ContactStrengthTrials.log``."""
+    ``StrengthTrials.log``."""
 
-    def __init__(self, path: str, trials: ContactStrengthTrials, workers: int = 1):
+    def __init__(self, path: str, trials: StrengthTrials, workers: int = 1):
         self.path = str(path)
         self.args = (trials.rows.copy(), trials.all_contacts, trials.associated, trials.steps, trials.ratio)
         self.workers = max(1, int(workers))

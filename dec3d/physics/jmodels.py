@@ -13,39 +13,20 @@ the residual friction with it, as 3DEC does.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
 from dec3d.io.state import register_known
+from dec3d.physics.modelprops import ModelProp, atan_deg, tan_deg
 
 from dec3d.kernels.joints import MODELS as KERNELS
 from dec3d.kernels.joints import NPROP, P_KN, P_KS
 
 
-def _tan_deg(v: float) -> float:
-    return math.tan(math.radians(v))
-
-
-def _atan_deg(v: float) -> float:
-    return math.degrees(math.atan(v))
-
-
 @dataclass(frozen=True)
-class Prop:
-    name: str
-    column: int
-    doc: str
-    units: str | None = None
-    to_column: Callable[[float], float] = float
-    from_column: Callable[[float], float] = float
-    default: float = 0.0
-    #: valid user values: [lo, hi], `hi_open` excludes hi (angles below 90°); None: unbounded
-    lo: float | None = 0.0
-    hi: float | None = None
-    hi_open: bool = False
+class Prop(ModelProp):
+    """A joint model's property (``ModelProp``: name, column, units, conversions, range)."""
     #: property whose value this one shows while it holds NaN (unset residual friction: the friction)
     fallback: str | None = None
 
@@ -53,7 +34,7 @@ class Prop:
 def angle(name, column, doc, hi_open=True, **kw) -> Prop:
     """An angle property: degrees in [0, 90), kept as its tangent. Above 90° the tangent turns
     negative (a block would slide that 30° holds)."""
-    return Prop(name, column, doc, "deg", _tan_deg, _atan_deg, hi=90.0, hi_open=hi_open, **kw)
+    return Prop(name, column, doc, "deg", tan_deg, atan_deg, hi=90.0, hi_open=hi_open, **kw)
 
 
 # friction 90 is a 3DEC idiom for "never slips" (shared decks use it): tan 90° in floating point is

@@ -44,7 +44,7 @@ import numpy as np
 
 from dec3d.errors import Dec3dError
 from dec3d.kernels.bundles import ZoneMaterial, ZoneMesh, ZonePlan, ZoneScratch
-from dec3d.kernels.zmodels import PLASTIC_CODES, make_tables, no_tables
+from dec3d.kernels.zmodels import CORRECTING_CODES, make_tables, no_tables
 from dec3d.kernels.zone_elastic import ElasticPlan
 from dec3d.kernels.zone_step import zone_step
 from dec3d.kernels.zonestep import gp_externals, gp_motion, gp_motion_ws, zone_mass_stiffness
@@ -177,8 +177,9 @@ class ZoneStepper:
         self.rows4 = np.ascontiguousarray(el[nn == 4])
         self.rows10 = np.ascontiguousarray(el[nn == 10])
         self.nmd = bool(model.settings.mechanical.get("nmd", True))
-        #: some 4-node zone has a plastic model (the step's third sweep, the plastic correction)
-        self.plastic = bool(np.isin(zs["cmodel"][self.rows4], sorted(PLASTIC_CODES)).any())
+        #: some 4-node zone's model returns a mean-stress correction (a plastic model, or an
+        #: anisotropic one): the step's third sweep averages it
+        self.plastic = bool(np.isin(zs["cmodel"][self.rows4], sorted(CORRECTING_CODES)).any())
         link0 = v["link"]
         #: NMD averaging node of each vertex row: its link master (one gridpoint of a joined set) or itself
         self.node = np.ascontiguousarray(np.where(link0 >= 0, link0, np.arange(v.n, dtype=_I)))

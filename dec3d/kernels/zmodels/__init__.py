@@ -8,8 +8,11 @@ A model's kernel file (any ``<name>.py`` here not starting with ``_``) declares
   ``_common.P_*``; from ``P_OWN`` on each model's own),
 - ``NHIST``, ``HIST_NAMES``: its per-zone history entries (``zones.hist[z, :NHIST]``, zero when
   the model is assigned; saved, restored, written to VTK and readable from FISH by name),
-- ``PLASTIC``: whether its update may return a plastic correction (the step then runs the sweep
-  that averages it, nodal mixed discretization Eqs. 73-76),
+- ``PLASTIC``: whether the model may yield (plastic-state counts; Rayleigh damping takes its zones
+  as elastic), and ``CORRECTS`` (optional, default ``PLASTIC``): whether its update may return a
+  mean-stress correction dsp that the step must average (its third sweep, nodal mixed
+  discretization Eqs. 73-76): the plastic models, and the anisotropic elastic ones, whose deviatoric
+  strain makes a mean stress that NMD must average to keep the stiffness symmetric,
 - ``update(p, h, z, K, G, d0..d5, s0..s5, tab, wf, mw)``: a numba function of one zone, given the
   property rows ``p`` (nz, NZPROP) and history rows ``h`` (nz, NZHIST) of the zones and its row
   ``z``, its bulk and shear moduli K, G [Pa] (those the mass scaling uses), the strain increment
@@ -39,7 +42,7 @@ from numba import njit
 
 from ._common import NWORK, NZHIST, NZPROP, P_OWN, Tables, make_tables, merge_state, no_tables, table_value
 
-__all__ = ["CODES", "MODELS", "NWORK", "NZHIST", "NZPROP", "P_OWN", "PLASTIC_CODES", "Tables", "make_tables",
+__all__ = ["CODES", "CORRECTING_CODES", "MODELS", "NWORK", "NZHIST", "NZPROP", "P_OWN", "PLASTIC_CODES", "Tables", "make_tables",
            "merge_state", "no_tables", "table_value", "zone_update"]
 
 
@@ -64,8 +67,10 @@ def _find():
 MODELS = tuple(_find())
 #: code of each zone model by name
 CODES = {m.NAME: m.CODE for m in MODELS}
-#: codes of the models that may return a plastic correction
+#: codes of the models that may yield
 PLASTIC_CODES = frozenset(m.CODE for m in MODELS if m.PLASTIC)
+#: codes of the models whose update may return a mean-stress correction (the step's third sweep)
+CORRECTING_CODES = frozenset(m.CODE for m in MODELS if getattr(m, "CORRECTS", m.PLASTIC))
 
 
 def _link(i):
