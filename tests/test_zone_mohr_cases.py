@@ -174,7 +174,7 @@ def test_mohr_props_check_accepts_good_rows_and_warns_at_the_apex():
     (_prow(ten=-5.0), "tension must be >= 0 Pa"),
     (_prow(dil=35.0), "dilation must not exceed friction: 1 zone(s) (4)"),
     (_prow(c=float("nan")), "cohesion must be >= 0 Pa"),
-    (np.where(np.arange(mz.NZPROP) == mz.ZP_SHEAR, 0.0, _prow()), "shear must be > 0 Pa: 1 zone(s) (4)"),
+    (np.where(np.arange(mz.NZPROP) == mz.ZP_SHEAR, 0.0, _prow()), "shear must be > 0 Pa (not set): 1 zone(s) (4)"),
     (np.where(np.arange(mz.NZPROP) == mz.ZP_DENSITY, -1.0, _prow()), "density must be > 0"),
 ])
 def test_mohr_props_check_errors(row, words):

@@ -209,10 +209,13 @@ def _column_value(session, p, value, where) -> float:
         return p.to_column(value)
     from ..fish.table_intrinsics import table_key
 
+    from .fish_cmds import attach_fish
+
     key = table_key(value)
     if key not in session.fish_rt.tables:
         raise CommandError(f"`{p.name}`: there is no table {value!r} (make it with `table {value!r} add …` "
                            "before this line)", where)
+    attach_fish(session)           # (the model reads the tables through the FISH run time when it cycles)
     ids = session.model.settings.mechanical.setdefault("zone_tables", [])
     if key not in ids:
         ids.append(key)
