@@ -4,9 +4,9 @@ rows stepped, sets, weights, averaging nodes, model codes, properties), as the e
 import numpy as np
 
 from dec3d.kernels.bundles import ZoneMaterial
-from dec3d.kernels.zmodels import CORRECTING_CODES, NZHIST, no_tables
+from dec3d.kernels.zmodels import CORRECTING_CODES, NZHIST, model_mask, no_tables
 from dec3d.kernels.zone_elastic import ElasticPlan
-from dec3d.kernels.zone_step import zone_step
+from dec3d.kernels.zone_step import zone_step_for
 from dec3d.model import zones as mz
 from dec3d.physics.zones import zone_bundles
 
@@ -18,6 +18,7 @@ class Stepper:
         nset = int(zset.max()) + 1 if len(zset) else 0
         self.plan = ElasticPlan(gp, rows, node, zset, weight, nv, parts)
         self.plastic = bool(np.isin(cm[rows], sorted(CORRECTING_CODES)).any())
+        self.models = model_mask(np.unique(cm[rows]))         # (bit 0, the correction sweep: ``plastic``)
         self.mesh, self.zplan, self.scr = zone_bundles(self.plan, nset, self.plastic)
         self.cm = np.ascontiguousarray(cm)
         self.prop = np.ascontiguousarray(prop)
@@ -28,7 +29,8 @@ class Stepper:
 
     def step(self, pos, vel, stress, state, force, fmag, dt, large, nmd):
         mat = ZoneMaterial(self.cm, self.prop, self.hist, self.bulk, self.shear, stress, state, self.tab)
-        zone_step(pos, vel, self.mesh, mat, self.zplan, self.scr, dt, large, nmd, self.plastic, force, fmag)
+        zone_step_for(self.models | int(self.plastic))(pos, vel, self.mesh, mat, self.zplan, self.scr, dt, large,
+                                                       nmd, force, fmag)
 
 
 def elastic_forces(pos, vel, gp, rows, zset, weight, nset, bulk, shear, dt, large, stress, force, fmag):

@@ -23,9 +23,10 @@ zone-entry order, foreign entries through slots), set sums serially between the 
 serial order, so one thread's bits for any thread count.
 """
 import numpy as np
-from numba import njit, prange
+from numba import literally, njit, prange, types
+from numba.extending import overload
 
-from .zmodels import NWORK, Tables, merge_state, zone_update
+from .zmodels import NWORK, Tables, merge_state, zone_update_for
 from .zone_elastic import _add, _faces, _force, _strain
 from .zone_mohr import mohr_work
 
@@ -46,12 +47,18 @@ def _scatter_forces(force, fmag, fbits, k, i0, i1, i2, i3, s0, s1, s2, s3, s4, s
 
 
 @njit(cache=True, parallel=True)
-def zone_step(pos, vel, mesh, mat, plan, scr, dt, large, nmd, plastic, force, fmag):
+def zone_step(pos, vel, mesh, mat, plan, scr, dt, large, nmd, models, force, fmag):
     """One step of the 4-node zones of ``mesh`` (``bundles.ZoneMesh``) with the materials
     ``mat`` (``bundles.ZoneMaterial``: stress, state and history updated), the plan ``plan``
     (``bundles.ZonePlan``) and scratch ``scr`` (``bundles.ZoneScratch``); pos, vel (nvert, 3)
-    gridpoints; ``plastic``: some zone's model is plastic (three sweeps); force (nvert, 3),
-    fmag (nvert,) added to (Σ |zone force contributions| for the equilibrium ratio)."""
+    gridpoints; ``models``: the mask of the model codes among the zones, bit 0 set when some
+    zone's model returns a mean-stress correction (three sweeps) (``zmodels.model_mask``); force
+    (nvert, 3), fmag (nvert,) added to (Σ |zone force contributions| for the equilibrium ratio).
+
+    ``models`` is a compile-time constant (numba's ``literally``): a deck compiles the step for the
+    models it uses, once (cached), not every model's return nor an unused sweep."""
+    literally(models)
+    plastic = (models & 1) != 0
     g4 = mesh.g4; n4 = mesh.n4; rows = mesh.rows; zset = mesh.zset; weight = mesh.weight; nset = mesh.nset
     stress = mat.stress; state = mat.state; cmodel = mat.cmodel; bulk = mat.bulk; shear = mat.shear
     prop = mat.prop; hist = mat.hist
@@ -152,9 +159,9 @@ def zone_step(pos, vel, mesh, mat, plan, scr, dt, large, nmd, plastic, force, fm
                 r4 = s4 + w02 * (s2 - s0) + w01 * s5 - w12 * s3
                 r5 = s5 + w12 * (s2 - s1) - w01 * s4 - w02 * s3
                 s0 = r0; s1 = r1; s2 = r2; s3 = r3; s4 = r4; s5 = r5
-            code, s0, s1, s2, s3, s4, s5, dp = zone_update(cmodel[z], prop, hist, z, bulk[z], shear[z],
-                                                           d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5,
-                                                           tab, wf, mw)
+            code, s0, s1, s2, s3, s4, s5, dp = zone_update_for(models, cmodel[z], prop, hist, z, bulk[z],
+                                                               shear[z], d0, d1, d2, d3, d4, d5, s0, s1, s2,
+                                                               s3, s4, s5, tab, wf, mw)
             stress[z, 0] = s0; stress[z, 1] = s1; stress[z, 2] = s2
             stress[z, 3] = s3; stress[z, 4] = s4; stress[z, 5] = s5
             if not plastic:
@@ -173,8 +180,7 @@ def zone_step(pos, vel, mesh, mat, plan, scr, dt, large, nmd, plastic, force, fm
                         j += 1
                     else:
                         nodedsp[n4[k, a]] += x
-    if plastic:
-        _correction_sweep(pos, mesh, mat, plan, scr, nmd, force, fmag)
+    _correct(models, pos, mesh, mat, plan, scr, nmd, force, fmag)
     fpstart = plan.fpstart; fptgt = plan.fptgt; fpslot = plan.fpslot
     for i in prange(fptgt.shape[0]):
         t = fptgt[i]
@@ -182,6 +188,26 @@ def zone_step(pos, vel, mesh, mat, plan, scr, dt, large, nmd, plastic, force, fm
             sl = fpslot[q]
             force[t, 0] += sb[sl, 0]; force[t, 1] += sb[sl, 1]; force[t, 2] += sb[sl, 2]
             fmag[t] += sb[sl, 3]
+
+
+def _correct(models, pos, mesh, mat, plan, scr, nmd, force, fmag):
+    """Sweep C when bit 0 of ``models`` is set (a literal: the step of a deck without correcting
+    models does not compile it)."""
+    raise NotImplementedError("called from zone_step only")
+
+
+@overload(_correct, jit_options={"cache": True})
+def _correct_impl(models, pos, mesh, mat, plan, scr, nmd, force, fmag):
+    if not isinstance(models, types.IntegerLiteral):
+        return None             # (typed again once ``literally`` has made it a literal)
+    if not models.literal_value & 1:
+        def nothing(models, pos, mesh, mat, plan, scr, nmd, force, fmag):
+            return None
+        return nothing
+
+    def sweep(models, pos, mesh, mat, plan, scr, nmd, force, fmag):
+        _correction_sweep(pos, mesh, mat, plan, scr, nmd, force, fmag)
+    return sweep
 
 
 @njit(cache=True, parallel=True)
@@ -236,3 +262,23 @@ def _correction_sweep(pos, mesh, mat, plan, scr, nmd, force, fmag):
             w = weight[k] / 3.0 if weight.shape[0] > 0 else 1.0 / 3.0
             j = _scatter_forces(force, fmag, fbits, k, i0, i1, i2, i3, s0, s1, s2, s3, s4, s5, a0x, a0y, a0z,
                                 a1x, a1y, a1z, a2x, a2y, a2z, a3x, a3y, a3z, w, sb, j)
+
+
+_STEPS: dict = {}
+
+
+def zone_step_for(models: int):
+    """``zone_step`` with ``models`` fixed: ``step(pos, vel, mesh, mat, plan, scr, dt, large, nmd,
+    force, fmag)``. Called from Python with the mask as a plain integer, ``zone_step`` would type
+    it as an integer first at every call and only then as the literal it asks for (about a
+    second a call); a small jitted function that passes the mask as a constant reaches the
+    literal specialization at once. One per mask and process (the step itself is cached on disk)."""
+    step = _STEPS.get(models)
+    if step is None:
+        mask = int(models)
+
+        @njit
+        def step(pos, vel, mesh, mat, plan, scr, dt, large, nmd, force, fmag):
+            zone_step(pos, vel, mesh, mat, plan, scr, dt, large, nmd, mask, force, fmag)
+        _STEPS[models] = step
+    return step

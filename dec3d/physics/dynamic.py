@@ -117,8 +117,8 @@ def zone_stiffness_damping(zst, beta: float, pos, vel, facc) -> None:
     anisotropic elastic models keep theirs), the 10-node zones (``zones_ho.tet10_step``) and the FE
     elements with their hourglass control (``FeStepper.stiffness_damping``). ``zst`` is the
     ``physics.zones.ZoneStepper``."""
-    from dec3d.kernels.zmodels import CODES, PLASTIC_CODES
-    from dec3d.kernels.zone_step import zone_step
+    from dec3d.kernels.zmodels import CODES, PLASTIC_CODES, model_mask
+    from dec3d.kernels.zone_step import zone_step_for
 
     zs = zst.model.store("zones")
     sc = getattr(zst, "_rayleigh_scratch", None)
@@ -136,8 +136,8 @@ def zone_stiffness_damping(zst, beta: float, pos, vel, facc) -> None:
     if zst.fast is not None:
         # (the anisotropic models' mean-stress correction is linear in the strain too: their zones
         # keep the step's averaging sweep, the plastic ones, taken as elastic, give it nothing)
-        zone_step(pos, vel, zst.zmesh, zst.material(stress, state, cm), zst.zplan, zst.zscratch, 1.0, False, zst.nmd,
-                  zst.plastic, f, fm)
+        step = zone_step_for(model_mask(np.unique(cm[zst.rows4]), zst.plastic))
+        step(pos, vel, zst.zmesh, zst.material(stress, state, cm), zst.zplan, zst.zscratch, 1.0, False, zst.nmd, f, fm)
     if gstress is not None:
         from dec3d.kernels.zones_ho import tet10_step
         gstress[zst.rows10] = 0.0

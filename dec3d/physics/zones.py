@@ -44,9 +44,9 @@ import numpy as np
 
 from dec3d.errors import Dec3dError
 from dec3d.kernels.bundles import ZoneMaterial, ZoneMesh, ZonePlan, ZoneScratch
-from dec3d.kernels.zmodels import CORRECTING_CODES, make_tables, no_tables
+from dec3d.kernels.zmodels import CORRECTING_CODES, make_tables, model_mask, no_tables
 from dec3d.kernels.zone_elastic import ElasticPlan
-from dec3d.kernels.zone_step import zone_step
+from dec3d.kernels.zone_step import zone_step_for
 from dec3d.kernels.zonestep import gp_externals, gp_motion, gp_motion_ws, zone_mass_stiffness
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.model import KIND_DEFORMABLE
@@ -180,6 +180,8 @@ class ZoneStepper:
         #: some 4-node zone's model returns a mean-stress correction (a plastic model, or an
         #: anisotropic one): the step's third sweep averages it
         self.plastic = bool(np.isin(zs["cmodel"][self.rows4], sorted(CORRECTING_CODES)).any())
+        #: the models among the 4-node zones: the step is compiled for these (``model_mask``)
+        self.models = model_mask(np.unique(zs["cmodel"][self.rows4]), self.plastic)
         link0 = v["link"]
         #: NMD averaging node of each vertex row: its link master (one gridpoint of a joined set) or itself
         self.node = np.ascontiguousarray(np.where(link0 >= 0, link0, np.arange(v.n, dtype=_I)))
@@ -452,8 +454,8 @@ class ZoneStepper:
             self.begin()
         pos, vel = v["pos"], v["velocity"]
         if self.fast is not None:
-            zone_step(pos, vel, self.zmesh, self.material(), self.zplan, self.zscratch, dt, large, self.nmd,
-                      self.plastic, facc, fmag)
+            zone_step_for(self.models)(pos, vel, self.zmesh, self.material(), self.zplan, self.zscratch, dt, large,
+                                       self.nmd, facc, fmag)
         if self.ho is not None:
             self.ho(pos, vel, zs["gp"], self.rows10, self.bulk, self.shear, dt, zs["gstress"], zs["stress"], facc)
         if self.beta > 0.0:             # Rayleigh damping's stiffness term (physics.dynamic)

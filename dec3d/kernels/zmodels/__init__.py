@@ -38,11 +38,12 @@ from __future__ import annotations
 import importlib
 import pkgutil
 
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 from ._common import NWORK, NZHIST, NZPROP, P_OWN, Tables, make_tables, merge_state, no_tables, table_value
 
-__all__ = ["CODES", "CORRECTING_CODES", "MODELS", "NWORK", "NZHIST", "NZPROP", "P_OWN", "PLASTIC_CODES", "Tables", "make_tables",
+__all__ = ["CODES", "CORRECTING_CODES", "MODELS", "model_mask", "zone_update_for", "NWORK", "NZHIST", "NZPROP", "P_OWN", "PLASTIC_CODES", "Tables", "make_tables",
            "merge_state", "no_tables", "table_value", "zone_update"]
 
 
@@ -73,18 +74,18 @@ PLASTIC_CODES = frozenset(m.CODE for m in MODELS if m.PLASTIC)
 CORRECTING_CODES = frozenset(m.CODE for m in MODELS if getattr(m, "CORRECTS", m.PLASTIC))
 
 
-def _link(i):
-    """``zone_update`` from model i on: its update when the code matches, else the next link;
-    the last link answers every other code (null zones are never stepped; codes are checked
-    when a model is assigned)."""
-    code = MODELS[i].CODE
-    upd = MODELS[i].update
-    if i == len(MODELS) - 1:
+def _link(i, models=MODELS):
+    """``zone_update`` from model i of ``models`` on: its update when the code matches, else the
+    next link; the last link answers every other code (null zones are never stepped; codes are
+    checked when a model is assigned)."""
+    code = models[i].CODE
+    upd = models[i].update
+    if i == len(models) - 1:
         @njit(inline="always")
         def last(model, p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
             return upd(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw)
         return last
-    rest = _link(i + 1)
+    rest = _link(i + 1, models)
 
     @njit(inline="always")
     def link(model, p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
@@ -95,3 +96,39 @@ def _link(i):
 
 
 zone_update = _link(0)
+
+
+def model_mask(codes, correct: bool = False) -> int:
+    """The bit mask of a set of model codes (bit c for code c; code 0, null, is never stepped), as
+    ``zone_update_for`` and the zone step take it; bit 0 set when ``correct`` (some model returns a
+    mean-stress correction: the step's third sweep)."""
+    mask = 1 if correct else 0
+    for c in codes:
+        if int(c):
+            mask |= 1 << int(c)
+    return mask
+
+
+def zone_update_for(models, model, p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
+    """``zone_update`` compiled for the models of the mask ``models`` only (a literal integer in the
+    caller, ``model_mask``): a kernel that steps elastic zones compiles Hooke, not the plastic
+    returns of every model in the folder. Numba picks the chain when it types the call."""
+    raise NotImplementedError("zone_update_for is called from numba kernels only")
+
+
+_CHAINS: dict = {}
+
+
+@overload(zone_update_for, jit_options={"cache": True})
+def _zone_update_for(models, model, p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
+    if not isinstance(models, types.IntegerLiteral):
+        return None
+    mask = int(models.literal_value)
+    chain = _CHAINS.get(mask)
+    if chain is None:
+        chosen = tuple(m for m in MODELS if (mask >> m.CODE) & 1) or MODELS[:1]
+        chain = _CHAINS[mask] = _link(0, chosen)
+
+    def impl(models, model, p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
+        return chain(model, p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw)
+    return impl
