@@ -27,6 +27,16 @@ The envelope is concave, so every tangent lies outside it: each iterate stays ou
 surface and the multiplier grows monotonically to the root (quadratically). The dilation,
 and so the flow direction, is fixed from the trial state (σ3 of the trial, as Itasca takes it).
 
+That iteration on arrays is the general path (``_general``). The common cases take a scalar
+path with the same result (to ~1e-12 of the stress scale, the same bits): principal values well
+apart (``GAP_REL``), and a single-plane shear return leaving σ2 between σ1 and σ3, Itasca's
+tension return, or a shear edge (σ2 = σ3 or σ1 = σ2 at the result). With the principal
+directions and the flow direction fixed, the return is one scalar equation in the plastic
+multiplier, solved by Halley's steps (``_fast``, ``_edge``); the last step and the rotation back
+are ``zone_mohr._fast_return``'s (or ``principal_axes`` and ``zone_mohr._rotate_back`` for
+edges). Whatever they do not settle clearly (nearly equal principal values, tension corners,
+the apex, decisions within FAST_MARGIN of a threshold) goes to the general path.
+
 The property keywords, the dilation rule and the trial-state tangent are taken from Itasca's
 published source of the model (``modelhoek.cpp``: ``ModelHoek::getProperties`` lists
 constant-mb, constant-s, constant-a, constant-sci, flag-dilation, constant-dilation …;
@@ -277,7 +287,8 @@ def _fast(p, z, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, 
     the admissibility checks are the general path's own. A trial beyond the tension cut-off
     takes Newton's steps instead, each tangent's choice between shear and tension (Itasca's h)
     checked as the general path makes it. Returns (code, t0..t5, dsp) as ``_fast_return``:
-    code -1 when not settled here (the general path then does it)."""
+    code -1 when not settled here (the general path then does it), -2 where the single-plane
+    return would carry σ2 past σ1 or σ3 (the edge return, ``_edge``, then does it)."""
     p1 = m + l1
     p2 = m + l2
     p3 = m + l3
@@ -375,8 +386,9 @@ def _fast(p, z, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, 
 
 @njit(cache=True)
 def fast_update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
-    """``update``'s scalar path alone (for the tests): (code, t0..t5, dsp), code -1 where
-    ``update`` would take the general path."""
+    """``update``'s scalar path alone (for the tests): (code, t0..t5, dsp) of ``_fast``; code
+    -1 where ``update`` takes the general path, -2 where it takes ``_edge`` (and the general
+    path if that does not settle)."""
     s0, s1, s2, s3, s4, s5 = hooke(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5)
     mb = p[z, C_MB]
     s = p[z, C_S]
