@@ -316,9 +316,9 @@ def test_scalar_path_equals_general_path_on_random_yielding_states():
     return onto the last tangent; the scalar edge return; the general path for the rest) against
     the general path alone (repeated ``mohr_plastic`` returns): the same stress and dsp to 1e-10
     of the stress scale and the same bits on random yielding states; and the scalar paths settle
-    most of them (single-plane shear, tension, edges)."""
+    most of them (single-plane shear, tension; edges and close principal values in ``_slow``)."""
     rng = np.random.default_rng(77)
-    settled = {1: 0, 2: 0, "edge": 0}
+    settled = {1: 0, 2: 0, "slow": 0}
     left = 0
     worst = 0.0
     n = 0
@@ -337,8 +337,8 @@ def test_scalar_path_equals_general_path_on_random_yielding_states():
         if rf[0] >= 0:
             assert ru == rf                            # update takes the scalar path's result
             settled[rf[0]] += 1
-        elif rf[0] == -2:
-            settled["edge"] += 1
+        elif rf[0] in (-2, -3):
+            settled["slow"] += 1                       # (edge, or close principal values)
         else:
             left += 1
             assert ru == rg                            # (update is the general path there)
@@ -347,7 +347,7 @@ def test_scalar_path_equals_general_path_on_random_yielding_states():
         worst = max(worst, err)
         assert ru[0] == rg[0], (ru, rg)
         assert err <= 1e-10, (err, s0, de, K, G, mb, s, a, sci, psi, flag)
-    assert settled[1] >= 1200 and settled[2] >= 200 and settled["edge"] >= 3, (settled, left)
+    assert settled[1] >= 1200 and settled[2] >= 200 and settled["slow"] >= 3, (settled, left)
     print("scalar vs general path: worst", worst, "settled", settled, "left to the general path", left)
 
 
@@ -371,10 +371,37 @@ def test_scalar_path_on_bench_like_states_and_flow_rules():
                 ru = hbk.update(*args, np.full(NWORK, np.nan), _MW)
                 if rg[0]:
                     total += 1
-                    settled += rf[0] >= 0 or rf[0] == -2
+                    settled += rf[0] >= 0 or rf[0] in (-2, -3)
                 assert ru[0] == rg[0]
                 scale = max(abs(x) for x in rg[1:7]) + 1e5
                 assert max(abs(x - y) for x, y in zip(ru[1:8], rg[1:8])) <= 1e-10 * scale
                 sv = np.array(rg[1:7])
         print("bench-like", a, psi, flag, "settled", settled, "of", total)
         assert total >= 300 and settled >= 0.9 * total, (a, psi, flag, settled, total)
+
+
+def test_close_principal_values_equal_general_path():
+    """Trials with two principal values equal or within 1 % of the spread (triaxial compression
+    and extension, where the scalar path works on Jacobi's values and ends on an edge or a
+    single plane): ``update`` against the general path, the same stress to 1e-10 of the scale
+    and the same bits."""
+    rng = np.random.default_rng(11)
+    K, G = 6.7e9, 4e9
+    n = 0
+    for a, psi, flag in ((0.5, 0.0, 0.0), (0.6, 5.0, 0.0), (0.55, 0.0, -1.0)):
+        p = _rows(1.0, 0.001, a, 1e5, psi, flag)
+        for _ in range(200):
+            R = _rand_rotation(rng)
+            lo, hi = -rng.uniform(6e4, 9e4), -rng.uniform(5e3, 3e4)
+            close = rng.uniform(0, 0.01) * (hi - lo) * rng.choice([0.0, 1.0])
+            prin = [lo, hi - close, hi] if rng.random() < 0.5 else [lo, lo + close, hi]
+            sv = _vec6(R @ np.diag(prin) @ R.T)
+            de = rng.normal(size=6) * 1e-8
+            args = (p, _H, 0, K, G, *[float(x) for x in de], *[float(x) for x in sv], _TAB)
+            rg = hbk.update_general(*args, np.full(NWORK, np.nan), _MW)
+            ru = hbk.update(*args, np.full(NWORK, np.nan), _MW)
+            assert ru[0] == rg[0], (ru, rg)
+            scale = max(abs(x) for x in rg[1:7]) + 1e5
+            assert max(abs(x - y) for x, y in zip(ru[1:8], rg[1:8])) <= 1e-10 * scale, (prin, a, psi, flag)
+            n += rg[0] != 0
+    assert n >= 500

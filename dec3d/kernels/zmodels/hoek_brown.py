@@ -176,20 +176,18 @@ FAST_MARGIN = 1e-8
 EDGE_REL = 1e-6
 
 
-@njit(cache=True)
-def _edge(s0, s1, s2, s3, s4, s5, p1, p2, p3, nps, a1, a2, mb, s, a, sci, st, tol, mar, wf, mw):
+@njit(cache=True, inline="always")
+def _edge_values(p1, p2, p3, nps, a1, a2, mb, s, a, sci, st, tol, mar):
     """The edge return in scalars (``_fast``'s, where the single-plane return would carry σ2
     past σ3 or σ1): two shear surfaces, σ1-σ3 and σ1-σ2 (σ2 = σ3 at the result) or σ1-σ3 and
     σ2-σ3 (σ1 = σ2), the flow of each Mohr-Coulomb's with the dilation fixed from the trial.
-    The trial's principal values p1 < p2 < p3 (well apart). With the multipliers μ of σ1-σ3
+    The trial's principal values p1 <= p2 <= p3. With the multipliers μ of σ1-σ3
     and μ - d of the other (d: where the single-plane return meets the edge), the condition
     that the two equal principal values stay equal is linear and leaves σ1(μ) = c1 + k1 μ,
     σ3(μ) = c3 + k3 μ; the return solves σ1(μ) = q(σ3(μ)) from μ = d by the steps of ``_fast``
     (g again convex and decreasing). This is the general path's two-plane return (the Itasca
-    plane with the plane of the pair that became equal), iterated onto the same tangents. The
-    rotation back by ``principal_axes`` and ``zone_mohr._rotate_back`` on the chunk scratch
-    (as the general path: trial wf[0:6], projectors wf[12:24], values wf[24:27], the new
-    values wf[27:30]). Returns (code, t0..t5, dsp); code -1: not settled here."""
+    plane with the plane of the pair that became equal), iterated onto the same tangents.
+    Returns (settled, n1, n2, n3): the new principal values."""
     dm1 = a2 * nps - a1                  # D m of σ1-σ3 (tension positive): (dm1, b, dm3)
     dm3 = a1 * nps - a2
     b = a2 * (nps - 1.0)
@@ -214,7 +212,7 @@ def _edge(s0, s1, s2, s3, s4, s5, p1, p2, p3, nps, a1, a2, mb, s, a, sci, st, to
     q, n, c = _envelope(y3, mb, s, a, sci)
     g = c1 + k1 * mu - q
     if not g > mar:
-        return -1, s0, s1, s2, s3, s4, s5, 0.0
+        return False, p1, p2, p3
     done = False
     dn = 0.0
     for _it in range(MAXIT):
@@ -237,10 +235,10 @@ def _edge(s0, s1, s2, s3, s4, s5, p1, p2, p3, nps, a1, a2, mb, s, a, sci, st, to
         q, n, c = _envelope(y3, mb, s, a, sci)
         g = c1 + k1 * mu - q
     if not done:
-        return -1, s0, s1, s2, s3, s4, s5, 0.0
+        return False, p1, p2, p3
     mu += dn                             # the last Newton step
     if not mu - d > EDGE_REL * mu:
-        return -1, s0, s1, s2, s3, s4, s5, 0.0
+        return False, p1, p2, p3
     if e3:
         n1 = p1 - (2.0 * mu - d3) * dm1
         n3 = p3 - mu * dm3 - (mu - d3) * b
@@ -250,18 +248,47 @@ def _edge(s0, s1, s2, s3, s4, s5, p1, p2, p3, nps, a1, a2, mb, s, a, sci, st, to
         n2 = n1
         n3 = p3 - (2.0 * mu - d1) * dm3
     if not (n3 <= st - mar and n3 - n1 > mar):
-        return -1, s0, s1, s2, s3, s4, s5, 0.0
-    t = wf[0:6]
-    t[0] = s0; t[1] = s1; t[2] = s2; t[3] = s3; t[4] = s4; t[5] = s5
-    lam = wf[24:27]
-    pr = wf[12:24]
-    principal_axes(t, lam, pr, mw[6])
-    sn = wf[27:30]
-    sn[0] = n1; sn[1] = n2; sn[2] = n3
-    bits, dsp = _rotate_back(t, lam, pr, sn, SHEAR_NOW)
-    t0 = t[0]; t1 = t[1]; t2 = t[2]; t3 = t[3]; t4 = t[4]; t5 = t[5]
-    wf[0] = math.nan
-    return bits, t0, t1, t2, t3, t4, t5, dsp
+        return False, p1, p2, p3
+    return True, n1, n2, n3
+
+
+@njit(cache=True, inline="always")
+def _plane(p1, p3, nps, a1, a2, mb, s, a, sci, tol, mar):
+    """The single-plane shear return of ``_fast`` (its steps, no tension violated at the trial)
+    for principal values p1 <= p3 that need not be well apart: (settled, λ) with λ the
+    multiplier of the last Newton step."""
+    dm1 = a2 * nps - a1
+    dm3 = a1 * nps - a2
+    lam = 0.0
+    yk = -p3
+    qk, nk, ck = _envelope(yk, mb, s, a, sci)
+    g = -p1 - qk
+    if not g > mar:
+        return False, 0.0
+    for _it in range(MAXIT):
+        if not ck > -1e300:
+            break
+        csn = qk - nk * yk
+        if csn < 0.0:
+            csn = 0.0
+        den = a1 * (1.0 + nk * nps) - a2 * (nk + nps)
+        if nk * p3 - p1 - csn <= mar:
+            break
+        dn = g / den
+        y3 = yk + dn * dm3
+        if 0.5 * (-ck) * (dm3 * dm3) * (dn * dn) <= 0.01 * tol and not (yk < 0.0 and y3 > 0.0):
+            return True, lam + dn
+        step = dn
+        dd = 2.0 * den * den + g * ck * (dm3 * dm3)
+        if dd > den * den:
+            step = 2.0 * g * den / dd
+        lam += step
+        yk = -p3 + lam * dm3
+        qk, nk, ck = _envelope(yk, mb, s, a, sci)
+        g = (-p1 + lam * dm1) - qk
+    return False, 0.0
+
+
 
 
 @njit(cache=True, inline="always")
@@ -288,18 +315,21 @@ def _fast(p, z, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, 
     takes Newton's steps instead, each tangent's choice between shear and tension (Itasca's h)
     checked as the general path makes it. Returns (code, t0..t5, dsp) as ``_fast_return``:
     code -1 when not settled here (the general path then does it), -2 where the single-plane
-    return would carry σ2 past σ1 or σ3 (the edge return, ``_edge``, then does it)."""
+    return would carry σ2 past σ1 or σ3, -3 for a clear shear return with principal values
+    not well apart (``_slow`` then does both)."""
     p1 = m + l1
     p2 = m + l2
     p3 = m + l3
-    if not (l3 - l1 > 0.0 and min(l2 - l1, l3 - l2) >= GAP_REL * (l3 - l1)):
-        return -1, s0, s1, s2, s3, s4, s5, 0.0
     scale = abs(p1) + abs(p2) + abs(p3) + sci
     tol = RTOL * scale
     mar = FAST_MARGIN * scale
     yk = -p3                                     # σ3 of the current point (compression positive)
     g = -p1 - (q0 + n0 * (yk - x0))              # g at the trial: the shear yield function
     ten = p3 - st
+    if not (l3 - l1 > 0.0 and min(l2 - l1, l3 - l2) >= GAP_REL * (l3 - l1)):
+        if ten < -mar and g > mar:
+            return -3, s0, s1, s2, s3, s4, s5, 0.0    # (a clear shear return: ``_slow``)
+        return -1, s0, s1, s2, s3, s4, s5, 0.0
     if ten <= tol and g <= tol:
         return 0, s0, s1, s2, s3, s4, s5, 0.0    # (the general path's test: elastic)
     tens = ten > tol
@@ -422,25 +452,58 @@ def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, w
     if r[0] >= 0:
         return r
     # (one call passing the arrays: each such call costs reference counts on every zone)
-    return _slow(p, z, K, G, s0, s1, s2, s3, s4, s5, mb, s, a, sci, st, wf, mw, r[0] == -2)
+    return _slow(p, z, K, G, s0, s1, s2, s3, s4, s5, mb, s, a, sci, st, wf, mw, r[0])
 
 
 @njit(cache=True)
-def _slow(p, z, K, G, s0, s1, s2, s3, s4, s5, mb, s, a, sci, st, wf, mw, edge):
-    """What ``_fast`` leaves: the edge return in scalars (``_edge``) where ``_fast`` found one,
-    else (or when it does not settle) the general path."""
-    if edge:
-        m, l1, l2, l3 = _dev_principal(s0, s1, s2, s3, s4, s5)
-        x0 = max(-(m + l3), 0.0)
-        _q0, n0 = hb_strength(x0, mb, s, a, sci)
-        p1 = m + l1
-        p2 = m + l2
-        p3 = m + l3
+def _slow(p, z, K, G, s0, s1, s2, s3, s4, s5, mb, s, a, sci, st, wf, mw, code):
+    """What ``_fast`` leaves (its code): the edge return (-2) or the shear return with principal
+    values not well apart (-3) in scalars, on ``principal_axes``' values and projectors
+    (cyclic Jacobi for close values, as the general path) and rotated back by
+    ``zone_mohr._rotate_back`` (chunk scratch as the general path's: trial wf[0:6], projectors
+    wf[12:24], values wf[24:27], new values wf[27:30]); else, or when they do not settle, the
+    general path."""
+    if code == -2 or code == -3:
+        t = wf[0:6]
+        t[0] = s0; t[1] = s1; t[2] = s2; t[3] = s3; t[4] = s4; t[5] = s5
+        lam = wf[24:27]
+        pr = wf[12:24]
+        principal_axes(t, lam, pr, mw[6])
+        p1 = lam[0]
+        p2 = lam[1]
+        p3 = lam[2]
         scale = abs(p1) + abs(p2) + abs(p3) + sci
-        r = _edge(s0, s1, s2, s3, s4, s5, p1, p2, p3, _nps(p[z, C_FLAGDIL], p[z, C_TANDIL], n0),
-                  K + 4.0 * G / 3.0, K - 2.0 * G / 3.0, mb, s, a, sci, st, RTOL * scale, FAST_MARGIN * scale, wf, mw)
-        if r[0] >= 0:
-            return r
+        tol = RTOL * scale
+        mar = FAST_MARGIN * scale
+        _q0, n0 = hb_strength(max(-p3, 0.0), mb, s, a, sci)
+        nps = _nps(p[z, C_FLAGDIL], p[z, C_TANDIL], n0)
+        a1 = K + 4.0 * G / 3.0
+        a2 = K - 2.0 * G / 3.0
+        ok = False
+        edge = code == -2
+        n1 = p1; n2 = p2; n3 = p3
+        if code == -3 and p3 - st < -mar:
+            ok, lamf = _plane(p1, p3, nps, a1, a2, mb, s, a, sci, tol, mar)
+            if ok:
+                g2 = a1 - a2
+                dmin = min((p3 - p2) / (g2 * nps), (p2 - p1) / g2)
+                if lamf < (1.0 - EDGE_REL) * dmin:
+                    n1 = p1 - lamf * (a2 * nps - a1)
+                    n2 = p2 - lamf * a2 * (nps - 1.0)
+                    n3 = p3 - lamf * (a1 * nps - a2)
+                    ok = n3 <= st - mar
+                else:
+                    ok = False
+                    edge = lamf > (1.0 + EDGE_REL) * dmin
+        if edge and p3 - st < -mar:
+            ok, n1, n2, n3 = _edge_values(p1, p2, p3, nps, a1, a2, mb, s, a, sci, st, tol, mar)
+        if ok:
+            sn = wf[27:30]
+            sn[0] = n1; sn[1] = n2; sn[2] = n3
+            bits, dsp = _rotate_back(t, lam, pr, sn, SHEAR_NOW)
+            t0 = t[0]; t1 = t[1]; t2 = t[2]; t3 = t[3]; t4 = t[4]; t5 = t[5]
+            wf[0] = math.nan
+            return bits, t0, t1, t2, t3, t4, t5, dsp
     return _general(p, z, K, G, s0, s1, s2, s3, s4, s5, mb, s, a, sci, st, wf, mw)
 
 
