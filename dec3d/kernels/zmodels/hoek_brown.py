@@ -28,14 +28,15 @@ surface and the multiplier grows monotonically to the root (quadratically). The 
 and so the flow direction, is fixed from the trial state (σ3 of the trial, as Itasca takes it).
 
 That iteration on arrays is the general path (``_general``). The common cases take a scalar
-path with the same result (to ~1e-12 of the stress scale, the same bits): principal values well
-apart (``GAP_REL``), and a single-plane shear return leaving σ2 between σ1 and σ3, Itasca's
-tension return, or a shear edge (σ2 = σ3 or σ1 = σ2 at the result). With the principal
+path with the same result (to ~1e-12 of the stress scale, the same bits): a single-plane shear
+return leaving σ2 between σ1 and σ3, Itasca's tension return, a shear edge (σ2 = σ3 or
+σ1 = σ2 at the result; also for principal values not well apart, ``GAP_REL``, on Jacobi's
+axes as the general path), and the apex of the three cut-offs (σ = σt I). With the principal
 directions and the flow direction fixed, the return is one scalar equation in the plastic
 multiplier, solved by Halley's steps (``_fast``, ``_edge``); the last step and the rotation back
 are ``zone_mohr._fast_return``'s (or ``principal_axes`` and ``zone_mohr._rotate_back`` for
-edges). Whatever they do not settle clearly (nearly equal principal values, tension corners,
-the apex, decisions within FAST_MARGIN of a threshold) goes to the general path.
+edges and close values). Whatever they do not settle clearly (tension corners with one or two
+cut-offs, decisions within FAST_MARGIN of a threshold) goes to the general path.
 
 The property keywords, the dilation rule and the trial-state tangent are taken from Itasca's
 published source of the model (``modelhoek.cpp``: ``ModelHoek::getProperties`` lists
@@ -178,7 +179,7 @@ EDGE_REL = 1e-6
 
 @njit(cache=True, inline="always")
 def _edge_values(p1, p2, p3, nps, a1, a2, mb, s, a, sci, st, tol, mar):
-    """The edge return in scalars (``_fast``'s, where the single-plane return would carry σ2
+    """The edge return in scalars (``_slow``'s, where the single-plane return would carry σ2
     past σ3 or σ1): two shear surfaces, σ1-σ3 and σ1-σ2 (σ2 = σ3 at the result) or σ1-σ3 and
     σ2-σ3 (σ1 = σ2), the flow of each Mohr-Coulomb's with the dilation fixed from the trial.
     The trial's principal values p1 <= p2 <= p3. With the multipliers μ of σ1-σ3
@@ -326,6 +327,12 @@ def _fast(p, z, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, 
     yk = -p3                                     # σ3 of the current point (compression positive)
     g = -p1 - (q0 + n0 * (yk - x0))              # g at the trial: the shear yield function
     ten = p3 - st
+    # the apex: the three cut-offs together, every multiplier clearly positive (λ = D⁻¹(p - σt),
+    # λ1 ∝ (p1 - σt) - (α2/K)(m - σt)): σ = σt I, no rotation; not where the shear lines meet
+    # there too (a = 1: the envelope's line at σ3 = 0 passes through σ1 = σ3 = -σt)
+    if (ten > mar and x0 == 0.0 and K > 0.0 and (p1 - st) - (1.0 - 2.0 * G / (3.0 * K)) * (m - st) > mar
+            and q0 - (n0 - 1.0) * st > mar):
+        return TENSION_NOW, st, st, st, 0.0, 0.0, 0.0, m - st
     if not (l3 - l1 > 0.0 and min(l2 - l1, l3 - l2) >= GAP_REL * (l3 - l1)):
         if ten < -mar and g > mar:
             return -3, s0, s1, s2, s3, s4, s5, 0.0    # (a clear shear return: ``_slow``)
