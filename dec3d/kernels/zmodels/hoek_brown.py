@@ -31,12 +31,12 @@ That iteration on arrays is the general path (``_general``). The common cases ta
 path with the same result (to ~1e-12 of the stress scale, the same bits): a single-plane shear
 return leaving σ2 between σ1 and σ3, Itasca's tension return, a shear edge (σ2 = σ3 or
 σ1 = σ2 at the result; also for principal values not well apart, ``GAP_REL``, on Jacobi's
-axes as the general path), and the apex of the three cut-offs (σ = σt I). With the principal
+axes as the general path), two cut-offs, and the apex of the three (σ = σt I). With the principal
 directions and the flow direction fixed, the return is one scalar equation in the plastic
 multiplier, solved by Halley's steps (``_fast``, ``_edge``); the last step and the rotation back
 are ``zone_mohr._fast_return``'s (or ``principal_axes`` and ``zone_mohr._rotate_back`` for
-edges and close values). Whatever they do not settle clearly (tension corners with one or two
-cut-offs, decisions within FAST_MARGIN of a threshold) goes to the general path.
+edges, close values and two cut-offs). Whatever they do not settle clearly (corners of shear
+and tension, decisions within FAST_MARGIN of a threshold) goes to the general path.
 
 The property keywords, the dilation rule and the trial-state tangent are taken from Itasca's
 published source of the model (``modelhoek.cpp``: ``ModelHoek::getProperties`` lists
@@ -293,6 +293,23 @@ def _plane(p1, p3, nps, a1, a2, mb, s, a, sci, tol, mar):
 
 
 @njit(cache=True, inline="always")
+def _two_cutoffs(p1, p2, p3, K, G, q0, n0, st, mar):
+    """The return onto the cut-offs of p2 and p3 together (tension positive p1 <= p2 <= p3, the
+    envelope's line at σ3 = 0 through q0 with slope n0): [α1 α2; α2 α1] (λ2, λ3) = (p2 - σt,
+    p3 - σt), p1 lowered by α2 (λ2 + λ3). (settled, new p1): settled where both multipliers
+    are clearly positive and the result clearly inside the third cut-off and the shear line."""
+    a1 = K + 4.0 * G / 3.0
+    a2 = K - 2.0 * G / 3.0
+    v2 = p2 - st
+    v3 = p3 - st
+    det = (a1 - a2) * (a1 + a2)
+    n1 = p1 - a2 * (v2 + v3) / (a1 + a2)
+    ok = (a1 * v2 - a2 * v3) * a1 > mar * det and (a1 * v3 - a2 * v2) * a1 > mar * det
+    ok = ok and n1 < st - mar and -n1 - (q0 - n0 * st) < -mar
+    return ok, n1
+
+
+@njit(cache=True, inline="always")
 def _fast(p, z, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a, sci, st):
     """The return of the trial s0..s5 in scalars for the common case (``update``'s fast path):
     principal values well apart (``GAP_REL``, as ``zone_mohr._fast_return``), a clear shear
@@ -317,7 +334,7 @@ def _fast(p, z, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, 
     checked as the general path makes it. Returns (code, t0..t5, dsp) as ``_fast_return``:
     code -1 when not settled here (the general path then does it), -2 where the single-plane
     return would carry σ2 past σ1 or σ3, -3 for a clear shear return with principal values
-    not well apart (``_slow`` then does both)."""
+    not well apart, -4 for the return onto two cut-offs (``_slow`` then does them)."""
     p1 = m + l1
     p2 = m + l2
     p3 = m + l3
@@ -333,6 +350,8 @@ def _fast(p, z, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, 
     if (ten > mar and x0 == 0.0 and K > 0.0 and (p1 - st) - (1.0 - 2.0 * G / (3.0 * K)) * (m - st) > mar
             and q0 - (n0 - 1.0) * st > mar):
         return TENSION_NOW, st, st, st, 0.0, 0.0, 0.0, m - st
+    if ten > mar and x0 == 0.0 and q0 - (n0 - 1.0) * st > mar and _two_cutoffs(p1, p2, p3, K, G, q0, n0, st, mar)[0]:
+        return -4, s0, s1, s2, s3, s4, s5, 0.0    # (two cut-offs: ``_slow``)
     if not (l3 - l1 > 0.0 and min(l2 - l1, l3 - l2) >= GAP_REL * (l3 - l1)):
         if ten < -mar and g > mar:
             return -3, s0, s1, s2, s3, s4, s5, 0.0    # (a clear shear return: ``_slow``)
@@ -464,12 +483,28 @@ def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, w
 
 @njit(cache=True)
 def _slow(p, z, K, G, s0, s1, s2, s3, s4, s5, mb, s, a, sci, st, wf, mw, code):
-    """What ``_fast`` leaves (its code): the edge return (-2) or the shear return with principal
-    values not well apart (-3) in scalars, on ``principal_axes``' values and projectors
+    """What ``_fast`` leaves (its code): the edge return (-2), the shear return with principal
+    values not well apart (-3) or the return onto two cut-offs (-4) in scalars, on ``principal_axes``' values and projectors
     (cyclic Jacobi for close values, as the general path) and rotated back by
     ``zone_mohr._rotate_back`` (chunk scratch as the general path's: trial wf[0:6], projectors
     wf[12:24], values wf[24:27], new values wf[27:30]); else, or when they do not settle, the
     general path."""
+    if code == -4:
+        t = wf[0:6]
+        t[0] = s0; t[1] = s1; t[2] = s2; t[3] = s3; t[4] = s4; t[5] = s5
+        lam = wf[24:27]
+        pr = wf[12:24]
+        principal_axes(t, lam, pr, mw[6])
+        scale = abs(lam[0]) + abs(lam[1]) + abs(lam[2]) + sci
+        q0, n0 = hb_strength(0.0, mb, s, a, sci)
+        ok, n1 = _two_cutoffs(lam[0], lam[1], lam[2], K, G, q0, n0, st, FAST_MARGIN * scale)
+        if ok and lam[2] - st > FAST_MARGIN * scale:
+            sn = wf[27:30]
+            sn[0] = n1; sn[1] = st; sn[2] = st
+            bits, dsp = _rotate_back(t, lam, pr, sn, TENSION_NOW)
+            t0 = t[0]; t1 = t[1]; t2 = t[2]; t3 = t[3]; t4 = t[4]; t5 = t[5]
+            wf[0] = math.nan
+            return bits, t0, t1, t2, t3, t4, t5, dsp
     if code == -2 or code == -3:
         t = wf[0:6]
         t[0] = s0; t[1] = s1; t[2] = s2; t[3] = s3; t[4] = s4; t[5] = s5
