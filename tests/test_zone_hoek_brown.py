@@ -309,3 +309,100 @@ def test_host_refuses_out_of_range_properties():
     rows[0, m.props["constant-dilation"].column] = math.tan(math.radians(10))
     rows[0, m.props["flag-dilation"].column] = -1
     assert len(m.problems(rows, [3])[1]) == 1                     # warning: the flag decides
+
+
+def test_scalar_path_equals_general_path_on_random_yielding_states():
+    """``update`` (the scalar path: Halley/Newton in the plastic multiplier, one Mohr-Coulomb
+    return onto the last tangent; the scalar edge return; the general path for the rest) against
+    the general path alone (repeated ``mohr_plastic`` returns): the same stress and dsp to 1e-10
+    of the stress scale and the same bits on random yielding states; and the scalar paths settle
+    most of them (single-plane shear, tension, apex; edges, close principal values and two
+    cut-offs in ``_slow``)."""
+    rng = np.random.default_rng(77)
+    settled = {1: 0, 2: 0, "slow": 0}
+    left = 0
+    worst = 0.0
+    n = 0
+    while n < 3000:
+        s0, de, K, G, mb, s, a, sci, psi, flag = _random_case(rng)
+        if rng.random() < 0.3:                      # also pushes into tension
+            de = de + np.array([1, 1, 1, 0, 0, 0]) * 10 ** rng.uniform(-5, -3)
+        p = _rows(mb, s, a, sci, psi, flag)
+        args = (p, _H, 0, K, G, *[float(x) for x in de], *[float(x) for x in s0], _TAB)
+        rg = hbk.update_general(*args, np.full(NWORK, np.nan), _MW)
+        if rg[0] == 0:
+            continue
+        n += 1
+        rf = hbk.fast_update(*args, np.full(NWORK, np.nan), _MW)
+        ru = hbk.update(*args, np.full(NWORK, np.nan), _MW)
+        if rf[0] >= 0:
+            assert ru == rf                            # update takes the scalar path's result
+            settled[rf[0]] += 1
+        elif rf[0] in (-2, -3, -4):
+            settled["slow"] += 1                       # (edge, close principal values, two cut-offs)
+        else:
+            left += 1
+            assert ru == rg                            # (update is the general path there)
+        scale = max(abs(x) for x in rg[1:7]) + sci
+        err = max(abs(x - y) for x, y in zip(ru[1:8], rg[1:8])) / scale
+        worst = max(worst, err)
+        assert ru[0] == rg[0], (ru, rg)
+        assert err <= 1e-10, (err, s0, de, K, G, mb, s, a, sci, psi, flag)
+    assert settled[1] >= 1200 and settled[2] >= 200 and settled["slow"] >= 3, (settled, left)
+    print("scalar vs general path: worst", worst, "settled", settled, "left to the general path", left)
+
+
+def test_scalar_path_on_bench_like_states_and_flow_rules():
+    """The same comparison near the surface (small increments from returned states), for each
+    dilation rule and exponents a = 0.5 and 0.6: the scalar path settles almost every state."""
+    rng = np.random.default_rng(3)
+    K, G = 6.7e9, 4e9
+    for a, psi, flag in ((0.5, 0.0, 0.0), (0.6, 0.0, 0.0), (0.55, 10.0, 0.0), (0.55, 0.0, -1.0), (0.6, 0.0, 0.5)):
+        p = _rows(1.0, 0.001, a, 1e5, psi, flag)
+        settled = 0
+        total = 0
+        for _ in range(300):
+            R = _rand_rotation(rng)
+            sv = _vec6(R @ np.diag(-np.sort(rng.uniform(5e3, 9e4, 3))) @ R.T)
+            for _k in range(4):
+                de = rng.normal(size=6) * 2e-7
+                args = (p, _H, 0, K, G, *[float(x) for x in de], *[float(x) for x in sv], _TAB)
+                rg = hbk.update_general(*args, np.full(NWORK, np.nan), _MW)
+                rf = hbk.fast_update(*args, np.full(NWORK, np.nan), _MW)
+                ru = hbk.update(*args, np.full(NWORK, np.nan), _MW)
+                if rg[0]:
+                    total += 1
+                    settled += rf[0] >= 0 or rf[0] in (-2, -3, -4)
+                assert ru[0] == rg[0]
+                scale = max(abs(x) for x in rg[1:7]) + 1e5
+                assert max(abs(x - y) for x, y in zip(ru[1:8], rg[1:8])) <= 1e-10 * scale
+                sv = np.array(rg[1:7])
+        print("bench-like", a, psi, flag, "settled", settled, "of", total)
+        assert total >= 300 and settled >= 0.9 * total, (a, psi, flag, settled, total)
+
+
+def test_close_principal_values_equal_general_path():
+    """Trials with two principal values equal or within 1 % of the spread (triaxial compression
+    and extension, where the scalar path works on Jacobi's values and ends on an edge or a
+    single plane): ``update`` against the general path, the same stress to 1e-10 of the scale
+    and the same bits."""
+    rng = np.random.default_rng(11)
+    K, G = 6.7e9, 4e9
+    n = 0
+    for a, psi, flag in ((0.5, 0.0, 0.0), (0.6, 5.0, 0.0), (0.55, 0.0, -1.0)):
+        p = _rows(1.0, 0.001, a, 1e5, psi, flag)
+        for _ in range(200):
+            R = _rand_rotation(rng)
+            lo, hi = -rng.uniform(6e4, 9e4), -rng.uniform(5e3, 3e4)
+            close = rng.uniform(0, 0.01) * (hi - lo) * rng.choice([0.0, 1.0])
+            prin = [lo, hi - close, hi] if rng.random() < 0.5 else [lo, lo + close, hi]
+            sv = _vec6(R @ np.diag(prin) @ R.T)
+            de = rng.normal(size=6) * 1e-8
+            args = (p, _H, 0, K, G, *[float(x) for x in de], *[float(x) for x in sv], _TAB)
+            rg = hbk.update_general(*args, np.full(NWORK, np.nan), _MW)
+            ru = hbk.update(*args, np.full(NWORK, np.nan), _MW)
+            assert ru[0] == rg[0], (ru, rg)
+            scale = max(abs(x) for x in rg[1:7]) + 1e5
+            assert max(abs(x - y) for x, y in zip(ru[1:8], rg[1:8])) <= 1e-10 * scale, (prin, a, psi, flag)
+            n += rg[0] != 0
+    assert n >= 500

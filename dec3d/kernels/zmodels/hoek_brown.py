@@ -27,6 +27,17 @@ The envelope is concave, so every tangent lies outside it: each iterate stays ou
 surface and the multiplier grows monotonically to the root (quadratically). The dilation,
 and so the flow direction, is fixed from the trial state (σ3 of the trial, as Itasca takes it).
 
+That iteration on arrays is the general path (``_general``). The common cases take a scalar
+path with the same result (to ~1e-12 of the stress scale, the same bits): a single-plane shear
+return leaving σ2 between σ1 and σ3, Itasca's tension return, a shear edge (σ2 = σ3 or
+σ1 = σ2 at the result; also for principal values not well apart, ``GAP_REL``, on Jacobi's
+axes as the general path), two cut-offs, and the apex of the three (σ = σt I). With the principal
+directions and the flow direction fixed, the return is one scalar equation in the plastic
+multiplier, solved by Halley's steps (``_fast``, ``_edge``); the last step and the rotation back
+are ``zone_mohr._fast_return``'s (or ``principal_axes`` and ``zone_mohr._rotate_back`` for
+edges, close values and two cut-offs). Whatever they do not settle clearly (corners of shear
+and tension, decisions within FAST_MARGIN of a threshold) goes to the general path.
+
 The property keywords, the dilation rule and the trial-state tangent are taken from Itasca's
 published source of the model (``modelhoek.cpp``: ``ModelHoek::getProperties`` lists
 constant-mb, constant-s, constant-a, constant-sci, flag-dilation, constant-dilation …;
@@ -54,8 +65,8 @@ import math
 
 from numba import njit
 
-from ..principal import _dev_principal, principal_axes
-from ..zone_mohr import SHEAR_NOW, mohr_plastic
+from ..principal import GAP_REL, _dev_principal, principal_axes
+from ..zone_mohr import SHEAR_NOW, TENSION_NOW, _fast_return, _rotate_back, mohr_plastic
 from ._common import P_OWN, hooke
 
 NAME = "hoek-brown"
@@ -81,24 +92,36 @@ RTOL = 1e-12
 
 
 @njit(cache=True, inline="always")
+def _envelope(x, mb, s, a, sci):
+    """(σ1 at yield, its slope N = dσ1/dσ3, the curvature dN/dσ3) at σ3 = x (compression
+    positive) on the envelope: the Hoek-Brown curve for x >= 0, its tangent at 0 for x < 0
+    (curvature 0). N is capped at NPHI_MAX; where the cap acts on the curve the line is no
+    tangent and the curvature is NaN. One power per call: base^a = base × base^(a-1)."""
+    if x < 0.0:
+        if s > 0.0:
+            t = s ** (a - 1.0)
+            n0 = 1.0 + a * mb * t
+            if n0 > NPHI_MAX:
+                return sci * s ** a + NPHI_MAX * x, NPHI_MAX, 0.0
+            return sci * s * t + n0 * x, n0, 0.0
+        return NPHI_MAX * x, NPHI_MAX, 0.0
+    base = mb * x / sci + s
+    if base > 0.0:
+        t = base ** (a - 1.0)
+        n = 1.0 + a * mb * t
+        if n > NPHI_MAX:            # (also where base^(a-1) overflows)
+            return x + sci * base ** a, NPHI_MAX, math.nan
+        # dN/dσ3 = a (a - 1) mb² base^(a-2) / σci = (a - 1) mb (N - 1) / (σci base)
+        return x + sci * base * t, n, (a - 1.0) * mb * (n - 1.0) / (sci * base)
+    return x, NPHI_MAX, math.nan
+
+
+@njit(cache=True, inline="always")
 def hb_strength(x, mb, s, a, sci):
     """(σ1 at yield, its slope N = dσ1/dσ3) at σ3 = x (compression positive) on the envelope:
     the Hoek-Brown curve for x >= 0, its tangent at 0 for x < 0. N is capped at NPHI_MAX."""
-    if x < 0.0:
-        if s > 0.0:
-            n0 = 1.0 + a * mb * s ** (a - 1.0)
-            if n0 > NPHI_MAX:
-                n0 = NPHI_MAX
-        else:
-            n0 = NPHI_MAX
-        return sci * s ** a + n0 * x, n0
-    base = mb * x / sci + s
-    if base > 0.0:
-        n = 1.0 + a * mb * base ** (a - 1.0)
-        if n > NPHI_MAX:
-            n = NPHI_MAX
-        return x + sci * base ** a, n
-    return x, NPHI_MAX
+    q, n, _c = _envelope(x, mb, s, a, sci)
+    return q, n
 
 
 @njit(cache=True, inline="always")
@@ -120,6 +143,319 @@ def _dot(p, o, u0, u1, u2, u3, u4, u5):
     return p[o] * u0 + p[o + 1] * u1 + p[o + 2] * u2 + 2.0 * (p[o + 3] * u3 + p[o + 4] * u4 + p[o + 5] * u5)
 
 
+@njit(cache=True, inline="always")
+def _nps(flag, tandil, n0):
+    """N_ψ = (1 + sin ψ)/(1 - sin ψ) of the flow rule: ψ from the dilation rule (column C_FLAGDIL,
+    C_TANDIL = tan ψ), capped at φc, the friction angle of the tangent at the trial σ3, whose
+    N_φc is n0 (so N_ψ = n0 where ψ = φc); the same ψ as the general path's, without its
+    arctangent and tangent in the common cases (flag 0, flag < 0)."""
+    if flag < 0.0:
+        return n0
+    if flag == 0.0 and tandil == 0.0:
+        return 1.0
+    tphi0 = 0.5 * (n0 - 1.0) / math.sqrt(n0)
+    if flag > 0.0:
+        phic = math.atan(tphi0)
+        psi = flag * phic
+        if psi >= phic:
+            return n0
+        sp = math.sin(psi)
+    else:
+        if tandil >= tphi0:
+            return n0
+        sp = tandil / math.sqrt(1.0 + tandil * tandil)
+    return (1.0 + sp) / (1.0 - sp)
+
+
+#: the scalar return takes a state only when its decisions are this far (relative to the stress
+#: scale) from the general path's thresholds; nearer states go to the general path
+FAST_MARGIN = 1e-8
+
+
+#: the single-plane return and the edge return are told apart when the multiplier of the first is
+#: this far (relative) from where σ2 meets σ1 or σ3; nearer states go to the general path
+EDGE_REL = 1e-6
+
+
+@njit(cache=True, inline="always")
+def _edge_values(p1, p2, p3, nps, a1, a2, mb, s, a, sci, st, tol, mar):
+    """The edge return in scalars (``_slow``'s, where the single-plane return would carry σ2
+    past σ3 or σ1): two shear surfaces, σ1-σ3 and σ1-σ2 (σ2 = σ3 at the result) or σ1-σ3 and
+    σ2-σ3 (σ1 = σ2), the flow of each Mohr-Coulomb's with the dilation fixed from the trial.
+    The trial's principal values p1 <= p2 <= p3. With the multipliers μ of σ1-σ3
+    and μ - d of the other (d: where the single-plane return meets the edge), the condition
+    that the two equal principal values stay equal is linear and leaves σ1(μ) = c1 + k1 μ,
+    σ3(μ) = c3 + k3 μ; the return solves σ1(μ) = q(σ3(μ)) from μ = d by the steps of ``_fast``
+    (g again convex and decreasing). This is the general path's two-plane return (the Itasca
+    plane with the plane of the pair that became equal), iterated onto the same tangents.
+    Returns (settled, n1, n2, n3): the new principal values."""
+    dm1 = a2 * nps - a1                  # D m of σ1-σ3 (tension positive): (dm1, b, dm3)
+    dm3 = a1 * nps - a2
+    b = a2 * (nps - 1.0)
+    g2 = a1 - a2                         # 2G
+    d3 = (p3 - p2) / (g2 * nps)
+    d1 = (p2 - p1) / g2
+    e3 = d3 <= d1
+    if e3:                               # σ2 = σ3: the second plane σ1-σ2, D m = (dm1, dm3, b)
+        d = d3
+        c1 = -p1 - d3 * dm1
+        k1 = 2.0 * dm1
+        c3 = -p3 - d3 * b
+        k3 = dm3 + b
+    else:                                # σ1 = σ2: the second plane σ2-σ3, D m = (b, dm1, dm3)
+        d = d1
+        c1 = -p1 - d1 * b
+        k1 = dm1 + b
+        c3 = -p3 - d1 * dm3
+        k3 = 2.0 * dm3
+    mu = d
+    y3 = c3 + k3 * mu
+    q, n, c = _envelope(y3, mb, s, a, sci)
+    g = c1 + k1 * mu - q
+    if not g > mar:
+        return False, p1, p2, p3
+    done = False
+    dn = 0.0
+    for _it in range(MAXIT):
+        if not c > -1e300:
+            break
+        den = n * k3 - k1
+        if not den > 0.0:
+            break
+        dn = g / den
+        y3n = y3 + dn * k3
+        if 0.5 * (-c) * (k3 * k3) * (dn * dn) <= 0.01 * tol and not (y3 < 0.0 and y3n > 0.0):
+            done = True
+            break
+        step = dn
+        dd = 2.0 * den * den + g * c * (k3 * k3)
+        if dd > den * den:
+            step = 2.0 * g * den / dd
+        mu += step
+        y3 = c3 + k3 * mu
+        q, n, c = _envelope(y3, mb, s, a, sci)
+        g = c1 + k1 * mu - q
+    if not done:
+        return False, p1, p2, p3
+    mu += dn                             # the last Newton step
+    if not mu - d > EDGE_REL * mu:
+        return False, p1, p2, p3
+    if e3:
+        n1 = p1 - (2.0 * mu - d3) * dm1
+        n3 = p3 - mu * dm3 - (mu - d3) * b
+        n2 = n3
+    else:
+        n1 = p1 - mu * dm1 - (mu - d1) * b
+        n2 = n1
+        n3 = p3 - (2.0 * mu - d1) * dm3
+    if not (n3 <= st - mar and n3 - n1 > mar):
+        return False, p1, p2, p3
+    return True, n1, n2, n3
+
+
+@njit(cache=True, inline="always")
+def _plane(p1, p3, nps, a1, a2, mb, s, a, sci, tol, mar):
+    """The single-plane shear return of ``_fast`` (its steps, no tension violated at the trial)
+    for principal values p1 <= p3 that need not be well apart: (settled, λ) with λ the
+    multiplier of the last Newton step."""
+    dm1 = a2 * nps - a1
+    dm3 = a1 * nps - a2
+    lam = 0.0
+    yk = -p3
+    qk, nk, ck = _envelope(yk, mb, s, a, sci)
+    g = -p1 - qk
+    if not g > mar:
+        return False, 0.0
+    for _it in range(MAXIT):
+        if not ck > -1e300:
+            break
+        csn = qk - nk * yk
+        if csn < 0.0:
+            csn = 0.0
+        den = a1 * (1.0 + nk * nps) - a2 * (nk + nps)
+        if nk * p3 - p1 - csn <= mar:
+            break
+        dn = g / den
+        y3 = yk + dn * dm3
+        if 0.5 * (-ck) * (dm3 * dm3) * (dn * dn) <= 0.01 * tol and not (yk < 0.0 and y3 > 0.0):
+            return True, lam + dn
+        step = dn
+        dd = 2.0 * den * den + g * ck * (dm3 * dm3)
+        if dd > den * den:
+            step = 2.0 * g * den / dd
+        lam += step
+        yk = -p3 + lam * dm3
+        qk, nk, ck = _envelope(yk, mb, s, a, sci)
+        g = (-p1 + lam * dm1) - qk
+    return False, 0.0
+
+
+
+
+@njit(cache=True, inline="always")
+def _two_cutoffs(p1, p2, p3, K, G, q0, n0, st, mar):
+    """The return onto the cut-offs of p2 and p3 together (tension positive p1 <= p2 <= p3, the
+    envelope's line at σ3 = 0 through q0 with slope n0): [α1 α2; α2 α1] (λ2, λ3) = (p2 - σt,
+    p3 - σt), p1 lowered by α2 (λ2 + λ3). (settled, new p1): settled where both multipliers
+    are clearly positive and the result clearly inside the third cut-off and the shear line."""
+    a1 = K + 4.0 * G / 3.0
+    a2 = K - 2.0 * G / 3.0
+    v2 = p2 - st
+    v3 = p3 - st
+    det = (a1 - a2) * (a1 + a2)
+    n1 = p1 - a2 * (v2 + v3) / (a1 + a2)
+    ok = (a1 * v2 - a2 * v3) * a1 > mar * det and (a1 * v3 - a2 * v2) * a1 > mar * det
+    ok = ok and n1 < st - mar and -n1 - (q0 - n0 * st) < -mar
+    return ok, n1
+
+
+@njit(cache=True, inline="always")
+def _fast(p, z, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a, sci, st):
+    """The return of the trial s0..s5 in scalars for the common case (``update``'s fast path):
+    principal values well apart (``GAP_REL``, as ``zone_mohr._fast_return``), a clear shear
+    return onto the σ1-σ3 surface leaving σ2 between them, or Itasca's tension return. Given
+    the trial's deviatoric principal values l1 <= l2 <= l3 about the mean m
+    (``_dev_principal``) and the envelope's tangent at x0 = max(σ3, 0) of the trial
+    (σ1 = q0 + n0 (σ3 - x0)).
+
+    With the principal directions kept and the flow direction fixed from the trial (ψ, so
+    N_ψ), the principal stresses of the return are p(λ) = p_trial - λ D m, m = (-1, 0, N_ψ):
+    σ1(λ) = -p1 + λ (α2 N_ψ - α1), σ3(λ) = -p3 + λ (α1 N_ψ - α2), and the shear return solves
+    g(λ) = σ1(λ) - q(σ3(λ)) = 0. g is convex (q is concave, σ1 and σ3 linear in λ) and
+    decreasing (g' = -den < 0). The general path's iteration is Newton's method on g (its
+    Mohr-Coulomb return of the trial onto the tangent at σ3(λ_k) is the Newton step from
+    λ_k). Here: Halley's steps (g'' = -dN/dσ3 (dσ3/dλ)², from the same power), until the
+    Newton step from the current point is known to land on the surface: its error
+    g''/2 × step² (exact where the envelope is straight) at most RTOL/100 of the stress scale.
+    That last Newton step, with the rotation back, is ``zone_mohr._fast_return`` on the
+    tangent at the current point (its constants computed here from the tangent's N), so that
+    the admissibility checks are the general path's own. A trial beyond the tension cut-off
+    takes Newton's steps instead, each tangent's choice between shear and tension (Itasca's h)
+    checked as the general path makes it. Returns (code, t0..t5, dsp) as ``_fast_return``:
+    code -1 when not settled here (the general path then does it), -2 where the single-plane
+    return would carry σ2 past σ1 or σ3, -3 for a clear shear return with principal values
+    not well apart, -4 for the return onto two cut-offs (``_slow`` then does them)."""
+    p1 = m + l1
+    p2 = m + l2
+    p3 = m + l3
+    scale = abs(p1) + abs(p2) + abs(p3) + sci
+    tol = RTOL * scale
+    mar = FAST_MARGIN * scale
+    yk = -p3                                     # σ3 of the current point (compression positive)
+    g = -p1 - (q0 + n0 * (yk - x0))              # g at the trial: the shear yield function
+    ten = p3 - st
+    # the apex: the three cut-offs together, every multiplier clearly positive (λ = D⁻¹(p - σt),
+    # λ1 ∝ (p1 - σt) - (α2/K)(m - σt)): σ = σt I, no rotation; not where the shear lines meet
+    # there too (a = 1: the envelope's line at σ3 = 0 passes through σ1 = σ3 = -σt)
+    if (ten > mar and x0 == 0.0 and K > 0.0 and (p1 - st) - (1.0 - 2.0 * G / (3.0 * K)) * (m - st) > mar
+            and q0 - (n0 - 1.0) * st > mar):
+        return TENSION_NOW, st, st, st, 0.0, 0.0, 0.0, m - st
+    if ten > mar and x0 == 0.0 and q0 - (n0 - 1.0) * st > mar and _two_cutoffs(p1, p2, p3, K, G, q0, n0, st, mar)[0]:
+        return -4, s0, s1, s2, s3, s4, s5, 0.0    # (two cut-offs: ``_slow``)
+    if not (l3 - l1 > 0.0 and min(l2 - l1, l3 - l2) >= GAP_REL * (l3 - l1)):
+        if ten < -mar and g > mar:
+            return -3, s0, s1, s2, s3, s4, s5, 0.0    # (a clear shear return: ``_slow``)
+        return -1, s0, s1, s2, s3, s4, s5, 0.0
+    if ten <= tol and g <= tol:
+        return 0, s0, s1, s2, s3, s4, s5, 0.0    # (the general path's test: elastic)
+    tens = ten > tol
+    if (tens and ten <= mar) or abs(g) <= mar:
+        return -1, s0, s1, s2, s3, s4, s5, 0.0
+    # the curvature dN/dσ3 at the trial (``_envelope``'s, from N)
+    if yk < 0.0:
+        ck = 0.0
+    elif n0 < NPHI_MAX:
+        ck = (a - 1.0) * mb * (n0 - 1.0) / (sci * (mb * x0 / sci + s))
+    else:
+        ck = math.nan
+    nps = _nps(p[z, C_FLAGDIL], p[z, C_TANDIL], n0)
+    a1 = K + 4.0 * G / 3.0
+    a2 = K - 2.0 * G / 3.0
+    dm1 = a2 * nps - a1                          # dσ1/dλ
+    dm3 = a1 * nps - a2                          # dσ3/dλ (> 0)
+    xk = x0                                      # the tangent at the current point:
+    qk = q0                                      # σ1 = qk + nk (σ3 - xk)
+    nk = n0
+    lam = 0.0
+    ap = 0.0
+    sp = 0.0
+    code = SHEAR_NOW
+    done = False
+    for it in range(MAXIT):
+        if not ck > -1e300:
+            break                                # (N capped on the curve: no tangent)
+        csn = qk - nk * xk                       # the tangent: σ1 = csn + nk σ3
+        if csn < 0.0:
+            csn = 0.0
+        den = a1 * (1.0 + nk * nps) - a2 * (nk + nps)
+        if tens:
+            # Itasca's choice between shear and tension returns (``zone_mohr``'s h), tangent k
+            ap = math.sqrt(1.0 + nk * nk) + nk
+            sp = st * nk - csn
+            hk = ten + ap * (p1 - sp)
+            hm = FAST_MARGIN * (1.0 + ap) * scale
+            if it == 0 and (g < -mar or hk > hm):
+                code = TENSION_NOW               # Itasca's tension return
+                done = True
+                break
+            if hk >= -hm:
+                break
+        if nk * p3 - p1 - csn <= mar:
+            break                                # (the tangent's return would be elastic)
+        dn = g / den                             # Newton's step
+        y3 = yk + dn * dm3
+        if tens and it == 0 and -y3 > st - mar:
+            break                                # (the general path may take the tension corner)
+        if 0.5 * (-ck) * (dm3 * dm3) * (dn * dn) <= 0.01 * tol and not (yk < 0.0 and y3 > 0.0):
+            done = True                          # Newton's step from here is on the surface
+            break
+        step = dn
+        if not tens:
+            dd = 2.0 * den * den + g * ck * (dm3 * dm3)
+            if dd > den * den:
+                step = 2.0 * g * den / dd        # Halley's step
+        lam += step
+        yk = -p3 + lam * dm3
+        qk, nk, ck = _envelope(yk, mb, s, a, sci)
+        xk = yk
+        g = (-p1 + lam * dm1) - qk
+    if not done:
+        return -1, s0, s1, s2, s3, s4, s5, 0.0
+    if not tens:
+        ap = 0.0                                 # (h is not looked at: no tension violated)
+        sp = 0.0
+        if code == SHEAR_NOW:
+            # σ2 stays between σ1 and σ3 up to the multiplier dmin; beyond it, the edge return
+            lamf = lam + g / den
+            g2 = a1 - a2
+            dmin = min((p3 - p2) / (g2 * nps), (p2 - p1) / g2)
+            if lamf > (1.0 + EDGE_REL) * dmin:
+                return -2, s0, s1, s2, s3, s4, s5, 0.0        # (the edge return: ``_slow``)
+            if lamf > (1.0 - EDGE_REL) * dmin:
+                return -1, s0, s1, s2, s3, s4, s5, 0.0
+    coh = 0.5 * csn / math.sqrt(nk)
+    r = _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, coh, nk, csn, st, nps, a1, a2, sp, ap, den)
+    if r[0] != code:
+        return -1, s0, s1, s2, s3, s4, s5, 0.0
+    return r
+
+
+@njit(cache=True)
+def fast_update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
+    """``update``'s scalar path alone (for the tests): (code, t0..t5, dsp) of ``_fast``; code
+    -1 where ``update`` takes the general path, -2 where it takes ``_edge`` (and the general
+    path if that does not settle)."""
+    s0, s1, s2, s3, s4, s5 = hooke(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5)
+    mb = p[z, C_MB]
+    s = p[z, C_S]
+    a = p[z, C_A]
+    sci = p[z, C_SCI]
+    m, l1, l2, l3 = _dev_principal(s0, s1, s2, s3, s4, s5)
+    x0 = max(-(m + l3), 0.0)
+    q0, n0 = hb_strength(x0, mb, s, a, sci)
+    return _fast(p, z, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a, sci, s * sci / mb)
+
+
 @njit(cache=True)
 def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
     s0, s1, s2, s3, s4, s5 = hooke(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5)
@@ -131,13 +467,104 @@ def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, w
         return 0, s0, s1, s2, s3, s4, s5, 0.0          # (refused by the host; never cycled)
     st = s * sci / mb
     # clearly elastic from the closed-form principal values (no arrays), with a margin far above
-    # their round-off; what this cannot tell goes to the exact test below
-    m, l1, _l2, l3 = _dev_principal(s0, s1, s2, s3, s4, s5)
+    # their round-off; what this cannot tell goes to the exact test of the return
+    m, l1, l2, l3 = _dev_principal(s0, s1, s2, s3, s4, s5)
     margin = 1e-7 * (3.0 * abs(m) + abs(l1) + abs(l3) + sci)
-    if m + l3 - st < -margin:
-        q, _n = hb_strength(-(m + l3), mb, s, a, sci)
-        if -(m + l1) - q < -margin:
-            return 0, s0, s1, s2, s3, s4, s5, 0.0
+    x0 = max(-(m + l3), 0.0)                      # σ3 of the trial, compression positive, >= 0
+    q0, n0 = hb_strength(x0, mb, s, a, sci)       # the envelope's tangent there
+    if m + l3 - st < -margin and -(m + l1) - (q0 + n0 * (-(m + l3) - x0)) < -margin:
+        return 0, s0, s1, s2, s3, s4, s5, 0.0
+    r = _fast(p, z, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a, sci, st)
+    if r[0] >= 0:
+        return r
+    # (one call passing the arrays: each such call costs reference counts on every zone)
+    return _slow(p, z, K, G, s0, s1, s2, s3, s4, s5, mb, s, a, sci, st, wf, mw, r[0])
+
+
+@njit(cache=True)
+def _slow(p, z, K, G, s0, s1, s2, s3, s4, s5, mb, s, a, sci, st, wf, mw, code):
+    """What ``_fast`` leaves (its code): the edge return (-2), the shear return with principal
+    values not well apart (-3) or the return onto two cut-offs (-4) in scalars, on ``principal_axes``' values and projectors
+    (cyclic Jacobi for close values, as the general path) and rotated back by
+    ``zone_mohr._rotate_back`` (chunk scratch as the general path's: trial wf[0:6], projectors
+    wf[12:24], values wf[24:27], new values wf[27:30]); else, or when they do not settle, the
+    general path."""
+    if code == -4:
+        t = wf[0:6]
+        t[0] = s0; t[1] = s1; t[2] = s2; t[3] = s3; t[4] = s4; t[5] = s5
+        lam = wf[24:27]
+        pr = wf[12:24]
+        principal_axes(t, lam, pr, mw[6])
+        scale = abs(lam[0]) + abs(lam[1]) + abs(lam[2]) + sci
+        q0, n0 = hb_strength(0.0, mb, s, a, sci)
+        ok, n1 = _two_cutoffs(lam[0], lam[1], lam[2], K, G, q0, n0, st, FAST_MARGIN * scale)
+        if ok and lam[2] - st > FAST_MARGIN * scale:
+            sn = wf[27:30]
+            sn[0] = n1; sn[1] = st; sn[2] = st
+            bits, dsp = _rotate_back(t, lam, pr, sn, TENSION_NOW)
+            t0 = t[0]; t1 = t[1]; t2 = t[2]; t3 = t[3]; t4 = t[4]; t5 = t[5]
+            wf[0] = math.nan
+            return bits, t0, t1, t2, t3, t4, t5, dsp
+    if code == -2 or code == -3:
+        t = wf[0:6]
+        t[0] = s0; t[1] = s1; t[2] = s2; t[3] = s3; t[4] = s4; t[5] = s5
+        lam = wf[24:27]
+        pr = wf[12:24]
+        principal_axes(t, lam, pr, mw[6])
+        p1 = lam[0]
+        p2 = lam[1]
+        p3 = lam[2]
+        scale = abs(p1) + abs(p2) + abs(p3) + sci
+        tol = RTOL * scale
+        mar = FAST_MARGIN * scale
+        _q0, n0 = hb_strength(max(-p3, 0.0), mb, s, a, sci)
+        nps = _nps(p[z, C_FLAGDIL], p[z, C_TANDIL], n0)
+        a1 = K + 4.0 * G / 3.0
+        a2 = K - 2.0 * G / 3.0
+        ok = False
+        edge = code == -2
+        n1 = p1; n2 = p2; n3 = p3
+        if code == -3 and p3 - st < -mar:
+            ok, lamf = _plane(p1, p3, nps, a1, a2, mb, s, a, sci, tol, mar)
+            if ok:
+                g2 = a1 - a2
+                dmin = min((p3 - p2) / (g2 * nps), (p2 - p1) / g2)
+                if lamf < (1.0 - EDGE_REL) * dmin:
+                    n1 = p1 - lamf * (a2 * nps - a1)
+                    n2 = p2 - lamf * a2 * (nps - 1.0)
+                    n3 = p3 - lamf * (a1 * nps - a2)
+                    ok = n3 <= st - mar
+                else:
+                    ok = False
+                    edge = lamf > (1.0 + EDGE_REL) * dmin
+        if edge and p3 - st < -mar:
+            ok, n1, n2, n3 = _edge_values(p1, p2, p3, nps, a1, a2, mb, s, a, sci, st, tol, mar)
+        if ok:
+            sn = wf[27:30]
+            sn[0] = n1; sn[1] = n2; sn[2] = n3
+            bits, dsp = _rotate_back(t, lam, pr, sn, SHEAR_NOW)
+            t0 = t[0]; t1 = t[1]; t2 = t[2]; t3 = t[3]; t4 = t[4]; t5 = t[5]
+            wf[0] = math.nan
+            return bits, t0, t1, t2, t3, t4, t5, dsp
+    return _general(p, z, K, G, s0, s1, s2, s3, s4, s5, mb, s, a, sci, st, wf, mw)
+
+
+@njit(cache=True)
+def update_general(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
+    """``update`` by the general path alone (for the tests)."""
+    s0, s1, s2, s3, s4, s5 = hooke(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5)
+    mb = p[z, C_MB]
+    s = p[z, C_S]
+    a = p[z, C_A]
+    sci = p[z, C_SCI]
+    return _general(p, z, K, G, s0, s1, s2, s3, s4, s5, mb, s, a, sci, s * sci / mb, wf, mw)
+
+
+@njit(cache=True)
+def _general(p, z, K, G, s0, s1, s2, s3, s4, s5, mb, s, a, sci, st, wf, mw):
+    """The return of the trial s0..s5 on arrays (every case): the yield test on
+    ``principal_axes``' values, then Newton's method as repeated ``zone_mohr.mohr_plastic``
+    returns onto the tangent at the σ3 of the previous result (the module text)."""
     # the chunk scratch: trial t = wf[0:6], working copy wf[6:12], projectors wf[12:24],
     # principal values wf[24:27]; wf[0] is left NaN so that no cache of another model matches
     t = wf[0:6]
