@@ -27,7 +27,9 @@ def test_every_verification_problem_is_there():
                                          "D8_jointed_deformable", "D9_wedge_deformable",
                                          "E1_eigenmodes", "DY1_rayleigh_block_on_spring", "DY2_newmark_sliding_block",
                                          "DY3_shear_wave_quiet_base", "DY5_energy", "FE1_cantilever",
-                                         "FE2_fe_deformable_contacts", "F2_griffiths_lane_slope", "F3_vertical_cut"}
+                                         "FE2_fe_deformable_contacts", "F2_griffiths_lane_slope", "F3_vertical_cut",
+                                         "D10_hoek_brown_triaxial", "D11_strain_softening", "D12_ubiquitous_joint",
+                                         "D13_drucker_prager_triaxial", "D14_anisotropic_elastic"}
 
 
 def _demo(tmp_path, expects: str):
