@@ -32,7 +32,7 @@ from dec3d.kernels.zmodels import NZPROP, P_OWN
 from dec3d.kernels.zmodels._common import (P_BULK, P_COHESION, P_DENSITY, P_SHEAR, P_SRF, P_TANDIL, P_TANFRIC,
                                            P_TENSION)
 
-__all__ = ["ALL_PROPS", "MODEL_BY_CODE", "Prop", "ZONE_MODELS", "ZoneModel", "angle", "table", "zmodel",
+__all__ = ["MOHR_COLUMNS", "MOHR_NAMES", "coulomb_reduce", "coulomb_rules", "ALL_PROPS", "MODEL_BY_CODE", "Prop", "ZONE_MODELS", "ZoneModel", "angle", "table", "zmodel",
            "ELASTIC", "MOHR_STRENGTH", "P_BULK", "P_SHEAR", "P_DENSITY", "P_COHESION", "P_TANFRIC", "P_TENSION",
            "P_TANDIL", "P_SRF", "P_OWN", "NZPROP", "which_zones"]
 
@@ -66,6 +66,45 @@ MOHR_STRENGTH = [Prop("cohesion", P_COHESION, "cohesion c", "Pa"),
                  angle("friction", P_TANFRIC, "friction angle φ"),
                  Prop("tension", P_TENSION, "tensile strength σt (capped at c/tan φ)", "Pa"),
                  angle("dilation", P_TANDIL, "dilation angle ψ ≤ φ")]
+
+
+#: the columns of the shared Mohr-Coulomb strength (c, tan φ, σt, tan ψ) and their keywords
+MOHR_COLUMNS = (P_COHESION, P_TANFRIC, P_TENSION, P_TANDIL)
+MOHR_NAMES = ("cohesion", "friction", "tension", "dilation")
+
+
+def coulomb_rules(p, ids, cols=MOHR_COLUMNS, names=MOHR_NAMES, dilation_rows=None, tension_rows=None):
+    """(problems, warnings) of one Coulomb strength in columns ``cols`` (c, tan φ, σt, tan ψ, named
+    ``names``) of rows ``p`` (Itasca's Mohr-Coulomb rules): a dilation above the friction is refused;
+    a tension above the apex c/tan φ is used as the apex value, with a warning. ``dilation_rows`` /
+    ``tension_rows``: the rows each rule applies to (default all; strain-softening leaves out the
+    rows whose values come from tables)."""
+    c, tf, t, td = (p[:, k] for k in cols)
+    problems, warnings = [], []
+    bad = td > tf * (1.0 + 1e-12)
+    if dilation_rows is not None:
+        bad &= dilation_rows
+    if bad.any():
+        problems.append(f"{names[3]} must not exceed {names[1]}: {which_zones(ids, bad)}")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        apex = np.where(tf > 0.0, c / np.where(tf > 0.0, tf, 1.0), np.inf)
+    over = t > apex
+    if tension_rows is not None:
+        over &= tension_rows
+    if over.any():
+        warnings.append(f"{names[2]} above {names[0]}/tan({names[1]}) in {which_zones(ids, over)}: the apex value "
+                        f"{names[0]}/tan({names[1]}) is used as the tensile strength")
+    return problems, warnings
+
+
+def coulomb_reduce(q, F, cols=MOHR_COLUMNS) -> None:
+    """One Coulomb strength of rows ``q`` divided by F in place (``model factor-of-safety``, as
+    FLAC3D and 3DEC reduce it): c/F, tan φ/F, σt/F, and tan ψ at most the reduced tan φ."""
+    c, tf, t, td = cols
+    q[:, c] /= F
+    q[:, tf] /= F
+    q[:, t] /= F
+    q[:, td] = np.minimum(q[:, td], q[:, tf])
 
 
 def which_zones(ids, bad: np.ndarray, blocks=None) -> str:

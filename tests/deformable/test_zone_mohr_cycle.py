@@ -84,7 +84,7 @@ def test_strength_properties_are_stored_in_si_and_tangents(tmp_path):
     ("block zone property dilation 95", r"`dilation` must be in \[0, 90\)"),
     ("block zone property cohesion -1", "`cohesion` must be ≥ 0"),
     ("block zone property tension -5", "`tension` must be ≥ 0"),
-    ("block zone cmodel assign mohr-x", r"needs model null\|elastic\|.*mohr-coulomb.* here, got `mohr-x`"),
+    ("block zone cmodel assign mohr-x", r"needs model null\|.*mohr-coulomb.* here, got `mohr-x`"),
 ])
 def test_bad_strength_input_is_a_clear_error_with_its_location(tmp_path, line, msg):
     s = _session(tmp_path, ["block create brick 0 1 0 1 0 1", "block zone generate edgelength 0.5"])

@@ -10,29 +10,17 @@ constant values (dilation <= friction where neither has a table). Strength reduc
 factor-of-safety``): the constant strengths as ``mohr-coulomb`` (c/F, tan φ/F, σt/F), and F kept in
 the zone's P_SRF column, by which the kernel divides the strengths it reads from tables.
 """
-import numpy as np
-
 from dec3d.kernels.zmodels import strain_softening as kernel
-from dec3d.physics.cmodels import (ELASTIC, MOHR_STRENGTH, P_COHESION, P_SRF, P_TANDIL, P_TANFRIC, P_TENSION, table,
-                                   which_zones, zmodel)
+from dec3d.physics.cmodels import ELASTIC, MOHR_STRENGTH, P_SRF, coulomb_reduce, coulomb_rules, table, zmodel
 
 
 def ssoft_check(p, ids):
     """The Mohr-Coulomb rules on the constant strengths (Itasca's): dilation <= friction; a tension
     above c / tan φ is used as that value (a warning). Tabled values are the user's to choose."""
-    problems, warnings = [], []
-    c, tf, t, td = p[:, P_COHESION], p[:, P_TANFRIC], p[:, P_TENSION], p[:, P_TANDIL]
-    bad = (td > tf * (1.0 + 1e-12)) & (p[:, kernel.P_TABLE_DILATION] <= 0) & (p[:, kernel.P_TABLE_FRICTION] <= 0)
-    if bad.any():
-        problems.append(f"dilation must not exceed friction: {which_zones(ids, bad)}")
-    with np.errstate(divide="ignore", invalid="ignore"):
-        apex = np.where(tf > 0.0, c / np.where(tf > 0.0, tf, 1.0), np.inf)
-    over = (t > apex) & (p[:, kernel.P_TABLE_TENSION] <= 0) & (p[:, kernel.P_TABLE_COHESION] <= 0) \
-        & (p[:, kernel.P_TABLE_FRICTION] <= 0)
-    if over.any():
-        warnings.append(f"tension above c/tan(friction) in {which_zones(ids, over)}: the apex value "
-                        "c/tan(friction) is used as the tensile strength")
-    return problems, warnings
+    const = p[:, kernel.P_TABLE_FRICTION] <= 0
+    return coulomb_rules(p, ids, dilation_rows=const & (p[:, kernel.P_TABLE_DILATION] <= 0),
+                         tension_rows=const & (p[:, kernel.P_TABLE_TENSION] <= 0)
+                         & (p[:, kernel.P_TABLE_COHESION] <= 0))
 
 
 def ssoft_reduce(p, F):
@@ -40,10 +28,7 @@ def ssoft_reduce(p, F):
     σt/F, tan ψ at most the reduced tan φ (as mohr-coulomb's), and F in P_SRF, by which the kernel
     divides the strengths it reads from tables."""
     q = p.copy()
-    q[:, P_COHESION] /= F
-    q[:, P_TANFRIC] /= F
-    q[:, P_TENSION] /= F
-    q[:, P_TANDIL] = np.minimum(q[:, P_TANDIL], q[:, P_TANFRIC])
+    coulomb_reduce(q, F)
     q[:, P_SRF] = F
     return q
 

@@ -12,49 +12,27 @@ c_j / tan φ_j is used as that value (a warning). Strength reduction: the matrix
 ``mohr-coulomb`` and the plane alike (c_j/F, tan φ_j/F, σ_t^j/F, tan ψ_j at most tan φ_j/F), as
 Itasca scales both.
 """
-import numpy as np
-
 from dec3d.kernels.zmodels import ubiquitous_joint as kernel
-from dec3d.physics.cmodels import (ELASTIC, MOHR_STRENGTH, P_COHESION, P_TANDIL, P_TANFRIC, P_TENSION, Prop, angle,
-                                   which_zones, zmodel)
+from dec3d.physics.cmodels import ELASTIC, MOHR_STRENGTH, Prop, angle, coulomb_reduce, coulomb_rules, zmodel
 
 JC, JTF, JT, JTD = kernel.P_JCOHESION, kernel.P_JTANFRIC, kernel.P_JTENSION, kernel.P_JTANDIL
-
-
-def _coulomb_rules(p, ids, cols, what, problems, warnings):
-    """Itasca's rules of one Coulomb strength (columns c, tan φ, σt, tan ψ; names ``what``)."""
-    c, tf, t, td = (p[:, k] for k in cols)
-    bad = td > tf * (1.0 + 1e-12)
-    if bad.any():
-        problems.append(f"{what[3]} must not exceed {what[1]}: {which_zones(ids, bad)}")
-    with np.errstate(divide="ignore", invalid="ignore"):
-        apex = np.where(tf > 0.0, c / np.where(tf > 0.0, tf, 1.0), np.inf)
-    over = t > apex
-    if over.any():
-        warnings.append(f"{what[2]} above {what[0]}/tan({what[1]}) in {which_zones(ids, over)}: that value is used "
-                        "as the tensile strength")
 
 
 def ubiquitous_check(p, ids):
     """The matrix's rules and the plane's (Itasca's): dilation <= friction; a tension above
     c / tan φ is used as that value (a warning)."""
-    problems, warnings = [], []
-    _coulomb_rules(p, ids, (P_COHESION, P_TANFRIC, P_TENSION, P_TANDIL), ("cohesion", "friction", "tension",
-                   "dilation"), problems, warnings)
-    _coulomb_rules(p, ids, (JC, JTF, JT, JTD), ("joint-cohesion", "joint-friction", "joint-tension",
-                   "joint-dilation"), problems, warnings)
-    return problems, warnings
+    problems, warnings = coulomb_rules(p, ids)
+    more, warn = coulomb_rules(p, ids, (JC, JTF, JT, JTD), ("joint-cohesion", "joint-friction", "joint-tension",
+                                                             "joint-dilation"))
+    return problems + more, warnings + warn
 
 
 def ubiquitous_reduce(p, F):
     """Rows ``p`` with the matrix's and the plane's strengths divided by F (c/F, tan φ/F, σt/F,
     tan ψ at most the reduced tan φ)."""
     q = p.copy()
-    for c, tf, t, td in ((P_COHESION, P_TANFRIC, P_TENSION, P_TANDIL), (JC, JTF, JT, JTD)):
-        q[:, c] /= F
-        q[:, tf] /= F
-        q[:, t] /= F
-        q[:, td] = np.minimum(q[:, td], q[:, tf])
+    coulomb_reduce(q, F)
+    coulomb_reduce(q, F, (JC, JTF, JT, JTD))
     return q
 
 
