@@ -70,7 +70,7 @@ MOHR_STRENGTH = [Prop("cohesion", P_COHESION, "cohesion c", "Pa"),
 
 #: the columns of the shared Mohr-Coulomb strength (c, tan φ, σt, tan ψ) and their keywords
 MOHR_COLUMNS = (P_COHESION, P_TANFRIC, P_TENSION, P_TANDIL)
-MOHR_NAMES = ("cohesion", "friction", "tension", "dilation")
+MOHR_NAMES = ("c", "friction", "tension", "dilation")     # (c: as the warnings have always said)
 
 
 def coulomb_rules(p, ids, cols=MOHR_COLUMNS, names=MOHR_NAMES, dilation_rows=None, tension_rows=None):
