@@ -119,7 +119,7 @@ def zone_update_for(models, model, p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1
 _CHAINS: dict = {}
 
 
-@overload(zone_update_for, jit_options={"cache": True})
+@overload(zone_update_for, inline="always", jit_options={"cache": True})
 def _zone_update_for(models, model, p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
     if not isinstance(models, types.IntegerLiteral):
         return None
