@@ -61,7 +61,7 @@ def make_tables(points) -> Tables:
     return Tables(np.ascontiguousarray(x), np.ascontiguousarray(y), start, counts)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def table_value(tab, t, xq):
     """Table t (0-based) at xq: linear interpolation between its points, the end values held
     outside them (as FISH's ``table(t, x)``); 0 for an empty table."""

@@ -84,9 +84,9 @@ _TAG = float(CODE)
 #: largest friction or dilation angle a table may give [degrees]: tan and N_φ stay finite
 MAX_ANGLE = 89.99
 _RAD = math.pi / 180.0
-#: ``_common.table_value`` inlined here (the same function): a call would count references of the
-#: tables' arrays on each of the four reads
-_table_value = njit(cache=True, inline="always")(table_value.py_func)
+#: ``_common.table_value`` (inlined where it is called: a call would count references of the
+#: tables' arrays on each of the four reads)
+_table_value = table_value
 
 
 @njit(cache=True, inline="always")
