@@ -276,13 +276,23 @@ def test_hostile_inputs_stay_finite_and_admissible(mb, s, a, psi, flag):
 
 
 def test_dispatch_chain_calls_the_model_by_its_code():
-    from dec3d.kernels.zmodels import CODES, PLASTIC_CODES, zone_update
+    """The chain the zone step compiles for a deck of elastic and Hoek-Brown zones
+    (``zone_update_for`` with their mask) reaches the Hoek-Brown update by its code."""
+    from numba import njit
+
+    from dec3d.kernels.zmodels import CODES, PLASTIC_CODES, model_mask, zone_update_for
     assert CODES["hoek-brown"] == 4 and 4 in PLASTIC_CODES
+    mask = model_mask([1, 4], True)
+
+    @njit
+    def chain(code, p, h, de, s, tab, wf, mw):
+        return zone_update_for(mask, code, p, h, 0, 10e9, 6e9, de[0], de[1], de[2], de[3], de[4], de[5],
+                               s[0], s[1], s[2], s[3], s[4], s[5], tab, wf, mw)
     p = _rows(10.0, 1.0, 0.5, 100e6)
     s0 = np.array([-10e6, -10e6, -10e6, 0.0, 0.0, 0.0])
     de = np.array([2e-3, 1e-3, -5e-2, 1e-4, 0.0, -3e-4])       # yields
     wf = np.full(NWORK, np.nan)
-    r = zone_update(4, p, _H, 0, 10e9, 6e9, *de, *s0, _TAB, wf, _MW)
+    r = chain(4, p, _H, de, s0, _TAB, wf, _MW)
     sk, bits, dsp = kernel(p, 10e9, 6e9, s0, de)
     assert r[0] == bits == 1 and np.array_equal(np.array(r[1:7]), sk) and r[7] == dsp
 

@@ -30,8 +30,9 @@ A model's kernel file (any ``<name>.py`` here not starting with ``_``) declares
 Its host file of the same name in ``dec3d/physics/zmodels`` declares the user-facing properties.
 ``zone_update(code, ...)`` calls the update of the model with that code: a chain of small numba
 functions, one per model, built here at import from the files found, so adding a model adds two
-files and edits none (the chain is compiled into the zone step; ``dec3d.kcache`` hashes this
-folder with the other kernels).
+files and edits none. The zone step calls ``zone_update_for(models, code, ...)`` instead, whose
+chain holds only the models of the literal mask ``models`` (``model_mask``): each deck compiles
+(once, cached) the updates it uses. ``dec3d.kcache`` hashes this folder with the other kernels.
 """
 from __future__ import annotations
 
