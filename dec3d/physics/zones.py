@@ -91,7 +91,7 @@ def zone_tables(model, error=Dec3dError):
         tab = get(tid) if get is not None else None
         if tab is None:
             raise error(f"zone properties name table {tid!r}, which does not exist (any more): make it with "
-                             "`table` before cycling")
+                        "`table` before cycling")
         points.append((list(tab.xs), list(tab.ys)))
     return make_tables(points)
 
@@ -161,12 +161,10 @@ class ZoneStepper:
                             "tetrahedra: 10-node zones cycle elastic only (use `block zone generate edgelength` "
                             "or `hexahedra` for these blocks, or an elastic model)")
             bad, warns = zm.problems(p[mine], zs["id"][mine], bid[zs["block"][mine]])
-            problems += [f"{x}" for x in bad]
+            problems += [f"{zm.name} zones: {x}" for x in bad]
             self.warnings += [f"{zm.name} zones: {x}" for x in warns]
             if zm.moduli is not None and not bad:
                 self.bulk[mine], self.shear[mine] = zm.bulk_shear(p[mine])
-            if bad:
-                problems[-len(bad):] = [f"{zm.name} zones: {x}" for x in bad]
         if problems:
             raise error("zone properties: " + "; ".join(problems)
                         + " (set them with `block zone property` before cycling)")
