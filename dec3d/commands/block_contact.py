@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import CommandError
-from ..physics.jmodels import ALL_PROPS, JOINT_MODELS, MODEL_BY_CODE
+from ..physics.jmodels import ALIASES, ALL_PROPS, JOINT_MODELS, MODEL_BY_CODE, REFUSED
 from ..physics.contacts import default_row
 from ..physics.rigid import engine, mech
 from .registry import command
@@ -37,8 +37,14 @@ def _check(call, model_name, props):
                            f"(it has: {', '.join(allowed)})", call.location)
 
 
-#: 3DEC's other built-in joint models (Itasca joint-model reference), known by name
-OTHER_3DEC_MODELS = ("softening-mohr", "bilinear-mohr", "cyjm", "nonlinear", "power", "ratestate")
+#: 3DEC's other built-in joint models (Itasca joint-model reference), known by name, until one of ours
+#: takes the name
+OTHER_3DEC_MODELS = tuple(n for n in ("softening-mohr", "bilinear-mohr", "cyjm", "nonlinear", "power", "ratestate")
+                          if n not in JOINT_MODELS and n not in ALIASES)
+
+
+def _known_names() -> tuple[str, ...]:
+    return tuple(JOINT_MODELS) + tuple(ALIASES)
 
 
 def _check_model_name(name: str, where) -> None:
@@ -48,7 +54,9 @@ def _check_model_name(name: str, where) -> None:
     from ..errors import NotSupportedError
     from ..lang.abbrev import matches
 
-    hits = matches(name, tuple(JOINT_MODELS) + OTHER_3DEC_MODELS)
+    if name in REFUSED:
+        raise NotSupportedError(REFUSED[name], where, hint=f"implemented: {', '.join(JOINT_MODELS)}")
+    hits = matches(name, _known_names() + OTHER_3DEC_MODELS)
     if len(hits) == 1 and hits[0] in OTHER_3DEC_MODELS:
         raise NotSupportedError(f"joint model `{hits[0]}` is not supported yet", where,
                                 hint=f"implemented: {', '.join(JOINT_MODELS)}")
@@ -59,14 +67,14 @@ def _check_model_name(name: str, where) -> None:
 
 
 def _model_arg(call, key):
-    """The model name as bound, with a built-in abbreviation expanded (`el` = elastic)."""
+    """The model name as bound, with a built-in abbreviation (`el` = elastic) or alias expanded."""
     from ..lang.abbrev import matches
 
     name = call.args.get(key)
-    if isinstance(name, str):
-        hits = matches(name, tuple(JOINT_MODELS))
+    if isinstance(name, str) and name not in REFUSED:
+        hits = matches(name, _known_names())
         if len(hits) == 1:
-            call.args[key] = hits[0]
+            call.args[key] = ALIASES.get(hits[0], hits[0])
     return call.args.get(key)
 
 

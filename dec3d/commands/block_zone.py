@@ -229,7 +229,7 @@ def insitu_contact_forces(model, cmask, stress_at) -> tuple | None:
     The joint law works from the total normal displacement (Fn = −kn A (un − u_dil),
     dec3d.kernels.jointlaw), so un is set to u_dil − fn / (kn A) for the force to persist.
     Returns (sub-contact rows, fn, fs, un) or None when there are no contacts."""
-    from ..kernels.joints import P_KN
+    from ..physics.jmodels import stiffness
     from ..model.zone_quality import tensor
     if "contacts" not in model.stores:
         return None
@@ -244,7 +244,7 @@ def insitu_contact_forces(model, cmask, stress_at) -> tuple | None:
     tn = np.einsum("ki,ki->k", t, n)
     fn = -area * tn
     fs = -area[:, None] * (t - tn[:, None] * n)
-    kna = cs["prop"][c, P_KN] * area
+    kna = stiffness(cs, ss)[0][sub] * area
     un = np.where(kna > 0.0, ss["udil"][sub] - fn / np.where(kna > 0.0, kna, 1.0), ss["un"][sub])
     return sub, fn, fs, un
 

@@ -231,8 +231,8 @@ def threaded(kernel, n):
 @njit(cache=True, nogil=True)
 def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, sgap,
                old_start, old_count, old_kind, old_key0, old_key1, old_area,
-               old_fs, old_un, old_udil, old_us, old_state, old_n, new_n,
-               fs, un, udil, us, state):
+               old_fs, old_un, old_udil, old_us, old_state, old_hist, old_n, new_n,
+               fs, un, udil, us, state, hist):
     """State of the new sub-contacts from the old ones (see the module docstring).
 
     cprev (nc,) old contact row of each new contact or -1; new_sc_* (ns,) the new
@@ -240,7 +240,9 @@ def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, sg
     the uⁿ of every sub-contact without an old twin (state ``ST_NEW``); old_start/old_count
     (nold,) CSR of the old sub-contacts per old contact; old_* the old sub-contact arrays;
     old_n (nold, 3) / new_n (nc, 3) contact normals: old shear forces are first turned to
-    the new plane by Eq. (23). Writes fs (ns, 3) N, un, udil (ns,) m, us (ns, 3) m, state (ns,).
+    the new plane by Eq. (23). Writes fs (ns, 3) N, un, udil (ns,) m, us (ns, 3) m, state (ns,),
+    hist (ns, NJHIST) the joint models' history: the twin's, or the area-weighted mean of the old
+    contact's sub-contacts (zero on a new contact).
     """
     rot = np.empty(3)
     mean_fs = np.zeros(3)
@@ -253,6 +255,8 @@ def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, sg
         udil[s] = 0.0
         state[s] = ST_NEW
         un[s] = sgap[s]
+        for j in range(hist.shape[1]):
+            hist[s, j] = 0.0
         if p < 0:
             continue
         k0 = old_n[p, 1] * new_n[c, 2] - old_n[p, 2] * new_n[c, 1]
@@ -282,6 +286,8 @@ def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, sg
             un[s] = old_un[hit]
             udil[s] = old_udil[hit]
             state[s] = old_state[hit]
+            for j in range(hist.shape[1]):
+                hist[s, j] = old_hist[hit, j]
             continue
         # no old twin: the mean shear stress and dilation of the old contact, its failure
         # state; its own gap
@@ -296,8 +302,14 @@ def carry_over(cprev, new_sc_contact, new_kind, new_key0, new_key1, new_area, sg
             for d in range(3):
                 mean_fs[d] += old_fs[o, d]
             st |= old_state[o] & 1
+            for j in range(hist.shape[1]):
+                hist[s, j] += old_hist[o, j] * old_area[o]
         if atot <= 0.0:
+            for j in range(hist.shape[1]):
+                hist[s, j] = 0.0
             continue
+        for j in range(hist.shape[1]):
+            hist[s, j] /= atot
         f0 = mean_fs[0]
         f1 = mean_fs[1]
         f2 = mean_fs[2]
@@ -317,12 +329,12 @@ def gather_subcontacts(lo, hi, base, starts, counts, nold, old, new, out):
     read from row base[c] of the old rows followed by the new ones (base[c] ≥ nold: row
     base[c] − nold of the new). Its rows in order, one contact after the other.
 
-    old: (kind, key0, key1, pos, area, fn, fs, un, udil, us, state), the old sub-contact arrays
-    (nold rows); new: the same without fn (a new sub-contact starts with fn 0); out: (contact,
-    kind, key0, key1, pos, area, fn, fs, un, udil, us, state), ``out[0][i]`` the contact of row i."""
-    o_kind, o_key0, o_key1, o_pos, o_area, o_fn, o_fs, o_un, o_udil, o_us, o_state = old
-    n_kind, n_key0, n_key1, n_pos, n_area, n_fs, n_un, n_udil, n_us, n_state = new
-    w_c, w_kind, w_key0, w_key1, w_pos, w_area, w_fn, w_fs, w_un, w_udil, w_us, w_state = out
+    old: (kind, key0, key1, pos, area, fn, fs, un, udil, us, state, hist), the old sub-contact
+    arrays (nold rows); new: the same without fn (a new sub-contact starts with fn 0); out: (contact,
+    kind, key0, key1, pos, area, fn, fs, un, udil, us, state, hist), ``out[0][i]`` the contact of row i."""
+    o_kind, o_key0, o_key1, o_pos, o_area, o_fn, o_fs, o_un, o_udil, o_us, o_state, o_hist = old
+    n_kind, n_key0, n_key1, n_pos, n_area, n_fs, n_un, n_udil, n_us, n_state, n_hist = new
+    w_c, w_kind, w_key0, w_key1, w_pos, w_area, w_fn, w_fs, w_un, w_udil, w_us, w_state, w_hist = out
     for c in range(lo, hi):
         for j in range(counts[c]):
             i = starts[c] + j
@@ -341,6 +353,8 @@ def gather_subcontacts(lo, hi, base, starts, counts, nold, old, new, out):
                     w_pos[i, d] = o_pos[r, d]
                     w_fs[i, d] = o_fs[r, d]
                     w_us[i, d] = o_us[r, d]
+                for d in range(w_hist.shape[1]):
+                    w_hist[i, d] = o_hist[r, d]
             else:
                 r -= nold
                 w_kind[i] = n_kind[r]
@@ -355,6 +369,8 @@ def gather_subcontacts(lo, hi, base, starts, counts, nold, old, new, out):
                     w_pos[i, d] = n_pos[r, d]
                     w_fs[i, d] = n_fs[r, d]
                     w_us[i, d] = n_us[r, d]
+                for d in range(w_hist.shape[1]):
+                    w_hist[i, d] = n_hist[r, d]
 
 
 @njit(cache=True)

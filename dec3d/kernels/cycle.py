@@ -99,7 +99,7 @@ def _move_points(dt, ca, cb, owner, pts, centroid, vel, spin):
 
 @njit(cache=True, parallel=True)
 def _contact_pass(move, dt, centroid, vel, spin, ca, cb, cn, cc, cmodel, cprop, cstart,
-                  sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg):
+                  sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg):
     """One parallel loop over the contacts: when ``move``, first Eq. (11) for the contact point and
     the sub-contact points (the motion of the step before), then the joint law of each sub-contact
     (``jointlaw.update_one``; force on B to sg). The sub-contacts of contact c are rows
@@ -113,7 +113,7 @@ def _contact_pass(move, dt, centroid, vel, spin, ca, cb, cn, cc, cmodel, cprop, 
             if move:
                 _move_point(dt, a, b, sc_pos, s, centroid, vel, spin)
             update_one(s, c, a, b, dt, centroid, vel, spin, cn, cmodel, cprop,
-                       sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg)
+                       sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg)
 
 
 @njit(cache=True)
@@ -166,7 +166,7 @@ def _run_steps(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies,
     gstart, gmember = groups.start, groups.member
     centroid, vel, spin, force, moment = bodies.centroid, bodies.vel, bodies.spin, bodies.force, bodies.moment
     ca, cb, cn, cc, cown, cmodel, cprop = contacts
-    sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state = subs
+    sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist = subs
     radius, acc, trigger, motion = bounds
     done = 0
     bad = -1
@@ -175,11 +175,11 @@ def _run_steps(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies,
     pending = False             # the points still have to move with the last step's motion
     for _ in range(nsteps):
         _contact_pass(pending, dt, centroid, vel, spin, ca, cb, cn, cc, cmodel, cprop, cstart,
-                      sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg)
+                      sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg)
         pending = False
         if beta > 0.0:
-            contact_stiffness_damping(beta, centroid, vel, spin, ca, cb, cn, cprop, sc_contact, sc_pos, sc_area,
-                                      sc_fn, sc_state, sg)
+            contact_stiffness_damping(beta, centroid, vel, spin, ca, cb, cn, cmodel, cprop, sc_contact, sc_pos, sc_area,
+                                      sc_fn, sc_state, sc_hist, sg)
         for k in range(orphans.shape[0]):
             block_sum(orphans[k], centroid, force, moment, sc_pos, sg, bstart, bent)
         g = rigid_motion_groups(dt, gravity, full_inertia, damping, groups, bodies, vmax, out, fused)

@@ -33,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .joints import P_KN, P_KS
+from .joints import joint_stiffness
 
 
 @njit(cache=True)
@@ -58,19 +58,21 @@ def subcontact_increments(dt, bpos, bvel, bspin, ca, cb, sc_contact, sc_pos, du)
 
 
 @njit(cache=True)
-def contact_strain(cn, cprop, sc_contact, sc_area, sc_fn, sc_fs, du_next, flag):
+def contact_strain(cn, cmodel, cprop, sc_contact, sc_area, sc_fn, sc_fs, sc_hist, du_next, flag):
     """(Uⁿ, U(n+1/2), U of the flagged sub-contacts) [J]: the elastic energy of the sub-contact springs
     with the forces as they are, the same at the half step, Uⁿ − ½ F_B·du_next (module docstring), and
     the part of Uⁿ in the sub-contacts with flag (ns,) true (those made at the last detection: their
     first update sets the force from their gap, without a displacement increment). A spring of zero
-    stiffness stores nothing."""
+    stiffness stores nothing. Stiffnesses: each joint model's current ones (``joints.joint_stiffness``;
+    for a nonlinear joint F²/2k with its tangent k, the springs' energy if they were linear now)."""
     u = 0.0
     uf = 0.0
     corr = 0.0
     for s in range(sc_contact.shape[0]):
         c = sc_contact[s]
-        kn = cprop[c, P_KN] * sc_area[s]
-        ks = cprop[c, P_KS] * sc_area[s]
+        kn, ks = joint_stiffness(cmodel[c], cprop, c, sc_hist, s)
+        kn *= sc_area[s]
+        ks *= sc_area[s]
         fn = sc_fn[s]
         f0 = sc_fs[s, 0]
         f1 = sc_fs[s, 1]

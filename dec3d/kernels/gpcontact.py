@@ -146,7 +146,7 @@ def vertex_sides(kind, key0, ca, cb, sc_contact, zoned, nodes_a, w_a, nodes_b, w
 @njit(cache=True, parallel=True)
 def mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce,
                             ca, cb, cn, cmodel, cprop,
-                            sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state,
+                            sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist,
                             nodes_a, w_a, nodes_b, w_b):
     """One force update of every sub-contact when some blocks are zoned: as
     ``jointlaw.subcontact_forces``, with each zoned side's velocity interpolated from its
@@ -199,7 +199,7 @@ def mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce
             dun = 0.0
             st0 &= ~ST_NEW
         fn, f0, f1, f2, un, ud, u0, u1, u2, st = joint_law(
-            cmodel[c], cprop, c, sc_area[s], dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s],
+            cmodel[c], cprop, c, sc_hist, s, sc_area[s], dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s],
             sc_udil[s], sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
         sc_fn[s] = fn
         sc_fs[s, 0] = f0

@@ -23,12 +23,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .joints import ST_NEW, joint_law
+from .joints import ST_NEW, joint_law, joint_stiffness
 
 
 @njit(cache=True, inline="always")   # (inlined into each caller's loop: the call costs as much as the work)
 def update_one(s, c, a, b, dt, bpos, bvel, bspin, cn, cmodel, cprop,
-               sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg):
+               sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg):
     """The joint law of sub-contact s of contact c (blocks a = A, b = B): its rows of sc_* updated,
     the force on B to sg[s] [N] (``subcontact_update`` for one sub-contact)."""
     n0 = cn[c, 0]
@@ -65,7 +65,7 @@ def update_one(s, c, a, b, dt, bpos, bvel, bspin, cn, cmodel, cprop,
         dun = 0.0
         st0 &= ~ST_NEW
     fn, f0, f1, f2, un, ud, u0, u1, u2, st = joint_law(
-        cmodel[c], cprop, c, sc_area[s], dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s],
+        cmodel[c], cprop, c, sc_hist, s, sc_area[s], dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s],
         sc_udil[s], sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
     sc_fn[s] = fn
     sc_fs[s, 0] = f0
@@ -85,13 +85,13 @@ def update_one(s, c, a, b, dt, bpos, bvel, bspin, cn, cmodel, cprop,
 
 @njit(cache=True, parallel=True)
 def subcontact_update(dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
-                      sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg):
+                      sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg):
     """The joint law of every sub-contact, in parallel (each writes only its own rows); the
     force on B of sub-contact s goes to sg (ns, 3) [N] for ``block_sums``."""
     for s in prange(sc_contact.shape[0]):
         c = sc_contact[s]
         update_one(s, c, ca[c], cb[c], dt, bpos, bvel, bspin, cn, cmodel, cprop,
-                   sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg)
+                   sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg)
 
 
 @njit(cache=True)
@@ -181,19 +181,28 @@ def block_sums(bpos, bforce, bmoment, sc_pos, sg, bstart, bent):
 @njit(cache=True)
 def subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment,
                       ca, cb, cn, cmodel, cprop,
-                      sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state):
+                      sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist):
     """One force update of every sub-contact; adds the forces and moments to the blocks.
 
     bpos/bvel/bspin (nb, 3): centroid [m], velocity [m/s], spin [rad/s] at t − Δt/2.
     bforce/bmoment (nb, 3): accumulated in place [N], [N·m].
     ca, cb (nc,) block rows; cn (nc, 3) unit normal A → B; cmodel (nc,); cprop (nc, NPROP).
-    sc_* (ns, ...): contact row, position on the c-p (3), area, Fn, Fs (3), uⁿ, u_dil, uˢ (3), state.
+    sc_* (ns, ...): contact row, position on the c-p (3), area, Fn, Fs (3), uⁿ, u_dil, uˢ (3), state, history (NJHIST).
     Two parallel passes with fixed-order sums (``subcontact_update``, ``block_sums``): the result
     is that of a serial loop over s adding the force on B, then on A, whatever the thread count.
     (``cycle.run_steps`` calls the passes itself, making ``block_lists`` once per call.)
     """
     sg = np.empty((sc_contact.shape[0], 3))
     subcontact_update(dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
-                      sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sg)
+                      sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg)
     bstart, bent = block_lists(bpos.shape[0], ca, cb, sc_contact)
     block_sums(bpos, bforce, bmoment, sc_pos, sg, bstart, bent)
+
+
+@njit(cache=True)
+def subcontact_stiffness(cmodel, cprop, sc_contact, sc_hist, kn, ks):
+    """Each sub-contact's current normal and shear stiffness [Pa/m] from its joint model
+    (``joints.joint_stiffness``) into kn, ks (ns,)."""
+    for s in range(sc_contact.shape[0]):
+        c = sc_contact[s]
+        kn[s], ks[s] = joint_stiffness(cmodel[c], cprop, c, sc_hist, s)

@@ -3,7 +3,8 @@
 Itasca's 3DEC "Dynamic Analysis" pages (Damping): stiffness-proportional damping "applies a force,
 which is proportional to the incremental stiffness matrix multiplied by relative velocities [...], to
 contacts"; with the Rayleigh damping matrix C = α M + β K the contact part is β K. For a sub-contact
-of area A with normal stiffness kn and shear stiffness ks [Pa/m], relative velocity V (Eq. 15 of the
+of area A with normal stiffness kn and shear stiffness ks [Pa/m] (its joint model's current ones,
+``joints.joint_stiffness``), relative velocity V (Eq. 15 of the
 3DEC theory text, B relative to A), Vⁿ = V·n, Vˢ = V − Vⁿ n:
 
     Fᵈ = −β A (kn Vⁿ n + ks Vˢ)          (the damping force on B; A takes −Fᵈ)
@@ -18,12 +19,12 @@ from __future__ import annotations
 
 from numba import njit, prange
 
-from .joints import P_KN, P_KS, ST_SLIP
+from .joints import ST_SLIP, joint_stiffness
 
 
 @njit(cache=True, parallel=True)
-def contact_stiffness_damping(beta, bpos, bvel, bspin, ca, cb, cn, cprop, sc_contact, sc_pos, sc_area,
-                              sc_fn, sc_state, sg):
+def contact_stiffness_damping(beta, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop, sc_contact, sc_pos, sc_area,
+                              sc_fn, sc_state, sc_hist, sg):
     """Add β K V (see the module text) of every sub-contact to sg (ns, 3) [N], in parallel (each
     sub-contact writes only its own row). beta [s]; the other arrays as ``jointlaw.subcontact_update``."""
     for s in prange(sc_contact.shape[0]):
@@ -48,16 +49,17 @@ def contact_stiffness_damping(beta, bpos, bvel, bspin, ca, cb, cn, cprop, sc_con
         v2 = (bvel[b, 2] + bspin[b, 0] * rb1 - bspin[b, 1] * rb0
               - bvel[a, 2] - (bspin[a, 0] * ra1 - bspin[a, 1] * ra0))
         vn = v0 * n0 + v1 * n1 + v2 * n2
-        kn = beta * cprop[c, P_KN] * sc_area[s]
-        ks = 0.0 if (sc_state[s] & ST_SLIP) else beta * cprop[c, P_KS] * sc_area[s]
+        kn, ks = joint_stiffness(cmodel[c], cprop, c, sc_hist, s)
+        kn *= beta * sc_area[s]
+        ks = 0.0 if (sc_state[s] & ST_SLIP) else beta * ks * sc_area[s]
         sg[s, 0] -= kn * vn * n0 + ks * (v0 - vn * n0)
         sg[s, 1] -= kn * vn * n1 + ks * (v1 - vn * n1)
         sg[s, 2] -= kn * vn * n2 + ks * (v2 - vn * n2)
 
 
 @njit(cache=True)
-def mixed_stiffness_damping(beta, bpos, bvel, bspin, bforce, bmoment, gvel, gforce, ca, cb, cn, cprop,
-                            sc_contact, sc_pos, sc_area, sc_fn, sc_state, nodes_a, w_a, nodes_b, w_b):
+def mixed_stiffness_damping(beta, bpos, bvel, bspin, bforce, bmoment, gvel, gforce, ca, cb, cn, cmodel, cprop,
+                            sc_contact, sc_pos, sc_area, sc_fn, sc_state, sc_hist, nodes_a, w_a, nodes_b, w_b):
     """The damping force of the module text on every sub-contact of a model where zoned (or FE) and
     rigid blocks touch (``gpcontact.mixed_subcontact_forces`` arrays): V from each side's rigid
     motion or its gridpoints' velocities interpolated with the weights (node -1: rigid side), the
@@ -97,8 +99,9 @@ def mixed_stiffness_damping(beta, bpos, bvel, bspin, bforce, bmoment, gvel, gfor
                         v1 += sg * w[s, j] * gvel[g, 1]
                         v2 += sg * w[s, j] * gvel[g, 2]
         vn = v0 * n0 + v1 * n1 + v2 * n2
-        kn = beta * cprop[c, P_KN] * sc_area[s]
-        ks = 0.0 if (sc_state[s] & ST_SLIP) else beta * cprop[c, P_KS] * sc_area[s]
+        kn, ks = joint_stiffness(cmodel[c], cprop, c, sc_hist, s)
+        kn *= beta * sc_area[s]
+        ks = 0.0 if (sc_state[s] & ST_SLIP) else beta * ks * sc_area[s]
         d0 = -(kn * vn * n0 + ks * (v0 - vn * n0))
         d1 = -(kn * vn * n1 + ks * (v1 - vn * n1))
         d2 = -(kn * vn * n2 + ks * (v2 - vn * n2))

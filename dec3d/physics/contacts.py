@@ -37,7 +37,7 @@ from dec3d.kernels import contactmap as _cm
 from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, gather_subcontacts, match_sorted,
                                       subcontact_gaps, threaded, vertex_point_areas)
 from dec3d.kernels.kept import add_turns, as_they_are, pairs_to_look_at, take_defaults
-from dec3d.kernels.joints import NPROP
+from dec3d.kernels.joints import NJHIST, NPROP
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.groups import group_field
 from dec3d.model.model import KIND_DEFORMABLE, KIND_FE, KIND_RIGID
@@ -90,6 +90,7 @@ SUBCONTACT_FIELDS = {
     "udil": Field((), _F, 0.0),          # dilation [m]
     "us": Field((3,), _F, 0.0),          # accumulated shear displacement [m]
     "state": Field((), _I, 0),           # ST_* bits (kernels.jointlaw)
+    "hist": Field((NJHIST,), _F, 0.0),   # the joint model's own history (kernels.joints: its first NHIST)
     # on a zoned (deformable) side: the gridpoints of the surface triangle the point moves with
     # and its interpolation weights (set at detection by gpcontact.surface_weights; -1: rigid side)
     "gp_a": Field((3,), _I, -1),
@@ -109,7 +110,7 @@ QUIET = 0.1
 RELATIVE = True
 
 #: the sub-contact fields a detection writes (``contactmap.gather_subcontacts``), in its order
-_GATHERED = ("contact", "kind", "key0", "key1", "pos", "area", "fn", "fs", "un", "udil", "us", "state")
+_GATHERED = ("contact", "kind", "key0", "key1", "pos", "area", "fn", "fs", "un", "udil", "us", "state", "hist")
 
 
 def contact_stores(model) -> tuple[Store, Store]:
@@ -120,6 +121,14 @@ def contact_stores(model) -> tuple[Store, Store]:
         model.add_store(Store("contacts", CONTACT_FIELDS, capacity=64))
     if "subcontacts" not in stores:
         model.add_store(Store("subcontacts", SUBCONTACT_FIELDS, capacity=256))
+    # a model restored from an older save: fields added since (the joint models' ``hist``) start at
+    # their fill value, a property row narrower than today's widest model is widened
+    for store, fields in ((model.store("contacts"), CONTACT_FIELDS), (model.store("subcontacts"), SUBCONTACT_FIELDS)):
+        for key, fld in fields.items():
+            if key not in store:
+                store.add_field(key, fld)
+            elif store.fields[key].shape != fld.shape and key in ("prop", "hist"):
+                store.resize_field(key, fld.shape)
     for key in ("map_pos", "look_pos", "turn_pos"):
         if key not in model.vertices:
             model.vertices.add_field(key, Field((3,), _F, 0.0))
@@ -502,12 +511,13 @@ class ContactDetection:
         udil = np.empty(ns)
         us = np.empty((ns, 3))
         state = np.empty(ns, _I)
+        hist = np.empty((ns, NJHIST))
         olds = (cs["sub_start"], cs["sub_count"], ss["kind"], ss["key0"], ss["key1"], ss["area"], ss["fs"], ss["un"],
-                ss["udil"], ss["us"], ss["state"], cs["normal"], f_n)
+                ss["udil"], ss["us"], ss["state"], ss["hist"], cs["normal"], f_n)
         nt = get_num_threads() if ns >= _cm.PARALLEL_FROM else 1
         cut = np.linspace(0, ns, nt + 1).astype(_I)       # (each sub-contact's state is its own: rows apart)
         in_threads(lambda j: carry_over(f_prev, *(x[cut[j]:cut[j + 1]] for x in (sc_c, kind, key0, key1, area, sgap)),
-                                        *olds, *(x[cut[j]:cut[j + 1]] for x in (fs, un, udil, us, state))), nt, nt)
+                                        *olds, *(x[cut[j]:cut[j + 1]] for x in (fs, un, udil, us, state, hist))), nt, nt)
         nf = len(fresh)
         f_count = np.bincount(sc_c, minlength=nf).astype(_I) if nf else np.zeros(0, _I)
         f_start = (np.cumsum(f_count) - f_count).astype(_I)
@@ -528,7 +538,7 @@ class ContactDetection:
             # straight into new arrays (the old rows are read from the store's own), installed below
             gathered = ss.blank(total, _GATHERED)
             old_rows = tuple(ss[key] for key in _GATHERED[1:])
-            new_rows = (kind, key0, key1, pos, area, fs, un, udil, us, state)
+            new_rows = (kind, key0, key1, pos, area, fs, un, udil, us, state, hist)
             out = tuple(gathered[key] for key in _GATHERED)
             nt = get_num_threads() if total >= _cm.PARALLEL_FROM else 1
             cut = np.linspace(0, nc, nt + 1).astype(_I)

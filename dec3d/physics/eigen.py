@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dec3d.kernels.joints import P_KN, P_KS
+from dec3d.physics.jmodels import stiffness as joint_stiffness
 
 from .contacts import default_row
 from .rigid import engine, mech
@@ -100,7 +100,7 @@ def assemble(model, tol: float | None = None):
     sc, ci, ba, bb = sc[use], ci[use], ba[use], bb[use]
     n = c["normal"][ci]
     a = s["area"][sc]
-    kn, ks = prop[ci, P_KN] * a, prop[ci, P_KS] * a
+    kn, ks = (k[sc] * a for k in joint_stiffness(c, s, prop))
     nn = n[:, :, None] * n[:, None, :]
     k3 = kn[:, None, None] * nn + ks[:, None, None] * (np.eye(3) - nn)
     p = s["pos"][sc]

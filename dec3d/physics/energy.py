@@ -53,7 +53,8 @@ from __future__ import annotations
 import numpy as np
 
 from dec3d.io.state import register_known
-from dec3d.kernels.joints import P_KN, ST_NEW
+from dec3d.kernels.joints import ST_NEW
+from dec3d.physics.jmodels import stiffness as joint_stiffness
 from dec3d.kernels.energy import (contact_strain, group_energy, group_kinetic, spring_work, subcontact_increments,
                                   zone_internal_forces, zone_strain)
 
@@ -174,7 +175,8 @@ class _Tracker:
     def _strain(self, fn, du, flag):
         eng = self.run.eng
         cs, ss = eng.contacts, eng.subcontacts
-        return contact_strain(cs["normal"], cs["prop"], ss["contact"], ss["area"], fn, ss["fs"], du, flag)
+        return contact_strain(cs["normal"], cs["jmodel"], cs["prop"], ss["contact"], ss["area"], fn, ss["fs"], ss["hist"],
+                              du, flag)
 
     def _normal_forces(self):
         """The sub-contact normal forces as the joint law holds them. A detection makes the normal force
@@ -186,7 +188,7 @@ class _Tracker:
         cs, ss = eng.contacts, eng.subcontacts
         fn = ss["fn"].copy()
         closed = ss["un"] - ss["udil"]
-        ka = cs["prop"][ss["contact"], P_KN] * ss["area"]
+        ka = joint_stiffness(cs, ss)[0] * ss["area"]
         stale = (fn == 0.0) & (closed < 0.0) & (ka > 0.0)
         fn[stale] = -ka[stale] * closed[stale]
         return fn

@@ -13,6 +13,7 @@ the residual friction with it, as 3DEC does.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -22,6 +23,7 @@ from dec3d.physics.modelprops import ModelProp, atan_deg, tan_deg
 
 from dec3d.kernels.joints import MODELS as KERNELS
 from dec3d.kernels.joints import NPROP, P_KN, P_KS
+from dec3d.kernels.jointlaw import subcontact_stiffness
 
 
 @dataclass(frozen=True)
@@ -29,6 +31,13 @@ class Prop(ModelProp):
     """A joint model's property (``ModelProp``: name, column, units, conversions, range)."""
     #: property whose value this one shows while it holds NaN (unset residual friction: the friction)
     fallback: str | None = None
+    #: the model cannot run without it: its column holds NaN until set, and cycling stops naming
+    #: the contacts that lack it (``missing``)
+    required: bool = False
+
+    def __post_init__(self):
+        if self.required:
+            object.__setattr__(self, "default", math.nan)
 
 
 def angle(name, column, doc, hi_open=True, **kw) -> Prop:
@@ -47,6 +56,8 @@ class JointModel:
     code: int
     doc: str
     props: dict[str, Prop] = field(default_factory=dict)
+    #: names of its history entries (the kernel's ``HIST_NAMES``: VTK arrays, FISH)
+    hist_names: tuple[str, ...] = ()
 
     def row(self, values: dict[str, float] | None = None) -> np.ndarray:
         """Kernel property row with every column at its default, then ``values`` applied."""
@@ -73,20 +84,31 @@ class JointModel:
 
 JOINT_MODELS: dict[str, JointModel] = {}
 MODEL_BY_CODE: dict[int, JointModel] = {}
+#: other names a model answers to (``jmodel assign``, ``material-table ... jmodel``): alias → model
+ALIASES: dict[str, str] = {}
+#: names refused with a reason (e.g. a plugin version whose properties differ from ours): name → message
+REFUSED: dict[str, str] = {}
 
 
-def jmodel(kernel, doc: str, props: list[Prop]) -> JointModel:
-    """Register a joint model: ``kernel`` is its module in ``dec3d/kernels/joints`` (name, code)."""
+def jmodel(kernel, doc: str, props: list[Prop], aliases=(), refused=None) -> JointModel:
+    """Register a joint model: ``kernel`` is its module in ``dec3d/kernels/joints`` (name, code).
+    ``aliases``: other names that mean this model; ``refused``: {name: why} for names that look
+    like it but are not (they stop with that message)."""
     name, code = kernel.NAME, kernel.CODE
     if name in JOINT_MODELS or code in MODEL_BY_CODE:
         raise ValueError(f"joint model '{name}' (code {code}) registered twice")
+    for a in (*aliases, *(refused or {})):
+        if a in JOINT_MODELS or a in ALIASES or a in REFUSED:
+            raise ValueError(f"joint model '{name}': the name '{a}' is taken")
     for p in props:
         if not 0 <= p.column < kernel.NCOLS:
             raise ValueError(f"joint model '{name}': property {p.name} in column {p.column}, the kernel reads "
                              f"{kernel.NCOLS}")
-    m = JointModel(name, code, doc, {p.name: p for p in props})
+    m = JointModel(name, code, doc, {p.name: p for p in props}, tuple(kernel.HIST_NAMES))
     JOINT_MODELS[name] = m
     MODEL_BY_CODE[code] = m
+    ALIASES.update({a: name for a in aliases})
+    REFUSED.update(refused or {})
     register_known(joint_models={name}, joint_model_codes={code})     # what a save file may name
     return m
 
@@ -94,6 +116,62 @@ def jmodel(kernel, doc: str, props: list[Prop]) -> JointModel:
 #: the stiffnesses every model has (columns 0, 1 of every kernel)
 STIFFNESS = [Prop("stiffness-normal", P_KN, "normal stiffness kn", "Pa/m"),
              Prop("stiffness-shear", P_KS, "shear stiffness ks", "Pa/m")]
+
+
+#: codes of the models whose kernel has a ``stiffness`` hook
+_HOOKED = np.array(sorted(k.CODE for k in KERNELS if hasattr(k, "stiffness")), dtype=np.int64)
+
+
+def stiffness(cs, ss, prop=None) -> tuple[np.ndarray, np.ndarray]:
+    """(kn, ks) (ns,) [Pa/m]: every sub-contact's current stiffness as its joint model gives it
+    (the kernel's ``stiffness`` hook; columns 0, 1 for a model without one). ``cs``, ``ss``: the
+    contacts and sub-contacts stores; ``prop`` (nc, NPROP) other property rows than the store's.
+    The one place the engine asks for a joint stiffness."""
+    n = ss.n
+    p = cs["prop"] if prop is None else prop
+    if not np.isin(cs["jmodel"], _HOOKED).any():          # constant stiffnesses: columns 0, 1
+        c = ss["contact"]
+        return p[c, P_KN], p[c, P_KS]
+    kn, ks = np.empty(n), np.empty(n)
+    if n:
+        subcontact_stiffness(cs["jmodel"], np.ascontiguousarray(cs["prop"] if prop is None else prop), ss["contact"],
+                             ss["hist"], kn, ks)
+    return kn, ks
+
+
+def contact_stiffness(cs, ss) -> tuple[np.ndarray, np.ndarray]:
+    """(kn, ks) (nc,) [Pa/m] per contact, for the time step and the mass scaling: the larger of its
+    row's columns 0, 1 and the stiffest of its sub-contacts now (``stiffness``), so that a joint
+    softer now than its stated stiffness does not lengthen the step it may need again."""
+    kn = cs["prop"][:, P_KN].copy()
+    ks = cs["prop"][:, P_KS].copy()
+    if ss.n:
+        skn, sks = stiffness(cs, ss)
+        np.maximum.at(kn, ss["contact"], skn)
+        np.maximum.at(ks, ss["contact"], sks)
+    return kn, ks
+
+
+def missing(cs, rows) -> str | None:
+    """A message naming the contacts that lack a required property (``Prop.required``) and that
+    property, or None. ``rows``: the property rows in force (nc, NPROP); only contacts with
+    sub-contacts count."""
+    used = cs["sub_count"] > 0
+    for code in np.unique(cs["jmodel"][used]):
+        m = MODEL_BY_CODE[int(code)]
+        on = used & (cs["jmodel"] == code)
+        for p in m.props.values():
+            if not p.required:
+                continue
+            bad = on & np.isnan(rows[:, p.column])
+            if bad.any():
+                k = np.flatnonzero(bad)
+                pairs = ", ".join(f"{int(cs['ida'][i])}-{int(cs['idb'][i])}" for i in k[:5])
+                more = f" and {len(k) - 5} more" if len(k) > 5 else ""
+                return (f"joint model '{m.name}' needs property '{p.name}': {len(k)} contact(s) lack it "
+                        f"(between blocks {pairs}{more}); set it with `block contact property {p.name} …` "
+                        "or `block contact material-table default property …`")
+    return None
 
 
 def _load_hosts() -> None:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from dec3d.kernels import bodyscale
-from dec3d.kernels.joints import P_KN, P_KS
+from dec3d.physics.jmodels import contact_stiffness
 from dec3d.kernels.motion import block_timestep
 
 from .bodies import inertial_masses
@@ -42,7 +42,7 @@ class DensityScaling:
         kb = np.zeros(b.n)
         if ss.n:
             c = ss["contact"]
-            k = np.maximum(cs["prop"][c, P_KN], cs["prop"][c, P_KS]) * ss["area"]
+            k = np.maximum(*contact_stiffness(cs, ss))[c] * ss["area"]
             kb += np.bincount(cs["a"][c], k, minlength=b.n) + np.bincount(cs["b"][c], k, minlength=b.n)
         return np.add.reduceat(kb[gmember], gstart[:-1]) if len(gmember) else np.zeros(0)
 
@@ -99,7 +99,7 @@ class DensityScaling:
         rt = np.zeros(ng)
         rr = np.zeros(ng)
         bodyscale.threaded(cs.n)(gid, gcen, rho, held, cs["a"], cs["b"], cs["normal"],
-                                 np.ascontiguousarray(cs["prop"][:, P_KN]), np.ascontiguousarray(cs["prop"][:, P_KS]),
+                                 *contact_stiffness(cs, ss),
                                  ss["contact"], ss["pos"], ss["area"], rt, rr)
         if dt_fixed is None and s["scale_timestep"]:
             dt_fixed = float(s["scale_timestep"])

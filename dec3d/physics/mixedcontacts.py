@@ -10,7 +10,7 @@ import numpy as np
 
 from dec3d.kernels.gpcontact import (mixed_move_points, mixed_subcontact_forces, surface_weights,
                                     take_contact_forces, vertex_sides)
-from dec3d.kernels.joints import P_KN, P_KS
+from dec3d.physics.jmodels import stiffness as joint_stiffness
 from dec3d.kernels.motion import rigid_motion_groups
 from dec3d.kernels.rayleigh import mixed_stiffness_damping
 from dec3d.model.model import KIND_DEFORMABLE, KIND_FE
@@ -78,8 +78,7 @@ class MixedContactSteps:
         # the gridpoints the sub-contacts load (``_mixed_steps``), made once per detection
         touched = np.unique(np.concatenate((na.ravel(), nb.ravel())))
         self._mixed_touched = (out[0], np.ascontiguousarray(touched[touched >= 0]))
-        c = ss["contact"]
-        kk = np.maximum(cs["prop"][c, P_KN], cs["prop"][c, P_KS]) * ss["area"]
+        kk = np.maximum(*joint_stiffness(cs, ss)) * ss["area"]
         rows = np.concatenate((na.ravel(), nb.ravel()))
         kw = np.concatenate(((wa * kk[:, None]).ravel(), (wb * kk[:, None]).ravel()))
         on = rows >= 0
@@ -109,12 +108,12 @@ class MixedContactSteps:
             facc = zst.begin()
             mixed_subcontact_forces(dt, b["centroid"], b["velocity"], b["spin"], b["force"], b["moment"], gvel, gc,
                                     cs["a"], cs["b"], cs["normal"], cs["jmodel"], cs["prop"], ss["contact"], ss["pos"],
-                                    ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"],
+                                    ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"], ss["hist"],
                                     *wsub)
             if zst.beta > 0.0:          # Rayleigh damping's stiffness term (physics.dynamic)
                 mixed_stiffness_damping(zst.beta, b["centroid"], b["velocity"], b["spin"], b["force"], b["moment"],
-                                        gvel, gc, cs["a"], cs["b"], cs["normal"], cs["prop"], ss["contact"],
-                                        ss["pos"], ss["area"], ss["fn"], ss["state"], *wsub)
+                                        gvel, gc, cs["a"], cs["b"], cs["normal"], cs["jmodel"], cs["prop"],
+                                        ss["contact"], ss["pos"], ss["area"], ss["fn"], ss["state"], ss["hist"], *wsub)
             take_contact_forces(touched, gc, facc, zst.fmag)
             if len(gmember):
                 gbad = rigid_motion_groups(dt, g, full, damping, groups, bodies, vmax, out)

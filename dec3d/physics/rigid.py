@@ -31,7 +31,7 @@ from dec3d.model.zones import has_zones
 from .massscale import DensityScaling
 from .contacts import ContactDetection, contact_stores, default_row
 from .dynamic import DYN_DEFAULTS, rayleigh_coefficients
-from .jmodels import JOINT_MODELS
+from .jmodels import JOINT_MODELS, contact_stiffness, missing
 from .mixedcontacts import MixedContactSteps, _deformable
 from . import runcontrol as _runcontrol
 from .runcontrol import CycleInterrupted, _sigint_stops_cycling, _StopFlag
@@ -175,7 +175,7 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
         if c.n:
             on = live[c["a"]] | live[c["b"]]
             if on.any():
-                kn = max(kn, float(c["prop"][on][:, [P_KN, P_KS]].max()))
+                kn = max(kn, float(np.maximum(*contact_stiffness(c, self.subcontacts))[on].max()))
         f = self.model.faces
         fb = f["block"]
         fa = f["area"][(fb >= 0) & live[np.maximum(fb, 0)]]
@@ -325,6 +325,18 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
             out["ratio-local"] = RATIO_SCALE * float((un[on] / A[on]).max())
         out["ratio"] = out["ratio-average"]
         return out
+
+    def property_problem(self) -> str | None:
+        """Why the joints cannot run (a contact in use lacks a property its model needs), or None:
+        the run stops before its first step with this message (``jmodels.missing``)."""
+        cs = self.contacts
+        if self.model.blocks.n == 0 or cs.n == 0:
+            return None
+        follow = cs["own_props"] == 0
+        prop = cs["prop"].copy()
+        for code in np.unique(cs["jmodel"][follow]):
+            prop[follow & (cs["jmodel"] == code)] = default_row(self.settings(), int(code))
+        return missing(cs, prop)
 
     def stiffness_warning(self) -> str | None:
         """A warning when contacts in use (with sub-contacts) have zero normal or shear

@@ -144,6 +144,10 @@ class _Run:
         between = between and s.get("dt_mode", self.dt_mode) == self.dt_mode
         if self.mixed:
             self.wsub, self.wcon = eng._mixed_weights(self.zst, recompute=not between)
+        bad = eng.property_problem()
+        if bad:
+            from .rigid import RunError
+            raise RunError(bad)
         if warn is not None:
             msg = eng.stiffness_warning()
             if msg:

@@ -3,7 +3,7 @@ state bits, and the elastic trial step (3DEC theory Eqs. 24-27).
 
 A joint model's kernel file (a sibling of this one, see ``__init__``) reads its own columns
 from the property row; columns 0 and 1 are the stiffnesses of every model (the time step and
-the density scaling read them without knowing the model)."""
+the density scaling read them as the stiffness of a model that has no ``stiffness`` hook)."""
 from __future__ import annotations
 
 from numba import njit
@@ -18,6 +18,15 @@ ST_TENSION = 4
 #: which already hold the motion of the step just taken, so its first update adds no
 #: displacement increment (cleared by that update, before the law is called)
 ST_NEW = 8
+
+#: history columns of every sub-contact (``subcontacts.hist``): a model uses the first ``NHIST``
+NJHIST = 8
+
+
+@njit(cache=True, inline="always")
+def constant_stiffness(p, c, h, s):
+    """The stiffness of a model that has no hook of its own: columns 0, 1 of its row [Pa/m]."""
+    return p[c, P_KN], p[c, P_KS]
 
 
 @njit(cache=True, inline="always")

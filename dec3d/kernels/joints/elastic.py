@@ -8,10 +8,12 @@ from ._common import P_KN, P_KS, ST_SLIP, elastic_trial
 NAME = "elastic"
 CODE = 0          # kept in save files: never renumber
 NCOLS = 2         # property columns read: kn, ks
+NHIST = 0
+HIST_NAMES = ()
 
 
 @njit(cache=True, inline="always")
-def law(p, c, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
+def law(p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
     """Elastic trial; an opening joint (tensile normal force) carries nothing."""
     fn, fs0, fs1, fs2, un, us0, us1, us2 = elastic_trial(p[c, P_KN], p[c, P_KS], area, dun, dus0, dus1, dus2, un,
                                                          udil, fs0, fs1, fs2, us0, us1, us2)

@@ -28,10 +28,12 @@ P_TANF_RES = 7    # residual tan φ (NaN: the peak value)
 P_COH_RES = 8     # residual cohesion [Pa]
 P_TEN_RES = 9     # residual tensile strength [Pa]
 NCOLS = 10
+NHIST = 0         # no history beyond the shared sub-contact state
+HIST_NAMES = ()
 
 
 @njit(cache=True, inline="always")
-def law(p, c, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
+def law(p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
     """Elastic trial, then the Coulomb and tension limits."""
     kn = p[c, P_KN]
     tanf_r = p[c, P_TANF_RES]
