@@ -109,6 +109,9 @@ def jmodel_assign(session, call):
     c["jmodel"][sel] = jm.code
     c["prop"][sel] = default_row(mech(session.model), jm.code)
     c["own_props"][sel] = 0
+    ss = e.subcontacts
+    if ss.n:
+        ss["hist"][sel[ss["contact"]]] = 0.0        # the model's history starts afresh
     if call.range is None:
         mech(session.model)["jmodel"] = name
 
