@@ -146,7 +146,6 @@ class _Run:
             self.wsub, self.wcon = eng._mixed_weights(self.zst, recompute=not between)
         bad = eng.property_problem()
         if bad:
-            from .rigid import RunError
             raise RunError(bad)
         if warn is not None:
             msg = eng.stiffness_warning()

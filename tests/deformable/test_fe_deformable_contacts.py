@@ -110,7 +110,7 @@ def _kernel_node_forces(m):
     mixed_subcontact_forces(0.0, b["centroid"], b["velocity"], b["spin"], b["force"].copy(), b["moment"].copy(),
                             v["velocity"], gc, cs["a"], cs["b"], cs["normal"], cs["jmodel"], cs["prop"],
                             ss["contact"], ss["pos"], ss["area"], cp["fn"], cp["fs"], cp["un"], cp["udil"], cp["us"],
-                            cp["state"], ss["gp_a"], ss["gw_a"], ss["gp_b"], ss["gw_b"])
+                            cp["state"], ss["hist"].copy(), ss["gp_a"], ss["gw_a"], ss["gp_b"], ss["gw_b"])
     assert np.array_equal(cp["fn"], ss["fn"])
     feb_slave_forces(es["nodes"], es["slaves"], np.arange(es.n, dtype=np.int64), gc)
     return gc

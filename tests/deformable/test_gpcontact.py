@@ -84,7 +84,7 @@ def test_mixed_forces_go_to_gridpoints_by_weight_and_balance():
               fs=np.zeros((1, 3)), un=np.zeros(1), udil=np.zeros(1), us=np.zeros((1, 3)), state=np.zeros(1, np.int64))
     mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce, ca, cb, cn, np.array([0]), prop,
                             sc["contact"], sc["pos"], sc["area"], sc["fn"], sc["fs"], sc["un"], sc["udil"], sc["us"],
-                            sc["state"], na, wa, nb, wb)
+                            sc["state"], np.zeros((1, 8)), na, wa, nb, wb)
     f_b = _force_twin(dt, bvel[1], bspin[1], bpos[1], gvel, x, cn[0], 1e9, 5e8, 0.2, [0, 1, 2], lam)
     assert np.allclose(bforce[1], f_b, rtol=1e-12, atol=1e-6)
     assert np.allclose(bforce[0], 0.0)                                   # side A is zoned: nothing on its block

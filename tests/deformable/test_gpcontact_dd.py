@@ -109,7 +109,7 @@ def test_deformable_subcontact_forces_against_a_twin_and_balanced():
         gforce = np.zeros((nv, 3))
         mixed_subcontact_forces(dt, nothing3, nothing3, nothing3, nothing3.copy(), nothing3.copy(), gvel, gforce,
                                 ca, cb, cn, np.array([MODEL_MOHR]), prop, owner, pos, area, st["fn"], st["fs"],
-                                st["un"], st["udil"], st["us"], st["state"], na, wa, nb, wb)
+                                st["un"], st["udil"], st["us"], st["state"], np.zeros((nv, 8)), na, wa, nb, wb)
         want = np.zeros((nv, 3))
         for s in range(nv):
             (an, aw), (bn, bw) = sides[s]

@@ -77,7 +77,9 @@ def test_kernel_matches_twin():
     args = (ca, cb, cn, cprop, sc_contact, sc_pos, sc_area, sc_fn, sc_state, na, wa, nb, wb)
     wf, wm, wg = twin(beta, bpos, bvel, bspin, gvel, *args)
     bf, bm, gf = np.zeros((nbk, 3)), np.zeros((nbk, 3)), np.zeros((nv, 3))
-    mixed_stiffness_damping(beta, bpos, bvel, bspin, bf, bm, gvel, gf, *args)
+    cmodel, hist = np.arange(nc, dtype=np.int64) % 2, np.zeros((ns, 8))     # elastic and mohr: kn, ks constant
+    mixed_stiffness_damping(beta, bpos, bvel, bspin, bf, bm, gvel, gf, ca, cb, cn, cmodel, cprop, sc_contact, sc_pos,
+                            sc_area, sc_fn, sc_state, hist, na, wa, nb, wb)
     scale = np.abs(wg).max()
     assert scale > 0 and np.abs(wf).max() > 0                 # both kinds of side were loaded
     np.testing.assert_allclose(bf, wf, rtol=1e-12, atol=1e-12 * scale)
@@ -99,8 +101,9 @@ def test_rigid_on_gridpoints_balances_and_dissipates():
     wa = np.array([[0.2, 0.3, 0.5]])
     nb = np.full((1, 3), -1, np.int64)
     mixed_stiffness_damping(1e-3, bpos, bvel, bspin, bf, bm, gvel, gf, np.array([0]), np.array([1]),
-                            np.array([[0.0, 0, 1]]), cprop, np.array([0]), np.array([[0.0, 0, 1]]),
-                            np.array([0.5]), np.array([10.0]), np.array([0], np.int32), na, wa, nb, np.zeros((1, 3)))
+                            np.array([[0.0, 0, 1]]), np.array([1]), cprop, np.array([0]), np.array([[0.0, 0, 1]]),
+                            np.array([0.5]), np.array([10.0]), np.array([0], np.int32), np.zeros((1, 8)), na, wa, nb,
+                            np.zeros((1, 3)))
     assert bf[1] == pytest.approx([-1e-3 * 0.5 * 1e8 * 0.2, 0.0, 1e-3 * 0.5 * 4e8 * 0.1], rel=1e-14)
     np.testing.assert_allclose(gf.sum(axis=0), -bf[1], rtol=1e-14)
     np.testing.assert_allclose(gf[2], 0.5 * -bf[1], rtol=1e-14)

@@ -28,8 +28,9 @@ NEW = 8   # the state bit of a sub-contact whose uⁿ is a freshly measured gap
 
 
 def carry_over(cprev, sc_contact, kind, key0, key1, area, sgap, old_start, old_count, old_kind, old_key0,
-               old_key1, old_area, old_fs, old_un, old_udil, old_us, old_state, old_n, new_n):
+               old_key1, old_area, old_fs, old_un, old_udil, old_us, old_state, old_hist, old_n, new_n):
     ns = len(sc_contact)
+    hist = np.zeros((ns, old_hist.shape[1]))
     fs, us = np.zeros((ns, 3)), np.zeros((ns, 3))
     un, udil, state = np.zeros(ns), np.zeros(ns), np.zeros(ns, np.int64)
     for s in range(ns):
@@ -47,6 +48,7 @@ def carry_over(cprev, sc_contact, kind, key0, key1, area, sgap, old_start, old_c
             ratio = area[s] / old_area[o] if old_area[o] > 0 else 1.0
             fs[s] = _turn(old_fs[o], old_n[p], new_n[c]) * ratio
             us[s], un[s], udil[s], state[s] = old_us[o], old_un[o], old_udil[o], old_state[o]
+            hist[s] = old_hist[o]      # the joint model's history goes with its sub-contact
             continue
         atot = sum(old_area[o] for o in olds)
         if atot <= 0:
@@ -54,7 +56,9 @@ def carry_over(cprev, sc_contact, kind, key0, key1, area, sgap, old_start, old_c
         fs[s] = _turn(sum(old_fs[o] for o in olds), old_n[p], new_n[c]) / atot * area[s]
         udil[s] = sum(old_udil[o] * old_area[o] for o in olds) / atot
         state[s] = int(np.bitwise_or.reduce([old_state[o] & 1 for o in olds])) | NEW
-    return fs, un, udil, us, state
+        # a sub-contact new on an old contact: the area-weighted mean history of the contact's old ones
+        hist[s] = sum(old_hist[o] * old_area[o] for o in olds) / atot
+    return fs, un, udil, us, state, hist
 
 
 def move_points(dt, ca, cb, owner, pts, centroid, vel, spin):

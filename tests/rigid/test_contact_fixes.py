@@ -143,7 +143,7 @@ def test_new_subcontact_adds_no_increment_on_its_first_update():
     prop[0, P_KN] = prop[0, P_KS] = 1e9
     sc = dict(contact=np.zeros(1, np.int64), pos=np.array([[0.0, 0.0, 0.5]]), area=np.ones(1), fn=np.zeros(1),
               fs=np.zeros((1, 3)), un=np.array([-1e-4]), udil=np.zeros(1), us=np.zeros((1, 3)),
-              state=np.array([ST_NEW], np.int64))
+              state=np.array([ST_NEW], np.int64), hist=np.zeros((1, 8)))
 
     def update():
         subcontact_forces(dt, pos, vel, spin, force, moment, np.array([0]), np.array([1]),

@@ -46,6 +46,7 @@ def test_carry_over_against_twin(seed):
     old_fs, old_us = rng.normal(size=(nso, 3)), rng.normal(size=(nso, 3))
     old_un, old_udil = rng.normal(size=nso), rng.normal(size=nso)
     old_state = rng.integers(0, 8, nso)
+    old_hist = rng.normal(size=(nso, 8))
     old_n = rng.normal(size=(nold, 3))
     old_n /= np.linalg.norm(old_n, axis=1)[:, None]
     new_n = old_n[rng.integers(0, nold, nnew)] + 0.05 * rng.normal(size=(nnew, 3))
@@ -57,9 +58,10 @@ def test_carry_over_against_twin(seed):
     key1 = rng.integers(0, 3, 30)
     area = rng.uniform(0.1, 1.0, 30)
     sgap = rng.normal(size=30) * 1e-3
-    out = (np.empty((30, 3)), np.empty(30), np.empty(30), np.empty((30, 3)), np.empty(30, np.int64))
+    out = (np.empty((30, 3)), np.empty(30), np.empty(30), np.empty((30, 3)), np.empty(30, np.int64),
+           np.empty((30, 8)))
     args = (cprev, sc_contact, kind, key0, key1, area, sgap, old_start, old_count, old_kind, old_key0, old_key1,
-            old_area, old_fs, old_un, old_udil, old_us, old_state, old_n, new_n)
+            old_area, old_fs, old_un, old_udil, old_us, old_state, old_hist, old_n, new_n)
     carry_over(*args, *out)
     want = ref.carry_over(*args)
     for got, exp in zip(out, want):
@@ -198,7 +200,7 @@ def test_run_steps_against_the_cycle_written_from_the_equations(session):
            "verts": m.vertices["pos"], "out": np.zeros(4),
            "contacts": dict(a=cs["a"], b=cs["b"], normal=cs["normal"], pos=cs["pos"], jmodel=cs["jmodel"],
                             prop=cs["prop"]),
-           "sub": {k: ss[k] for k in ("contact", "pos", "area", "fn", "fs", "un", "udil", "us", "state")}}
+           "sub": {k: ss[k] for k in ("contact", "pos", "area", "fn", "fs", "un", "udil", "us", "state", "hist")}}
     st0 = copy.deepcopy(st0)                      # plain copies of every array
     fast, slow = copy.deepcopy(st0), copy.deepcopy(st0)
     g, dt, n = np.array([0.0, 0.0, -10.0]), e.timestep(), 40

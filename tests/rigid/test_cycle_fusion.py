@@ -52,7 +52,7 @@ def state(tmp_path_factory):
                                              "centroid", "disp", "vert_start", "vert_count")},
           "vpos": np.array(m.vertices["pos"]),
           "c": {k: np.array(cs[k]) for k in ("a", "b", "normal", "pos", "jmodel", "prop")},
-          "s": {k: np.array(ss[k]) for k in ("contact", "pos", "area", "fn", "fs", "un", "udil", "us", "state")},
+          "s": {k: np.array(ss[k]) for k in ("contact", "pos", "area", "fn", "fs", "un", "udil", "us", "state", "hist")},
           "g": dict(start=gstart, member=gmember, mass=rng.uniform(2e3, 3e3, ng), imass=rng.uniform(3e3, 4e3, ng),
                     iscalar=rng.uniform(500, 900, ng), prin=rng.uniform(400, 500, (ng, 3)),
                     axes=np.repeat(np.eye(3)[None], ng, axis=0), centroid=np.zeros((ng, 3))),
@@ -146,13 +146,14 @@ def test_contact_pass_equals_moving_the_points_then_the_joint_law(state, threads
     cycle._move_points(dt, c["a"], c["b"], s["contact"], s["pos"], b["centroid"], b["velocity"], b["spin"])
     subcontact_update(dt, b["centroid"], b["velocity"], b["spin"], c["a"], c["b"], c["normal"], c["jmodel"],
                       c["prop"], s["contact"], s["pos"], s["area"], s["fn"], s["fs"], s["un"], s["udil"], s["us"],
-                      s["state"], sg)
+                      s["state"], s["hist"], sg)
     b, c, s = fus["b"], fus["c"], fus["s"]
     sg2 = np.empty_like(sg)
     cstart = cycle.contact_ranges(len(c["a"]), s["contact"])
     kernel = cycle._contact_pass if threads > 1 else cycle._run_steps_1.py_func.__globals__["_contact_pass"]
     kernel(True, dt, b["centroid"], b["velocity"], b["spin"], c["a"], c["b"], c["normal"], c["pos"], c["jmodel"],
-           c["prop"], cstart, s["pos"], s["area"], s["fn"], s["fs"], s["un"], s["udil"], s["us"], s["state"], sg2)
+           c["prop"], cstart, s["pos"], s["area"], s["fn"], s["fs"], s["un"], s["udil"], s["us"], s["state"], s["hist"],
+           sg2)
     assert _same(sep, fus) == [] and np.array_equal(sg, sg2)
     assert not np.array_equal(sep["s"]["pos"], st["s"]["pos"])          # the points did move
     assert (sep["s"]["fn"] > 0).sum() >= 8                               # and carry load

@@ -82,7 +82,7 @@ def test_chunked_subcontacts_equal_one_pass(case, monkeypatch):
 def _gather_ref(base, starts, counts, nold, old, new):
     """Plain twin of ``gather_subcontacts``: row by row, contact by contact, in Python."""
     total = int(sum(counts))
-    names = ("kind", "key0", "key1", "pos", "area", "fn", "fs", "un", "udil", "us", "state")
+    names = ("kind", "key0", "key1", "pos", "area", "fn", "fs", "un", "udil", "us", "state", "hist")
     out = {"contact": [None] * total}
     out.update({k: [None] * total for k in names})
     for c in range(len(counts)):
@@ -107,7 +107,7 @@ def _gather_case(seed):
     def rows(n, fn=True):
         r = [rng.integers(0, 4, n), rng.integers(-5, 99, n), rng.integers(-5, 99, n), rng.normal(size=(n, 3)),
              rng.uniform(0, 1, n), rng.normal(size=n), rng.normal(size=(n, 3)), rng.normal(size=n),
-             rng.normal(size=n), rng.normal(size=(n, 3)), rng.integers(0, 8, n)]
+             rng.normal(size=n), rng.normal(size=(n, 3)), rng.integers(0, 8, n), rng.normal(size=(n, 8))]
         return tuple(r if fn else r[:5] + r[6:])
 
     old, new = rows(nold), rows(nnew, fn=False)
@@ -123,9 +123,9 @@ def test_gather_subcontacts_kernel_against_its_twin(seed):
     base, starts, counts, nold, old, new = _gather_case(seed)
     want = _gather_ref(base, starts, counts, nold, old, new)
     total = int(counts.sum())
-    shapes = {"pos": 3, "fs": 3, "us": 3}
+    shapes = {"pos": 3, "fs": 3, "us": 3, "hist": 8}
     ints = {"contact", "kind", "key0", "key1", "state"}
-    names = ("contact", "kind", "key0", "key1", "pos", "area", "fn", "fs", "un", "udil", "us", "state")
+    names = ("contact", "kind", "key0", "key1", "pos", "area", "fn", "fs", "un", "udil", "us", "state", "hist")
     for cuts in ([0, 25], [0, 3, 11, 25], [0, 0, 24, 25]):     # in one piece, in three, with an empty one
         out = tuple(np.full((total, shapes[k]) if k in shapes else total, -9, np.int64 if k in ints else float)
                     for k in names)

@@ -89,7 +89,8 @@ def test_contact_kernels_against_slow_twins(seed):
         u += e
         uf += e if d["flag"][s] else 0.0
         corr += (d["fn"][s] * d["cn"][c] + d["fs"][s]) @ slow_du[s]
-    got = K.contact_strain(d["cn"], d["prop"], d["sc"], d["area"], d["fn"], d["fs"], du, d["flag"])
+    got = K.contact_strain(d["cn"], np.ones(len(d["prop"]), np.int64), d["prop"], d["sc"], d["area"], d["fn"], d["fs"],
+                           np.zeros((len(d["sc"]), 8)), du, d["flag"])
     assert np.allclose(got, (u, u - corr / 2, uf), rtol=1e-12)
     w = wf = 0.0
     for s, c in enumerate(d["sc"]):

@@ -14,24 +14,34 @@ from dec3d.kernels import joints
 from dec3d.physics.jmodels import JOINT_MODELS, MODEL_BY_CODE
 
 KERNEL = '''
-"""Test model: linear elastic joint that also carries tension (no cut-off)."""
+"""Test model: linear elastic joint that also carries tension (no cut-off), remembers the largest
+opening of each sub-contact (its history) and answers a softer normal stiffness while open."""
 from numba import njit
 
 from ._common import P_KN, P_KS, elastic_trial
 
 NAME = "linear-tension"
-CODE = 7
+CODE = 99
 NCOLS = 3
+NHIST = 1
+HIST_NAMES = ("max-opening",)
 P_FACTOR = 2      # tension stiffness as a fraction of kn
 
 
 @njit(cache=True)
-def law(p, c, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
+def law(p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
     fn, fs0, fs1, fs2, un, us0, us1, us2 = elastic_trial(p[c, P_KN], p[c, P_KS], area, dun, dus0, dus1, dus2, un,
                                                          udil, fs0, fs1, fs2, us0, us1, us2)
     if fn < 0.0:
         fn *= p[c, P_FACTOR]
+    if un > h[s, 0]:
+        h[s, 0] = un
     return fn, fs0, fs1, fs2, un, udil, us0, us1, us2, state
+
+
+@njit(cache=True)
+def stiffness(p, c, h, s):
+    return p[c, P_KN] * (p[c, P_FACTOR] if h[s, 0] > 0.0 else 1.0), p[c, P_KS]
 '''
 
 HOST = '''
@@ -57,7 +67,8 @@ model cycle 20
 
 
 def test_models_found_by_listing_and_registered_once():
-    assert [m.NAME for m in joints.MODELS] == ["elastic", "mohr"]
+    assert [m.NAME for m in joints.MODELS][:2] == ["elastic", "mohr"]
+    assert [m.CODE for m in joints.MODELS] == sorted(m.CODE for m in joints.MODELS)
     assert set(JOINT_MODELS) == {m.NAME for m in joints.MODELS}
     assert {c: m.name for c, m in MODEL_BY_CODE.items()} == {m.CODE: m.NAME for m in joints.MODELS}
     assert joints.NPROP == max(m.NCOLS for m in joints.MODELS)
@@ -67,12 +78,13 @@ def test_dispatch_calls_each_models_own_law():
     """The chain picks the law by code: elastic drops tension, mohr limits shear."""
     p = np.zeros(joints.NPROP)
     p[0] = p[1] = 1e9
-    opened = joints.joint_law(joints.CODES["elastic"], p[None, :], 0, 1.0, 1e-6, 0.0, 0.0, 0.0, 0.0, 0.0,
+    h = np.zeros((1, joints.NJHIST))
+    opened = joints.joint_law(joints.CODES["elastic"], p[None, :], 0, h, 0, 1.0, 1e-6, 0.0, 0.0, 0.0, 0.0, 0.0,
                               0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0)
     assert opened[0] == 0.0 and opened[4] == pytest.approx(1e-6)
     p[joints.mohr.P_TANF] = 0.5
     p[joints.mohr.P_TANF_RES] = np.nan          # residual friction = the friction
-    sheared = joints.joint_law(joints.CODES["mohr"], p[None, :], 0, 1.0, -1e-6, 1e-5, 0.0, 0.0, 0.0, 0.0,
+    sheared = joints.joint_law(joints.CODES["mohr"], p[None, :], 0, h, 0, 1.0, -1e-6, 1e-5, 0.0, 0.0, 0.0, 0.0,
                                0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0)
     assert sheared[0] == pytest.approx(1e3) and abs(sheared[1]) == pytest.approx(500.0)   # Fs = Fn tan φ
 
@@ -90,8 +102,12 @@ def test_a_new_model_is_two_new_files(tmp_path):
         from dec3d.session import Session
         s = Session()
         s.call("pull.dat")
-        sc = s.model.rigid_engine.subcontacts
-        print("FN", sc["fn"].sum(), "N", sc.n)
+        from dec3d.physics.jmodels import stiffness
+        e = s.model.rigid_engine
+        sc = e.subcontacts
+        kn = stiffness(e.contacts, sc)[0]
+        print("FN", sc["fn"].sum(), "N", sc.n, "H", sc["hist"][:, 0].min(), sc["hist"][:, 0].max(), "KN", kn.min(), kn.max(),
+              "DT", e.timestep())
     ''')
     env = dict(os.environ, NUMBA_DISABLE_JIT="1", PYTHONPATH=str(tmp_path))
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env,
@@ -100,3 +116,9 @@ def test_a_new_model_is_two_new_files(tmp_path):
     fn = float(out.stdout.split("FN")[1].split()[0])
     # opening 19-20 steps at 1e-3 m/s over 1 m² at 0.5 kn: a tensile force, which mohr/elastic would drop
     assert fn < 0.0
+    # the history: every sub-contact remembers its opening (un starts at the gap, 0, and grows by v Δt a step)
+    words = out.stdout.split()
+    hmin, hmax = float(words[words.index("H") + 1]), float(words[words.index("H") + 2])
+    assert 0.0 < hmin <= hmax < 20 * 1e-3 * 1.0
+    # and the stiffness hook answers for the open sub-contacts: kn × tension-factor
+    assert float(words[words.index("KN") + 1]) == float(words[words.index("KN") + 2]) == pytest.approx(0.5e9)

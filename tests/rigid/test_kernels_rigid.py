@@ -147,7 +147,7 @@ def test_coulomb_kernel_matches_scalar_reference():
             dus = rng.normal(size=3) * 5e-6 + np.array([4e-6, 0, 0]) * (1 if step < 300 else -1)
             dus[2] = 0.0
             fn, f0, f1, f2, un, ud, u0, u1, u2, st = joint_law(
-                mcode, prow[None, :], 0, 0.25, dun, dus[0], dus[1], dus[2],
+                mcode, prow[None, :], 0, np.zeros((1, 8)), 0, 0.25, dun, dus[0], dus[1], dus[2],
                 st_k["un"], st_k["udil"], *st_k["fs"], *st_k["us"], st_k["state"])
             st_k.update(un=un, udil=ud, fs=np.array([f0, f1, f2]), us=np.array([u0, u1, u2]), state=st)
             rfn, rfs, run, rud, rus, rfail, _ = coulomb_ref(p, model, 0.25, dun, dus, st_r["un"], st_r["udil"],

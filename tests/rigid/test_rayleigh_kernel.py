@@ -50,8 +50,9 @@ def test_kernel_matches_twin():
     beta = 3.7e-4
     want = twin(beta, bpos, bvel, bspin, ca, cb, cn, cprop, sc_contact, sc_pos, sc_area, sc_fn, sc_state, sg)
     got = sg.copy()
-    contact_stiffness_damping(beta, bpos, bvel, bspin, ca, cb, cn, cprop, sc_contact, sc_pos, sc_area, sc_fn,
-                              sc_state, got)
+    cmodel = np.arange(nc, dtype=np.int64) % 2           # elastic and mohr: kn, ks constant
+    contact_stiffness_damping(beta, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop, sc_contact, sc_pos, sc_area, sc_fn,
+                              sc_state, np.zeros((ns, 8)), got)
     np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-9)
     assert not np.array_equal(got, sg)                       # it did something
     assert np.array_equal(got[sc_fn <= 0], sg[sc_fn <= 0])  # open sub-contacts untouched
@@ -67,7 +68,7 @@ def test_damping_force_opposes_relative_motion():
     cprop[0, :2] = 2e8, 1e8
     sg = np.zeros((1, 3))
     contact_stiffness_damping(1e-3, bpos, bvel, bspin, np.array([0]), np.array([1]), np.array([[0.0, 0, 1]]),
-                              cprop, np.array([0]), np.array([[0.0, 0, 0.5]]), np.array([0.25]), np.array([5.0]),
-                              np.array([0], np.int32), sg)
+                              np.array([1]), cprop, np.array([0]), np.array([[0.0, 0, 0.5]]), np.array([0.25]),
+                              np.array([5.0]), np.array([0], np.int32), np.zeros((1, 8)), sg)
     assert sg[0, 2] == 1e-3 * 0.25 * 2e8 * 0.2 and sg[0, 0] == -1e-3 * 0.25 * 1e8 * 0.3
     assert sg[0] @ bvel[1] < 0
