@@ -337,7 +337,16 @@ def _c_prop(rt, c, name):
 @intrinsic("block.subcontact.prop", 2)
 def _s_prop(rt, s, name):
     """The property of the sub-contact's contact (3DEC keeps joint properties per sub-contact; dec3d per
-    contact, so every sub-contact of a contact reads the same value)."""
-    _sub_row(rt, s, "block.subcontact.prop")
+    contact, so every sub-contact of a contact reads the same value), or an entry of the sub-contact's
+    own joint-model history by the name its model gives it (e.g. a damage or a plastic displacement)."""
+    ss, k = _sub_row(rt, s, "block.subcontact.prop")
     cs, r = _contact_row(rt, ContactPtr("contact", s.key[:2], s.hint), "block.subcontact.prop")
+    m = JMODELS[0](int(cs["jmodel"][r])) if JMODELS[0] is not None else None
+    if type(name) is str and m is not None:
+        hist = [h.lower() for h in m.hist_names]
+        if name.lower() in hist:
+            return float(ss["hist"][k, hist.index(name.lower())])
+        if name.lower() not in m.props and hist:
+            raise FishValueError(f"`block.subcontact.prop`: joint model `{m.name}` has no property or history "
+                                 f"'{name}' (it has {', '.join(sorted(m.props) + list(m.hist_names))})")
     return _prop(rt, cs, r, name, "block.subcontact.prop")

@@ -12,7 +12,9 @@ Point data, per sub-contact:
 - ``normal`` (the contact's unit normal, A → B), ``normal_force`` [N, compression positive],
   ``normal_stress`` [Pa, Fⁿ/area], ``shear_force`` (vector on B) and ``shear_force_magnitude``,
   ``normal_displacement`` [m], ``shear_displacement`` (accumulated vector) and
-  ``shear_displacement_magnitude`` [m].
+  ``shear_displacement_magnitude`` [m];
+- ``jmodel`` (the joint model's code) and each joint model's history entries under the names its
+  kernel gives them (``HIST_NAMES`` of ``kernels/joints``), 0 on the sub-contacts of other models.
 
 Arrays are written like ``dec3d.io.vtk``'s (inline base64, numeric only), so ParaView, PyVista
 and meshio read them; a model with no sub-contacts gives a valid file with no points."""
@@ -54,8 +56,25 @@ def contact_point_data(model) -> tuple[np.ndarray, dict]:
         "shear_force": s["fs"][rows], "shear_force_magnitude": np.linalg.norm(s["fs"][rows], axis=1),
         "normal_displacement": s["un"][rows], "shear_displacement": s["us"][rows],
         "shear_displacement_magnitude": np.linalg.norm(s["us"][rows], axis=1),
+        "jmodel": c["jmodel"][ci].astype(np.int32),
     }
+    if "hist" in s:
+        data.update(_joint_history(c["jmodel"][ci], s["hist"][rows]))
     return s["pos"][rows], data
+
+
+def _joint_history(codes, hist) -> dict:
+    """The joint models' history entries, one array per name (a name two models share is one)."""
+    from dec3d.kernels.joints import MODELS
+    out: dict = {}
+    for k in MODELS:
+        mine = codes == k.CODE
+        if not k.NHIST or not mine.any():
+            continue
+        for j, name in enumerate(k.HIST_NAMES):
+            col = out.setdefault(name, np.zeros(len(codes)))
+            col[mine] = hist[mine, j]
+    return out
 
 
 def write_contacts_vtu(model, path: str | os.PathLike) -> str:
