@@ -116,6 +116,45 @@ def jmodel_assign(session, call):
         mech(session.model)["jmodel"] = name
 
 
+def _plugin_name(raw: str) -> str:
+    """The model a plugin file name stands for: its base name without directory and extension, and
+    without 3DEC's ``jmodel`` file-name prefix (``jmodelmason.dll``, ``jmodel_mason_v8.dll`` → ``mason``,
+    ``mason_v8``)."""
+    import os
+    import re
+
+    base = os.path.basename(raw.replace("\\", "/"))
+    base = re.sub(r"\.(dll|so|dylib)$", "", base, flags=re.IGNORECASE)
+    for pre in ("jmodel_", "jmodel-", "jmodel"):
+        if base.lower().startswith(pre) and len(base) > len(pre):
+            base = base[len(pre):]
+            break
+    return base.lower()
+
+
+@command("block contact jmodel load", positional=[P("name", Text(), "plugin file or model name", required=True)],
+         doc="3DEC's loader of joint-model plugins (DLLs): accepted for the models dec3d has built in, "
+             "refused for any other.",
+         details="dec3d runs no compiled plugin: a deck or a file from someone else never runs foreign code. "
+                 "When the plugin is one of dec3d's own models (by its name, an alias such as `mason_v8`, or a "
+                 "file name such as `jmodelmason.dll`) the command does nothing and `jmodel assign` takes the "
+                 "name; any other plugin stops the deck with the list of built-in models.",
+         examples=["block contact jmodel load 'mason'"])
+def jmodel_load(session, call):
+    from ..errors import NotSupportedError
+
+    raw = str(call.args["name"])
+    where = call.locations.get("name", call.location)
+    name = _plugin_name(raw)
+    if name in JOINT_MODELS or name in ALIASES:
+        return
+    if name in REFUSED:
+        raise NotSupportedError(REFUSED[name], where, hint=f"built in: {', '.join(JOINT_MODELS)}")
+    raise NotSupportedError(f"joint-model plugin '{raw}' cannot be loaded: dec3d runs no compiled plugins, and "
+                            f"'{name}' is not one of its built-in joint models", where,
+                            hint=f"built in: {', '.join(JOINT_MODELS)}")
+
+
 @command("block contact property", keywords=_KW, open_keywords=True, range="contact",
          doc="Set joint properties of the contacts in range (stiffness Pa/m, stress Pa, angles in degrees).",
          details="Without a range the values also become the defaults of contacts created later. Names not "
