@@ -41,7 +41,7 @@ def rows_for(name: str, n: int) -> np.ndarray:
     return np.tile(m.row(vals), (n, 1))
 
 
-@njit(cache=True)
+@njit   # (not cached: its cache would not know when a joint model's file changes)
 def _run(model, p, h, steps, area, un, udil, fs, us, state, fn_out):
     n = p.shape[0]
     for k in range(steps):
