@@ -27,12 +27,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import get_num_threads, njit, prange
+from numba import get_num_threads, literally, njit, prange
 from numba.core.cpu import ParallelOptions
 
 from dec3d.config import threading_layer
 
 from .bundles import Fused
+from .joints import model_mask
 from .jointlaw import block_lists, block_sum, update_one
 from .motion import rigid_motion_groups
 from .rayleigh import contact_stiffness_damping
@@ -98,12 +99,14 @@ def _move_points(dt, ca, cb, owner, pts, centroid, vel, spin):
 
 
 @njit(cache=True, parallel=True)
-def _contact_pass(move, dt, centroid, vel, spin, ca, cb, cn, cc, cmodel, cprop, cstart,
+def _contact_pass(models, move, dt, centroid, vel, spin, ca, cb, cn, cc, cmodel, cprop, cstart,
                   sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg):
     """One parallel loop over the contacts: when ``move``, first Eq. (11) for the contact point and
     the sub-contact points (the motion of the step before), then the joint law of each sub-contact
     (``jointlaw.update_one``; force on B to sg). The sub-contacts of contact c are rows
-    cstart[c]:cstart[c + 1] (``contact_ranges``). Each contact writes only its own rows."""
+    cstart[c]:cstart[c + 1] (``contact_ranges``). Each contact writes only its own rows. ``models``:
+    the mask of the joint models (a literal: ``_run_steps``)."""
+    literally(models)
     for c in prange(ca.shape[0]):
         a = ca[c]
         b = cb[c]
@@ -112,7 +115,7 @@ def _contact_pass(move, dt, centroid, vel, spin, ca, cb, cn, cc, cmodel, cprop, 
         for s in range(cstart[c], cstart[c + 1]):
             if move:
                 _move_point(dt, a, b, sc_pos, s, centroid, vel, spin)
-            update_one(s, c, a, b, dt, centroid, vel, spin, cn, cmodel, cprop,
+            update_one(models, s, c, a, b, dt, centroid, vel, spin, cn, cmodel, cprop,
                        sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg)
 
 
@@ -135,7 +138,7 @@ def contact_ranges(nc, sc_contact):
 
 
 @njit(cache=True)
-def _run_steps(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies, contacts, subs, bounds, vmax, out,
+def _run_steps(models, nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies, contacts, subs, bounds, vmax, out,
                bstart, bent, cstart, orphans, sg, step):
     """Take up to ``nsteps`` steps of Δt = dt [s]. Bundles (``kernels.bundles``): damping, groups,
     bodies as ``rigid_motion_groups`` takes them; contacts (``Contacts``: pos (nc, 3) the contact
@@ -162,7 +165,13 @@ def _run_steps(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies,
     the joint law, ``_contact_pass``) and over groups (block sums, motion, clearing the forces,
     step motion: ``rigid_motion_groups`` with ``Fused``); the points of the last step move
     before returning.
+
+    ``models``: the mask of the joint models among the contacts (``joints.model_mask``), a
+    compile-time constant (numba's ``literally``): a deck compiles the cycle for the joint laws it
+    uses, once (cached), not for every law in the folder (``run_steps`` reaches it through
+    ``_stepper``).
     """
+    literally(models)
     gstart, gmember = groups.start, groups.member
     centroid, vel, spin, force, moment = bodies.centroid, bodies.vel, bodies.spin, bodies.force, bodies.moment
     ca, cb, cn, cc, cown, cmodel, cprop = contacts
@@ -174,7 +183,7 @@ def _run_steps(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies,
     fused = Fused(bstart, bent, sc_pos, sg, radius, step)
     pending = False             # the points still have to move with the last step's motion
     for _ in range(nsteps):
-        _contact_pass(pending, dt, centroid, vel, spin, ca, cb, cn, cc, cmodel, cprop, cstart,
+        _contact_pass(models, pending, dt, centroid, vel, spin, ca, cb, cn, cc, cmodel, cprop, cstart,
                       sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg)
         pending = False
         if beta > 0.0:
@@ -225,17 +234,53 @@ def cycle_lists(nb, contacts, subs, gmember):
 
 
 def run_steps(nsteps, dt, gravity, full_inertia, damping, groups, bodies, contacts, subs, bounds, vmax, out,
-              beta=0.0, lists=None):
+              beta=0.0, lists=None, models=None):
     """``_run_steps`` (the kernel, documented there); a small model (``SERIAL_BELOW``), or any
     model on one thread, runs its serial twin ``_run_steps_1`` (the same numbers: every sum has a
-    fixed order). ``lists``: ``cycle_lists`` of these contacts (made here when None)."""
+    fixed order). ``lists``: ``cycle_lists`` of these contacts (made here when None); ``models``:
+    the mask of their joint models (``joints.model_mask``; worked out here when None)."""
     if lists is None:
         lists = cycle_lists(bodies.centroid.shape[0], contacts, subs, groups.member)
+    if models is None:
+        models = model_mask(contacts.jmodel)
     args = (nsteps, dt, gravity, bool(full_inertia), float(beta), damping, groups, bodies, contacts, subs,
             bounds, vmax, out) + tuple(lists)
-    if get_num_threads() > 1 and subs.contact.shape[0] + 4 * groups.member.shape[0] >= serial_below():
-        return _run_steps(*args)
-    return _run_steps_1(*args)
+    par = get_num_threads() > 1 and subs.contact.shape[0] + 4 * groups.member.shape[0] >= serial_below()
+    return _stepper(int(models), par)(*args)
+
+
+_STEPPERS: dict = {}
+
+
+def _stepper(models: int, parallel: bool):
+    """``_run_steps`` (or its serial twin) with the joint-model mask fixed. Called from Python with
+    the mask as a plain integer, the kernel would be typed with an integer first at every call and
+    only then with the literal it asks for (about a second a call); this small jitted function
+    passes the mask as a constant and reaches the literal specialization at once. One per mask
+    and process; cached on disk like the kernel (numba keys a closure's cache entry on the values
+    it closes over: each mask has its own)."""
+    f = _STEPPERS.get((models, parallel))
+    if f is None:
+        f = _STEPPERS[(models, parallel)] = (_parallel_stepper if parallel else _serial_stepper)(int(models))
+    return f
+
+
+def _parallel_stepper(mask):
+    @njit(cache=True)
+    def step_parallel(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies, contacts, subs, bounds, vmax,
+                      out, bstart, bent, cstart, orphans, sg, step):
+        return _run_steps(mask, nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies, contacts, subs,
+                          bounds, vmax, out, bstart, bent, cstart, orphans, sg, step)
+    return step_parallel
+
+
+def _serial_stepper(mask):
+    @njit(cache=True)
+    def step_serial(nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies, contacts, subs, bounds, vmax,
+                    out, bstart, bent, cstart, orphans, sg, step):
+        return _run_steps_1(mask, nsteps, dt, gravity, full_inertia, beta, damping, groups, bodies, contacts, subs,
+                            bounds, vmax, out, bstart, bent, cstart, orphans, sg, step)
+    return step_serial
 
 
 #: numba's parallel pipeline with every transformation off: ``prange`` runs as ``range`` and

@@ -27,9 +27,9 @@ from __future__ import annotations
 
 import math
 
-from numba import njit, prange
+from numba import literally, njit, prange
 
-from .joints import ST_NEW, joint_law
+from .joints import ST_NEW, joint_law_for, model_mask
 
 
 @njit(cache=True)
@@ -143,11 +143,44 @@ def vertex_sides(kind, key0, ca, cb, sc_contact, zoned, nodes_a, w_a, nodes_b, w
         w[s, 2] = 0.0
 
 
-@njit(cache=True, parallel=True)
 def mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce,
                             ca, cb, cn, cmodel, cprop,
                             sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist,
-                            nodes_a, w_a, nodes_b, w_b):
+                            nodes_a, w_a, nodes_b, w_b, models=None):
+    """``_mixed_subcontact_forces`` (the kernel, documented there) for the joint models of the mask
+    ``models`` (``joints.model_mask``; worked out from cmodel when None)."""
+    if models is None:
+        models = model_mask(cmodel)
+    _mixed_for(int(models))(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce, ca, cb, cn, cmodel, cprop,
+                            sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist,
+                            nodes_a, w_a, nodes_b, w_b)
+
+
+_MIXED: dict = {}
+
+
+def _mixed_for(models: int):
+    """The kernel with the mask fixed (a constant: see ``cycle._stepper``), one per mask and process,
+    cached on disk."""
+    f = _MIXED.get(models)
+    if f is None:
+        mask = int(models)
+
+        @njit(cache=True)
+        def f(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce, ca, cb, cn, cmodel, cprop, sc_contact, sc_pos,
+              sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, nodes_a, w_a, nodes_b, w_b):
+            _mixed_subcontact_forces(mask, dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce, ca, cb, cn, cmodel,
+                                     cprop, sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us,
+                                     sc_state, sc_hist, nodes_a, w_a, nodes_b, w_b)
+        _MIXED[models] = f
+    return f
+
+
+@njit(cache=True, parallel=True)
+def _mixed_subcontact_forces(models, dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce,
+                             ca, cb, cn, cmodel, cprop,
+                             sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist,
+                             nodes_a, w_a, nodes_b, w_b):
     """One force update of every sub-contact when some blocks are zoned: as
     ``jointlaw.subcontact_forces``, with each zoned side's velocity interpolated from its
     gridpoints (gvel (nv, 3)) and its force shared to them (added to gforce (nv, 3)).
@@ -155,7 +188,9 @@ def mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce
     (Both sides are written out in one loop over ``side`` rather than through a helper that
     returns a tuple: numba compiled that form some 40 times slower.) The joint laws run on
     threads (each sub-contact's own numbers); the forces are then added to the gridpoints and
-    blocks in sub-contact order, as before: the same bits for any thread count."""
+    blocks in sub-contact order, as before: the same bits for any thread count. ``models``: the mask
+    of the joint models among the contacts, a compile-time constant (``joints.joint_law_for``)."""
+    literally(models)
     for s in prange(sc_contact.shape[0]):
         c = sc_contact[s]
         n0 = cn[c, 0]
@@ -198,8 +233,8 @@ def mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce
             du2 = 0.0
             dun = 0.0
             st0 &= ~ST_NEW
-        fn, f0, f1, f2, un, ud, u0, u1, u2, st = joint_law(
-            cmodel[c], cprop, c, sc_hist, s, sc_area[s], dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s],
+        fn, f0, f1, f2, un, ud, u0, u1, u2, st = joint_law_for(
+            models, cmodel[c], cprop, c, sc_hist, s, sc_area[s], dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s],
             sc_udil[s], sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
         sc_fn[s] = fn
         sc_fs[s, 0] = f0

@@ -23,14 +23,15 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .joints import ST_NEW, joint_law, joint_stiffness
+from .joints import ALL_MODELS, ST_NEW, joint_law_for, joint_stiffness
 
 
 @njit(cache=True, inline="always")   # (inlined into each caller's loop: the call costs as much as the work)
-def update_one(s, c, a, b, dt, bpos, bvel, bspin, cn, cmodel, cprop,
+def update_one(models, s, c, a, b, dt, bpos, bvel, bspin, cn, cmodel, cprop,
                sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg):
     """The joint law of sub-contact s of contact c (blocks a = A, b = B): its rows of sc_* updated,
-    the force on B to sg[s] [N] (``subcontact_update`` for one sub-contact)."""
+    the force on B to sg[s] [N] (``subcontact_update`` for one sub-contact). ``models``: the mask
+    of the joint models that may come up (a literal, ``joints.joint_law_for``)."""
     n0 = cn[c, 0]
     n1 = cn[c, 1]
     n2 = cn[c, 2]
@@ -64,8 +65,8 @@ def update_one(s, c, a, b, dt, bpos, bvel, bspin, cn, cmodel, cprop,
         du2 = 0.0
         dun = 0.0
         st0 &= ~ST_NEW
-    fn, f0, f1, f2, un, ud, u0, u1, u2, st = joint_law(
-        cmodel[c], cprop, c, sc_hist, s, sc_area[s], dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s],
+    fn, f0, f1, f2, un, ud, u0, u1, u2, st = joint_law_for(
+        models, cmodel[c], cprop, c, sc_hist, s, sc_area[s], dun, du0 - dun * n0, du1 - dun * n1, du2 - dun * n2, sc_un[s],
         sc_udil[s], sc_fs[s, 0], sc_fs[s, 1], sc_fs[s, 2], sc_us[s, 0], sc_us[s, 1], sc_us[s, 2], st0)
     sc_fn[s] = fn
     sc_fs[s, 0] = f0
@@ -90,7 +91,7 @@ def subcontact_update(dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
     force on B of sub-contact s goes to sg (ns, 3) [N] for ``block_sums``."""
     for s in prange(sc_contact.shape[0]):
         c = sc_contact[s]
-        update_one(s, c, ca[c], cb[c], dt, bpos, bvel, bspin, cn, cmodel, cprop,
+        update_one(ALL_MODELS, s, c, ca[c], cb[c], dt, bpos, bvel, bspin, cn, cmodel, cprop,
                    sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg)
 
 

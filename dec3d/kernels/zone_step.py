@@ -272,12 +272,12 @@ def zone_step_for(models: int):
     force, fmag)``. Called from Python with the mask as a plain integer, ``zone_step`` would type
     it as an integer first at every call and only then as the literal it asks for (about a
     second a call); a small jitted function that passes the mask as a constant reaches the
-    literal specialization at once. One per mask and process (the step itself is cached on disk)."""
+    literal specialization at once. One per mask and process, cached on disk like the step."""
     step = _STEPS.get(models)
     if step is None:
         mask = int(models)
 
-        @njit
+        @njit(cache=True)      # (numba keys a closure's cache entry on the mask it closes over)
         def step(pos, vel, mesh, mat, plan, scr, dt, large, nmd, force, fmag):
             zone_step(pos, vel, mesh, mat, plan, scr, dt, large, nmd, mask, force, fmag)
         _STEPS[models] = step

@@ -21,7 +21,7 @@ from numba import njit
 from ._common import P_KN, P_KS, elastic_trial
 
 NAME = "linear-tension"
-CODE = 99
+CODE = 40
 NCOLS = 3
 NHIST = 1
 HIST_NAMES = ("max-opening",)

@@ -33,11 +33,15 @@ from __future__ import annotations
 import importlib
 import pkgutil
 
-from numba import njit
+import numpy as np
+
+from numba import njit, types
+from numba.extending import overload
 
 from ._common import NJHIST, P_KN, P_KS, ST_FAILED, ST_NEW, ST_SLIP, ST_TENSION, constant_stiffness
 
-__all__ = ["CODES", "MODELS", "NJHIST", "NPROP", "P_KN", "P_KS", "ST_FAILED", "ST_NEW", "ST_SLIP", "ST_TENSION", "joint_law", "joint_stiffness"]
+__all__ = ["ALL_MODELS", "CODES", "MODELS", "NJHIST", "NPROP", "P_KN", "P_KS", "ST_FAILED", "ST_NEW", "ST_SLIP",
+           "ST_TENSION", "joint_law", "joint_law_for", "joint_stiffness", "model_mask"]
 
 
 def _find():
@@ -51,6 +55,8 @@ def _find():
     names = [m.NAME for m in mods]
     if len(set(codes)) != len(codes) or len(set(names)) != len(names):
         raise ImportError(f"joint-law kernels: codes {codes} / names {names} must be unique")
+    if max(codes) > 62:
+        raise ImportError(f"joint-law kernels: codes {codes} must be below 63 (bits of one int64 mask)")
     for m in mods:
         if not 0 <= m.NHIST <= NJHIST or len(m.HIST_NAMES) != m.NHIST:
             raise ImportError(f"joint model {m.NAME}: NHIST {m.NHIST} must be at most {NJHIST}, with one name "
@@ -65,17 +71,17 @@ CODES = {m.NAME: m.CODE for m in MODELS}
 NPROP = max(m.NCOLS for m in MODELS)
 
 
-def _link(i):
-    """``joint_law`` from model i on: its law when the code matches, else the next link; the
-    last link answers every other code (codes are checked when a model is assigned)."""
-    code = MODELS[i].CODE
-    law = MODELS[i].law
-    if i == len(MODELS) - 1:
+def _link(i, models=MODELS):
+    """``joint_law`` from model i of ``models`` on: its law when the code matches, else the next
+    link; the last link answers every other code (codes are checked when a model is assigned)."""
+    code = models[i].CODE
+    law = models[i].law
+    if i == len(models) - 1:
         @njit(inline="always")
         def last(model, p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
             return law(p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state)
         return last
-    rest = _link(i + 1)
+    rest = _link(i + 1, models)
 
     @njit(inline="always")
     def link(model, p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
@@ -106,3 +112,47 @@ def _stiffness_link(i):
 
 joint_law = _link(0)
 joint_stiffness = _stiffness_link(0)
+
+
+def model_mask(codes) -> int:
+    """The bit mask of a set of joint-model codes (bit c for code c, c < 63), as ``joint_law_for``
+    takes it; ``codes`` any iterable, or an integer array (one vectorized pass)."""
+    if isinstance(codes, np.ndarray):
+        return int(np.bitwise_or.reduce(np.left_shift(np.int64(1), codes.astype(np.int64)))) if codes.size else 0
+    mask = 0
+    for c in codes:
+        mask |= 1 << int(c)
+    return mask
+
+
+#: the mask of every model found (``joint_law_for(ALL_MODELS, …)`` is ``joint_law``)
+ALL_MODELS = model_mask(m.CODE for m in MODELS)
+
+
+def joint_law_for(models, model, p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2,
+                  state):
+    """``joint_law`` compiled for the models of the mask ``models`` only (a literal integer in the
+    caller, ``model_mask``): a cycle over `mohr` joints compiles mohr's law, not every law in the
+    folder (with all of them inlined the rigid cycle took three times as long to compile). Numba
+    picks the chain when it types the call; a code outside the mask gets the mask's last law.
+    (This body runs only as plain Python, ``NUMBA_DISABLE_JIT``: every model.)"""
+    return joint_law(model, p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state)
+
+
+_CHAINS: dict = {}
+
+
+@overload(joint_law_for, inline="always", jit_options={"cache": True})
+def _joint_law_for(models, model, p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2,
+                   state):
+    if not isinstance(models, types.IntegerLiteral):
+        return None
+    mask = int(models.literal_value)
+    chain = _CHAINS.get(mask)
+    if chain is None:
+        chosen = tuple(m for m in MODELS if (mask >> m.CODE) & 1) or MODELS[:1]
+        chain = _CHAINS[mask] = _link(0, chosen)
+
+    def impl(models, model, p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state):
+        return chain(model, p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2, state)
+    return impl
