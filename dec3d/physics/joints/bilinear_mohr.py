@@ -1,0 +1,35 @@
+"""Host of joint model ``bilinear-mohr`` (kernel: ``dec3d/kernels/joints/bilinear_mohr.py``).
+
+Property keywords as 3DEC's page gives them (Itasca, "Bilinear Mohr-Coulomb Joint Model In 3DEC",
+https://docs.itascacg.com/itasca900/3dec/docproject/source/theory/bilinear/bilinearmc.html, Table 1).
+Names shared with ``mohr`` (friction, cohesion, tension, dilation, ...) keep mohr's ranges: the command
+layer checks a keyword once whatever the model (friction 90 stays the 3DEC idiom for "never slips")."""
+import math
+
+from dec3d.kernels.joints import bilinear_mohr as kernel
+from dec3d.physics.jmodels import STIFFNESS, Prop, angle, jmodel
+
+jmodel(kernel, "two Coulomb envelopes (peak and residual) switching at a normal-stress threshold, tension "
+       "cut-off, cohesion and tension lost at first failure, dilation (3DEC's Bilinear Mohr-Coulomb)", STIFFNESS + [
+           angle("friction", kernel.P_TANF, "friction angle φ₁ below the threshold σᶜ", hi_open=False),
+           angle("friction-2", kernel.P_TANF2, "friction angle φ₂ above the threshold σᶜ", hi_open=False),
+           angle("friction-residual", kernel.P_TANF_RES, "residual friction angle below σᶜʳ (default: friction)",
+                 hi_open=False, default=math.nan, fallback="friction"),
+           angle("f2-residual", kernel.P_TANF2_RES, "residual friction angle above σᶜʳ (default: friction-2)",
+                 hi_open=False, default=math.nan, fallback="friction-2"),
+           Prop("cohesion", kernel.P_COH, "cohesion c₁ below σᶜ", "Pa"),
+           Prop("cohesion-2", kernel.P_COH2, "cohesion c₂ above σᶜ", "Pa"),
+           Prop("cohesion-residual", kernel.P_COH_RES, "residual cohesion below σᶜʳ", "Pa"),
+           Prop("c2-residual", kernel.P_COH2_RES, "residual cohesion above σᶜʳ", "Pa"),
+           angle("dilation", kernel.P_TANDIL, "dilation angle ψ₁ below σᶜʳ"),
+           angle("dilation-2", kernel.P_TANDIL2, "dilation angle ψ₂ above σᶜʳ (default: dilation)",
+                 default=math.nan, fallback="dilation"),
+           Prop("dilation-zero", kernel.P_ZDIL, "shear displacement at which dilation stops (0: never)", "m"),
+           Prop("tension", kernel.P_TEN, "tensile strength T", "Pa"),
+           Prop("tension-residual", kernel.P_TEN_RES, "residual tensile strength", "Pa"),
+           Prop("nstress", kernel.P_NSTRESS, "normal-stress threshold σᶜ of the peak envelopes (default: where "
+                "they intersect, (c₁ − c₂)/(tan φ₂ − tan φ₁))", "Pa", default=math.nan),
+           Prop("nstress-residual", kernel.P_NSTRESS_RES, "normal-stress threshold σᶜʳ of the residual envelopes "
+                "and of the dilation angle (default: where the residual envelopes intersect)", "Pa",
+                default=math.nan),
+       ])
