@@ -2,8 +2,9 @@
 
 Property keywords as 3DEC's page gives them (Itasca, "Bilinear Mohr-Coulomb Joint Model In 3DEC",
 https://docs.itascacg.com/itasca900/3dec/docproject/source/theory/bilinear/bilinearmc.html, Table 1).
-Names shared with ``mohr`` (friction, cohesion, tension, dilation, ...) keep mohr's ranges: the command
-layer checks a keyword once whatever the model (friction 90 stays the 3DEC idiom for "never slips")."""
+Names shared with ``mohr`` (friction, cohesion, tension, dilation, ...) keep mohr's ranges and docs: the command
+layer checks and documents a keyword once whatever the model (friction 90 stays the 3DEC idiom for
+"never slips"); the meaning per model (φ₁ below the threshold, ...) is in the one-line doc and the kernel."""
 import math
 
 from dec3d.kernels.joints import bilinear_mohr as kernel
@@ -11,17 +12,17 @@ from dec3d.physics.jmodels import STIFFNESS, Prop, angle, jmodel
 
 jmodel(kernel, "two Coulomb envelopes (peak and residual) switching at a normal-stress threshold, tension "
        "cut-off, cohesion and tension lost at first failure, dilation (3DEC's Bilinear Mohr-Coulomb)", STIFFNESS + [
-           angle("friction", kernel.P_TANF, "friction angle φ₁ below the threshold σᶜ", hi_open=False),
+           angle("friction", kernel.P_TANF, "friction angle φ (90: never slips)", hi_open=False),
            angle("friction-2", kernel.P_TANF2, "friction angle φ₂ above the threshold σᶜ", hi_open=False),
-           angle("friction-residual", kernel.P_TANF_RES, "residual friction angle below σᶜʳ (default: friction)",
+           angle("friction-residual", kernel.P_TANF_RES, "residual friction angle (default: the friction angle)",
                  hi_open=False, default=math.nan, fallback="friction"),
            angle("f2-residual", kernel.P_TANF2_RES, "residual friction angle above σᶜʳ (default: friction-2)",
                  hi_open=False, default=math.nan, fallback="friction-2"),
-           Prop("cohesion", kernel.P_COH, "cohesion c₁ below σᶜ", "Pa"),
+           Prop("cohesion", kernel.P_COH, "cohesion c", "Pa"),
            Prop("cohesion-2", kernel.P_COH2, "cohesion c₂ above σᶜ", "Pa"),
-           Prop("cohesion-residual", kernel.P_COH_RES, "residual cohesion below σᶜʳ", "Pa"),
+           Prop("cohesion-residual", kernel.P_COH_RES, "residual cohesion", "Pa"),
            Prop("c2-residual", kernel.P_COH2_RES, "residual cohesion above σᶜʳ", "Pa"),
-           angle("dilation", kernel.P_TANDIL, "dilation angle ψ₁ below σᶜʳ"),
+           angle("dilation", kernel.P_TANDIL, "dilation angle ψ"),
            angle("dilation-2", kernel.P_TANDIL2, "dilation angle ψ₂ above σᶜʳ (default: dilation)",
                  default=math.nan, fallback="dilation"),
            Prop("dilation-zero", kernel.P_ZDIL, "shear displacement at which dilation stops (0: never)", "m"),
