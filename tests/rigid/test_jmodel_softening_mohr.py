@@ -251,3 +251,51 @@ def test_unset_dc_stops_the_cycle_naming_the_property(session, tmp_path):
                     "block fix range position-z 0 0.5\nmodel cycle 2\n")
     with pytest.raises(Dec3dError, match="joint model 'softening-mohr' needs property 'dc'"):
         session.call(deck)
+
+
+def test_slip_history_in_a_deck_is_the_plastic_displacement_and_reads_from_fish(session, tmp_path):
+    """The J3 shear box at 1 MN stopped mid-softening (0.75 mm past the peak displacement): every
+    sub-contact's history `slip` is its plastic displacement u − τ/ks, the stress is the linear
+    interpolation at that slip (to one step's lag), and FISH reads it by name."""
+    deck = tmp_path / "shear.dat"
+    deck.write_text("""model new
+block create brick -1.5 2.5 -1 2 -1 0
+block create brick 0 1 0 1 0 1
+block property density 2000
+model gravity 0 0 0
+block contact jmodel assign softening-mohr
+block contact material-table default property stiffness-normal 1e9 stiffness-shear 1e9 friction 35 friction-residual 25 cohesion 2e5 tension 1e5 dc 1e-3
+block fix range id 1
+block fix rotation range id 2
+block mechanical timestep 2.5e-4
+block apply force-z -1e6 range id 2
+block apply velocity-x 0 velocity-y 0 range id 2
+model solve ratio 1e-7
+block apply velocity-x 0.01 range id 2
+model cycle 480
+fish define slips
+  global smin = 1.0
+  global smax = 0.0
+  loop foreach local sc block.subcontact.list
+    local v = block.subcontact.prop(sc, 'slip')
+    smin = math.min(smin, v)
+    smax = math.max(smax, v)
+  endloop
+end
+[slips]
+""")
+    session.call(deck)
+    from dec3d.physics.rigid import engine
+
+    e = engine(session.model)
+    ss = e.subcontacts
+    ux = 480 * 2.5e-6
+    tau = -ss["fs"][:, 0] / ss["area"]
+    slip = ss["hist"][:, 0]
+    np.testing.assert_allclose(slip, ux - tau / 1e9, rtol=0, atol=1e-9)
+    assert 0.2e-3 < slip.min() and slip.max() < 1e-3
+    peak = 2e5 + 1e6 * math.tan(math.radians(35))
+    res = 1e6 * math.tan(math.radians(25))
+    np.testing.assert_allclose(tau, peak - (peak - res) * slip / 1e-3, rtol=0, atol=2e3)
+    smin, smax = session.variables["smin"], session.variables["smax"]
+    assert smin == pytest.approx(slip.min()) and smax == pytest.approx(slip.max())

@@ -27,7 +27,12 @@ The energy dissipated by a slip Δ is then ∫ S_F du over it to within one step
 Tension: T before any failure, the residual T_r after the first (tensile or shear) failure, as
 ``mohr`` (3DEC theory Eqs. 36-38). An open joint carries nothing and is not slipping: it heals.
 
-History h[s, 0]: u_s^p [m] ("slip", the page's read-only `slip`).
+Dilation: as ``mohr`` (only while slipping, up to `dilation-zero`). Itasca Denver's page says "Dilation (ψ)
+behaves in the same way as cohesion or friction", but the model has no residual dilation keyword to soften
+towards, so ψ is kept constant here.
+
+History h[s, 0]: u_s^p [m] ("slip", the page's read-only `slip`; the page's other read-only value,
+`friction-current`, is not kept: it is atan of the interpolated tan φ at that slip).
 """
 from __future__ import annotations
 
