@@ -218,3 +218,17 @@ def test_static_scenes_bench_reaches_the_static_answer_of_a_small_scene():
         r = ss.run("mix", setup, 1e-5)
         assert r["converged"] and 0 < r["steps"] < 20000
         assert r["z"][1] == pytest.approx(1.05, abs=1e-4) and r["z"][0] == pytest.approx(0.5, abs=1e-4)
+
+
+def test_joint_law_bench_runs_every_model_and_prints_its_cost():
+    """bench/joint_law_bench.py on a few sub-contacts: one row per joint model, mohr's ratio 1."""
+    from dec3d.physics.jmodels import JOINT_MODELS
+
+    out = subprocess.run([sys.executable, str(ROOT / "bench" / "joint_law_bench.py"), "--n", "50", "--steps", "20",
+                          "--repeat", "1"], capture_output=True, text=True, timeout=600, cwd=ROOT,
+                         env={**os.environ, "PYTHONPATH": os.pathsep.join(
+                             [str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])})
+    assert out.returncode == 0, out.stderr
+    rows = {ln.split()[0]: ln.split()[1:] for ln in out.stdout.splitlines()[1:]}
+    assert set(rows) == set(JOINT_MODELS)
+    assert float(rows["mohr"][1]) == 1.0 and all(float(r[0]) > 0 for r in rows.values())

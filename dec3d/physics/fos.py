@@ -3,7 +3,8 @@
 Method (Itasca, FLAC3D/3DEC manual, "Strength Reduction Procedure in FLAC3D and 3DEC" and
 "Computational Methods for Factor of Safety Calculation of Slopes", docs.itascacg.com; the
 bracketing of Dawson, Roth & Drescher 1999, Géotechnique 49(6)): every trial factor F divides the
-joint strengths, c/F, tan φ/F (and the tensile strength T/F); each trial is solved from the same
+joint strengths, c/F, tan φ/F (and the tensile strength T/F; each joint model's host says how, its
+``reduce`` in ``dec3d.physics.jmodels``); each trial is solved from the same
 initial state and is *stable* when it reaches equilibrium, *unstable* otherwise; the bracket
 [stable F, unstable F] is halved until it is narrower than the resolution.
 
@@ -15,7 +16,7 @@ its property row from that ``reduce`` for the trial, and the strength-reduction 
 to F (the factor a kernel applies to strengths it reads from tables).
 
 This module holds the bracketing logic (``bracket_fos``, independent of the engine: a trial is any
-callable F -> bool) and the trial on a model (``StrengthTrials``): reduce the `mohr` contacts' and
+callable F -> bool) and the trial on a model (``StrengthTrials``): reduce the contacts' and
 the zones' strengths, cycle, judge, put the model back exactly.
 """
 from __future__ import annotations
@@ -26,7 +27,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from dec3d.kernels.joints.mohr import CODE as MODEL_MOHR
 from dec3d.kernels.zmodels._common import P_SRF
 from dec3d.kernels.joints.mohr import P_COH, P_COH_RES, P_TANDIL, P_TANF, P_TANF_RES, P_TEN, P_TEN_RES
 
@@ -246,7 +246,11 @@ class StrengthTrials:
         engine.ensure_contacts()
         m = engine.model
         c = engine.contacts
-        sel = c["jmodel"] == MODEL_MOHR
+        from dec3d.physics.jmodels import MODEL_BY_CODE
+
+        # the contacts whose joint model says how its strengths are reduced (its host's ``reduce``)
+        self.jmodels = {code: m for code, m in MODEL_BY_CODE.items() if m.reduce is not None}
+        sel = np.isin(c["jmodel"], np.array(sorted(self.jmodels), dtype=np.int64))
         if mask is not None:
             sel &= np.asarray(mask, dtype=bool)
         self.rows = np.flatnonzero(sel)
@@ -261,7 +265,8 @@ class StrengthTrials:
 
     @property
     def empty(self) -> bool:
-        """Nothing to reduce: no `mohr` contact selected and no zone with a reducible model."""
+        """Nothing to reduce: no contact with a reducible joint model selected and no zone with a
+        reducible model."""
         return self.rows.size == 0 and self.zone_rows.size == 0
 
     def _reset(self) -> None:
@@ -280,9 +285,12 @@ class StrengthTrials:
         self._reset()
         c = e.contacts
         if self.rows.size:
-            block = c["prop"][self.rows]
-            reduce_rows(block, factor, self.associated)
-            c["prop"][self.rows] = block
+            codes = c["jmodel"][self.rows]
+            for code in np.unique(codes):
+                rows = self.rows[codes == code]
+                block = c["prop"][rows]
+                self.jmodels[int(code)].reduce(block, factor, self.associated)
+                c["prop"][rows] = block
             c["own_props"][self.rows] = 1          # kept through re-detection during the trial
         if self.all_contacts:
             s = e.settings()

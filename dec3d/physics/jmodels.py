@@ -58,6 +58,9 @@ class JointModel:
     props: dict[str, Prop] = field(default_factory=dict)
     #: names of its history entries (the kernel's ``HIST_NAMES``: VTK arrays, FISH)
     hist_names: tuple[str, ...] = ()
+    #: ``reduce(rows, F, associated)``: divide the strengths of property rows (k, NPROP) by F in place
+    #: (``model factor-of-safety``); None: the model has no strength to reduce
+    reduce: object = None
 
     def row(self, values: dict[str, float] | None = None) -> np.ndarray:
         """Kernel property row with every column at its default, then ``values`` applied."""
@@ -90,10 +93,11 @@ ALIASES: dict[str, str] = {}
 REFUSED: dict[str, str] = {}
 
 
-def jmodel(kernel, doc: str, props: list[Prop], aliases=(), refused=None) -> JointModel:
+def jmodel(kernel, doc: str, props: list[Prop], aliases=(), refused=None, reduce=None) -> JointModel:
     """Register a joint model: ``kernel`` is its module in ``dec3d/kernels/joints`` (name, code).
     ``aliases``: other names that mean this model; ``refused``: {name: why} for names that look
-    like it but are not (they stop with that message)."""
+    like it but are not (they stop with that message); ``reduce(rows, F, associated)``: its
+    strengths divided by F in property rows (k, NPROP), in place, for `model factor-of-safety`."""
     name, code = kernel.NAME, kernel.CODE
     if name in JOINT_MODELS or code in MODEL_BY_CODE:
         raise ValueError(f"joint model '{name}' (code {code}) registered twice")
@@ -104,7 +108,7 @@ def jmodel(kernel, doc: str, props: list[Prop], aliases=(), refused=None) -> Joi
         if not 0 <= p.column < kernel.NCOLS:
             raise ValueError(f"joint model '{name}': property {p.name} in column {p.column}, the kernel reads "
                              f"{kernel.NCOLS}")
-    m = JointModel(name, code, doc, {p.name: p for p in props}, tuple(kernel.HIST_NAMES))
+    m = JointModel(name, code, doc, {p.name: p for p in props}, tuple(kernel.HIST_NAMES), reduce)
     JOINT_MODELS[name] = m
     MODEL_BY_CODE[code] = m
     ALIASES.update({a: name for a in aliases})

@@ -122,3 +122,49 @@ def test_a_new_model_is_two_new_files(tmp_path):
     assert 0.0 < hmin <= hmax < 20 * 1e-3 * 1.0
     # and the stiffness hook answers for the open sub-contacts: kn × tension-factor
     assert float(words[words.index("KN") + 1]) == float(words[words.index("KN") + 2]) == pytest.approx(0.5e9)
+
+
+def _string_constants(path):
+    """(line, value) of the string literals of a module that are not docstrings."""
+    import ast
+
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    docs = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.FunctionDef, ast.ClassDef, ast.AsyncFunctionDef)) and node.body:
+            first = node.body[0]
+            if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant):
+                docs.add(id(first.value))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docs:
+            yield node.lineno, node.value
+
+
+def test_no_file_outside_a_joint_models_two_files_names_it():
+    """Every joint model after the first two is its kernel and host file alone: no other module of
+    dec3d names it, by name, alias or module. (``elastic`` and ``mohr`` predate the plug-ins: the
+    defaults and the factor of safety name them.)"""
+    import pathlib
+
+    import dec3d
+    from dec3d.physics.jmodels import ALIASES
+
+    root = pathlib.Path(dec3d.__file__).parent
+    mine = {}
+    for m in joints.MODELS:
+        if m.NAME in ("elastic", "mohr"):
+            continue
+        stem = pathlib.Path(m.__file__).stem
+        files = {root / "kernels" / "joints" / f"{stem}.py", root / "physics" / "joints" / f"{stem}.py"}
+        for name in (m.NAME, *(a for a, target in ALIASES.items() if target == m.NAME)):
+            mine[name] = (stem, files)
+    found = []
+    for f in root.rglob("*.py"):
+        for line, value in _string_constants(f):
+            if value in mine and f not in mine[value][1]:
+                found.append(f"{f.relative_to(root)}:{line} names {value}")
+        text = f.read_text(encoding="utf-8")
+        for name, (stem, files) in mine.items():
+            if f not in files and (f"joints import {stem}" in text or f"joints.{stem} import" in text):
+                found.append(f"{f.relative_to(root)} imports the {name} model's files")
+    assert not found, found

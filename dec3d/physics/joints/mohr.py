@@ -2,6 +2,7 @@
 import math
 
 from dec3d.kernels.joints import mohr as kernel
+from dec3d.physics.fos import reduce_rows
 from dec3d.physics.jmodels import STIFFNESS, Prop, angle, jmodel
 
 jmodel(kernel, "Coulomb slip with tension cut-off, cohesion and tension lost at first failure, "
@@ -15,4 +16,4 @@ jmodel(kernel, "Coulomb slip with tension cut-off, cohesion and tension lost at 
                  hi_open=False, default=math.nan, fallback="friction"),
            Prop("cohesion-residual", kernel.P_COH_RES, "residual cohesion", "Pa"),
            Prop("tension-residual", kernel.P_TEN_RES, "residual tensile strength", "Pa"),
-       ])
+       ], reduce=reduce_rows)
