@@ -263,3 +263,51 @@ def test_bad_values_are_refused_where_written(session, tmp_path, line, message, 
         session.call(deck)
     assert e.value.message == message
     assert (e.value.location.file, e.value.location.line, e.value.location.column) == (str(deck), 3, column)
+
+
+def test_reduce_hook_divides_every_strength_and_limits_dilation():
+    """`model factor-of-safety` (the host's reduce): c, tan φ, T of both envelopes, peak and residual,
+    over F; an unset residual friction and ψ₂ keep following; thresholds kept; ψ ≤ the reduced φ."""
+    rows = _row(friction_residual=30, cohesion_residual=5e4, dilation=30, nstress=2e6)
+    rows = np.vstack([rows, _row(dilation=5)])
+    before = rows.copy()
+    M.reduce(rows, 2.0, False)
+    for col in (K.P_TANF, K.P_TANF2, K.P_COH, K.P_COH2, K.P_COH_RES, K.P_COH2_RES, K.P_TEN, K.P_TEN_RES):
+        np.testing.assert_allclose(rows[:, col], before[:, col] / 2.0)
+    assert rows[0, K.P_TANF_RES] == pytest.approx(math.tan(math.radians(30)) / 2)
+    assert np.isnan(rows[1, K.P_TANF_RES]) and np.isnan(rows[:, K.P_TANF2_RES]).all()
+    assert rows[0, K.P_NSTRESS] == 2e6 and np.isnan(rows[1, K.P_NSTRESS])
+    # ψ 30° > the reduced φ₁ (tan 40°/2 = 0.42): capped; ψ₂ (unset: ψ₁) capped at the reduced tan 20°
+    assert rows[0, K.P_TANDIL] == pytest.approx(math.tan(math.radians(40)) / 2)
+    assert rows[0, K.P_TANDIL2] == pytest.approx(math.tan(math.radians(20)) / 2)
+    assert rows[1, K.P_TANDIL] == pytest.approx(math.tan(math.radians(5)))
+    rows = before.copy()
+    M.reduce(rows, 2.0, True)
+    assert rows[1, K.P_TANDIL2] == pytest.approx(math.tan(math.radians(20)) / 2)
+
+
+def test_factor_of_safety_of_a_block_on_the_second_envelope(session):
+    """A 4 x 4 x 1 m block on a plane dipping 30° (gravity tilted): σn = ρ g cos 30° · 1 m = 17.3 kPa,
+    above σᶜ = 1 kPa/(tan 60° − tan 40°) = 1.12 kPa, so envelope 2 (c₂ 1 kPa, φ₂ 40°) holds:
+    FS = (c₂ + σn tan 40°)/(σn tan 30°) = 1.5533 (envelope 1, φ 60° and c 0, would give 3.0). The residual
+    envelope 2 is the peak one (c2-residual 1 kPa): the block's corners, less loaded than its middle
+    (the tilt's moment), slip first, and a residual without c₂ would bring the factor down to 1.4534."""
+    from dec3d.physics.rigid import engine
+
+    g = 10.0
+    sn = 2000 * g * math.cos(math.radians(30))
+    want = (1e3 + sn * math.tan(math.radians(40))) / (sn * math.tan(math.radians(30)))
+    session.run_items(session.load_text(f"""model new
+block create brick -1 8 -1 5 -1 0
+block create brick 0 4 0 4 0 1
+block property density 2000
+model gravity {g * math.sin(math.radians(30))} 0 {-g * math.cos(math.radians(30))}
+block contact jmodel assign bilinear-mohr
+block contact material-table default property stiffness-normal 1e8 stiffness-shear 1e8 friction 60 friction-2 40 cohesion-2 1e3 c2-residual 1e3
+block fix range position-z -1 0
+model solve ratio 1e-6
+model factor-of-safety bracket 1.4 1.7 resolution 0.01 cycles 3000
+"""))
+    fs = session.results["fos"]
+    assert abs(fs - want) / want < 0.01 and session.results["fos.unstable"] > want * 0.998
+    assert engine(session.model).contacts["jmodel"].tolist() == [K.CODE]

@@ -299,3 +299,37 @@ end
     np.testing.assert_allclose(tau, peak - (peak - res) * slip / 1e-3, rtol=0, atol=2e3)
     smin, smax = session.variables["smin"], session.variables["smax"]
     assert smin == pytest.approx(slip.min()) and smax == pytest.approx(slip.max())
+
+
+def test_reduce_hook_divides_the_strengths_and_keeps_dc():
+    rows = np.vstack([M.row({**BASE, "dilation": 30, "tension-residual": 1e4}), M.row({"friction": 30, "dc": 2e-3})])
+    before = rows.copy()
+    M.reduce(rows, 2.0, False)
+    for col in (K.P_TANF, K.P_COH, K.P_COH_RES, K.P_TEN, K.P_TEN_RES):
+        np.testing.assert_allclose(rows[:, col], before[:, col] / 2.0)
+    assert rows[0, K.P_TANF_RES] == pytest.approx(math.tan(math.radians(25)) / 2) and np.isnan(rows[1, K.P_TANF_RES])
+    np.testing.assert_array_equal(rows[:, K.P_DC], before[:, K.P_DC])
+    assert rows[0, K.P_TANDIL] == pytest.approx(math.tan(math.radians(35)) / 2)      # capped at the reduced φ
+    M.reduce(before, 2.0, True)
+    assert before[1, K.P_TANDIL] == pytest.approx(math.tan(math.radians(30)) / 2)
+
+
+def test_factor_of_safety_of_a_block_at_rest_is_its_peak(session):
+    """The incline of the factor-of-safety tests with softening-mohr, c 2 kPa softening to 0 over
+    dc = 1 m: σn = 17.32 kPa, FS = (c + σn tan 40°)/(σn tan 30°) = 1.6533. (A short dc would lower it:
+    the corners, less loaded than the middle under the tilt's moment, slip first and soften.)"""
+    sn = 2000 * 10.0 * math.cos(math.radians(30))
+    want = (2e3 + sn * math.tan(math.radians(40))) / (sn * math.tan(math.radians(30)))
+    session.run_items(session.load_text("""model new
+block create brick -1 8 -1 5 -1 0
+block create brick 0 4 0 4 0 1
+block property density 2000
+model gravity 5.0 0 -8.660254037844386
+block contact jmodel assign softening-mohr
+block contact material-table default property stiffness-normal 1e8 stiffness-shear 1e8 friction 40 cohesion 2e3 dc 1
+block fix range position-z -1 0
+model solve ratio 1e-6
+model factor-of-safety bracket 1.5 1.8 resolution 0.01 cycles 3000
+"""))
+    fs = session.results["fos"]
+    assert abs(fs - want) / want < 0.01 and session.results["fos.unstable"] > want * 0.998

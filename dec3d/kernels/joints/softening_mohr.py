@@ -75,23 +75,24 @@ def law(p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, u
     failed = (state & ST_FAILED) != 0
     t = p[c, P_TEN_RES] if failed else p[c, P_TEN]
     state = state & ~(ST_SLIP | ST_TENSION)
+    up = h[s, H_SLIP]
     if fn < -t * area:                     # tensile failure: no softening, no healing of T
-        if heal:
+        if heal and up != 0.0:
             h[s, H_SLIP] = 0.0
         return 0.0, 0.0, 0.0, 0.0, un, udil, us0, us1, us2, state | ST_FAILED | ST_TENSION
-    up = h[s, H_SLIP]
-    dc = p[c, P_DC]
-    r = 1.0                                # fraction of the way to residual (a D_c not > 0: at once)
-    if dc > 0.0 and up < dc:
-        r = up / dc
-    coh = p[c, P_COH] + (p[c, P_COH_RES] - p[c, P_COH]) * r
-    tfu = tf + (tfr - tf) * r
+    coh = p[c, P_COH]
+    tfu = tf
+    if up > 0.0:                           # softened: r of the way to residual, all of it from D_c on
+        dc = p[c, P_DC]
+        r = up / dc if up < dc else 1.0    # (a D_c not > 0: at the first slip)
+        coh += (p[c, P_COH_RES] - coh) * r
+        tfu += (tfr - tf) * r
     fsmax = coh * area + fn * tfu
     if fsmax < 0.0:
         fsmax = 0.0
     fsm = math.sqrt(fs0 * fs0 + fs1 * fs1 + fs2 * fs2)
     if fsm <= fsmax:                       # not slipping: the strength heals to peak
-        if heal:
+        if heal and up != 0.0:
             h[s, H_SLIP] = 0.0
         return fn, fs0, fs1, fs2, un, udil, us0, us1, us2, state
     kA = ks * area

@@ -7,8 +7,29 @@ layer checks and documents a keyword once whatever the model (friction 90 stays 
 "never slips"); the meaning per model (φ₁ below the threshold, ...) is in the one-line doc and the kernel."""
 import math
 
+import numpy as np
+
 from dec3d.kernels.joints import bilinear_mohr as kernel
 from dec3d.physics.jmodels import STIFFNESS, Prop, angle, jmodel
+
+
+def reduce(rows, factor, associated):
+    """`model factor-of-safety`: every cohesion, tan φ and tensile strength of both envelopes, peak
+    and residual, divided by F (a NaN residual friction keeps following its reduced peak). The
+    automatic thresholds move with them unchanged ((c₁ − c₂)/F over (tan φ₂ − tan φ₁)/F); given ones
+    are normal stresses, not strengths, and stay. Dilation as mohr's (``fos.reduce_rows``): associated,
+    tan ψ₁, tan ψ₂ = the reduced tan φ₁, tan φ₂; otherwise each kept but never above them."""
+    for col in (kernel.P_TANF, kernel.P_TANF2, kernel.P_TANF_RES, kernel.P_TANF2_RES, kernel.P_COH, kernel.P_COH2,
+                kernel.P_COH_RES, kernel.P_COH2_RES, kernel.P_TEN, kernel.P_TEN_RES):
+        rows[:, col] = rows[:, col] / factor
+    psi2 = np.where(np.isnan(rows[:, kernel.P_TANDIL2]), rows[:, kernel.P_TANDIL], rows[:, kernel.P_TANDIL2])
+    if associated:
+        rows[:, kernel.P_TANDIL] = rows[:, kernel.P_TANF]
+        rows[:, kernel.P_TANDIL2] = rows[:, kernel.P_TANF2]
+    else:
+        rows[:, kernel.P_TANDIL] = np.minimum(rows[:, kernel.P_TANDIL], rows[:, kernel.P_TANF])
+        rows[:, kernel.P_TANDIL2] = np.minimum(psi2, rows[:, kernel.P_TANF2])
+
 
 jmodel(kernel, "two Coulomb envelopes (peak and residual) switching at a normal-stress threshold, tension "
        "cut-off, cohesion and tension lost at first failure, dilation (3DEC's Bilinear Mohr-Coulomb)", STIFFNESS + [
@@ -33,4 +54,4 @@ jmodel(kernel, "two Coulomb envelopes (peak and residual) switching at a normal-
            Prop("nstress-residual", kernel.P_NSTRESS_RES, "normal-stress threshold σᶜʳ of the residual envelopes "
                 "and of the dilation angle (default: where the residual envelopes intersect)", "Pa",
                 default=math.nan),
-       ])
+       ], reduce=reduce)

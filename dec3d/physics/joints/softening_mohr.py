@@ -7,8 +7,23 @@ entry of the same name. Names shared with ``mohr`` keep mohr's ranges and docs (
 keyword once whatever the model)."""
 import math
 
+import numpy as np
+
 from dec3d.kernels.joints import softening_mohr as kernel
 from dec3d.physics.jmodels import STIFFNESS, Prop, angle, jmodel
+
+
+def reduce(rows, factor, associated):
+    """`model factor-of-safety`: peak and residual cohesion, tan φ and tension divided by F (a NaN
+    residual friction keeps following the reduced peak); D_c is a length and stays. Dilation as mohr's
+    (``fos.reduce_rows``): associated, tan ψ = the reduced tan φ; otherwise kept but never above it."""
+    for col in (kernel.P_TANF, kernel.P_TANF_RES, kernel.P_COH, kernel.P_COH_RES, kernel.P_TEN, kernel.P_TEN_RES):
+        rows[:, col] = rows[:, col] / factor
+    if associated:
+        rows[:, kernel.P_TANDIL] = rows[:, kernel.P_TANF]
+    else:
+        rows[:, kernel.P_TANDIL] = np.minimum(rows[:, kernel.P_TANDIL], rows[:, kernel.P_TANF])
+
 
 jmodel(kernel, "Coulomb slip whose cohesion and friction fall linearly from peak to residual over the critical "
        "slip distance dc and heal when slipping stops; tension cut-off (3DEC's Softening-Healing Mohr-Coulomb)",
@@ -26,4 +41,4 @@ jmodel(kernel, "Coulomb slip whose cohesion and friction fall linearly from peak
                 lo_open=True, required=True),
            Prop("healing", kernel.P_HEAL, "1: the strength returns to peak when slipping stops (default); "
                 "0: no healing", "", hi=1.0, default=1.0),
-       ])
+       ], reduce=reduce)
