@@ -141,7 +141,8 @@ def _shear_ode(sn, ks, phi0, phi, R, u):
 
 
 def test_monotonic_shear_follows_the_ode_and_ends_at_the_intrinsic_friction():
-    """Constant σn, small equal shear steps: τ(u) follows the law's ODE within 0.3 % of the peak (peak within 0.2 %), and
+    """Constant σn, small equal shear steps: τ(u) follows the law's ODE within 0.3 % of the peak
+    (peak within 0.2 %), and
     after uᵖ ≫ R the stress is σn tan φ (the intrinsic friction) to 1e-6."""
     sn, ks, R = 1e6, 1e9, 5e-4
     p = _row(stiffness_normal=1e9, stiffness_shear=ks, friction=45, friction_intrinsic=30, roughness=R)
@@ -214,3 +215,15 @@ def test_model_answers_to_its_long_name_and_lists_its_history():
     assert m.code == 2 and m.hist_names[:3] == ("plastic-shear", "normal-stress", "friction-mobilized")
     from dec3d.physics.jmodels import ALIASES
     assert ALIASES["continuously-yielding"] == "cy"
+
+
+def test_strength_reduction_divides_both_friction_tangents():
+    """`model factor-of-safety` (the host's reduce): tan φ0 and tan φ divided by F; unset φ stays NaN."""
+    m = JOINT_MODELS["cy"]
+    rows = np.vstack([_row(friction=40, friction_intrinsic=30, roughness=1e-3),
+                      _row(friction=40, roughness=1e-3)])
+    m.reduce(rows, 1.5, False)
+    assert m.value(rows[0], "friction") == pytest.approx(math.degrees(math.atan(math.tan(math.radians(40)) / 1.5)))
+    assert m.value(rows[0], "friction-intrinsic") == pytest.approx(
+        math.degrees(math.atan(math.tan(math.radians(30)) / 1.5)))
+    assert np.isnan(rows[1, cy.P_PHI]) and m.value(rows[1], "friction-intrinsic") == m.value(rows[1], "friction")

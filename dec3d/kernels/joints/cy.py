@@ -39,8 +39,8 @@ Not implemented: the model's dilation (the normal displacement of the roughness)
 passed through unchanged.
 
 History h[s, :7]: plastic shear displacement uᵖ [m], normal stress σn [Pa], mobilised friction
-φm [deg] (after the step, for output), the factor r, and the unit direction of the previous
-shear increment (3 components).
+φm [deg] (the one this step's bound used: from uᵖ before the step; output only), the factor r,
+and the unit direction of the previous shear increment (3 components).
 """
 from __future__ import annotations
 
@@ -115,7 +115,8 @@ def law(p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, u
     h[s, H_PHIM] = math.degrees(phim)
     if sn <= 0.0 or area <= 0.0:           # open (or no area): carries nothing
         return 0.0, 0.0, 0.0, 0.0, un, udil, us0, us1, us2, state
-    ks = p[c, P_KS] * sn ** p[c, P_ES]
+    es = p[c, P_ES]
+    ks = p[c, P_KS] * sn ** es if es != 0.0 else p[c, P_KS]
     taum = sn * math.tan(phim)
     # shear stress acting against the motion (Fˢ is the force on B, Fˢ = −ks A uˢ elastically)
     t0 = -fs0 / area
@@ -149,7 +150,6 @@ def law(p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, u
         h[s, H_D0] = d0
         h[s, H_D0 + 1] = d1
         h[s, H_D0 + 2] = d2
-        h[s, H_PHIM] = math.degrees(mobilised_friction(p, c, up))
         if f < 1.0:
             state = state | ST_SLIP
     tm = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)

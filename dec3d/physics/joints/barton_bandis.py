@@ -8,7 +8,7 @@ from dec3d.physics.jmodels import STIFFNESS, Prop, jmodel
 
 jmodel(kernel, "Barton's peak strength σn tan(φr + JRC log10(JCS/σn)) (≤ 70°), residual σn tan φr after the "
        "peak, Bandis' hyperbolic normal closure σn = kni v/(1 − v/vm)", STIFFNESS + [
-           Prop("jrc", kernel.P_JRC, "joint roughness coefficient JRC (Barton's profiles 0-20)", hi=20.0),
+           Prop("jrc", kernel.P_JRC, "joint roughness coefficient JRC (Barton's profiles 0-20)", "", hi=20.0),
            Prop("jcs", kernel.P_JCS, "joint wall compressive strength JCS", "Pa", lo=0.0, lo_open=True,
                 required=True),
            Prop("friction-residual", kernel.P_PHIR, "residual friction angle φr", "deg", hi=90.0,

@@ -7,6 +7,8 @@ the stiffnesses are the plain kn, ks [Pa/m]; otherwise `stiffness-normal`/`stiff
 multipliers a_n, a_s of kn = a_n σn^e_n, ks = a_s σn^e_s [Pa^(1−e)/m]."""
 import math
 
+import numpy as np
+
 from dec3d.kernels.joints import cy as kernel
 from dec3d.physics.jmodels import Prop, jmodel
 
@@ -17,17 +19,25 @@ def _deg(name, column, doc, **kw) -> Prop:
     return Prop(name, column, doc, "deg", math.radians, math.degrees, hi=90.0, **kw)
 
 
+def reduce(rows, factor, associated):
+    """`model factor-of-safety`: tan φ0 and tan φ divided by F (the columns hold the angles in radians;
+    an unset intrinsic friction, NaN, keeps following φ0). The model has no cohesion, tension or dilation."""
+    for col in (kernel.P_PHI0, kernel.P_PHI):
+        rows[:, col] = np.arctan(np.tan(rows[:, col]) / factor)
+
+
 jmodel(kernel, "continuously yielding joint: friction mobilised from the initial toward the intrinsic angle "
        "with plastic shear displacement, stiffnesses kn = a_n σn^e_n, ks = a_s σn^e_s "
        "(3DEC's `cy`, Cundall & Lemos 1990)", [
            Prop("stiffness-normal", 0, "normal stiffness multiplier a_n (kn = a_n σn^e_n)", "Pa/m"),
            Prop("stiffness-shear", 1, "shear stiffness multiplier a_s (ks = a_s σn^e_s)", "Pa/m"),
            Prop("exponent-normal", kernel.P_EN, "normal stiffness exponent e_n (< 1: the closure integral is finite)",
+                "",
                 hi=1.0, hi_open=True),
-           Prop("exponent-shear", kernel.P_ES, "shear stiffness exponent e_s", hi=1.0, hi_open=True),
+           Prop("exponent-shear", kernel.P_ES, "shear stiffness exponent e_s", "", hi=1.0, hi_open=True),
            _deg("friction", kernel.P_PHI0, "initial (mobilised) friction angle φ0"),
            _deg("friction-intrinsic", kernel.P_PHI, "intrinsic friction angle φ, the limit of the mobilised "
                 "friction (default: the friction angle, no softening)", default=math.nan, fallback="friction"),
            Prop("roughness", kernel.P_R, "joint roughness R: plastic shear displacement over which φm − φ falls "
                 "by the factor e", "m", required=True),
-       ], aliases=("continuously-yielding",))
+       ], aliases=("continuously-yielding",), reduce=reduce)
