@@ -227,3 +227,31 @@ def test_strength_reduction_divides_both_friction_tangents():
     assert m.value(rows[0], "friction-intrinsic") == pytest.approx(
         math.degrees(math.atan(math.tan(math.radians(30)) / 1.5)))
     assert np.isnan(rows[1, cy.P_PHI]) and m.value(rows[1], "friction-intrinsic") == m.value(rows[1], "friction")
+
+
+def test_history_in_a_run_reads_back_from_fish_and_survives_save_restore(session, tmp_path):
+    """A cube sheared 1 mm under 1 MN on `cy` (the J1 set-up, shorter): every sub-contact's σn history
+    is N/A, its plastic shear displacement is positive and below the 1 mm sheared, the mobilised
+    friction lies between 30 and 40 degrees; FISH reads them by name, and a saved and restored model
+    has the same history."""
+    session.command(
+        "block create brick -1.5 2.5 -1 2 -1 0\nblock create brick 0 1 0 1 0 1\nblock property density 2000\n"
+        "block contact jmodel assign cy\n"
+        "block contact material-table default property stiffness-normal 1e6 exponent-normal 0.5 "
+        "stiffness-shear 1e9 friction 40 friction-intrinsic 30 roughness 1e-3\n"
+        "block fix range id 1\nblock fix rotation range id 2\nblock mechanical timestep 2.5e-4\n"
+        "block apply force-z -1e6 range id 2\nblock apply velocity-x 0 velocity-y 0 range id 2\n"
+        "model solve ratio 1e-7\nblock apply velocity-x 0.02 range id 2\nmodel cycle 200\n"
+        "fish define hist\n  local cl = block.contact.list\n  local c = cl(1)\n  local sl = block.contact.subcontactlist(c)\n"
+        "  global up = block.subcontact.prop(sl(1), 'plastic-shear')\n"
+        "  global phim = block.subcontact.prop(sl(1), 'friction-mobilized')\n"
+        "  global phi0 = block.subcontact.prop(sl(1), 'friction')\nend\n@hist\n")
+    v = session.variables
+    assert 0.0 < v["up"] < 1e-3 and 30.0 < v["phim"] < 40.0 and v["phi0"] == pytest.approx(40.0)
+    sc = session.model.rigid_engine.subcontacts
+    h = sc["hist"][:, :cy.NHIST].copy()
+    assert np.allclose(h[:, cy.H_SN], 1e6, rtol=1e-6)
+    assert np.allclose(sc["fn"] / sc["area"], 1e6, rtol=1e-6)
+    session.command(f"model save '{tmp_path / 'cy.sav'}'\nmodel new\nmodel restore '{tmp_path / 'cy.sav'}'\n")
+    from dec3d.physics.rigid import engine
+    assert np.array_equal(engine(session.model).subcontacts["hist"][:, :cy.NHIST], h)
