@@ -1,8 +1,10 @@
 """Host of joint model ``cy``, 3DEC's continuously yielding joint model (kernel:
 ``dec3d/kernels/joints/cy.py``; equations and sources there).
 
-Property names follow 3DEC's continuously yielding model ("Continuously Yielding Joint Model In
-3DEC", 3DEC Theory; https://www.itascacg.com/3dec-joint-constitutive-models); with both exponents 0
+Model name `cy` and the property keywords are 3DEC 7's style (its theory page "Continuously Yielding
+Joint Model In 3DEC" was not in the reference store, only the overview
+https://www.itascacg.com/3dec-joint-constitutive-models: the keywords are unverified against the
+page; the old syntax used names such as jif and jrough). With both exponents 0
 the stiffnesses are the plain kn, ks [Pa/m]; otherwise `stiffness-normal`/`stiffness-shear` are the
 multipliers a_n, a_s of kn = a_n σn^e_n, ks = a_s σn^e_s [Pa^(1−e)/m]."""
 import math
