@@ -17,6 +17,7 @@ import pytest
 
 from dec3d.errors import Dec3dError
 from dec3d.io import state
+from dec3d.physics.jmodels import JOINT_MODELS
 from dec3d.session import Session
 
 DECK = """model new
@@ -106,7 +107,7 @@ META_CASES = [
     (("settings", "mechanical", "damping"), "bogus",
      "mechanical setting `damping` is 'bogus', not one of local, combined, global, none, rayleigh"),
     (("settings", "mechanical", "jmodel"), "magic",
-     "mechanical setting `jmodel` is 'magic', not one of elastic, mohr"),
+     f"mechanical setting `jmodel` is 'magic', not one of {', '.join(sorted(JOINT_MODELS))}"),
     (("settings", "mechanical", "frac"), "abc",
      'mechanical setting `frac` has the value "abc", which is not allowed'),
     (("settings", "mechanical", "alpha"), 1.5,
