@@ -5,9 +5,9 @@ import math
 
 import numpy as np
 import pytest
+from joint_binding import assert_refused_at_binding
 from scipy.integrate import solve_ivp
 
-from dec3d.commands.values import ValueRangeError
 from dec3d.kernels.joints import cy
 from dec3d.physics.jmodels import JOINT_MODELS
 
@@ -201,13 +201,7 @@ BASE = "block create brick 0 1 0 1 0 1\nblock contact jmodel assign cy\n"
     ("block contact property roughness -1e-3", "`roughness` must be ≥ 0, got -0.001", 34),
 ])
 def test_bad_properties_are_refused_at_binding(session, tmp_path, line, message, column):
-    deck = tmp_path / "deck.dat"
-    deck.write_text(BASE + line + "\n")
-    with pytest.raises(ValueRangeError) as e:
-        session.call(deck)
-    assert e.value.message == message
-    assert (e.value.location.file, e.value.location.line, e.value.location.column) == (str(deck), 3, column)
-    assert session.model.blocks.n == 0
+    assert_refused_at_binding(session, tmp_path, BASE + line, message, column)
 
 
 def test_model_answers_to_its_long_name_and_lists_its_history():
