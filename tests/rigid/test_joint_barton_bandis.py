@@ -173,16 +173,31 @@ def test_bad_properties_are_refused_at_binding(session, tmp_path, line, message,
     assert_refused_at_binding(session, tmp_path, BASE + line, message, column)
 
 
-@pytest.mark.xfail(strict=True, reason="the command layer (commands/block_contact.py _BOUNDS/_KW) drops lo_open "
-                   "and keys ranges by property name (the last model's wins): JCS = 0, vm = 0 and "
-                   "friction-residual 90 pass binding until it checks per model (report of issue 27)")
-@pytest.mark.parametrize("line", ["block contact property jcs 0", "block contact property closure-maximum 0",
-                                  "block contact property friction-residual 90"])
-def test_open_bounds_are_refused_at_binding(session, tmp_path, line):
+@pytest.mark.xfail(strict=True, reason="commands/block_contact.py builds its keyword ranges (_BOUNDS, _KW) without "
+                   "lo_open: JCS = 0 and vm = 0 pass binding (the two-line fix is in the report of issue 27)")
+@pytest.mark.parametrize("line", ["block contact property jcs 0", "block contact property closure-maximum 0"])
+def test_zero_jcs_and_maximum_closure_are_refused_at_binding(session, tmp_path, line):
     deck = tmp_path / "deck.dat"
     deck.write_text(BASE + line + "\n")
     with pytest.raises(ValueRangeError):
         session.call(deck)
+
+
+@pytest.mark.xfail(strict=True, reason="commands/block_contact.py keys keyword ranges by name, the last model's "
+                   "winning (mohr's friction-residual [0, 90]): barton-bandis's [0, 90) needs a check per model")
+def test_residual_friction_90_is_refused_at_binding(session, tmp_path):
+    deck = tmp_path / "deck.dat"
+    deck.write_text(BASE + "block contact property friction-residual 90\n")
+    with pytest.raises(ValueRangeError):
+        session.call(deck)
+
+
+def test_residual_friction_90_never_slips():
+    """Until then, φr = 90 (as mohr's idiom) is a joint that never slips: the strength is σn tan 90°."""
+    p = _row({**P0, "friction-residual": 90.0})
+    h = np.zeros((1, 8))
+    fn, fs, un, st = _kstep(p, h, 1.0, -5e-4, np.array([1e-2, 0, 0]), 0.0, np.zeros(3), 0)
+    assert fn == pytest.approx(1e6) and fs[0] == pytest.approx(-1e7) and st & FAILED == 0
 
 
 def test_missing_required_properties_stop_the_cycle(session):
