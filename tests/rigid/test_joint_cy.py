@@ -181,6 +181,17 @@ def test_reversal_unloads_with_the_full_shear_stiffness():
         or h[0, cy.H_R] < 0
 
 
+def test_an_exponent_near_one_stays_finite():
+    """e_n = 0.99: σn = (0.01 a_n v)^100 overflows a double at v = 1 mm for a_n = 1e9; the law caps it
+    (1e30 Pa) and every output and the hook stay finite."""
+    p = _row(stiffness_normal=1e9, stiffness_shear=1e9, exponent_normal=0.99, exponent_shear=0.99, friction=30,
+             roughness=1e-3)
+    h = np.zeros((1, 8))
+    out = LAW(p, 0, h, 0, 1.0, -1e-3, 1e-4, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0)
+    assert all(math.isfinite(x) for x in out[:9]) and out[0] == 1e30
+    assert all(math.isfinite(k) for k in HOOK(p, 0, h, 0))
+
+
 def test_zero_area_and_zero_friction_are_finite():
     p = _row(stiffness_normal=1e9, stiffness_shear=1e9, friction=0, roughness=1e-3)
     h = np.zeros((1, 8))

@@ -15,6 +15,8 @@ is elastic (path-independent) in its normal direction and re-closes where it ope
 
   σn = ((1 − e_n) a_n v)^(1/(1 − e_n)),   v = −(uⁿ − u_dil) ≥ 0      (e_n < 1; e_n = 0: σn = a_n v)
 
+(capped at 10³⁰ Pa, so that e_n near 1 cannot overflow to an infinite force).
+
 The joint carries no tension: v ≤ 0 gives σn = 0 and no shear force.
 
 Shear (3DEC/UDEC continuously yielding law), per step, with τ the shear stress along the shear
@@ -64,6 +66,10 @@ H_PHIM = 2        # mobilised friction [deg] (output)
 H_R = 3           # factor r
 H_D0 = 4          # previous shear increment direction, x, y, z
 NHIST = 7
+#: the normal stress is capped here [Pa] (finite forces for any closure; e_n → 1 makes the power law
+#: overflow: with e_n = 0.99 it is (0.01 a_n v)^100)
+SN_MAX = 1e30
+LOG_SN_MAX = math.log(SN_MAX)
 HIST_NAMES = ("plastic-shear", "normal-stress", "friction-mobilized", "reversal-factor",
               "increment-x", "increment-y", "increment-z")
 
@@ -75,7 +81,13 @@ def normal_stress(an, en, v):
         return 0.0
     if en == 0.0:
         return an * v
-    return ((1.0 - en) * an * v) ** (1.0 / (1.0 - en))
+    x = (1.0 - en) * an * v
+    if x <= 0.0:
+        return 0.0
+    y = math.log(x) / (1.0 - en)
+    if y > LOG_SN_MAX:                     # e_n near 1: the power overflows long before this matters
+        return SN_MAX
+    return math.exp(y)
 
 
 @njit(cache=True, inline="always")
