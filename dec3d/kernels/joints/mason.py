@@ -34,8 +34,8 @@ out here as this module implements them (none of the plugin's code was read or u
   F3 cap (L&R Eq. 9): Cnn σ² + Css τ² + Cn σ ≤ σ̄c², returned along the normal only (a
   non-associated simplification: Δu_pc = (σ_trial − σ_cap)/kn0), the shear clipped to
   τ ≤ σ̄c/√Css where the ellipse leaves no compression. σ̄c is a function of the total closure
-  d = −(uⁿ − u_dil): kn0 d up to d_e = σ_e/kn0, σ_e = 2 fc/(n + 1); then the parabola tangent to
-  the elastic line, fc − (fc − σ_e)((d_p − d)/(d_p − d_e))², reaching fc with zero slope at
+  d = −(uⁿ − u_dil): σ_e = 2 fc/(n + 1) (the initial cap) up to d_e = σ_e/kn0; then the parabola
+  tangent to the elastic line, fc − (fc − σ_e)((d_p − d)/(d_p − d_e))², reaching fc with zero slope at
   d_p = n d_e (n = peak_ratio: displacement at peak / elastic-limit displacement); beyond,
   fc_r + (fc − fc_r) exp(−(fc − fc_r)(d − d_p)/G_c): G_c is the post-peak area above fc_r.
   Unloading and reloading in compression at kn0 (plastic), the crack closing at full stiffness.
@@ -92,8 +92,8 @@ def cap_envelope(d, kn0, fc, npk, gc, fcr):
     se = 2.0 * fc / (npk + 1.0)
     de = se / kn0
     dp = npk * de
-    if d <= de:
-        return kn0 * d
+    if d <= de:                            # the initial cap: elastic inside it
+        return se
     if d < dp:
         x = (dp - d) / (dp - de)
         return fc - (fc - se) * x * x
