@@ -10,12 +10,28 @@ so they are aliases; ``mason_debug2`` is set with four more keywords whose meani
 documentation does not give, so it is refused rather than silently run without them."""
 import math
 
+import numpy as np
+
 from dec3d.kernels.joints import mason as kernel
 from dec3d.physics.jmodels import STIFFNESS, Prop, angle, jmodel
 
 _DEBUG2 = ("'mason_debug2' is a development build of the MASON plugin whose property set differs from "
            "MASON's documented one: it takes nlimit1, nlimit2, mult_base and mult_dc_gain, which the MASON "
            "documentation does not define (dec3d's 'mason' has no such properties); assign 'mason' and drop them")
+
+
+
+def _reduce(prop, factor, associated):
+    """`model factor-of-safety`: the Coulomb and tension strengths (peak and residual) divided by F, as
+    for ``mohr`` (tan φ/F, c/F, ft/F; the dilatancy then at most the reduced friction, or equal to it
+    when associated); the compression cap and the fracture energies are kept."""
+    for col in (kernel.P_TANF, kernel.P_COH, kernel.P_FT, kernel.P_TANF_RES, kernel.P_COH_RES, kernel.P_FT_RES):
+        prop[:, col] = prop[:, col] / factor
+    if associated:
+        prop[:, kernel.P_TANDIL] = prop[:, kernel.P_TANF]
+    else:
+        prop[:, kernel.P_TANDIL] = np.minimum(prop[:, kernel.P_TANDIL], prop[:, kernel.P_TANF])
+
 
 jmodel(kernel, "MASON masonry joint: tension cut-off, Coulomb with cohesion and dilatancy, elliptical "
        "compression cap, fracture-energy softening, secant damage in tension (Lourenço & Rots 1997 surfaces)",
@@ -47,4 +63,4 @@ jmodel(kernel, "MASON masonry joint: tension cut-off, Coulomb with cohesion and 
            Prop("comp-residual", kernel.P_FC_RES, "residual compressive strength fc_r", "Pa"),
        ],
        aliases=("mason_v6", "mason_v7", "mason_v8"),
-       refused={"mason_debug2": _DEBUG2})
+       refused={"mason_debug2": _DEBUG2}, reduce=_reduce)
