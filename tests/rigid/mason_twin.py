@@ -81,13 +81,12 @@ class MasonTwin:
             tau = tau * (tau_max / tmag)
             tmag = tau_max
             tpsi = math.tan(math.radians(self.get("dilation")))
-            if tpsi > 0 and slip > 0:
+            if tpsi > 0 and slip > 0 and gap <= 0:
                 s0 = self.get("dilation-zero")
                 conf = 1.0 if s0 <= 0 else min(max(1 - sigma / s0, 0.0), 1.0)
                 lift = slip * tpsi * conf * math.exp(-self.get("delta", 2.0) * H["kappa_s"])
                 udil += lift
-                if gap <= 0:
-                    sigma += kn0 * lift
+                sigma += kn0 * lift
             H["kappa_s"] += slip
             H["ds"] = 1 - math.exp(-(coh - cr) * H["kappa_s"] / gII)
             flags |= {"slip", "failed"}

@@ -203,6 +203,30 @@ def test_shear_with_friction_softening_dissipates_the_coupled_energy():
     assert area == pytest.approx(gII * (1 + sig * (tf - tr) / c), rel=0.03)
 
 
+def test_dilatancy_decays_with_slip_and_confinement_and_not_when_open():
+    """L&R Eq. 12: Δu_dil = Δκs tan ψ₀ (1 − σ/σ_ψ0) e^(−δ κs). Without a confinement limit the uplift
+    after a slip κ is tan ψ₀ (1 − e^(−δκ))/δ (1 %); at σ ≥ σ_ψ0 there is none; an open joint slides
+    without dilating."""
+    props = dict(BASE, **{"dilation": 10.0, "delta": 2000.0, "cohesion": 0.0, "tension": 0.0})
+    j = Joint(props)
+    j.step(-0.2e6 / props["stiffness-normal"])
+    for _ in range(2000):
+        j.step(0.0, (2e-6, 0.0, 0.0))
+    k = j.hist("kappa_s")
+    assert k > 3e-3
+    assert j.udil == pytest.approx(math.tan(math.radians(10)) * (1 - math.exp(-2000 * k)) / 2000, rel=0.01)
+    confined = Joint(dict(props, **{"dilation-zero": 0.1e6}))
+    confined.step(-0.2e6 / props["stiffness-normal"])
+    for _ in range(200):
+        confined.step(0.0, (2e-6, 0.0, 0.0))
+    assert confined.hist("kappa_s") > 0 and confined.udil == 0.0
+    opened = Joint(props)
+    opened.step(1e-5)
+    for _ in range(200):
+        opened.step(0.0, (2e-6, 0.0, 0.0))
+    assert opened.udil == 0.0 and opened.fn == 0.0 and not opened.fs.any()
+
+
 def test_compression_cap_hardening_peak_and_G_c():
     """Pure compression (Cnn = 1, Cn = 0): elastic to σe = 2fc/(n+1), then hardening to fc at the
     closure n σe/kn0, then the post-peak area above fc_r is G_c (3 %); unloading at kn0 leaves the

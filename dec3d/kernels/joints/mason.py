@@ -30,7 +30,8 @@ out here as this module implements them (none of the plugin's code was read or u
   so G_II is the area of the (τ − τ_res)–plastic-slip curve. Tension-shear coupling (d_ts): one
   remaining-strength fraction r = min(rt, rs) softens tension, cohesion and friction together.
   Dilatancy (L&R Eq. 12): Δu_dil = Δκs tan ψ, tan ψ = tan ψ₀ (1 − σ/σ_ψ0) exp(−δ κs), 0 for
-  σ ≥ σ_ψ0 (σ_ψ0 = 0: no confinement limit); always an uplift, whichever way the joint slips.
+  σ ≥ σ_ψ0 (σ_ψ0 = 0: no confinement limit); always an uplift, whichever way the joint slips, and
+  only while the joint is closed (an open crack slides freely).
   F3 cap (L&R Eq. 9): Cnn σ² + Css τ² + Cn σ ≤ σ̄c², returned along the normal only (a
   non-associated simplification: Δu_pc = (σ_trial − σ_cap)/kn0), the shear clipped to
   τ ≤ σ̄c/√Css where the ellipse leaves no compression. σ̄c is a function of the total closure
@@ -40,8 +41,12 @@ out here as this module implements them (none of the plugin's code was read or u
   fc_r + (fc − fc_r) exp(−(fc − fc_r)(d − d_p)/G_c): G_c is the post-peak area above fc_r.
   Unloading and reloading in compression at kn0 (plastic), the crack closing at full stiffness.
 
-Property 0 (``compression`` 0) disables the cap; ``G_c`` is required, as the README says.
-The optional damage tables of the plugin (``table-dt``, ``table-ds``) are not provided.
+Keywords are the README's, lower-case as dec3d reads every keyword (``G_I`` in a deck is ``g_i``).
+``compression`` 0 (the default) disables the cap (the README: omitted, the cap is "effectively
+disabled"); ``g_c`` is required, as the README says, and so are ``g_i`` and ``g_ii`` (the README's
+alternative, the damage tables ``table-dt``/``table-ds``, is not provided). Simplifications against
+the plugin as its papers describe it: the shear stiffness does not degrade, the cap returns along
+the normal only, compression unloads and reloads linearly at kn0.
 """
 from __future__ import annotations
 
@@ -182,7 +187,7 @@ def law(p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, u
         tau2 *= q
         tm = tmax
         tandil = p[c, P_TANDIL]
-        if tandil > 0.0 and dks > 0.0:
+        if tandil > 0.0 and dks > 0.0 and e <= 0.0:     # an open joint slides without dilating
             sd = p[c, P_SDIL]
             conf = 1.0
             if sd > 0.0:
@@ -190,8 +195,7 @@ def law(p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, u
                 conf = min(max(conf, 0.0), 1.0)
             ddil = dks * tandil * conf * math.exp(-p[c, P_DELTA] * kss)
             udil += ddil
-            if e <= 0.0:                   # closed: the blocked uplift raises the normal stress
-                sig += kn0 * ddil
+            sig += kn0 * ddil              # the blocked uplift raises the normal stress (Eq. 43)
         kss += dks
         h[s, H_KS] = kss
         rs = math.exp(-(coh - cr) * kss / p[c, P_GII])
