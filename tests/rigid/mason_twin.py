@@ -13,7 +13,7 @@ import numpy as np
 class MasonTwin:
     props: dict                      # user units: Pa, Pa/m, degrees, J/m², 1/m
     hist: dict = field(default_factory=lambda: dict(kappa_t=0.0, dt=0.0, kappa_s=0.0, ds=0.0, u_pc=0.0,
-                                                     d_max=0.0, dc=0.0, open=0.0))
+                                                     dft=0.0, dc=0.0, open=0.0))
 
     def get(self, name, default=0.0):
         return float(self.props.get(name, default))
@@ -52,7 +52,8 @@ class MasonTwin:
         tau = np.asarray(fs, float) / area - ks * np.asarray(dus, float)
 
         def remaining():
-            return min(math.exp(-(ft - ftr) * H["kappa_t"] / gI), math.exp(-(coh - cr) * H["kappa_s"] / gII))
+            """min(rt, rs) from the kept losses dft = 1 − rt, ds = 1 − rs (each set with its exp)."""
+            return min(1 - H["dft"], 1 - H["ds"])
 
         # tension cut-off with secant damage
         gap = un - udil + H["u_pc"]
@@ -61,6 +62,7 @@ class MasonTwin:
             strength = ftr + (ft - ftr) * remaining()
             if secant * gap > strength:
                 H["kappa_t"] += gap - strength / secant
+                H["dft"] = 1 - math.exp(-(ft - ftr) * H["kappa_t"] / gI)
                 t = ftr + (ft - ftr) * remaining()
                 H["dt"] = min(max(1 - t / (kn * gap), H["dt"]), 1.0)
                 flags |= {"tension", "failed"}
@@ -97,21 +99,19 @@ class MasonTwin:
             d = udil - un
             sbar = self.cap_strength(d)
             cnn, cn, css = self.get("cnn", 1.0), self.get("cn"), self.get("css", 1.0)
-            room = sbar ** 2 - css * tmag ** 2
-            if room <= 0 and css > 0:
-                limit = sbar / math.sqrt(css)
-                tau = tau * (limit / tmag) if tmag > 0 else tau
-                tmag = limit
-                room = 0.0
-            room = max(room, 0.0)
-            sigma_cap = max((-cn + math.sqrt(cn ** 2 + 4 * cnn * room)) / (2 * cnn), 0.0)
-            if sigma > sigma_cap:
-                H["u_pc"] = d - sigma_cap / kn0
-                sigma = sigma_cap
-                flags.add("failed")
-            if d > H["d_max"]:
-                H["d_max"] = d
+            if cnn * sigma ** 2 + css * tmag ** 2 + cn * sigma > sbar ** 2:    # outside the ellipse
+                room = sbar ** 2 - css * tmag ** 2
+                if room <= 0 and css > 0:
+                    limit = sbar / math.sqrt(css)
+                    tau = tau * (limit / tmag) if tmag > 0 else tau
+                    tmag = limit
+                room = max(room, 0.0)
+                sigma_cap = max((-cn + math.sqrt(cn ** 2 + 4 * cnn * room)) / (2 * cnn), 0.0)
+                if sigma > sigma_cap:
+                    H["u_pc"] = d - sigma_cap / kn0
+                    sigma = sigma_cap
+                    flags.add("failed")
                 n = self.get("peak_ratio", 1.0)
                 if d > n * (2 * fc / (n + 1)) / kn0:
-                    H["dc"] = 1 - self.cap_strength(d) / fc
+                    H["dc"] = max(H["dc"], 1 - sbar / fc)
         return sigma * area, tau * area, un, udil, us, flags

@@ -84,11 +84,11 @@ H_DT = 1          # dt: tensile damage, 1 − secant/kn
 H_KS = 2          # κs: accumulated plastic slip [m]
 H_DS = 3          # ds: shear softening, 1 − rs
 H_UPC = 4         # u_pc: permanent (plastic) closure from the cap [m]
-H_DMAX = 5        # largest total closure reached (the cap's hardening variable) [m]
-H_DC = 6          # dc: compressive damage, 1 − σ̄c(dmax)/fc past the peak
+H_DFT = 5         # 1 − rt: tensile strength lost (kept so a step needs no exp() unless it yields)
+H_DC = 6          # dc: compressive damage, 1 − σ̄c(d)/fc at the furthest closure past the peak
 H_OPEN = 7        # 1 while the joint is open (e > 0): which normal stiffness is current
 NHIST = 8
-HIST_NAMES = ("kappa_t", "dt", "kappa_s", "ds", "u_pc", "d_max", "dc", "open")
+HIST_NAMES = ("kappa_t", "dt", "kappa_s", "ds", "u_pc", "dft", "dc", "open")
 
 
 @njit(cache=True, inline="always")
@@ -145,8 +145,8 @@ def law(p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, u
         tanfr = tanf
     kt = h[s, H_KT]
     kss = h[s, H_KS]
-    rt = math.exp(-(ft - ftr) * kt / p[c, P_GI])
-    rs = math.exp(-(coh - cr) * kss / p[c, P_GII])
+    rt = 1.0 - h[s, H_DFT]                 # exp(−(ft − ft_r) κt / G_I), kept
+    rs = 1.0 - h[s, H_DS]                  # exp(−(c − c_r) κs / G_II), kept
     r = min(rt, rs)
 
     # F1: tension, secant damage
@@ -159,6 +159,7 @@ def law(p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, u
         if t > sig_t:                      # on the softening front: the crack opens further
             kt += e - sig_t / ksec
             rt = math.exp(-(ft - ftr) * kt / p[c, P_GI])
+            h[s, H_DFT] = 1.0 - rt
             r = min(rt, rs)
             t = ftr + (ft - ftr) * r
             dt = 1.0 - t / (kn * e) if kn > 0.0 else 1.0
@@ -213,28 +214,26 @@ def law(p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, u
         cnn = p[c, P_CNN]
         cn = p[c, P_CN]
         css = p[c, P_CSS]
-        qq = sbar * sbar - css * tm * tm
-        if qq <= 0.0 and css > 0.0:        # the ellipse leaves no compression at this shear
-            tl = sbar / math.sqrt(css)
-            if tm > 0.0:
-                f = tl / tm
-                tau0 *= f
-                tau1 *= f
-                tau2 *= f
-            tm = tl
-            qq = 0.0
-        if qq < 0.0:
-            qq = 0.0
-        scap = (-cn + math.sqrt(cn * cn + 4.0 * cnn * qq)) / (2.0 * cnn)
-        if scap < 0.0:
-            scap = 0.0
-        if sig > scap:
-            h[s, H_UPC] = d - scap / kn0
-            sig = scap
-            state = state | ST_FAILED
-        if d > h[s, H_DMAX]:
-            h[s, H_DMAX] = d
-            se = 2.0 * fc / (npk + 1.0)
-            if d > npk * se / kn0:
-                h[s, H_DC] = 1.0 - cap_envelope(d, kn0, fc, npk, gc, fcr) / fc
+        if cnn * sig * sig + css * tm * tm + cn * sig > sbar * sbar:   # outside the ellipse
+            qq = sbar * sbar - css * tm * tm
+            if qq <= 0.0 and css > 0.0:    # the ellipse leaves no compression at this shear
+                tl = sbar / math.sqrt(css)
+                if tm > 0.0:
+                    f = tl / tm
+                    tau0 *= f
+                    tau1 *= f
+                    tau2 *= f
+                tm = tl
+            if qq < 0.0:
+                qq = 0.0
+            scap = (-cn + math.sqrt(cn * cn + 4.0 * cnn * qq)) / (2.0 * cnn)
+            if scap < 0.0:
+                scap = 0.0
+            if sig > scap:
+                h[s, H_UPC] = d - scap / kn0
+                sig = scap
+                state = state | ST_FAILED
+            # yielding happens only at the furthest closure: past the peak it sets the damage
+            if d > npk * 2.0 * fc / (npk + 1.0) / kn0:
+                h[s, H_DC] = max(h[s, H_DC], 1.0 - sbar / fc)
     return sig * area, tau0 * area, tau1 * area, tau2 * area, un, udil, us0, us1, us2, state
