@@ -21,21 +21,24 @@ out here as this module implements them (none of the plugin's code was read or u
   (opening +; u_pc the permanent closure left by the cap).
 
   F1 tension (e > 0), damage with secant unloading: σ = −kn (1 − dt) e while
-      kn (1 − dt) e ≤ σt;  σt = ft_r + (ft − ft_r) r,  rt = exp(−(ft − ft_r) κt / G_I)   (L&R Eq. 6)
+      kn (1 − dt) e ≤ σt;  σt = ft_r + (ft − ft_r) r,  rt = exp(−(ft − ft_r) κt / G_I)   (L&R's law)
   beyond it the opening advances on the softening front: Δκt = e − σt/(kn(1 − dt)), σ = −σt(κt),
-  dt = 1 − σt/(kn e). So G_I is the area of the post-peak stress–opening curve above ft_r.
+  dt = 1 − σt/(kn e) (the README's secant unloading; the softening is taken along the opening past
+  the peak, dec3d's choice, so that G_I is the area of the post-peak stress–opening curve above ft_r).
   F2 Coulomb: τ ≤ c + σ tan φ (≥ 0), c = c_r + (c − c_r) r, tan φ = tan φ_r + (tan φ − tan φ_r) r
-      (friction softening coupled to cohesion softening, L&R Eq. 8), rs = exp(−(c − c_r) κs / G_II)
-  (L&R Eq. 7); plastic slip Δκs = (τ_trial − τ_max)/ks with τ returned to τ_max (ks unchanged),
+      (friction softening coupled to cohesion softening, as L&R), rs = exp(−(c − c_r) κs / G_II)
+  (L&R's law); plastic slip Δκs = (τ_trial − τ_max)/ks with τ returned to τ_max (ks unchanged),
   so G_II is the area of the (τ − τ_res)–plastic-slip curve. Tension-shear coupling (d_ts): one
-  remaining-strength fraction r = min(rt, rs) softens tension, cohesion and friction together.
-  Dilatancy (L&R Eq. 12): Δu_dil = Δκs tan ψ, tan ψ = tan ψ₀ (1 − σ/σ_ψ0) exp(−δ κs), 0 for
+  remaining-strength fraction r = min(rt, rs) softens tension, cohesion and friction together
+  (dec3d's choice: the README names the coupling, not its form).
+  Dilatancy (L&R's law): Δu_dil = Δκs tan ψ, tan ψ = tan ψ₀ (1 − σ/σ_ψ0) exp(−δ κs), 0 for
   σ ≥ σ_ψ0 (σ_ψ0 = 0: no confinement limit); always an uplift, whichever way the joint slips, and
   only while the joint is closed (an open crack slides freely).
-  F3 cap (L&R Eq. 9): Cnn σ² + Css τ² + Cn σ ≤ σ̄c², returned along the normal only (a
+  F3 cap (L&R's ellipse): Cnn σ² + Css τ² + Cn σ ≤ σ̄c², returned along the normal only (a
   non-associated simplification: Δu_pc = (σ_trial − σ_cap)/kn0), the shear clipped to
   τ ≤ σ̄c/√Css where the ellipse leaves no compression. σ̄c is a function of the total closure
-  d = −(uⁿ − u_dil): σ_e = 2 fc/(n + 1) (the initial cap) up to d_e = σ_e/kn0; then the parabola
+  d = −(uⁿ − u_dil) (dec3d's reading of the README's "parabolic hardening to the peak at n times the
+  elastic-limit displacement"): σ_e = 2 fc/(n + 1) (the initial cap) up to d_e = σ_e/kn0; then the parabola
   tangent to the elastic line, fc − (fc − σ_e)((d_p − d)/(d_p − d_e))², reaching fc with zero slope at
   d_p = n d_e (n = peak_ratio: displacement at peak / elastic-limit displacement); beyond,
   fc_r + (fc − fc_r) exp(−(fc − fc_r)(d − d_p)/G_c): G_c is the post-peak area above fc_r.
@@ -196,7 +199,7 @@ def law(p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, u
                 conf = min(max(conf, 0.0), 1.0)
             ddil = dks * tandil * conf * math.exp(-p[c, P_DELTA] * kss)
             udil += ddil
-            sig += kn0 * ddil              # the blocked uplift raises the normal stress (Eq. 43)
+            sig += kn0 * ddil              # the blocked uplift raises the normal stress (as mohr, theory Eq. 43)
         kss += dks
         h[s, H_KS] = kss
         rs = math.exp(-(coh - cr) * kss / p[c, P_GII])
