@@ -407,3 +407,22 @@ def test_missing_fracture_energy_stops_cycling_naming_it(tmp_path):
     s.command("block fix range id 1")
     with pytest.raises(Dec3dError, match="needs property 'g_c'"):
         s.command("model cycle 1")
+
+
+def test_factor_of_safety_reduces_coulomb_and_tension_strengths_only():
+    """`model factor-of-safety`: tan φ, c, ft (peak and residual) over F, dilatancy at most the
+    reduced friction; the cap, the stiffnesses and the fracture energies unchanged."""
+    vals = dict(BASE, **{"friction-residual": 30.0, "cohesion-residual": 0.1e6, "tension-residual": 0.05e6,
+                         "dilation": 40.0})
+    rows = np.tile(MODEL.row(vals), (2, 1))
+    before = rows.copy()
+    MODEL.reduce(rows, 2.0, False)
+    for name in ("cohesion", "tension", "cohesion-residual", "tension-residual"):
+        assert np.allclose([MODEL.value(r, name) for r in rows], vals[name] / 2)
+    for name in ("friction", "friction-residual"):
+        tan = math.tan(math.radians(vals[name])) / 2
+        assert np.allclose([MODEL.value(r, name) for r in rows], math.degrees(math.atan(tan)))
+    assert np.allclose([MODEL.value(r, "dilation") for r in rows], math.degrees(math.atan(math.tan(math.radians(35)) / 2)))
+    for name in ("stiffness-normal", "stiffness-shear", "compression", "g_i", "g_ii", "g_c", "peak_ratio"):
+        col = MODEL.props[name].column
+        assert np.array_equal(rows[:, col], before[:, col])
