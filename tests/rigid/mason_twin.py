@@ -19,7 +19,8 @@ class MasonTwin:
         return float(self.props.get(name, default))
 
     def cap_strength(self, d):
-        """σ̄c(d): σe (initial cap) up to de = σe/kn0, with σe = 2fc/(n+1), parabola tangent to it up to fc at n·de, exponential after."""
+        """σ̄c(d): σe = 2fc/(n+1) (initial cap) up to de = σe/kn0, a parabola tangent to the elastic
+        line up to fc at n·de, exponential after."""
         fc, n, kn0 = self.get("compression"), self.get("peak_ratio", 1.0), self.kn0()
         gc, fcr = self.get("g_c"), min(self.get("comp-residual"), fc)
         sigma_e = 2 * fc / (n + 1)

@@ -105,7 +105,8 @@ def test_kernel_matches_its_twin_on_random_paths(seed):
             assert j.hist(name) == pytest.approx(v, rel=1e-9, abs=1e-15), (k, name)
         kn, ks = kernel.stiffness(j.p, 0, j.h, 0)
         kn_twin = props["stiffness-normal"] * (1 - t.hist["dt"]) if t.hist["open"] else props["stiffness-initial"]
-        assert kn == pytest.approx(kn_twin, rel=1e-9, abs=1e-12 * props["stiffness-normal"]) and ks == props["stiffness-shear"]
+        assert kn == pytest.approx(kn_twin, rel=1e-9, abs=1e-12 * props["stiffness-normal"])
+        assert ks == props["stiffness-shear"]
     assert seen & {"slip", "failed"}
 
 
@@ -376,7 +377,8 @@ def test_bad_input_refused_at_binding_with_its_location(tmp_path, extra, msg):
     loc = exc.value.location
     assert loc is not None and loc.file.endswith("bad.dat") and loc.line == 4
     line = DECK.splitlines()[3].format(extra=extra)
-    assert loc.column in (line.index(extra) + 1, line.index(extra) + len(extra.split()[0]) + 2)   # the word or its value
+    # the keyword or its value
+    assert loc.column in (line.index(extra) + 1, line.index(extra) + len(extra.split()[0]) + 2)
 
 
 def test_safego_names(tmp_path):
@@ -422,7 +424,8 @@ def test_factor_of_safety_reduces_coulomb_and_tension_strengths_only():
     for name in ("friction", "friction-residual"):
         tan = math.tan(math.radians(vals[name])) / 2
         assert np.allclose([MODEL.value(r, name) for r in rows], math.degrees(math.atan(tan)))
-    assert np.allclose([MODEL.value(r, "dilation") for r in rows], math.degrees(math.atan(math.tan(math.radians(35)) / 2)))
+    reduced_friction = math.degrees(math.atan(math.tan(math.radians(35)) / 2))
+    assert np.allclose([MODEL.value(r, "dilation") for r in rows], reduced_friction)
     for name in ("stiffness-normal", "stiffness-shear", "compression", "g_i", "g_ii", "g_c", "peak_ratio"):
         col = MODEL.props[name].column
         assert np.array_equal(rows[:, col], before[:, col])
