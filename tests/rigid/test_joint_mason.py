@@ -350,10 +350,11 @@ block contact property stiffness-normal 1e10 stiffness-shear 1e10 G_I 10 G_II 50
 """
 
 
-#: `block contact property` checks a keyword against one range shared by every model with that name,
-#: without ``lo_open``; the model's own range needs the check in commands/block_contact._check that
-#: /work/notes/mason_block_contact_ranges.patch adds (reported, not in this branch: a file outside the
-#: model's two). Remove this mark with that change.
+#: `block contact property` binds a keyword with one range per name, the last model's (mohr's friction
+#: takes 90), without ``lo_open``: a model's own range needs commands/block_contact.py to check each
+#: model's ``Prop`` range in ``_check`` (and bind with the widest range, ``lo_open`` included). That
+#: change is proposed with this branch, not made in it (a file outside the model's two); remove this
+#: mark with it.
 MODEL_RANGES = pytest.mark.xfail(strict=True, reason="per-model property ranges not checked by block contact property")
 
 
