@@ -13,9 +13,24 @@ from .values import FLAG, Choice, Num, P, Text, ValueRangeError
 PROPS = ALL_PROPS
 _UNITS = {p.name: p.units for m in JOINT_MODELS.values() for p in m.props.values()}
 _DOCS = {p.name: p.doc for m in JOINT_MODELS.values() for p in m.props.values()}
-_BOUNDS = {p.name: (p.lo, p.hi, p.hi_open) for m in JOINT_MODELS.values() for p in m.props.values()}
-_KW = [P(name, Num(lo=_BOUNDS[name][0], hi=_BOUNDS[name][1], hi_open=_BOUNDS[name][2]), _DOCS[name],
-         units=_UNITS[name]) for name in PROPS]
+
+
+def _loosest(name):
+    """(lo, lo_open, hi, hi_open) of keyword ``name`` at binding: the widest range any model gives it
+    (each model's own range is checked when its contacts take the value, ``_check``)."""
+    ps = [m.props[name] for m in JOINT_MODELS.values() if name in m.props]
+    los = [p for p in ps if p.lo is not None]
+    his = [p for p in ps if p.hi is not None]
+    lo = min(p.lo for p in los) if len(los) == len(ps) else None
+    hi = max(p.hi for p in his) if len(his) == len(ps) else None
+    lo_open = lo is not None and all(p.lo_open for p in los if p.lo == lo)
+    hi_open = hi is not None and all(p.hi_open for p in his if p.hi == hi)
+    return lo, lo_open, hi, hi_open
+
+
+_BOUNDS = {name: _loosest(name) for name in PROPS}
+_KW = [P(name, Num(lo=_BOUNDS[name][0], lo_open=_BOUNDS[name][1], hi=_BOUNDS[name][2], hi_open=_BOUNDS[name][3]),
+         _DOCS[name], units=_UNITS[name]) for name in PROPS]
 
 
 def _given(call):
@@ -30,11 +45,21 @@ def _given(call):
 
 
 def _check(call, model_name, props):
-    allowed = tuple(JOINT_MODELS[model_name].props)
+    model = JOINT_MODELS[model_name]
+    allowed = tuple(model.props)
     bad = [k for k in props if k not in allowed]
     if bad:
         raise CommandError(f"joint model '{model_name}' has no property '{bad[0]}' "
                            f"(it has: {', '.join(allowed)})", call.location)
+    # a keyword several models share binds with the widest range (``_BOUNDS``): the model's own
+    # range (``Prop.lo/hi/lo_open/hi_open``) is checked here, at the keyword's location
+    for k, v in props.items():
+        p = model.props[k]
+        try:
+            Num(lo=p.lo, hi=p.hi, lo_open=p.lo_open, hi_open=p.hi_open).convert(
+                v, call.locations.get(k.replace("-", "_"), call.location))
+        except ValueRangeError as exc:
+            raise exc.named(k) from None
 
 
 #: 3DEC's other built-in joint models (Itasca joint-model reference), known by name, until one of ours

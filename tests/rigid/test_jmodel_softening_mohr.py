@@ -221,7 +221,7 @@ def _col(line):
     ("block contact property cohesion -1e5", "`cohesion` must be ≥ 0, got -100000"),
     ("block contact property tension-residual -1", "`tension-residual` must be ≥ 0, got -1"),
     # (says "≥ 0" until the command layer passes lo_open: see test_zero_dc_is_refused_where_written)
-    ("block contact property dc -1e-3", "`dc` must be ≥ 0, got -0.001"),
+    ("block contact property dc -1e-3", "`dc` must be > 0, got -0.001"),
     ("block contact property healing 2", "`healing` must be in [0, 1], got 2"),
 ])
 def test_bad_values_are_refused_where_written(session, tmp_path, line, message):
@@ -233,8 +233,6 @@ def test_bad_values_are_refused_where_written(session, tmp_path, line, message):
     assert (e.value.location.file, e.value.location.line, e.value.location.column) == (str(deck), 3, _col(line))
 
 
-@pytest.mark.xfail(strict=True, reason="block_contact.py builds its Num(lo, hi, hi_open) without the property's "
-                   "lo_open, so `dc 0` passes binding (see the report of issue 27)")
 def test_zero_dc_is_refused_where_written(session, tmp_path):
     deck = tmp_path / "deck.dat"
     deck.write_text(BAD_BASE + "block contact property dc 0\n")

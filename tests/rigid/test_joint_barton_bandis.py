@@ -164,17 +164,15 @@ BASE = "block create brick 0 1 0 1 0 1\nblock contact jmodel assign barton-bandi
 
 @pytest.mark.parametrize("line, message, column", [
     ("block contact property jrc -1", "`jrc` must be in [0, 20], got -1", 28),
-    ("block contact property jcs -1e6", "`jcs` must be ≥ 0, got -1e+06", 28),
+    ("block contact property jcs -1e6", "`jcs` must be > 0, got -1e+06", 28),
     ("block contact property stiffness-shear -5", "`stiffness-shear` must be ≥ 0, got -5", 40),
     ("block contact property friction-residual 95", "`friction-residual` must be in [0, 90], got 95", 42),
-    ("block contact property closure-maximum -1e-3", "`closure-maximum` must be ≥ 0, got -0.001", 40),
+    ("block contact property closure-maximum -1e-3", "`closure-maximum` must be > 0, got -0.001", 40),
 ])
 def test_bad_properties_are_refused_at_binding(session, tmp_path, line, message, column):
     assert_refused_at_binding(session, tmp_path, BASE + line, message, column)
 
 
-@pytest.mark.xfail(strict=True, reason="commands/block_contact.py builds its keyword ranges (_BOUNDS, _KW) without "
-                   "lo_open: JCS = 0 and vm = 0 pass binding (the two-line fix is in the report of issue 27)")
 @pytest.mark.parametrize("line", ["block contact property jcs 0", "block contact property closure-maximum 0"])
 def test_zero_jcs_and_maximum_closure_are_refused_at_binding(session, tmp_path, line):
     deck = tmp_path / "deck.dat"
@@ -183,8 +181,6 @@ def test_zero_jcs_and_maximum_closure_are_refused_at_binding(session, tmp_path, 
         session.call(deck)
 
 
-@pytest.mark.xfail(strict=True, reason="commands/block_contact.py keys keyword ranges by name, the last model's "
-                   "winning (mohr's friction-residual [0, 90]): barton-bandis's [0, 90) needs a check per model")
 def test_residual_friction_90_is_refused_at_binding(session, tmp_path):
     deck = tmp_path / "deck.dat"
     deck.write_text(BASE + "block contact property friction-residual 90\n")
@@ -193,7 +189,7 @@ def test_residual_friction_90_is_refused_at_binding(session, tmp_path):
 
 
 def test_residual_friction_90_never_slips():
-    """Until then, φr = 90 (as mohr's idiom) is a joint that never slips: the strength is σn tan 90°."""
+    """The kernel given φr = 90 (refused by the command, but a row may hold it) never slips: σn tan 90°."""
     p = _row({**P0, "friction-residual": 90.0})
     h = np.zeros((1, 8))
     fn, fs, un, st = _kstep(p, h, 1.0, -5e-4, np.array([1e-2, 0, 0]), 0.0, np.zeros(3), 0)

@@ -350,24 +350,18 @@ block contact property stiffness-normal 1e10 stiffness-shear 1e10 G_I 10 G_II 50
 """
 
 
-#: `block contact property` binds a keyword with one range per name, the last model's (mohr's friction
-#: takes 90), without ``lo_open``: a model's own range needs commands/block_contact.py to check each
-#: model's ``Prop`` range in ``_check`` (and bind with the widest range, ``lo_open`` included). That
-#: change is proposed with this branch, not made in it (a file outside the model's two); remove this
-#: mark with it.
-MODEL_RANGES = pytest.mark.xfail(strict=True, reason="per-model property ranges not checked by block contact property")
 
 
 @pytest.mark.parametrize("extra,msg", [
-    pytest.param("G_I 0", "`g_i` must be > 0", marks=MODEL_RANGES),
+    ("G_I 0", "`g_i` must be > 0"),
     ("G_II -5", "`g_ii` must be [>≥] 0"),
-    pytest.param("G_c 0", "`g_c` must be > 0", marks=MODEL_RANGES),
+    ("G_c 0", "`g_c` must be > 0"),
     ("stiffness-shear -1e9", "`stiffness-shear` must be ≥ 0"),
     ("stiffness-initial -1", "`stiffness-initial` must be ≥ 0"),
-    pytest.param("friction 90", r"`friction` must be in \[0, 90\)", marks=MODEL_RANGES),
+    ("friction 90", r"`friction` must be in \[0, 90\)"),
     ("friction-residual 95", r"`friction-residual` must be in \[0, 90[\])]"),
     ("peak_ratio 0.5", "`peak_ratio` must be ≥ 1"),
-    pytest.param("Cnn 0", "`cnn` must be > 0", marks=MODEL_RANGES),
+    ("Cnn 0", "`cnn` must be > 0"),
 ])
 def test_bad_input_refused_at_binding_with_its_location(tmp_path, extra, msg):
     deck = tmp_path / "bad.dat"
