@@ -37,7 +37,7 @@ from dec3d.kernels import contactmap as _cm
 from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, gather_subcontacts, match_sorted,
                                       subcontact_gaps, threaded, vertex_point_areas)
 from dec3d.kernels.kept import add_turns, as_they_are, pairs_to_look_at, take_defaults
-from dec3d.kernels.joints import NJHIST, NPROP
+from dec3d.kernels.joints import HISTORY_MODELS, NJHIST, NPROP, model_mask
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.groups import group_field
 from dec3d.model.model import KIND_DEFORMABLE, KIND_FE, KIND_RIGID
@@ -108,6 +108,9 @@ QUIET = 0.1
 #: contacts between rigid blocks follow the relative rule (``detect``): kept while their blocks have
 #: moved (and turned) less than QUIET·CTOL relative to each other (a stack settling or sliding as one)
 RELATIVE = True
+
+#: a zero-width history (no model in use keeps one): the carry-over and gather kernels skip it
+_NO_HIST = np.empty((1, 0))
 
 #: the sub-contact fields a detection writes (``contactmap.gather_subcontacts``), in its order
 _GATHERED = ("contact", "kind", "key0", "key1", "pos", "area", "fn", "fs", "un", "udil", "us", "state", "hist")
@@ -511,9 +514,12 @@ class ContactDetection:
         udil = np.empty(ns)
         us = np.empty((ns, 3))
         state = np.empty(ns, _I)
-        hist = np.empty((ns, NJHIST))
+        # the joint models' history goes along only when a model in use keeps one (else it is all zero:
+        # zero-width arrays make the kernels skip it, the store fills it)
+        keep_hist = bool((model_mask(jcode) | model_mask(cs["jmodel"])) & HISTORY_MODELS)
+        hist = np.empty((ns, NJHIST if keep_hist else 0))
         olds = (cs["sub_start"], cs["sub_count"], ss["kind"], ss["key0"], ss["key1"], ss["area"], ss["fs"], ss["un"],
-                ss["udil"], ss["us"], ss["state"], ss["hist"], cs["normal"], f_n)
+                ss["udil"], ss["us"], ss["state"], ss["hist"] if keep_hist else _NO_HIST, cs["normal"], f_n)
         nt = get_num_threads() if ns >= _cm.PARALLEL_FROM else 1
         cut = np.linspace(0, ns, nt + 1).astype(_I)       # (each sub-contact's state is its own: rows apart)
         in_threads(lambda j: carry_over(f_prev, *(x[cut[j]:cut[j + 1]] for x in (sc_c, kind, key0, key1, area, sgap)),
@@ -536,10 +542,11 @@ class ContactDetection:
         same = nf == 0 and total == ss.n and np.array_equal(base, starts)
         if not same:
             # straight into new arrays (the old rows are read from the store's own), installed below
-            gathered = ss.blank(total, _GATHERED)
-            old_rows = tuple(ss[key] for key in _GATHERED[1:])
+            keys = _GATHERED if keep_hist else _GATHERED[:-1]
+            gathered = ss.blank(total, keys)
+            old_rows = tuple(ss[key] for key in keys[1:]) + (() if keep_hist else (_NO_HIST,))
             new_rows = (kind, key0, key1, pos, area, fs, un, udil, us, state, hist)
-            out = tuple(gathered[key] for key in _GATHERED)
+            out = tuple(gathered[key] for key in keys) + (() if keep_hist else (np.empty((total, 0)),))
             nt = get_num_threads() if total >= _cm.PARALLEL_FROM else 1
             cut = np.linspace(0, nc, nt + 1).astype(_I)
             in_threads(lambda j: gather_subcontacts(cut[j], cut[j + 1], base, starts, counts, ss.n, old_rows, new_rows,

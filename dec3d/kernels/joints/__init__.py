@@ -40,7 +40,7 @@ from numba.extending import overload
 
 from ._common import NJHIST, P_KN, P_KS, ST_FAILED, ST_NEW, ST_SLIP, ST_TENSION, constant_stiffness
 
-__all__ = ["ALL_MODELS", "CODES", "MODELS", "NJHIST", "NPROP", "P_KN", "P_KS", "ST_FAILED", "ST_NEW", "ST_SLIP",
+__all__ = ["ALL_MODELS", "CODES", "HISTORY_MODELS", "MODELS", "NJHIST", "NPROP", "P_KN", "P_KS", "ST_FAILED", "ST_NEW", "ST_SLIP",
            "ST_TENSION", "joint_law", "joint_law_for", "joint_stiffness", "model_mask"]
 
 
@@ -127,6 +127,8 @@ def model_mask(codes) -> int:
 
 #: the mask of every model found (``joint_law_for(ALL_MODELS, …)`` is ``joint_law``)
 ALL_MODELS = model_mask(m.CODE for m in MODELS)
+#: the mask of the models that keep a history (detection carries ``hist`` only when one is in use)
+HISTORY_MODELS = model_mask(m.CODE for m in MODELS if m.NHIST)
 
 
 def joint_law_for(models, model, p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2,
