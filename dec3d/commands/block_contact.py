@@ -5,7 +5,7 @@ import numpy as np
 
 from ..errors import CommandError
 from ..physics.jmodels import ALIASES, ALL_PROPS, JOINT_MODELS, MODEL_BY_CODE, REFUSED
-from ..physics.contacts import default_row
+from ..physics.contacts import default_row, history_columns
 from ..physics.rigid import engine, mech
 from .registry import command
 from .values import FLAG, Choice, Num, P, Text, ValueRangeError
@@ -135,6 +135,7 @@ def jmodel_assign(session, call):
     c["prop"][sel] = default_row(mech(session.model), jm.code)
     c["own_props"][sel] = 0
     ss = e.subcontacts
+    history_columns(ss, c["jmodel"])
     if ss.n:
         ss["hist"][sel[ss["contact"]]] = 0.0        # the model's history starts afresh
     if call.range is None:
@@ -276,6 +277,10 @@ def material_add(session, call):
     c["jmodel"][sel] = jm.code
     c["prop"][sel] = jm.row(props)
     c["own_props"][sel] = 1
+    ss = e.subcontacts
+    history_columns(ss, c["jmodel"])
+    if ss.n:
+        ss["hist"][sel[ss["contact"]]] = 0.0
     if rule is not None or call.range is None:
         tables.append(entry)
     session.results["material-table.count"] = float(len(tables))

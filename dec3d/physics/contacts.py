@@ -90,7 +90,9 @@ SUBCONTACT_FIELDS = {
     "udil": Field((), _F, 0.0),          # dilation [m]
     "us": Field((3,), _F, 0.0),          # accumulated shear displacement [m]
     "state": Field((), _I, 0),           # ST_* bits (kernels.jointlaw)
-    "hist": Field((NJHIST,), _F, 0.0),   # the joint model's own history (kernels.joints: its first NHIST)
+    # the joint models' own history (kernels.joints: a model's first NHIST columns): NJHIST columns while a
+    # contact's model keeps one, none otherwise (``history_columns``: a mohr-only model carries nothing)
+    "hist": Field((0,), _F, 0.0),
     # on a zoned (deformable) side: the gridpoints of the surface triangle the point moves with
     # and its interpolation weights (set at detection by gpcontact.surface_weights; -1: rigid side)
     "gp_a": Field((3,), _I, -1),
@@ -108,9 +110,6 @@ QUIET = 0.1
 #: contacts between rigid blocks follow the relative rule (``detect``): kept while their blocks have
 #: moved (and turned) less than QUIET·CTOL relative to each other (a stack settling or sliding as one)
 RELATIVE = True
-
-#: a zero-width history (no model in use keeps one): the carry-over and gather kernels skip it
-_NO_HIST = np.empty((1, 0))
 
 #: the sub-contact fields a detection writes (``contactmap.gather_subcontacts``), in its order
 _GATHERED = ("contact", "kind", "key0", "key1", "pos", "area", "fn", "fs", "un", "udil", "us", "state", "hist")
@@ -130,7 +129,7 @@ def contact_stores(model) -> tuple[Store, Store]:
         for key, fld in fields.items():
             if key not in store:
                 store.add_field(key, fld)
-            elif store.fields[key].shape != fld.shape and key in ("prop", "hist"):
+            elif store.fields[key].shape != fld.shape and key == "prop":
                 store.resize_field(key, fld.shape)
     for key in ("map_pos", "look_pos", "turn_pos"):
         if key not in model.vertices:
@@ -139,6 +138,16 @@ def contact_stores(model) -> tuple[Store, Store]:
         if key not in model.blocks:
             model.blocks.add_field(key, Field(shape, _F, 0.0))
     return model.store("contacts"), model.store("subcontacts")
+
+
+def history_columns(ss, codes) -> None:
+    """Give the sub-contacts' ``hist`` NJHIST columns when one of the joint-model ``codes`` (an int
+    array) keeps a history, none otherwise (the columns are zero when added; dropping them loses
+    nothing: only those models write them). Called by detection, by the commands that change
+    contacts' models and before every run."""
+    width = NJHIST if model_mask(np.asarray(codes, dtype=np.int64)) & HISTORY_MODELS else 0
+    if ss.fields["hist"].shape != (width,):
+        ss.resize_field("hist", (width,))
 
 
 def in_threads(work, nitems: int, nthreads: int) -> None:
@@ -514,12 +523,11 @@ class ContactDetection:
         udil = np.empty(ns)
         us = np.empty((ns, 3))
         state = np.empty(ns, _I)
-        # the joint models' history goes along only when a model in use keeps one (else it is all zero:
-        # zero-width arrays make the kernels skip it, the store fills it)
-        keep_hist = bool((model_mask(jcode) | model_mask(cs["jmodel"])) & HISTORY_MODELS)
-        hist = np.empty((ns, NJHIST if keep_hist else 0))
+        # the joint models' history goes along only while a model in use keeps one (no columns otherwise)
+        history_columns(ss, np.concatenate((jcode, cs["jmodel"])))
+        hist = np.empty((ns, ss.fields["hist"].shape[0]))
         olds = (cs["sub_start"], cs["sub_count"], ss["kind"], ss["key0"], ss["key1"], ss["area"], ss["fs"], ss["un"],
-                ss["udil"], ss["us"], ss["state"], ss["hist"] if keep_hist else _NO_HIST, cs["normal"], f_n)
+                ss["udil"], ss["us"], ss["state"], ss["hist"], cs["normal"], f_n)
         nt = get_num_threads() if ns >= _cm.PARALLEL_FROM else 1
         cut = np.linspace(0, ns, nt + 1).astype(_I)       # (each sub-contact's state is its own: rows apart)
         in_threads(lambda j: carry_over(f_prev, *(x[cut[j]:cut[j + 1]] for x in (sc_c, kind, key0, key1, area, sgap)),
@@ -542,11 +550,10 @@ class ContactDetection:
         same = nf == 0 and total == ss.n and np.array_equal(base, starts)
         if not same:
             # straight into new arrays (the old rows are read from the store's own), installed below
-            keys = _GATHERED if keep_hist else _GATHERED[:-1]
-            gathered = ss.blank(total, keys)
-            old_rows = tuple(ss[key] for key in keys[1:]) + (() if keep_hist else (_NO_HIST,))
+            gathered = ss.blank(total, _GATHERED)
+            old_rows = tuple(ss[key] for key in _GATHERED[1:])
             new_rows = (kind, key0, key1, pos, area, fs, un, udil, us, state, hist)
-            out = tuple(gathered[key] for key in keys) + (() if keep_hist else (np.empty((total, 0)),))
+            out = tuple(gathered[key] for key in _GATHERED)
             nt = get_num_threads() if total >= _cm.PARALLEL_FROM else 1
             cut = np.linspace(0, nc, nt + 1).astype(_I)
             in_threads(lambda j: gather_subcontacts(cut[j], cut[j + 1], base, starts, counts, ss.n, old_rows, new_rows,

@@ -22,7 +22,7 @@ from dec3d.io.state import register_known
 from dec3d.physics.modelprops import ModelProp, atan_deg, tan_deg
 
 from dec3d.kernels.joints import MODELS as KERNELS
-from dec3d.kernels.joints import NPROP, P_KN, P_KS
+from dec3d.kernels.joints import NJHIST, NPROP, P_KN, P_KS
 from dec3d.kernels.jointlaw import subcontact_stiffness
 
 
@@ -137,9 +137,12 @@ def stiffness(cs, ss, prop=None) -> tuple[np.ndarray, np.ndarray]:
         c = ss["contact"]
         return p[c, P_KN], p[c, P_KS]
     kn, ks = np.empty(n), np.empty(n)
+    hist = ss["hist"]
+    if hist.shape[1] < NJHIST:          # (no history columns yet: a model just assigned, before its first run)
+        hist = np.zeros((n, NJHIST))
     if n:
         subcontact_stiffness(cs["jmodel"], np.ascontiguousarray(cs["prop"] if prop is None else prop), ss["contact"],
-                             ss["hist"], kn, ks)
+                             hist, kn, ks)
     return kn, ks
 
 

@@ -145,6 +145,7 @@ class _Run:
         between = between and s.get("dt_mode", self.dt_mode) == self.dt_mode
         if self.mixed:
             self.wsub, self.wcon = eng._mixed_weights(self.zst, recompute=not between)
+        _contacts.history_columns(eng.subcontacts, eng.contacts["jmodel"])   # (a restored or edited model)
         bad = eng.property_problem()
         if bad:
             raise RunError(bad)
