@@ -480,16 +480,22 @@ class ContactDetection:
         old = prev_c >= 0
         jm = JOINT_MODELS[s["jmodel"]]
         jcode = np.full(nc, jm.code, _I)
-        prop = np.tile(default_row(s, jm.code), (nc, 1)) if nc else np.zeros((0, NPROP))
         group = np.full((nc, cs["group"].shape[1]), -1, np.int32)
         own = np.zeros(nc, np.uint8)
         jcode[old] = cs["jmodel"][prev_c[old]]
         own[old] = cs["own_props"][prev_c[old]]
         keep_row = old & (own == 1)
-        prop[keep_row] = cs["prop"][prev_c[keep_row]]
-        for code in np.unique(jcode[old & (own == 0)]):      # contacts that follow the defaults
-            sel = old & (own == 0) & (jcode == code)
-            prop[sel] = default_row(s, int(code))
+        follow = ~keep_row                 # new contacts and old ones that follow the defaults
+        codes = np.unique(jcode[follow])
+        # (each row written once: a model of one joint model following its defaults is one broadcast;
+        # the property rows are as wide as the widest model's, so every pass over them counts)
+        prop = np.empty((nc, NPROP))
+        if len(codes) == 1 and follow.all():
+            prop[:] = default_row(s, int(codes[0]))
+        else:
+            prop[keep_row] = cs["prop"][prev_c[keep_row]]
+            for code in codes:
+                prop[follow & (jcode == code)] = default_row(s, int(code))
         group[old] = cs["group"][prev_c[old]]
         if s.get("mtables") and not old.all():      # `block contact material-table add` entries
             apply_material_tables(m, s["mtables"], ~old, ra_c, rb_c, jcode, prop, own)

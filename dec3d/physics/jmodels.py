@@ -126,6 +126,13 @@ STIFFNESS = [Prop("stiffness-normal", P_KN, "normal stiffness kn", "Pa/m"),
 _HOOKED = np.array(sorted(k.CODE for k in KERNELS if hasattr(k, "stiffness")), dtype=np.int64)
 
 
+def changing_stiffness(cs) -> bool:
+    """Whether a contact's joint model answers its own stiffness (``stiffness`` hook): its stiffness
+    then changes with the joint's state, and the time step and the masses are worked out again at
+    every detection."""
+    return bool(cs.n) and bool(np.isin(cs["jmodel"], _HOOKED).any())
+
+
 def stiffness(cs, ss, prop=None) -> tuple[np.ndarray, np.ndarray]:
     """(kn, ks) (ns,) [Pa/m]: every sub-contact's current stiffness as its joint model gives it
     (the kernel's ``stiffness`` hook; columns 0, 1 for a model without one). ``cs``, ``ss``: the
@@ -133,7 +140,7 @@ def stiffness(cs, ss, prop=None) -> tuple[np.ndarray, np.ndarray]:
     The one place the engine asks for a joint stiffness."""
     n = ss.n
     p = cs["prop"] if prop is None else prop
-    if not np.isin(cs["jmodel"], _HOOKED).any():          # constant stiffnesses: columns 0, 1
+    if not changing_stiffness(cs):          # constant stiffnesses: columns 0, 1
         c = ss["contact"]
         return p[c, P_KN], p[c, P_KS]
     kn, ks = np.empty(n), np.empty(n)

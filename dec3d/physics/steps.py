@@ -23,6 +23,7 @@ from dec3d.kernels.bundles import (NSERVO, Bodies, Bounds, Contacts, Groups, Sub
                                    new_servo, servo_values)
 from dec3d.kernels.contactmap import blocks_moved
 from dec3d.kernels.joints import model_mask
+from dec3d.physics.jmodels import changing_stiffness
 from dec3d.kernels.cycle import cycle_lists, run_steps
 from dec3d.kernels.motion import DAMP_ADAPTIVE
 
@@ -236,7 +237,8 @@ class _Run:
     def _keeps_masses(self) -> bool:
         """A detection that kept every contact as it was leaves density scaling by body as it is
         (as a detection left out does, ``quiet``: a run resumed there then agrees with one run)."""
-        return self.by_body and self.eng.detect_kept_all and self.gimass is not None
+        return (self.by_body and self.eng.detect_kept_all and self.gimass is not None
+                and not changing_stiffness(self.eng.contacts))
 
     def _zoned_dt(self) -> float:
         """Δt of a model with zoned blocks for the contacts as they are now."""
@@ -261,9 +263,12 @@ class _Run:
         and keep every contact and sub-contact as it is. Never for the first detection of a run
         (commands between runs may have changed contact defaults, which a detection applies), nor
         with zoned blocks, a motion trigger, a geometry change, or a step hook other than
-        histories (a FISH callback may change what a detection reads)."""
+        histories (a FISH callback may change what a detection reads), nor when a joint model in use
+        answers its own stiffness (it changes with the joint's state, not with motion: Δt and the
+        masses follow it at every detection)."""
         eng = self.eng
         if (not SKIP_QUIET or not self.looked or self.zoned or self.due or _contacts.QUIET <= 0.0
+                or changing_stiffness(eng.contacts)
                 or eng._signature != eng._geometry_signature() or eng.settings().get("grid") is None
                 or any(not isinstance(h, HistorySet) for h in eng.step_hooks)):
             return False
