@@ -148,8 +148,8 @@ def test_material_table_survives_save_and_restore(session):
 @pytest.mark.parametrize("line, message", [
     ("block contact material-table add jmodel mohr prop frobnicate 1 range group-intersection 'lo' 'hi'",
      r"joint model 'mohr' has no property 'frobnicate'"),
-    ("block contact material-table add jmodel cyjm prop stiffness-normal 1e9",
-     r"`cyjm` is not supported yet"),
+    ("block contact material-table add jmodel nonlinear prop stiffness-normal 1e9",
+     r"`nonlinear` is not supported yet"),
     ("block contact material-table add prop stiffness-normal -1 range group-intersection 'lo' 'hi'",
      r"stiffness-normal"),
 ])

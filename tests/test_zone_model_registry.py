@@ -1,7 +1,6 @@
 """The zone-model plug-ins as a whole: the registry, the guard that a model lives in its two files,
 what `block zone cmodel assign` and `block zone property` do with models' own properties, the
 history block through save/restore, VTK and FISH, and save files from before the model library."""
-import ast
 import io
 import pathlib
 
@@ -18,17 +17,8 @@ ROOT = pathlib.Path(dec3d.__file__).parent
 
 
 def _string_constants(path: pathlib.Path):
-    """(line, value) of the string literals of a module that are not docstrings."""
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    docs = set()
-    for node in ast.walk(tree):
-        if isinstance(node, (ast.Module, ast.FunctionDef, ast.ClassDef, ast.AsyncFunctionDef)) and node.body:
-            first = node.body[0]
-            if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant):
-                docs.add(id(first.value))
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docs:
-            yield node.lineno, node.value
+    from source_scan import string_constants
+    return string_constants(path)
 
 
 def test_every_kernel_has_its_host_and_codes_are_unique():

@@ -62,10 +62,8 @@ def _check(call, model_name, props):
             raise exc.named(k) from None
 
 
-#: 3DEC's other built-in joint models (Itasca joint-model reference), known by name, until one of ours
-#: takes the name
-OTHER_3DEC_MODELS = tuple(n for n in ("softening-mohr", "bilinear-mohr", "cyjm", "nonlinear", "power", "ratestate")
-                          if n not in JOINT_MODELS and n not in ALIASES)
+#: 3DEC's built-in joint models dec3d does not have (Itasca joint-model reference), known by name
+OTHER_3DEC_MODELS = ("nonlinear", "power", "ratestate")
 
 
 def _known_names() -> tuple[str, ...]:

@@ -23,7 +23,7 @@ model gravity 0 0 -10
 """
 
 #: the continuously yielding model keeps a history; with both exponents 0 its stiffnesses are kn, ks
-CY = "block contact jmodel assign cy\nblock contact property stiffness-normal 1e9 stiffness-shear 5e8 friction 30 roughness 1e-3"
+CY = "block contact jmodel assign cyjm\nblock contact property kn-initial 1e9 ks-initial 5e8 friction 30 roughness 1e-3"
 
 
 def _stack(session, extra=""):

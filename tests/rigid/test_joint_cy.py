@@ -11,7 +11,7 @@ from scipy.integrate import solve_ivp
 from dec3d.kernels.joints import cy
 from dec3d.physics.jmodels import JOINT_MODELS
 
-NAME = "cy"
+NAME = "cyjm"
 LAW = cy.law.py_func
 HOOK = cy.stiffness.py_func
 
@@ -27,10 +27,10 @@ def _row(**kw):
 def twin_step(P, st, area, dun, dus, un, udil, fs):
     """One step of the continuously yielding joint. P: user properties (degrees); st: the twin's
     own state {up, r, d (previous increment direction), sn}. Returns (fn, fs (3,), un)."""
-    an, asf = P["stiffness-normal"], P["stiffness-shear"]
+    an, asf = P["kn-initial"], P["ks-initial"]
     en, es = P["exponent-normal"], P["exponent-shear"]
-    phi0 = math.radians(P["friction"])
-    phi = math.radians(P.get("friction-intrinsic", P["friction"]))
+    phi = math.radians(P["friction"])
+    phi0 = math.radians(P.get("friction-initial", P["friction"]))
     R = P["roughness"]
     un = un + dun
     v = -(un - udil)
@@ -70,10 +70,10 @@ def test_kernel_matches_the_twin_on_random_paths():
     history and normal displacement agree with the twin to 1e-9 (relative)."""
     rng = np.random.default_rng(27)
     for trial in range(60):
-        P = {"stiffness-normal": 10 ** rng.uniform(5, 9), "stiffness-shear": 10 ** rng.uniform(5, 9),
+        P = {"kn-initial": 10 ** rng.uniform(5, 9), "ks-initial": 10 ** rng.uniform(5, 9),
              "exponent-normal": rng.choice([0.0, rng.uniform(0, 0.8)]),
              "exponent-shear": rng.choice([0.0, rng.uniform(0, 0.8)]),
-             "friction": rng.uniform(20, 60), "friction-intrinsic": rng.uniform(5, 20),
+             "friction-initial": rng.uniform(20, 60), "friction": rng.uniform(5, 20),
              "roughness": 10 ** rng.uniform(-5, -3)}
         p = _row(**{k.replace("-", "_"): v for k, v in P.items()})
         h = np.zeros((1, 8))
@@ -105,7 +105,7 @@ def test_kernel_matches_the_twin_on_random_paths():
 def test_normal_stress_and_tangent_stiffness_follow_the_power_law():
     """σn at closure v is ((1 − e) a v)^(1/(1 − e)) and the hook's kn is a σn^e (both exact)."""
     a, e = 1e6, 0.5
-    p = _row(stiffness_normal=a, stiffness_shear=2e6, exponent_normal=e, exponent_shear=0.25, friction=30,
+    p = _row(kn_initial=a, ks_initial=2e6, exponent_normal=e, exponent_shear=0.25, friction_initial=30,
              roughness=1e-3)
     h = np.zeros((1, 8))
     for v in (1e-5, 1e-4, 2e-3):
@@ -145,7 +145,7 @@ def test_monotonic_shear_follows_the_ode_and_ends_at_the_intrinsic_friction():
     (peak within 0.2 %), and
     after uᵖ ≫ R the stress is σn tan φ (the intrinsic friction) to 1e-6."""
     sn, ks, R = 1e6, 1e9, 5e-4
-    p = _row(stiffness_normal=1e9, stiffness_shear=ks, friction=45, friction_intrinsic=30, roughness=R)
+    p = _row(kn_initial=1e9, ks_initial=ks, friction_initial=45, friction=30, roughness=R)
     h = np.zeros((1, 8))
     v = sn / 1e9
     fn, fs, un, _ = _kernel_step(p, h, 1.0, -v, np.zeros(3), 0.0, 0.0, np.zeros(3))
@@ -169,7 +169,7 @@ def test_monotonic_shear_follows_the_ode_and_ends_at_the_intrinsic_friction():
 def test_reversal_unloads_with_the_full_shear_stiffness():
     """After a reversal F = 1: the first reversed step changes τ by ks |Δu| exactly, and then yields."""
     sn, ks = 1e6, 1e9
-    p = _row(stiffness_normal=1e9, stiffness_shear=ks, friction=40, friction_intrinsic=30, roughness=1e-3)
+    p = _row(kn_initial=1e9, ks_initial=ks, friction_initial=40, friction=30, roughness=1e-3)
     h = np.zeros((1, 8))
     fn, fs, un, _ = _kernel_step(p, h, 1.0, -1e-3, np.zeros(3), 0.0, 0.0, np.zeros(3))
     for i in range(2000):
@@ -184,7 +184,7 @@ def test_reversal_unloads_with_the_full_shear_stiffness():
 def test_an_exponent_near_one_stays_finite():
     """e_n = 0.99: σn = (0.01 a_n v)^100 overflows a double at v = 1 mm for a_n = 1e9; the law caps it
     (1e30 Pa) and every output and the hook stay finite."""
-    p = _row(stiffness_normal=1e9, stiffness_shear=1e9, exponent_normal=0.99, exponent_shear=0.99, friction=30,
+    p = _row(kn_initial=1e9, ks_initial=1e9, exponent_normal=0.99, exponent_shear=0.99, friction_initial=30,
              roughness=1e-3)
     h = np.zeros((1, 8))
     out = LAW(p, 0, h, 0, 1.0, -1e-3, 1e-4, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0)
@@ -193,7 +193,7 @@ def test_an_exponent_near_one_stays_finite():
 
 
 def test_zero_area_and_zero_friction_are_finite():
-    p = _row(stiffness_normal=1e9, stiffness_shear=1e9, friction=0, roughness=1e-3)
+    p = _row(kn_initial=1e9, ks_initial=1e9, friction_initial=0, roughness=1e-3)
     h = np.zeros((1, 8))
     out = LAW(p, 0, h, 0, 0.0, -1e-4, 1e-5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0)
     assert all(math.isfinite(x) for x in out[:9]) and out[0] == 0.0
@@ -201,14 +201,14 @@ def test_zero_area_and_zero_friction_are_finite():
     assert out[0] == pytest.approx(1e5) and out[1] == 0.0      # no friction: no shear force
 
 
-BASE = "block create brick 0 1 0 1 0 1\nblock contact jmodel assign cy\n"
+BASE = "block create brick 0 1 0 1 0 1\nblock contact jmodel assign cyjm\n"
 
 
 @pytest.mark.parametrize("line, message, column", [
-    ("block contact property stiffness-normal -1e9", "`stiffness-normal` must be ≥ 0, got -1e+09", 41),
+    ("block contact property kn-initial -1e9", "`kn-initial` must be ≥ 0, got -1e+09", 35),
     ("block contact property exponent-normal 1", "`exponent-normal` must be in [0, 1), got 1", 40),
     ("block contact property exponent-shear -0.1", "`exponent-shear` must be in [0, 1), got -0.1", 39),
-    ("block contact property friction-intrinsic 95", "`friction-intrinsic` must be in [0, 90], got 95", 43),
+    ("block contact property friction-initial 95", "`friction-initial` must be in [0, 90], got 95", 41),
     ("block contact property roughness -1e-3", "`roughness` must be ≥ 0, got -0.001", 34),
 ])
 def test_bad_properties_are_refused_at_binding(session, tmp_path, line, message, column):
@@ -216,41 +216,41 @@ def test_bad_properties_are_refused_at_binding(session, tmp_path, line, message,
 
 
 def test_model_answers_to_its_long_name_and_lists_its_history():
-    m = JOINT_MODELS["cy"]
+    m = JOINT_MODELS["cyjm"]
     assert m.code == 2 and m.hist_names[:3] == ("plastic-shear", "normal-stress", "friction-mobilized")
     from dec3d.physics.jmodels import ALIASES
-    assert ALIASES["continuously-yielding"] == "cy"
+    assert ALIASES["continuously-yielding"] == ALIASES["cy"] == "cyjm"
 
 
 def test_strength_reduction_divides_both_friction_tangents():
     """`model factor-of-safety` (the host's reduce): tan φ0 and tan φ divided by F; unset φ stays NaN."""
-    m = JOINT_MODELS["cy"]
-    rows = np.vstack([_row(friction=40, friction_intrinsic=30, roughness=1e-3),
-                      _row(friction=40, roughness=1e-3)])
+    m = JOINT_MODELS["cyjm"]
+    rows = np.vstack([_row(friction_initial=40, friction=30, roughness=1e-3),
+                      _row(friction=30, roughness=1e-3)])
     m.reduce(rows, 1.5, False)
-    assert m.value(rows[0], "friction") == pytest.approx(math.degrees(math.atan(math.tan(math.radians(40)) / 1.5)))
-    assert m.value(rows[0], "friction-intrinsic") == pytest.approx(
+    assert m.value(rows[0], "friction-initial") == pytest.approx(math.degrees(math.atan(math.tan(math.radians(40)) / 1.5)))
+    assert m.value(rows[0], "friction") == pytest.approx(
         math.degrees(math.atan(math.tan(math.radians(30)) / 1.5)))
-    assert np.isnan(rows[1, cy.P_PHI]) and m.value(rows[1], "friction-intrinsic") == m.value(rows[1], "friction")
+    assert np.isnan(rows[1, cy.P_PHI0]) and m.value(rows[1], "friction-initial") == m.value(rows[1], "friction")
 
 
 def test_history_in_a_run_reads_back_from_fish_and_survives_save_restore(session, tmp_path):
     """A cube sheared 1 mm under 1 MN on `cy` (the J1 set-up, shorter): every sub-contact's σn history
     is N/A, its plastic shear displacement is positive and below the 1 mm sheared, the mobilised
-    friction lies between 30 and 40 degrees; FISH reads them by name, and a saved and restored model
+    friction-initial lies between 30 and 40 degrees; FISH reads them by name, and a saved and restored model
     has the same history."""
     session.command(
         "block create brick -1.5 2.5 -1 2 -1 0\nblock create brick 0 1 0 1 0 1\nblock property density 2000\n"
-        "block contact jmodel assign cy\n"
-        "block contact material-table default property stiffness-normal 1e6 exponent-normal 0.5 "
-        "stiffness-shear 1e9 friction 40 friction-intrinsic 30 roughness 1e-3\n"
+        "block contact jmodel assign cyjm\n"
+        "block contact material-table default property kn-initial 1e6 exponent-normal 0.5 "
+        "ks-initial 1e9 friction-initial 40 friction 30 roughness 1e-3\n"
         "block fix range id 1\nblock fix rotation range id 2\nblock mechanical timestep 2.5e-4\n"
         "block apply force-z -1e6 range id 2\nblock apply velocity-x 0 velocity-y 0 range id 2\n"
         "model solve ratio 1e-7\nblock apply velocity-x 0.02 range id 2\nmodel cycle 200\n"
         "fish define hist\n  local cl = block.contact.list\n  local c = cl(1)\n  local sl = block.contact.subcontactlist(c)\n"
         "  global up = block.subcontact.prop(sl(1), 'plastic-shear')\n"
         "  global phim = block.subcontact.prop(sl(1), 'friction-mobilized')\n"
-        "  global phi0 = block.subcontact.prop(sl(1), 'friction')\nend\n@hist\n")
+        "  global phi0 = block.subcontact.prop(sl(1), 'friction-initial')\nend\n@hist\n")
     v = session.variables
     assert 0.0 < v["up"] < 1e-3 and 30.0 < v["phim"] < 40.0 and v["phi0"] == pytest.approx(40.0)
     sc = session.model.rigid_engine.subcontacts

@@ -124,28 +124,9 @@ def test_a_new_model_is_two_new_files(tmp_path):
     assert float(words[words.index("KN") + 1]) == float(words[words.index("KN") + 2]) == pytest.approx(0.5e9)
 
 
-#: names whose value is a catalogue of 3DEC's joint-model names, not a use of one of ours
-#: (``commands/block_contact.py``: 3DEC's built-ins dec3d does not have yet, filtered by the registry)
-_CATALOGUES = ("OTHER_3DEC_MODELS",)
-
-
 def _string_constants(path):
-    """(line, value) of the string literals of a module that are not docstrings nor in a catalogue
-    of 3DEC's model names (``_CATALOGUES``)."""
-    import ast
-
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    docs = set()
-    for node in ast.walk(tree):
-        if isinstance(node, (ast.Module, ast.FunctionDef, ast.ClassDef, ast.AsyncFunctionDef)) and node.body:
-            first = node.body[0]
-            if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant):
-                docs.add(id(first.value))
-        if isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id in _CATALOGUES for t in node.targets):
-            docs.update(id(c) for c in ast.walk(node.value) if isinstance(c, ast.Constant))
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docs:
-            yield node.lineno, node.value
+    from source_scan import string_constants
+    return string_constants(path)
 
 
 def test_no_file_outside_a_joint_models_two_files_names_it():

@@ -6,6 +6,8 @@ from the property row; columns 0 and 1 are the stiffnesses of every model (the t
 the density scaling read them as the stiffness of a model that has no ``stiffness`` hook)."""
 from __future__ import annotations
 
+import math
+
 from numba import njit
 
 P_KN = 0          # normal stiffness kn [Pa/m]
@@ -21,6 +23,23 @@ ST_NEW = 8
 
 #: history columns of every sub-contact (``subcontacts.hist``): a model uses the first ``NHIST``
 NJHIST = 8
+
+
+@njit(cache=True, inline="always")
+def slip_dilation(kn, area, tandil, zdil, dus0, dus1, dus2, us0, us1, us2, udil, fn):
+    """Dilation of a slipping sub-contact (3DEC theory Eqs. 41-43): Δu_dil = ±|ΔUˢ| tan ψ, + when
+    ΔUˢ is along the accumulated shear displacement uˢ, − against it, none once |uˢ| exceeds the
+    dilation-zero limit ``zdil`` (0: no limit); the normal force grows by kn A Δu_dil.
+    Returns (udil, fn)."""
+    dmag = math.sqrt(dus0 * dus0 + dus1 * dus1 + dus2 * dus2)
+    if tandil != 0.0 and dmag > 0.0:
+        usm = math.sqrt(us0 * us0 + us1 * us1 + us2 * us2)
+        if zdil <= 0.0 or usm <= zdil:
+            sgn = 1.0 if (dus0 * us0 + dus1 * us1 + dus2 * us2) >= 0.0 else -1.0
+            ddil = sgn * dmag * tandil     # Eq. (42), direction-dependent
+            udil += ddil
+            fn += kn * area * ddil         # Eq. (43)
+    return udil, fn
 
 
 @njit(cache=True, inline="always")

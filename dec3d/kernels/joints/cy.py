@@ -1,4 +1,4 @@
-"""Joint model ``cy``: the continuously yielding joint model of 3DEC (Cundall & Hart 1984; Cundall &
+"""Joint model ``cyjm`` (also ``cy``): the continuously yielding joint model of 3DEC (Cundall & Hart 1984; Cundall &
 Lemos 1990, "Numerical analysis of fault instabilities due to stick-slip", in *Mechanics of Jointed
 and Faulted Rock*, Balkema, 97-100), as the 3DEC manual describes it: page "Continuously Yielding
 Joint Model In 3DEC" (3DEC Theory, joint constitutive models), summarised on
@@ -27,8 +27,8 @@ increment Δuˢ (the stress acting against the motion, |τ| the magnitude of Fˢ
   dφm = −(φm − φ) duᵖ / R                                (R: roughness, a length)
 
 The last is integrated exactly: φm = φ + (φ0 − φ) exp(−uᵖ/R), so the mobilised friction φm is a
-function of the accumulated plastic shear displacement alone (φ0: the initial friction ``friction``,
-φ: the intrinsic friction ``friction-intrinsic``). r is 0 at first and is reset to τ/τm when the
+function of the accumulated plastic shear displacement alone (φ0: the initial friction ``friction-initial``,
+φ: the intrinsic friction ``friction``). r is 0 at first and is reset to τ/τm when the
 shear increment reverses (its dot product with the previous one is negative), so a reversal
 starts elastically (F = 1). The stress vector is incremented along Δuˢ: Fˢ −= F ks A Δuˢ.
 
@@ -52,12 +52,12 @@ from numba import njit
 
 from ._common import P_KN, P_KS, ST_SLIP
 
-NAME = "cy"
+NAME = "cyjm"       # 3DEC's name (its command reference: `block contact jmodel assign cyjm`)
 CODE = 2          # kept in save files: never renumber
 P_EN = 2          # exponent e_n of the normal stiffness
 P_ES = 3          # exponent e_s of the shear stiffness
-P_PHI0 = 4        # initial (mobilised) friction φ0 [rad]
-P_PHI = 5         # intrinsic friction φ [rad] (NaN: φ0, no softening)
+P_PHI0 = 4        # initial (mobilised) friction φ0 [rad] (NaN: φ, no softening)
+P_PHI = 5         # intrinsic friction φ [rad]
 P_R = 6           # roughness R [m]
 NCOLS = 7
 H_UP = 0          # plastic shear displacement [m]
@@ -95,8 +95,8 @@ def mobilised_friction(p, c, up):
     """φm [rad] after plastic shear displacement up: φ + (φ0 − φ) exp(−up/R)."""
     phi0 = p[c, P_PHI0]
     phi = p[c, P_PHI]
-    if phi != phi:                         # NaN: intrinsic friction = initial friction
-        phi = phi0
+    if phi0 != phi0:                       # NaN: initial friction = intrinsic friction (no softening)
+        phi0 = phi
     rr = p[c, P_R]
     if rr > 0.0:
         return phi + (phi0 - phi) * math.exp(-up / rr)

@@ -15,7 +15,7 @@ import math
 
 from numba import njit
 
-from ._common import P_KN, P_KS, ST_FAILED, ST_SLIP, ST_TENSION, elastic_trial
+from ._common import P_KN, P_KS, ST_FAILED, ST_SLIP, ST_TENSION, elastic_trial, slip_dilation
 
 NAME = "mohr"
 CODE = 1          # kept in save files: never renumber
@@ -63,13 +63,5 @@ def law(p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, u
         fs1 *= r
         fs2 *= r
         state = state | ST_SLIP
-        dmag = math.sqrt(dus0 * dus0 + dus1 * dus1 + dus2 * dus2)
-        usm = math.sqrt(us0 * us0 + us1 * us1 + us2 * us2)
-        tandil = p[c, P_TANDIL]
-        zdil = p[c, P_ZDIL]
-        if tandil != 0.0 and dmag > 0.0 and (zdil <= 0.0 or usm <= zdil):
-            sgn = 1.0 if (dus0 * us0 + dus1 * us1 + dus2 * us2) >= 0.0 else -1.0
-            ddil = sgn * dmag * tandil     # Eq. (42), direction-dependent
-            udil += ddil
-            fn += kn * area * ddil         # Eq. (43)
+        udil, fn = slip_dilation(kn, area, p[c, P_TANDIL], p[c, P_ZDIL], dus0, dus1, dus2, us0, us1, us2, udil, fn)
     return fn, fs0, fs1, fs2, un, udil, us0, us1, us2, state

@@ -1,12 +1,11 @@
-"""Host of joint model ``cy``, 3DEC's continuously yielding joint model (kernel:
+"""Host of joint model ``cyjm``, 3DEC's continuously yielding joint model (kernel:
 ``dec3d/kernels/joints/cy.py``; equations and sources there).
 
-Model name `cy` and the property keywords are 3DEC 7's style (its theory page "Continuously Yielding
-Joint Model In 3DEC" was not in the reference store, only the overview
-https://www.itascacg.com/3dec-joint-constitutive-models: the keywords are unverified against the
-page; the old syntax used names such as jif and jrough). With both exponents 0
-the stiffnesses are the plain kn, ks [Pa/m]; otherwise `stiffness-normal`/`stiffness-shear` are the
-multipliers a_n, a_s of kn = a_n σn^e_n, ks = a_s σn^e_s [Pa^(1−e)/m]."""
+Model name `cyjm` and the keywords `kn-initial`, `ks-initial`, `exponent-normal`, `exponent-shear`,
+`friction`, `friction-initial`, `roughness` as 3DEC 7's command reference lists them (summarised in
+shared/reference/3dec_command_reference.md, section 7; `cy` and `continuously-yielding` are accepted
+too). With both exponents 0 the stiffnesses are the plain kn, ks [Pa/m]; otherwise `kn-initial`,
+`ks-initial` are the multipliers a_n, a_s of kn = a_n σn^e_n, ks = a_s σn^e_s [Pa^(1−e)/m]."""
 import math
 
 import numpy as np
@@ -23,23 +22,24 @@ def _deg(name, column, doc, **kw) -> Prop:
 
 def reduce(rows, factor, associated):
     """`model factor-of-safety`: tan φ0 and tan φ divided by F (the columns hold the angles in radians;
-    an unset intrinsic friction, NaN, keeps following φ0). The model has no cohesion, tension or dilation."""
+    an unset initial friction, NaN, keeps following φ). The model has no cohesion, tension or dilation."""
     for col in (kernel.P_PHI0, kernel.P_PHI):
         rows[:, col] = np.arctan(np.tan(rows[:, col]) / factor)
 
 
 jmodel(kernel, "continuously yielding joint: friction mobilised from the initial toward the intrinsic angle "
        "with plastic shear displacement, stiffnesses kn = a_n σn^e_n, ks = a_s σn^e_s "
-       "(3DEC's `cy`, Cundall & Lemos 1990)", [
-           Prop("stiffness-normal", 0, "normal stiffness multiplier a_n (kn = a_n σn^e_n)", "Pa/m"),
-           Prop("stiffness-shear", 1, "shear stiffness multiplier a_s (ks = a_s σn^e_s)", "Pa/m"),
+       "(3DEC's `cyjm`, Cundall & Lemos 1990)", [
+           Prop("kn-initial", 0, "normal stiffness multiplier a_n (kn = a_n σn^e_n; with e_n = 0 the stiffness)",
+                "Pa/m"),
+           Prop("ks-initial", 1, "shear stiffness multiplier a_s (ks = a_s σn^e_s; with e_s = 0 the stiffness)",
+                "Pa/m"),
            Prop("exponent-normal", kernel.P_EN, "normal stiffness exponent e_n (< 1: the closure integral is finite)",
-                "",
-                hi=1.0, hi_open=True),
+                "", hi=1.0, hi_open=True),
            Prop("exponent-shear", kernel.P_ES, "shear stiffness exponent e_s", "", hi=1.0, hi_open=True),
-           _deg("friction", kernel.P_PHI0, "initial (mobilised) friction angle φ0"),
-           _deg("friction-intrinsic", kernel.P_PHI, "intrinsic friction angle φ, the limit of the mobilised "
-                "friction (default: the friction angle, no softening)", default=math.nan, fallback="friction"),
+           _deg("friction", kernel.P_PHI, "intrinsic friction angle φ, the limit of the mobilised friction"),
+           _deg("friction-initial", kernel.P_PHI0, "initial (mobilised) friction angle φ0 (default: the friction "
+                "angle, no softening)", default=math.nan, fallback="friction"),
            Prop("roughness", kernel.P_R, "joint roughness R: plastic shear displacement over which φm − φ falls "
                 "by the factor e", "m", required=True),
-       ], aliases=("continuously-yielding",), reduce=reduce)
+       ], aliases=("cy", "continuously-yielding"), reduce=reduce)
