@@ -33,7 +33,7 @@ from numba.core.cpu import ParallelOptions
 from dec3d.config import threading_layer
 
 from .bundles import Fused
-from .joints import model_mask
+from .joints import cycle_mask
 from .jointlaw import block_lists, block_sum, update_one
 from .motion import rigid_motion_groups
 from .rayleigh import contact_stiffness_damping
@@ -166,7 +166,7 @@ def _run_steps(models, nsteps, dt, gravity, full_inertia, beta, damping, groups,
     step motion: ``rigid_motion_groups`` with ``Fused``); the points of the last step move
     before returning.
 
-    ``models``: the mask of the joint models among the contacts (``joints.model_mask``), a
+    ``models``: the mask of the joint models among the contacts (``joints.cycle_mask``), a
     compile-time constant (numba's ``literally``): a deck compiles the cycle for the joint laws it
     uses, once (cached), not for every law in the folder (``run_steps`` reaches it through
     ``_stepper``).
@@ -238,11 +238,11 @@ def run_steps(nsteps, dt, gravity, full_inertia, damping, groups, bodies, contac
     """``_run_steps`` (the kernel, documented there); a small model (``SERIAL_BELOW``), or any
     model on one thread, runs its serial twin ``_run_steps_1`` (the same numbers: every sum has a
     fixed order). ``lists``: ``cycle_lists`` of these contacts (made here when None); ``models``:
-    the mask of their joint models (``joints.model_mask``; worked out here when None)."""
+    the mask of their joint models (``joints.cycle_mask``; worked out here when None)."""
     if lists is None:
         lists = cycle_lists(bodies.centroid.shape[0], contacts, subs, groups.member)
     if models is None:
-        models = model_mask(contacts.jmodel)
+        models = cycle_mask(contacts.jmodel)
     args = (nsteps, dt, gravity, bool(full_inertia), float(beta), damping, groups, bodies, contacts, subs,
             bounds, vmax, out) + tuple(lists)
     par = get_num_threads() > 1 and subs.contact.shape[0] + 4 * groups.member.shape[0] >= serial_below()

@@ -29,7 +29,7 @@ import math
 
 from numba import literally, njit, prange
 
-from .joints import ST_NEW, joint_law_for, model_mask
+from .joints import ST_NEW, cycle_mask, joint_law_for
 
 
 @njit(cache=True)
@@ -148,9 +148,9 @@ def mixed_subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce
                             sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist,
                             nodes_a, w_a, nodes_b, w_b, models=None):
     """``_mixed_subcontact_forces`` (the kernel, documented there) for the joint models of the mask
-    ``models`` (``joints.model_mask``; worked out from cmodel when None)."""
+    ``models`` (``joints.cycle_mask``; worked out from cmodel when None)."""
     if models is None:
-        models = model_mask(cmodel)
+        models = cycle_mask(cmodel)
     _mixed_for(int(models))(dt, bpos, bvel, bspin, bforce, bmoment, gvel, gforce, ca, cb, cn, cmodel, cprop,
                             sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist,
                             nodes_a, w_a, nodes_b, w_b)

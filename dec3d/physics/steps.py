@@ -22,7 +22,7 @@ from dec3d.io.vtk import periodic_vtk
 from dec3d.kernels.bundles import (NSERVO, Bodies, Bounds, Contacts, Groups, SubContacts, load_servo, new_damping,
                                    new_servo, servo_values)
 from dec3d.kernels.contactmap import blocks_moved
-from dec3d.kernels.joints import model_mask
+from dec3d.kernels.joints import cycle_mask
 from dec3d.physics.jmodels import changing_stiffness
 from dec3d.kernels.cycle import cycle_lists, run_steps
 from dec3d.kernels.motion import DAMP_ADAPTIVE
@@ -424,7 +424,7 @@ class RigidBatch(_Step):
             kk = min(k - n_ok, self.chunk) if self.chunked else k
             t0 = _time.perf_counter()
             # (the joint models in use, every call: a callback may assign one between batches; O(nc))
-            models = model_mask(cs["jmodel"])
+            models = cycle_mask(cs["jmodel"])
             c_ok, bad = run_steps(kk, r.dt, r.g, r.full, r.damping, r.groups(), r.bodies(), contacts, subs, bounds,
                                   r.vmax, r.out, r.beta, self.lists, models)
             spent = _time.perf_counter() - t0

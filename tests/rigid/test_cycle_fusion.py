@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from dec3d import config
-from dec3d.kernels.joints import model_mask
+from dec3d.kernels.joints import cycle_mask
 from dec3d.kernels import cycle
 from dec3d.kernels.bundles import Bodies, Fused, Groups, new_damping
 from dec3d.kernels.jointlaw import block_lists, block_sums, subcontact_update
@@ -152,7 +152,7 @@ def test_contact_pass_equals_moving_the_points_then_the_joint_law(state, threads
     sg2 = np.empty_like(sg)
     cstart = cycle.contact_ranges(len(c["a"]), s["contact"])
     kernel = cycle._contact_pass if threads > 1 else cycle._run_steps_1.py_func.__globals__["_contact_pass"]
-    kernel(model_mask(c["jmodel"]), True, dt, b["centroid"], b["velocity"], b["spin"], c["a"], c["b"], c["normal"], c["pos"], c["jmodel"],
+    kernel(cycle_mask(c["jmodel"]), True, dt, b["centroid"], b["velocity"], b["spin"], c["a"], c["b"], c["normal"], c["pos"], c["jmodel"],
            c["prop"], cstart, s["pos"], s["area"], s["fn"], s["fs"], s["un"], s["udil"], s["us"], s["state"], s["hist"],
            sg2)
     assert _same(sep, fus) == [] and np.array_equal(sg, sg2)

@@ -40,7 +40,7 @@ from numba.extending import overload
 
 from ._common import NJHIST, P_KN, P_KS, ST_FAILED, ST_NEW, ST_SLIP, ST_TENSION, constant_stiffness
 
-__all__ = ["ALL_MODELS", "CODES", "HISTORY_MODELS", "MODELS", "NJHIST", "NPROP", "P_KN", "P_KS", "ST_FAILED", "ST_NEW", "ST_SLIP",
+__all__ = ["ALL_MODELS", "CODES", "COMMON_MODELS", "HISTORY_MODELS", "cycle_mask", "MODELS", "NJHIST", "NPROP", "P_KN", "P_KS", "ST_FAILED", "ST_NEW", "ST_SLIP",
            "ST_TENSION", "joint_law", "joint_law_for", "joint_stiffness", "model_mask"]
 
 
@@ -129,6 +129,15 @@ def model_mask(codes) -> int:
 ALL_MODELS = model_mask(m.CODE for m in MODELS)
 #: the mask of the models that keep a history (detection carries ``hist`` only when one is in use)
 HISTORY_MODELS = model_mask(m.CODE for m in MODELS if m.NHIST)
+#: the models every compiled cycle holds (the two small founding laws): decks of elastic joints, of
+#: mohr joints and of both then share one compiled cycle, as before the chain was per mask
+COMMON_MODELS = model_mask(m.CODE for m in MODELS if m.NAME in ("elastic", "mohr"))
+
+
+def cycle_mask(codes) -> int:
+    """The mask a kernel is compiled for, for contacts of the joint-model ``codes`` (an int array):
+    theirs and ``COMMON_MODELS``."""
+    return model_mask(codes) | COMMON_MODELS
 
 
 def joint_law_for(models, model, p, c, h, s, area, dun, dus0, dus1, dus2, un, udil, fs0, fs1, fs2, us0, us1, us2,
