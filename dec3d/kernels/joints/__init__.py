@@ -23,10 +23,12 @@ A model's kernel file (any ``<name>.py`` here not starting with ``_``) declares
 Its host file of the same name in ``dec3d/physics/joints`` declares the user-facing properties.
 ``joint_law(code, ...)`` calls the law of the model with that code and ``joint_stiffness(code,
 ...)`` its stiffness; each is a chain of small numba functions, one per model, built here at
-import from the files found, so adding a model adds two files and edits none. (Compiled into
-the callers ``jointlaw.subcontact_update``, ``gpcontact``, ``energy``, ``rayleigh``; the chain
-links are not cached themselves, because they are closures sharing one name, the callers are;
-``dec3d.kcache`` hashes this folder with the rest of the kernels, so a new model recompiles them.)
+import from the files found, so adding a model adds two files and edits none. The rigid cycle
+and the zoned-contact pass take the law through ``joint_law_for(mask, …)``: a chain of the models
+in use only (``cycle_mask``: theirs, elastic and mohr), compiled once per mask, so that a new law
+costs its own decks compile time, not every deck. (The chain links are not cached themselves,
+because they are closures sharing one name, the callers are; ``dec3d.kcache`` hashes this folder
+with the rest of the kernels, so a new model recompiles them.)
 """
 from __future__ import annotations
 
@@ -40,8 +42,9 @@ from numba.extending import overload
 
 from ._common import NJHIST, P_KN, P_KS, ST_FAILED, ST_NEW, ST_SLIP, ST_TENSION, constant_stiffness
 
-__all__ = ["ALL_MODELS", "CODES", "COMMON_MODELS", "HISTORY_MODELS", "cycle_mask", "MODELS", "NJHIST", "NPROP", "P_KN", "P_KS", "ST_FAILED", "ST_NEW", "ST_SLIP",
-           "ST_TENSION", "joint_law", "joint_law_for", "joint_stiffness", "model_mask"]
+__all__ = ["ALL_MODELS", "CODES", "COMMON_MODELS", "HISTORY_MODELS", "MODELS", "NJHIST", "NPROP", "P_KN", "P_KS",
+           "ST_FAILED", "ST_NEW", "ST_SLIP", "ST_TENSION", "cycle_mask", "joint_law", "joint_law_for",
+           "joint_stiffness", "model_mask"]
 
 
 def _find():
