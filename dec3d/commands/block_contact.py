@@ -5,7 +5,8 @@ import numpy as np
 
 from ..errors import CommandError
 from ..physics.jmodels import ALIASES, ALL_PROPS, JOINT_MODELS, MODEL_BY_CODE, REFUSED
-from ..physics.contacts import default_row, history_columns
+from ..physics.contact_store import history_columns
+from ..physics.contacts import default_row
 from ..physics.rigid import engine, mech
 from .registry import command
 from .values import FLAG, Choice, Num, P, Text, ValueRangeError

@@ -29,7 +29,8 @@ from dec3d.model.feblocks import has_feblocks
 from dec3d.model.zones import has_zones
 
 from .massscale import DensityScaling
-from .contacts import ContactDetection, contact_stores, default_row
+from .contact_store import contact_stores
+from .contacts import ContactDetection, default_row
 from .dynamic import DYN_DEFAULTS, rayleigh_coefficients
 from .jmodels import JOINT_MODELS, contact_stiffness, missing
 from .mixedcontacts import MixedContactSteps, _deformable

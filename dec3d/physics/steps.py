@@ -28,6 +28,7 @@ from dec3d.kernels.cycle import cycle_lists, run_steps
 from dec3d.kernels.motion import DAMP_ADAPTIVE
 
 from . import contacts as _contacts
+from .contact_store import history_columns
 from .bodies import group_properties
 from .dynamic import TimeFunctions, has_timefns, stiffness_timestep
 from .energy import is_active as is_energy_active
@@ -146,7 +147,7 @@ class _Run:
         between = between and s.get("dt_mode", self.dt_mode) == self.dt_mode
         if self.mixed:
             self.wsub, self.wcon = eng._mixed_weights(self.zst, recompute=not between)
-        _contacts.history_columns(eng.subcontacts, eng.contacts["jmodel"])   # (a restored or edited model)
+        history_columns(eng.subcontacts, eng.contacts["jmodel"])   # (a restored or edited model)
         bad = eng.property_problem()
         if bad:
             raise RunError(bad)
