@@ -330,11 +330,46 @@ class Session:
         self.run_items(items)
 
     def run_items(self, items: Iterable[Item]) -> None:
+        items = list(items)
         try:
-            for item in items:
-                self._run_one(item)
+            i = 0
+            while i < len(items):
+                j = self._batch_end(items, i)
+                if j > i + 1:
+                    i = self._run_batch(items[i:j]) + i
+                else:
+                    self._run_one(items[i])
+                    i += 1
         except StopDeck:
             pass
+
+    def _batch_end(self, items: list, i: int) -> int:
+        """End of the run of lines from ``items[i]`` whose commands share a batch function."""
+        item = items[i]
+        if self.echo or not isinstance(item, CommandCall) or item.command.batch is None:
+            return i + 1
+        fn, j = item.command.batch, i + 1
+        while j < len(items) and isinstance(items[j], CommandCall) and items[j].command.batch is fn:
+            j += 1
+        return j
+
+    def _run_batch(self, items: list) -> int:
+        """Run a run of batchable lines (``Command.batch``): as many as the batch function does in
+        one pass, then the first it stopped before through its own handler (which reports the error
+        at its line, with the lines before it done, as line-by-line running would). Returns how many
+        lines ran."""
+        calls = []
+        for item in items:
+            try:
+                calls.append(self.resolve(item))
+            except Dec3dError:
+                break                   # that line runs on its own, below, and reports
+        done = items[0].command.batch(self, calls) if len(calls) > 1 else 0
+        self.record.extend(_source_of(item) for item in items[:done])
+        if done < len(items):
+            self._run_one(items[done])
+            done += 1
+        return done
 
     def _run_one(self, item: Item) -> None:
         try:

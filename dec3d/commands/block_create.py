@@ -8,9 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry.polyhedron import brick, polyhedron_from_faces, prism, tetrahedron
+from ..errors import Dec3dError
+from ..geometry.polyhedron import (brick_faces, build_many, polyhedron_from_faces, prism_faces,
+                                   tetrahedron_faces)
 from ..geometry.tunnel import tunnel, tunnel_block_count
-from ..model.blocks import add_blocks
+from ..model.blocks import add_blocks, add_pieces
 from .budget import check_blocks
 from .registry import command
 from .values import ANGLE, COORD, LENGTH, POINT, InPath, Nums, Num, P, Text
@@ -26,13 +28,78 @@ def _add(session, call, polys) -> None:
     m = session.model
     check_blocks(session, len(polys), f"`{call.name}`", call.location)
     rows = add_blocks(m, polys, group=call.args["group"], slot=call.args["slot"])
-    if call.args.get("region") is not None:
-        m.blocks["region"][rows] = call.args["region"]
-    if call.args.get("face_group") is not None:
-        fs = m.blocks["face_start"][rows]
-        fc = m.blocks["face_count"][rows]
-        faces = np.concatenate([np.arange(s, s + c) for s, c in zip(fs, fc)])
-        m.groups.assign(m.faces, faces, call.args["face_group"], call.args["slot"])
+    _label(m, [call], rows)
+
+
+def _label(m, calls, rows) -> None:
+    """Regions and groups of new blocks (and face groups of their faces), ``calls[i]`` giving its
+    words to the blocks ``rows[i]`` (one row per call, or all rows for one call). Groups are named
+    in the order the lines name them, so group codes come out as line-by-line running makes them."""
+    per_call = len(calls) > 1
+    assign: dict[tuple, list] = {}
+    for i, call in enumerate(calls):
+        a = call.args
+        r = rows[i:i + 1] if per_call else rows
+        if a.get("region") is not None:
+            m.blocks["region"][r] = a["region"]
+        if a["group"] is not None:
+            assign.setdefault(("block", a["group"], a["slot"]), []).append(r)
+        if a.get("face_group") is not None:
+            fs, fc = m.blocks["face_start"][r], m.blocks["face_count"][r]
+            assign.setdefault(("face", a["face_group"], a["slot"]), []).extend(
+                np.arange(s, s + c) for s, c in zip(fs, fc))
+    for (store, name, slot), parts in assign.items():
+        m.groups.assign(m.blocks if store == "block" else m.faces, np.concatenate(parts), name, slot)
+
+
+def _shape(call, tol: float):
+    """(corners (n, 3), corners per face) of one `block create brick|polyhedron|prism|tetrahedron` line."""
+    kind, a = call.command.path[-1], call.args
+    if kind == "brick":
+        b = list(a["bounds"])
+        while len(b) < 6:
+            b += b[-2:]
+        return brick_faces(*b, tol=tol)
+    if kind == "polyhedron":
+        faces = [np.asarray(f, dtype=np.float64).reshape(-1, 3) for f in a["face"]]
+        if not faces:
+            return np.zeros((0, 3)), np.zeros(0, dtype=np.int64)
+        return np.concatenate(faces), np.array([len(f) for f in faces], dtype=np.int64)
+    if kind == "prism":
+        return prism_faces(a["face_1"], a["face_2"], tol)
+    return tetrahedron_faces(*np.reshape(a["corners"], (4, 3)))
+
+
+def _create(session, call) -> None:
+    tol = session.model.tolerance
+    pts, fn = _shape(call, tol)
+    what = call.command.path[-1]
+    _add(session, call, [polyhedron_from_faces(np.split(pts, np.cumsum(fn)[:-1]), tol,
+                                               "polyhedron" if what == "polyhedron" else what)])
+
+
+def _create_many(session, calls) -> int:
+    """`block create brick|polyhedron|prism|tetrahedron` lines in a row, built in one compiled pass
+    (a deck of thousands of bricks or masonry polyhedra). Stops before the first line whose shape is
+    refused or that the block budget would refuse: that line runs on its own and reports."""
+    m = session.model
+    tol = m.tolerance
+    shapes = []
+    for call in calls:
+        try:
+            shapes.append(_shape(call, tol))
+        except Dec3dError:
+            break
+    built, batch = build_many(shapes, tol)
+    if built == 0:
+        return 0
+    try:
+        check_blocks(session, built, f"`{calls[0].name}`", calls[0].location)
+    except Dec3dError:
+        return 0
+    rows = add_pieces(m, batch)
+    _label(m, calls[:built], rows)
+    return built
 
 
 @command("block create brick",
@@ -40,12 +107,10 @@ def _add(session, call, polys) -> None:
          keywords=GROUP_KW,
          doc="Create a block spanning x1..x2, y1..y2, z1..z2 (a pair left out repeats the one before).",
          examples=["block create brick 0 1.292 -0.05 0 0.0 0.210 group 'S'", "block create brick 0 10",
-                   "block create group 'rock' brick 0 10 0 10 0 10"])
+                   "block create group 'rock' brick 0 10 0 10 0 10"],
+         batch=_create_many)
 def create_brick(session, call):
-    b = list(call.args["bounds"])
-    while len(b) < 6:
-        b += b[-2:]
-    _add(session, call, [brick(*b, tol=session.model.tolerance)])
+    _create(session, call)
 
 
 @command("block create polyhedron",
@@ -58,10 +123,10 @@ def create_brick(session, call):
          examples=["block create polyhedron face 0,0,0 1,0,0 0,1,0 face 0,0,0 0,0,1 1,0,0 "
                    "face 0,0,0 0,1,0 0,0,1 face 1,0,0 0,0,1 0,1,0",
                    "block create group 'Supports' poly face 0 0 0 1 0 0 0 1 0 face 0 0 0 0 0 1 1 0 0 "
-                   "face 0 0 0 0 1 0 0 0 1 face 1 0 0 0 0 1 0 1 0"])
+                   "face 0 0 0 0 1 0 0 0 1 face 1 0 0 0 0 1 0 1 0"],
+         batch=_create_many)
 def create_polyhedron(session, call):
-    faces = [np.asarray(f, dtype=np.float64).reshape(-1, 3) for f in call.args["face"]]
-    _add(session, call, [polyhedron_from_faces(faces, session.model.tolerance)])
+    _create(session, call)
 
 
 @command("block create prism",
@@ -69,20 +134,20 @@ def create_polyhedron(session, call):
                    P("face-2", Nums(9, 10**6, multiple_of=3, item=COORD), "corners of the other end, in the same order",
                      required=True, units="m"), *GROUP_KW],
          doc="Create a prism between two polygons with as many corners (corner i joined to corner i).",
-         examples=["block create prism face-1 0 0 0 1 0 0 0 1 0 face-2 0 0 1 1 0 1 0 1 1 group 'p'"])
+         examples=["block create prism face-1 0 0 0 1 0 0 0 1 0 face-2 0 0 1 1 0 1 0 1 1 group 'p'"],
+         batch=_create_many)
 def create_prism(session, call):
-    _add(session, call, [prism(np.reshape(call.args["face_1"], (-1, 3)), np.reshape(call.args["face_2"], (-1, 3)),
-                               session.model.tolerance)])
+    _create(session, call)
 
 
 @command("block create tetrahedron",
          positional=[P("corners", Nums(12, 12, item=COORD), "four corners v1 v2 v3 v4", required=True, units="m")],
          keywords=GROUP_KW,
          doc="Create a tetrahedron on four corners.",
-         examples=["block create tetrahedron 0 0 0 1 0 0 0 1 0 0 0 1"])
+         examples=["block create tetrahedron 0 0 0 1 0 0 0 1 0 0 0 1"],
+         batch=_create_many)
 def create_tetrahedron(session, call):
-    c = np.reshape(call.args["corners"], (4, 3))
-    _add(session, call, [tetrahedron(*c, tol=session.model.tolerance)])
+    _create(session, call)
 
 
 @command("block create tunnel",

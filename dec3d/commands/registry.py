@@ -32,6 +32,10 @@ class Command:
     accepts_anything: bool = False     # display-only commands: every token ignored
     module: str = ""
     check: Callable | None = None      # check(call) at bind time: value combinations, not-supported choices
+    # batch(session, calls) -> n: run lines of commands sharing this function, met one after another
+    # in a deck, in one pass; runs the first n calls as the handler would have, one by one, and stops
+    # before a call it cannot do (the session runs that one and the rest through the handler)
+    batch: Callable | None = None
 
     def __post_init__(self) -> None:
         # looked up for every bound line: computed once
@@ -157,17 +161,18 @@ REGISTRY = Registry()
 def command(path: str, *, positional: Sequence[Param] = (), keywords: Sequence[Param] = (),
             range: str | None = None, doc: str = "", details: str = "", examples: Sequence[str] = (),
             open_keywords: bool = False, accepts_anything: bool = False, check: Callable | None = None,
-            registry: Registry = REGISTRY):
+            batch: Callable | None = None, registry: Registry = REGISTRY):
     """Register the decorated function as the handler of `path`.
 
     `check(call)`, if given, runs when a line is bound (before anything in the deck runs):
     for rules one keyword's type cannot say, such as a model name dec3d knows but does not
-    implement (raise NotSupportedError) or keywords that exclude each other (BindError)."""
+    implement (raise NotSupportedError) or keywords that exclude each other (BindError).
+    `batch(session, calls) -> n`, if given, runs a run of such lines in one pass (``Command.batch``)."""
 
     def deco(fn: Callable) -> Callable:
         registry.add(Command(tuple(path.split()), fn, tuple(positional), tuple(keywords), range,
                              doc or (fn.__doc__ or "").strip().split("\n")[0], details, tuple(examples),
-                             open_keywords, accepts_anything, fn.__module__, check))
+                             open_keywords, accepts_anything, fn.__module__, check, batch))
         return fn
 
     return deco

@@ -198,28 +198,33 @@ def poly_volume(poly: Poly) -> float:
 
 
 # ------------------------------------------------------------------ primitives
-def brick(x1: float, x2: float, y1: float, y2: float, z1: float, z2: float,
-          tol: float = 1e-6) -> Poly:
-    """Axis-aligned box [x1, x2] × [y1, y2] × [z1, z2] (bounds in either order)."""
+# Each shape has a ``*_faces`` form, (corners (n, 3), corners per face), which ``build_many``
+# takes, and a ``Poly`` form that builds and checks it at once.
+_BRICK_QUADS = np.array([(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)])
+_BRICK_FN = np.full(6, 4, dtype=np.int64)
+_TET_TRIS = [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)]
+
+
+def brick_faces(x1: float, x2: float, y1: float, y2: float, z1: float, z2: float,
+                tol: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+    """Faces of the axis-aligned box [x1, x2] × [y1, y2] × [z1, z2] (bounds in either order)."""
     xs, ys, zs = sorted((x1, x2)), sorted((y1, y2)), sorted((z1, z2))
     for name, (a, b) in (("x", xs), ("y", ys), ("z", zs)):
         if b - a <= tol:
             raise GeometryError(f"brick: zero thickness in {name} ({a:g} to {b:g})")
-    c = np.array([[xs[i], ys[j], zs[k]] for k in (0, 1) for j in (0, 1) for i in (0, 1)])
-    quads = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
-    return polyhedron_from_faces([c[list(q)] for q in quads], tol, "brick")
+    c = np.array([[xs[i], ys[j], zs[k]] for k in (0, 1) for j in (0, 1) for i in (0, 1)], dtype=np.float64)
+    return c[_BRICK_QUADS.ravel()], _BRICK_FN
 
 
-def tetrahedron(v1, v2, v3, v4, tol: float = 1e-6) -> Poly:
-    """Tetrahedron on four corners (any order)."""
-    p = [np.asarray(x, dtype=np.float64) for x in (v1, v2, v3, v4)]
-    tris = [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)]
-    return polyhedron_from_faces([[p[i] for i in t] for t in tris], tol, "tetrahedron")
+def tetrahedron_faces(v1, v2, v3, v4) -> tuple[np.ndarray, np.ndarray]:
+    """Faces of the tetrahedron on four corners (any order)."""
+    p = np.array([np.asarray(x, dtype=np.float64) for x in (v1, v2, v3, v4)])
+    return p[np.array(_TET_TRIS).ravel()], np.full(4, 3, dtype=np.int64)
 
 
-def prism(face1, face2, tol: float = 1e-6) -> Poly:
-    """Prism between two polygons with the same number of corners, corner i of
-    ``face1`` joined to corner i of ``face2``; the side faces must be planar."""
+def prism_faces(face1, face2, tol: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+    """Faces of the prism between two polygons with the same number of corners, corner i of
+    ``face1`` joined to corner i of ``face2`` (the side faces must be planar)."""
     a = np.asarray(face1, dtype=np.float64).reshape(-1, 3)
     b = np.asarray(face2, dtype=np.float64).reshape(-1, 3)
     if len(a) != len(b):
@@ -232,5 +237,56 @@ def prism(face1, face2, tol: float = 1e-6) -> Poly:
         if h.max() <= tol:
             raise GeometryError("prism: zero volume: face-2 lies in the plane of face-1")
     k = len(a)
-    sides = [np.array([a[i], a[(i + 1) % k], b[(i + 1) % k], b[i]]) for i in range(k)]
-    return polyhedron_from_faces([a, b, *sides], tol, "prism")
+    i = np.arange(k)
+    j = (i + 1) % k
+    sides = np.stack([a[i], a[j], b[j], b[i]], axis=1).reshape(-1, 3)
+    return np.concatenate([a, b, sides]), np.array([k, k] + [4] * k, dtype=np.int64)
+
+
+def _split(pts: np.ndarray, fn: np.ndarray) -> list[np.ndarray]:
+    return np.split(pts, np.cumsum(fn)[:-1])
+
+
+def brick(x1: float, x2: float, y1: float, y2: float, z1: float, z2: float,
+          tol: float = 1e-6) -> Poly:
+    """Axis-aligned box [x1, x2] × [y1, y2] × [z1, z2] (bounds in either order)."""
+    return polyhedron_from_faces(_split(*brick_faces(x1, x2, y1, y2, z1, z2, tol)), tol, "brick")
+
+
+def tetrahedron(v1, v2, v3, v4, tol: float = 1e-6) -> Poly:
+    """Tetrahedron on four corners (any order)."""
+    return polyhedron_from_faces(_split(*tetrahedron_faces(v1, v2, v3, v4)), tol, "tetrahedron")
+
+
+def prism(face1, face2, tol: float = 1e-6) -> Poly:
+    """Prism between two polygons with the same number of corners, corner i of
+    ``face1`` joined to corner i of ``face2``; the side faces must be planar."""
+    return polyhedron_from_faces(_split(*prism_faces(face1, face2, tol)), tol, "prism")
+
+
+def build_many(shapes: Sequence[tuple[np.ndarray, np.ndarray]], tol: float = 1e-6):
+    """Build many polyhedra, each given as (corners (n, 3), corners per face), with the compiled
+    checks of ``dec3d.kernels.polybuild`` (the same as ``polyhedron_from_faces``).
+
+    Returns (built, batch): the polyhedra before the first refused one are built, and ``batch`` is
+    their (pos, vsrc, piece_nv, fn, fsrc, piece_nf, fv), what ``polys_to_batch`` makes, for
+    ``dec3d.geometry.assemble.write_pieces``. The refused one (index ``built``) gets its reason from
+    ``polyhedron_from_faces``."""
+    from dec3d.kernels.polybuild import build_polyhedra
+
+    if not shapes:
+        return 0, None
+    pts = np.ascontiguousarray(np.concatenate([s[0] for s in shapes]), dtype=np.float64)
+    fn_in = np.concatenate([s[1] for s in shapes]).astype(np.int64)
+    piece_nf = np.array([len(s[1]) for s in shapes], dtype=np.int64)
+    pos = np.empty_like(pts)
+    piece_nv = np.zeros(len(shapes), dtype=np.int64)
+    fn = np.zeros(len(fn_in), dtype=np.int64)
+    fv = np.empty(len(pts), dtype=np.int64)
+    built, nv, nl = build_polyhedra(pts, fn_in, piece_nf, float(tol), pos, piece_nv, fn, fv)
+    if built == 0:
+        return 0, None
+    nf = int(piece_nf[:built].sum())
+    batch = (pos[:nv], np.full(nv, -1, dtype=np.int64), piece_nv[:built], fn[:nf],
+             np.full(nf, -1, dtype=np.int64), piece_nf[:built], fv[:nl])
+    return int(built), batch

@@ -24,8 +24,14 @@ def add_blocks(model: Model, polys: Sequence[Poly], group: str | None = None,
     """Append one block per polyhedron; return their rows. Ids continue from the last one."""
     if not polys:
         return np.zeros(0, dtype=np.int64)
+    return add_pieces(model, polys_to_batch(polys), group, slot, density, kind)
+
+
+def add_pieces(model: Model, batch, group: str | None = None, slot: str | None = None,
+               density: float | None = None, kind: int = KIND_RIGID) -> np.ndarray:
+    """Append one block per piece of ``batch`` (``polys_to_batch``'s form); return their rows."""
     b = model.blocks
-    sl = b.append(len(polys))
+    sl = b.append(len(batch[2]))
     rows = np.arange(sl.start, sl.stop, dtype=np.int64)
     b["id"][rows] = np.arange(model.next_block_id, model.next_block_id + len(rows))
     model.next_block_id += len(rows)
@@ -35,7 +41,7 @@ def add_blocks(model: Model, polys: Sequence[Poly], group: str | None = None,
         b["density"][rows] = density
     if group is not None:
         model.groups.assign(b, rows, group, slot)
-    write_pieces(model, rows, *polys_to_batch(polys))
+    write_pieces(model, rows, *batch)
     return rows
 
 
