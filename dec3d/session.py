@@ -22,7 +22,7 @@ from .commands.values import Deferred, InPath, OutPath, ValueRangeError
 from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation, StopDeck, printable
 from .fish import FishRuntime, compile_function, compile_inline, inline_source, parse_block, parse_inline
 from .io import paths
-from .lang.parser import ParsedDeck, parse_deck
+from .lang.parser import ParsedDeck, gc_paused, parse_deck
 from .lang.prepass import FishBlock
 from .model.model import Model
 
@@ -172,7 +172,8 @@ class Session:
         deck = parse_deck(text, filename, stack)
         if base_dir is not None and filename in PSEUDO_FILES:
             self._text_dirs[filename] = Path(base_dir)     # where its calls and restores look first
-        return self._bind_deck(deck, base_dir or Path.cwd(), stack)
+        with gc_paused():                   # binding makes objects per line too (lang.parser.gc_paused)
+            return self._bind_deck(deck, base_dir or Path.cwd(), stack)
 
     def load_file(self, path: str | Path, stack: tuple[SourceLocation, ...] = ()) -> list[Item]:
         """Read and bind a deck. With a ``stack`` the file is called by a deck (its last entry is

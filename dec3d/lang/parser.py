@@ -16,7 +16,9 @@ tokens on every public deck.
 """
 from __future__ import annotations
 
+import gc
 import re
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -77,15 +79,31 @@ def normalise(text: str) -> str:
     return text
 
 
+@contextmanager
+def gc_paused():
+    """Python's cycle collector off while a deck is read. Reading makes an object per token and
+    frees none: every few hundred of them the collector scanned them all again (a 664 000-token
+    masonry deck lexed in 3.9 s with it, 1.3 s without). Nothing made here forms cycles; the
+    collector is turned back on (if it was on) when reading ends, by error or not."""
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()
+
+
 def parse_deck(text: str, filename: str = "<input>", stack=()) -> ParsedDeck:
     """Parse a whole deck; raise DeckSyntaxError with file:line:col on bad text."""
     text = normalise(text)
     source_lines = text.split("\n")
     lifted, fish = lift_fish(text, filename)
     try:
-        lines = _lex_fast(lifted)
-        if lines is None:                       # text the fast lexer cannot take: lark's reports it
-            lines = _lex_lark(lifted)
+        with gc_paused():
+            lines = _lex_fast(lifted)
+            if lines is None:                   # text the fast lexer cannot take: lark's reports it
+                lines = _lex_lark(lifted)
     except UnexpectedInput as exc:
         raise _syntax_error(exc, filename, source_lines, stack) from None
     for line in lines:
