@@ -166,10 +166,22 @@ class Nums(ValueType):
     def take(self, toks, i, binder):
         out = []
         start = i
-        item = self.item
-        while i < len(toks) and len(out) < self.most and toks[i].type in NUMBERISH:
-            v, i = item.take(toks, i, binder)
-            out.append(v)
+        n, most = len(toks), self.most
+        literal, convert = self.item.literal, self.item.convert
+        # ``Num.take`` written out: a masonry deck's `block create polyhedron` line holds 72 numbers
+        while i < n and len(out) < most:
+            tok = toks[i]
+            kind = tok.type
+            if kind == "NUMBER":
+                try:
+                    out.append(convert(literal(tok), None))
+                except BindError as exc:
+                    raise exc.with_location(binder.where(tok)) from None
+            elif kind == "EXPR" or kind == "ATNAME":
+                out.append(binder.deferred(tok))
+            else:
+                break
+            i += 1
         if len(out) < self.least or len(out) % self.multiple_of or (self.counts and len(out) not in self.counts):
             want = str(self.least) if self.least == self.most else f"{self.least} to {self.most}"
             if self.counts:
