@@ -99,22 +99,27 @@ def parse_deck(text: str, filename: str = "<input>", stack=()) -> ParsedDeck:
     text = normalise(text)
     source_lines = text.split("\n")
     lifted, fish = lift_fish(text, filename)
+    def check(tok):
+        _no_control(tok, filename, source_lines, stack)
+
     try:
         with gc_paused():
             lines = _lex_fast(lifted)
             if lines is None:                   # text the fast lexer cannot take: lark's reports it
-                lines = _lex_lark(lifted)
+                lines = _lex_lark(lifted, check)
     except UnexpectedInput as exc:
         raise _syntax_error(exc, filename, source_lines, stack) from None
     for line in lines:
         for tok in line.tokens:
             if tok.type in ("STRING", "EXPR"):
-                _no_control(tok, filename, source_lines, stack)
+                check(tok)
     return ParsedDeck(filename, source_lines, lines, fish)
 
 
-def _lex_lark(text: str) -> list[RawLine]:
-    """Token lines by lark's lexer (the reference ``_lex_fast`` is tested against)."""
+def _lex_lark(text: str, check=None) -> list[RawLine]:
+    """Token lines by lark's lexer (the reference ``_lex_fast`` is tested against). ``check(tok)``
+    sees each string and inline expression as it is read, so that of two faults the first in the
+    text is reported (a control character on line 1 before bytes that are not text on line 2)."""
     lines: list[RawLine] = []
     current: list[Token] = []
     for tok in deck_parser().lex(text):
@@ -123,6 +128,8 @@ def _lex_lark(text: str) -> list[RawLine]:
                 lines.append(RawLine(tuple(current)))
                 current = []
         else:
+            if check is not None and tok.type in ("STRING", "EXPR"):
+                check(tok)
             current.append(tok)
     if current:
         lines.append(RawLine(tuple(current)))
