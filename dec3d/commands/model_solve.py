@@ -196,7 +196,8 @@ def _implicit(session, call, e) -> None:
         return
     except RunError as exc:
         raise CommandError(exc.message, call.location)
-    session.write(f"model solve implicit: {r['unknowns']} unknowns solved directly in {r['seconds']:.3g} CPU s "
+    how = (f"by conjugate gradients ({r['iterations']} iterations)" if r["iterations"] else "directly")
+    session.write(f"model solve implicit: {r['unknowns']} unknowns solved {how} in {r['seconds']:.3g} CPU s "
                   f"(largest unbalanced force {r['first']:.4g} N before, {r['left']:.3g} N after"
                   f"{', ' + str(r['refines']) + ' refinement(s)' if r['refines'] else ''}); cycling on")
 

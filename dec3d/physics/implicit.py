@@ -33,8 +33,9 @@ import time as _time
 
 import numpy as np
 
-from dec3d.kernels.feblock import feb_element_pass_serial
 from dec3d.kernels.zonestep import gp_externals
+
+from .implicit_stiffness import assemble, element_stiffness, tet4_stiffness, tet10_stiffness
 
 _F = np.float64
 _I = np.int64
@@ -43,6 +44,9 @@ _I = np.int64
 REFINE_TOL = 1e-10
 #: at most this many refinement solves (each one more residual and one more pair of triangular solves)
 MAX_REFINE = 3
+#: conjugate gradients (zoned blocks): relative residual and iteration limit of one solve
+CG_TOL = 1e-11
+CG_MAXITER = 5000
 #: a solve whose residual stays above this times the first one is refused (singular stiffness)
 ACCEPT_TOL = 1e-6
 
@@ -51,55 +55,22 @@ class Refusal(Exception):
     """The model is not one the implicit solve takes; the message says why."""
 
 
-def element_stiffness(pos, nodes, rows, bulk, shear, nq, hg) -> tuple[np.ndarray, np.ndarray]:
-    """(ke (len(rows), 60, 60), ok (len(rows),) bool): the stiffness of each element of ``rows``
-    as the explicit element pass (``feb_element_pass_serial``) computes forces from velocities:
-    ke[k, 3a+i, 3b+j] = −(force on node a, component i, of element k) for a unit velocity of node
-    b in direction j over a unit time from zero stress. Each element runs on its own copy of its
-    nodes, so the 60 passes give every element's columns at once."""
-    nr = len(rows)
-    xp = np.ascontiguousarray(pos[nodes[rows]].reshape(nr * 20, 3))
-    pnodes = np.arange(nr * 20, dtype=_I).reshape(nr, 20)
-    prow = np.arange(nr, dtype=_I)
-    bk = np.ascontiguousarray(bulk[rows])
-    sh = np.ascontiguousarray(shear[rows])
-    vel = np.zeros((nr * 20, 3))
-    gs = np.zeros((nr, 27, 6))
-    st = np.zeros((nr, 6))
-    fe = np.empty((nr, 20, 3))
-    ok = np.ones(nr, np.bool_)
-    okk = np.empty(nr, np.bool_)
-    ke = np.empty((nr, 60, 60))
-    for a in range(20):
-        for i in range(3):
-            vel[:] = 0.0
-            vel[a::20, i] = 1.0
-            gs[:] = 0.0
-            feb_element_pass_serial(xp, vel, pnodes, prow, bk, sh, 1.0, gs, st, fe, okk, nq, hg)
-            ok &= okk
-            ke[:, :, 3 * a + i] = -fe.reshape(nr, 60)
-    return ke, ok
-
-
 def refusal(eng) -> str | None:
     """Why the model cannot take the implicit solve (before any stepper is made), or None."""
-    from dec3d.model.feblocks import has_feblocks
     from dec3d.model.model import KIND_DEFORMABLE, KIND_FE
 
     from .dynamic import has_timefns
     from .energy import is_active
     from .history import HistorySet
+    from .rigid import _has_gridpoints
 
     m = eng.model
     b = m.blocks
     s = eng.settings()
-    if not has_feblocks(m):
-        return "the model has no FE blocks (the implicit solve takes FE blocks only)"
-    live = ~b["hidden"]
+    if not _has_gridpoints(m):
+        return "the model has no zoned or FE blocks"
     kind = b["kind"]
-    if (live & (kind == KIND_DEFORMABLE)).any():
-        return "the model has zoned blocks (the implicit solve takes FE blocks only)"
-    if (live & (kind != KIND_FE) & (kind != KIND_DEFORMABLE)).any():
+    if (~b["hidden"] & (kind != KIND_FE) & (kind != KIND_DEFORMABLE)).any():
         return "the model has rigid blocks"
     if m.settings.large_strain:
         return "large strain is on (`model large-strain off` first)"
@@ -115,17 +86,20 @@ def refusal(eng) -> str | None:
 
 
 class _Solve:
-    """The free degrees of freedom, the factorised stiffness and the engine's residual of one
-    implicit solve on the FE blocks of ``stepper`` (a ``physics.zones.ZoneStepper``)."""
+    """The free degrees of freedom, the factorised stiffness, the engine's residual and operator of
+    one implicit solve on the zoned and FE blocks of ``stepper`` (a ``physics.zones.ZoneStepper``)."""
 
     def __init__(self, model, stepper):
+        from dec3d.model.zones import ZMODEL_ELASTIC
+
         self.m, self.zst, self.fe = model, stepper, stepper.fe
         v = model.vertices
         zst, fe = self.zst, self.fe
-        if fe is None or len(zst.rows4) or len(zst.rows10):
-            raise Refusal("the model has zoned blocks (the implicit solve takes FE blocks only)")
         if zst.quiet is not None or zst.dyn:
             raise Refusal("quiet boundaries or table-driven face loads act")
+        zs = model.store("zones") if len(zst.rows4) or len(zst.rows10) else None
+        if zs is not None and (zs["cmodel"][np.concatenate((zst.rows4, zst.rows10))] != ZMODEL_ELASTIC).any():
+            raise Refusal("zones have a constitutive model other than elastic")
         self.M = M = zst.masters
         held = zst.held[M]
         nm = len(M)
@@ -138,76 +112,148 @@ class _Solve:
             fixed[:, i] = at_vapp | at_now
         idx = np.full(v.n, -1, _I)
         idx[M] = np.arange(nm, dtype=_I)
-        pos = np.ascontiguousarray(v["pos"])
-        ii, jj, kk = [], [], []
-        for q, h, rows in fe.groups:
-            if not len(rows):
-                continue
-            ke, ok = element_stiffness(pos, fe.nodes, rows, fe.bulk, fe.shear, q, h)
-            if not ok.all():
-                raise Refusal("an FE element has a non-positive Jacobian")
-            mn = idx[fe.mnodes[rows]]
+        pos = self.pos = np.ascontiguousarray(v["pos"])
+        parts = []
+
+        def dofs(rows_of_nodes):
+            mn = idx[rows_of_nodes]
             if (mn < 0).any():
                 raise Refusal("an element node is not a master gridpoint")
-            dof = (3 * mn[:, :, None] + np.arange(3)).reshape(len(rows), 60)
-            ii.append(np.repeat(dof[:, :, None], 60, axis=2).ravel())
-            jj.append(np.repeat(dof[:, None, :], 60, axis=1).ravel())
-            kk.append(ke.ravel())
-        from scipy.sparse import coo_matrix
-        from scipy.sparse.linalg import splu
+            return (3 * mn[:, :, None] + np.arange(3)).reshape(len(mn), -1)
 
-        n = 3 * nm
-        K = coo_matrix((np.concatenate(kk), (np.concatenate(ii), np.concatenate(jj))), shape=(n, n)).tocsc()
+        for q, h, rows in (fe.groups if fe is not None else ()):
+            if len(rows):
+                ke, ok = element_stiffness(pos, fe.nodes, rows, fe.bulk, fe.shear, q, h)
+                if not ok.all():
+                    raise Refusal("an FE element has a non-positive Jacobian")
+                parts.append((dofs(fe.mnodes[rows]), ke))
+        if len(zst.rows4):
+            g = zs["gp"][zst.rows4, :4]
+            parts.append((dofs(zst.node[g]), tet4_stiffness(pos[g], zst.bulk[zst.rows4], zst.shear[zst.rows4],
+                                                            zst.weight)))
+        if len(zst.rows10):
+            ke, ok = tet10_stiffness(pos, zs["gp"], zst.rows10, zst.bulk, zst.shear)
+            if not ok:
+                raise Refusal("a 10-node zone is inverted or flat")
+            parts.append((dofs(zst.node[zs["gp"][zst.rows10]]), ke))
+        K = assemble(parts, 3 * nm)
         diag = K.diagonal().reshape(nm, 3)
         #: free degrees of freedom (flattened master × component): not held, with stiffness
         self.free = free = (~fixed & (diag > 0.0)).ravel()
         self.nfree = int(free.sum())
         if not self.nfree:
             raise Refusal("no degree of freedom is free")
-        Kff = K[free][:, free].tocsc()
+        #: the assembled stiffness is the step's own (FE and 10-node elements only): solve directly;
+        #: else it preconditions conjugate gradients of the zone operator
+        self.exact = not len(zst.rows4)
+        from scipy.sparse.linalg import splu
         try:
-            self.lu = splu(Kff)
+            self.lu = splu(K[free][:, free].tocsc())
         except RuntimeError as exc:
             raise Refusal(f"the stiffness is singular ({exc}): is every block held against rigid motion?")
         self.zero = np.zeros((v.n, 3))
         self.g = np.asarray(model.settings.gravity, _F)
+        self.iterations = 0
+
+    def _velocity(self, du: np.ndarray) -> np.ndarray:
+        """(nv, 3) velocities of master displacements du (nm, 3): linked copies and slave nodes follow."""
+        zst, v = self.zst, self.m.vertices
+        vel = np.zeros((v.n, 3))
+        vel[self.M] = du
+        lk = zst.linked
+        vel[lk] = vel[v["link"][lk]]
+        if self.fe is not None:
+            self.fe.follow(vel)
+        return vel
+
+    def operator(self, x: np.ndarray) -> np.ndarray:
+        """K x on the free degrees of freedom, by the step kernels themselves on zero stresses
+        (``dynamic.zone_stiffness_damping``: −K v of the zones and FE elements), linked rows summed."""
+        from .dynamic import zone_stiffness_damping
+
+        v = self.m.vertices
+        du = np.zeros(3 * len(self.M))
+        du[self.free] = x
+        f = np.zeros((v.n, 3))
+        zone_stiffness_damping(self.zst, 1.0, self.pos, self._velocity(du.reshape(-1, 3)), f)
+        lk = self.zst.linked
+        np.add.at(f, v["link"][lk], f[lk])
+        self.iterations += 1
+        return -f[self.M].ravel()[self.free]
 
     def residual(self) -> np.ndarray:
-        """The unbalanced force (nm, 3) of the master nodes at rest, as ``ZoneStepper.step`` sums it
-        before the motion (element forces, consistent gravity, applied and face forces, linked
-        rows onto masters, slave forces by Eq. 9); held components zero."""
+        """The unbalanced force (nm, 3) of the master gridpoints at rest, as ``ZoneStepper.step`` sums it
+        before the motion (zone and element forces, gravity, applied and face forces, linked rows onto
+        masters, slave forces by Eq. 9); held components zero."""
+        from dec3d.kernels.zone_step import zone_step_for
+
         zst, fe, v = self.zst, self.fe, self.m.vertices
         facc = zst.begin()
-        fe.forces(np.ascontiguousarray(v["pos"]), self.zero, 1.0, self.g, facc, zst.fmag)
-        gp_externals(zst.rows, v["link"], zst.gmass, self.g, v["fapp"], v["fface"], facc, zst.fmag)
-        fe.slave_forces(facc)
+        pos, zero, g = self.pos, self.zero, self.g
+        if zst.fast is not None:
+            zone_step_for(zst.models)(pos, zero, zst.zmesh, zst.material(), zst.zplan, zst.zscratch, 1.0, False,
+                                      zst.nmd, facc, zst.fmag)
+        if zst.ho is not None:
+            zs = self.m.store("zones")
+            zst.ho(pos, zero, zs["gp"], zst.rows10, zst.bulk, zst.shear, 1.0, zs["gstress"], zs["stress"], facc)
+        if fe is not None:
+            fe.forces(pos, zero, 1.0, g, facc, zst.fmag)
+        if len(zst.r10):
+            zst._body_force10(g)
+            facc[zst.r10] += zst.fb10
+        gp_externals(zst.rows, v["link"], zst.gmass, g, v["fapp"], v["fface"], facc, zst.fmag)
+        if fe is not None:
+            fe.slave_forces(facc)
         r = facc[self.M].copy()
         r.ravel()[~self.free] = 0.0
         return r
 
     def apply(self, du: np.ndarray) -> None:
-        """Move the model by master displacements du (nm, 3): stresses by the element pass with
-        velocity du over a unit time, displacements, linked copies and slave nodes as a step does."""
+        """Move the model by master displacements du (nm, 3): stresses by the step kernels with velocity
+        du over a unit time, displacements, linked copies and slave nodes as a step does."""
+        from dec3d.kernels.zone_step import zone_step_for
+
         zst, fe, v = self.zst, self.fe, self.m.vertices
-        vel = np.zeros((v.n, 3))
-        vel[self.M] = du
-        lk = zst.linked
-        link = v["link"]
-        vel[lk] = vel[link[lk]]
-        fe.follow(vel)
-        fe.forces(np.ascontiguousarray(v["pos"]), vel, 1.0, np.zeros(3), np.zeros((v.n, 3)))
+        vel = self._velocity(du)
+        f, fm = np.zeros((v.n, 3)), np.zeros(v.n)
+        if zst.fast is not None:
+            zone_step_for(zst.models)(self.pos, vel, zst.zmesh, zst.material(), zst.zplan, zst.zscratch, 1.0, False,
+                                      zst.nmd, f, fm)
+        if zst.ho is not None:
+            zs = self.m.store("zones")
+            zst.ho(self.pos, vel, zs["gp"], zst.rows10, zst.bulk, zst.shear, 1.0, zs["gstress"], zs["stress"], f)
+        if fe is not None:
+            fe.forces(self.pos, vel, 1.0, np.zeros(3), f)
         disp = v["disp"]
         disp[self.M] += du
-        disp[lk] = disp[link[lk]]
-        fe.follow(disp)
+        lk = zst.linked
+        disp[lk] = disp[v["link"][lk]]
+        if fe is not None:
+            fe.follow(disp)
+
+    def correction(self, r: np.ndarray) -> np.ndarray:
+        """The displacements (nm, 3) that remove the residual r: K_ff⁻¹ r directly, or by conjugate
+        gradients of the step's operator preconditioned by the assembled stiffness."""
+        b = r.ravel()[self.free]
+        if self.exact:
+            x = self.lu.solve(b)
+        else:
+            from scipy.sparse.linalg import LinearOperator, cg
+
+            n = self.nfree
+            A = LinearOperator((n, n), matvec=self.operator, dtype=_F)
+            P = LinearOperator((n, n), matvec=self.lu.solve, dtype=_F)
+            x, _ = cg(A, b, rtol=CG_TOL, atol=0.0, maxiter=CG_MAXITER, M=P)
+        du = np.zeros(3 * len(self.M))
+        du[self.free] = x
+        return du.reshape(-1, 3)
 
     def solve(self) -> dict:
         r0 = self.residual()
         first = float(np.abs(r0).max())
         r, refines = r0, 0
         while True:
-            du = np.zeros(r.shape)
-            du.ravel()[self.free] = self.lu.solve(r.ravel()[self.free])
+            du = self.correction(r)
             if not np.isfinite(du).all():
                 raise Refusal("the stiffness is singular: is every block held against rigid motion?")
             self.apply(du)
@@ -219,12 +265,13 @@ class _Solve:
         if not left <= ACCEPT_TOL * max(first, 1e-300) and first > 0.0:
             raise Refusal(f"the solve left an unbalanced force of {left:.3g} N of {first:.3g} N: the stiffness is "
                           "singular or ill-conditioned (is every block held against rigid motion?)")
-        return {"unknowns": self.nfree, "first": first, "left": left, "refines": refines, "residual": r}
+        return {"unknowns": self.nfree, "first": first, "left": left, "refines": refines,
+                "iterations": self.iterations, "residual": r}
 
 
 def implicit_static(eng, warn=None) -> dict:
-    """Solve the model's FE blocks to static equilibrium in one sparse solve (module text) and
-    leave them at rest there. Returns {"unknowns", "first", "left", "refines", "seconds"}; raises
+    """Solve the model's zoned and FE blocks to static equilibrium (module text) and leave them at
+    rest there. Returns {"unknowns", "first", "left", "refines", "iterations", "seconds"}; raises
     ``Refusal`` (the model unchanged) when the model is not one it takes."""
     t0 = _time.process_time()
     why = refusal(eng)
@@ -239,17 +286,19 @@ def implicit_static(eng, warn=None) -> dict:
     from .zones import ZoneStepper
 
     zst = ZoneStepper(m, RunError, warn)
-    v, es = m.vertices, m.store("feblocks")
-    keep = {k: v[k].copy() for k in ("disp", "velocity", "force")}
-    keep_s = {k: es[k].copy() for k in ("gstress", "stress")}
+    v = m.vertices
+    keep = [(v, {k: v[k].copy() for k in ("disp", "velocity", "force")})]
+    for name in ("feblocks", "zones"):
+        if name in m.stores:
+            st = m.store(name)
+            keep.append((st, {k: st[k].copy() for k in ("gstress", "stress")}))
     try:
         with np.errstate(over="ignore", invalid="ignore"):
             out = _Solve(m, zst).solve()
     except BaseException:
-        for k, a in keep.items():
-            v[k][:] = a
-        for k, a in keep_s.items():
-            es[k][:] = a
+        for store, arrays in keep:
+            for k, a in arrays.items():
+                store[k][:] = a
         raise
     v["velocity"][zst.rows] = 0.0
     v["force"][zst.masters] = out.pop("residual")
