@@ -78,8 +78,8 @@ def _fmt_criteria(values: dict) -> str:
                    P("clock", Num(lo=0, lo_open=True), "stop after this much wall-clock time", units="min"),
                    P("and", FLAG, "every given limit must be met", bare=True),
                    P("or", FLAG, "any given limit is enough (default)", bare=True),
-                   P("implicit", FLAG, "FE blocks: reach the static answer by one sparse direct solve first, "
-                                       "then cycle on as usual (dec3d keyword)", bare=True), _TIMING],
+                   P("implicit", FLAG, "elastic zoned and FE blocks: reach the static answer by a sparse solve "
+                                       "first, then cycle on as usual (dec3d keyword)", bare=True), _TIMING],
          doc=f"Cycle until the limits are met (default: ratio {DEFAULT_RATIO:g}; at most {SOLVE_CYCLE_CAP} steps "
              "unless `cycles`, or `time` without `and`, is given).",
          details="The ratios are Itasca's (FLAC3D/3DEC manual, \"Reaching Equilibrium\", section \"Out-of-Balance "
@@ -100,17 +100,20 @@ def _fmt_criteria(values: dict) -> str:
                  "\"not converged\", and `dec3d run` repeats that as a warning at the end of the run (the exit "
                  "status stays 0). A warning is printed first when contacts in use have zero normal or shear "
                  "stiffness. When the output is not a terminal, a progress line is printed every 10 s.\n\n"
-                 "`implicit` (dec3d's own keyword, not Itasca's) is for linear elastic FE blocks in small strain: "
-                 "before cycling, the static equilibrium of the explicit scheme's own discretisation (the same "
-                 "element pass, Gauss rule and hourglass control; gravity, applied and face forces) is found by "
-                 "one sparse direct solve of the stiffness the element pass defines, stresses and displacements "
-                 "are set to it and velocities to zero (dec3d.physics.implicit). The solve then cycles as "
-                 "usual, so the limits, the printed ratios, histories and FISH see the state the explicit steps "
-                 "find: at rest, a solve stops after its first batch of steps (at most `model update-interval` "
-                 "steps; the model time moves on only by these). A model it cannot take (zoned or rigid blocks, "
-                 "contacts on FE blocks, large strain, dynamic mode, time functions, quiet boundaries, energy "
-                 "tracking, FISH callbacks, a held gridpoint moving, a block not held against rigid motion) is "
-                 "solved by cycling alone, with a line saying why.",
+                 "`implicit` (dec3d's own keyword, not Itasca's) is for linear elastic zoned and FE blocks in "
+                 "small strain: before cycling, the static equilibrium of the explicit scheme's own "
+                 "discretisation (the same zone and element kernels: nodal mixed discretization, Gauss rules, "
+                 "hourglass control; gravity, applied and face forces) is found by a sparse solve: sparse LU "
+                 "of the stiffness probed from the element kernels for FE blocks and 10-node zones, conjugate "
+                 "gradients of the zone step itself preconditioned by that LU with 4-node zones. Stresses and "
+                 "displacements are set to it and velocities to zero (dec3d.physics.implicit). The solve then "
+                 "cycles as usual, so the limits, the printed ratios, histories and FISH see the state the "
+                 "explicit steps find: at rest, a solve stops after its first batch of steps (at most "
+                 "`model update-interval` steps; the model time moves on only by these). A model it cannot "
+                 "take (rigid blocks, contacts on deformable blocks, zone models other than elastic, large "
+                 "strain, dynamic mode, time functions, quiet boundaries, energy tracking, FISH callbacks, a "
+                 "held gridpoint moving, a block not held against rigid motion) is solved by cycling alone, "
+                 "with a line saying why.",
          examples=["model solve", "model solve ratio 1e-6", "model solve ratio 1e-6 implicit",
                    "model solve ratio-local 1e-6 time 0.02",
                    "model solve time 0.5 cycles 20000 or", "model solve unbalanced-maximum 1 clock 5"])

@@ -1,31 +1,39 @@
-"""A static answer for linear elastic FE blocks in one sparse direct solve (`model solve … implicit`).
+"""The static answer of linear elastic zoned and FE blocks by a sparse solve (`model solve … implicit`).
 
 The explicit, density-scaled and damped cycle of ``physics.zones`` reaches the equilibrium of its
-own discretisation: at rest, the force of the element stresses plus gravity, applied and face forces
-vanishes at every free master node. In small strain that force is linear in the displacement since
-the start of the solve: the geometry does not move, and every element stress grows by
-D : ε(v Δt) at each step, so after displacements Δu the stresses are σ0 + D : ε(Δu) and
+own discretisation: at rest, the force of the zone and element stresses plus gravity, applied and
+face forces vanishes at every free master gridpoint. In small strain that force is linear in the
+displacement since the start of the solve: the geometry does not move, and every stress grows by
+D : ε(v Δt) at each step (the zone step's nodal or hexahedral averaging of the volumetric strain is
+linear too), so after displacements Δu the stresses are σ0 + D : ε(Δu) and
 
     F(Δu) = F(0) − K Δu,
 
 with F(0) the force the engine's own step finds at rest now (``residual``) and K the stiffness of
-exactly the element pass the explicit step runs (its Gauss rule, the hourglass control of 2×2×2
-elements). K is assembled here from that pass itself: each element is run alone (on a copy of its
-20 nodes) with a unit velocity on each of its 60 degrees of freedom over a unit time, from zero
-stress, and the negated nodal forces are its stiffness columns (``element_stiffness``); no second
-formulation of the element exists to drift from the first. K_ff Δu_f = F_f(0) on the free degrees of
-freedom (master nodes, components not held, with stiffness) is solved by sparse LU
-(``scipy.sparse.linalg.splu``), refined with the engine's residual until it is below
-``REFINE_TOL`` of the first one. The stresses are then moved on by the engine's element pass with
-"velocity" Δu over a unit time, the displacements by Δu (linked copies and slave nodes follow as in
-a step), velocities set to zero: the state an explicit run that converged would leave, to rounding.
+exactly the kernels the explicit step runs. K Δu is evaluated by those kernels themselves
+(``operator``: ``dynamic.zone_stiffness_damping``, the step on zero stresses with velocity Δu over
+a unit time). The solve of K_ff Δu_f = F_f(0) on the free degrees of freedom (master gridpoints,
+components not held, with stiffness):
+
+- FE blocks and 10-node zones only: K is assembled from the step kernels by probing each element
+  (``implicit_stiffness``), so it is the operator itself, and is solved by sparse LU
+  (``scipy.sparse.linalg.splu``);
+- with 4-node zones: conjugate gradients (the operator is symmetric and, held against rigid motion,
+  positive definite) on ``operator``, preconditioned by the LU of the assembled stiffness with
+  constant-strain tetrahedra in place of the averaged ones; 10-20 iterations on the D3 decks.
+
+Either way the answer is refined with the engine's residual until it is below ``REFINE_TOL`` of the
+first one. The stresses are then moved on by the step kernels with velocity Δu over a unit time, the
+displacements by Δu (linked copies and FE slave nodes follow as in a step), velocities set to zero:
+the state an explicit run that converged would leave, to rounding.
 
 ``model solve … implicit`` (``commands.model_solve``) calls ``implicit_static`` and then cycles as
-usual: the explicit steps that follow find the model at rest, check the requested ratio and stop
+usual: the explicit steps that follow find the model at rest, check the requested limits and stop
 after their first batch (or carry on from there when the answer was not good enough). What this
-solve cannot take stays with the explicit cycle: ``refusal`` names why (zones, rigid blocks,
-contacts on deformable blocks, large strain, dynamic mode, time functions, quiet boundaries,
-energy tracking, FISH callbacks, held components moving at a non-zero velocity).
+solve cannot take stays with the explicit cycle: ``refusal`` and ``_Solve`` name why (rigid blocks,
+contacts on deformable blocks, zone models other than elastic, large strain, dynamic mode, time
+functions, quiet boundaries or table-driven face loads, energy tracking, FISH callbacks, held
+components moving at a non-zero velocity, a stiffness that is singular).
 """
 from __future__ import annotations
 
