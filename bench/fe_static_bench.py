@@ -2,6 +2,7 @@
 dec3d's `model solve … implicit` and, when `ccx` is on PATH, CalculiX's direct solve of the same mesh.
 
     python bench/fe_static_bench.py [--mesh 2x2x20 4x4x40] [--nq 3] [--ratio 1e-6] [--clock 1] [--no-explicit]
+    python bench/fe_static_bench.py --d3 [--ratio 1e-8]
 
 The beam: 10 m long (x), 1 × 1 m section, E = 1 MPa, ν = 0.2, ρ = 2000 kg/m³ (no gravity), root
 (x = 0) held in x, y, z; 100 N down at the tip shared equally by the master nodes of the top tip
@@ -10,6 +11,11 @@ edge (x = 10, z = 1: 2 ny + 1 nodes). Elements ny × nz × nx of (1/ny) × (1/nz
 (`--nq 3`, CalculiX C3D20) or 2 × 2 × 2 with dec3d's hourglass control (`--nq 2`; CalculiX C3D20R has
 no hourglass control, so the answers differ by more than rounding there). Beam theory WL³/(3EI) is
 0.400 m (plus shear deflection, about 0.1 % here).
+
+`--d3` times the zoned elastic-hole decks of verification/D3_elastic_hole_{tet,hex,ho} instead: each
+deck's model lines, then its own `model cycle 2000`, an explicit `model solve ratio R` and `model solve
+ratio R implicit` (fresh models), with the largest difference of the implicit gridpoint displacements
+and zone stresses from the explicit solve's, relative to the largest value.
 
 Each dec3d run is the `model solve` line of a fresh model in this process, after a warm-up solve of a
 one-element beam (numba compilation is not counted); CPU s is ``time.process_time`` around that one
@@ -21,7 +27,6 @@ from __future__ import annotations
 
 import argparse
 import io
-import itertools
 import os
 import platform
 import re
@@ -114,6 +119,31 @@ def ccx_run(m, nq, ny, workdir):
     return cpu, -float(row[2])
 
 
+def d3(ratio):
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent / "verification"
+    print(f"{'deck':>22} {'run':>34} {'CPU s':>8} {'steps':>7}  implicit vs explicit (disp, stress)")
+    for name in ("D3_elastic_hole_tet", "D3_elastic_hole_hex", "D3_elastic_hole_ho"):
+        src = (root / name / "deck.dat").read_text().replace("model cycle 2000", "")
+        res = {}
+        for how in ("model cycle 2000", f"model solve ratio {ratio}", f"model solve ratio {ratio} implicit"):
+            out = io.StringIO()
+            s = Session(out_dir=tempfile.mkdtemp(prefix="fe_static_"), stdout=out)
+            s.command(src)
+            c0 = time.process_time()
+            s.command(how)
+            cpu = time.process_time() - c0
+            zs, v = s.model.store("zones"), s.model.vertices
+            res[how] = (v["disp"][: v.n].copy(), zs["stress"][: zs.n].copy())
+            cmp = ""
+            if how.endswith("implicit"):
+                ue, se = res[f"model solve ratio {ratio}"]
+                cmp = (f"{np.abs(res[how][0] - ue).max() / np.abs(ue).max():.1e}, "
+                       f"{np.abs(res[how][1] - se).max() / np.abs(se).max():.1e}")
+            print(f"{name:>22} {how:>34} {cpu:8.3f} {s.model.step:7d}  {cmp}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--mesh", nargs="+", default=["2x2x20", "4x4x40"], help="ny x nz x nx elements")
@@ -121,9 +151,13 @@ def main():
     ap.add_argument("--ratio", type=float, default=1e-6)
     ap.add_argument("--clock", type=float, default=1.0, help="cap of the explicit solve [min]")
     ap.add_argument("--no-explicit", action="store_true")
+    ap.add_argument("--d3", action="store_true", help="the D3 zoned elastic-hole decks instead")
     a = ap.parse_args()
     print(f"# {platform.processor() or platform.machine()}, {os.cpu_count()} cores, load average "
           f"{os.getloadavg()[0]:.2f}; NUMBA_NUM_THREADS={os.environ.get('NUMBA_NUM_THREADS', 'default')}")
+    if a.d3:
+        d3(a.ratio)
+        return
     dec3d_run(1, 1, 1, a.nq, f"ratio {a.ratio} implicit")              # warm-up (compilation)
     if not a.no_explicit:
         dec3d_run(1, 1, 1, a.nq, "cycles 20")
