@@ -55,8 +55,15 @@ MAX_REFINE = 3
 #: conjugate gradients (zoned blocks): relative residual and iteration limit of one solve
 CG_TOL = 1e-11
 CG_MAXITER = 5000
+#: elements whose stiffness matrices are made and assembled at once (memory: about 90 kB each for bricks)
+CHUNK_ELEMENTS = 2048
 #: a solve whose residual stays above this times the first one is refused (singular stiffness)
 ACCEPT_TOL = 1e-6
+
+
+def _chunks(rows: np.ndarray) -> list:
+    """``rows`` in pieces of at most CHUNK_ELEMENTS."""
+    return np.array_split(rows, -(-len(rows) // CHUNK_ELEMENTS)) if len(rows) else []
 
 
 class Refusal(Exception):
@@ -121,7 +128,8 @@ class _Solve:
         idx = np.full(v.n, -1, _I)
         idx[M] = np.arange(nm, dtype=_I)
         pos = self.pos = np.ascontiguousarray(v["pos"])
-        parts = []
+        n = 3 * nm
+        K = assemble([], n)
 
         def dofs(rows_of_nodes):
             mn = idx[rows_of_nodes]
@@ -129,22 +137,22 @@ class _Solve:
                 raise Refusal("an element node is not a master gridpoint")
             return (3 * mn[:, :, None] + np.arange(3)).reshape(len(mn), -1)
 
+        # (element matrices made and summed in chunks: 60 × 60 per brick would need 29 kB an element at once)
         for q, h, rows in (fe.groups if fe is not None else ()):
-            if len(rows):
-                ke, ok = element_stiffness(pos, fe.nodes, rows, fe.bulk, fe.shear, q, h)
+            for part in _chunks(rows):
+                ke, ok = element_stiffness(pos, fe.nodes, part, fe.bulk, fe.shear, q, h)
                 if not ok.all():
                     raise Refusal("an FE element has a non-positive Jacobian")
-                parts.append((dofs(fe.mnodes[rows]), ke))
-        if len(zst.rows4):
-            g = zs["gp"][zst.rows4, :4]
-            parts.append((dofs(zst.node[g]), tet4_stiffness(pos[g], zst.bulk[zst.rows4], zst.shear[zst.rows4],
-                                                            zst.weight)))
-        if len(zst.rows10):
-            ke, ok = tet10_stiffness(pos, zs["gp"], zst.rows10, zst.bulk, zst.shear)
+                K += assemble([(dofs(fe.mnodes[part]), ke)], n)
+        for part in _chunks(zst.rows4):
+            g = zs["gp"][part, :4]
+            w = np.where(zs["overlay"][part] >= 0, 0.5, 1.0)
+            K += assemble([(dofs(zst.node[g]), tet4_stiffness(pos[g], zst.bulk[part], zst.shear[part], w))], n)
+        for part in _chunks(zst.rows10):
+            ke, ok = tet10_stiffness(pos, zs["gp"], part, zst.bulk, zst.shear)
             if not ok:
                 raise Refusal("a 10-node zone is inverted or flat")
-            parts.append((dofs(zst.node[zs["gp"][zst.rows10]]), ke))
-        K = assemble(parts, 3 * nm)
+            K += assemble([(dofs(zst.node[zs["gp"][part]]), ke)], n)
         diag = K.diagonal().reshape(nm, 3)
         #: free degrees of freedom (flattened master × component): not held, with stiffness
         self.free = free = (~fixed & (diag > 0.0)).ravel()
@@ -156,7 +164,10 @@ class _Solve:
         self.exact = not len(zst.rows4)
         from scipy.sparse.linalg import splu
         try:
-            self.lu = splu(K[free][:, free].tocsc())
+            # (K_ff is symmetric positive definite: minimum degree on Kᵀ + K and diagonal pivots; on the
+            # 2160-element cantilever 1.8 s and 33 M factor entries against 13.6 s and 85 M with COLAMD)
+            self.lu = splu(K[free][:, free].tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                           options={"SymmetricMode": True})
         except RuntimeError as exc:
             raise Refusal(f"the stiffness is singular ({exc}): is every block held against rigid motion?")
         self.zero = np.zeros((v.n, 3))
