@@ -317,3 +317,15 @@ def test_fe1_verification_deck_with_implicit_meets_its_calculix_values(tmp_path)
         assert abs(tip(y) - ref) < 0.002 * ref, (y, tip(y))
     assert abs(tip(10) - 0.4) < 0.01 * 0.4
     assert tip(13) < 0.2
+
+
+def test_fe_blocks_in_contact_are_refused(tmp_path):
+    """Two FE blocks stacked without `block join`: the contact between them carries force, which the
+    implicit solve does not model; refused with the reason, and the solve cycles."""
+    out = io.StringIO()
+    s = Session(out_dir=tmp_path, stdout=out)
+    s.command(JOINED.replace("block join\n", "block contact jmodel assign elastic\n"
+                             "block contact material-table default property stiffness-normal 1e8 "
+                             "stiffness-shear 1e8\n").format(how="implicit").replace("ratio 1e-9", "cycles 5"))
+    assert "model solve implicit: contacts act on deformable blocks: solving by cycling alone" in out.getvalue()
+    assert s.model.step == 5
