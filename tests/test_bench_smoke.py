@@ -232,3 +232,23 @@ def test_joint_law_bench_runs_every_model_and_prints_its_cost():
     rows = {ln.split()[0]: ln.split()[1:] for ln in out.stdout.splitlines()[1:]}
     assert set(rows) == set(JOINT_MODELS)
     assert float(rows["mohr"][1]) == 1.0 and all(float(r[0]) > 0 for r in rows.values())
+
+
+def test_fe_static_bench_runs_and_agrees_with_calculix_when_present():
+    """bench/fe_static_bench.py on a 1x1x4 cantilever (explicit capped at about a second): a row per run
+    with the tip deflection; when CalculiX (`ccx`) is on PATH its row too, the implicit tip within
+    1e-6 of it (the same C3D20 mesh and loads)."""
+    import shutil
+
+    out = subprocess.run([sys.executable, str(ROOT / "bench" / "fe_static_bench.py"), "--mesh", "1x1x4",
+                          "--clock", "0.02"], capture_output=True, text=True, timeout=300, cwd=ROOT,
+                         env={**os.environ, "PYTHONPATH": os.pathsep.join(
+                             [str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])})
+    assert out.returncode == 0, out.stderr
+    rows = {" ".join(ln.split()[2:4]): ln.split() for ln in out.stdout.splitlines()
+            if ln.strip().startswith("1x1x4")}
+    assert {"dec3d implicit", "dec3d explicit"} <= set(rows)
+    imp = float(rows["dec3d implicit"][7])
+    assert 0.3 < imp < 0.45 and "converged;" in " ".join(rows["dec3d implicit"])
+    if shutil.which("ccx"):
+        assert abs(imp - float(rows["CalculiX C3D20"][5])) < 1e-6 * imp

@@ -77,7 +77,9 @@ def _fmt_criteria(values: dict) -> str:
                    P("cycles", Num(integer=True, lo=1), "stop after this many steps"),
                    P("clock", Num(lo=0, lo_open=True), "stop after this much wall-clock time", units="min"),
                    P("and", FLAG, "every given limit must be met", bare=True),
-                   P("or", FLAG, "any given limit is enough (default)", bare=True), _TIMING],
+                   P("or", FLAG, "any given limit is enough (default)", bare=True),
+                   P("implicit", FLAG, "elastic zoned and FE blocks: reach the static answer by a sparse solve "
+                                       "first, then cycle on as usual (dec3d keyword)", bare=True), _TIMING],
          doc=f"Cycle until the limits are met (default: ratio {DEFAULT_RATIO:g}; at most {SOLVE_CYCLE_CAP} steps "
              "unless `cycles`, or `time` without `and`, is given).",
          details="The ratios are Itasca's (FLAC3D/3DEC manual, \"Reaching Equilibrium\", section \"Out-of-Balance "
@@ -97,8 +99,23 @@ def _fmt_criteria(values: dict) -> str:
                  "solve with a ratio or unbalanced-force limit that stops on its step, time or clock limit says "
                  "\"not converged\", and `dec3d run` repeats that as a warning at the end of the run (the exit "
                  "status stays 0). A warning is printed first when contacts in use have zero normal or shear "
-                 "stiffness. When the output is not a terminal, a progress line is printed every 10 s.",
-         examples=["model solve", "model solve ratio 1e-6", "model solve ratio-local 1e-6 time 0.02",
+                 "stiffness. When the output is not a terminal, a progress line is printed every 10 s.\n\n"
+                 "`implicit` (dec3d's own keyword, not Itasca's) is for linear elastic zoned and FE blocks in "
+                 "small strain: before cycling, the static equilibrium of the explicit scheme's own "
+                 "discretisation (the same zone and element kernels: nodal mixed discretization, Gauss rules, "
+                 "hourglass control; gravity, applied and face forces) is found by a sparse solve: sparse LU "
+                 "of the stiffness probed from the element kernels for FE blocks and 10-node zones, conjugate "
+                 "gradients of the zone step itself preconditioned by that LU with 4-node zones. Stresses and "
+                 "displacements are set to it and velocities to zero (dec3d.physics.implicit). The solve then "
+                 "cycles as usual, so the limits, the printed ratios, histories and FISH see the state the "
+                 "explicit steps find: at rest, a solve stops after its first batch of steps (at most "
+                 "`model update-interval` steps; the model time moves on only by these). A model it cannot "
+                 "take (rigid blocks, contacts on deformable blocks, zone models other than elastic, large "
+                 "strain, dynamic mode, time functions, quiet boundaries, energy tracking, FISH callbacks, a "
+                 "held gridpoint moving, a block not held against rigid motion) is solved by cycling alone, "
+                 "with a line saying why.",
+         examples=["model solve", "model solve ratio 1e-6", "model solve ratio 1e-6 implicit",
+                   "model solve ratio-local 1e-6 time 0.02",
                    "model solve time 0.5 cycles 20000 or", "model solve unbalanced-maximum 1 clock 5"])
 def model_solve(session, call):
     a = call.args
@@ -131,6 +148,8 @@ def model_solve(session, call):
                 why.setdefault("clock", True)
         return all(ok) if both else any(ok)
 
+    if a.get("implicit"):
+        _implicit(session, call, e)
     time0 = e.time
     done = _run(session, call, n, stop, max_time=t_end if (t_end is not None and not both) else None)
     if e.model.blocks.n == 0:
@@ -166,6 +185,24 @@ def model_solve(session, call):
         if warnings is not None:
             warnings.append(f"{at}model solve did not converge ({want}): stopped by {limit or 'a limit'} at step "
                             f"{e.step}; {_fmt_criteria(values)}")
+
+
+def _implicit(session, call, e) -> None:
+    """The sparse direct solve of ``model solve … implicit`` (``physics.implicit``), or a line saying
+    why the model is solved by cycling alone."""
+    from ..physics.implicit import Refusal, implicit_static
+
+    try:
+        r = implicit_static(e, warn=lambda msg: session.write(f"warning: {msg}"))
+    except Refusal as exc:
+        session.write(f"model solve implicit: {exc}: solving by cycling alone")
+        return
+    except RunError as exc:
+        raise CommandError(exc.message, call.location)
+    how = (f"by conjugate gradients ({r['iterations']} iterations)" if r["iterations"] else "directly")
+    session.write(f"model solve implicit: {r['unknowns']} unknowns solved {how} in {r['seconds']:.3g} CPU s "
+                  f"(largest unbalanced force {r['first']:.4g} N before, {r['left']:.3g} N after"
+                  f"{', ' + str(r['refines']) + ' refinement(s)' if r['refines'] else ''}); cycling on")
 
 
 @command("model update-interval", positional=[P("n", Num(integer=True, lo=1), "steps between contact detections",
