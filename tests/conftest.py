@@ -23,7 +23,7 @@ NO_DECKS = (f"public 3DEC decks not found at {DECKS}: set DEC3D_SHARED=<folder h
 
 #: what the tests import: dec3d's dependencies and its test extras (pyproject.toml)
 NEEDED = ("numpy", "numba", "lark", "scipy", "meshio", "pyvista", "prompt_toolkit", "rich", "matplotlib",
-          "hypothesis", "dask")
+          "hypothesis", "dask", "xdist")
 
 
 def pytest_configure(config):
@@ -34,6 +34,20 @@ def pytest_configure(config):
         pytest.exit(f"this Python ({sys.executable}) lacks {', '.join(missing)}: install dec3d and its test "
                     "extras into it first, `pip install -e \".[test]\"` (README, 'Set up'), or run the "
                     "`pytest` of the environment where you did", returncode=4)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_cmdline_main(config):
+    """The suite runs on every core, up to four worker processes (pytest-xdist, a test extra), unless
+    the command line says otherwise (`-n 0`: one process, as for a debugger). Runs before xdist reads
+    its options. Each worker compiles or loads the kernels from numba's shared cache on disk."""
+    opt = config.option
+    if getattr(opt, "numprocesses", "absent") is None and not os.environ.get("PYTEST_XDIST_WORKER") \
+            and not getattr(opt, "usepdb", False) and not getattr(opt, "collectonly", False):
+        opt.numprocesses = "auto"
+        opt.maxprocesses = opt.maxprocesses or 4
+        if opt.dist == "no":
+            opt.dist = "worksteal"
 
 
 @pytest.fixture
