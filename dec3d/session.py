@@ -344,15 +344,20 @@ class Session:
         except StopDeck:
             pass
 
+    #: a run of batchable lines shorter than this runs line by line: a batch function's compiled
+    #: kernel costs seconds to compile on a cold cache, which only long runs win back
+    batch_min = 50
+
     def _batch_end(self, items: list, i: int) -> int:
-        """End of the run of lines from ``items[i]`` whose commands share a batch function."""
+        """End of the run of lines from ``items[i]`` whose commands share a batch function (i + 1
+        when the run is shorter than ``batch_min``)."""
         item = items[i]
         if self.echo or not isinstance(item, CommandCall) or item.command.batch is None:
             return i + 1
         fn, j = item.command.batch, i + 1
         while j < len(items) and isinstance(items[j], CommandCall) and items[j].command.batch is fn:
             j += 1
-        return j
+        return j if j - i >= self.batch_min else i + 1
 
     def _run_batch(self, items: list) -> int:
         """Run a run of batchable lines (``Command.batch``): as many as the batch function does in

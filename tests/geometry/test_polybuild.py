@@ -142,6 +142,7 @@ def test_a_run_of_create_lines_in_one_pass_equals_line_by_line(tmp_path, monkeyp
     monkeypatch.setattr(bc, "build_many", lambda shapes, tol: passes.append(len(shapes)) or build_many(shapes, tol))
     text = _deck(np.random.default_rng(3), 60)
     one = Session(out_dir=tmp_path, stdout=io.StringIO())
+    assert one.batch_min <= 60
     items = one.load_text(text, "deck.dat")
     one.run_items(items)                            # runs of create lines in one pass
     assert passes == [60]
@@ -165,13 +166,20 @@ def test_a_run_of_create_lines_in_one_pass_equals_line_by_line(tmp_path, monkeyp
     ("block create polyhedron face 0,0,0 1,0,0 1,1,0.3 0,1,0 face 0,0,0 0,0,1 1,0,0 "
      "face 0,0,0 0,1,0 0,0,1 face 1,0,0 0,0,1 1,1,0.3", 4, "face 1 is not planar"),
 ])
-def test_a_refused_line_in_a_run_reports_its_line_and_keeps_the_lines_before(tmp_path, bad, line, words):
+def test_a_refused_line_in_a_run_reports_its_line_and_keeps_the_lines_before(tmp_path, monkeypatch, bad, line,
+                                                                             words):
+    import dec3d.commands.block_create as bc
+
+    passes = []
+    monkeypatch.setattr(bc, "build_many", lambda shapes, tol: passes.append(len(shapes)) or build_many(shapes, tol))
     text = ("model new\nblock create brick 0 1\nblock create brick 1 2 group 'a'\n" + bad
             + "\nblock create brick 5 6\n")
     s = Session(out_dir=tmp_path, stdout=io.StringIO())
+    s.batch_min = 2                                 # the run of four lines in one pass
     with pytest.raises(Dec3dError, match=words) as info:
         s.run_items(s.load_text(text, "deck.dat"))
     assert info.value.location.line == line
     assert s.model.blocks.n == 2                    # the two lines before it, not the one after
     assert list(s.model.blocks["id"]) == [1, 2]
     assert s.record[-2:] == ["block create brick 0 1", "block create brick 1 2 group 'a'"]
+    assert passes and passes[0] >= 2                # the lines before it went in one pass
