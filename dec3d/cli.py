@@ -29,6 +29,7 @@ def _run(args) -> int:
             print(f"error: the output folder '{out}' cannot be used: {what}", file=sys.stderr)
             return 2
         session = Session(out_dir=out, echo=not args.quiet, allow_outside_paths=args.allow_outside_paths)
+        session.trust_saves = args.trust_save
         try:
             items = session.load_file(deck)          # parse and bind everything first
         except Dec3dError as exc:
@@ -122,6 +123,9 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--allow-outside-paths", action="store_true",
                    help="let the deck read and write files outside its folder and the output folder "
                         "(only for decks you trust; see docs/safety.md)")
+    r.add_argument("--trust-save", action="store_true",
+                   help="`model restore` installs the FISH functions and callbacks of every save it reads, "
+                        "also of saves not made by you on this machine (only for saves you trust; docs/safety.md)")
     r.set_defaults(fn=_run)
     b = sub.add_parser("batch", help="run a deck for many parameter values (process pool or Dask) and "
                                      "collect one table")

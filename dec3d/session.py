@@ -66,6 +66,8 @@ class Session:
                  allow_outside_paths: bool = False, parameters: dict[str, Any] | None = None):
         load_all()
         self.allow_outside_paths = bool(allow_outside_paths)
+        #: `model restore` installs the FISH code of saves this user's key did not sign (`--trust-save`)
+        self.trust_saves = False
         self.model = Model()
         # values set from outside the deck (`dec3d batch --param`): FISH variables from the start, kept
         # through `model new`, and a deck's own assignment of one (its default) does not replace it
