@@ -28,6 +28,7 @@ from dec3d.model.store import Store
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.zones import has_zones
 
+from .cables import grouted_timestep
 from .massscale import DensityScaling
 from .contact_store import contact_stores
 from .contacts import ContactDetection, default_row
@@ -182,7 +183,8 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
         fa = f["area"][(fb >= 0) & live[np.maximum(fb, 0)]]
         area = float(fa.max()) if len(fa) else 1.0
         mmin = float(b["mass"][live].min()) if live.any() else 1.0
-        return block_timestep(mmin, kn * area, float(s["frac"])) or 1e-3
+        dt = block_timestep(mmin, kn * area, float(s["frac"])) or 1e-3
+        return min(dt, grouted_timestep(self.model, float(s["frac"]), live))   # blocks held by cable grout
 
     def _held_still(self) -> np.ndarray:
         """Per block: all six velocity components held (bits 0-5 of ``fixity | apply_fix``, of the
