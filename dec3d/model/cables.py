@@ -160,3 +160,7 @@ def remap_hosts(model: Model, remap: np.ndarray) -> None:
         # (the grout force went with the block's applied force; the node carries none from now on)
         nodes["hforce"][lost] = 0.0
         nodes["hmoment"][lost] = 0.0
+        segs = st[SEGMENTS]
+        gone = np.flatnonzero(lost)
+        segs["gf"][np.isin(segs["na"], gone), 0] = 0.0
+        segs["gf"][np.isin(segs["nb"], gone), 1] = 0.0
