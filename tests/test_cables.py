@@ -239,3 +239,14 @@ def test_deleted_host_leaves_no_grout(tmp_path):
     segs = s.model.stores["cable_segments"]
     assert (s.model.stores["cable_nodes"]["host"] == -1).all()
     assert not segs["gf"].any() and np.isfinite(segs["fa"]).all()
+
+
+def test_block_vtk_writes_the_cables_as_lines(tmp_path):
+    meshio = pytest.importorskip("meshio")
+    s = _run(_session(tmp_path), HANG + "model cycle 200\nblock vtk 'hang'\n")
+    m = meshio.read(tmp_path / "hang_cables_0000.vtu")
+    assert m.cells[0].type == "line" and m.cells[0].data.shape == (29, 2)
+    segs = s.model.stores["cable_segments"]
+    np.testing.assert_array_equal(m.cell_data["axial_force"][0], segs["fa"])
+    assert m.point_data["grouted"].sum() == 10          # the nodes at z = -0.9 … 0 lie in the block
+    assert "hang_cables_0000.vtu" in (tmp_path / "hang.pvd").read_text()
