@@ -78,7 +78,8 @@ def twin_step(dt, g, alpha, damp, safety, N, S, B):
                 hforce[node][k] -= f * t[k]
         S["state"][e] = flags
     for i in range(n):
-        mi = max(N["mass"][i], rowsum[i] * (dt / (2 * safety)) ** 2) or 1.0
+        # density-scaled (safety > 0) or real mass; a massless node gets 1 kg
+        mi = (max(N["mass"][i], rowsum[i] * (dt / (2 * safety)) ** 2) if safety else N["mass"][i]) or 1.0
         N["imass"][i] = mi
         for k in range(3):
             F = force[i][k] + N["fapp"][i][k] + N["mass"][i] * g[k]
@@ -129,22 +130,22 @@ def _random_case(seed):
     return N, S, B
 
 
-@pytest.mark.parametrize("damp", [0, 1, 2])
-def test_kernel_matches_twin(damp):
+@pytest.mark.parametrize("damp, safety", [(0, 0.5), (1, 0.5), (2, 0.5), (0, 0.0)])
+def test_kernel_matches_twin(damp, safety):
     from dec3d.kernels.cable import cable_step, empty_scratch
 
-    N, S, B = _random_case(7 + damp)
+    N, S, B = _random_case(7 + damp + int(10 * safety))
     tw = ({k: [list(r) if np.ndim(r) else r for r in v.tolist()] for k, v in N.items()},
           {k: [list(r) if np.ndim(r) else r for r in v.tolist()] for k, v in S.items()},
           {k: v.tolist() for k, v in B.items()})
     dt, g, alpha = 1e-3, np.array([0.0, 0.0, -9.81]), 0.8
     for _ in range(25):
-        bad = cable_step(dt, g, alpha, damp, 0.5, N["pos"], N["vel"], N["disp"], N["mass"], N["host"], N["hpos"],
+        bad = cable_step(dt, g, alpha, damp, safety, N["pos"], N["vel"], N["disp"], N["mass"], N["host"], N["hpos"],
                          N["fix"], N["fapp"], N["conf"], N["force"], N["hforce"], N["hmoment"], N["imass"],
                          S["na"], S["nb"], S["l0"], S["lcur"], S["prop"], S["fa"], S["gf"], S["state"], S["tapp"],
                          S["tact"], B["vel"], B["spin"], B["cen"], empty_scratch(len(N["pos"])))
         assert bad == 0
-        twin_step(dt, [0.0, 0.0, -9.81], alpha, damp, 0.5, *tw)
+        twin_step(dt, [0.0, 0.0, -9.81], alpha, damp, safety, *tw)
     for k in ("pos", "vel", "disp", "hpos", "force", "hforce", "hmoment", "imass"):
         np.testing.assert_allclose(N[k], np.array(tw[0][k]), rtol=1e-10, atol=1e-12, err_msg=k)
     for k in ("fa", "gf", "lcur"):

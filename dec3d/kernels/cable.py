@@ -47,7 +47,8 @@ def cable_step(dt, g, alpha, damp, safety,
                na, nb, l0, lcur, prop, fa, gf, state, tapp, tact,
                bvel, bspin, bcen, scratch):
     """One step; ``scratch (n, 7)``: work space (relative displacement, stiffness row sum, last force);
-    ``damp``: 0 none, 1 local, 2 combined damping with coefficient ``alpha``.
+    ``damp``: 0 none, 1 local, 2 combined damping with coefficient ``alpha``; ``safety`` > 0: inertial
+    masses max(m, R (Δt / 2 safety)²) (density scaling), 0: the real masses.
     Returns the number of nodes that are not finite after the step (0: all well)."""
     n = pos.shape[0]
     s = na.shape[0]
@@ -135,10 +136,10 @@ def cable_step(dt, g, alpha, damp, safety,
         state[e] = st
     # --- pass 3, nodes: law of motion (local damping when ``damp``), moment on the host
     bad = 0
-    q = (dt / (2.0 * safety)) ** 2
+    q = (dt / (2.0 * safety)) ** 2 if safety > 0.0 else 0.0
     for i in range(n):
         m = mass[i]
-        mi = max(m, scratch[i, 3] * q)
+        mi = max(m, scratch[i, 3] * q) if safety > 0.0 else m
         if mi <= 0.0:
             mi = 1.0
         imass[i] = mi

@@ -27,11 +27,14 @@ Itasca's structural-element nodes do, with combined damping (3DEC theory Eq. 83,
 parts in steady motion, such as a cable being pulled out: local damping, Eq. 79, takes only the sign
 of the velocity, which does not change in a steady pull, and left a pulled chain ringing 20 % over its
 capacity) in static mode and none in dynamic mode (or with Rayleigh/no damping).
-A node's inertial mass is the larger of its real mass (``density`` × area × tributary length) and the
-mass that keeps it stable at the run's Δt, R (Δt / 2s)², with R the Gershgorin row sum of the
-stiffness at the node (2 E A / L per element + k_g × tributary length) and s = ``SAFETY``: this is
-density scaling of the nodes (3DEC theory, "Mass (Density) Scaling"), so a cable never shortens the
-blocks' time step; in dynamic mode it removes only the cable's own (very high) axial frequencies.
+With density scaling on (static runs), a node's inertial mass is the larger of its real mass
+(``density`` × area × tributary length) and the mass that keeps it stable at the run's Δt,
+R (Δt / 2s)², with R the Gershgorin row sum of the stiffness at the node (2 E A / L per element +
+k_g × tributary length) and s = ``SAFETY``: density scaling of the nodes (3DEC theory, "Mass (Density)
+Scaling"), so a cable never shortens the blocks' static step. Without it (dynamic mode, damping none
+or Rayleigh) the nodes keep their real masses (a density is then required) and bound Δt by
+2 s √(m / R) (``cable_timestep``): a scaled node dragged along by its block adds its inertia to the
+block's (SE2's bolted block slid 7 % slow with the scaled head node).
 The grout stiffness enters the blocks' stiffness sums (density scaling, Eq. 87 and the
 unscaled Δt: ``block_stiffness``), so a block held by cables has a stable step too.
 
@@ -88,6 +91,25 @@ def block_stiffness(model) -> tuple[np.ndarray, np.ndarray]:
     return kt, kr
 
 
+def cable_timestep(model) -> float:
+    """The cable nodes' critical step with their real masses, 2 s √(m / R) (R: the Gershgorin row sum
+    of the stiffness at the node, s = ``SAFETY``); inf without cables or densities."""
+    if not has_cables(model):
+        return np.inf
+    nodes, segs = cable_stores(model)
+    p = segs["prop"]
+    r = np.zeros(nodes.n)
+    ka = 2.0 * p[:, C_E] * p[:, C_A] / segs["l0"]
+    np.add.at(r, segs["na"], ka)
+    np.add.at(r, segs["nb"], ka)
+    kend = p[:, C_KG] * 0.5 * segs["l0"]
+    np.add.at(r, segs["na"], np.where(nodes["host"][segs["na"]] >= 0, kend, 0.0))
+    np.add.at(r, segs["nb"], np.where(nodes["host"][segs["nb"]] >= 0, kend, 0.0))
+    m = nodes["mass"]
+    on = (r > 0) & (m > 0)
+    return float(2.0 * SAFETY * np.sqrt(m[on] / r[on]).min()) if on.any() else np.inf
+
+
 def grouted_timestep(model, frac: float, moving=None) -> float:
     """Eq. (87) for each (moving) block hosting grout: its mass against its grout stiffness (inf: none)."""
     kt, _ = block_stiffness(model)
@@ -111,6 +133,15 @@ class CableStep:
             raise _run_error(bad)
         update_masses(run.m)
         self.g = np.asarray(run.m.settings.gravity, dtype=np.float64)
+        #: density scaling of the nodes: with the blocks' (static runs); else real masses, and the
+        #: cable bounds Δt (``cable_timestep``, in ``RigidEngine.timestep``)
+        self.scaled = bool(run.eng.mass_scaling())
+        if not self.scaled:
+            nodes, _ = cable_stores(run.m)
+            if (nodes["mass"] <= 0).any():
+                raise _run_error("a cable has no density: without density scaling (dynamic mode, or damping "
+                                 "none/rayleigh) its nodes move with their real mass: set `structure cable "
+                                 "property density <f>`")
 
     def prepare(self) -> None:
         pass
@@ -127,7 +158,7 @@ class CableStep:
         old_f = nodes["hforce"].copy()
         old_m = nodes["hmoment"].copy()
         conf = np.zeros(nodes.n)
-        bad = cable_step(float(r.dt), self.g, a, damp, SAFETY,
+        bad = cable_step(float(r.dt), self.g, a, damp, SAFETY if self.scaled else 0.0,
                          nodes["pos"], nodes["vel"], nodes["disp"], nodes["mass"], nodes["host"], nodes["hpos"],
                          nodes["fix"], nodes["fapp"], conf, nodes["force"], nodes["hforce"], nodes["hmoment"],
                          nodes["imass"], segs["na"], segs["nb"], segs["l0"], segs["lcur"], segs["prop"], segs["fa"],

@@ -28,7 +28,7 @@ from dec3d.model.store import Store
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.zones import has_zones
 
-from .cables import grouted_timestep
+from .cables import cable_timestep, grouted_timestep
 from .massscale import DensityScaling
 from .contact_store import contact_stores
 from .contacts import ContactDetection, default_row
@@ -184,7 +184,9 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
         area = float(fa.max()) if len(fa) else 1.0
         mmin = float(b["mass"][live].min()) if live.any() else 1.0
         dt = block_timestep(mmin, kn * area, float(s["frac"])) or 1e-3
-        return min(dt, grouted_timestep(self.model, float(s["frac"]), live))   # blocks held by cable grout
+        dt = min(dt, grouted_timestep(self.model, float(s["frac"]), live))   # blocks held by cable grout
+        # cable nodes with their real masses (no density scaling: they are scaled to Δt otherwise)
+        return dt if self.mass_scaling() else min(dt, cable_timestep(self.model))
 
     def _held_still(self) -> np.ndarray:
         """Per block: all six velocity components held (bits 0-5 of ``fixity | apply_fix``, of the
