@@ -251,3 +251,20 @@ def test_block_vtk_writes_the_cables_as_lines(tmp_path):
     np.testing.assert_array_equal(m.cell_data["axial_force"][0], segs["fa"])
     assert m.point_data["grouted"].sum() == 10          # the nodes at z = -0.9 … 0 lie in the block
     assert "hang_cables_0000.vtu" in (tmp_path / "hang.pvd").read_text()
+
+
+def test_cable_histories_sample_and_survive_save(tmp_path):
+    text = HANG + ("structure cable history name 'top' force component-id 29\n"
+                   "structure node history name 'uz' displacement-z position 0 0 -0.9\n"
+                   "history interval 100\nmodel cycle 1000\n")
+    s = _run(_session(tmp_path), text)
+    from dec3d.physics.history import histories
+    hs = histories(s.model)
+    top, uz = hs.find("top"), hs.find("uz")
+    assert len(top.values) == 10 and top.values[-1] == s.model.stores["cable_segments"]["fa"][28]
+    assert uz.values[-1] == s.model.stores["cable_nodes"]["disp"][0, 2] < 0
+    _run(s, f"model save '{tmp_path / 'h.sav'}'\n")
+    b = _run(_session(tmp_path), f"model restore '{tmp_path / 'h.sav'}'\nmodel cycle 100\n")
+    assert len(histories(b.model).find("top").values) == 11
+    with pytest.raises(Dec3dError, match="no cable element with id 99"):
+        _run(b, "structure cable history force component-id 99\n")
