@@ -132,7 +132,10 @@ def cable_apply_tension(session, call):
 
 
 @command("structure cable list", range=SEGMENTS,
-         doc="List the cable elements in range: nodes, axial force, grout forces, yield state.")
+         doc="List the cable elements in range: nodes, axial force, grout forces, yield state.",
+         details="State words: yield-t / yield-c (yielding in tension / compression now), slip (grout slipping "
+                 "now at an end), yielded, slipped (in the past).",
+         examples=["structure cable list", "structure cable list range id-list 1 2 3"])
 def cable_list(session, call):
     _need_cables(session, call)
     mask = session.range_mask(call, SEGMENTS)
