@@ -417,6 +417,9 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
                           if has_zones(m) else {}),
                 "feblocks": ({k: m.store("feblocks")[k].copy() for k in ("stress", "gstress")}
                              if has_feblocks(m) else {}),
+                # cable nodes and elements (``physics.cables``): every field, rolled back with the blocks
+                "cables": {n: {k: m.stores[n][k].copy() for k in m.stores[n].fields}
+                           for n in ("cable_nodes", "cable_segments") if n in m.stores},
                 # (to_arrays gives views where it can: copy them)
                 "contacts": {k: a.copy() for k, a in self.contacts.to_arrays().items()},
                 "subcontacts": {k: a.copy() for k, a in self.subcontacts.to_arrays().items()},
@@ -435,6 +438,9 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
             m.store("zones").full(k)[: len(a)] = a
         for k, a in snap.get("feblocks", {}).items():
             m.store("feblocks").full(k)[: len(a)] = a
+        for n, fields in snap.get("cables", {}).items():
+            for k, a in fields.items():
+                m.stores[n].full(k)[: len(a)] = a
         self.contacts.load_arrays(snap["contacts"])
         self.subcontacts.load_arrays(snap["subcontacts"])
         mechanical = m.settings.mechanical
