@@ -110,7 +110,9 @@ class DensityScaling:
             rows = np.flatnonzero(g & (kt > 0))
             rt += np.bincount(gid[rows], kt[rows], minlength=ng)
             r2 = np.sum((b["centroid"][rows] - gcen[gid[rows]]) ** 2, axis=1)
-            rr += np.bincount(gid[rows], kr[rows] + kt[rows] * r2, minlength=ng)
+            # Σ k |r + d|² ≤ Σ k |r|² + 2 |d| √(Σ k · Σ k |r|²) + |d|² Σ k (d: block centroid − body centroid)
+            rr += np.bincount(gid[rows], kr[rows] + kt[rows] * r2 + 2.0 * np.sqrt(kt[rows] * kr[rows] * r2),
+                              minlength=ng)
         if dt_fixed is None and s["scale_timestep"]:
             dt_fixed = float(s["scale_timestep"])
         on = rt > 0
