@@ -268,3 +268,15 @@ def test_cable_histories_sample_and_survive_save(tmp_path):
     assert len(histories(b.model).find("top").values) == 11
     with pytest.raises(Dec3dError, match="no cable element with id 99"):
         _run(b, "structure cable history force component-id 99\n")
+
+
+def test_undamped_run_needs_a_cable_density_and_the_cable_bounds_the_step(tmp_path):
+    s = _run(_session(tmp_path), HANG + "block mechanical damping none\n")
+    with pytest.raises(Dec3dError, match="cable has no density"):
+        _run(s, "model cycle 1\n")
+    _run(s, "structure cable property density 7800\nmodel cycle 10\n")
+    from dec3d.physics.cables import cable_timestep
+    # the nodes' real masses: 2 s √(m / R) for the stiffest node, below the block's own step
+    assert s.model.rigid_engine.dt <= cable_timestep(s.model) < 1e-4
+    nodes = s.model.stores["cable_nodes"]
+    np.testing.assert_allclose(nodes["imass"], nodes["mass"])
