@@ -237,6 +237,7 @@ def test_no_cable_no_property(tmp_path):
 
 def test_deleted_host_leaves_no_grout(tmp_path):
     s = _run(_session(tmp_path), HANG + "model cycle 20\nblock delete\nmodel cycle 20\n")
+    assert "notice: 10 cable node(s) lay in the deleted blocks" in s.stdout.getvalue()
     segs = s.model.stores["cable_segments"]
     assert (s.model.stores["cable_nodes"]["host"] == -1).all()
     assert not segs["gf"].any() and np.isfinite(segs["fa"]).all()

@@ -148,6 +148,16 @@ def update_masses(model: Model) -> None:
     nodes["mass"][:] = m
 
 
+def nodes_hosted_by(model: Model, mask) -> int:
+    """How many cable nodes have their host among the blocks of ``mask`` (bool over block rows)."""
+    st = model.stores
+    if NODES not in st or not st[NODES].n:
+        return 0
+    h = st[NODES]["host"]
+    on = h >= 0
+    return int(np.asarray(mask, bool)[h[on]].sum())
+
+
 def remap_hosts(model: Model, remap: np.ndarray) -> None:
     """After blocks are deleted (old row -> new row, -1 gone): nodes whose block went lose their host."""
     st = model.stores
