@@ -10,7 +10,9 @@ Arrays (n nodes, s segments):
 - nodes: ``pos, vel, disp (n, 3)`` [m, m/s, m]; ``mass (n,)`` [kg, real]; ``host (n,)`` block row or
   -1; ``hpos (n, 3)`` the host point (the material point of the host block where the node sits);
   ``fix (n,)`` bits 0-2 held velocity components; ``fapp (n, 3)`` applied force [N]; ``conf (n,)``
-  confining stress around the node [Pa, compression positive]. Out: ``force (n, 3)`` unbalanced
+  confining stress around the node [Pa, compression positive]; ``hz (n,)`` 1 where the host is a zoned
+  block, whose host-point velocity ``hvel (n, 3)`` the caller gives (the kernel then leaves ``hpos`` and
+  the moment alone). Out: ``force (n, 3)`` unbalanced
   force, ``hforce, hmoment (n, 3)`` force on the host block and its moment about the block's
   centroid, ``imass (n,)`` inertial mass used.
 - segments: ``na, nb (s,)`` node rows; ``l0`` reference length; ``lcur`` length at the last step
@@ -43,7 +45,7 @@ def _sgn(x):
 
 @njit(cache=True)
 def cable_step(dt, g, alpha, damp, safety,
-               pos, vel, disp, mass, host, hpos, fix, fapp, conf, force, hforce, hmoment, imass,
+               pos, vel, disp, mass, host, hpos, fix, fapp, conf, force, hforce, hmoment, imass, hz, hvel,
                na, nb, l0, lcur, prop, fa, gf, state, tapp, tact,
                bvel, bspin, bcen, scratch):
     """One step; ``scratch (n, 7)``: work space (relative displacement, stiffness row sum, last force);
@@ -61,7 +63,12 @@ def cable_step(dt, g, alpha, damp, safety,
             scratch[i, k] = 0.0
         scratch[i, 3] = 0.0          # Gershgorin row sum of the stiffness at the node [N/m]
         h = host[i]
-        if h >= 0:
+        if h >= 0 and hz[i] != 0:
+            # a zoned host: the host point's velocity is given (from its zone's gridpoints)
+            scratch[i, 0] = (vel[i, 0] - hvel[i, 0]) * dt
+            scratch[i, 1] = (vel[i, 1] - hvel[i, 1]) * dt
+            scratch[i, 2] = (vel[i, 2] - hvel[i, 2]) * dt
+        elif h >= 0:
             # the block's centroid one step ago (the motion kernel moved it on by v dt since)
             r0 = hpos[i, 0] - bcen[h, 0] + bvel[h, 0] * dt
             r1 = hpos[i, 1] - bcen[h, 1] + bvel[h, 1] * dt
@@ -161,7 +168,7 @@ def cable_step(dt, g, alpha, damp, safety,
             if not math.isfinite(pos[i, k]):
                 bad += 1
         h = host[i]
-        if h >= 0:
+        if h >= 0 and hz[i] == 0:
             r0 = hpos[i, 0] - bcen[h, 0]
             r1 = hpos[i, 1] - bcen[h, 1]
             r2 = hpos[i, 2] - bcen[h, 2]

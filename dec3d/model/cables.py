@@ -7,7 +7,9 @@
     pos, vel, disp (3,)   m, m/s, m
     mass ()        kg     real mass: density × area × tributary length (0 without density)
     imass ()       kg     inertial mass of the last step (density-scaled to the step, see physics.cables)
-    host ()        int64  row of the rigid block the node lies in, -1 none (ungrouted)
+    host ()        int64  row of the block the node lies in, -1 none (ungrouted)
+    hz ()          int8   1: the host is a zoned block, the node follows a 4-node zone: hzone () its row,
+                   hgp (4,) its gridpoint rows, hw (4,) the node's barycentric weights in it
     hpos (3,)      m      host point: the material point of the host block where the node sits
     fix ()         uint8  bits 0-2: velocity components held (``structure node fix``)
     fapp (3,)      N      applied force (``structure node apply``)
@@ -54,7 +56,8 @@ def _node_fields() -> dict[str, Field]:
     return {"id": Field((), _I, 0), "cable": Field((), _I, 0), "pos": v3, "vel": v3, "disp": v3,
             "mass": Field((), _F, 0.0), "imass": Field((), _F, 0.0), "host": Field((), _I, -1), "hpos": v3,
             "fix": Field((), np.uint8, 0), "fapp": v3, "force": v3, "hforce": v3, "hmoment": v3,
-            "group": group_field()}
+            "group": group_field(), "hz": Field((), np.int8, 0), "hzone": Field((), _I, -1),
+            "hgp": Field((4,), _I, -1), "hw": Field((4,), _F, 0.0)}
 
 
 def _segment_fields() -> dict[str, Field]:
@@ -73,6 +76,10 @@ def cable_stores(model: Model) -> tuple[Store, Store]:
     if SEGMENTS not in st:
         model.add_store(Store(SEGMENTS, _segment_fields()))
     st = model.stores
+    for name, fields in ((NODES, _node_fields()), (SEGMENTS, _segment_fields())):
+        for key, spec in fields.items():      # (a store restored from a file that had fewer fields)
+            if key not in st[name]:
+                st[name].add_field(key, spec)
     return st[NODES], st[SEGMENTS]
 
 
@@ -81,10 +88,34 @@ def has_cables(model: Model) -> bool:
     return SEGMENTS in st and st[SEGMENTS].n > 0
 
 
+def zone_host(model: Model, block: int, p: np.ndarray, tol: float):
+    """(zone row, gridpoint rows (4,), barycentric weights (4,)) of the 4-node zone of ``block`` that
+    holds ``p`` (weights ≥ −tol), or None."""
+    if "zones" not in model.stores:
+        return None
+    zs = model.stores["zones"]
+    rows = np.flatnonzero((zs["block"] == block) & (zs["nnode"] == 4))
+    if not rows.size:
+        return None
+    gp = zs["gp"][rows, :4]
+    x = model.vertices["pos"][gp]                      # (z, 4, 3)
+    a = np.transpose(x[:, 1:, :] - x[:, :1, :], (0, 2, 1))   # columns x1-x0, x2-x0, x3-x0
+    ok = np.abs(np.linalg.det(a)) > 0
+    w = np.full((len(rows), 4), -np.inf)
+    w[ok, 1:] = np.linalg.solve(a[ok], (p[None, :] - x[ok, 0, :])[:, :, None])[:, :, 0]
+    w[ok, 0] = 1.0 - w[ok, 1:].sum(axis=1)
+    inside = np.flatnonzero(w.min(axis=1) >= -tol)
+    if not inside.size:
+        return None
+    k = int(inside[0])
+    return int(rows[k]), gp[k].copy(), np.clip(w[k], 0.0, None) / np.clip(w[k], 0.0, None).sum()
+
+
 def host_blocks(model: Model, pts: np.ndarray, tol: float) -> np.ndarray:
     """Row of the visible rigid block each point lies in (on its boundary counts; the lowest row when
     several hold it), -1 for none. A point is in a convex block when it is behind every face plane
-    by ``tol`` at most. Points in zoned or FE blocks are reported as -2 (not supported as hosts yet)."""
+    by ``tol`` at most. Points in zoned or FE blocks are reported as -2 (the caller looks for their
+    zone, ``zone_host``)."""
     b, f = model.blocks, model.faces
     out = np.full(len(pts), -1, _I)
     if not b.n:
@@ -100,6 +131,16 @@ def host_blocks(model: Model, pts: np.ndarray, tol: float) -> np.ndarray:
             r = int(rows[0])
             out[i] = r if b["kind"][r] == KIND_RIGID else -2
     return out
+
+
+def _first_block(model: Model, p: np.ndarray, tol: float) -> int:
+    b, f = model.blocks, model.faces
+    fb = f["block"]
+    dist = np.einsum("fk,fk->f", p[None, :] - f["centroid"], f["normal"])
+    outside = np.zeros(b.n, bool)
+    np.logical_or.at(outside, fb[fb >= 0], dist[fb >= 0] > tol)
+    rows = np.flatnonzero(~outside & ~b["hidden"] & (b["face_count"] > 0))
+    return int(rows[0]) if rows.size else -1
 
 
 def add_cable(model: Model, p1, p2, segments: int, cable_id: int | None, group: str | None,
@@ -121,6 +162,16 @@ def add_cable(model: Model, p1, p2, segments: int, cable_id: int | None, group: 
     nodes["cable"][rn] = cid
     nodes["pos"][rn] = pts
     nodes["hpos"][rn] = pts
+    for k in np.flatnonzero(hosts == -2):
+        # a node in a zoned block follows the 4-node zone that holds it (-3: none, e.g. 10-node zones)
+        r = _first_block(model, pts[k], tol)
+        z = zone_host(model, r, pts[k], max(tol, 1e-9)) if r >= 0 else None
+        if z is None:
+            hosts[k] = -3
+            continue
+        hosts[k] = r
+        nodes["hz"][rn[k]] = 1
+        nodes["hzone"][rn[k]], nodes["hgp"][rn[k]], nodes["hw"][rn[k]] = z
     nodes["host"][rn] = np.maximum(hosts, -1)
     sl = segs.append(segments)
     rs = np.arange(sl.start, sl.stop)
@@ -170,6 +221,15 @@ def remap_hosts(model: Model, remap: np.ndarray) -> None:
         # (the grout force went with the block's applied force; the node carries none from now on)
         nodes["hforce"][lost] = 0.0
         nodes["hmoment"][lost] = 0.0
+        # zone-hosted nodes of surviving blocks: the zones' and gridpoints' rows moved, find them again
+        for i in np.flatnonzero((h >= 0) & (nodes["hz"] == 1)):
+            z = zone_host(model, int(h[i]), nodes["hpos"][i], 1e-9)
+            if z is None:
+                h[i] = -1
+                lost[i] = True
+            else:
+                nodes["hzone"][i], nodes["hgp"][i], nodes["hw"][i] = z
+        nodes["hz"][lost] = 0
         segs = st[SEGMENTS]
         gone = np.flatnonzero(lost)
         segs["gf"][np.isin(segs["na"], gone), 0] = 0.0

@@ -15,12 +15,17 @@ Model (Itasca's, as those pages state it):
   confining stress around the node). The force on the node is that per-length force times the node's
   tributary length: each element gives half its length to each of its nodes (so a node inside a
   chain has L, an end node L/2). The equal and opposite force acts on the host at the host point.
-* Hosts here are rigid blocks: the host point moves with the block (v = v_c + ω × r), the reaction goes
-  to the block as a force and a moment about its centroid (through the block's applied force and
-  moment, as a change from the last step). A rigid block has no stress field, so σ_m = 0 there and
-  only the cohesion bounds the grout (the friction and perimeter are stored and used by the kernel
-  when a confinement is given). Zoned and FE blocks are not hosts yet (``structure cable create``
-  refuses a node in one).
+* Rigid hosts: the host point moves with the block (v = v_c + ω × r), the reaction goes to the block
+  as a force and a moment about its centroid (through the block's applied force and moment, as a
+  change from the last step). A rigid block has no stress field, so σ_m = 0 there and only the
+  cohesion bounds the grout.
+* Zoned hosts: the node follows the 4-node zone that holds it: the host point is Σ wᵢ xᵢ over the
+  zone's gridpoints (barycentric weights wᵢ fixed at creation), its velocity Σ wᵢ vᵢ, and the reaction
+  goes to the gridpoints' applied forces as wᵢ F. σ_m is the mean of the zone's normal stresses
+  across the cable, −(tr σ − tᵀ σ t) / 2 (``zone_host_state``), so friction and perimeter count
+  there. The grout stiffness enters the gridpoints' stiffness sums (wᵢ k_g × tributary length,
+  ``gridpoint_grout_stiffness``, added in ``ZoneStepper._stiffness``), hence their scaled masses.
+  FE blocks and 10-node zones are not hosts yet (``structure cable create`` refuses a node in one).
 
 Motion: the nodes carry mass and move explicitly with the blocks' central-difference scheme, as
 Itasca's structural-element nodes do, with combined damping (3DEC theory Eq. 83, the form meant for
@@ -84,7 +89,7 @@ def block_stiffness(model) -> tuple[np.ndarray, np.ndarray]:
     np.add.at(kn, segs["na"], kend)
     np.add.at(kn, segs["nb"], kend)
     h = nodes["host"]
-    on = h >= 0
+    on = (h >= 0) & (nodes["hz"] == 0)
     r2 = np.sum((nodes["hpos"][on] - b["centroid"][h[on]]) ** 2, axis=1)
     np.add.at(kt, h[on], kn[on])
     np.add.at(kr, h[on], kn[on] * r2)
@@ -157,26 +162,77 @@ class CableStep:
             damp, a = 2, (float(alpha) if mode in (DAMP_LOCAL, DAMP_COMBINED) else ALPHA_DEFAULT)
         old_f = nodes["hforce"].copy()
         old_m = nodes["hmoment"].copy()
+        hz = nodes["hz"]
+        zn = np.flatnonzero((hz != 0) & (nodes["host"] >= 0))
         conf = np.zeros(nodes.n)
+        hvel = np.zeros((nodes.n, 3))
+        if zn.size:
+            conf[zn], hvel[zn] = zone_host_state(m, nodes, segs, zn)
         bad = cable_step(float(r.dt), self.g, a, damp, SAFETY if self.scaled else 0.0,
                          nodes["pos"], nodes["vel"], nodes["disp"], nodes["mass"], nodes["host"], nodes["hpos"],
                          nodes["fix"], nodes["fapp"], conf, nodes["force"], nodes["hforce"], nodes["hmoment"],
-                         nodes["imass"], segs["na"], segs["nb"], segs["l0"], segs["lcur"], segs["prop"], segs["fa"],
-                         segs["gf"], segs["state"], segs["tapp"], segs["tact"],
+                         nodes["imass"], hz, hvel, segs["na"], segs["nb"], segs["l0"], segs["lcur"], segs["prop"],
+                         segs["fa"], segs["gf"], segs["state"], segs["tapp"], segs["tact"],
                          b["velocity"], b["spin"], b["centroid"], empty_scratch(nodes.n))
         if bad:
             raise _run_error(f"a cable node moved off to infinity at step {m.step + 1} (Δt {r.dt:.3g} s): "
                              f"check the cable and grout properties")
         h = nodes["host"]
-        on = h >= 0
+        on = (h >= 0) & (hz == 0)
         if on.any():
             np.add.at(b["fapp"], h[on], nodes["hforce"][on] - old_f[on])
             np.add.at(b["mapp"], h[on], nodes["hmoment"][on] - old_m[on])
+        if zn.size:
+            # a zoned host: the reaction goes to the zone's gridpoints by the node's weights
+            df = nodes["hforce"][zn] - old_f[zn]
+            np.add.at(m.vertices["fapp"], nodes["hgp"][zn].ravel(),
+                      (nodes["hw"][zn][:, :, None] * df[:, None, :]).reshape(-1, 3))
         # (segments clear their "now" bits at the next step: the kernel rebuilds them)
         return min(n, 1)
 
     def __repr__(self) -> str:
         return "CableStep"
+
+
+def zone_host_state(m, nodes, segs, zn):
+    """For the zone-hosted nodes ``zn``: (confining stress [Pa, compression positive], host-point
+    velocity (k, 3)), and their host points set from the gridpoints. The confinement is the mean of the
+    zone's normal stresses across the cable, −(tr σ − tᵀ σ t) / 2 (t: the axis of an element at the
+    node; 3DEC's stresses are tension positive)."""
+    v = m.vertices
+    w, gp = nodes["hw"][zn], nodes["hgp"][zn]
+    nodes["hpos"][zn] = np.einsum("kj,kjc->kc", w, v["pos"][gp])
+    hvel = np.einsum("kj,kjc->kc", w, v["velocity"][gp])
+    # an element at each node (the one it starts, else the one it ends)
+    seg = np.full(nodes.n, -1, np.int64)
+    seg[segs["nb"]] = np.arange(segs.n)
+    seg[segs["na"]] = np.arange(segs.n)
+    e = seg[zn]
+    d = nodes["pos"][segs["nb"][e]] - nodes["pos"][segs["na"][e]]
+    t = d / np.linalg.norm(d, axis=1)[:, None]
+    sx = m.stores["zones"]["stress"][nodes["hzone"][zn]]      # xx yy zz xy yz xz
+    tr = sx[:, 0] + sx[:, 1] + sx[:, 2]
+    tst = (sx[:, 0] * t[:, 0] ** 2 + sx[:, 1] * t[:, 1] ** 2 + sx[:, 2] * t[:, 2] ** 2
+           + 2.0 * (sx[:, 3] * t[:, 0] * t[:, 1] + sx[:, 4] * t[:, 1] * t[:, 2] + sx[:, 5] * t[:, 0] * t[:, 2]))
+    return -(tr - tst) / 2.0, hvel
+
+
+def gridpoint_grout_stiffness(m, n: int) -> np.ndarray:
+    """Per vertex row (length n): Σ k_g × tributary length × weight of the grout springs on it [N/m]
+    (a grout spring on a host point Σ wᵢ xᵢ adds wᵢ k to gridpoint i's Gershgorin row: Σ wⱼ = 1)."""
+    out = np.zeros(n)
+    if not has_cables(m):
+        return out
+    nodes, segs = cable_stores(m)
+    zn = np.flatnonzero((nodes["hz"] != 0) & (nodes["host"] >= 0))
+    if not zn.size:
+        return out
+    kend = segs["prop"][:, C_KG] * 0.5 * segs["l0"]
+    kn = np.zeros(nodes.n)
+    np.add.at(kn, segs["na"], kend)
+    np.add.at(kn, segs["nb"], kend)
+    np.add.at(out, nodes["hgp"][zn].ravel(), (nodes["hw"][zn] * kn[zn][:, None]).ravel())
+    return out
 
 
 def _run_error(msg: str):
