@@ -41,7 +41,8 @@ def _axial(rt, i):
 
 @intrinsic("struct.cable.grout.slip", 2)
 def _slip(rt, i, end):
-    """Whether the grout at end 1 or 2 of the element is slipping now."""
+    """Whether the element's grout slips now and end 1 or 2 carries grout (dec3d keeps one slip flag per
+    element: an element whose grout slips at one end reads as slipping at both ends that are grouted)."""
     st, r = _seg(rt, i, "struct.cable.grout.slip")
     if end not in (1, 2):
         raise FishValueError("`struct.cable.grout.slip` takes the end as 1 or 2")
