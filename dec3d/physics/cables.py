@@ -58,7 +58,7 @@ from dec3d.model.cables import cable_stores, has_cables, update_masses
 #: ω_max Δt ≤ 2 s for the cable nodes (s = 0.5: ω Δt ≤ 1, as the local damping likes it)
 SAFETY = 0.5
 
-#: local damping of the cable nodes when the blocks use a form other than local/combined (adaptive)
+#: damping coefficient of the cable nodes when the blocks use adaptive (global) damping
 ALPHA_DEFAULT = 0.8
 
 
