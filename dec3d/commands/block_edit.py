@@ -33,8 +33,14 @@ def block_delete(session, call):
     loads = None
     if call.args["reaction"] is not None:
         loads = reaction_loads(session.model, mask, call.location)
+    from ..model.cables import nodes_hosted_by
+
+    lost = nodes_hosted_by(session.model, mask)
     if delete_blocks(session.model, mask):
         relink(session.model)
+    if lost:
+        session.write(f"notice: {lost} cable node(s) lay in the deleted blocks: from now on they are free "
+                      "(no grout force)")
     if loads is not None:
         ids, f, m = loads
         b = session.model.blocks
