@@ -29,6 +29,40 @@ def _add(session, call, polys) -> None:
     check_blocks(session, len(polys), f"`{call.name}`", call.location)
     rows = add_blocks(m, polys, group=call.args["group"], slot=call.args["slot"])
     _label(m, [call], rows)
+    _warn_coincident(session, rows, [call] * len(rows))
+
+
+def _warn_coincident(session, rows, calls) -> None:
+    """One warning when new blocks ``rows`` (made by ``calls[i]``) lie exactly where a block made before
+    them is (the same centroid within the tolerance and the same volume: a line given twice); the run
+    goes on."""
+    m = session.model
+    b = m.blocks
+    tol = max(m.tolerance, 1e-12)
+    cen, vol = b["centroid"], b["volume"]
+    live = np.flatnonzero(b["vert_count"] > 0)
+    hits = []
+    if len(rows) <= 8:                  # a line at a time: one vectorised look at every block
+        for i, row in enumerate(rows):
+            same = live[(np.abs(cen[live] - cen[row]) <= tol).all(axis=1)
+                        & (np.abs(vol[live] - vol[row]) <= 1e-9 * vol[row]) & (live < row)]
+            if len(same):
+                hits.append((i, int(row), int(same[0])))
+    else:                               # a run of lines: blocks by their centroid's cell
+        seen: dict = {}
+        for row, k in zip(live, map(tuple, np.round(cen[live] / tol).astype(np.int64))):
+            seen.setdefault(k, []).append(int(row))
+        keys = np.round(cen[rows] / tol).astype(np.int64)
+        for i, (row, k) in enumerate(zip(rows, map(tuple, keys))):
+            other = next((o for o in seen.get(k, ()) if o < row and abs(vol[o] - vol[row]) <= 1e-9 * vol[row]), None)
+            if other is not None:
+                hits.append((i, int(row), other))
+    if hits:
+        i, row, other = hits[0]
+        more = f" ({len(hits)} new blocks in all)" if len(hits) > 1 else ""
+        session.write(f"warning: {calls[i].location}: block {int(b['id'][row])} lies exactly where block "
+                      f"{int(b['id'][other])} is (same centroid and volume){more}: blocks must not overlap; "
+                      "is the line given twice?")
 
 
 def _label(m, calls, rows) -> None:
@@ -99,6 +133,7 @@ def _create_many(session, calls) -> int:
         return 0
     rows = add_pieces(m, batch)
     _label(m, calls[:built], rows)
+    _warn_coincident(session, rows, calls[:built])
     return built
 
 

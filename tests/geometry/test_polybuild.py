@@ -183,3 +183,18 @@ def test_a_refused_line_in_a_run_reports_its_line_and_keeps_the_lines_before(tmp
     assert list(s.model.blocks["id"]) == [1, 2]
     assert s.record[-2:] == ["block create brick 0 1", "block create brick 1 2 group 'a'"]
     assert passes and passes[0] >= 2                # the lines before it went in one pass
+
+
+@pytest.mark.parametrize("batch_min", [50, 2])
+def test_a_block_given_twice_is_warned_about(tmp_path, batch_min):
+    """Issue 35: identical overlapping blocks were accepted silently; a warning names the line and both
+    blocks (line by line and in one pass alike), and blocks that only touch are not named."""
+    out = io.StringIO()
+    s = Session(out_dir=tmp_path, stdout=out)
+    s.batch_min = batch_min
+    s.run_items(s.load_text("block create brick 0 1 0 1 0 1\nblock create brick 1 2 0 1 0 1\n"
+                            "block create brick 0 1 0 1 1 2\nblock create brick 0 1 0 1 0 1\n", "d.dat"))
+    warnings = [ln for ln in out.getvalue().splitlines() if ln.startswith("warning")]
+    assert warnings == ["warning: d.dat:4:1: block 4 lies exactly where block 1 is (same centroid and volume): "
+                        "blocks must not overlap; is the line given twice?"]
+    assert s.model.blocks.n == 4
