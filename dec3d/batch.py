@@ -37,6 +37,8 @@ from itertools import product
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
+from .io.paths import replace_via_temp
+
 #: columns every row has, in this order, before the parameters' and the results'
 FIXED = ("run", "status", "error", "wall_s")
 #: largest total size of the files one Dask run sends back (bytes); more stays on the worker
@@ -224,6 +226,7 @@ def run_one(deck: str, values: dict[str, Any], out_dir: str) -> dict[str, Any]:
         finally:
             if session is not None:
                 session.close_log()
+                session.files.finish()
     row["wall_s"] = time.perf_counter() - t0
     if session is not None:
         row.update(_history_finals(session.model))
@@ -469,9 +472,8 @@ def _read_result(path: Path, values: dict) -> dict | None:
 
 
 def _write_json(path: Path, data) -> None:
-    tmp = path.with_name(path.name + ".part")
-    tmp.write_text(json.dumps(data, indent=1, allow_nan=False), encoding="utf-8")
-    os.replace(tmp, path)                    # a killed batch never leaves half a result
+    text = json.dumps(data, indent=1, allow_nan=False).encode("utf-8")
+    replace_via_temp(path, lambda fh: fh.write(text), ".dec3d-batch-")   # a killed batch leaves no half result
 
 
 def _columns(table: list[dict], names: list[str]) -> list[str]:
@@ -488,13 +490,13 @@ def _cell(v) -> str:
 
 
 def _write_csv(path: Path, table: list[dict], columns: list[str]) -> None:
-    tmp = path.with_name(path.name + ".part")
-    with open(tmp, "w", newline="", encoding="utf-8") as f:
-        w = csv.writer(f)
-        w.writerow(columns)
-        for r in table:
-            w.writerow([_cell(r.get(c)) for c in columns])
-    os.replace(tmp, path)
+    buf = io.StringIO(newline="")
+    w = csv.writer(buf)
+    w.writerow(columns)
+    for r in table:
+        w.writerow([_cell(r.get(c)) for c in columns])
+    text = buf.getvalue().encode("utf-8")
+    replace_via_temp(path, lambda fh: fh.write(text), ".dec3d-batch-")
 
 
 def _write_parquet(path: Path, table: list[dict], columns: list[str]) -> None:

@@ -28,7 +28,8 @@ def _run(args) -> int:
             what = "is a file, not a folder" if out.exists() and not out.is_dir() else (exc.strerror or str(exc))
             print(f"error: the output folder '{out}' cannot be used: {what}", file=sys.stderr)
             return 2
-        session = Session(out_dir=out, echo=not args.quiet, allow_outside_paths=args.allow_outside_paths)
+        session = Session(out_dir=out, echo=not args.quiet, allow_outside_paths=args.allow_outside_paths,
+                          allow_overwrite=args.allow_overwrite)
         try:
             items = session.load_file(deck)          # parse and bind everything first
         except Dec3dError as exc:
@@ -43,6 +44,7 @@ def _run(args) -> int:
             return 1
         finally:
             session.close_log()
+            session.files.finish()           # the record of the files dec3d wrote (dec3d/io/guard.py)
         for w in session.warnings:
             print(f"warning: {w}", file=sys.stderr)
         return 0
@@ -122,6 +124,9 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--allow-outside-paths", action="store_true",
                    help="let the deck read and write files outside its folder and the output folder "
                         "(only for decks you trust; see docs/safety.md)")
+    r.add_argument("--allow-overwrite", action="store_true",
+                   help="let outputs replace existing files dec3d did not write (never the deck or another "
+                        "file the run reads; see docs/safety.md)")
     r.set_defaults(fn=_run)
     b = sub.add_parser("batch", help="run a deck for many parameter values (process pool or Dask) and "
                                      "collect one table")
