@@ -37,8 +37,6 @@ from itertools import product
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
-from .io.paths import replace_via_temp
-
 #: columns every row has, in this order, before the parameters' and the results'
 FIXED = ("run", "status", "error", "wall_s")
 #: largest total size of the files one Dask run sends back (bytes); more stays on the worker
@@ -471,9 +469,25 @@ def _read_result(path: Path, values: dict) -> dict | None:
     return row if row.get("status") in ("ok", "error") else None
 
 
+def _replace(path: Path, data: bytes) -> None:
+    """Write ``path`` whole or not at all (a killed batch never leaves half a result): a temporary file
+    beside it replaces it in one step, and is removed on every other way out (Ctrl-C included)."""
+    fd, tmp = tempfile.mkstemp(prefix=".dec3d-batch-", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)          # mkstemp makes 0600: the mode an ordinary open gives
+        os.replace(tmp, path)
+        tmp = None
+    finally:
+        if tmp is not None:
+            Path(tmp).unlink(missing_ok=True)
+
+
 def _write_json(path: Path, data) -> None:
-    text = json.dumps(data, indent=1, allow_nan=False).encode("utf-8")
-    replace_via_temp(path, lambda fh: fh.write(text), ".dec3d-batch-")   # a killed batch leaves no half result
+    _replace(path, json.dumps(data, indent=1, allow_nan=False).encode("utf-8"))
 
 
 def _columns(table: list[dict], names: list[str]) -> list[str]:
@@ -495,8 +509,7 @@ def _write_csv(path: Path, table: list[dict], columns: list[str]) -> None:
     w.writerow(columns)
     for r in table:
         w.writerow([_cell(r.get(c)) for c in columns])
-    text = buf.getvalue().encode("utf-8")
-    replace_via_temp(path, lambda fh: fh.write(text), ".dec3d-batch-")
+    _replace(path, buf.getvalue().encode("utf-8"))
 
 
 def _write_parquet(path: Path, table: list[dict], columns: list[str]) -> None:

@@ -17,12 +17,13 @@ from pathlib import Path
 from typing import Any, Iterable, TextIO
 
 from .commands import load_all
+from .commands._file_check import bind_check
 from .commands.binder import BindContext, Binder, CommandCall, ExprStatement
 from .commands.values import Deferred, InPath, OutPath, ValueRangeError
 from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation, StopDeck, printable
 from .fish import FishRuntime, compile_function, compile_inline, inline_source, parse_block, parse_inline
 from .io import paths
-from .io.guard import FileRecord, bind_check
+from .io.guard import FileRecord
 from .lang.parser import ParsedDeck, gc_paused, parse_deck
 from .lang.prepass import FishBlock
 from .model.model import Model

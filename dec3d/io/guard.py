@@ -12,8 +12,9 @@ write goes through ``claim`` (``Session.out_path``), which refuses
   since), or a dec3d save (a zip holding ``meta.json``) or a VTK XML file — or the user lets the
   run replace any file (``dec3d run --allow-overwrite``, ``Session(allow_overwrite=True)``).
 
-``bind_check`` applies the same rules, in deck order, to the literal names of a bound deck
-before anything runs. ``finish`` writes the manifest of the files the run wrote.
+``dec3d.commands._file_check.bind_check`` applies the same rules, in deck order, to the literal
+names of a bound deck before anything runs. ``finish`` writes the manifest of the files the run
+wrote.
 """
 from __future__ import annotations
 
@@ -44,7 +45,8 @@ def _digest(p: Path):
         return None
 
 
-def _key(p: Path):
+def file_key(p: Path):
+    """(device, inode) of a file, None when it cannot be reached: the same file under any name."""
     try:
         st = os.stat(p)
     except OSError:
@@ -70,7 +72,7 @@ class FileRecord:
         if real in self.created or real in self.inputs:
             return
         self.inputs[real] = what
-        k = _key(real)
+        k = file_key(real)
         if k is not None:
             self.input_keys[k] = real
 
@@ -78,7 +80,7 @@ class FileRecord:
         inputs = self.inputs if inputs is None else inputs
         if real in inputs:
             return inputs[real]
-        k = _key(real)
+        k = file_key(real)
         keys = self.input_keys if keys is None else keys
         return inputs.get(keys[k]) if k is not None and k in keys else None
 
@@ -184,43 +186,3 @@ class FileRecord:
         except OSError:
             pass                         # a read-only or full folder: the next run asks before replacing
         self._manifest = entries
-
-
-def bind_check(session, items) -> None:
-    """Bind time: the rules of ``FileRecord.refusal`` for the literal file names of the bound ``items``
-    of ``session``, in deck order (a save the deck writes before it restores it is the run's own file,
-    not an input). Every deck read so far is an input already (``Session.load_file``)."""
-    from ..commands.binder import CommandCall
-    from ..commands.values import InPath, OutPath
-    from .paths import find_input, output_path
-
-    record = session.files
-    created = set(record.created)
-    inputs, keys = dict(record.inputs), dict(record.input_keys)
-    for item in items:
-        if not isinstance(item, CommandCall):
-            continue
-        for p in item.command.positional + item.command.keywords:
-            value = item.args.get(p.key)
-            if not isinstance(value, str) or not isinstance(p.value, (InPath, OutPath)):
-                continue
-            where = item.locations.get(p.key, item.location)
-            try:
-                if isinstance(p.value, OutPath):
-                    real = output_path(p.value.final(value), session.out_dir, session.allow_outside_paths)
-                else:
-                    real = find_input(value, session._read_bases(where), session._read_roots(where),
-                                      session.allow_outside_paths, p.value.exts, prefer=created)
-            except PathError:
-                continue             # not there yet (a read), or refused when it runs
-            if isinstance(p.value, InPath):
-                if real not in created and real not in inputs:
-                    inputs[real] = f"the file `{printable(value)}`"
-                    k = _key(real)
-                    if k is not None:
-                        keys[k] = real
-                continue
-            exc = record.refusal(real, p.value.final(value), created, inputs, keys)
-            if exc is not None:
-                raise exc.with_location(where)
-            created.add(real)
