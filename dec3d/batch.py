@@ -196,10 +196,12 @@ def _history_finals(model) -> dict[str, float]:
     return out
 
 
-def run_one(deck: str, values: dict[str, Any], out_dir: str) -> dict[str, Any]:
-    """Run ``deck`` with ``values`` into ``out_dir``; return the row (never raises for a bad deck)."""
+def run_one(deck: str, values: dict[str, Any], out_dir: str, timeout: float | None = None) -> dict[str, Any]:
+    """Run ``deck`` with ``values`` into ``out_dir``; return the row (never raises for a bad deck).
+    ``timeout``: seconds of wall time after which the run is stopped (status ``timeout``)."""
     from .errors import Dec3dError
     from .session import Session
+    from .timelimit import time_limit
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -207,15 +209,22 @@ def run_one(deck: str, values: dict[str, Any], out_dir: str) -> dict[str, Any]:
     t0 = time.perf_counter()
     session = None
     with open(out / "output.txt", "w", encoding="utf-8") as log, redirect_stdout(log), redirect_stderr(log):
+        limit = None
         try:
-            session = Session(out_dir=out, stdout=log, parameters=values)
-            items = session.load_file(deck)
-            session.run_items(items)
+            with time_limit(timeout) as limit:
+                session = Session(out_dir=out, stdout=log, parameters=values)
+                items = session.load_file(deck)
+                session.run_items(items)
         except Dec3dError as exc:
             row.update(status="error", error=exc.format().splitlines()[0])
             print(exc.format(), file=log)
         except KeyboardInterrupt:
-            row.update(status="error", error="interrupted")
+            if limit is not None and limit.expired:
+                step = session.model.step if session is not None else 0
+                row.update(status="timeout", error=f"stopped at step {step} after {timeout:g} s (--timeout)")
+                print(row["error"], file=log)
+            else:
+                row.update(status="error", error="interrupted")
         except Exception as exc:           # an engine bug must not stop the other runs
             row.update(status="error", error=f"internal error: {type(exc).__name__}: {exc}")
             import traceback
@@ -238,7 +247,7 @@ def run_one(deck: str, values: dict[str, Any], out_dir: str) -> dict[str, Any]:
 
 def _run_local(task: dict) -> dict:
     """Process-pool task: run in the run's own folder."""
-    return run_one(task["deck"], task["values"], task["out"])
+    return run_one(task["deck"], task["values"], task["out"], task.get("timeout"))
 
 
 def _run_shipped(task: dict) -> dict:
@@ -251,7 +260,7 @@ def _run_shipped(task: dict) -> dict:
             p = src / rel
             p.parent.mkdir(parents=True, exist_ok=True)
             p.write_bytes(data)
-        row = run_one(str(src / task["deck_rel"]), task["values"], str(out))
+        row = run_one(str(src / task["deck_rel"]), task["values"], str(out), task.get("timeout"))
         if row.get("error"):
             # the message names the deck where the user has it, not the worker's temporary copy
             row["error"] = row["error"].replace(str(src) + os.sep, task["deck_dir"])
@@ -275,7 +284,8 @@ def _run_shipped(task: dict) -> dict:
 def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch", *, mode: str = "grid",
         workers: int | None = None, scheduler: str | None = None, client=None, retries: int = 3,
         rerun_failed: bool = False, progress: bool | str | None = None,
-        on_result: Callable[[dict], None] | None = None, warn: Callable[[str], None] | None = None):
+        on_result: Callable[[dict], None] | None = None, warn: Callable[[str], None] | None = None,
+        timeout: float | None = None):
     """Run ``deck`` once per combination of ``params`` ({name: [values]}); return the table (a pandas
     DataFrame when pandas is installed, else a list of dicts), also written to ``out/results.csv``.
 
@@ -283,7 +293,9 @@ def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch"
     (``tcp://host:port``) or ``"local"`` (a LocalCluster of ``workers`` processes); client: a
     ``dask.distributed.Client`` to use instead. retries: times Dask runs a task again when it raises
     (a run lost with its worker is rescheduled by Dask itself, up to its ``allowed-failures``). progress: a bar (True), a line per run (False), None: a bar on a terminal, "off": nothing.
-    on_result(row) is called in the calling process as each run finishes.
+    on_result(row) is called in the calling process as each run finishes, and ``results.csv`` is
+    written again with every run finished so far (a batch stopped half-way keeps its table).
+    timeout: seconds of wall time a run may take; a run stopped by it has status ``timeout``.
     """
     deck = Path(deck)
     if not deck.is_file():
@@ -328,6 +340,8 @@ def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch"
         rdir.mkdir(parents=True, exist_ok=True)
         _write_json(rdir / "result.json", {"values": values, "row": full})
         rows[i] = full
+        done = [rows[k] for k in sorted(rows)]
+        _write_csv(out / "results.csv", done, _columns(done, names))     # the table so far
         if on_result is not None:
             on_result(full)
         return full
@@ -349,7 +363,7 @@ def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch"
                 task = {"files": shipped, "deck_rel": deck.resolve().relative_to(base).as_posix(),
                         # the folder as the user named it, so messages read as in a local run
                         "deck_dir": "" if str(deck.parent) == "." else str(deck.parent) + os.sep,
-                        "values": values}
+                        "values": values, "timeout": timeout}
                 fut = client.submit(_run_shipped_task, task, retries=retries, pure=False,
                                     key=f"dec3d-batch-{os.getpid()}-{time.time_ns()}-{i}")
                 futures[fut] = (i, values, rdir)
@@ -370,7 +384,8 @@ def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch"
             n = max(1, min(workers or os.cpu_count() or 1, len(todo)))
             with _one_thread_each(), \
                     ProcessPoolExecutor(max_workers=n, mp_context=multiprocessing.get_context("spawn")) as pool:
-                futures = {pool.submit(_run_local, {"deck": str(deck), "values": values, "out": str(rdir)}):
+                futures = {pool.submit(_run_local, {"deck": str(deck), "values": values, "out": str(rdir),
+                                                    "timeout": timeout}):
                            (i, values, rdir) for i, values, rdir in todo}
                 for fut in as_completed(futures):
                     i, values, rdir = futures[fut]

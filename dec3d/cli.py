@@ -11,7 +11,13 @@ from . import __version__
 
 def _run(args) -> int:
     from . import warmup
+    from .timelimit import time_limit
 
+    with time_limit(args.max_seconds) as limit:
+        return _run_limited(args, limit, warmup)
+
+
+def _run_limited(args, limit, warmup) -> int:
     session = None
     helper = warmup.start()          # cold cache: half of the kernels compile on the other core
     try:
@@ -30,6 +36,7 @@ def _run(args) -> int:
             return 2
         session = Session(out_dir=out, echo=not args.quiet, allow_outside_paths=args.allow_outside_paths,
                           allow_overwrite=args.allow_overwrite)
+        session.trust_saves = args.trust_save
         try:
             items = session.load_file(deck)          # parse and bind everything first
         except Dec3dError as exc:
@@ -53,10 +60,26 @@ def _run(args) -> int:
         step = getattr(exc, "step", None)
         if step is None:
             step = session.model.step if session is not None else 0
+        if limit.expired:
+            print(f"stopped at step {step}: the run reached --max-seconds {args.max_seconds:g}", file=sys.stderr)
+            return 124
         print(f"interrupted at step {step}", file=sys.stderr)
         return 130
     finally:
         warmup.stop(helper)
+
+
+def _seconds(text: str) -> float:
+    """A time limit in seconds: a finite number > 0."""
+    import math
+
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected seconds, got {text!r}") from None
+    if not (math.isfinite(v) and v > 0):
+        raise argparse.ArgumentTypeError(f"expected a number of seconds > 0, got {text!r}")
+    return v
 
 
 def _batch(args) -> int:
@@ -74,7 +97,7 @@ def _batch(args) -> int:
             raise BatchError(f"--dask {args.dask!r}: only `local` (a LocalCluster); use --scheduler for a cluster")
         combinations(params, "zip" if args.zip else "grid")     # bad combinations stop here
         table = run(args.deck, params, args.out, mode="zip" if args.zip else "grid", workers=args.workers,
-                    scheduler=scheduler, rerun_failed=args.rerun_failed)
+                    scheduler=scheduler, rerun_failed=args.rerun_failed, timeout=args.timeout)
     except BatchError as exc:
         print(f"error: {exc}", file=sys.stderr)
         print("nothing was run", file=sys.stderr)
@@ -127,6 +150,11 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--allow-overwrite", action="store_true",
                    help="let outputs replace existing files dec3d did not write (never the deck or another "
                         "file the run reads; see docs/safety.md)")
+    r.add_argument("--max-seconds", type=_seconds, default=None, metavar="S",
+                   help="stop the run after S seconds of wall time, as Ctrl-C would (exit status 124)")
+    r.add_argument("--trust-save", action="store_true",
+                   help="`model restore` installs the FISH functions and callbacks of every save it reads, "
+                        "also of saves not made by you on this machine (only for saves you trust; docs/safety.md)")
     r.set_defaults(fn=_run)
     b = sub.add_parser("batch", help="run a deck for many parameter values (process pool or Dask) and "
                                      "collect one table")
@@ -142,6 +170,8 @@ def main(argv: list[str] | None = None) -> int:
     b.add_argument("--workers", type=int, default=None, help="worker processes (default: the CPU count; "
                                                             "2 for --dask local)")
     b.add_argument("--out", required=True, help="folder for the runs' folders and results.csv")
+    b.add_argument("--timeout", type=_seconds, default=None, metavar="S",
+                   help="stop a run after S seconds of wall time; it is recorded with status `timeout`")
     b.add_argument("--rerun-failed", action="store_true", help="run again the runs that failed last time "
                                                               "(finished runs are always skipped)")
     b.set_defaults(fn=_batch)

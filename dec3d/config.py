@@ -128,3 +128,8 @@ def init_threads(environ=None) -> str | None:
         return f"dec3d: {THREADS_ENV}={n} is more than the {top} cores numba may use here; using {top}"
     set_threads(n)
     return None
+
+
+#: largest mass density dec3d accepts (kg/m³): 4e4 times osmium's, room for any density scaling a
+#: deck does by hand, while a block's mass ρ·V stays a finite number (1e308 made it infinite)
+DENSITY_LIMIT = 1e9

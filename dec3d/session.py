@@ -67,6 +67,8 @@ class Session:
                  allow_overwrite: bool = False):
         load_all()
         self.allow_outside_paths = bool(allow_outside_paths)
+        #: `model restore` installs the FISH code of saves this user's key did not sign (`--trust-save`)
+        self.trust_saves = False
         self.model = Model()
         # values set from outside the deck (`dec3d batch --param`): FISH variables from the start, kept
         # through `model new`, and a deck's own assignment of one (its default) does not replace it
@@ -124,10 +126,8 @@ class Session:
         this session wrote (``self.written``) first, so a run never reads an older copy beside the deck
         in place of the one it has just saved."""
         try:
-            real = paths.find_input(name, self._read_bases(where), self._read_roots(where),
-                                    self.allow_outside_paths, exts, what, prefer=self.written)
-            self.files.read(real, f"the {what} `{paths.printable(str(name))}`")
-            return real
+            return self.files.read(paths.find_input(name, self._read_bases(where), self._read_roots(where),
+                                   self.allow_outside_paths, exts, what, prefer=self.written), f"the {what} `{name}`")
         except paths.PathError as exc:
             raise exc.with_location(where)
 

@@ -13,6 +13,12 @@ SHARED = Path(os.environ.get("DEC3D_SHARED", ROOT.parent / "shared"))
 # no warm-up process (dec3d/warmup.py) from the `dec3d run`s of the tests: tests/test_warmup.py
 # runs it itself
 os.environ.setdefault("DEC3D_WARMUP", "0")
+# the key that signs saves (dec3d.io.savesign) lives in a folder of the test run, not in the user's
+# ~/.config/dec3d: the tests neither read nor make the real one
+if "DEC3D_CONFIG_DIR" not in os.environ:
+    import tempfile
+
+    os.environ["DEC3D_CONFIG_DIR"] = tempfile.mkdtemp(prefix="dec3d-test-config-")
 DECKS = SHARED / "decks"
 NO_DECKS = (f"public 3DEC decks not found at {DECKS}: set DEC3D_SHARED=<folder holding decks/> "
             "or place shared/ beside the repository (README, 'Set up')")

@@ -61,7 +61,8 @@ MAY_IMPORT = {
     "commands": BASE | {"lang", "fish", "model", "geometry", "kernels", "io", "physics"},
     "session": BASE | {"lang", "fish", "commands", "model", "geometry", "kernels", "io", "physics"},
     "check": BASE | {"lang", "fish", "commands", "session"},
-    "batch": BASE | {"lang", "commands", "session"},
+    "batch": BASE | {"lang", "commands", "session", "timelimit"},
+    "timelimit": BASE | {"fish", "physics"},     # stops a run: the engine's and FISH's stop flags
     "warmup": BASE | {"kcache", "session"},      # the cold-start helper process of `dec3d run`      # runs decks in sessions, in processes or on Dask
     "docs": BASE | {"lang", "commands"},
     "ssdem": {"errors"},                         # independent of the rest; only the CLI and verify reach it

@@ -6,7 +6,7 @@ import numpy as np
 from ..model.blocks import (delete_blocks, group_blocks, hide_blocks, join_blocks, joined_groups,
                             set_density, summary)
 from .registry import command
-from .values import FLAG, ONOFF, Choice, Num, P, Text
+from .values import DENSITY, FLAG, ONOFF, Choice, Num, P, Text
 
 
 @command("block delete", keywords=[P("reaction", Num(lo=0.0, hi=1.0), "fraction of the deleted blocks' contact "
@@ -33,8 +33,14 @@ def block_delete(session, call):
     loads = None
     if call.args["reaction"] is not None:
         loads = reaction_loads(session.model, mask, call.location)
+    from ..model.cables import nodes_hosted_by
+
+    lost = nodes_hosted_by(session.model, mask)
     if delete_blocks(session.model, mask):
         relink(session.model)
+    if lost:
+        session.write(f"notice: {lost} cable node(s) lay in the deleted blocks: from now on they are free "
+                      "(no grout force)")
     if loads is not None:
         ids, f, m = loads
         b = session.model.blocks
@@ -117,7 +123,7 @@ def block_join(session, call):
     relink(session.model)            # zoned and FE blocks of one joined set share their coincident gridpoints
 
 
-@command("block property", keywords=[P("density", Num(lo=0, lo_open=True), "mass density", required=True,
+@command("block property", keywords=[P("density", DENSITY, "mass density", required=True,
                                        units="kg/m³")],
          range="block",
          doc="Set the density of the blocks in range (mass and inertia follow).",

@@ -38,7 +38,11 @@ STEM = OutPath(stem=True)
                  "`<file>_contacts_<nnnn>.vtu`, the last part of the same time in the .pvd, with point data "
                  "contact_id, block_a, block_b, kind, area, state (joint-law bits: 1 failed, 2 slipping now, 4 open), "
                  "slip (1 where failed or slipping), normal, normal_force, normal_stress, shear_force, "
-                 "shear_force_magnitude, normal_displacement, shear_displacement and shear_displacement_magnitude.",
+                 "shear_force_magnitude, normal_displacement, shear_displacement and shear_displacement_magnitude. "
+                 "A model with cables (`structure cable create`) also gets `<file>_cables_<nnnn>.vtu` per snapshot: "
+                 "one line cell per cable element with cell data element_id, cable_id, axial_force (N, tension "
+                 "positive; colour by it), axial_stress, grout_force_a, grout_force_b, state, yield and slip, and "
+                 "point data node_id, displacement, velocity and grouted (dec3d/io/cablevtk.py).",
          examples=["block vtk", "block vtk 'jointed' interval 100", "block vtk filename 'out/blocks'",
                    "block vtk 'stage1' contacts",
                    "block vtk off"])

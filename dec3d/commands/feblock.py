@@ -12,7 +12,7 @@ from ..model.feblocks import add_feblock, element_volumes, feblock_store, instal
 from ..model.model import KIND_DEFORMABLE, KIND_FE
 from ..model.zones import ZMODEL_ELASTIC, ZMODEL_NULL
 from .registry import command
-from .values import FLAG, Choice, InPath, Num, Nums, P, Text
+from .values import DENSITY, FLAG, Choice, InPath, Num, Nums, P, Text
 
 # Memory budget: about 3 kB per element (stress at 27 Gauss points, 20 node rows, nodes);
 # refuse beyond this many elements per command.
@@ -159,7 +159,7 @@ _CMODELS = {"elastic": ZMODEL_ELASTIC, "null": ZMODEL_NULL}
                    P("poisson", Num(lo=-1, hi=0.5, lo_open=True, hi_open=True), "Poisson's ratio, -1 < nu < 0.5"),
                    P("bulk", _POS, "bulk modulus K", units="Pa"),
                    P("shear", _POS, "shear modulus G", units="Pa"),
-                   P("density", _POS, "mass density", units="kg/m³"),
+                   P("density", DENSITY, "mass density", units="kg/m³"),
                    P("hourglass", Num(lo=0, hi=1), "hourglass control eps_h of 2x2x2 elements, 0 to 1 "
                      "(0: none; dec3d keyword)")],
          range="block",

@@ -11,6 +11,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..config import DENSITY_LIMIT
 from ..errors import BindError
 from ..lang.abbrev import matches, suggest
 from ..lang.deferred import Deferred  # noqa: F401  (commands and FISH share it)
@@ -327,6 +328,7 @@ def P(name: str, value: ValueType | None = None, doc: str = "", **kw) -> Param:
 FLOAT = Num()
 #: a coordinate (m)
 COORD = Num(lo=-COORD_LIMIT, hi=COORD_LIMIT)
+DENSITY = Num(lo=0, lo_open=True, hi=DENSITY_LIMIT)
 #: a length or distance (m), > 0
 LENGTH = Num(lo=0, lo_open=True, hi=COORD_LIMIT)
 INT = Num(integer=True)

@@ -18,8 +18,15 @@ STOP_CHECK = 1023          # loops look at the stop flag every STOP_CHECK + 1 it
 
 _STOP = [False]
 
-if sys.getrecursionlimit() < 20000:      # each FISH call is a few Python frames deep
-    sys.setrecursionlimit(20000)
+#: Python frames FISH may need: each FISH call is a few frames deep, MAX_DEPTH calls at most
+RECURSION_LIMIT = 20000
+
+
+def _deep_enough() -> None:
+    """Raise Python's recursion limit to what FISH needs, when a FISH run time is made (a session),
+    not when the module is imported: importing dec3d changes no process-wide setting."""
+    if sys.getrecursionlimit() < RECURSION_LIMIT:
+        sys.setrecursionlimit(RECURSION_LIMIT)
 
 
 def request_stop() -> None:
@@ -84,6 +91,7 @@ class FishFunction:
 
 class FishRuntime:
     def __init__(self, session):
+        _deep_enough()
         self.session = session
         self.functions: dict[str, FishFunction] = {}
         self.auto_create = True

@@ -66,15 +66,17 @@ class FileRecord:
         self._manifest: dict | None = None
 
     # ---------------------------------------------------------------- reads
-    def read(self, path, what: str) -> None:
-        """Note a file the run reads (a file it wrote itself before is not an input)."""
+    def read(self, path, what: str) -> Path:
+        """Note a file the run reads (a file it wrote itself before is not an input); returns ``path``."""
         real = Path(path).resolve()
         if real in self.created or real in self.inputs:
-            return
+            return path
+        what = printable(what)
         self.inputs[real] = what
         k = file_key(real)
         if k is not None:
             self.input_keys[k] = real
+        return path
 
     def input_of(self, real: Path, inputs=None, keys=None) -> str | None:
         inputs = self.inputs if inputs is None else inputs

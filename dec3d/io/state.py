@@ -8,7 +8,10 @@ A state file is a zip archive (numpy's ``.npz`` layout) holding:
   command record list and any extra JSON data the caller passes;
 * ``<store>.<field>.npy``: the live rows of every field of every store;
 * ``@history.<id>.steps|times|values.npy``: the samples of each history (``meta['histories']``
-  says how to make each history again: ``HistorySet.to_state``).
+  says how to make each history again: ``HistorySet.to_state``);
+* ``signature.json``: the SHA-256 of ``meta.json`` and its HMAC under the user's key
+  (``dec3d.io.savesign``): ``restore_state`` refuses a metadata member that fails its checksum and
+  says in ``meta['signed_here']`` whether this user's key made the file.
 
 Members are written in a fixed order with a fixed timestamp and compression level, so the
 same model gives the same bytes: restore → save reproduces the file exactly. Arrays are
@@ -33,6 +36,7 @@ import numpy as np
 from dec3d.config import SAVE_FORMAT_VERSION
 from dec3d.errors import Dec3dError
 from dec3d.io.finite import require_finite
+from dec3d.io.savesign import MEMBER as _SIGNATURE, signature, signed_here
 from dec3d.kernels.zmodels import NZPROP
 from dec3d.io.state_meta import (_HIST, _NPY_HEADER_MAX, _expected_arrays, _known, _meta_problem, _settings_problem,
                                   register_known)
@@ -118,6 +122,7 @@ def save_state(model: Model, path: str | os.PathLike, records: list[str] | None 
     def write(fh):
         with zipfile.ZipFile(fh, "w", compresslevel=6) as zf:
             zf.writestr(_member(_META), text)
+            zf.writestr(_member(_SIGNATURE), json.dumps(signature(text), sort_keys=True).encode("ascii"))
             for name, b in blobs.items():
                 zf.writestr(_member(name + ".npy"), b)
 
@@ -150,6 +155,26 @@ def _read_meta_member(path: str, zf: zipfile.ZipFile) -> bytes:
         raise StateFileError(f"'{path}': {_META} declares {info.file_size} bytes, more than a state file's "
                              f"metadata ({MAX_META_BYTES} at most)")
     return zf.read(info)
+
+
+def _read_signature(path: str, zf: zipfile.ZipFile, meta_raw: bytes) -> dict | None:
+    """The ``signature.json`` member (None in a file from before it), with the metadata's checksum
+    checked."""
+    try:
+        info = zf.getinfo(_SIGNATURE)
+    except KeyError:
+        return None
+    if info.file_size > 4096:
+        raise StateFileError(f"'{path}': {_SIGNATURE} declares {info.file_size} bytes, more than a signature")
+    try:
+        sig = json.loads(zf.read(info).decode("ascii"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise StateFileError(f"'{path}': {_SIGNATURE} is corrupted ({type(exc).__name__})") from None
+    if not isinstance(sig, dict) or not isinstance(sig.get("meta_sha256"), str):
+        raise StateFileError(f"'{path}': {_SIGNATURE} is corrupted")
+    if hashlib.sha256(meta_raw).hexdigest() != sig["meta_sha256"]:
+        raise StateFileError(f"'{path}': {_META} is corrupted (checksum mismatch)")
+    return sig
 
 
 #: what reading a damaged zip can raise (zlib.error: corrupt compressed data; NotImplementedError:
@@ -190,7 +215,10 @@ def restore_state(path: str | os.PathLike) -> tuple[Model, dict]:
     path = os.fspath(path)
     try:
         with zipfile.ZipFile(path) as zf:
-            meta = _check_meta(path, _read_meta_member(path, zf))
+            raw = _read_meta_member(path, zf)
+            sig = _read_signature(path, zf, raw)
+            meta = _check_meta(path, raw)
+            meta["signed_here"] = signed_here(raw, sig)
             bad = _meta_problem(meta)
             if bad:
                 raise StateFileError(f"'{path}': the file is inconsistent: {bad}")

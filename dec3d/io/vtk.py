@@ -329,6 +329,13 @@ class VtkSeries:
             fvtu = self.guard(f"{self.stem}_fe_{k:04d}.vtu")
             write_feblocks_vtu(model, fvtu)
             self.entries.append((float(time), fvtu, 2))
+        if "cable_segments" in model.stores and model.store("cable_segments").n:
+            # the cables as lines (``dec3d.io.cablevtk``): the part after the others of this time
+            from dec3d.io.cablevtk import write_cables_vtu
+            lvtu = self.guard(f"{self.stem}_cables_{k:04d}.vtu")
+            write_cables_vtu(model, lvtu)
+            part = 1 + max((e[2] if len(e) > 2 else 0) for e in self.entries[first:])
+            self.entries.append((float(time), lvtu, part))
         if self.contacts:
             # the sub-contacts as points (``dec3d.io.contactvtk``): the part after the others of this time
             from dec3d.io.contactvtk import write_contacts_vtu

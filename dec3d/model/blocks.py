@@ -79,6 +79,9 @@ def delete_blocks(model: Model, mask) -> int:
     vblock[:] = np.where(vblock >= 0, remap[vblock], -1)
     fblock[:] = np.where(fblock >= 0, remap[fblock], -1)
     follow_geometry(model, compact_geometry(model), remap)
+    from .cables import remap_hosts     # cable nodes in a deleted block lose their host (and grout)
+
+    remap_hosts(model, remap)
     return int(rows.size)
 
 

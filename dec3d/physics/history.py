@@ -236,6 +236,9 @@ class HistorySet:
             h = self.add_energy(q, name)
         elif kind == "fish" and isinstance(q, str) and FISH_NAME.fullmatch(q):
             h = self.add_fish(q, name)
+        elif kind in ("cable", "cable-node") and isinstance(spec.get("id"), int) and spec["id"] >= 1:
+            from .cable_history import add_cable_history     # (raises ValueError for a quantity it has not)
+            h = add_cable_history(self, kind, q, spec["id"], name)
         else:
             raise ValueError(f"history {hid}: unknown kind {kind!r} or quantity {q!r}")
         self.items.pop()

@@ -12,6 +12,7 @@ from dec3d.physics.jmodels import contact_stiffness
 from dec3d.kernels.motion import block_timestep
 
 from .bodies import inertial_masses
+from .cables import block_stiffness
 from .dynamic import stiffness_timestep
 
 _I = np.int64
@@ -44,6 +45,7 @@ class DensityScaling:
             c = ss["contact"]
             k = np.maximum(*contact_stiffness(cs, ss))[c] * ss["area"]
             kb += np.bincount(cs["a"][c], k, minlength=b.n) + np.bincount(cs["b"][c], k, minlength=b.n)
+        kb += block_stiffness(self.model)[0]          # grout of cables hosted by the block
         return np.add.reduceat(kb[gmember], gstart[:-1]) if len(gmember) else np.zeros(0)
 
     def _masses(self, gstart, gmember, gmass, giscalar, dt_fixed, near=None, gprin=None):
@@ -101,6 +103,16 @@ class DensityScaling:
         bodyscale.threaded(cs.n)(gid, gcen, rho, held, cs["a"], cs["b"], cs["normal"],
                                  *contact_stiffness(cs, ss),
                                  ss["contact"], ss["pos"], ss["area"], rt, rr)
+        # grout of cables hosted by the bodies: translational and (bounded by k |r|²) rotational rows
+        kt, kr = block_stiffness(self.model)
+        if kt.any():
+            g = gid >= 0
+            rows = np.flatnonzero(g & (kt > 0))
+            rt += np.bincount(gid[rows], kt[rows], minlength=ng)
+            r2 = np.sum((b["centroid"][rows] - gcen[gid[rows]]) ** 2, axis=1)
+            # Σ k |r + d|² ≤ Σ k |r|² + 2 |d| √(Σ k · Σ k |r|²) + |d|² Σ k (d: block centroid − body centroid)
+            rr += np.bincount(gid[rows], kr[rows] + kt[rows] * r2 + 2.0 * np.sqrt(kt[rows] * kr[rows] * r2),
+                              minlength=ng)
         if dt_fixed is None and s["scale_timestep"]:
             dt_fixed = float(s["scale_timestep"])
         on = rt > 0

@@ -28,6 +28,7 @@ from dec3d.model.store import Store
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.zones import has_zones
 
+from .cables import cable_timestep, grouted_timestep
 from .massscale import DensityScaling
 from .contact_store import contact_stores
 from .contacts import ContactDetection, default_row
@@ -182,7 +183,10 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
         fa = f["area"][(fb >= 0) & live[np.maximum(fb, 0)]]
         area = float(fa.max()) if len(fa) else 1.0
         mmin = float(b["mass"][live].min()) if live.any() else 1.0
-        return block_timestep(mmin, kn * area, float(s["frac"])) or 1e-3
+        dt = block_timestep(mmin, kn * area, float(s["frac"])) or 1e-3
+        dt = min(dt, grouted_timestep(self.model, float(s["frac"]), live))   # blocks held by cable grout
+        # cable nodes with their real masses (no density scaling: they are scaled to Δt otherwise)
+        return dt if self.mass_scaling() else min(dt, cable_timestep(self.model))
 
     def _held_still(self) -> np.ndarray:
         """Per block: all six velocity components held (bits 0-5 of ``fixity | apply_fix``, of the
@@ -413,6 +417,9 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
                           if has_zones(m) else {}),
                 "feblocks": ({k: m.store("feblocks")[k].copy() for k in ("stress", "gstress")}
                              if has_feblocks(m) else {}),
+                # cable nodes and elements (``physics.cables``): every field, rolled back with the blocks
+                "cables": {n: {k: m.stores[n][k].copy() for k in m.stores[n].fields}
+                           for n in ("cable_nodes", "cable_segments") if n in m.stores},
                 # (to_arrays gives views where it can: copy them)
                 "contacts": {k: a.copy() for k, a in self.contacts.to_arrays().items()},
                 "subcontacts": {k: a.copy() for k, a in self.subcontacts.to_arrays().items()},
@@ -431,6 +438,9 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
             m.store("zones").full(k)[: len(a)] = a
         for k, a in snap.get("feblocks", {}).items():
             m.store("feblocks").full(k)[: len(a)] = a
+        for n, fields in snap.get("cables", {}).items():
+            for k, a in fields.items():
+                m.stores[n].full(k)[: len(a)] = a
         self.contacts.load_arrays(snap["contacts"])
         self.subcontacts.load_arrays(snap["subcontacts"])
         mechanical = m.settings.mechanical

@@ -30,6 +30,7 @@ from dec3d.kernels.motion import DAMP_ADAPTIVE
 from . import contacts as _contacts
 from .contact_store import history_columns
 from .bodies import group_properties
+from .cables import cable_steps
 from .dynamic import TimeFunctions, has_timefns, stiffness_timestep
 from .energy import is_active as is_energy_active
 from .history import HistorySet
@@ -118,6 +119,8 @@ class _Run:
         if self.zst is not None:
             self.zst.beta = self.beta
         self.dynamic = bool(s["dynamic"])
+        # grouted cables (``physics.cables``): their forces at t go into the host blocks' applied loads
+        self.steps[:0] = cable_steps(self)
         if has_timefns(m):
             self.steps.insert(0, TimeFunctions(self))
         if is_energy_active(m):

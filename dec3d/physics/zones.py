@@ -53,6 +53,8 @@ from dec3d.model.model import KIND_DEFORMABLE
 from dec3d.model.zones import ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
 from dec3d.physics.cmodels import MODEL_BY_CODE
 
+from .cables import gridpoint_grout_stiffness
+
 _F = np.float64
 _I = np.int64
 
@@ -332,6 +334,7 @@ class ZoneStepper:
             if fe:
                 self.fe.stiffness(geo)
             stiff += self.fe.stiff
+        stiff += gridpoint_grout_stiffness(m, n)        # grout of cables hosted by zones (physics.cables)
         lk = self.linked
         np.add.at(stiff, v["link"][lk], stiff[lk])
         self.kzone = stiff

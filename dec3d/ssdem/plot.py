@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import printable
 from .analysis import Analysis
 from .units import factors
 
@@ -89,7 +90,8 @@ def build_figure(an: Analysis):
             ax.plot(np.where(inside, xs, np.nan) / L, np.where(inside, ys, np.nan) / L, style, lw=1.5,
                     label=f"{name}: FS {c['fs']:.3f}")
     fs = s.fs_global
-    ax.set_title(f"{p.title}\nstatic DEM FS = {fs:.3f}" if np.isfinite(fs) else p.title)
+    title = printable(p.title)
+    ax.set_title(f"{title}\nstatic DEM FS = {fs:.3f}" if np.isfinite(fs) else title)
     handles = ax.get_legend_handles_labels()[0]
     if handles:          # below the axes, so that it hides nothing of the model
         from matplotlib.transforms import offset_copy

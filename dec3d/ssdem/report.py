@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import printable
 from .analysis import Analysis, summary_numbers
 from .safety import STATE_NAMES
 from .units import factors, labels
@@ -69,7 +70,7 @@ def write_csv(path: Path, cols: dict) -> None:
 def _fmt(v):
     if isinstance(v, (float, np.floating)):
         return "inf" if v == np.inf else ("nan" if not np.isfinite(v) else f"{v:.6g}")
-    return v
+    return printable(v) if isinstance(v, str) else v      # a layer name from the input: no raw control bytes
 
 
 def summary_text(an: Analysis) -> str:
@@ -154,7 +155,7 @@ def write_all(an: Analysis, out: Path) -> list[Path]:
     blocks, interfaces = tables(an)
     files = [out / "summary.txt", out / "blocks.csv", out / "interfaces.csv", out / "steps.csv", out / "result.json",
              out / "timings.json"]
-    files[0].write_text(summary_text(an))
+    files[0].write_text(printable(summary_text(an), newlines=True))   # titles and names from the input
     write_csv(files[1], blocks)
     write_csv(files[2], interfaces)
     steps = an.state.steps

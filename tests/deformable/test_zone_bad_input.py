@@ -57,7 +57,7 @@ def test_missing_properties_at_cycle_time_name_blocks_and_the_cycle_line(tmp_pat
                     "block zone property young 1e9 poisson 0.2 density 2000 range position-x 0 1\n"
                     "model cycle 3\n")
     s = Session(out_dir=tmp_path)
-    with pytest.raises(Dec3dError, match=r"bulk must be > 0 Pa \(not set\): 43 zone\(s\) of blocks 2 .*density must be > 0 kg/m³ \(not set\): "
+    with pytest.raises(Dec3dError, match=r"bulk must be > 0 Pa \(not set\): 43 zone\(s\) of blocks 2 .*density must be > 0 and <= 1e\+09 kg/m³ \(not set\): "
                        r"43 zone\(s\) of blocks 2") as exc:
         s.call(deck)
     loc = exc.value.location

@@ -64,7 +64,7 @@ def test_cmodel_null_clears_stress_and_group_range_reaches_zones_of_the_block(s)
     ("block zone property young -5", "`young` must be > 0"),
     ("block zone property poisson 0.5 young 1e9", r"`poisson` must be in \(-1, 0.5\)"),
     ("block zone property poisson -1 young 1e9", r"`poisson` must be in \(-1, 0.5\)"),
-    ("block zone property density 0", "`density` must be > 0"),
+    ("block zone property density 0", r"`density` must be in \(0, 1e\+09\]"),
     ("block zone property bulk 1e9 young 1e9", "give bulk/shear or young/poisson, not both"),
     ("block zone property young 1e9", r"`block zone property young` needs poisson too: \d+ zone\(s\) in range"),
     ("block zone property poisson 0.2", r"needs young too"),

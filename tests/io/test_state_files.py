@@ -60,9 +60,20 @@ def test_arrays_are_loaded_without_pickle(model, tmp_path):
 
 
 def rewrite(path, out, change):
-    with zipfile.ZipFile(path) as zin, zipfile.ZipFile(out, "w") as zout:
-        for info in zin.infolist():
-            data = change(info.filename, zin.read(info.filename))
+    """A copy of a state file with ``change(name, bytes)`` applied to each member (None drops it). A
+    changed meta.json gets a matching checksum in signature.json, as anyone editing the file can make:
+    the deeper checks are what these tests reach (test_save_trust.py tests the checksum itself)."""
+    import hashlib
+
+    with zipfile.ZipFile(path) as zin:
+        members = [(info, change(info.filename, zin.read(info.filename))) for info in zin.infolist()]
+    meta = next((d for info, d in members if info.filename == "meta.json"), None)
+    with zipfile.ZipFile(out, "w") as zout:
+        for info, data in members:
+            if info.filename == "signature.json" and data is not None and meta is not None:
+                sig = json.loads(data)
+                sig["meta_sha256"] = hashlib.sha256(meta).hexdigest()
+                data = json.dumps(sig).encode()
             if data is not None:
                 zout.writestr(info, data)
     return out

@@ -52,7 +52,8 @@ def _members(path):
 
 
 def _rewrite(src, dst, meta_fn=None, arrays=None):
-    """Copy save file `src` to `dst`, with meta_fn(meta) applied and arrays replaced (checksums made right)."""
+    """Copy save file `src` to `dst`, with meta_fn(meta) applied and arrays replaced (checksums made right,
+    the metadata's in signature.json too)."""
     members = _members(src)
     meta = json.loads(members.pop("meta.json"))
     for name, arr in (arrays or {}).items():
@@ -61,8 +62,13 @@ def _rewrite(src, dst, meta_fn=None, arrays=None):
         meta["sha256"][name] = __import__("hashlib").sha256(blob).hexdigest()
     if meta_fn:
         meta_fn(meta)
+    raw = json.dumps(meta, sort_keys=True, indent=1).encode()
+    if "signature.json" in members:             # the metadata's checksum made right too
+        sig = json.loads(members["signature.json"])
+        sig["meta_sha256"] = __import__("hashlib").sha256(raw).hexdigest()
+        members["signature.json"] = json.dumps(sig).encode()
     with zipfile.ZipFile(dst, "w") as zf:
-        zf.writestr(state._member("meta.json"), json.dumps(meta, sort_keys=True, indent=1).encode())
+        zf.writestr(state._member("meta.json"), raw)
         for n, b in sorted(members.items()):
             zf.writestr(state._member(n), b)
     return dst

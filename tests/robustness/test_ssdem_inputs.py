@@ -250,3 +250,16 @@ def test_critical_circle_on_flat_ground_is_a_clean_error(tmp_path, capsys):
     assert rc == 2
     assert first_line(err) == f"{f}:11:1: error: field 'surface.type': the circle search found no valid slip circle"
     assert "RuntimeWarning" not in err
+
+
+def test_control_characters_of_the_input_are_not_written_raw(tmp_path, capsys):
+    """Issue 35: a title (or a layer name) holding ESC sequences reached summary.txt as raw bytes, which
+    a terminal runs when the file is shown; they are written as visible escapes."""
+    text = SLOPE.replace('title = "robustness"', 'title = "rob\\u001b[31mustness"').replace(
+        "[[layer]]\n", '[[layer]]\nname = "clay\\u001b]0;owned\\u0007"\n', 1)
+    rc, _, _ = run(tmp_path, capsys, "esc.toml", text)
+    assert rc == 0
+    for name in ("summary.txt", "blocks.csv", "interfaces.csv", "steps.csv", "result.json"):
+        data = (tmp_path / "out" / name).read_bytes()
+        assert b"\x1b" not in data and b"\x07" not in data, name
+    assert "rob\\x1b[31mustness" in (tmp_path / "out" / "summary.txt").read_text()

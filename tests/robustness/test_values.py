@@ -42,8 +42,8 @@ def _fail(session, tmp_path, line, kind=ValueRangeError):
     ("block mechanical damping combined -0.1", "`combined damping` must be in [0, 1), got -0.1", 35),
     ("block mechanical damping global 0", "`global damping` must be > 0, got 0", 33),
     # densities > 0
-    ("block property density 0", "`density` must be > 0, got 0", 24),
-    ("block property density -2500", "`density` must be > 0, got -2500", 24),
+    ("block property density 0", "`density` must be in (0, 1e+09], got 0", 24),
+    ("block property density -2500", "`density` must be in (0, 1e+09], got -2500", 24),
     # non-finite literals, anywhere
     ("model gravity 0 0 1e999", "`g` must be a finite number, got inf", 19),
     ("model cycle 1e999", "`n` must be a finite number, got inf", 13),
@@ -69,7 +69,7 @@ def test_literal_out_of_range_is_refused_before_anything_runs(session, tmp_path,
 @pytest.mark.parametrize("line, message, column", [
     ("block contact property friction [90.0 + 1]", "`friction` must be in [0, 90], got 91", 33),
     ("block mechanical damping local [2]", "`local damping` must be in [0, 1), got 2", 32),
-    ("block property density [0 - 1]", "`density` must be > 0, got -1", 24),
+    ("block property density [0 - 1]", "`density` must be in (0, 1e+09], got -1", 24),
     # (an overflow inside `[ ]` points at the operator that overflowed)
     ("model gravity 0 0 [1e308*10]", "value of `g`: numeric overflow: the result is not a finite number", 25),
     ("model gravity 0 [1] [10^400]", "value of `g`: integer overflow: the result does not fit in 64 bits (write a float, e.g. 2.0)", 24),
@@ -144,3 +144,18 @@ def test_a_joint_model_name_from_an_expression_is_checked_when_it_runs(session, 
                                "(`block contact jmodel load`) are not supported yet")
     assert e.value.location.column == column
     assert mech(session.model)["jmodel"] == "mohr"
+
+
+@pytest.mark.parametrize("line", ["block property density 1e308", "block zone property density 1e308",
+                                  "feblock change density 1e308"])
+def test_a_density_no_block_can_have_is_refused_at_binding(tmp_path, line):
+    """Issue 35: density 1e308 made masses infinite; the bound (dec3d.config.DENSITY_LIMIT) is stated."""
+    import io
+
+    from dec3d.errors import Dec3dError
+    from dec3d.session import Session
+
+    s = Session(out_dir=tmp_path, stdout=io.StringIO())
+    with pytest.raises(Dec3dError, match=r"`density` must be in \(0, 1e\+09\], got 1e\+308") as e:
+        s.load_text(line + "\n", "d.dat")
+    assert (e.value.location.line, e.value.location.column) >= (1, 1)

@@ -1,0 +1,85 @@
+"""FISH intrinsics of cable structural elements (``dec3d.model.cables``).
+
+Names follow Itasca's structural-element FISH (``struct.cable.force.axial``, ``struct.cable.grout.slip``,
+``struct.node.disp``, ``struct.node.pos``, ``struct.node.force.unbal``). Itasca hands these pointers;
+dec3d hands ids, as it does for blocks: a cable element by its element id, a node by its node id
+(both from 1, as ``structure cable list`` shows them).
+"""
+from __future__ import annotations
+
+from .intrinsics import intrinsic
+from .values import FishValueError, Vec, type_name
+
+
+def _row(rt, i, name, store_name, what):
+    if type(i) is not int:
+        raise FishValueError(f"`{name}` takes a {what} id (an integer), not a {type_name(i)}")
+    st = rt.session.model.stores.get(store_name)
+    if st is not None and st.n:
+        import numpy as np
+
+        rows = np.flatnonzero(st["id"] == i)
+        if rows.size:
+            return st, int(rows[0])
+    raise FishValueError(f"`{name}`: there is no cable {what} with id {i}")
+
+
+def _seg(rt, i, name):
+    return _row(rt, i, name, "cable_segments", "element")
+
+
+def _node(rt, i, name):
+    return _row(rt, i, name, "cable_nodes", "node")
+
+
+@intrinsic("struct.cable.force.axial", 1)
+def _axial(rt, i):
+    """Axial force of the cable element [N], tension positive."""
+    st, r = _seg(rt, i, "struct.cable.force.axial")
+    return float(st["fa"][r])
+
+
+@intrinsic("struct.cable.grout.slip", 2)
+def _slip(rt, i, end):
+    """Whether the element's grout slips now and end 1 or 2 carries grout (dec3d keeps one slip flag per
+    element: an element whose grout slips at one end reads as slipping at both ends that are grouted)."""
+    st, r = _seg(rt, i, "struct.cable.grout.slip")
+    if end not in (1, 2):
+        raise FishValueError("`struct.cable.grout.slip` takes the end as 1 or 2")
+    return bool(int(st["state"][r]) & 4) and abs(float(st["gf"][r, end - 1])) > 0.0
+
+
+@intrinsic("struct.cable.yield", 1)
+def _yield(rt, i):
+    """Whether the element yields (tension or compression) now."""
+    st, r = _seg(rt, i, "struct.cable.yield")
+    return bool(int(st["state"][r]) & 3)
+
+
+def _vec(arr, r):
+    return Vec(float(arr[r, 0]), float(arr[r, 1]), float(arr[r, 2]))
+
+
+@intrinsic("struct.node.pos", 1)
+def _npos(rt, i):
+    st, r = _node(rt, i, "struct.node.pos")
+    return _vec(st["pos"], r)
+
+
+@intrinsic("struct.node.disp", 1)
+def _ndisp(rt, i):
+    st, r = _node(rt, i, "struct.node.disp")
+    return _vec(st["disp"], r)
+
+
+@intrinsic("struct.node.vel", 1)
+def _nvel(rt, i):
+    st, r = _node(rt, i, "struct.node.vel")
+    return _vec(st["vel"], r)
+
+
+@intrinsic("struct.node.force.unbal", 1)
+def _nunbal(rt, i):
+    """Unbalanced force of the node at the last step [N] (at a fixed node: the reaction, sign reversed)."""
+    st, r = _node(rt, i, "struct.node.force.unbal")
+    return _vec(st["force"], r)

@@ -1,0 +1,236 @@
+"""The stores of grouted cable structural elements (``structure cable …``; physics in
+``dec3d.physics.cables``, kernel ``dec3d.kernels.cable``).
+
+``cable_nodes``   one row per cable node
+    id ()          int64  node id, from 1 (``range id``)
+    cable ()       int64  id of the cable the node belongs to
+    pos, vel, disp (3,)   m, m/s, m
+    mass ()        kg     real mass: density × area × tributary length (0 without density)
+    imass ()       kg     inertial mass of the last step (density-scaled to the step, see physics.cables)
+    host ()        int64  row of the block the node lies in, -1 none (ungrouted)
+    hz ()          int8   1: the host is a zoned block, the node follows a 4-node zone: hzone () its row,
+                   hgp (4,) its gridpoint rows, hw (4,) the node's barycentric weights in it
+    hpos (3,)      m      host point: the material point of the host block where the node sits
+    fix ()         uint8  bits 0-2: velocity components held (``structure node fix``)
+    fapp (3,)      N      applied force (``structure node apply``)
+    force (3,)     N      unbalanced force of the last step
+    hforce, hmoment (3,)  N, N·m  force of the grout on the host block at the last step, and its
+                   moment about the block's centroid (added to the block's ``fapp``/``mapp``)
+    group (1,)     int32  group code
+``cable_segments`` one row per cable element (segment)
+    id (), cable () int64
+    na, nb ()      int64  node rows
+    l0 ()          m      length as created; lcur () m length at the last step
+    prop (NPROP,)  young, cross-sectional-area, yield-tension, yield-compression, grout-stiffness,
+                   grout-cohesion, grout-friction [rad], grout-perimeter, density
+    fa ()          N      axial force, tension positive
+    gf (2,)        N      grout force on the cable at the a and b ends, along the axis a → b
+    state ()       int32  yield/slip bits (``kernels.cable``)
+    tapp (), tact () applied tension and whether it is active (``structure cable apply tension``)
+    group (1,)     int32
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from dec3d.kernels.cable import NPROP
+
+from .groups import group_field
+from .model import KIND_RIGID, Model
+from .store import Field, Store
+
+_F = np.float64
+_I = np.int64
+
+NODES = "cable_nodes"
+SEGMENTS = "cable_segments"
+
+#: property names as 3DEC spells them, in ``prop`` column order
+PROPS = ("young", "cross-sectional-area", "yield-tension", "yield-compression", "grout-stiffness",
+         "grout-cohesion", "grout-friction", "grout-perimeter", "density")
+assert len(PROPS) == NPROP
+
+
+def _node_fields() -> dict[str, Field]:
+    v3 = Field((3,), _F, 0.0)
+    return {"id": Field((), _I, 0), "cable": Field((), _I, 0), "pos": v3, "vel": v3, "disp": v3,
+            "mass": Field((), _F, 0.0), "imass": Field((), _F, 0.0), "host": Field((), _I, -1), "hpos": v3,
+            "fix": Field((), np.uint8, 0), "fapp": v3, "force": v3, "hforce": v3, "hmoment": v3,
+            "group": group_field(), "hz": Field((), np.int8, 0), "hzone": Field((), _I, -1),
+            "hgp": Field((4,), _I, -1), "hw": Field((4,), _F, 0.0)}
+
+
+def _segment_fields() -> dict[str, Field]:
+    return {"id": Field((), _I, 0), "cable": Field((), _I, 0), "na": Field((), _I, -1), "nb": Field((), _I, -1),
+            "l0": Field((), _F, 0.0), "lcur": Field((), _F, 0.0), "prop": Field((NPROP,), _F, 0.0),
+            "fa": Field((), _F, 0.0), "gf": Field((2,), _F, 0.0), "state": Field((), np.int32, 0),
+            "tapp": Field((), _F, 0.0), "tact": Field((), np.uint8, 0), "group": group_field(),
+            "pos": Field((3,), _F, 0.0)}     # segment midpoint as created (``range position``)
+
+
+def cable_stores(model: Model) -> tuple[Store, Store]:
+    """The node and segment stores, added to the model on first use (saved and restored with it)."""
+    st = model.stores
+    if NODES not in st:
+        model.add_store(Store(NODES, _node_fields()))
+    if SEGMENTS not in st:
+        model.add_store(Store(SEGMENTS, _segment_fields()))
+    st = model.stores
+    for name, fields in ((NODES, _node_fields()), (SEGMENTS, _segment_fields())):
+        for key, spec in fields.items():      # (a store restored from a file that had fewer fields)
+            if key not in st[name]:
+                st[name].add_field(key, spec)
+    return st[NODES], st[SEGMENTS]
+
+
+def has_cables(model: Model) -> bool:
+    st = model.stores
+    return SEGMENTS in st and st[SEGMENTS].n > 0
+
+
+def zone_host(model: Model, block: int, p: np.ndarray, tol: float):
+    """(zone row, gridpoint rows (4,), barycentric weights (4,)) of the 4-node zone of ``block`` that
+    holds ``p`` (weights ≥ −tol), or None."""
+    if "zones" not in model.stores:
+        return None
+    zs = model.stores["zones"]
+    rows = np.flatnonzero((zs["block"] == block) & (zs["nnode"] == 4))
+    if not rows.size:
+        return None
+    gp = zs["gp"][rows, :4]
+    x = model.vertices["pos"][gp]                      # (z, 4, 3)
+    a = np.transpose(x[:, 1:, :] - x[:, :1, :], (0, 2, 1))   # columns x1-x0, x2-x0, x3-x0
+    ok = np.abs(np.linalg.det(a)) > 0
+    w = np.full((len(rows), 4), -np.inf)
+    w[ok, 1:] = np.linalg.solve(a[ok], (p[None, :] - x[ok, 0, :])[:, :, None])[:, :, 0]
+    w[ok, 0] = 1.0 - w[ok, 1:].sum(axis=1)
+    inside = np.flatnonzero(w.min(axis=1) >= -tol)
+    if not inside.size:
+        return None
+    k = int(inside[0])
+    return int(rows[k]), gp[k].copy(), np.clip(w[k], 0.0, None) / np.clip(w[k], 0.0, None).sum()
+
+
+def host_blocks(model: Model, pts: np.ndarray, tol: float) -> np.ndarray:
+    """Row of the visible rigid block each point lies in (on its boundary counts; the lowest row when
+    several hold it), -1 for none. A point is in a convex block when it is behind every face plane
+    by ``tol`` at most. Points in zoned or FE blocks are reported as -2 (the caller looks for their
+    zone, ``zone_host``)."""
+    b, f = model.blocks, model.faces
+    out = np.full(len(pts), -1, _I)
+    if not b.n:
+        return out
+    fb = f["block"]
+    for i, p in enumerate(pts):
+        dist = np.einsum("fk,fk->f", p[None, :] - f["centroid"], f["normal"])
+        outside = np.zeros(b.n, bool)
+        np.logical_or.at(outside, fb[fb >= 0], dist[fb >= 0] > tol)
+        inside = ~outside & ~b["hidden"] & (b["face_count"] > 0)
+        rows = np.flatnonzero(inside)
+        if rows.size:
+            r = int(rows[0])
+            out[i] = r if b["kind"][r] == KIND_RIGID else -2
+    return out
+
+
+def _first_block(model: Model, p: np.ndarray, tol: float) -> int:
+    b, f = model.blocks, model.faces
+    fb = f["block"]
+    dist = np.einsum("fk,fk->f", p[None, :] - f["centroid"], f["normal"])
+    outside = np.zeros(b.n, bool)
+    np.logical_or.at(outside, fb[fb >= 0], dist[fb >= 0] > tol)
+    rows = np.flatnonzero(~outside & ~b["hidden"] & (b["face_count"] > 0))
+    return int(rows[0]) if rows.size else -1
+
+
+def add_cable(model: Model, p1, p2, segments: int, cable_id: int | None, group: str | None,
+              tol: float) -> tuple[int, np.ndarray]:
+    """Append a straight cable of ``segments`` equal elements from p1 to p2; returns (cable id,
+    host rows of its nodes). The nodes take the block they lie in as host."""
+    nodes, segs = cable_stores(model)
+    p1, p2 = np.asarray(p1, _F), np.asarray(p2, _F)
+    t = np.linspace(0.0, 1.0, segments + 1)[:, None]
+    pts = p1[None, :] * (1.0 - t) + p2[None, :] * t
+    hosts = host_blocks(model, pts, tol)
+    cid = int(cable_id) if cable_id is not None else int(max(nodes["cable"].max(initial=0),
+                                                              segs["cable"].max(initial=0)) + 1)
+    nid0 = int(nodes["id"].max(initial=0)) + 1
+    sid0 = int(segs["id"].max(initial=0)) + 1
+    sl = nodes.append(segments + 1)
+    rn = np.arange(sl.start, sl.stop)
+    nodes["id"][rn] = np.arange(nid0, nid0 + segments + 1)
+    nodes["cable"][rn] = cid
+    nodes["pos"][rn] = pts
+    nodes["hpos"][rn] = pts
+    for k in np.flatnonzero(hosts == -2):
+        # a node in a zoned block follows the 4-node zone that holds it (-3: none, e.g. 10-node zones)
+        r = _first_block(model, pts[k], tol)
+        z = zone_host(model, r, pts[k], max(tol, 1e-9)) if r >= 0 else None
+        if z is None:
+            hosts[k] = -3
+            continue
+        hosts[k] = r
+        nodes["hz"][rn[k]] = 1
+        nodes["hzone"][rn[k]], nodes["hgp"][rn[k]], nodes["hw"][rn[k]] = z
+    nodes["host"][rn] = np.maximum(hosts, -1)
+    sl = segs.append(segments)
+    rs = np.arange(sl.start, sl.stop)
+    segs["id"][rs] = np.arange(sid0, sid0 + segments)
+    segs["cable"][rs] = cid
+    segs["na"][rs] = rn[:-1]
+    segs["nb"][rs] = rn[1:]
+    length = float(np.linalg.norm(p2 - p1)) / segments
+    segs["l0"][rs] = length
+    segs["lcur"][rs] = length
+    segs["pos"][rs] = 0.5 * (pts[:-1] + pts[1:])
+    if group:
+        model.groups.assign(nodes, rn, group)
+        model.groups.assign(segs, rs, group)
+    return cid, hosts
+
+
+def update_masses(model: Model) -> None:
+    """Real node masses: density × area × half of each adjacent segment's length."""
+    nodes, segs = cable_stores(model)
+    m = np.zeros(nodes.n)
+    lm = segs["prop"][:, 8] * segs["prop"][:, 1] * segs["l0"] * 0.5
+    np.add.at(m, segs["na"], lm)
+    np.add.at(m, segs["nb"], lm)
+    nodes["mass"][:] = m
+
+
+def nodes_hosted_by(model: Model, mask) -> int:
+    """How many cable nodes have their host among the blocks of ``mask`` (bool over block rows)."""
+    st = model.stores
+    if NODES not in st or not st[NODES].n:
+        return 0
+    h = st[NODES]["host"]
+    on = h >= 0
+    return int(np.asarray(mask, bool)[h[on]].sum())
+
+
+def remap_hosts(model: Model, remap: np.ndarray) -> None:
+    """After blocks are deleted (old row -> new row, -1 gone): nodes whose block went lose their host."""
+    st = model.stores
+    if NODES in st and st[NODES].n:
+        nodes = st[NODES]
+        h = nodes["host"]
+        ok = h >= 0
+        h[ok] = remap[h[ok]]
+        lost = ok & (h < 0)
+        # (the grout force went with the block's applied force; the node carries none from now on)
+        nodes["hforce"][lost] = 0.0
+        nodes["hmoment"][lost] = 0.0
+        # zone-hosted nodes of surviving blocks: the zones' and gridpoints' rows moved, find them again
+        for i in np.flatnonzero((h >= 0) & (nodes["hz"] == 1)):
+            z = zone_host(model, int(h[i]), nodes["hpos"][i], 1e-9)
+            if z is None:
+                h[i] = -1
+                lost[i] = True
+            else:
+                nodes["hzone"][i], nodes["hgp"][i], nodes["hw"][i] = z
+        nodes["hz"][lost] = 0
+        segs = st[SEGMENTS]
+        gone = np.flatnonzero(lost)
+        segs["gf"][np.isin(segs["na"], gone), 0] = 0.0
+        segs["gf"][np.isin(segs["nb"], gone), 1] = 0.0
