@@ -120,29 +120,31 @@ class FileRecord:
             return self.out_dir
 
     def _own(self, real: Path) -> bool:
-        """Whether an existing file is one of dec3d's outputs, unchanged since dec3d wrote it."""
-        entry = self._entries().get(self._rel(real) or "")
-        try:
-            size = real.stat().st_size
-        except OSError:
-            return False
-        if entry is not None and entry[0] == size and entry == _digest(real):
-            return True
+        """Whether an existing file is one of dec3d's outputs: a dec3d save or VTK XML file (a look at
+        its start), else one the manifest lists with its size and SHA-256 (unchanged since)."""
+        ext = real.suffix.lower()
         try:
             with open(real, "rb") as fh:
                 head = fh.read(512)
         except OSError:
             return False
-        ext = real.suffix.lower()
         if ext == ".sav" and head.startswith(b"PK\x03\x04"):
             import zipfile
 
             try:
                 with zipfile.ZipFile(real) as zf:
-                    return "meta.json" in zf.namelist()
+                    if "meta.json" in zf.namelist():
+                        return True
             except (OSError, zipfile.BadZipFile, ValueError):
-                return False
-        return ext in _VTK and b"<VTKFile" in head
+                pass
+        if ext in _VTK and b"<VTKFile" in head:
+            return True
+        entry = self._entries().get(self._rel(real) or "")
+        try:
+            size = real.stat().st_size
+        except OSError:
+            return False
+        return entry is not None and entry[0] == size and entry == _digest(real)
 
     # ---------------------------------------------------------------- manifest
     def _rel(self, real: Path) -> str | None:

@@ -232,3 +232,15 @@ def test_batch_results_are_written_through_a_temporary_file_removed_on_ctrl_c(tm
     batch._write_json(tmp_path / "r.json", {"a": 1})
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.json", "results.csv"]
     assert path.read_text() == "old\n"
+
+
+def test_without_the_record_saves_and_vtk_files_are_still_dec3d_s_own(tmp_path):
+    text = BRICK + HIST + "model cycle 2\nmodel save 's'\nblock vtk 'v'\nhistory export 1 file 'h.csv'\n"
+    s, err = run(tmp_path, text)
+    assert err is None
+    (tmp_path / MANIFEST).unlink()                     # outputs of a run from before the record existed
+    s, err = run(tmp_path, text.replace("history export 1 file 'h.csv'\n", ""))
+    assert err is None                                 # s.sav (a dec3d zip) and v.pvd / v_0000.vtu (VTK XML)
+    s, err = run(tmp_path, text)
+    assert err.message.startswith(f"`h.csv` would replace the existing file {tmp_path / 'h.csv'}")
+    assert where(err) == ("d.dat", 7, 23)
