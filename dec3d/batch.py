@@ -326,7 +326,7 @@ def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch"
     client_own = cluster = None
     if todo and (scheduler is not None or client is not None):
         if client is None:
-            client, cluster = _dask_client(scheduler, workers)
+            client, cluster = _dask_client(scheduler, workers, out / DASK_SCRATCH)
             client_own = client
 
     def finish(i, values, rdir, row, shipped=None):
@@ -399,6 +399,8 @@ def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch"
         bar.close()
         if client_own is not None:
             _quiet_close(client_own, cluster)
+            if cluster is not None:
+                shutil.rmtree(out / DASK_SCRATCH, ignore_errors=True)
 
     table = [rows[i] for i in sorted(rows)]
     columns = _columns(table, names)
@@ -436,7 +438,12 @@ def _run_shipped_task(task: dict) -> dict:
     return _run_shipped(task)
 
 
-def _dask_client(scheduler: str | None, workers: int | None):
+#: the scratch folder of the LocalCluster's workers, inside the batch's output folder (Dask's default is
+#: the system's temporary folder: a batch writes nothing outside --out); removed when the batch ends
+DASK_SCRATCH = ".dask-scratch"
+
+
+def _dask_client(scheduler: str | None, workers: int | None, scratch: Path | None = None):
     try:
         from dask.distributed import Client, LocalCluster
     except ImportError:
@@ -444,8 +451,9 @@ def _dask_client(scheduler: str | None, workers: int | None):
     if scheduler in (None, "local"):
         import logging
 
+        extra = {"local_directory": str(scratch)} if scratch is not None else {}
         cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.CRITICAL)
+                               dashboard_address=None, silence_logs=logging.CRITICAL, **extra)
         return Client(cluster), cluster
     if not re.match(r"^(tcp|tls|inproc|ucx)://", scheduler):
         raise BatchError(f"--scheduler {scheduler!r}: give an address such as tcp://host:8786, or --dask local")

@@ -164,3 +164,17 @@ def test_cli_warns_of_a_parameter_the_deck_does_not_use(tmp_path, capsys):
     assert "1 runs, 0 failed" in cap.out
     rows = batch.read_table(tmp_path / "results.csv")
     assert rows[0]["run"] == "run-0001-phi=40-ncycles=10-spacing=1" and rows[0]["status"] == "ok"
+
+
+def test_a_local_dask_cluster_keeps_its_scratch_inside_the_output_folder(tmp_path):
+    """Issue 35: Dask's worker scratch went to the system's temporary folder, outside --out; it is
+    out/.dask-scratch while the batch runs, removed at the end."""
+    pytest.importorskip("dask.distributed")
+    deck = tmp_path / "d.dat"
+    deck.write_text("[r = 2 * a]\n")
+    out = tmp_path / "out"
+    seen = []
+    rows = _rows(batch.run(deck, {"a": [1, 2]}, out, scheduler="local", workers=1, progress=False,
+                           on_result=lambda row: seen.append(any((out / batch.DASK_SCRATCH).iterdir()))))
+    assert [r["status"] for r in rows] == ["ok", "ok"] and seen == [True, True]
+    assert not (out / batch.DASK_SCRATCH).exists()

@@ -16,6 +16,7 @@ from lark import Lark, Transformer
 from lark.exceptions import UnexpectedInput
 
 from ..errors import DeckSyntaxError
+from .fastexpr import parse_fast
 
 Node = tuple
 
@@ -78,7 +79,11 @@ def _parser() -> Lark:
 
 @lru_cache(maxsize=4096)
 def parse_expression(text: str) -> Node:
-    """Parse the inside of `[ ... ]`. Raises DeckSyntaxError with a 1-based column."""
+    """Parse the inside of `[ ... ]`. Raises DeckSyntaxError with a 1-based column. The recursive
+    descent of ``fastexpr`` first; lark's parser for what it does not take (and for the message)."""
+    tree = parse_fast(text)
+    if tree is not None:
+        return tree
     try:
         return _parser().parse(text)
     except UnexpectedInput as exc:
