@@ -233,6 +233,7 @@ def run_one(deck: str, values: dict[str, Any], out_dir: str, timeout: float | No
         finally:
             if session is not None:
                 session.close_log()
+                session.files.finish()
     row["wall_s"] = time.perf_counter() - t0
     if session is not None:
         row.update(_history_finals(session.model))
@@ -491,10 +492,25 @@ def _read_result(path: Path, values: dict) -> dict | None:
     return row if row.get("status") in ("ok", "error") else None
 
 
+def _replace(path: Path, data: bytes) -> None:
+    """Write ``path`` whole or not at all (a killed batch never leaves half a result): a temporary file
+    beside it replaces it in one step, and is removed on every other way out (Ctrl-C included)."""
+    fd, tmp = tempfile.mkstemp(prefix=".dec3d-batch-", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)          # mkstemp makes 0600: the mode an ordinary open gives
+        os.replace(tmp, path)
+        tmp = None
+    finally:
+        if tmp is not None:
+            Path(tmp).unlink(missing_ok=True)
+
+
 def _write_json(path: Path, data) -> None:
-    tmp = path.with_name(path.name + ".part")
-    tmp.write_text(json.dumps(data, indent=1, allow_nan=False), encoding="utf-8")
-    os.replace(tmp, path)                    # a killed batch never leaves half a result
+    _replace(path, json.dumps(data, indent=1, allow_nan=False).encode("utf-8"))
 
 
 def _columns(table: list[dict], names: list[str]) -> list[str]:
@@ -511,13 +527,12 @@ def _cell(v) -> str:
 
 
 def _write_csv(path: Path, table: list[dict], columns: list[str]) -> None:
-    tmp = path.with_name(path.name + ".part")
-    with open(tmp, "w", newline="", encoding="utf-8") as f:
-        w = csv.writer(f)
-        w.writerow(columns)
-        for r in table:
-            w.writerow([_cell(r.get(c)) for c in columns])
-    os.replace(tmp, path)
+    buf = io.StringIO(newline="")
+    w = csv.writer(buf)
+    w.writerow(columns)
+    for r in table:
+        w.writerow([_cell(r.get(c)) for c in columns])
+    _replace(path, buf.getvalue().encode("utf-8"))
 
 
 def _write_parquet(path: Path, table: list[dict], columns: list[str]) -> None:

@@ -34,7 +34,8 @@ def _run_limited(args, limit, warmup) -> int:
             what = "is a file, not a folder" if out.exists() and not out.is_dir() else (exc.strerror or str(exc))
             print(f"error: the output folder '{out}' cannot be used: {what}", file=sys.stderr)
             return 2
-        session = Session(out_dir=out, echo=not args.quiet, allow_outside_paths=args.allow_outside_paths)
+        session = Session(out_dir=out, echo=not args.quiet, allow_outside_paths=args.allow_outside_paths,
+                          allow_overwrite=args.allow_overwrite)
         session.trust_saves = args.trust_save
         try:
             items = session.load_file(deck)          # parse and bind everything first
@@ -50,6 +51,7 @@ def _run_limited(args, limit, warmup) -> int:
             return 1
         finally:
             session.close_log()
+            session.files.finish()           # the record of the files dec3d wrote (dec3d/io/guard.py)
         for w in session.warnings:
             print(f"warning: {w}", file=sys.stderr)
         return 0
@@ -145,6 +147,9 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--allow-outside-paths", action="store_true",
                    help="let the deck read and write files outside its folder and the output folder "
                         "(only for decks you trust; see docs/safety.md)")
+    r.add_argument("--allow-overwrite", action="store_true",
+                   help="let outputs replace existing files dec3d did not write (never the deck or another "
+                        "file the run reads; see docs/safety.md)")
     r.add_argument("--max-seconds", type=_seconds, default=None, metavar="S",
                    help="stop the run after S seconds of wall time, as Ctrl-C would (exit status 124)")
     r.add_argument("--trust-save", action="store_true",

@@ -17,11 +17,13 @@ from pathlib import Path
 from typing import Any, Iterable, TextIO
 
 from .commands import load_all
+from .commands._file_check import bind_check
 from .commands.binder import BindContext, Binder, CommandCall, ExprStatement
 from .commands.values import Deferred, InPath, OutPath, ValueRangeError
 from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation, StopDeck, printable
 from .fish import FishRuntime, compile_function, compile_inline, inline_source, parse_block, parse_inline
 from .io import paths
+from .io.guard import FileRecord
 from .lang.parser import ParsedDeck, gc_paused, parse_deck
 from .lang.prepass import FishBlock
 from .model.model import Model
@@ -55,15 +57,14 @@ DECK_MAX_BYTES = 64 * 2**20
 
 
 class Session:
-    """One model and the decks run on it.
-
-    out_dir: the output folder (default: the working folder); every file a deck writes stays
-    in it. allow_outside_paths: let decks read and write anywhere (regular files only) — only
-    for decks the user trusts (`dec3d run --allow-outside-paths`; docs/safety.md).
-    """
+    """One model and the decks run on it. out_dir: the output folder (default: the working folder);
+    every file a deck writes stays in it. allow_outside_paths: let decks read and write anywhere
+    (regular files only), for decks the user trusts; allow_overwrite: let outputs replace existing
+    files dec3d did not write (never the run's inputs). See docs/safety.md."""
 
     def __init__(self, out_dir: str | Path | None = None, echo: bool = False, stdout: TextIO | None = None,
-                 allow_outside_paths: bool = False, parameters: dict[str, Any] | None = None):
+                 allow_outside_paths: bool = False, parameters: dict[str, Any] | None = None,
+                 allow_overwrite: bool = False):
         load_all()
         self.allow_outside_paths = bool(allow_outside_paths)
         #: `model restore` installs the FISH code of saves this user's key did not sign (`--trust-save`)
@@ -87,6 +88,7 @@ class Session:
         self.bind_context = BindContext(self.variables)
         self._text_dirs: dict[str, Path] = {}  # folder of text given by load_text(base_dir=…)
         self.written: set[Path] = set()        # resolved files `model save` wrote (read first by restores)
+        self.files = FileRecord(self.out_dir, allow_overwrite)  # what the run read and wrote (io/guard.py)
 
     # ------------------------------------------------------------------ output
     def write(self, text: str) -> None:
@@ -115,7 +117,7 @@ class Session:
         """The file a deck's name writes: under the output folder (``dec3d.io.paths.output_path``);
         a name that leaves it, or is not a regular file, raises ``PathError`` at ``where``."""
         try:
-            return paths.output_path(name, self.out_dir, self.allow_outside_paths)
+            return self.files.claim(paths.output_path(name, self.out_dir, self.allow_outside_paths), name)
         except paths.PathError as exc:
             raise exc.with_location(where) if where is not None else exc
 
@@ -124,8 +126,8 @@ class Session:
         this session wrote (``self.written``) first, so a run never reads an older copy beside the deck
         in place of the one it has just saved."""
         try:
-            return paths.find_input(name, self._read_bases(where), self._read_roots(where),
-                                    self.allow_outside_paths, exts, what, prefer=self.written)
+            return self.files.read(paths.find_input(name, self._read_bases(where), self._read_roots(where),
+                                   self.allow_outside_paths, exts, what, prefer=self.written), f"the {what} `{name}`")
         except paths.PathError as exc:
             raise exc.with_location(where)
 
@@ -175,7 +177,10 @@ class Session:
         if base_dir is not None and filename in PSEUDO_FILES:
             self._text_dirs[filename] = Path(base_dir)     # where its calls and restores look first
         with gc_paused():                   # binding makes objects per line too (lang.parser.gc_paused)
-            return self._bind_deck(deck, base_dir or Path.cwd(), stack)
+            items = self._bind_deck(deck, base_dir or Path.cwd(), stack)
+        if not stack:                       # every deck is read: no literal output may replace an input
+            bind_check(self, items)
+        return items
 
     def load_file(self, path: str | Path, stack: tuple[SourceLocation, ...] = ()) -> list[Item]:
         """Read and bind a deck. With a ``stack`` the file is called by a deck (its last entry is
@@ -200,6 +205,7 @@ class Session:
                 raise CommandError(f"cannot read deck `{shown}`: {size} bytes is more than a deck "
                                    f"({DECK_MAX_BYTES // 2**20} MiB at most)", where)
             raw = path.read_bytes()
+            self.files.read(path, "a deck it calls" if stack else "the running deck")
         except OSError as exc:
             # a called file: point at the `program call` line that names it
             raise CommandError(f"cannot read deck `{shown}`: {paths.os_error_text(exc)}", where) from None
@@ -288,16 +294,6 @@ class Session:
             bound[id(node)] = items
         return bound
 
-    def _resolve_call_path(self, name: str, base_dir: Path) -> Path:
-        """The file `program call '<name>'` from a deck in ``base_dir`` would read (the first candidate
-        that exists, else the name beside the deck); no checks — kept for tools such as `dec3d check`.
-        Running decks use ``find_deck``."""
-        for c in paths.input_candidates(name, [Path(base_dir), self.out_dir], (".dat", ".3ddat", ".fis", ".dec")):
-            if c.is_file():
-                return c
-        p = Path(name)
-        return p if p.is_absolute() else Path(base_dir) / p
-
     def find_deck(self, name: str, where) -> Path:
         """The file `program call '<name>'` reads (3DEC adds a default extension when there is none)."""
         return self.in_path(name, where, (".dat", ".3ddat", ".fis", ".dec"), "deck")
@@ -330,7 +326,10 @@ class Session:
     def call(self, path: str | Path) -> None:
         """Read, bind and run a deck file."""
         items = self.load_file(path)
-        self.run_items(items)
+        try:
+            self.run_items(items)
+        finally:
+            self.files.finish()
 
     def run_items(self, items: Iterable[Item]) -> None:
         items = list(items)
@@ -593,9 +592,9 @@ def _source_of(call: CommandCall) -> str:
 
 
 def run_deck(path: str | Path, out_dir: str | Path | None = None, echo: bool = False,
-             allow_outside_paths: bool = False) -> Session:
+             allow_outside_paths: bool = False, allow_overwrite: bool = False) -> Session:
     """Run a deck in a new Session and return it."""
     s = Session(out_dir=out_dir if out_dir is not None else Path(path).parent, echo=echo,
-                allow_outside_paths=allow_outside_paths)
+                allow_outside_paths=allow_outside_paths, allow_overwrite=allow_overwrite)
     s.call(path)
     return s

@@ -197,3 +197,27 @@ def chmod_like_outputs(path: str | os.PathLike) -> None:
 
 
 printable = _short
+
+
+def replace_via_temp(path, write, prefix: str = ".dec3d-") -> None:
+    """Write a file whole or not at all: ``write(binary file)`` fills a temporary file beside ``path``,
+    which then replaces ``path`` in one step. The temporary file is removed on every other way out
+    (an OS error, Ctrl-C, any exception), so a stopped write leaves the old file as it was and no
+    half-written file behind."""
+    import tempfile
+
+    folder = os.path.dirname(os.path.abspath(path))
+    os.makedirs(folder, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=prefix, dir=folder)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            write(fh)
+        chmod_like_outputs(tmp)             # mkstemp makes 0600; other outputs get 0666 less the umask
+        os.replace(tmp, path)
+        tmp = None
+    finally:
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass

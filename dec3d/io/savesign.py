@@ -63,8 +63,14 @@ def signing_key(create: bool = True) -> bytes | None:
     try:
         with os.fdopen(fd, "w", encoding="ascii") as fh:
             fh.write(secrets.token_hex(32) + "\n")
-    except OSError:
-        return None
+    except BaseException as exc:            # a full disk, Ctrl-C: no empty key file is left behind
+        try:
+            os.unlink(path)
+        except OSError:
+            pass
+        if isinstance(exc, OSError):
+            return None
+        raise
     return _read_key(path)
 
 

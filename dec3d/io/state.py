@@ -28,7 +28,6 @@ import hashlib
 import io
 import json
 import os
-import tempfile
 import zipfile
 import zlib
 
@@ -118,26 +117,19 @@ def save_state(model: Model, path: str | os.PathLike, records: list[str] | None 
     if hdesc is not None:
         meta["histories"] = hdesc
     text = json.dumps(meta, sort_keys=True, indent=1, allow_nan=False).encode("utf-8")
-    folder = os.path.dirname(os.path.abspath(path))
-    try:
-        os.makedirs(folder, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=".dec3d-save-", dir=folder)
-        with os.fdopen(fd, "wb") as fh, zipfile.ZipFile(fh, "w", compresslevel=6) as zf:
+    from .paths import os_error_text, replace_via_temp
+
+    def write(fh):
+        with zipfile.ZipFile(fh, "w", compresslevel=6) as zf:
             zf.writestr(_member(_META), text)
             zf.writestr(_member(_SIGNATURE), json.dumps(signature(text), sort_keys=True).encode("ascii"))
             for name, b in blobs.items():
                 zf.writestr(_member(name + ".npy"), b)
-        from .paths import chmod_like_outputs
 
-        chmod_like_outputs(tmp)             # mkstemp makes 0600; other outputs get 0666 less the umask
-        os.replace(tmp, path)
+    try:
+        # the temporary file is removed on every way out (Ctrl-C included): the old file stays whole
+        replace_via_temp(path, write, ".dec3d-save-")
     except OSError as exc:
-        try:
-            os.unlink(tmp)
-        except (OSError, NameError):
-            pass
-        from .paths import os_error_text
-
         raise StateFileError(f"cannot write state file '{path}': {os_error_text(exc)}") from None
     return path
 

@@ -109,7 +109,7 @@ def test_allowed_writes_land_in_the_output_folder(tree):
     after = listing(tree)
     assert changes_outside_out(before, after) == ["deck/d.dat"]
     assert sorted(k for k in after if k.startswith("out/")) == [
-        "out/abs.sav", "out/h.csv", "out/h_1.png", "out/run.log", "out/stage", "out/stage/one.sav",
+        "out/.dec3d-outputs.json", "out/abs.sav", "out/h.csv", "out/h_1.png", "out/run.log", "out/stage", "out/stage/one.sav",
         "out/v.pvd", "out/v_0000.vtu"]
     assert after["out/run.log"].decode().splitlines()[-1] == "done"
 
@@ -127,7 +127,7 @@ def test_a_history_name_cannot_steer_the_plot_file(tree):
     s, err = run_deck_text(tree, BRICK + "block history name '../../evil' displacement-z position 0.5 0.5 0.5\n"
                                          "model cycle 10\nhistory export '../../evil' file 'h.csv'\n")
     assert err is None
-    assert sorted(p.name for p in (tree / "out").iterdir()) == ["h.csv", "h_.._.._evil.png"]
+    assert sorted(p.name for p in (tree / "out").iterdir()) == [".dec3d-outputs.json", "h.csv", "h_.._.._evil.png"]
     assert sorted(p.name for p in tree.iterdir()) == ["deck", "out", "outside"]
 
 
