@@ -36,6 +36,12 @@ def pytest_configure(config):
     """A Python without dec3d's dependencies (a `pytest` from another environment) gets one clear
     message instead of an import error for every test module."""
     missing = [m for m in NEEDED if importlib.util.find_spec(m) is None]
+    if not missing:
+        # FISH raises Python's recursion limit when a session is made (dec3d.fish.runtime); the tests
+        # raise it once here, so that no test sees it change under it (hypothesis warns when it does)
+        from dec3d.fish.runtime import _deep_enough
+
+        _deep_enough()
     if missing:
         pytest.exit(f"this Python ({sys.executable}) lacks {', '.join(missing)}: install dec3d and its test "
                     "extras into it first, `pip install -e \".[test]\"` (README, 'Set up'), or run the "
