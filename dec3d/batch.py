@@ -233,7 +233,7 @@ def run_one(deck: str, values: dict[str, Any], out_dir: str, timeout: float | No
         finally:
             if session is not None:
                 session.close_log()
-                session.files.finish()
+                session.files.finish([session.log_path])
     row["wall_s"] = time.perf_counter() - t0
     if session is not None:
         row.update(_history_finals(session.model))

@@ -51,7 +51,7 @@ def _run_limited(args, limit, warmup) -> int:
             return 1
         finally:
             session.close_log()
-            session.files.finish()           # the record of the files dec3d wrote (dec3d/io/guard.py)
+            session.files.finish([session.log_path])     # the record of the files dec3d wrote (io/guard.py)
         for w in session.warnings:
             print(f"warning: {w}", file=sys.stderr)
         return 0

@@ -141,7 +141,7 @@ def run_repl(out_dir=None, history_file=None, input=None, output=None) -> int:
             session.write("internal error (please report it with the command that caused it):")
             session.write("".join(traceback.format_exception_only(type(exc), exc)).rstrip())
     session.close_log()
-    session.files.finish()           # the record of the files dec3d wrote (docs/safety.md)
+    session.files.finish([session.log_path])     # the record of the files dec3d wrote (docs/safety.md)
     return 0
 
 

@@ -12,6 +12,7 @@ evaluated just before their command runs.
 from __future__ import annotations
 
 import sys
+from contextlib import suppress
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable, TextIO
@@ -106,10 +107,8 @@ class Session:
                 # a full disk, a removed medium: logging stops, the run is told once
                 self.log_on = False
                 handle, self._log_handle = self._log_handle, None
-                try:
+                with suppress(OSError):
                     handle.close()
-                except OSError:
-                    pass
                 raise CommandError(f"cannot write the log file '{self.log_path}': {paths.os_error_text(exc)}; "
                                    "logging is off") from None
 
@@ -163,10 +162,8 @@ class Session:
 
     def close_log(self) -> None:
         if self._log_handle is not None:
-            try:
+            with suppress(OSError):
                 self._log_handle.close()
-            except OSError:
-                pass
             self._log_handle = None
 
     # ------------------------------------------------------------------ reading
@@ -325,33 +322,35 @@ class Session:
 
     def call(self, path: str | Path) -> None:
         """Read, bind and run a deck file."""
-        items = self.load_file(path)
-        try:
-            self.run_items(items)
-        finally:
-            self.files.finish()
+        self.run_items(self.load_file(path))
 
     def run_items(self, items: Iterable[Item]) -> None:
-        items = list(items)
+        """Run bound items; a top-level call ends by recording the files written (io/guard.py)."""
+        self._depth = getattr(self, "_depth", 0) + 1
         try:
-            i = 0
+            self._run_items(list(items))
+        finally:
+            self._depth -= 1
+            if self._depth == 0:
+                self.files.finish(still_writing=[self.log_path if self._log_handle is not None else None])
+
+    def _run_items(self, items: list) -> None:
+        i = 0
+        try:
             while i < len(items):
                 j = self._batch_end(items, i)
                 if j > i + 1:
-                    i = self._run_batch(items[i:j]) + i
-                else:
-                    self._run_one(items[i])
-                    i += 1
+                    i += self._run_batch(items[i:j])
+                    continue
+                self._run_one(items[i])
+                i += 1
         except StopDeck:
             pass
 
-    #: a run of batchable lines shorter than this runs line by line: a batch function's compiled
-    #: kernel costs seconds to compile on a cold cache, which only long runs win back
-    batch_min = 50
+    batch_min = 50      # shorter runs of batchable lines go line by line (a cold compile costs seconds)
 
     def _batch_end(self, items: list, i: int) -> int:
-        """End of the run of lines from ``items[i]`` whose commands share a batch function (i + 1
-        when the run is shorter than ``batch_min``)."""
+        """End of the run of lines from ``items[i]`` sharing a batch function (i + 1 if under batch_min)."""
         item = items[i]
         if self.echo or not isinstance(item, CommandCall) or item.command.batch is None:
             return i + 1

@@ -63,6 +63,7 @@ class FileRecord:
         self.inputs: dict[Path, str] = {}       # resolved path -> what it was read as
         self.input_keys: dict[tuple, Path] = {}  # (device, inode) -> resolved path
         self.created: set[Path] = set()
+        self.dirty: set[Path] = set()            # written since the manifest was last written
         self._manifest: dict | None = None
 
     # ---------------------------------------------------------------- reads
@@ -111,6 +112,7 @@ class FileRecord:
         if exc is not None:
             raise exc.with_location(where) if where is not None else exc
         self.created.add(real)
+        self.dirty.add(real)
         return real
 
     def _root(self) -> Path:
@@ -167,21 +169,26 @@ class FileRecord:
                 pass
         return self._manifest
 
-    def finish(self) -> None:
-        """Write the manifest: the files this run wrote (as they are now) and earlier entries still true."""
-        if not self.created:
+    def finish(self, still_writing=()) -> None:
+        """Write the manifest: the files written since it was last written (as they are now; also the
+        files in ``still_writing``, such as an open log, which may grow after this) and earlier
+        entries still true. Cheap when nothing was written: it runs at the end of every top-level
+        ``Session.run_items``."""
+        todo = self.dirty | {Path(p).resolve() for p in still_writing if p is not None}
+        if not todo:
             return
         root = self._root()
         entries = {}
         for rel, v in self._entries().items():
             if (root / rel).is_file():
-                entries[rel] = v          # an earlier run's output (checked again before it is replaced)
-        for real in self.created:
+                entries[rel] = v          # an earlier output (checked again before it is replaced)
+        for real in todo:
             rel = self._rel(real)
             if rel is not None and real.is_file() and rel != MANIFEST:
                 v = _digest(real)
                 if v is not None:
                     entries[rel] = v
+        self.dirty.clear()
         if not entries or not root.is_dir():
             return
         text = json.dumps({"version": 1, "files": dict(sorted(entries.items()))}, indent=0)

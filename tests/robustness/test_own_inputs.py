@@ -244,3 +244,24 @@ def test_without_the_record_saves_and_vtk_files_are_still_dec3d_s_own(tmp_path):
     s, err = run(tmp_path, text)
     assert err.message.startswith(f"`h.csv` would replace the existing file {tmp_path / 'h.csv'}")
     assert where(err) == ("d.dat", 7, 23)
+
+
+def test_sessions_from_python_one_after_another_replace_their_own_outputs(tmp_path):
+    """A deck run from Python (load_file + run_items, no `dec3d run`) records what it wrote when the
+    top-level run_items ends, so the next session in the same folder may replace its log and tables."""
+    import io
+
+    from dec3d.session import Session
+
+    deck = tmp_path / "d.dat"
+    deck.write_text("program log on\n[a = 1]\nblock create brick 0 1 0 1 0 1\nmodel history mechanical ratio\n"
+                    "block property density 1000\nmodel cycle 2\nhistory export '1' file 'h.csv'\n")
+    for _ in range(2):
+        s = Session(out_dir=tmp_path, stdout=io.StringIO())
+        s.run_items(s.load_file(deck))
+    assert (tmp_path / "dec3d.log").is_file() and (tmp_path / "h.csv").is_file()
+    (tmp_path / "h.csv").write_text("edited by hand\n")          # changed since: kept
+    s = Session(out_dir=tmp_path, stdout=io.StringIO())
+    with pytest.raises(Exception, match="which dec3d did not write"):
+        s.run_items(s.load_file(deck))
+    assert (tmp_path / "h.csv").read_text() == "edited by hand\n"
