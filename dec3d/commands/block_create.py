@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import Dec3dError
-from ..geometry.polyhedron import (brick_faces, build_many, polyhedron_from_faces, prism_faces,
+from ..geometry.polyhedron import (brick_faces, build_many, polyhedron_from_faces, prism_faces, split_faces,
                                    tetrahedron_faces)
 from ..geometry.tunnel import tunnel, tunnel_block_count
 from ..model.blocks import add_blocks, add_pieces
@@ -107,9 +107,7 @@ def _shape(call, tol: float):
 def _create(session, call) -> None:
     tol = session.model.tolerance
     pts, fn = _shape(call, tol)
-    what = call.command.path[-1]
-    _add(session, call, [polyhedron_from_faces(np.split(pts, np.cumsum(fn)[:-1]), tol,
-                                               "polyhedron" if what == "polyhedron" else what)])
+    _add(session, call, [polyhedron_from_faces(split_faces(pts, fn), tol, call.command.path[-1])])
 
 
 def _create_many(session, calls) -> int:

@@ -243,25 +243,26 @@ def prism_faces(face1, face2, tol: float = 1e-6) -> tuple[np.ndarray, np.ndarray
     return np.concatenate([a, b, sides]), np.array([k, k] + [4] * k, dtype=np.int64)
 
 
-def _split(pts: np.ndarray, fn: np.ndarray) -> list[np.ndarray]:
+def split_faces(pts: np.ndarray, fn: np.ndarray) -> list[np.ndarray]:
+    """The face arrays of a (corners, corners per face) shape, as ``polyhedron_from_faces`` takes them."""
     return np.split(pts, np.cumsum(fn)[:-1])
 
 
 def brick(x1: float, x2: float, y1: float, y2: float, z1: float, z2: float,
           tol: float = 1e-6) -> Poly:
     """Axis-aligned box [x1, x2] × [y1, y2] × [z1, z2] (bounds in either order)."""
-    return polyhedron_from_faces(_split(*brick_faces(x1, x2, y1, y2, z1, z2, tol)), tol, "brick")
+    return polyhedron_from_faces(split_faces(*brick_faces(x1, x2, y1, y2, z1, z2, tol)), tol, "brick")
 
 
 def tetrahedron(v1, v2, v3, v4, tol: float = 1e-6) -> Poly:
     """Tetrahedron on four corners (any order)."""
-    return polyhedron_from_faces(_split(*tetrahedron_faces(v1, v2, v3, v4)), tol, "tetrahedron")
+    return polyhedron_from_faces(split_faces(*tetrahedron_faces(v1, v2, v3, v4)), tol, "tetrahedron")
 
 
 def prism(face1, face2, tol: float = 1e-6) -> Poly:
     """Prism between two polygons with the same number of corners, corner i of
     ``face1`` joined to corner i of ``face2``; the side faces must be planar."""
-    return polyhedron_from_faces(_split(*prism_faces(face1, face2, tol)), tol, "prism")
+    return polyhedron_from_faces(split_faces(*prism_faces(face1, face2, tol)), tol, "prism")
 
 
 def build_many(shapes: Sequence[tuple[np.ndarray, np.ndarray]], tol: float = 1e-6):
