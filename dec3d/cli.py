@@ -37,6 +37,7 @@ def _run_limited(args, limit, warmup) -> int:
         session = Session(out_dir=out, echo=not args.quiet, allow_outside_paths=args.allow_outside_paths,
                           allow_overwrite=args.allow_overwrite)
         session.trust_saves = args.trust_save
+        session.skip_unsupported = args.skip_unsupported
         try:
             items = session.load_file(deck)          # parse and bind everything first
         except Dec3dError as exc:
@@ -155,6 +156,9 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--trust-save", action="store_true",
                    help="`model restore` installs the FISH functions and callbacks of every save it reads, "
                         "also of saves not made by you on this machine (only for saves you trust; docs/safety.md)")
+    r.add_argument("--skip-unsupported", action="store_true",
+                   help="skip the lines dec3d does not implement yet (each is printed and warned about) "
+                        "instead of stopping there")
     r.set_defaults(fn=_run)
     b = sub.add_parser("batch", help="run a deck for many parameter values (process pool or Dask) and "
                                      "collect one table")
