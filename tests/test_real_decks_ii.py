@@ -292,3 +292,68 @@ def test_check_says_the_run_stops_at_the_unimplemented_line(tmp_path, capsys):
     check_main([str(tmp_path / "master.dat")])
     text = capsys.readouterr().out
     assert "would run the lines before" in text and "sub.dat:2" in text and "--skip-unsupported" in text
+
+
+STACK = """model new
+model large-strain off
+block create brick 0 1 0 1 -1 0 group 'base'
+block create brick 0 1 0 1 0 1 group 'dig'
+block create brick 0 1 0 1 1 2 group 'top'
+block zone generate edgelength 0.5 range group 'dig' or 'top'
+block zone cmodel assign elastic
+block zone property bulk 1e8 shear 6e7 density 2000
+block property density 2000
+block contact property stiffness-normal 1e10 stiffness-shear 1e10
+model gravity 0 0 -9.81
+block fix range group 'base'
+"""
+
+
+def _stack(tmp_path, more: str) -> Session:
+    s = Session(out_dir=tmp_path, stdout=io.StringIO())
+    s.command(STACK + more)
+    return s
+
+
+def _top_settlement(s) -> float:
+    v, b = s.model.vertices, s.model.blocks
+    top = v["zoned"] & (b["id"][v["block"]] == 3)
+    return float(v["disp"][top, 2].mean())
+
+
+def test_excavate_takes_a_block_out_and_fill_puts_it_back(tmp_path):
+    # the block under 'top' excavated: nothing holds 'top' up and it falls; kept, it settles by micrometres
+    kept = _stack(tmp_path / "a", "model cycle 1000")
+    dug = _stack(tmp_path / "b", "block excavate face-group 'wall' range group 'dig'\nmodel cycle 1000")
+    assert -1e-3 < _top_settlement(kept) < 0 and _top_settlement(dug) < -1e-2
+    m = dug.model
+    assert m.blocks["excavated"][1] and m.blocks["hidden"][1]
+    dug.command("block hide off")                                 # does not bring an excavated block back
+    assert m.blocks["hidden"][1]
+    # the faces next to the excavation: the base's top (z = 0, up) and the top block's bottom triangles (z = 1,
+    # down), one square metre each
+    f = m.faces
+    wall = np.flatnonzero((f["group"][: f.n] == m.groups.code("wall")).any(axis=1))
+    z, nz, area = f["centroid"][wall, 2], f["normal"][wall, 2], f["area"][wall]
+    assert set(np.round(z, 9)) == {0.0, 1.0}
+    assert area[z < 0.5].sum() == pytest.approx(1.0) and np.allclose(nz[z < 0.5], 1.0)
+    assert area[z > 0.5].sum() == pytest.approx(1.0) and np.allclose(nz[z > 0.5], -1.0)
+    # filled before any cycle: the same numbers as never excavated
+    refilled = _stack(tmp_path / "c", "block excavate range group 'dig'\n"
+                                      "block fill block-group 'filled' boundary-contact-group 'bnd' "
+                                      "internal-contact-group 'inner' range group 'dig'\nmodel cycle 1000")
+    assert np.array_equal(refilled.model.vertices["disp"], kept.model.vertices["disp"])
+    from dec3d.physics.rigid import engine
+    c = engine(refilled.model).contacts
+    g = refilled.model.groups
+    bnd = (c["group"][: c.n] == g.code("bnd")).any(axis=1)
+    assert bnd.sum() == 2 and not (c["group"][: c.n] == g.code("inner")).any()     # dig-base and dig-top
+    assert refilled.model.blocks["group"][1, 0] == g.code("filled")
+
+
+def test_excavate_refuses_rigid_blocks_and_keeps_the_model(tmp_path):
+    s = _stack(tmp_path, "")
+    with pytest.raises(Dec3dError) as e:
+        s.command("block excavate range group 'base' or 'dig'")
+    assert "rigid block(s) in range (id 1)" in e.value.message and "block delete" in e.value.message
+    assert not s.model.blocks["excavated"].any() and not s.model.blocks["hidden"].any()

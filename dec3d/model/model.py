@@ -80,6 +80,7 @@ def _block_fields() -> dict[str, Field]:
         "apply_fix": Field((), np.uint8, 0),
         "kind": Field((), np.int8, KIND_RIGID),
         "hidden": Field((), np.bool_, False),
+        "excavated": Field((), np.bool_, False),   # `block excavate`: hidden until `block fill`
         "leader": Field((), _I, -1),
         "region": Field((), _I, 0),          # 3DEC 5 region number (`r=<i>` of generators, `range region`)
         "group": group_field(),
