@@ -27,7 +27,8 @@ from .io import paths
 from .io.guard import FileRecord
 from .lang.parser import ParsedDeck, gc_paused, parse_deck
 from .lang.prepass import FishBlock
-from .lang.unsupported import Unsupported, bind_or_defer
+from .lang.progress import BindProgress
+from .lang.unsupported import Unsupported, bind_or_defer, empty_range
 from .model.model import Model
 
 
@@ -220,7 +221,9 @@ class Session:
         items: list[Item] = []
         fish = iter(deck.fish)
         next_fish = next(fish, None)
+        progress = BindProgress(self.write, paths.printable(deck.filename))
         for raw in deck.lines:
+            progress.tick(raw.line)
             while next_fish is not None and next_fish.line < raw.line:
                 items.append(self._fish_item(deck, next_fish, stack))
                 next_fish = next(fish, None)
@@ -432,9 +435,10 @@ class Session:
                 raise CommandError(f"range element `{rc.element.name}` gave {m.shape[0]} values for {n} {store}s",
                                    rc.location)
             masks.append(~m if rc.negate else m)
-        if call.range.union:
-            return np.logical_or.reduce(masks)
-        return np.logical_and.reduce(masks)
+        mask = np.logical_or.reduce(masks) if call.range.union else np.logical_and.reduce(masks)
+        if n and not mask.any():
+            empty_range(self, call, store, n)
+        return mask
 
     def _value(self, vtype, value, where, name: str = ""):
         """A deferred value evaluated and converted by its type; `name` (the keyword) is put in
