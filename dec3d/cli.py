@@ -1,4 +1,4 @@
-"""The `dec3d` command line: run, batch, repl, verify, ssdem, docs."""
+"""The `dec3d` command line: run (decks and Python drivers), batch, repl, verify, ssdem, docs."""
 from __future__ import annotations
 
 import argparse
@@ -37,6 +37,12 @@ def _run_limited(args, limit, warmup) -> int:
         session = Session(out_dir=out, echo=not args.quiet, allow_outside_paths=args.allow_outside_paths,
                           allow_overwrite=args.allow_overwrite)
         session.trust_saves = args.trust_save
+        session.allow_python = args.allow_python
+        if args.allow_python or deck.suffix.lower() == ".py":
+            from .itasca.driver import run_driver      # (and runs the Python files decks call)
+
+            if deck.suffix.lower() == ".py":     # a Python driver, dec3d.itasca bound to this session
+                return run_driver(session, deck)
         try:
             items = session.load_file(deck)          # parse and bind everything first
         except Dec3dError as exc:
@@ -140,7 +146,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="dec3d", description="3DEC-style distinct element program")
     ap.add_argument("--version", action="version", version=f"dec3d {__version__}")
     sub = ap.add_subparsers(dest="cmd", required=True)
-    r = sub.add_parser("run", help="run a deck")
+    r = sub.add_parser("run", help="run a deck, or a Python driver (script.py: `import itasca`, docs/python.md)")
     r.add_argument("deck")
     r.add_argument("--out", help="folder for outputs (default: the deck's folder)")
     r.add_argument("-q", "--quiet", action="store_true", help="do not echo commands")
@@ -155,6 +161,9 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--trust-save", action="store_true",
                    help="`model restore` installs the FISH functions and callbacks of every save it reads, "
                         "also of saves not made by you on this machine (only for saves you trust; docs/safety.md)")
+    r.add_argument("--allow-python", action="store_true",
+                   help="let decks run Python files (`program call 'x.py'`); Python is code, decks are data "
+                        "(docs/python.md)")
     r.set_defaults(fn=_run)
     b = sub.add_parser("batch", help="run a deck for many parameter values (process pool or Dask) and "
                                      "collect one table")
