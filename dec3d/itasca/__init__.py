@@ -65,7 +65,7 @@ def set_gravity(g) -> None:
     from ._objects import vec3
 
     a = vec3(g, "set_gravity")
-    current().command(f"model gravity {a[0]!r} {a[1]!r} {a[2]!r}")
+    current().command("model gravity " + " ".join(repr(float(c)) for c in a))
 
 
 def threads() -> int:

@@ -32,8 +32,8 @@ class StaleError(RuntimeError):
 
 
 class CallbackError(RuntimeError):
-    """A Python callback raised while the model cycled: cycling stopped after the last whole step; the
-    user's exception is chained (``__cause__``) with its traceback."""
+    """A Python callback raised while the model cycled: cycling stopped and the model is back at its state
+    before the cycling command; the user's exception is chained (``__cause__``) with its traceback."""
 
 
 def _caller() -> str:

@@ -8,7 +8,8 @@ motion (it sees the state the step left). Callbacks belong to the ``dec3d.Model`
 `model new` and `model restore`).
 
 A callback that raises stops the cycling at once: ``CallbackError`` (naming the callback and the step)
-with the user's exception chained, traceback included; the model keeps the state of the last whole step.
+with the user's exception chained, traceback included. As for every error while cycling, the model is
+back at its state before the cycling command (``RigidEngine.cycle`` restores it), consistent and intact.
 """
 from __future__ import annotations
 
@@ -19,17 +20,32 @@ from typing import Callable
 from ._bind import CallbackError, Model, current
 
 
-def _resolve(func, depth: int = 3) -> tuple[Callable, str]:
+def _user_frame():
+    """The first frame outside dec3d.itasca (the user's code that called us)."""
+    here = __file__.rsplit("/", 1)[0].rsplit("\\", 1)[0]
+    f = sys._getframe(1)
+    while f is not None and f.f_code.co_filename.startswith(here):
+        f = f.f_back
+    return f
+
+
+def _resolve(func, registered=()) -> tuple[Callable, str]:
+    """(function, name) of ``func``: a callable, or a name looked up in the registered callbacks, then in the
+    calling code's locals and globals, then in ``__main__`` (Itasca passes callbacks by name)."""
     if callable(func):
         return func, getattr(func, "__name__", repr(func))
     if isinstance(func, str):
-        f = sys._getframe(depth)
-        for scope in (f.f_globals, sys.modules["__main__"].__dict__):
+        for c in registered:
+            if c[2] == func:
+                return c[1], func
+        f = _user_frame()
+        scopes = (f.f_locals, f.f_globals) if f is not None else ()
+        for scope in (*scopes, sys.modules["__main__"].__dict__):
             fn = scope.get(func)
             if callable(fn):
                 return fn, func
-        raise ValueError(f"set_callback: there is no Python function named '{func}'")
-    raise TypeError(f"set_callback takes a function (or its name), not a {type(func).__name__}")
+        raise ValueError(f"there is no Python function named '{func}'")
+    raise TypeError(f"a callback is a function (or its name), not a {type(func).__name__}")
 
 
 def _position(position) -> float:
@@ -59,7 +75,7 @@ def remove_callback(func, position: float | None = None, model: Model | None = N
     """Remove the callback ``func`` (at ``position``; every position when omitted). ValueError when it is
     not set."""
     api = model or current()
-    fn, name = _resolve(func)
+    fn, name = _resolve(func, api.callbacks)
     keep = [c for c in api.callbacks if not (c[1] is fn and (position is None or c[0] == _position(position)))]
     if len(keep) == len(api.callbacks):
         where = "" if position is None else f" at position {position}"
@@ -75,7 +91,8 @@ def run(api: Model, before: bool, step: int) -> None:
             fn()
         except Exception as exc:
             raise CallbackError(f"Python callback '{name}' (position {p:g}) raised at step {step}: "
-                                f"{type(exc).__name__}: {exc}; cycling stopped") from exc
+                                f"{type(exc).__name__}: {exc}; cycling stopped, the model is back at its state before "
+                                "this cycling command") from exc
 
 
 class PyAfter:

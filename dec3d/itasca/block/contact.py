@@ -29,12 +29,14 @@ class Contact(Entity):
 
     def _call(self, name, *args):
         self._model()
+        _stores(self._api)              # detected again first when the blocks changed
         return fish_call(self._api, name, self._ptr(), *args)
 
     def _row(self):
         from ...fish.contact_intrinsics import _contact_row
 
         self._model()
+        _stores(self._api)
         try:
             return _contact_row(self._api.session.fish_rt, self._ptr(), "Contact")
         except Exception as exc:          # FishValueError: the contact is gone

@@ -24,7 +24,10 @@ class Subcontact(Entity):
         return ContactPtr("subcontact", self._id)
 
     def _call(self, name):
+        from .contact import _stores
+
         self._model()
+        _stores(self._api)              # detected again first when the blocks changed
         return fish_call(self._api, name, self._ptr())
 
     def id(self) -> tuple[int, int, int]:
