@@ -1,0 +1,99 @@
+"""`dec3d run script.py` (a Python driver with `import itasca` bound to a fresh model, under the output
+folder rules of decks) and decks calling Python files (refused unless --allow-python)."""
+import sys
+
+import pytest
+
+from dec3d.cli import main
+
+DRIVER = '''import itasca as it
+from itasca import blockarray as ba
+import itasca.block.contact
+
+it.command("python-reset-state false")
+it.command("""
+model new
+block create brick 0 1 0 1 0 1
+block create brick 0 1 0 1 1 2
+block property density 2000
+block contact jmodel assign mohr
+block contact property stiffness-normal 1e9 ...
+    stiffness-shear 1e9 friction 30
+model gravity 0 0 -10
+block fix range position-z 0 0.5
+""")
+steps = []
+def record(*args):
+    steps.append(it.step())
+it.set_callback("record", 1.0)
+it.cycle(50)
+c = list(it.block.contact.list())[0]
+print("RESULT", len(steps), round(c.force_norm()), ba.pos().shape, itasca.block.contact is it.block.contact)
+it.command("model save 'state.sav'")
+'''
+
+
+@pytest.fixture
+def folder(tmp_path):
+    (tmp_path / "drv.py").write_text(DRIVER)
+    return tmp_path
+
+
+def test_run_a_python_driver_into_the_output_folder(folder, capsys):
+    out = folder / "out"
+    assert main(["run", str(folder / "drv.py"), "--out", str(out), "-q"]) == 0
+    text = capsys.readouterr().out
+    assert "RESULT 50 19999 (2, 3) True" in text
+    assert (out / "state.sav").exists() and not (folder / "state.sav").exists()
+    # the default output folder is the script's
+    assert main(["run", str(folder / "drv.py"), "-q"]) == 0
+    assert (folder / "state.sav").exists()
+    assert "itasca" not in sys.modules or sys.modules["itasca"].__name__ == "dec3d.itasca"
+
+
+def test_a_deck_calling_python_is_refused_unless_allowed(folder, capsys):
+    deck = folder / "deck.dat"
+    deck.write_text("model new\nprogram call 'drv.py'\n")
+    assert main(["run", str(deck), "--out", str(folder / "o"), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert f"{deck}:2:1: error: `drv.py` is a Python file" in err and "--allow-python" in err
+    assert "nothing was run" in err
+    assert not (folder / "o" / "state.sav").exists()
+    assert main(["run", str(deck), "--out", str(folder / "o"), "-q", "--allow-python"]) == 0
+    assert "RESULT 50 19999" in capsys.readouterr().out
+    assert (folder / "o" / "state.sav").exists()
+
+
+def test_a_failing_command_or_syntax_error_in_a_driver(folder, capsys):
+    bad = folder / "bad.py"
+    bad.write_text('import itasca as it\nit.command("""\nmodel new\nblock frobnicate 3\n""")\n')
+    assert main(["run", str(bad), "-q"]) == 1
+    err = capsys.readouterr().err
+    assert f"{bad}:2: it.command failed" in err and "<command>:3:7: error: unknown command `block frobnicate`" in err
+    syn = folder / "syn.py"
+    syn.write_text("import itasca as it\nit.command('model new'\n")
+    assert main(["run", str(syn), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert f"{syn}:2:" in err and "nothing was run" in err
+    boom = folder / "boom.py"
+    boom.write_text("import itasca as it\n\ndef f():\n    return 1 / 0\n\nf()\n")
+    assert main(["run", str(boom), "-q"]) == 1
+    err = capsys.readouterr().err
+    assert "ZeroDivisionError" in err and 'boom.py", line 4, in f' in err and "dec3d/cli.py" not in err
+    # an error in a Python file a deck calls stops the deck at the call
+    deck = folder / "d.dat"
+    deck.write_text("model new\ncall 'boom.py'\n")
+    assert main(["run", str(deck), "-q", "--allow-python"]) == 1
+    err = capsys.readouterr().err
+    assert f"{deck}:2:1: error: the Python file `boom.py` raised ZeroDivisionError" in err and "(line 4:" in err
+
+
+def test_the_top_level_itasca_shim_is_dec3d_itasca():
+    import dec3d.itasca
+    import itasca
+    from itasca import blockarray
+
+    assert itasca is dec3d.itasca and blockarray is dec3d.itasca.blockarray
+    import itasca.block.contact as c
+
+    assert c is dec3d.itasca.block.contact
