@@ -5,6 +5,7 @@ import numpy as np
 import dec3d
 import dec3d.itasca as it
 from arch import arch_commands
+from it_fixture import fresh_it  # noqa: F401  (autouse: no model bound, a fresh working folder)
 
 G = 9.81
 

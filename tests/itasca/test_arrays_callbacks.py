@@ -8,6 +8,7 @@ import pytest
 import dec3d
 import dec3d.itasca as it
 from dec3d.itasca import blockarray as ba
+from it_fixture import fresh_it  # noqa: F401  (autouse: no model bound, a fresh working folder)
 
 STACK = """
 model new

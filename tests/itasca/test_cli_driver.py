@@ -9,6 +9,7 @@ from dec3d.cli import main
 DRIVER = '''import itasca as it
 from itasca import blockarray as ba
 import itasca.block.contact
+from it_fixture import fresh_it  # noqa: F401  (autouse: no model bound, a fresh working folder)
 
 it.command("python-reset-state false")
 it.command("""

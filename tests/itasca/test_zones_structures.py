@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 
 import dec3d.itasca as it
+from it_fixture import fresh_it  # noqa: F401  (autouse: no model bound, a fresh working folder)
 
 ZONED = """
 model new

@@ -1,9 +1,6 @@
-import sys
-from pathlib import Path
-
+"""The fixture of the tests of dec3d.itasca (imported by each module: a conftest.py here would shadow the
+top-level `conftest` other test folders import)."""
 import pytest
-
-sys.path.insert(0, str(Path(__file__).parent))          # arch.py, the drivers' model text
 
 
 @pytest.fixture(autouse=True)
