@@ -108,3 +108,19 @@ def program_echo(session, call):
          examples=["python-reset-state false"])
 def python_reset_state(session, call):
     pass
+
+
+def _check_autosave(call):
+    from ..errors import NotSupportedError
+
+    if call.args["active"]:
+        raise NotSupportedError("dec3d does not save the model on its own: `program automatic-model-save active "
+                                "on` is not supported (save with `model save`)", call.location)
+
+
+@command("program automatic-model-save", keywords=[P("active", ONOFF, "off: no automatic saves (what dec3d does)",
+                                                     required=True)], check=_check_autosave,
+         doc="Accepted as `active off` (3DEC's Python drivers switch automatic saves off); dec3d never saves on its own.",
+         examples=["program automatic-model-save active off"])
+def program_autosave(session, call):
+    pass

@@ -2,7 +2,9 @@
 
 A driver runs as ``__main__`` with ``import itasca`` giving ``dec3d.itasca`` (``alias_itasca``), bound to
 the run's model: the session `dec3d run` made with the output folder of decks (``--out``, default the
-script's folder; files written stay in it, docs/safety.md), relative names read from the script's folder.
+script's folder; files its commands write stay in it, docs/safety.md), relative names in commands read
+from the script's folder, then the output folder. The script runs in its own folder (the working folder
+while it runs, as 3DEC drivers expect for their own ``open()``/``np.loadtxt`` of sibling files).
 
 A deck that calls a Python file is refused when it is read (nothing runs) unless the user passed
 ``--allow-python`` (``Session.allow_python``; ``dec3d.commands.program_cmds.python_call``): Python is code,
@@ -48,16 +50,19 @@ def model_of(session, base_dir: Path) -> Model:
 def exec_script(api: Model, path: Path, argv: list[str] | None = None) -> None:
     """Run the Python file ``path`` as ``__main__`` (``runpy.run_path``: compiled first, so a syntax error
     stops it before anything runs) with ``dec3d.itasca`` bound to ``api``."""
+    import os
     import runpy
 
     alias_itasca()
-    old_argv = sys.argv
+    old_argv, old_cwd = sys.argv, os.getcwd()
     sys.argv = [str(path), *(argv or [])]
+    os.chdir(path.resolve().parent)          # the script's own open()/os.path calls: beside it, as in 3DEC
     try:
         with api.bound():
-            runpy.run_path(str(path), run_name="__main__")
+            runpy.run_path(str(path.resolve()), run_name="__main__")
     finally:
         sys.argv = old_argv
+        os.chdir(old_cwd)
 
 
 def run_driver(session, path: Path) -> int:
@@ -99,7 +104,7 @@ def run_driver(session, path: Path) -> int:
 def _print_user_traceback(path: Path) -> None:
     """The traceback from the script's first frame on (dec3d's own frames before it left out)."""
     etype, exc, tb = sys.exc_info()
-    while tb is not None and tb.tb_frame.f_code.co_filename != str(path):
+    while tb is not None and tb.tb_frame.f_code.co_filename != str(path.resolve()):
         tb = tb.tb_next
     traceback.print_exception(etype, exc, tb, file=sys.stderr)
 
@@ -118,7 +123,7 @@ def _run_from_deck(session, path: Path, where) -> None:
         raise CommandError(f"`{path.name}` is not valid Python: line {exc.lineno}: {exc.msg}", where) from None
     except Exception as exc:
         tb = traceback.extract_tb(exc.__traceback__)
-        at = next((f for f in reversed(tb) if f.filename == str(path)), None)
+        at = next((f for f in reversed(tb) if f.filename == str(path.resolve())), None)
         line = f" (line {at.lineno}: {at.line})" if at is not None else ""
         raise CommandError(f"the Python file `{path.name}` raised {type(exc).__name__}: {exc}{line}", where) from exc
 

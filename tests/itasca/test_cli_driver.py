@@ -98,3 +98,39 @@ def test_the_top_level_itasca_shim_is_dec3d_itasca():
     import itasca.block.contact as c
 
     assert c is dec3d.itasca.block.contact
+
+
+STYLE = '''import itasca as it
+import os
+import numpy as np
+
+it.command("python-reset-state false")
+it.command("program automatic-model-save active off")
+os.makedirs("tables", exist_ok=True)                      # the script's own files: beside it
+with open(os.path.join("tables", "pulse.txt"), "w") as f:
+    f.write("pulse\\n3\\t0\\n0 0\\n1 2\\n2 0\\n")
+spacing = np.loadtxt("spacing.csv")                       # a sibling input, read by Python
+it.command("call 'geometry.dat'")                          # a sibling deck, read by dec3d
+it.command("table 'p' import 'tables/pulse.txt'")
+it.command("""
+fish define top_z
+    top_z = block.pos.z(2)
+end
+[height = top_z + {sp}]
+""".format(sp=float(spacing)))
+print("HEIGHT", it.fish.get("height"), it.block.count())
+'''
+
+
+def test_a_driver_in_the_style_of_public_3dec_scripts(tmp_path, capsys):
+    (tmp_path / "style.py").write_text(STYLE)
+    (tmp_path / "spacing.csv").write_text("0.25\n")
+    (tmp_path / "geometry.dat").write_text("block create brick 0 1 0 1 0 1\nblock create brick 0 1 0 1 1 2\n")
+    out = tmp_path / "results"
+    assert main(["run", str(tmp_path / "style.py"), "--out", str(out), "-q"]) == 0
+    assert "HEIGHT 1.75 2" in capsys.readouterr().out
+    assert (tmp_path / "tables" / "pulse.txt").exists()
+    bad = tmp_path / "auto.py"
+    bad.write_text('import itasca as it\nit.command("program automatic-model-save active on")\n')
+    assert main(["run", str(bad), "-q"]) == 1
+    assert "automatic-model-save active on` is not supported" in capsys.readouterr().err
