@@ -77,6 +77,8 @@ class Model:
         self.base_dir = Path(base_dir) if base_dir is not None else Path.cwd()
         #: Python callbacks: [position, function, name] sorted by position (``it.set_callback``)
         self.callbacks: list[list] = []
+        #: > 0 while a callback runs (commands that cycle or change the block set are refused then)
+        self.in_callback = 0
 
     # ------------------------------------------------------------------ state
     @property
@@ -95,6 +97,8 @@ class Model:
         s = self.session
         try:
             items = s.load_text(text, "<command>", self.base_dir)
+            if self.in_callback:
+                _refuse_in_callback(items)
             for chunk in _chunks(items):
                 attach(self)
                 s.run_items(chunk)
@@ -125,6 +129,19 @@ class Model:
     def __repr__(self) -> str:
         st = self.session.model
         return f"<dec3d.Model: {st.blocks.n} blocks, step {st.step}, out_dir '{self.session.out_dir}'>"
+
+
+def _refuse_in_callback(items: list) -> None:
+    """Inside a callback the engine's step loop is running on the block set it started with: the commands a
+    FISH callback may not run (they cycle, replace the model or change its blocks) are refused here too."""
+    from ..errors import CommandError
+    from ..fish.sections import _cycle_bound
+
+    for it in items:
+        path = getattr(getattr(it, "command", None), "path", ())
+        if path and _cycle_bound(path):
+            raise CommandError(f"`{' '.join(path)}` cannot run in a Python callback: the cycle that calls it is "
+                               "still going on (cycle again, or change the blocks, after it returns)", it.location)
 
 
 def _chunks(items: list) -> list[list]:

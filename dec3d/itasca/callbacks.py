@@ -87,12 +87,15 @@ def run(api: Model, before: bool, step: int) -> None:
     for p, fn, name in list(api.callbacks):
         if (p < 0) != before:
             continue
+        api.in_callback += 1
         try:
             fn()
         except Exception as exc:
             raise CallbackError(f"Python callback '{name}' (position {p:g}) raised at step {step}: "
                                 f"{type(exc).__name__}: {exc}; cycling stopped, the model is back at its state before "
                                 "this cycling command") from exc
+        finally:
+            api.in_callback -= 1
 
 
 class PyAfter:

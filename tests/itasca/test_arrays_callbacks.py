@@ -191,3 +191,17 @@ def test_several_models_in_one_interpreter(tmp_path):
         assert (tmp_path / f"m{k}" / "x.sav").exists()
     with pytest.raises(TypeError, match="dec3d.Model"):
         it.bind("model")
+
+
+def test_a_callback_may_not_cycle_or_change_the_blocks():
+    it.command(STACK)
+
+    def nested():
+        it.command("block apply force 0 0 1 range id 3")          # allowed: a load
+        it.cycle(1)                                               # refused: the cycle is still going on
+
+    it.set_callback(nested, 0)
+    with pytest.raises(it.CallbackError, match="ItascaError") as info:
+        it.cycle(2)
+    assert "`model cycle` cannot run in a Python callback" in str(info.value.__cause__)
+    assert it.step() == 0

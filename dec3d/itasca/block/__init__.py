@@ -25,14 +25,22 @@ FIX_ALL = 0b111111        # velocity x, y, z and rotation x, y, z (dec3d.model.m
 class Block(Entity):
     """One block (found by its id; ids are never reused)."""
 
-    __slots__ = ()
+    __slots__ = ("_hint",)
     kind = "block.Block"
+
+    def __init__(self, api: Model, ident: int, hint: int = -1):
+        super().__init__(api, ident)
+        self._hint = hint
 
     def _row(self) -> int:
         st = self._model()
+        r, ids = self._hint, st.blocks["id"]
+        if 0 <= r < len(ids) and ids[r] == self._id:      # the row it had (blocks are rarely deleted)
+            return r
         r = int(st.block_rows([self._id])[0])
         if r < 0:
             raise ValueError(f"block {self._id} does not exist any more (deleted since it was found)")
+        self._hint = r
         return r
 
     # ---------------------------------------------------------------- reading
@@ -196,7 +204,7 @@ def count(model: Model | None = None) -> int:
 def list(model: Model | None = None) -> Iterator[Block]:  # noqa: A001 - Itasca's name
     """Every block, in row order (an iterator, as Itasca's)."""
     api = api_of(model)
-    return iter([Block(api, int(i)) for i in api.session.model.blocks["id"]])
+    return iter([Block(api, int(i), r) for r, i in enumerate(api.session.model.blocks["id"])])
 
 
 def find(ident: int, model: Model | None = None) -> Block | None:

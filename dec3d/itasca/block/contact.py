@@ -19,13 +19,17 @@ from .._objects import Entity, api_of, fish_call, group_of, in_group
 class Contact(Entity):
     """A contact between two blocks."""
 
-    __slots__ = ()
+    __slots__ = ("_p",)
     kind = "block.contact.Contact"
 
-    def _ptr(self):
+    def __init__(self, api: Model, ident, hint: int = -1):
         from ...fish.contact_intrinsics import ContactPtr
 
-        return ContactPtr("contact", self._id)
+        super().__init__(api, tuple(ident))
+        self._p = ContactPtr("contact", self._id, hint)      # FISH's pointer: keeps its last row as a hint
+
+    def _ptr(self):
+        return self._p
 
     def _call(self, name, *args):
         self._model()
@@ -131,7 +135,7 @@ def list(model: Model | None = None) -> Iterator[Contact]:  # noqa: A001 - Itasc
     cs, _ = _stores(api)
     if cs is None:
         return iter(())
-    return iter([Contact(api, (int(a), int(b))) for a, b in zip(cs["ida"], cs["idb"])])
+    return iter([Contact(api, (int(a), int(b)), r) for r, (a, b) in enumerate(zip(cs["ida"], cs["idb"]))])
 
 
 def find(b1: int, b2: int, model: Model | None = None) -> Contact | None:
