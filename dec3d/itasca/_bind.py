@@ -56,8 +56,9 @@ class Model:
         with m.bound():                 # dec3d.itasca functions act on m inside the block
             it.block.count()
 
-    out_dir: the output folder (default: the working folder); every file the model's commands write
-    stays in it unless ``allow_outside_paths``. base_dir: the folder relative names in commands are read
+    out_dir: the output folder (default: the working folder; inside `dec3d run script.py` the run's output
+    folder, and a relative out_dir is taken from there); every file the model's commands write stays in it
+    unless ``allow_outside_paths``. base_dir: the folder relative names in commands are read
     from first (default: the working folder; `dec3d run script.py`: the script's folder).
     allow_python: let decks this model runs call Python files (`program call 'x.py'`)."""
 
@@ -66,6 +67,10 @@ class Model:
                  allow_python: bool = False, session: Any = None):
         if session is None:
             from ..session import Session
+
+            base = DEFAULT_OUT[0]
+            if base is not None:        # inside `dec3d run script.py`: under the run's output folder
+                out_dir = base if out_dir is None else Path(base) / out_dir
 
             session = Session(out_dir=out_dir, echo=echo, allow_outside_paths=allow_outside_paths,
                               allow_overwrite=allow_overwrite)
@@ -158,6 +163,10 @@ def _chunks(items: list) -> list[list]:
         out.append(cur)
     return out
 
+
+#: the output folder of the `dec3d run script.py` running now (None outside one): the folder new Models
+#: write into by default, and the folder their relative ``out_dir`` is taken from
+DEFAULT_OUT: list[Path | None] = [None]
 
 #: the model ``dec3d.itasca`` acts on (None: one is made on first use)
 _CURRENT: list[Model | None] = [None]

@@ -54,14 +54,17 @@ def exec_script(api: Model, path: Path, argv: list[str] | None = None) -> None:
     import runpy
 
     alias_itasca()
-    old_argv, old_cwd = sys.argv, os.getcwd()
+    from ._bind import DEFAULT_OUT
+
+    old_argv, old_cwd, old_out = sys.argv, os.getcwd(), DEFAULT_OUT[0]
     sys.argv = [str(path), *(argv or [])]
+    DEFAULT_OUT[0] = Path(api.session.out_dir).resolve()     # dec3d.Model()s the script makes write there
     os.chdir(path.resolve().parent)          # the script's own open()/os.path calls: beside it, as in 3DEC
     try:
         with api.bound():
             runpy.run_path(str(path.resolve()), run_name="__main__")
     finally:
-        sys.argv = old_argv
+        sys.argv, DEFAULT_OUT[0] = old_argv, old_out
         os.chdir(old_cwd)
 
 

@@ -134,3 +134,23 @@ def test_a_driver_in_the_style_of_public_3dec_scripts(tmp_path, capsys):
     bad.write_text('import itasca as it\nit.command("program automatic-model-save active on")\n')
     assert main(["run", str(bad), "-q"]) == 1
     assert "automatic-model-save active on` is not supported" in capsys.readouterr().err
+
+
+STUDY = '''import dec3d
+import itasca as it
+
+for phi in (20, 40):
+    m = dec3d.Model(out_dir="runs/phi%d" % phi)
+    with m.bound():
+        it.command("block create brick 0 1 0 1 0 1")
+        it.command("model save 'end.sav'")
+it.command("model save 'main.sav'")
+'''
+
+
+def test_models_a_driver_makes_write_under_the_runs_output_folder(tmp_path):
+    (tmp_path / "study.py").write_text(STUDY)
+    out = tmp_path / "out"
+    assert main(["run", str(tmp_path / "study.py"), "--out", str(out), "-q"]) == 0
+    assert (out / "runs" / "phi20" / "end.sav").exists() and (out / "runs" / "phi40" / "end.sav").exists()
+    assert (out / "main.sav").exists() and not (tmp_path / "runs").exists()
