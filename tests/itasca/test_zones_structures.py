@@ -26,7 +26,12 @@ structure node fix velocity range id 30
 
 def test_zones_and_zonearray_read_the_zone_store():
     it.command(ZONED)
-    it.cycle(50)
+    ids, gp = it.zonearray.ids(), it.gridpointarray.pos()
+    z0 = gp[:, 2].copy()
+    it.cycle(50)                          # views taken before cycling stay valid and show the new state
+    # (small strain: the gridpoints keep their positions; the displacement is the motion)
+    np.testing.assert_array_equal(gp[:, 2], z0)
+    assert ids.shape == it.zonearray.ids().shape and it.gridpointarray.disp()[:, 2].min() < 0
     zs = it.current().session.model.stores["zones"]
     assert it.block.zone.count() == zs.n > 0
     za = it.zonearray
