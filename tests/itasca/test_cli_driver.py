@@ -154,3 +154,13 @@ def test_models_a_driver_makes_write_under_the_runs_output_folder(tmp_path):
     assert main(["run", str(tmp_path / "study.py"), "--out", str(out), "-q"]) == 0
     assert (out / "runs" / "phi20" / "end.sav").exists() and (out / "runs" / "phi40" / "end.sav").exists()
     assert (out / "main.sav").exists() and not (tmp_path / "runs").exists()
+
+
+def test_dec3d_check_names_python_files(folder, capsys):
+    deck = folder / "deck.dat"
+    deck.write_text("model new\nprogram call 'drv.py'\n")
+    assert main(["check", str(deck)]) == 1
+    out = capsys.readouterr().out
+    assert "deck.dat:2:1: error: `drv.py` is a Python file" in out and "--allow-python" in out
+    assert main(["check", str(folder / "drv.py")]) == 2
+    assert "is a Python driver, not a deck" in capsys.readouterr().err
