@@ -68,3 +68,30 @@ def set(name: str, value, model: Model | None = None) -> None:  # noqa: A001 - I
         raise ValueError(f"fish.set: '{name}' is a FISH function, not a variable")
     api.session.variables[key] = v
     api.session.bind_context.assigned.add(key)
+
+
+def call_function(name: str, *args, model: Model | None = None):
+    """Call FISH function ``name`` with ``args`` (numbers, strings, booleans, three-number vectors) and
+    return its value (FLAC3D's ``itasca.fish.call_function``). KeyError when there is no such function; an
+    error inside it raises ``ItascaError`` with FISH's report."""
+    from ..errors import Dec3dError
+    from ..fish.values import Vec
+    from ._bind import ItascaError
+
+    api = api_of(model)
+    fn = api.session.fish_rt.functions.get(str(name).lower())
+    if fn is None:
+        raise KeyError(f"there is no FISH function '{name}'")
+    conv = []
+    for a in args:
+        if isinstance(a, (bool, int, float, str, np.bool_, np.integer, np.floating)):
+            conv.append(a.item() if isinstance(a, np.generic) else a)
+        else:
+            v = np.asarray(a, dtype=float)
+            if v.shape != (3,):
+                raise TypeError(f"fish.call_function: an argument is a number, a string or three numbers, not {a!r}")
+            conv.append(Vec(float(v[0]), float(v[1]), float(v[2])))
+    try:
+        return _out(fn.invoke(conv, None))
+    except Dec3dError as exc:
+        raise ItascaError(f"FISH function '{name}' failed:\n{exc.format()}", exc.format()) from None

@@ -166,6 +166,12 @@ end
     assert it.fish.get("result") == 5.0 and it.fish.get("twice") == 5.0
     assert it.fish.get("up") == pytest.approx(2.5)
     np.testing.assert_array_equal(it.fish.get("dir"), [0, 0, 1])
+    it.command("fish define scaled(a, v)\n    scaled = a * vector.z(v)\nend")
+    assert it.fish.call_function("scaled", 3, np.array([0, 0, 2.0])) == 6.0
+    with pytest.raises(KeyError, match="no FISH function 'nope'"):
+        it.fish.call_function("nope")
+    with pytest.raises(it.ItascaError, match="FISH function 'scaled' failed"):
+        it.fish.call_function("scaled", "text", (0, 0, 1))
     with pytest.raises(KeyError, match="no FISH variable 'nothing'"):
         it.fish.get("nothing")
     with pytest.raises(ValueError, match="finite"):
