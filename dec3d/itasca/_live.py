@@ -149,8 +149,8 @@ def put(api: Model, store_name: str, key: str, value, what: str, shape_tail=None
     want = (store.n, *tail)
     a = plain(value)
     if a.shape != want:
-        raise ValueError(f"{what}: expected an array of shape {want} (one row per {store_name[:-1] if store_name.endswith('s') else store_name}), "
-                         f"got {a.shape}")
+        one = {"blocks": "block", "vertices": "gridpoint", "zones": "zone"}.get(store_name, store_name)
+        raise ValueError(f"{what}: expected an array of shape {want} (one row per {one}), got {a.shape}")
     bad = ~np.isfinite(a)
     if bad.any():
         row = int(np.argwhere(bad)[0][0])
