@@ -207,3 +207,20 @@ def test_a_callback_may_not_cycle_or_change_the_blocks():
         it.cycle(2)
     assert "`model cycle` cannot run in a Python callback" in str(info.value.__cause__)
     assert it.step() == 0
+
+
+def test_array_setters_then_a_cycle():
+    """Two free unit cubes far apart, no gravity, no damping: what the setters write is what the cycle moves
+    with (x = v t, v = F/m t, a cube's spin is kept: its inertia is isotropic)."""
+    it.command("model new\nblock create brick 0 1 0 1 0 1\nblock create brick 5 6 0 1 0 1\n"
+               "block property density 1000\nblock mechanical damping local 0")
+    ba.set_vel([[0.5, 0, 0], [0, 0, 0]])
+    ba.set_force_app([[0, 0, 0], [0, 0, 200.0]])
+    ba.set_rvel([[0, 0, 0], [0, 0, 0.1]])
+    p0 = ba.pos().copy()
+    it.cycle(20)
+    t = it.mech_age()
+    np.testing.assert_allclose(ba.pos()[0] - p0[0], [0.5 * t, 0, 0], rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(ba.vel()[1], [0, 0, 200.0 / 1000.0 * t], rtol=1e-9)
+    np.testing.assert_allclose(ba.rvel()[1], [0, 0, 0.1], rtol=1e-12)
+    np.testing.assert_array_equal(ba.force_app()[1], [0, 0, 200.0])
