@@ -110,6 +110,7 @@ class Model:
             attach(self)
         except Dec3dError as exc:
             at = _caller()
+            _in_script(exc, text, at)
             report = exc.format()
             raise ItascaError(f"{at + ': ' if at else ''}it.command failed:\n{report}", report) from None
 
@@ -134,6 +135,39 @@ class Model:
     def __repr__(self) -> str:
         st = self.session.model
         return f"<dec3d.Model: {st.blocks.n} blocks, step {st.step}, out_dir '{self.session.out_dir}'>"
+
+
+def _in_script(exc, text: str, at: str) -> None:
+    """When the failing command text is a string literal of the script line ``at`` (file:line) that ran it,
+    point the error at the script: its file, the line and column inside the literal (a text built at run
+    time keeps `<command>` and its own line numbers)."""
+    import ast
+
+    from ..errors import SourceLocation
+
+    loc = exc.location
+    if loc is None or loc.file != "<command>" or loc.stack or ":" not in at:
+        return
+    path, _, line = at.rpartition(":")
+    try:
+        src = Path(path).read_text(encoding="utf-8")
+        tree = ast.parse(src)
+    except (OSError, SyntaxError, ValueError):
+        return
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.Call) and node.args and isinstance(node.args[0], ast.Constant)
+                and node.args[0].value == text and node.lineno <= int(line) <= (node.end_lineno or node.lineno)):
+            lit = node.args[0]
+            seg = ast.get_source_segment(src, lit) or ""
+            body = seg.lstrip("rRuU")
+            quote = 3 if body[:3] in ('"""', "'''") else 1
+            start = lit.col_offset + (len(seg) - len(body)) + quote      # 0-based column of the text's first char
+            col = loc.column + (start if loc.line == 1 else 0)
+            n = lit.lineno + loc.line - 1
+            lines = src.splitlines()
+            shown = lines[n - 1] if n <= len(lines) else loc.text          # the caret sits under the script's line
+            exc.location = SourceLocation(path, n, col, shown, loc.length, ())
+            return
 
 
 def _refuse_in_callback(items: list) -> None:

@@ -70,7 +70,15 @@ def test_a_failing_command_or_syntax_error_in_a_driver(folder, capsys):
     bad.write_text('import itasca as it\nit.command("""\nmodel new\nblock frobnicate 3\n""")\n')
     assert main(["run", str(bad), "-q"]) == 1
     err = capsys.readouterr().err
-    assert f"{bad}:2: it.command failed" in err and "<command>:3:7: error: unknown command `block frobnicate`" in err
+    # the error points into the script: the line of the bad command inside the triple-quoted text
+    assert f"{bad}:2: it.command failed" in err and f"{bad}:4:7: error: unknown command `block frobnicate`" in err
+    one = folder / "one.py"
+    one.write_text('import itasca as it\nx = 1\nit.command("block frobnicate 3")\nit.command("model " + "nw")\n')
+    assert main(["run", str(one), "-q"]) == 1
+    assert f"{one}:3:19: error: unknown command `block frobnicate`" in capsys.readouterr().err
+    one.write_text('import itasca as it\nit.command("model " + "nw")\n')
+    assert main(["run", str(one), "-q"]) == 1
+    assert "<command>:1:7: error:" in capsys.readouterr().err        # a text built at run time: its own lines
     syn = folder / "syn.py"
     syn.write_text("import itasca as it\nit.command('model new'\n")
     assert main(["run", str(syn), "-q"]) == 2
