@@ -12,7 +12,7 @@ from typing import Iterator
 import numpy as np
 
 from ._bind import Model
-from ._objects import Entity, api_of, fish_call
+from ._objects import Entity, api_of
 
 
 def _ids(api, store):
@@ -79,4 +79,4 @@ def _module(name, cls, store):
 cable = _module("cable", Cable, "cable_segments")
 node = _module("node", Node, "cable_nodes")
 
-__all__ = ["cable", "node", "Cable", "Node", "fish_call"]
+__all__ = ["cable", "node", "Cable", "Node"]
