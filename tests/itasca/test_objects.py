@@ -76,6 +76,13 @@ def test_contact_and_subcontact_getters_sum_the_subcontact_store():
         np.testing.assert_array_equal(s.disp_shear(), ss["us"][k])
         assert s.contact() == c
     assert it.block.subcontact.count() == ss.n
+    # out-of-balance loads: the settled top block is in balance; the fixed base needs the reaction of both
+    # weights (20 kN each); Python reads what FISH reads
+    base, top = it.block.find(1), it.block.find(2)
+    assert abs(top.force_unbal()).max() < 20000.0 * 1e-3
+    assert base.force_unbal()[2] == pytest.approx(-40000.0, rel=1e-3)
+    it.command("[fu = block.force.unbal.z(1)]\n[mu = block.moment.x(1)]")
+    assert it.fish.get("fu") == base.force_unbal()[2] and it.fish.get("mu") == base.moment_unbal()[0]
 
 
 def test_setters_then_cycle():
