@@ -105,11 +105,20 @@ def run_driver(session, path: Path) -> int:
 
 
 def _print_user_traceback(path: Path) -> None:
-    """The traceback from the script's first frame on (dec3d's own frames before it left out)."""
-    etype, exc, tb = sys.exc_info()
-    while tb is not None and tb.tb_frame.f_code.co_filename != str(path.resolve()):
-        tb = tb.tb_next
-    traceback.print_exception(etype, exc, tb, file=sys.stderr)
+    """The traceback of the script's error without the frames of dec3d and of ``runpy`` (in every chained
+    exception too: a callback's error shows the user's callback, then the script line that cycled)."""
+    import runpy
+
+    hidden = (str(Path(__file__).resolve().parent.parent), str(Path(runpy.__file__).resolve()))
+    top = traceback.TracebackException(*sys.exc_info())
+    te, seen = top, set()
+    while te is not None and id(te) not in seen:
+        seen.add(id(te))
+        te.stack = traceback.StackSummary.from_list(
+            [f for f in te.stack if not (f.filename.startswith("<frozen runpy")
+                                         or str(Path(f.filename).resolve()).startswith(hidden))])
+        te = te.__cause__ or te.__context__
+    print("".join(top.format()), end="", file=sys.stderr)
 
 
 # -------------------------------------------------------------------- `program call 'x.py'` in a deck

@@ -89,6 +89,15 @@ def test_a_failing_command_or_syntax_error_in_a_driver(folder, capsys):
     assert main(["run", str(boom), "-q"]) == 1
     err = capsys.readouterr().err
     assert "ZeroDivisionError" in err and 'boom.py", line 4, in f' in err and "dec3d/cli.py" not in err
+    # a callback's error: the user's callback frame, then the script line that cycled; no dec3d frames
+    cb = folder / "cb.py"
+    cb.write_text('import itasca as it\nit.command("block create brick 0 1 0 1 0 1\\nblock property density 1000")\n\ndef watch():\n'
+                  '    if it.step() == 3:\n        raise RuntimeError("stop here")\n\n'
+                  'it.set_callback(watch, 1.0)\nit.cycle(10)\n')
+    assert main(["run", str(cb), "-q"]) == 1
+    err = capsys.readouterr().err
+    assert 'cb.py", line 6, in watch' in err and 'cb.py", line 9, in <module>' in err
+    assert "raised at step 3: RuntimeError: stop here" in err and "dec3d/physics" not in err and "runpy" not in err
     # an error in a Python file a deck calls stops the deck at the call
     deck = folder / "d.dat"
     deck.write_text("model new\ncall 'boom.py'\n")
