@@ -116,9 +116,15 @@ class Model:
 
     def cycle(self, n: int) -> None:
         """Take ``n`` mechanical steps (`model cycle n`)."""
-        if type(n) is bool or not isinstance(n, int) or n < 0:
+        import operator
+
+        try:
+            k = operator.index(n) if type(n) is not bool else -1      # ints and numpy integers
+        except TypeError:
+            k = -1
+        if k < 0:
             raise ValueError(f"cycle takes a whole number of steps ≥ 0, not {n!r}")
-        self.command(f"model cycle {n}")
+        self.command(f"model cycle {k}")
 
     # ------------------------------------------------------------------ binding
     @contextmanager
