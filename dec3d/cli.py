@@ -1,4 +1,4 @@
-"""The `dec3d` command line: run, batch, repl, verify, ssdem, docs."""
+"""The `dec3d` command line: run (decks and Python drivers), batch, repl, verify, ssdem, docs."""
 from __future__ import annotations
 
 import argparse
@@ -60,6 +60,12 @@ def _run_limited(args, limit, warmup) -> int:
         session.trust_saves = args.trust_save
         session.skip_unsupported = args.skip_unsupported
         session.strict = args.strict
+        session.allow_python = args.allow_python
+        if args.allow_python or deck.suffix.lower() == ".py":
+            from .itasca.driver import run_driver      # (and runs the Python files decks call)
+
+            if deck.suffix.lower() == ".py":     # a Python driver, dec3d.itasca bound to this session
+                return run_driver(session, deck)
         try:
             items = session.load_file(deck)          # parse and bind everything first
         except Dec3dError as exc:
@@ -164,7 +170,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="dec3d", description="3DEC-style distinct element program")
     ap.add_argument("--version", action="version", version=f"dec3d {__version__}")
     sub = ap.add_subparsers(dest="cmd", required=True)
-    r = sub.add_parser("run", help="run a deck")
+    r = sub.add_parser("run", help="run a deck, or a Python driver (script.py: `import itasca`, docs/python.md)")
     r.add_argument("deck")
     r.add_argument("--out", help="folder for outputs (default: the deck's folder)")
     r.add_argument("-q", "--quiet", action="store_true", help="do not echo commands")
@@ -184,6 +190,9 @@ def main(argv: list[str] | None = None) -> int:
                         "instead of stopping there")
     r.add_argument("--strict", action="store_true",
                    help="a range that selects nothing is an error (a warning otherwise)")
+    r.add_argument("--allow-python", action="store_true",
+                   help="let decks run Python files (`program call 'x.py'`); Python is code, decks are data "
+                        "(docs/python.md)")
     r.set_defaults(fn=_run)
     b = sub.add_parser("batch", help="run a deck for many parameter values (process pool or Dask) and "
                                      "collect one table")

@@ -133,9 +133,7 @@ class Session:
             raise exc.with_location(where)
 
     def _deck_folder(self, file: str) -> Path:
-        if file in PSEUDO_FILES:
-            return self._text_dirs.get(file) or Path.cwd()
-        return Path(file).parent
+        return (self._text_dirs.get(file) or Path.cwd()) if file in PSEUDO_FILES else Path(file).parent
 
     def _read_bases(self, where) -> list[Path]:
         loc = getattr(where, "resolve", lambda: where)()
@@ -198,6 +196,10 @@ class Session:
                 me, callers = path, []
             if me in callers:
                 raise BindError(f"`{paths.printable(path.name)}` calls itself (directly or through other files)", where)
+        if path.suffix.lower() == ".py":      # a Python file: refused unless allowed (commands.program_cmds)
+            from .commands.program_cmds import python_call
+
+            return python_call(self, path, where)
         try:
             size = path.stat().st_size
             if size > DECK_MAX_BYTES:
@@ -562,11 +564,7 @@ class Session:
 
 
 def _contains_deferred(v) -> bool:
-    if isinstance(v, Deferred):
-        return True
-    if isinstance(v, (tuple, list)):
-        return any(_contains_deferred(x) for x in v)
-    return False
+    return isinstance(v, Deferred) or (isinstance(v, (tuple, list)) and any(_contains_deferred(x) for x in v))
 
 
 def _has_deferred(call: CommandCall) -> bool:
