@@ -59,7 +59,7 @@ def translate_main(deck: str, out: str | None) -> int:
             return 2
     else:
         sys.stdout.write(tr.text)
-    if not looks_legacy(text):
+    if tr.text == text.replace("\r\n", "\n").replace("\r", "\n"):
         print(f"dec3d translate: `{deck}` has no 3DEC 4/5 commands (the text is unchanged)", file=sys.stderr)
     if tr.untranslated:
         print(f"dec3d translate: {tr.untranslated} line(s) could not be translated: they are kept as "

@@ -19,6 +19,8 @@ from .lines import NOTE, LineMap, Out, OutLine, continues, split_comment, tokens
 _DEF = re.compile(r"^\s*(def|define)\s+([A-Za-z_]\w*)(.*)$", re.IGNORECASE)
 _FISH_END = re.compile(r"^\s*end\s*$", re.IGNORECASE)
 _CMD = re.compile(r"^\s*command\s*$", re.IGNORECASE)
+_AT_CALL = re.compile(r"^\s*@([A-Za-z_]\w*)\s*\((.*)\)\s*$")
+_VEC = re.compile(r"\(\s*([^(),]+,[^(),]+,[^(),]+)\)")      # (x, y, z): a vector in 3DEC 5 FISH
 _ENDCMD = re.compile(r"^\s*(endcommand|end_command)\s*$", re.IGNORECASE)
 
 
@@ -128,6 +130,11 @@ def translate_text(text: str, filename: str = "<input>", state: State | None = N
         toks = [t for k in group for t in tokens(split_comment(src[k])[0], k + 1)]
         if not toks:
             rows += [OutLine([], k + 1, split_comment(src[k])[1]) for k in group]
+            continue
+        call = _AT_CALL.match(code)
+        if call and len(group) == 1:           # `@f( (@x, @y, @z) )`: a FISH function called with arguments
+            args = _VEC.sub(lambda mv: f"vector({mv.group(1)})", call.group(2).replace("@", ""))
+            rows.append(OutLine([Out(f"[{call.group(1)}({args.strip()})]", line, code.index("@") + 1)], line, comment))
             continue
         if toks[0].text.startswith("@") or toks[0].text.startswith("["):
             rows += [OutLine([Out(split_comment(src[k])[0].rstrip(), k + 1, 1)], k + 1, split_comment(src[k])[1])
