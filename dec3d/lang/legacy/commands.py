@@ -95,8 +95,10 @@ def _poly(toks, state):
         groups.append([O("group 'mat1' slot 'material'", toks[-1])])     # 3DEC 5: every block has a material, 1 by default
         state.created_mats.add("1")
     note = None
-    if kind == "polyhedron":
-        body, note = _convex(body)
+    if kind in ("polyhedron", "prism"):
+        body, note = _convex(body, kind == "prism")
+        if note and kind == "prism":
+            kind = "polyhedron"
     first = [O(f"block create {kind}", toks[0])] + body
     for g in groups:
         first += [Out(p.text, toks[-1].line, toks[-1].col) for p in g]
@@ -105,9 +107,11 @@ def _poly(toks, state):
     return [first], ""
 
 
-def _convex(body: list[Out]) -> tuple[list[Out], str | None]:
+def _convex(body: list[Out], prism: bool = False) -> tuple[list[Out], str | None]:
     """The faces of a `poly … face …` block, or those of the convex hull of its corners when the block is
-    clearly not convex (a corner outside a face's plane by more than 1e-4 of its size), with a note."""
+    clearly not convex (a corner outside a face's plane by more than 1e-4 of its size), with a note. A
+    `poly prism` whose side faces are not planar (end faces of different shapes: a tapered column drum)
+    is written as the hull of its two end faces the same way."""
     import numpy as np
 
     from .hull import convex_excess, hull_faces, solid_volume
@@ -115,7 +119,7 @@ def _convex(body: list[Out]) -> tuple[list[Out], str | None]:
     faces, heads = [], []
     try:
         for p in body:
-            if p.text == "face":
+            if p.text in ("face", "face-1", "face-2"):
                 faces.append([])
                 heads.append(p)
             else:
@@ -125,6 +129,12 @@ def _convex(body: list[Out]) -> tuple[list[Out], str | None]:
     if not faces or any(len(f) % 3 or len(f) < 9 for f in faces):
         return body, None
     arrays = [np.array(f).reshape(-1, 3) for f in faces]
+    if prism:
+        if len(arrays) != 2 or len(arrays[0]) != len(arrays[1]):
+            return body, None
+        a, b = arrays
+        k = len(a)
+        arrays = arrays + [np.array([a[i], a[(i + 1) % k], b[(i + 1) % k], b[i]]) for i in range(k)]
     pts = np.vstack(arrays)
     size = float(np.max(np.ptp(pts, axis=0)))
     excess = convex_excess(arrays)
@@ -137,7 +147,8 @@ def _convex(body: list[Out]) -> tuple[list[Out], str | None]:
         h = heads[min(k, len(heads) - 1)]
         out.append(Out("face", h.line, h.col))
         out.append(Out(" ".join(f"{c:.10g}" for c in f.ravel()), h.line, h.col))
-    return out, (f"; dec3d translate: not convex (a corner {excess:.3g} m outside a face's plane): the convex hull "
+    what = "side faces not planar" if prism else "not convex"
+    return out, (f"; dec3d translate: {what} (a corner {excess:.3g} m outside a face's plane): the convex hull "
                  f"of its corners is built, volume {given:.6g} -> {hv:.6g} ({100 * (hv - given) / given:+.2f} %)")
 
 
