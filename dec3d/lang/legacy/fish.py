@@ -27,7 +27,7 @@ CALLS = {
     "z_sxx": "block.zone.stress.xx", "z_syy": "block.zone.stress.yy", "z_szz": "block.zone.stress.zz",
     "z_sxy": "block.zone.stress.xy", "z_sxz": "block.zone.stress.xz", "z_syz": "block.zone.stress.yz",
     "z_vol": "block.zone.vol", "z_x": "block.zone.pos.x", "z_y": "block.zone.pos.y", "z_z": "block.zone.pos.z",
-    "c_next": "block.contact.next", "c_b1": "block.contact.b1", "c_b2": "block.contact.b2",
+    "c_next": "block.contact.next", "c_near": "block.contact.near", "c_b1": "block.contact.b1", "c_b2": "block.contact.b2",
     "c_x": "block.contact.pos.x", "c_y": "block.contact.pos.y", "c_z": "block.contact.pos.z",
     "cx_next": "block.subcontact.next", "cx_nforce": "block.subcontact.force.norm",
     "cx_sforce": "block.subcontact.force.shear", "cx_area": "block.subcontact.area",
@@ -45,13 +45,13 @@ MISSING = {
     "z_sig3": "principal stresses of a zone (no block.zone.stress.prin in dec3d)",
     "gp_head": "the global gridpoint list head (use loop foreach over block.gp.list)",
     "b_gp": "the first gridpoint of a block (loop foreach over block.gplist(b): a list, not a pointer)",
-    "c_near": "the contact nearest a point (no block.contact.near in dec3d)",
     "c_cx": "the first sub-contact of a contact (loop foreach over block.contact.subcontactlist(c))",
     "open": "FISH file input/output (file.open in 3DEC 7+)", "write": "FISH file input/output (file.write in 3DEC 7+)",
     "read": "FISH file input/output (file.read in 3DEC 7+)", "close": "FISH file input/output (file.close in 3DEC 7+)",
     "lose_array": "arrays are freed automatically in 3DEC 7+ (drop the line)",
 }
 
+_CX = re.compile(r"^(\s*)(local\s+)?([A-Za-z_]\w*)\s*=\s*c_cx\s*\((.+)\)\s*$", re.IGNORECASE)
 _WORD = re.compile(r"""('[^']*'|"[^"]*")|(?<![.\w])([A-Za-z_]\w*)(\s*\()?""")
 _ARRAY = re.compile(r"^(\s*)array\s+(.*)$", re.IGNORECASE)
 _DECL = re.compile(r"([A-Za-z_]\w*)\s*\(([^()]*)\)")
@@ -60,6 +60,13 @@ _DECL = re.compile(r"([A-Za-z_]\w*)\s*\(([^()]*)\)")
 def translate_fish_line(code: str, known: set[str]) -> tuple[str, list[str]]:
     """(3DEC 7+ code, notes) for one line of a legacy FISH function body. ``known`` holds the deck's own
     FISH names (a function of the deck called `open` stays the deck's)."""
+    m = _CX.match(code)
+    if m and "c_cx" not in known:      # `x = c_cx(c)`: the first sub-contact, 0 when there is none
+        ind, loc, x, c = m.groups()
+        c = translate_fish_line(c, known)[0]
+        return "\n".join([f"{ind}{loc or ''}{x} = 0", f"{ind}local {x}_subs = block.contact.subcontactlist({c})",
+                          f"{ind}if list.size({x}_subs) > 0 then", f"{ind}  {x} = {x}_subs(1)",
+                          f"{ind}endif"]), []
     m = _ARRAY.match(code)
     if m:
         decls = _DECL.findall(m.group(2))

@@ -107,7 +107,9 @@ def translate_text(text: str, filename: str = "<input>", state: State | None = N
                 if notes:
                     state.untranslated += 1
                     comment = (comment + " " if comment else "") + NOTE + "; ".join(notes)
-                rows.append(OutLine([Out(new, line, 1)] if new.strip() else [], line, comment))
+                parts = new.split("\n")         # a line that became several (`x = c_cx(c)`)
+                rows.append(OutLine([Out(parts[0], line, 1)] if parts[0].strip() else [], line, comment))
+                rows += [OutLine([Out(p, line, 1)], line) for p in parts[1:]]
             i += 1
             continue
         if in_cmd and _ENDCMD.match(code):
