@@ -32,7 +32,7 @@ from pathlib import Path
 from .commands import load_all
 from .commands.binder import BindContext, Binder, CommandCall, LegacySyntaxError
 from .commands.values import Deferred
-from .errors import Dec3dError, NotSupportedError, SourceLocation
+from .errors import Dec3dError, NotSupportedError, SourceLocation, UnimplementedError
 from .lang.parser import parse_deck
 
 RUNNABLE, DOES_NOTHING, NOT_SUPPORTED, LEGACY, ERROR = (
@@ -73,11 +73,11 @@ class _Walker:
     def add(self, deck, line, status, what, column=1, when="bind"):
         self.reports.append(LineReport(line, status, what, deck.filename, column, when))
 
-    def problem(self, deck, raw, status, exc):
+    def problem(self, deck, raw, status, exc, when="bind"):
         loc = exc.location
         col = loc.column if loc is not None and loc.line == raw.line and loc.file == deck.filename else 1
         self.add(deck, raw.line, status, exc.message + (f" (hint: {exc.hint})" if getattr(exc, "hint", None) else ""),
-                 col)
+                 col, when=when)
 
     def fish(self, deck, block):
         """A `fish define`: parsed, its command lines bound and its body compiled, as `dec3d run`
@@ -140,7 +140,10 @@ class _Walker:
                 self.problem(deck, raw, LEGACY, exc)
                 continue
             except NotSupportedError as exc:
-                self.problem(deck, raw, NOT_SUPPORTED, exc)
+                # a command, keyword, range element or intrinsic dec3d does not implement: the run goes up
+                # to it (dec3d.lang.unsupported); other such problems stop the deck before it runs
+                self.problem(deck, raw, NOT_SUPPORTED, exc, when="run" if isinstance(exc, UnimplementedError)
+                             else "bind")
                 continue
             except Dec3dError as exc:
                 self.problem(deck, raw, ERROR, exc)
@@ -353,8 +356,9 @@ def main(paths: list[str], verbose: bool = False) -> int:
                       "history calls a FISH function that cannot run)" +
                       (f", or at {first.file}:{first.line}, where one is called" if at_run else ""))
             else:
-                print(f"  dec3d run would run the lines before {first.file}:{first.line} and stop there: it calls "
-                      "a FISH function that cannot run")
+                why = ("it calls a FISH function that cannot run" if first.status != NOT_SUPPORTED else
+                       "dec3d does not implement it yet (`dec3d run --skip-unsupported` skips such lines)")
+                print(f"  dec3d run would run the lines before {first.file}:{first.line} and stop there: {why}")
         elif blockers:
             print("  dec3d run would run to the end: no line calls the FISH functions above (they stop a run "
                   "only when called)")

@@ -39,6 +39,7 @@ def _run_limited(args, limit, warmup) -> int:
             out_dir=out, echo=not args.quiet, allow_outside_paths=args.allow_outside_paths,
             allow_overwrite=args.allow_overwrite)
         session.trust_saves = args.trust_save
+        session.skip_unsupported = args.skip_unsupported
         try:
             items = session.load_file(deck)          # parse and bind everything first
         except Dec3dError as exc:
@@ -159,6 +160,9 @@ def main(argv: list[str] | None = None) -> int:
                         "also of saves not made by you on this machine (only for saves you trust; docs/safety.md)")
     r.add_argument("--no-legacy", action="store_true",
                    help="refuse 3DEC 4/5 (legacy) decks instead of running their translation (docs/legacy.md)")
+    r.add_argument("--skip-unsupported", action="store_true",
+                   help="skip the lines dec3d does not implement yet (each is printed and warned about) "
+                        "instead of stopping there")
     r.set_defaults(fn=_run)
     t = sub.add_parser("translate", help="write the 3DEC 7+ equivalent of a 3DEC 4/5 (legacy) deck (docs/legacy.md)")
     t.add_argument("deck")

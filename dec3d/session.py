@@ -27,6 +27,7 @@ from .io import paths
 from .io.guard import FileRecord
 from .lang.parser import ParsedDeck, gc_paused, parse_deck
 from .lang.prepass import FishBlock
+from .lang.unsupported import Unsupported, bind_or_defer
 from .model.model import Model
 
 
@@ -48,7 +49,7 @@ class Enter:
     source: str
 
 
-Item = CommandCall | ExprStatement | FishDefine | Enter
+Item = CommandCall | ExprStatement | FishDefine | Enter | Unsupported
 
 
 #: file names of text that does not come from a file (its folder is the working folder)
@@ -209,29 +210,10 @@ class Session:
         if raw.startswith(b"\xef\xbb\xbf"):
             raw = raw[3:]                   # a UTF-8 byte-order mark
         if path.suffix.lower() == ".dec":
-            return self._load_dec(raw, path, shown, where, stack)
+            from .lang.unsupported import load_dec
+            return load_dec(self, raw, path, shown, where, stack)
         text = raw.decode("utf-8", errors="replace")
         return self.load_text(text, str(path), path.parent, stack)
-
-    def _load_dec(self, raw: bytes, path: Path, shown: str, where, stack) -> list:
-        """A `.dec` file: read as a deck when it holds 3DEC commands; 3DEC's legacy binary/tabular
-        block-geometry format (not documented) is refused by name."""
-        from .errors import NotSupportedError
-
-        why = ("3DEC's legacy .dec block-geometry files are not supported (their format is not documented); "
-               "a .dec file that holds 3DEC commands is read as a deck")
-        if b"\x00" in raw[:4096]:
-            raise NotSupportedError(f"`{shown}` is a binary file, not a deck: {why}", where)
-        try:
-            return self.load_text(raw.decode("utf-8", errors="replace"), str(path), path.parent, stack)
-        except NotSupportedError:
-            raise
-        except Dec3dError as exc:
-            loc = exc.location
-            if loc is not None and loc.file == str(path):
-                raise NotSupportedError(f"`{shown}` is not a deck of commands (line {loc.line}: {exc.message}): "
-                                        f"{why}", where) from None
-            raise
 
     def _bind_deck(self, deck: ParsedDeck, base_dir: Path, stack) -> list[Item]:
         binder = Binder(deck, self.bind_context, stack)
@@ -242,8 +224,8 @@ class Session:
             while next_fish is not None and next_fish.line < raw.line:
                 items.append(self._fish_item(deck, next_fish, stack))
                 next_fish = next(fish, None)
-            call = binder.bind_line(raw)
-            if isinstance(call, ExprStatement):
+            call = bind_or_defer(self, binder, raw)
+            if isinstance(call, (ExprStatement, Unsupported)):
                 items.append(call)
                 continue
             path = call.command.path
@@ -396,6 +378,8 @@ class Session:
                 self.bind_context.assigned.update(self.variables)
             elif isinstance(item, FishDefine):
                 self.define_fish(item)
+            elif isinstance(item, Unsupported):
+                item.run(self)
         except Dec3dError as exc:
             raise exc.with_location(item.location)
         except OSError as exc:

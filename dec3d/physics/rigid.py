@@ -406,6 +406,20 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
             raise CycleInterrupted(m.step)
         return done
 
+    def predict_timestep(self) -> float:
+        """The time step the next cycle would start with (detection, masses and zone steps worked
+        out as a run does), the model left exactly as it was: for listings before the first cycle
+        (3DEC's `model dynamic list` prints the step it will use). Raises RunError when the model
+        cannot cycle yet (a block without mass, properties missing)."""
+        from .steps import _Run
+
+        snap = self._snapshot()
+        try:
+            with np.errstate(over="ignore", invalid="ignore"):
+                return float(_Run(self, 0, None).dt)
+        finally:
+            self._restore(snap)
+
     def _snapshot(self) -> dict:
         m = self.model
         b, v = m.blocks, m.vertices
