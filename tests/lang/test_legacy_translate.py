@@ -199,3 +199,25 @@ def test_non_convex_poly_is_built_as_its_hull_with_a_note():
     assert math.isclose(solid_volume(arrays), 0.95) and math.isclose(convex_excess(arrays), 0.2 / math.sqrt(1.04))
     hull, vol = hull_faces(np.vstack(arrays), 1e-9)
     assert len(hull) == 6 and math.isclose(vol, 1.0)
+
+
+def test_fish_line_columns_and_lines_after_an_expanded_line_map_back():
+    old = "def f\n  if 1 = 2 then\n    cxi = c_cx(ci)\n  endif\n  y = 1 / zz\nend\n"
+    t = translate_text(old, "old.dat")
+    lines = t.text.split("\n")
+    k = lines.index("  y = 1 / zz") + 1            # `c_cx` became five lines: this one moved down by 4
+    assert k == 9
+    assert t.map.where(k, lines[k - 1].index("zz") + 1) == (5, 11)
+
+
+def test_a_run_time_error_names_the_original_line(tmp_path):
+    from dec3d.errors import Dec3dError
+    from dec3d.legacy_run import LegacySession
+
+    deck = tmp_path / "old.dat"
+    deck.write_text("new\ndef f\n  if 1 = 2 then\n    cxi = c_cx(ci)\n  endif\n  y = 1 / 0\nend\n@f\n")
+    s = LegacySession(out_dir=tmp_path, notice=lambda t: None)
+    with pytest.raises(Dec3dError) as info:
+        s.run_items(s.load_file(deck))
+    loc = info.value.location
+    assert (loc.file, loc.line) == (str(deck), 6) and loc.text == "  y = 1 / 0"

@@ -95,7 +95,11 @@ class LineMap:
         best = (orig, 1)
         for out_col, oline, ocol in segs:
             if out_col <= column:
-                best = (oline, ocol if ocol > 0 else max(1, column))
+                # within a piece the columns run on from the piece's original column (exact for text the
+                # translation kept, such as most of a FISH line), never past the original line's end
+                width = len(self.original[oline - 1]) if 1 <= oline <= len(self.original) else column
+                col = ocol + (column - out_col) if ocol > 0 else column
+                best = (oline, max(1, min(col, width)))
             else:
                 break
         return best
