@@ -141,6 +141,13 @@ setup"""
     assert out[11:] == ["  end_command", "end", "[setup]"]
 
 
+def test_fish_file_output_maps_to_file_intrinsics():
+    old = ("def w\n  o = open('s.txt', 1, 1)\n  n = write(buf, 3)\n  c = close\n  l = lose_array(buf)\n"
+           "  k = close()\nend")
+    assert tr(old).split("\n")[1:6] == ["  o = file.open('s.txt', 1, 1)", "  n = file.write(buf, 3)",
+                                        "  c = file.close", "  l = 0", "  k = file.close()"]
+
+
 def test_define_and_endcommand_spellings():
     out = tr("define f\n  command\n    cycle 5\n  endcommand\nend").split("\n")
     assert out == ["fish define f", "  command", "    model cycle 5", "  endcommand", "end"]
@@ -221,3 +228,15 @@ def test_a_run_time_error_names_the_original_line(tmp_path):
         s.run_items(s.load_file(deck))
     loc = info.value.location
     assert (loc.file, loc.line) == (str(deck), 6) and loc.text == "  y = 1 / 0"
+
+
+def test_legacy_file_output_runs(tmp_path):
+    from dec3d.legacy_run import LegacySession
+
+    deck = tmp_path / "old.dat"
+    deck.write_text("def w\n  array buf(2)\n  buf(1) = 'a 1'\n  buf(2) = 2.5\n  o = open('s.txt', 1, 1)\n"
+                    "  n = write(buf, 2)\n  c = close\n  l = lose_array(buf)\nend\n@w\n")
+    out = tmp_path / "out"
+    s = LegacySession(out_dir=out, notice=lambda t: None)
+    s.run_items(s.load_file(deck))
+    assert (out / "s.txt").read_text() == "a 1\n2.5\n"

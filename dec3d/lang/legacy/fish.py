@@ -27,6 +27,7 @@ CALLS = {
     "z_sxx": "block.zone.stress.xx", "z_syy": "block.zone.stress.yy", "z_szz": "block.zone.stress.zz",
     "z_sxy": "block.zone.stress.xy", "z_sxz": "block.zone.stress.xz", "z_syz": "block.zone.stress.yz",
     "z_vol": "block.zone.vol", "z_x": "block.zone.pos.x", "z_y": "block.zone.pos.y", "z_z": "block.zone.pos.z",
+    "open": "file.open", "write": "file.write", "read": "file.read", "close": "file.close",
     "c_next": "block.contact.next", "c_near": "block.contact.near", "c_b1": "block.contact.b1", "c_b2": "block.contact.b2",
     "c_x": "block.contact.pos.x", "c_y": "block.contact.pos.y", "c_z": "block.contact.pos.z",
     "cx_next": "block.subcontact.next", "cx_nforce": "block.subcontact.force.norm",
@@ -35,7 +36,8 @@ CALLS = {
 }
 #: legacy names used without parentheses
 BARE = {"block_head": "block.head", "contact_head": "block.contact.head", "pi": "math.pi",
-        "clock": "time.clock", "gp_head": None}
+        "clock": "time.clock", "gp_head": None, "close": "file.close"}
+_LOSE = re.compile(r"(?<![.\w])lose_array\s*\([^()]*\)", re.IGNORECASE)    # arrays are freed automatically
 #: legacy intrinsics with no 3DEC 7+ equivalent in dec3d (kept, with a note)
 MISSING = {
     "b_zone": "3DEC 5 zone pointer walks (no block.zone.head/next in dec3d: use loop foreach over block.zone.list)",
@@ -46,9 +48,6 @@ MISSING = {
     "gp_head": "the global gridpoint list head (use loop foreach over block.gp.list)",
     "b_gp": "the first gridpoint of a block (loop foreach over block.gplist(b): a list, not a pointer)",
     "c_cx": "the first sub-contact of a contact (loop foreach over block.contact.subcontactlist(c))",
-    "open": "FISH file input/output (file.open in 3DEC 7+)", "write": "FISH file input/output (file.write in 3DEC 7+)",
-    "read": "FISH file input/output (file.read in 3DEC 7+)", "close": "FISH file input/output (file.close in 3DEC 7+)",
-    "lose_array": "arrays are freed automatically in 3DEC 7+ (drop the line)",
 }
 
 _CX = re.compile(r"^(\s*)(local\s+)?([A-Za-z_]\w*)\s*=\s*c_cx\s*\((.+)\)\s*$", re.IGNORECASE)
@@ -100,4 +99,6 @@ def translate_fish_line(code: str, known: set[str]) -> tuple[str, list[str]]:
             return BARE[low]
         return mt.group(0)
 
+    if "lose_array" not in known:
+        code = _LOSE.sub("0", code)
     return _WORD.sub(sub, code), notes
