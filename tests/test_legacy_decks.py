@@ -131,3 +131,19 @@ def test_grav_normal_and_shear_sums_the_support_contact_forces(tmp_path):
     nf, sf = s.variables["probe_nf"], s.variables["sf_sum2"]     # sf_sum2: set by nf_sum2, as in 3DEC 5
     assert math.isclose(nf, weight / 2, rel_tol=0.1)
     assert 0.05 * weight < sf < 0.5 * weight
+
+
+def test_dec3d_check_reads_a_legacy_deck_through_its_translation():
+    """`dec3d check old.dat` checks what `dec3d run` runs; its reports stand on the original lines."""
+    _needs_decks()
+    from dec3d.check import check_file
+
+    arch = check_file(LEGACY / ARCH)
+    assert {r.status for r in arch} == {"runnable"}
+    assert [r.line for r in arch][-2:] == [1587, 1588]         # `fix reg @base_reg`, `save 0_2_cyc0`
+    raw = check_file(LEGACY / ARCH, legacy=False)
+    assert "legacy syntax" in {r.status for r in raw}
+    # grav_normal_and_shear alone: the arch deck's FISH variables are missing, named on the original line
+    alone = [r for r in check_file(LEGACY / GRAV_NS) if r.status not in ("runnable", "does nothing")]
+    assert alone and all("sup_face_pos_x" in r.what for r in alone)
+    assert (alone[0].line, alone[0].column) == (11, 14)         # `hist nf_sum @sup_face_pos_x …`

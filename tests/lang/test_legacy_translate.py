@@ -170,6 +170,9 @@ def test_looks_legacy():
     assert looks_legacy("def f\n f = 1\nend")
     assert not looks_legacy("model new\nblock create brick 0 1\nfish define f\n  f = 1\nend\n[f]")
     assert not looks_legacy("; new\nmodel new")
+    # a modern continuation line may start with a word that was a 3DEC 5 command
+    assert not looks_legacy("block create tunnel dip 0 &\n  boundary 9 radius-ratio 1.4\nblock contact property friction 30 ...\n"
+                            "  range group 'a'")
 
 
 def test_line_map_points_at_the_original_column():

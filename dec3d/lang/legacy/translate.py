@@ -49,10 +49,12 @@ def looks_legacy(text: str) -> bool:
     modern = {"model", "block", "program", "fish", "history", "plot", "feblock", "structure", "table",
               "list", "call", "zone", "title", "return", "exit", "quit"}
     depth = 0
+    cont = False
     for raw in text.splitlines():
         code, _ = split_comment(raw)
         words = code.split()
-        if not words:
+        after, cont = cont, continues(code)
+        if not words or after:         # a continuation line (`… &` before it) starts no command
             continue
         w = words[0].lower()
         if depth == 0 and w in ("def", "define"):
