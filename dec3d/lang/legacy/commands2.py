@@ -271,6 +271,8 @@ def _bound(toks, state):
         return None, why
     words = {"xvelocity": "velocity-x", "yvelocity": "velocity-y", "zvelocity": "velocity-z",
              "xload": "force-x", "yload": "force-y", "zload": "force-z"}
+    if head and legacy_word(head[0].low, {"stress": (3, 0)}) and len(head) == 7 and all(is_value(t) for t in head[1:]):
+        return [[O("block face apply stress", toks[0])] + [_v(t) for t in head[1:]] + r], ""
     out = []
     for k, v in _pairs(head):
         hit = legacy_word(k.low, {w: (4, m) for w, m in words.items()})
@@ -278,6 +280,16 @@ def _bound(toks, state):
             return None, f"`bound {k.text}`"
         out.append([O(f"block gridpoint apply {hit[1]}", k), _v(v)] + r)
     return (out, "") if out else (None, "`bound` without a condition")
+
+
+def _insitu(toks, state):
+    head, rng = _split_range(toks[1:])
+    r, why = _range(rng, state)
+    if r is None:
+        return None, why
+    if head and legacy_word(head[0].low, {"stress": (3, 0)}) and len(head) == 7 and all(is_value(t) for t in head[1:]):
+        return [[O("block insitu stress", toks[0])] + [_v(t) for t in head[1:]] + r], ""
+    return None, "this form of `insitu` (gradients: write `block insitu stress … gradient-z …`)"
 
 
 def _title(toks, state):
@@ -300,7 +312,7 @@ COMMANDS = {
     "step": (3, _cycle), "solve": (3, _solve), "history": (4, _hist), "fix": (3, _fix), "free": (3, _free),
     "save": (3, _file_cmd("model save")), "restore": (3, _file_cmd("model restore")),
     "call": (3, _file_cmd("program call")), "plot": (2, _plot), "generate": (3, _gen), "range": (3, _range_cmd),
-    "set": (3, _set), "list": (4, _list), "print": (3, _list), "boundary": (3, _bound), "title": (3, _title),
+    "set": (3, _set), "list": (4, _list), "print": (3, _list), "boundary": (3, _bound), "title": (3, _title), "insitu": (3, _insitu),
     "return": (3, _simple("program return")), "delete": (3, _simple("block delete")),
 }
 
