@@ -33,6 +33,7 @@ def tr(text: str) -> str:
     ("solve time 1 cyc 100", "model solve time 1 cycles 100"),
     ("solve ratio @rat cyc 10000", "model solve ratio @rat cycles 10000"),
     ("hist time", "model history mechanical time-total"),
+    ("history interval 10", "history interval 10"),
     ("hist unbal", "model history mechanical unbalanced-maximum"),
     ("hist @nf2", "fish history @nf2"),
     ("hist xdis 0.5 0.5 0.5", "block history displacement-x position 0.5 0.5 0.5"),
@@ -252,3 +253,11 @@ def test_legacy_file_output_runs(tmp_path):
     s = LegacySession(out_dir=out, notice=lambda t: None)
     s.run_items(s.load_file(deck))
     assert (out / "s.txt").read_text() == "a 1\n2.5\n"
+
+
+def test_3dec7_lines_in_a_legacy_deck_are_kept():
+    old = ("new\nblock create brick 0 1 0 1 0 1 &\n   group 'a'\nfish define f\n  f = block.head\nend\n"
+           "model gravity 0 0 -10 ; z\ncycle 10")
+    assert tr(old).split("\n") == ["model new", "block create brick 0 1 0 1 0 1 &", "   group 'a'",
+                                   "fish define f", "  f = block.head", "end", "model gravity 0 0 -10 ; z",
+                                   "model cycle 10"]

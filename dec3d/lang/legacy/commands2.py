@@ -174,6 +174,8 @@ _HIST_POS = {"nf_sum": "block contact history force-normal", "sf_sum": "block co
 
 def _hist(toks, state):
     rest = toks[1:]
+    if rest and rest[0].low in ("interval", "name", "rename", "delete", "export", "list", "purge"):
+        return [[O("history", toks[0])] + [_v(t) for t in rest]], ""        # 3DEC 7+ `history …` as it is
     if len(rest) == 1 and rest[0].text.startswith("@"):
         return [[O("fish history", toks[0]), _v(rest[0])]], ""
     if len(rest) == 1 and rest[0].low in state.fish:

@@ -16,6 +16,9 @@ from .commands2 import is_legacy_word, translate_command
 from .fish import translate_fish_line
 from .lines import NOTE, LineMap, Out, OutLine, continues, split_comment, tokens
 
+#: 3DEC 7+ top-level words: a line that starts with one is kept as it is (a deck that mixes both)
+MODERN = {"model", "block", "program", "fish", "feblock", "structure", "table", "zone", "exit", "quit"}
+_FISH_DEFINE = re.compile(r"^\s*fish\s+def\w*\s+", re.IGNORECASE)
 _DEF = re.compile(r"^\s*(def|define)\s+([A-Za-z_]\w*)(.*)$", re.IGNORECASE)
 _FISH_END = re.compile(r"^\s*end\s*$", re.IGNORECASE)
 _CMD = re.compile(r"^\s*command\s*$", re.IGNORECASE)
@@ -46,8 +49,7 @@ class Translation:
 def looks_legacy(text: str) -> bool:
     """Whether a deck is 3DEC 4/5 syntax: a top-level line starts with a 3DEC 5 command word that is not
     a 3DEC 7+ command (`new`, `poly`, `prop`, `def`, `cycle` …)."""
-    modern = {"model", "block", "program", "fish", "history", "plot", "feblock", "structure", "table",
-              "list", "call", "zone", "title", "return", "exit", "quit"}
+    modern = MODERN | {"list", "call", "title", "return", "plot", "history"}
     depth = 0
     cont = False
     for raw in text.splitlines():
@@ -119,6 +121,13 @@ def translate_text(text: str, filename: str = "<input>", state: State | None = N
             rows.append(OutLine([Out(code.rstrip(), line, 1)], line, comment))
             i += 1
             continue
+        if _FISH_DEFINE.match(code) and not in_cmd:      # a 3DEC 7+ function: kept as it is, to its `end`
+            while i < n:
+                rows.append(OutLine([Out(src[i], i + 1, 1)], i + 1))
+                i += 1
+                if _FISH_END.match(split_comment(src[i - 1])[0]):
+                    break
+            continue
         m = _DEF.match(code)
         if m and not in_cmd:
             in_fish = True
@@ -140,7 +149,7 @@ def translate_text(text: str, filename: str = "<input>", state: State | None = N
             args = _VEC.sub(lambda mv: f"vector({mv.group(1)})", call.group(2).replace("@", ""))
             rows.append(OutLine([Out(f"[{call.group(1)}({args.strip()})]", line, code.index("@") + 1)], line, comment))
             continue
-        if toks[0].text.startswith("@") or toks[0].text.startswith("["):
+        if toks[0].text.startswith("@") or toks[0].text.startswith("[") or toks[0].low in MODERN:
             rows += [OutLine([Out(split_comment(src[k])[0].rstrip(), k + 1, 1)], k + 1, split_comment(src[k])[1])
                      for k in group]
             continue
