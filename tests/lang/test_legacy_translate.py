@@ -109,11 +109,12 @@ def test_change_jmat_without_properties_is_a_noted_line():
     assert out.startswith(NOTE + "change jmat=5") and "prop jmat=5" in out
 
 
-def test_hidden_blocks_are_shown_while_cycling_and_hidden_again():
-    out = tr("hide reg 2\ncycle 10\nseek\ncycle 10").split("\n")
+def test_hidden_blocks_take_part_in_the_mechanics_and_are_hidden_again_before_a_cut():
+    out = tr("hide reg 2\ncycle 10\nsolve\njset dip 0 dd 0\nseek\ncycle 10").split("\n")
     assert out[0] == "block hide range region 2"
-    assert out[1].startswith("block hide off ; dec3d translate: the hidden blocks take part while cycling")
-    assert out[2:] == ["model cycle 10", "block hide range region 2", "block hide off", "model cycle 10"]
+    assert out[1].startswith("block hide off ; dec3d translate: the hidden blocks take part in the mechanics")
+    assert out[2:] == ["model cycle 10", "model solve", "block hide range region 2",
+                       "block cut joint-set dip 90 dip-direction 0", "block hide off", "model cycle 10"]
 
 
 def test_named_ranges_become_groups_of_their_own_slot():

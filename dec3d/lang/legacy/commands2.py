@@ -106,24 +106,32 @@ def _hide(toks, state, off=False):
     if r is None:
         return None, why
     cmd = [O("block hide off" if off else "block hide", toks[0])] + r
-    if off:
-        state.hides = [] if not r else state.hides + [cmd]
+    if off and not r:
+        state.hides, state.shown = [], False
     else:
         state.hides = state.hides + [cmd]
     return [cmd], ""
 
 
-_SHOWN = ("; dec3d translate: the hidden blocks take part while cycling, as in 3DEC 5 (`hide` only hid them "
-          "from view and from cutting; dec3d's `block hide` leaves them out of the mechanics): shown, then hidden again")
+_SHOWN = ("; dec3d translate: the hidden blocks take part in the mechanics, as in 3DEC 5 (`hide` only hid them "
+          "from view and from cutting; dec3d's `block hide` leaves them out): shown from here, hidden again before "
+          "the next `jset`")
 
 
 def _cycling(cmds, toks, state):
-    """A cycling command with the deck's hidden blocks shown during it (see _SHOWN)."""
-    if not state.hides or not cmds:
+    """A cycling command with the deck's hidden blocks shown from there on (see _SHOWN; `rehide`)."""
+    if not state.hides or state.shown or not cmds:
         return cmds, ""
-    off = [O("block hide off", toks[0]), O(_SHOWN, toks[-1])]
-    again = [[Out(p.text, toks[0].line, toks[0].col) for p in h] for h in state.hides]
-    return [off] + cmds + again, ""
+    state.shown = True
+    return [[O("block hide off", toks[0]), O(_SHOWN, toks[-1])]] + cmds, ""
+
+
+def rehide(cmds, toks, state):
+    """Before a cut: the blocks the deck hid are hidden again (3DEC 5 cut only what was visible)."""
+    if not state.shown or cmds is None:
+        return cmds
+    state.shown = False
+    return [[Out(p.text, toks[0].line, toks[0].col) for p in h] for h in state.hides] + cmds
 
 
 def _seek(toks, state):
@@ -324,7 +332,10 @@ def translate_command(toks: list[Tok], state):
     hit = legacy_word(toks[0].low, COMMANDS)
     if hit is None:
         return None, f"the command `{toks[0].text}`"
-    return hit[1](toks, state)
+    cmds, why = hit[1](toks, state)
+    if hit[0] == "jset":
+        cmds = rehide(cmds, toks, state)
+    return cmds, why
 
 
 def is_legacy_word(word: str) -> bool:

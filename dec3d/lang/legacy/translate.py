@@ -36,6 +36,7 @@ class State:
     fish: set = field(default_factory=set)            # the deck's FISH function names (lower case)
     zoned: bool | None = None
     hides: list = field(default_factory=list)         # the `hide` commands in force (3DEC 7+ text)
+    shown: bool = False                               # they are shown for the mechanics (since a cycle)
     untranslated: int = 0
 
 
