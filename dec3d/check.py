@@ -184,6 +184,10 @@ class _Walker:
                 Path(deck.filename).resolve() == target.resolve():
             self.add(deck, raw.line, ERROR, f"`{target.name}` calls itself (directly or through other files)")
             return
+        if target.suffix.lower() == ".py":     # dec3d run refuses it unless --allow-python (docs/python.md)
+            self.add(deck, raw.line, ERROR, f"`{target.name}` is a Python file: `dec3d run` refuses it unless you "
+                                            "pass --allow-python (then it runs when the deck reaches it; not checked)")
+            return
         try:
             text = target.read_text(encoding="utf-8", errors="replace")
         except OSError as exc:
@@ -335,8 +339,9 @@ def main(paths: list[str], verbose: bool = False) -> int:
     worst = 0
     for path in paths:
         p = Path(path)
-        if not p.is_file():
-            why = "is a folder, not a deck file" if p.is_dir() else "does not exist"
+        if not p.is_file() or p.suffix.lower() == ".py":
+            why = ("is a folder, not a deck file" if p.is_dir() else "does not exist" if not p.is_file() else
+                   "is a Python driver, not a deck (`dec3d run` runs it; docs/python.md)")
             print(f"dec3d check: error: `{path}` {why}", file=sys.stderr)
             worst = 2
             continue

@@ -27,7 +27,8 @@ from .io import paths
 from .io.guard import FileRecord
 from .lang.parser import ParsedDeck, gc_paused, parse_deck
 from .lang.prepass import FishBlock
-from .lang.unsupported import Unsupported, bind_or_defer
+from .lang.progress import BindProgress
+from .lang.unsupported import Unsupported, bind_or_defer, empty_range
 from .model.model import Model
 
 
@@ -132,9 +133,7 @@ class Session:
             raise exc.with_location(where)
 
     def _deck_folder(self, file: str) -> Path:
-        if file in PSEUDO_FILES:
-            return self._text_dirs.get(file) or Path.cwd()
-        return Path(file).parent
+        return (self._text_dirs.get(file) or Path.cwd()) if file in PSEUDO_FILES else Path(file).parent
 
     def _read_bases(self, where) -> list[Path]:
         loc = getattr(where, "resolve", lambda: where)()
@@ -197,6 +196,10 @@ class Session:
                 me, callers = path, []
             if me in callers:
                 raise BindError(f"`{paths.printable(path.name)}` calls itself (directly or through other files)", where)
+        if path.suffix.lower() == ".py":      # a Python file: refused unless allowed (commands.program_cmds)
+            from .commands.program_cmds import python_call
+
+            return python_call(self, path, where)
         try:
             size = path.stat().st_size
             if size > DECK_MAX_BYTES:
@@ -220,7 +223,9 @@ class Session:
         items: list[Item] = []
         fish = iter(deck.fish)
         next_fish = next(fish, None)
+        progress = BindProgress(self.write, paths.printable(deck.filename))
         for raw in deck.lines:
+            progress.tick(raw.line)
             while next_fish is not None and next_fish.line < raw.line:
                 items.append(self._fish_item(deck, next_fish, stack))
                 next_fish = next(fish, None)
@@ -432,9 +437,10 @@ class Session:
                 raise CommandError(f"range element `{rc.element.name}` gave {m.shape[0]} values for {n} {store}s",
                                    rc.location)
             masks.append(~m if rc.negate else m)
-        if call.range.union:
-            return np.logical_or.reduce(masks)
-        return np.logical_and.reduce(masks)
+        mask = np.logical_or.reduce(masks) if call.range.union else np.logical_and.reduce(masks)
+        if n and not mask.any():
+            empty_range(self, call, store, n)
+        return mask
 
     def _value(self, vtype, value, where, name: str = ""):
         """A deferred value evaluated and converted by its type; `name` (the keyword) is put in
@@ -558,11 +564,7 @@ class Session:
 
 
 def _contains_deferred(v) -> bool:
-    if isinstance(v, Deferred):
-        return True
-    if isinstance(v, (tuple, list)):
-        return any(_contains_deferred(x) for x in v)
-    return False
+    return isinstance(v, Deferred) or (isinstance(v, (tuple, list)) and any(_contains_deferred(x) for x in v))
 
 
 def _has_deferred(call: CommandCall) -> bool:

@@ -54,7 +54,7 @@ def test_gridpoint_range_group_selects_the_gridpoints_of_the_blocks_in_the_group
     top = np.flatnonzero(v["fapp"][:, 2] != 0)
     assert len(top) > 0 and np.allclose(v["pos"][top, 2], 1.0)
     zoned.command("block gridpoint apply force-z -100 range group 'nothing'")
-    assert "selected no gridpoint" in zoned.output.getvalue()
+    assert "the range selects no gridpoint" in zoned.output.getvalue()
 
 
 def test_zone_groups_are_kept_in_a_save_and_select_zones(zoned, tmp_path):

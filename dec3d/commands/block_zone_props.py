@@ -146,6 +146,9 @@ def block_zone_property(session, call):
         where = loc.get("young" if a["young"] is not None else "poisson", call.location)
         raise BindError("`block zone property`: give bulk/shear or young/poisson, not both pairs in one command",
                         where)
+    if a["density"] is not None:
+        from .block_edit import density_warning
+        density_warning(session, call, float(a["density"]))
     fe = _fe_rows(session, call)
     if len(fe):
         try:

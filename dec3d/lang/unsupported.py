@@ -50,6 +50,26 @@ def bind_or_defer(session, binder, raw):
         return Unsupported(line, text, exc)
 
 
+def empty_range(session, call, store: str, n: int) -> None:
+    """A range that selects nothing: a warning naming the line (once per line), an error with
+    ``dec3d run --strict`` (``Session.strict``)."""
+    loc = call.range.elements[0].location if call.range.elements else call.location
+    text = f"the range selects no {store} (of {n})"
+    if getattr(session, "strict", False):
+        from ..errors import CommandError
+        raise CommandError(text + " (--strict)", loc)
+    where = loc.resolve() if hasattr(loc, "resolve") else loc
+    at = f"{where.file}:{where.line}:{where.column}" if where is not None else "<input>"
+    # once per bound line: a FISH loop running one command line many times warns once (the calls are
+    # kept, so that their ids are not reused)
+    seen = session.__dict__.setdefault("_empty_ranges", {})
+    if id(call) in seen:
+        return
+    seen[id(call)] = call
+    session.write(f"warning: {at}: {text}")
+    session.warnings.append(f"{at}: {text}")
+
+
 def load_dec(session, raw: bytes, path: Path, shown: str, where, stack) -> list:
     """A `.dec` file: read as a deck when it holds 3DEC commands; 3DEC's legacy binary/tabular
     block-geometry format (not documented) is refused by name."""
