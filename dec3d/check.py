@@ -303,9 +303,25 @@ def check_text(text: str, filename: str = "<input>", base_dir: Path | None = Non
     return w.reports
 
 
-def check_file(path: str | Path, standalone: bool = False) -> list[LineReport]:
+def check_file(path: str | Path, standalone: bool = False, legacy: bool = True) -> list[LineReport]:
+    """Reports for a deck file; a 3DEC 4/5 deck is checked as `dec3d run` runs it, through its translation
+    (dec3d.lang.legacy), its reports placed on the original lines (``legacy=False``: as written)."""
+    from dataclasses import replace
+
+    from .lang.legacy import looks_legacy, translate_text
+
     p = Path(path)
-    return check_text(p.read_text(encoding="utf-8", errors="replace"), str(p), p.parent, standalone)
+    text = p.read_text(encoding="utf-8", errors="replace")
+    if not (legacy and looks_legacy(text)):
+        return check_text(text, str(p), p.parent, standalone)
+    tr = translate_text(text, str(p))
+    out = []
+    for r in check_text(tr.text, str(p), p.parent, standalone):
+        if r.file == str(p):
+            line, col = tr.map.where(r.line, r.column)
+            r = replace(r, line=line, column=col)
+        out.append(r)
+    return out
 
 
 def _before(a: LineReport, b: LineReport, reports: list[LineReport]) -> bool:

@@ -43,6 +43,7 @@ def _run_limited(args, limit, warmup) -> int:
     helper = warmup.start()          # cold cache: half of the kernels compile on the other core
     try:
         from .errors import Dec3dError
+        from .legacy_run import LegacySession
         from .session import Session
 
         deck = Path(args.deck)
@@ -55,8 +56,9 @@ def _run_limited(args, limit, warmup) -> int:
             what = "is a file, not a folder" if out.exists() and not out.is_dir() else (exc.strerror or str(exc))
             print(f"error: the output folder '{out}' cannot be used: {what}", file=sys.stderr)
             return 2
-        session = Session(out_dir=out, echo=not args.quiet, allow_outside_paths=args.allow_outside_paths,
-                          allow_overwrite=args.allow_overwrite)
+        session = (Session if args.no_legacy else LegacySession)(   # legacy decks: translated in memory
+            out_dir=out, echo=not args.quiet, allow_outside_paths=args.allow_outside_paths,
+            allow_overwrite=args.allow_overwrite)
         session.trust_saves = args.trust_save
         session.skip_unsupported = args.skip_unsupported
         session.strict = args.strict
@@ -185,6 +187,8 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--trust-save", action="store_true",
                    help="`model restore` installs the FISH functions and callbacks of every save it reads, "
                         "also of saves not made by you on this machine (only for saves you trust; docs/safety.md)")
+    r.add_argument("--no-legacy", action="store_true",
+                   help="refuse 3DEC 4/5 (legacy) decks instead of running their translation (docs/legacy.md)")
     r.add_argument("--skip-unsupported", action="store_true",
                    help="skip the lines dec3d does not implement yet (each is printed and warned about) "
                         "instead of stopping there")
@@ -194,6 +198,10 @@ def main(argv: list[str] | None = None) -> int:
                    help="let decks run Python files (`program call 'x.py'`); Python is code, decks are data "
                         "(docs/python.md)")
     r.set_defaults(fn=_run)
+    t = sub.add_parser("translate", help="write the 3DEC 7+ equivalent of a 3DEC 4/5 (legacy) deck (docs/legacy.md)")
+    t.add_argument("deck")
+    t.add_argument("--out", help="file to write (default: standard output)")
+    t.set_defaults(fn=lambda a: __import__("dec3d.legacy_run", fromlist=["translate_main"]).translate_main(a.deck, a.out))
     b = sub.add_parser("batch", help="run a deck for many parameter values (process pool or Dask) and "
                                      "collect one table")
     b.add_argument("deck")
