@@ -21,15 +21,15 @@ def _row(rt, i, name, store_name, what):
         rows = np.flatnonzero(st["id"] == i)
         if rows.size:
             return st, int(rows[0])
-    raise FishValueError(f"`{name}`: there is no cable {what} with id {i}")
+    raise FishValueError(f"`{name}`: there is no {what} with id {i}")
 
 
 def _seg(rt, i, name):
-    return _row(rt, i, name, "cable_segments", "element")
+    return _row(rt, i, name, "cable_segments", "cable element")
 
 
 def _node(rt, i, name):
-    return _row(rt, i, name, "cable_nodes", "node")
+    return _row(rt, i, name, "cable_nodes", "cable node")
 
 
 @intrinsic("struct.cable.force.axial", 1)
@@ -83,3 +83,34 @@ def _nunbal(rt, i):
     """Unbalanced force of the node at the last step [N] (at a fixed node: the reaction, sign reversed)."""
     st, r = _node(rt, i, "struct.node.force.unbal")
     return _vec(st["force"], r)
+
+
+# ------------------------------------------------------------------ hybrid bolts' dowels
+def _dowel(rt, i, name):
+    return _row(rt, i, name, "cable_dowels", "dowel")
+
+
+@intrinsic("struct.hybrid.dowel.force", 1)
+def _dforce(rt, i):
+    """Shear force of the dowel [N] (its magnitude; the force on the second block is along the slip's
+    opposite)."""
+    import math
+
+    st, r = _dowel(rt, i, "struct.hybrid.dowel.force")
+    return math.sqrt(float((st["fs"][r] ** 2).sum()))
+
+
+@intrinsic("struct.hybrid.dowel.disp", 1)
+def _ddisp(rt, i):
+    """Accumulated shear displacement across the bolt at the dowel [m] (magnitude)."""
+    import math
+
+    st, r = _dowel(rt, i, "struct.hybrid.dowel.disp")
+    return math.sqrt(float((st["us"][r] ** 2).sum()))
+
+
+@intrinsic("struct.hybrid.dowel.state", 1)
+def _dstate(rt, i):
+    """State bits of the dowel: 1 yielding now, 2 yielded in the past, 4 ruptured."""
+    st, r = _dowel(rt, i, "struct.hybrid.dowel.state")
+    return int(st["state"][r])

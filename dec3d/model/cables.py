@@ -212,6 +212,9 @@ def nodes_hosted_by(model: Model, mask) -> int:
 def remap_hosts(model: Model, remap: np.ndarray) -> None:
     """After blocks are deleted (old row -> new row, -1 gone): nodes whose block went lose their host."""
     st = model.stores
+    from .dowels import remap_dowels     # dowels with a side deleted go (hybrid bolts)
+
+    remap_dowels(model, remap)
     if NODES in st and st[NODES].n:
         nodes = st[NODES]
         h = nodes["host"]

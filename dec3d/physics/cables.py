@@ -55,6 +55,10 @@ from dec3d.kernels.cable import C_A, C_E, C_KG, cable_step, empty_scratch
 from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, block_timestep
 from dec3d.model.cables import cable_stores, has_cables, update_masses
 
+from .dowels import advance_dowels
+from .dowels import block_stiffness as dowel_block_stiffness
+from .dowels import gridpoint_stiffness as dowel_gridpoint_stiffness
+
 #: ω_max Δt ≤ 2 s for the cable nodes (s = 0.5: ω Δt ≤ 1, as the local damping likes it)
 SAFETY = 0.5
 
@@ -93,7 +97,8 @@ def block_stiffness(model) -> tuple[np.ndarray, np.ndarray]:
     r2 = np.sum((nodes["hpos"][on] - b["centroid"][h[on]]) ** 2, axis=1)
     np.add.at(kt, h[on], kn[on])
     np.add.at(kr, h[on], kn[on] * r2)
-    return kt, kr
+    dkt, dkr = dowel_block_stiffness(model)      # dowels of hybrid bolts (``physics.dowels``)
+    return kt + dkt, kr + dkr
 
 
 def cable_timestep(model) -> float:
@@ -177,6 +182,7 @@ class CableStep:
         if bad:
             raise _run_error(f"a cable node moved off to infinity at step {m.step + 1} (Δt {r.dt:.3g} s): "
                              f"check the cable and grout properties")
+        advance_dowels(m, r.dt, nodes["pos"], segs["na"], segs["nb"])   # hybrid bolts' dowels
         h = nodes["host"]
         on = (h >= 0) & (hz == 0)
         if on.any():
@@ -223,6 +229,7 @@ def gridpoint_grout_stiffness(m, n: int) -> np.ndarray:
     out = np.zeros(n)
     if not has_cables(m):
         return out
+    out += dowel_gridpoint_stiffness(m, n)
     nodes, segs = cable_stores(m)
     zn = np.flatnonzero((nodes["hz"] != 0) & (nodes["host"] >= 0))
     if not zn.size:

@@ -419,7 +419,8 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
                              if has_feblocks(m) else {}),
                 # cable nodes and elements (``physics.cables``): every field, rolled back with the blocks
                 "cables": {n: {k: m.stores[n][k].copy() for k in m.stores[n].fields}
-                           for n in ("cable_nodes", "cable_segments") if n in m.stores},
+                           for n in ("cable_nodes", "cable_segments", "cable_dowels", "beam_nodes", "beam_elements")
+                           if n in m.stores},
                 # (to_arrays gives views where it can: copy them)
                 "contacts": {k: a.copy() for k, a in self.contacts.to_arrays().items()},
                 "subcontacts": {k: a.copy() for k, a in self.subcontacts.to_arrays().items()},
