@@ -55,6 +55,10 @@ from dec3d.kernels.cable import C_A, C_E, C_KG, cable_step, empty_scratch
 from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, block_timestep
 from dec3d.model.cables import cable_stores, has_cables, update_masses
 
+from dec3d.model.beams import has_beams
+
+from .beams import BeamStep, beam_timestep
+from .beams import block_stiffness as beam_block_stiffness
 from .dowels import advance_dowels
 from .dowels import block_stiffness as dowel_block_stiffness
 from .dowels import gridpoint_stiffness as dowel_gridpoint_stiffness
@@ -82,9 +86,10 @@ def check_cables(model) -> str | None:
 
 def block_stiffness(model) -> tuple[np.ndarray, np.ndarray]:
     """Per block row: Σ k_g × tributary length of the grout springs it hosts [N/m], and the same
-    weighted by |r|² (r: host point − block centroid) [N·m] (its rotational bound)."""
+    weighted by |r|² (r: host point − block centroid) [N·m] (its rotational bound); with the dowels
+    of hybrid bolts and the links of beams."""
     b = model.blocks
-    kt, kr = np.zeros(b.n), np.zeros(b.n)
+    kt, kr = beam_block_stiffness(model)          # beam links (``physics.beams``)
     if not has_cables(model):
         return kt, kr
     nodes, segs = cable_stores(model)
@@ -103,9 +108,10 @@ def block_stiffness(model) -> tuple[np.ndarray, np.ndarray]:
 
 def cable_timestep(model) -> float:
     """The cable nodes' critical step with their real masses, 2 s √(m / R) (R: the Gershgorin row sum
-    of the stiffness at the node, s = ``SAFETY``); inf without cables or densities."""
+    of the stiffness at the node, s = ``SAFETY``); inf without cables or densities. The beams' too
+    (``physics.beams.beam_timestep``)."""
     if not has_cables(model):
-        return np.inf
+        return beam_timestep(model)
     nodes, segs = cable_stores(model)
     p = segs["prop"]
     r = np.zeros(nodes.n)
@@ -117,7 +123,8 @@ def cable_timestep(model) -> float:
     np.add.at(r, segs["nb"], np.where(nodes["host"][segs["nb"]] >= 0, kend, 0.0))
     m = nodes["mass"]
     on = (r > 0) & (m > 0)
-    return float(2.0 * SAFETY * np.sqrt(m[on] / r[on]).min()) if on.any() else np.inf
+    dt = float(2.0 * SAFETY * np.sqrt(m[on] / r[on]).min()) if on.any() else np.inf
+    return min(dt, beam_timestep(model))
 
 
 def grouted_timestep(model, frac: float, moving=None) -> float:
@@ -160,11 +167,7 @@ class CableStep:
         r = self.run
         m, b = r.m, r.m.blocks
         nodes, segs = cable_stores(m)
-        mode, alpha = r.mode, r.alpha
-        if r.dynamic or mode not in (DAMP_LOCAL, DAMP_COMBINED, DAMP_ADAPTIVE):
-            damp, a = 0, 0.0
-        else:
-            damp, a = 2, (float(alpha) if mode in (DAMP_LOCAL, DAMP_COMBINED) else ALPHA_DEFAULT)
+        damp, a = _damping(r)
         old_f = nodes["hforce"].copy()
         old_m = nodes["hmoment"].copy()
         hz = nodes["hz"]
@@ -198,6 +201,14 @@ class CableStep:
 
     def __repr__(self) -> str:
         return "CableStep"
+
+
+def _damping(r) -> tuple[int, float]:
+    """(damping kind for the structural nodes: 0 none, 2 combined; its coefficient) of run ``r``."""
+    mode, alpha = r.mode, r.alpha
+    if r.dynamic or mode not in (DAMP_LOCAL, DAMP_COMBINED, DAMP_ADAPTIVE):
+        return 0, 0.0
+    return 2, (float(alpha) if mode in (DAMP_LOCAL, DAMP_COMBINED) else ALPHA_DEFAULT)
 
 
 def zone_host_state(m, nodes, segs, zn):
@@ -248,5 +259,5 @@ def _run_error(msg: str):
 
 
 def cable_steps(run) -> list:
-    """[CableStep] when the model has cables, else []."""
-    return [CableStep(run)] if has_cables(run.m) else []
+    """[CableStep] when the model has cables, [BeamStep] when it has beams (``physics.beams``)."""
+    return ([CableStep(run)] if has_cables(run.m) else []) + ([BeamStep(run)] if has_beams(run.m) else [])

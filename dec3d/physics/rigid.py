@@ -28,6 +28,7 @@ from dec3d.model.store import Store
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.zones import has_zones
 
+from .beams import beam_balance, has_beams
 from .cables import cable_timestep, grouted_timestep
 from .massscale import DensityScaling
 from .contact_store import contact_stores
@@ -318,6 +319,10 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
             gu, ga = zst.balance()
             un = np.concatenate((un, gu))
             A = np.concatenate((A, ga))
+        if has_beams(m):
+            # beam nodes count as bodies too (``physics.beams.beam_balance``)
+            bu, ba = beam_balance(m)
+            un, A = np.concatenate((un, bu)), np.concatenate((A, ba))
         if not len(un):
             return out
         umax = float(un.max())
