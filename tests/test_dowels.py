@@ -176,3 +176,32 @@ def test_bolt_in_no_block_is_refused(tmp_path):
         _run("structure hybrid create by-line 5 5 5 6 6 6 segments 3\n", tmp_path, s)
     assert exc.value.location.line == 1 and exc.value.location.column > 1
     assert s.model.stores["cable_dowels"].n == 1
+
+
+def test_dowel_on_a_zoned_block_loads_its_gridpoints(tmp_path):
+    """A rigid block sliding on a zoned base across a hybrid bolt: the base side of the dowel follows a
+    4-node zone, and the dowel's force reaches the base's gridpoints whole (Σ wᵢ F = F)."""
+    s = _run("""model new
+block create brick -1 1 -1 1 -1 0
+block create brick -0.5 0.5 -0.5 0.5 0 0.5
+block zone generate edgelength 0.5 range position-z -1 0
+block zone cmodel assign elastic range position-z -1 0
+block zone property bulk 1e9 shear 1e9 density 2500 range position-z -1 0
+block property density 2500 range position-z 0 0.5
+block gridpoint apply velocity 0 0 0 range position-z -1
+block contact jmodel assign mohr
+block contact material-table default property stiffness-normal 1e9 stiffness-shear 1e9 friction 0
+structure hybrid create by-line 0.1 0.1 0.4 0.1 0.1 -0.8 segments 6
+structure hybrid property young 200e9 cross-sectional-area 5e-4 grout-stiffness 1e9 grout-cohesion 1e9
+structure hybrid property dowel-stiffness 1e7 dowel-yield 2e4
+block fix velocity range position-z 0 0.5
+block initialize velocity-x 1e-3 range position-z 0 0.5
+model cycle 200
+""", tmp_path)
+    st = s.model.stores["cable_dowels"]
+    assert st["hz"][0].tolist() == [0, 1] and abs(st["hw"][0, 1].sum() - 1.0) < 1e-12
+    f = st["fs"][0]
+    assert f[0] > 100.0 and np.linalg.norm(f) == pytest.approx(1e7 * np.linalg.norm(st["us"][0]), rel=1e-9)
+    # the grout acts along the (vertical) bolt only: the horizontal load on the gridpoints is the dowel's
+    v = s.model.vertices
+    np.testing.assert_allclose(v["fapp"][: v.n, :2].sum(axis=0), f[:2], rtol=1e-9)
