@@ -21,12 +21,9 @@ def _cross(a, b):
     return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 
 
-def twin_step(dt, D, npos, na, nb, B):
-    for i in range(len(D["seg"])):
-        e = D["seg"][i]
-        t = [npos[nb[e]][k] - npos[na[e]][k] for k in range(3)]
-        ln = sum(x * x for x in t) ** 0.5
-        t = [x / ln for x in t]
+def twin_step(dt, D, B):
+    for i in range(len(D["axis"])):
+        t = D["axis"][i]
         vel = []
         for s in range(2):
             if D["hz"][i][s]:
@@ -71,30 +68,29 @@ def twin_step(dt, D, npos, na, nb, B):
 
 def _case(seed):
     rng = np.random.default_rng(seed)
-    n, d = 7, 5
-    npos = np.cumsum(rng.uniform(0.2, 0.5, (n, 3)), axis=0)
-    na, nb = np.arange(n - 1, dtype=np.int64), np.arange(1, n, dtype=np.int64)
-    D = {"seg": np.array([0, 1, 3, 4, 5], np.int64), "blk": np.array([[0, 1], [1, 2], [2, 0], [0, 2], [1, 0]], np.int64),
+    d = 5
+    ax = rng.normal(size=(d, 3))
+    D = {"axis": ax / np.linalg.norm(ax, axis=1)[:, None], "blk": np.array([[0, 1], [1, 2], [2, 0], [0, 2], [1, 0]], np.int64),
          "hz": np.array([[0, 0], [0, 1], [1, 0], [0, 0], [0, 0]], np.int8), "hvel": rng.normal(0, 1e-2, (d, 2, 3)),
          "pos": rng.normal(0, 1, (d, 3)), "prop": np.array([[1e7, 0, 0], [2e7, 300.0, 0], [1e7, 0, 2e-4],
                                                              [5e6, 200.0, 5e-4], [1e7, 1e3, 0]]),
          "fs": rng.normal(0, 50, (d, 3)), "us": rng.normal(0, 1e-5, (d, 3)), "state": np.array([0, 0, 0, 0, 4], np.int32),
          "moment": np.zeros((d, 2, 3))}
     B = {"vel": rng.normal(0, 1e-2, (3, 3)), "spin": rng.normal(0, 1e-2, (3, 3)), "cen": rng.normal(0, 1, (3, 3))}
-    return npos, na, nb, D, B
+    return D, B
 
 
 def test_dowel_kernel_matches_twin():
     from dec3d.kernels.dowel import dowel_step
 
-    npos, na, nb, D, B = _case(3)
+    D, B = _case(3)
     tw = {k: v.tolist() for k, v in D.items()}
     tb = {k: v.tolist() for k, v in B.items()}
     dt = 1e-3
     for _ in range(30):
-        dowel_step(dt, D["seg"], na, nb, npos, D["blk"], D["hz"], D["hvel"], D["pos"], D["prop"], D["fs"], D["us"],
+        dowel_step(dt, D["axis"], D["blk"], D["hz"], D["hvel"], D["pos"], D["prop"], D["fs"], D["us"],
                    D["state"], D["moment"], B["vel"], B["spin"], B["cen"])
-        twin_step(dt, tw, npos.tolist(), na.tolist(), nb.tolist(), tb)
+        twin_step(dt, tw, tb)
     for k in ("pos", "fs", "us", "moment"):
         np.testing.assert_allclose(D[k], np.array(tw[k]), rtol=1e-10, atol=1e-12, err_msg=k)
     assert D["state"].tolist() == tw["state"]
@@ -205,3 +201,29 @@ model cycle 200
     # the grout acts along the (vertical) bolt only: the horizontal load on the gridpoints is the dowel's
     v = s.model.vertices
     np.testing.assert_allclose(v["fapp"][: v.n, :2].sum(axis=0), f[:2], rtol=1e-9)
+
+
+def test_factor_of_safety_keeps_the_dowel_strength(tmp_path):
+    """A block on a plane of dip ψ = 35° (W = 1e5 N, φ = 30°, no cohesion) held by a hybrid bolt across
+    the plane whose cable carries nothing (yield forces of 1 N) and whose dowel yields at F_y = 2e4 N.
+    The strength reduction divides the joint's tan φ only, the dowel keeping F_y (as 3DEC does with bolts):
+    FS = W cos ψ tan φ / (W sin ψ − F_y) = 47 294.0 / 37 357.6 = 1.26600."""
+    s = _run("""model new
+[gx = 10.0 * math.sin(35.0 * math.pi / 180.0)]
+[gz = -10.0 * math.cos(35.0 * math.pi / 180.0)]
+block create brick -5 10 -3 5 -2 0
+block create brick 0 2 0 2 0 1
+block property density 2500
+block fix range position-z -2 0
+block contact jmodel assign mohr
+block contact material-table default property stiffness-normal 10e6 stiffness-shear 10e6 friction 30
+structure hybrid create by-line 1 1 0.9 1 1 -1.5 segments 4
+structure hybrid property young 200e9 cross-sectional-area 5e-4 grout-stiffness 1e8 grout-cohesion 1e7 density 7800
+structure hybrid property yield-tension 1 yield-compression 1 dowel-stiffness 1e7 dowel-yield 2e4
+model gravity [gx] 0 [gz]
+model solve ratio 1e-6
+model factor-of-safety bracket 1.1 1.5 resolution 0.005 cycles 2000
+""", tmp_path)
+    w = 1e5
+    want = w * np.cos(np.radians(35)) * np.tan(np.radians(30)) / (w * np.sin(np.radians(35)) - 2e4)
+    assert s.results["fos"] == pytest.approx(want, rel=0.01)

@@ -7,8 +7,8 @@ yield force; once the accumulated shear displacement |u_s| reaches the rupture d
 dowel carries nothing from then on. Returns its force on B (A gets the opposite) and the moments of
 both about their blocks' centroids. The tests hold a plain-Python twin (``tests/test_dowels.py``).
 
-Arrays (d dowels): ``seg (d,)`` cable segment row (its nodes ``na, nb`` and the node positions
-``npos`` give the axis); ``blk (d, 2)`` block rows of the two sides; ``hz (d, 2)`` 1 where a side is a
+Arrays (d dowels): ``axis (d, 3)`` the bolt's unit axis (as created: the cable's nodes are free
+across it, so its elements' present directions are no guide); ``blk (d, 2)`` block rows of the two sides; ``hz (d, 2)`` 1 where a side is a
 zoned block, whose point velocity ``hvel (d, 2, 3)`` the caller gives; ``pos (d, 3)`` the dowel point
 (moved on with the mean motion of its sides); ``prop (d, 3)`` stiffness [N/m], yield force [N, 0: no
 limit], rupture displacement [m, 0: none]; ``fs (d, 3)`` shear force on B [N]; ``us (d, 3)``
@@ -43,19 +43,10 @@ def _side_velocity(i, s, dt, blk, hz, hvel, pos, bvel, bspin, bcen):
 
 
 @njit(cache=True)
-def dowel_step(dt, seg, na, nb, npos, blk, hz, hvel, pos, prop, fs, us, state, moment, bvel, bspin, bcen):
-    d = seg.shape[0]
+def dowel_step(dt, axis, blk, hz, hvel, pos, prop, fs, us, state, moment, bvel, bspin, bcen):
+    d = axis.shape[0]
     for i in range(d):
-        e = seg[i]
-        a = na[e]
-        b = nb[e]
-        t0 = npos[b, 0] - npos[a, 0]
-        t1 = npos[b, 1] - npos[a, 1]
-        t2 = npos[b, 2] - npos[a, 2]
-        ln = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
-        t0 /= ln
-        t1 /= ln
-        t2 /= ln
+        t0, t1, t2 = axis[i, 0], axis[i, 1], axis[i, 2]
         # velocity of each side at the dowel point
         va0, va1, va2 = _side_velocity(i, 0, dt, blk, hz, hvel, pos, bvel, bspin, bcen)
         vb0, vb1, vb2 = _side_velocity(i, 1, dt, blk, hz, hvel, pos, bvel, bspin, bcen)

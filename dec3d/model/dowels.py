@@ -9,6 +9,7 @@ kernel ``dec3d.kernels.dowel``.
     hz (2,)           int8   1: that side is a zoned block; hzone (2,) its 4-node zone, hgp (2, 4) the
                       zone's gridpoint rows, hw (2, 4) the dowel point's barycentric weights
     pos (3,)          m      the dowel point (on the contact, moved with the mean of its sides)
+    axis (3,)                the bolt's unit axis as created (the shear is what is across it)
     prop (3,)         dowel-stiffness [N/m], dowel-yield [N], dowel-rupture [m]
     fs (3,)           N      shear force on side B (A carries −fs)
     us (3,)           m      accumulated shear displacement of B against A across the bolt
@@ -37,7 +38,7 @@ def _fields() -> dict[str, Field]:
     v3 = Field((3,), np.float64, 0.0)
     return {"id": Field((), np.int64, 0), "cable": Field((), np.int64, 0), "seg": Field((), np.int64, -1),
             "blk": Field((2,), np.int64, -1), "hz": Field((2,), np.int8, 0), "hzone": Field((2,), np.int64, -1),
-            "hgp": Field((2, 4), np.int64, -1), "hw": Field((2, 4), np.float64, 0.0), "pos": v3,
+            "hgp": Field((2, 4), np.int64, -1), "hw": Field((2, 4), np.float64, 0.0), "pos": v3, "axis": v3,
             "prop": Field((NDPROP,), np.float64, 0.0), "fs": v3, "us": v3, "moment": Field((2, 3), np.float64, 0.0),
             "state": Field((), np.int32, 0), "group": group_field()}
 
@@ -117,6 +118,7 @@ def add_dowels(model: Model, cable_id: int, p1, p2, seg_rows: np.ndarray, tol: f
         st["blk"][r] = (ba, bb)
         x = p1 + t * d
         st["pos"][r] = x
+        st["axis"][r] = d / size
         for side, (blk, tt) in enumerate(((ba, t - eps), (bb, t + eps))):
             if b["kind"][blk] == KIND_RIGID:
                 continue

@@ -185,7 +185,7 @@ class CableStep:
         if bad:
             raise _run_error(f"a cable node moved off to infinity at step {m.step + 1} (Δt {r.dt:.3g} s): "
                              f"check the cable and grout properties")
-        advance_dowels(m, r.dt, nodes["pos"], segs["na"], segs["nb"])   # hybrid bolts' dowels
+        advance_dowels(m, r.dt)   # hybrid bolts' dowels
         h = nodes["host"]
         on = (h >= 0) & (hz == 0)
         if on.any():

@@ -3,7 +3,8 @@ a shear spring where the bolt crosses each joint; stores ``dec3d.model.dowels``,
 ``dec3d.kernels.dowel``).
 
 Model. Where a bolt crosses the contact between blocks A and B, the steel resists the relative shear
-displacement of the two faces: a spring across the bolt's axis t acting on the shear part of the
+displacement of the two faces: a spring across the bolt's axis t (as created: the cable's nodes are coupled to the rock along the axis only,
+so its elements' present directions are no guide; small rotations) acting on the shear part of the
 relative displacement of B against A at the crossing point,
     Δu_s = (Δu − (Δu·t) t),  Δu = (v_B(x) − v_A(x)) Δt,   F ← F − k_d Δu_s   (force on B; A gets −F),
 elastic, perfectly plastic with |F| ≤ F_y (``dowel-yield``), and broken for good once the accumulated
@@ -27,7 +28,7 @@ from dec3d.kernels.dowel import D_K, dowel_step
 from dec3d.model.dowels import DOWELS, has_dowels
 
 
-def advance_dowels(m, dt: float, npos, na, nb) -> None:
+def advance_dowels(m, dt: float) -> None:
     """One dowel step (after the cable step of the same step)."""
     if not has_dowels(m):
         return
@@ -41,7 +42,7 @@ def advance_dowels(m, dt: float, npos, na, nb) -> None:
     if zs.size:
         i, s = zs[:, 0], zs[:, 1]
         hvel[i, s] = np.einsum("kj,kjc->kc", st["hw"][i, s], v["velocity"][st["hgp"][i, s]])
-    dowel_step(float(dt), st["seg"], na, nb, npos, st["blk"], hz, hvel, st["pos"], st["prop"], st["fs"], st["us"],
+    dowel_step(float(dt), st["axis"], st["blk"], hz, hvel, st["pos"], st["prop"], st["fs"], st["us"],
                st["state"], st["moment"], b["velocity"], b["spin"], b["centroid"])
     df = st["fs"] - old_f
     dm = st["moment"] - old_m
