@@ -48,6 +48,11 @@ def twin_step(dt, g, alpha, damp, safety, N, S, B, last):
         h = N["host"][i]
         if h < 0:
             continue
+        if N["hz"][i]:
+            N["lf"][i] = [N["lf"][i][k] - N["klt"][i] * (N["vel"][i][k] - N["hvel"][i][k]) * dt for k in range(3)]
+            F[i] = list(N["lf"][i])
+            N["hforce"][i] = [-x for x in N["lf"][i]]
+            continue
         c0 = [B["cen"][h][k] - B["vel"][h][k] * dt for k in range(3)]
         r = [N["hpos"][i][k] - c0[k] for k in range(3)]
         w = B["spin"][h]
@@ -106,7 +111,8 @@ def _case(seed):
     N = {"pos": pos, "vel": rng.normal(0, 1e-3, (n, 3)), "disp": rng.normal(0, 1e-4, (n, 3)),
          "rot": rng.normal(0, 1e-4, (n, 3)), "avel": rng.normal(0, 1e-3, (n, 3)), "mass": rng.uniform(1, 3, n),
          "inert": rng.uniform(0.01, 0.1, n), "rt": rng.uniform(1e7, 1e8, n), "rr": rng.uniform(1e5, 1e6, n),
-         "host": np.array([0, -1, -1, 1, -1, 0], np.int64), "hpos": pos + rng.normal(0, 1e-3, (n, 3)),
+         "host": np.array([0, -1, -1, 1, -1, 0], np.int64), "hz": np.array([0, 0, 0, 0, 0, 1], np.int8),
+         "hvel": rng.normal(0, 1e-3, (n, 3)), "hpos": pos + rng.normal(0, 1e-3, (n, 3)),
          "klt": rng.uniform(1e6, 1e7, n), "klr": rng.uniform(1e4, 1e5, n), "lf": rng.normal(0, 10, (n, 3)),
          "lm": rng.normal(0, 1, (n, 3)), "fix": np.array([0, 7, 56, 0, 9, 0], np.uint8),
          "fapp": rng.normal(0, 10, (n, 3)), "mapp": rng.normal(0, 1, (n, 3)), "force": rng.normal(0, 5, (n, 3)),
@@ -142,8 +148,8 @@ def test_kernel_matches_twin(damp, safety):
     dt, g, alpha = 1e-4, np.array([0.0, 0.0, -9.81]), 0.8
     for _ in range(20):
         bad = beam_step(dt, g, alpha, damp, safety, *(N[k] for k in (
-            "pos", "vel", "disp", "rot", "avel", "mass", "inert", "rt", "rr", "host", "hpos", "klt", "klr", "lf", "lm",
-            "fix", "fapp", "mapp", "force", "moment", "hforce", "hmoment", "imass", "iinert")),
+            "pos", "vel", "disp", "rot", "avel", "mass", "inert", "rt", "rr", "host", "hz", "hvel", "hpos", "klt", "klr",
+            "lf", "lm", "fix", "fapp", "mapp", "force", "moment", "hforce", "hmoment", "imass", "iinert")),
             S["na"], S["nb"], S["l0"], S["prop"], S["axes"], S["fl"], B["vel"], B["spin"], B["cen"], last)
         assert bad == 0
         twin_step(dt, [0.0, 0.0, -9.81], alpha, damp, safety, tw[0], tw[1], tb, tlast)
@@ -188,19 +194,37 @@ def test_cantilever_bends_about_both_axes_and_twists(tmp_path):
 def test_beam_linked_to_a_block_carries_it(tmp_path):
     """A 1 m³ block (20 kN) hangs on a vertical beam through it, fixed at its top: the beam's axial
     force above the block is the weight, and the block comes to rest."""
-    s = _run("""model new
+    s = _run(HANG + "model cycle 3000\n", tmp_path)
+    els = s.model.stores["beam_elements"]
+    assert els["fl"][-1, 6] == pytest.approx(20000.0, rel=2e-3)
+    assert abs(s.model.blocks["velocity"][0]).max() < 1e-4
+    assert abs(s.model.blocks["mapp"][0]).max() < 1.0
+
+
+HANG = """model new
 block create brick -0.5 0.5 -0.5 0.5 -1 0
 block property density 2000
 model gravity 0 0 -10
 structure beam create by-line 0 0 -0.9 0 0 2 segments 29
 structure beam property young 200e9 poisson 0.3 cross-sectional-area 1e-3 moi-y 1e-7 moi-z 1e-7 moi-polar 2e-7
 structure node fix velocity rotation range id 30
-model cycle 3000
-""", tmp_path)
-    els = s.model.stores["beam_elements"]
-    assert els["fl"][-1, 6] == pytest.approx(20000.0, rel=2e-3)
-    assert abs(s.model.blocks["velocity"][0]).max() < 1e-4
-    assert abs(s.model.blocks["mapp"][0]).max() < 1.0
+"""
+
+
+def test_beam_linked_to_a_zoned_block_carries_it(tmp_path):
+    """The same hanging block, zoned: the nodes inside follow their zones (translational links), whose
+    gridpoints take the links' pull, and the beam above the block carries its weight."""
+    text = HANG.replace("block property density 2000\n",
+                        "block zone generate edgelength 0.5\nblock zone cmodel assign elastic\n"
+                        "block zone property young 10e9 poisson 0.25 density 2000\n")
+    s = _run(text + "model solve ratio 1e-6\n", tmp_path)
+    nodes, els = s.model.stores["beam_nodes"], s.model.stores["beam_elements"]
+    assert nodes["hz"].sum() == 10 and (nodes["hw"][nodes["hz"] == 1] >= 0).all()
+    assert els["fl"][-1, 6] == pytest.approx(20000.0, rel=5e-3)
+    v = s.model.vertices
+    assert v["fapp"][:, 2].sum() == pytest.approx(els["fl"][-1, 6], rel=5e-3)
+    _run("block delete\nmodel cycle 5\n", tmp_path, s)
+    assert (nodes["host"] == -1).all() and not nodes["lf"].any()
 
 
 def test_save_restore_vtk_history_fish(tmp_path):

@@ -12,7 +12,8 @@ Arrays (n nodes, s elements):
 
 - nodes: ``pos, vel, disp, rot, avel (n, 3)``; ``mass, inert (n,)`` real mass and rotary inertia;
   ``rt, rr (n,)`` Gershgorin row sums of the stiffness at the node (translational, rotational rows);
-  ``host (n,)`` block row or -1; ``hpos (n, 3)`` host point; ``klt, klr (n,)`` link stiffnesses;
+  ``host (n,)`` block row or -1; ``hz (n,)`` 1 where the host is a zoned block, whose host-point
+  velocity ``hvel (n, 3)`` the caller gives (translational link only); ``hpos (n, 3)`` host point; ``klt, klr (n,)`` link stiffnesses;
   ``lf, lm (n, 3)`` link force and moment on the node (updated); ``fix (n,)`` bits 0-2 velocity,
   3-5 rotational velocity held; ``fapp, mapp (n, 3)``. Out: ``force, moment (n, 3)`` unbalanced,
   ``hforce, hmoment (n, 3)`` force on the host and its moment about the host's centroid,
@@ -78,7 +79,7 @@ def _sgn(x):
 
 @njit(cache=True)
 def beam_step(dt, g, alpha, damp, safety,
-              pos, vel, disp, rot, avel, mass, inert, rt, rr, host, hpos, klt, klr, lf, lm, fix, fapp, mapp,
+              pos, vel, disp, rot, avel, mass, inert, rt, rr, host, hz, hvel, hpos, klt, klr, lf, lm, fix, fapp, mapp,
               force, moment, hforce, hmoment, imass, iinert,
               na, nb, l0, prop, axes, fl, bvel, bspin, bcen, last):
     """One step; ``last (n, 6)``: the last step's force and moment (combined damping); ``damp`` 0
@@ -97,6 +98,13 @@ def beam_step(dt, g, alpha, damp, safety,
             hmoment[i, k] = 0.0
         h = host[i]
         if h < 0:
+            continue
+        if hz[i] != 0:
+            # a zoned host: the node's link follows the host point (its zone's gridpoints), translation only
+            for k in range(3):
+                lf[i, k] -= klt[i] * (vel[i, k] - hvel[i, k]) * dt
+                force[i, k] += lf[i, k]
+                hforce[i, k] = -lf[i, k]
             continue
         r0 = hpos[i, 0] - bcen[h, 0] + bvel[h, 0] * dt
         r1 = hpos[i, 1] - bcen[h, 1] + bvel[h, 1] * dt

@@ -8,7 +8,9 @@ kernel ``dec3d.kernels.beam``).
     rot, avel (3,)        rad, rad/s  rotation (small, total) and rotational velocity
     mass, inert ()        kg, kg·m²  real mass and rotary inertia (from the elements' density)
     imass, iinert ()      the inertial ones of the last step (density-scaled in static runs)
-    host ()               int64  rigid block the node is linked to (-1: free)
+    host ()               int64  block the node is linked to (-1: free)
+    hz ()                 int8   1: the host is a zoned block, the node follows a 4-node zone: hzone () its
+                          row, hgp (4,) its gridpoint rows, hw (4,) the node's barycentric weights
     hpos (3,)             m      host point
     lf, lm (3,)           N, N·m link force and moment on the node
     fix ()                uint8  bits 0-2 velocity, 3-5 rotational velocity held (``structure node fix``)
@@ -31,7 +33,7 @@ import numpy as np
 
 from dec3d.kernels.beam import NBPROP
 
-from .cables import host_blocks
+from .cables import _first_block, host_blocks, zone_host
 from .groups import group_field
 from .model import Model
 from .store import Field, Store
@@ -47,7 +49,8 @@ def _node_fields():
     f = {k: v3 for k in ("pos", "pos0", "vel", "disp", "rot", "avel", "hpos", "lf", "lm", "fapp", "mapp", "force",
                          "moment", "hforce", "hmoment")}
     f.update({"id": Field((), np.int64, 0), "beam": Field((), np.int64, 0), "host": Field((), np.int64, -1),
-              "fix": Field((), np.uint8, 0), "group": group_field()})
+              "fix": Field((), np.uint8, 0), "group": group_field(), "hz": Field((), np.int8, 0),
+              "hzone": Field((), np.int64, -1), "hgp": Field((4,), np.int64, -1), "hw": Field((4,), np.float64, 0.0)})
     f.update({k: Field((), np.float64, 0.0) for k in ("mass", "inert", "imass", "iinert")})
     return f
 
@@ -96,7 +99,7 @@ def element_axes(x: np.ndarray, ydir) -> np.ndarray:
 
 def add_beam(model: Model, p1, p2, segments: int, beam_id, group, tol: float) -> tuple[int, np.ndarray]:
     """Append a straight beam of equal elements; returns (beam id, host rows of its nodes: -1 free,
-    -2 in a zoned or FE block)."""
+    -3 in a block that cannot host it: an FE block or 10-node zones)."""
     nodes, els = beam_stores(model)
     p1, p2 = np.asarray(p1, float), np.asarray(p2, float)
     t = np.linspace(0.0, 1.0, segments + 1)[:, None]
@@ -113,6 +116,16 @@ def add_beam(model: Model, p1, p2, segments: int, beam_id, group, tol: float) ->
     nodes["pos"][rn] = pts
     nodes["pos0"][rn] = pts
     nodes["hpos"][rn] = pts
+    for k in np.flatnonzero(hosts == -2):
+        # a node in a zoned block follows the 4-node zone that holds it (-3: none, e.g. 10-node zones)
+        r = _first_block(model, pts[k], tol)
+        z = zone_host(model, r, pts[k], max(tol, 1e-9)) if r >= 0 else None
+        if z is None:
+            hosts[k] = -3
+            continue
+        hosts[k] = r
+        nodes["hz"][rn[k]] = 1
+        nodes["hzone"][rn[k]], nodes["hgp"][rn[k]], nodes["hw"][rn[k]] = z
     nodes["host"][rn] = np.maximum(hosts, -1)
     sl = els.append(segments)
     rs = np.arange(sl.start, sl.stop)
@@ -154,6 +167,15 @@ def remap_beam_hosts(model: Model, remap: np.ndarray) -> int:
     ok = h >= 0
     h[ok] = remap[h[ok]]
     lost = ok & (h < 0)
+    # zone-hosted nodes of surviving blocks: the zones' and gridpoints' rows moved, find them again
+    for i in np.flatnonzero((h >= 0) & (nodes["hz"] == 1)):
+        z = zone_host(model, int(h[i]), nodes["hpos"][i], 1e-9)
+        if z is None:
+            h[i] = -1
+            lost[i] = True
+        else:
+            nodes["hzone"][i], nodes["hgp"][i], nodes["hw"][i] = z
+    nodes["hz"][lost] = 0
     for k in ("lf", "lm", "hforce", "hmoment"):
         nodes[k][lost] = 0.0
     return int(lost.sum())

@@ -23,8 +23,11 @@ block's material point there, translational k_l = ``LINK`` × max(EA/L, 12 E I/L
 k_r = ``LINK`` × max(4 E I/L, GJ/L) over its elements (I the larger of I_y, I_z): a stiff, "rigid"
 link that the explicit scheme can carry. The link forces (incremental) act on the block through its
 ``fapp``/``mapp`` (as a change from the last step, as the cables' grout) and enter its stiffness sums.
-Nodes in zoned or FE blocks are not linked yet (refused at creation); `structure node fix` holds
-nodes (and rotations) in place.
+A node in a zoned block follows the 4-node zone that holds it: its host point is Σ wᵢ xᵢ over the
+zone's gridpoints (barycentric weights fixed at creation), the translational link acts on the
+relative velocity to Σ wᵢ vᵢ and its reaction goes to the gridpoints as wᵢ F (a zone has no rotation:
+no rotational link there); wᵢ k_l enters the gridpoints' stiffness (``gridpoint_stiffness``). Nodes in
+FE blocks or 10-node zones are refused at creation; `structure node fix` holds nodes (and rotations).
 """
 from __future__ import annotations
 
@@ -79,6 +82,7 @@ def link_stiffness(model) -> tuple[np.ndarray, np.ndarray]:
     free = nodes["host"] < 0
     klt[free] = 0.0
     klr[free] = 0.0
+    klr[nodes["hz"] != 0] = 0.0          # (a zone has no rotation to link to)
     return LINK * klt, LINK * klr
 
 
@@ -120,11 +124,24 @@ def block_stiffness(model) -> tuple[np.ndarray, np.ndarray]:
     nodes, _ = beam_stores(model)
     klt, klr = link_stiffness(model)
     h = nodes["host"]
-    on = h >= 0
+    on = (h >= 0) & (nodes["hz"] == 0)
     r2 = np.sum((nodes["hpos"][on] - b["centroid"][h[on]]) ** 2, axis=1)
     np.add.at(kt, h[on], klt[on])
     np.add.at(kr, h[on], klr[on] + klt[on] * r2)
     return kt, kr
+
+
+def gridpoint_stiffness(model, n: int) -> np.ndarray:
+    """Per vertex row: Σ wᵢ k_l of the links of beam nodes in zoned blocks."""
+    out = np.zeros(n)
+    if not has_beams(model):
+        return out
+    nodes, _ = beam_stores(model)
+    zn = np.flatnonzero((nodes["hz"] != 0) & (nodes["host"] >= 0))
+    if zn.size:
+        klt, _ = link_stiffness(model)
+        np.add.at(out, nodes["hgp"][zn].ravel(), (nodes["hw"][zn] * klt[zn][:, None]).ravel())
+    return out
 
 
 class BeamStep:
@@ -162,9 +179,17 @@ class BeamStep:
         damp, a = _damping(r)
         old_f = nodes["hforce"].copy()
         old_m = nodes["hmoment"].copy()
+        hz = nodes["hz"]
+        zn = np.flatnonzero((hz != 0) & (nodes["host"] >= 0))
+        hvel = np.zeros((nodes.n, 3))
+        if zn.size:
+            v = m.vertices
+            w, gp = nodes["hw"][zn], nodes["hgp"][zn]
+            nodes["hpos"][zn] = np.einsum("kj,kjc->kc", w, v["pos"][gp])
+            hvel[zn] = np.einsum("kj,kjc->kc", w, v["velocity"][gp])
         bad = beam_step(float(r.dt), self.g, a, damp, SAFETY if self.scaled else 0.0,
                         nodes["pos"], nodes["vel"], nodes["disp"], nodes["rot"], nodes["avel"], nodes["mass"],
-                        nodes["inert"], self.rt, self.rr, nodes["host"], nodes["hpos"], self.klt, self.klr,
+                        nodes["inert"], self.rt, self.rr, nodes["host"], hz, hvel, nodes["hpos"], self.klt, self.klr,
                         nodes["lf"], nodes["lm"], nodes["fix"], nodes["fapp"], nodes["mapp"], nodes["force"],
                         nodes["moment"], nodes["hforce"], nodes["hmoment"], nodes["imass"], nodes["iinert"],
                         els["na"], els["nb"], els["l0"], els["prop"], els["axes"], els["fl"],
@@ -173,10 +198,15 @@ class BeamStep:
             raise RunError(f"a beam node moved off to infinity at step {m.step + 1} (Δt {r.dt:.3g} s): check the "
                            f"beam properties")
         h = nodes["host"]
-        on = h >= 0
+        on = (h >= 0) & (hz == 0)
         if on.any():
             np.add.at(b["fapp"], h[on], nodes["hforce"][on] - old_f[on])
             np.add.at(b["mapp"], h[on], nodes["hmoment"][on] - old_m[on])
+        if zn.size:
+            # a zoned host: the link's reaction goes to the zone's gridpoints by the node's weights
+            df = nodes["hforce"][zn] - old_f[zn]
+            np.add.at(m.vertices["fapp"], nodes["hgp"][zn].ravel(),
+                      (nodes["hw"][zn][:, :, None] * df[:, None, :]).reshape(-1, 3))
         return min(n, 1)
 
     def __repr__(self) -> str:

@@ -59,6 +59,7 @@ from dec3d.model.beams import has_beams
 
 from .beams import BeamStep, beam_timestep
 from .beams import block_stiffness as beam_block_stiffness
+from .beams import gridpoint_stiffness as beam_gridpoint_stiffness
 from .dowels import advance_dowels
 from .dowels import block_stiffness as dowel_block_stiffness
 from .dowels import gridpoint_stiffness as dowel_gridpoint_stiffness
@@ -237,7 +238,7 @@ def zone_host_state(m, nodes, segs, zn):
 def gridpoint_grout_stiffness(m, n: int) -> np.ndarray:
     """Per vertex row (length n): Σ k_g × tributary length × weight of the grout springs on it [N/m]
     (a grout spring on a host point Σ wᵢ xᵢ adds wᵢ k to gridpoint i's Gershgorin row: Σ wⱼ = 1)."""
-    out = np.zeros(n)
+    out = beam_gridpoint_stiffness(m, n)          # links of beam nodes in zones (``physics.beams``)
     if not has_cables(m):
         return out
     out += dowel_gridpoint_stiffness(m, n)
