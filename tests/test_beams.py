@@ -91,7 +91,8 @@ def twin_step(dt, g, alpha, damp, safety, N, S, B, last):
             f = F[i][k] + N["fapp"][i][k] + N["mass"][i] * g[k]
             mo = M[i][k] + N["mapp"][i][k]
             N["force"][i][k], N["moment"][i][k] = f, mo
-            for val, inertia, key, bit, lastv in ((f, m, "vel", k, last[i][k]), (mo, ri, "avel", 3 + k, last[i][3 + k])):
+            for val, inertia, key, bit, lastv in ((f, m, "vel", k, last[i][k]),
+                                                  (mo, ri, "avel", 3 + k, last[i][3 + k])):
                 if (N["fix"][i] >> bit) & 1:
                     continue
                 v = N[key][i][k]
@@ -148,8 +149,8 @@ def test_kernel_matches_twin(damp, safety):
     dt, g, alpha = 1e-4, np.array([0.0, 0.0, -9.81]), 0.8
     for _ in range(20):
         bad = beam_step(dt, g, alpha, damp, safety, *(N[k] for k in (
-            "pos", "vel", "disp", "rot", "avel", "mass", "inert", "rt", "rr", "host", "hz", "hvel", "hpos", "klt", "klr",
-            "lf", "lm", "fix", "fapp", "mapp", "force", "moment", "hforce", "hmoment", "imass", "iinert")),
+            "pos", "vel", "disp", "rot", "avel", "mass", "inert", "rt", "rr", "host", "hz", "hvel", "hpos",
+            "klt", "klr", "lf", "lm", "fix", "fapp", "mapp", "force", "moment", "hforce", "hmoment", "imass", "iinert")),
             S["na"], S["nb"], S["l0"], S["prop"], S["axes"], S["fl"], B["vel"], B["spin"], B["cen"], last)
         assert bad == 0
         twin_step(dt, [0.0, 0.0, -9.81], alpha, damp, safety, tw[0], tw[1], tb, tlast)

@@ -70,11 +70,13 @@ def _case(seed):
     rng = np.random.default_rng(seed)
     d = 5
     ax = rng.normal(size=(d, 3))
-    D = {"axis": ax / np.linalg.norm(ax, axis=1)[:, None], "blk": np.array([[0, 1], [1, 2], [2, 0], [0, 2], [1, 0]], np.int64),
+    D = {"axis": ax / np.linalg.norm(ax, axis=1)[:, None],
+         "blk": np.array([[0, 1], [1, 2], [2, 0], [0, 2], [1, 0]], np.int64),
          "hz": np.array([[0, 0], [0, 1], [1, 0], [0, 0], [0, 0]], np.int8), "hvel": rng.normal(0, 1e-2, (d, 2, 3)),
          "pos": rng.normal(0, 1, (d, 3)), "prop": np.array([[1e7, 0, 0], [2e7, 300.0, 0], [1e7, 0, 2e-4],
                                                              [5e6, 200.0, 5e-4], [1e7, 1e3, 0]]),
-         "fs": rng.normal(0, 50, (d, 3)), "us": rng.normal(0, 1e-5, (d, 3)), "state": np.array([0, 0, 0, 0, 4], np.int32),
+         "fs": rng.normal(0, 50, (d, 3)), "us": rng.normal(0, 1e-5, (d, 3)),
+         "state": np.array([0, 0, 0, 0, 4], np.int32),
          "moment": np.zeros((d, 2, 3))}
     B = {"vel": rng.normal(0, 1e-2, (3, 3)), "spin": rng.normal(0, 1e-2, (3, 3)), "cen": rng.normal(0, 1, (3, 3))}
     return D, B

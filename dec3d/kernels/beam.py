@@ -13,7 +13,8 @@ Arrays (n nodes, s elements):
 - nodes: ``pos, vel, disp, rot, avel (n, 3)``; ``mass, inert (n,)`` real mass and rotary inertia;
   ``rt, rr (n,)`` Gershgorin row sums of the stiffness at the node (translational, rotational rows);
   ``host (n,)`` block row or -1; ``hz (n,)`` 1 where the host is a zoned block, whose host-point
-  velocity ``hvel (n, 3)`` the caller gives (translational link only); ``hpos (n, 3)`` host point; ``klt, klr (n,)`` link stiffnesses;
+  velocity ``hvel (n, 3)`` the caller gives (translational link only); ``hpos (n, 3)`` host point;
+  ``klt, klr (n,)`` link stiffnesses;
   ``lf, lm (n, 3)`` link force and moment on the node (updated); ``fix (n,)`` bits 0-2 velocity,
   3-5 rotational velocity held; ``fapp, mapp (n, 3)``. Out: ``force, moment (n, 3)`` unbalanced,
   ``hforce, hmoment (n, 3)`` force on the host and its moment about the host's centroid,

@@ -8,13 +8,14 @@ dowel carries nothing from then on. Returns its force on B (A gets the opposite)
 both about their blocks' centroids. The tests hold a plain-Python twin (``tests/test_dowels.py``).
 
 Arrays (d dowels): ``axis (d, 3)`` the bolt's unit axis (as created: the cable's nodes are free
-across it, so its elements' present directions are no guide); ``blk (d, 2)`` block rows of the two sides; ``hz (d, 2)`` 1 where a side is a
-zoned block, whose point velocity ``hvel (d, 2, 3)`` the caller gives; ``pos (d, 3)`` the dowel point
-(moved on with the mean motion of its sides); ``prop (d, 3)`` stiffness [N/m], yield force [N, 0: no
-limit], rupture displacement [m, 0: none]; ``fs (d, 3)`` shear force on B [N]; ``us (d, 3)``
-accumulated relative shear displacement of B against A [m]; ``state (d,)`` bits 1 yielding now, 2
-yielded in the past, 4 ruptured. Out: ``moment (d, 2, 3)`` moments of −F (on A) and F (on B) about
-the blocks' centroids (rigid sides; 0 on zoned ones).
+across it, so its elements' present directions are no guide); ``blk (d, 2)`` block rows of the two
+sides; ``hz (d, 2)`` 1 where a side is a zoned block, whose point velocity ``hvel (d, 2, 3)`` the
+caller gives; ``pos (d, 3)`` the dowel point (moved on with the mean motion of its sides);
+``prop (d, 3)`` stiffness [N/m], yield force [N, 0: no limit], rupture displacement [m, 0: none];
+``fs (d, 3)`` shear force on B [N]; ``us (d, 3)`` accumulated relative shear displacement of B
+against A [m]; ``state (d,)`` bits 1 yielding now, 2 yielded in the past, 4 ruptured.
+Out: ``moment (d, 2, 3)`` moments of −F (on A) and F (on B) about the blocks' centroids (rigid
+sides; 0 on zoned ones).
 """
 from __future__ import annotations
 

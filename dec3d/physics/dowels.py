@@ -3,8 +3,9 @@ a shear spring where the bolt crosses each joint; stores ``dec3d.model.dowels``,
 ``dec3d.kernels.dowel``).
 
 Model. Where a bolt crosses the contact between blocks A and B, the steel resists the relative shear
-displacement of the two faces: a spring across the bolt's axis t (as created: the cable's nodes are coupled to the rock along the axis only,
-so its elements' present directions are no guide; small rotations) acting on the shear part of the
+displacement of the two faces: a spring across the bolt's axis t (as created: the cable's nodes are
+coupled to the rock along the axis only, so its elements' present directions are no guide; small
+rotations) acting on the shear part of the
 relative displacement of B against A at the crossing point,
     Δu_s = (Δu − (Δu·t) t),  Δu = (v_B(x) − v_A(x)) Δt,   F ← F − k_d Δu_s   (force on B; A gets −F),
 elastic, perfectly plastic with |F| ≤ F_y (``dowel-yield``), and broken for good once the accumulated

@@ -422,7 +422,7 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
                           if has_zones(m) else {}),
                 "feblocks": ({k: m.store("feblocks")[k].copy() for k in ("stress", "gstress")}
                              if has_feblocks(m) else {}),
-                # cable nodes and elements (``physics.cables``): every field, rolled back with the blocks
+                # cable nodes, elements and dowels, beam nodes and elements: every field, rolled back with the blocks
                 "cables": {n: {k: m.stores[n][k].copy() for k in m.stores[n].fields}
                            for n in ("cable_nodes", "cable_segments", "cable_dowels", "beam_nodes", "beam_elements")
                            if n in m.stores},
