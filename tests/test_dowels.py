@@ -143,11 +143,14 @@ def test_dowel_ruptures(tmp_path):
 
 
 def test_save_restore_and_delete(tmp_path):
-    a = _run(SLIDE + "model cycle 100\n", tmp_path)
+    a = _run(SLIDE + "structure hybrid history name 'fd' shear-force component-id 1\nhistory interval 10\n"
+             "model cycle 100\n", tmp_path)
     p = tmp_path / "h.sav"
     _run(f"model save '{p}'\nmodel cycle 100\n", tmp_path, a)
     b = _run(f"model restore '{p}'\nmodel cycle 100\n", tmp_path)
     np.testing.assert_array_equal(a.model.stores["cable_dowels"]["fs"], b.model.stores["cable_dowels"]["fs"])
+    h = b.model.history_set.items[0]
+    assert h.values[-1] == pytest.approx(np.linalg.norm(b.model.stores["cable_dowels"]["fs"][0]), rel=1e-12)
     _run("block delete range id 2\nmodel cycle 10\n", tmp_path, b)
     assert b.model.stores["cable_dowels"].n == 0
     # the dowel's force on the base went with it: what is left is the grout of the nodes in the base, along z

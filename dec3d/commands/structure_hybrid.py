@@ -8,9 +8,9 @@ import numpy as np
 from ..errors import BindError, CommandError
 from ..model.cables import PROPS, SEGMENTS, cable_stores, update_masses
 from ..model.dowels import DOWELS, DPROPS, add_dowels, dowel_store, has_dowels
-from .registry import command
+from .registry import REGISTRY, command
 from .structure_cable import _DOCS, _UNITS, cable_create
-from .values import COORD, Num, Nums, P, Text
+from .values import COORD, POINT, Num, Nums, P, Text
 
 _DDOCS = {"dowel-stiffness": "shear stiffness of the dowel at each joint crossing",
           "dowel-yield": "shear force at which the dowel yields (0: no limit)",
@@ -119,3 +119,45 @@ def hybrid_list(session, call):
         session.write(f"{int(st['id'][i]):6d} {int(st['cable'][i]):5d} {int(bid[st['blk'][i, 0]]):8d} "
                       f"{int(bid[st['blk'][i, 1]]):8d} {np.linalg.norm(st['fs'][i]):16.5g} "
                       f"{np.linalg.norm(st['us'][i]):15.5g}  {' '.join(words) or '-'}")
+
+
+# ------------------------------------------------------------------ histories
+REGISTRY.node_keywords("structure hybrid history", [P("name", Text(), "history name")])
+
+
+def _check_hist(call):
+    if (call.args["component_id"] is None) == (call.args["position"] is None):
+        raise BindError("give either `component-id <i>` or `position <x y z>`", call.location)
+
+
+def _hist_handler(quantity):
+    def handler(session, call):
+        from ..physics.dowels import add_dowel_history
+        from ..physics.history import histories
+        from .histories import _name
+
+        m = session.model
+        if not has_dowels(m):
+            raise CommandError("there is no dowel: make a hybrid bolt across a joint first", call.location)
+        name = _name(session, call)
+        st = m.stores[DOWELS]
+        if call.args["component_id"] is not None:
+            ident = int(call.args["component_id"])
+        else:
+            d = np.linalg.norm(st["pos"] - np.asarray([float(x) for x in call.args["position"]]), axis=1)
+            ident = int(st["id"][int(np.argmin(d))])
+        try:
+            add_dowel_history(histories(m), quantity, ident, name)
+        except CommandError as exc:
+            raise exc.with_location(call.locations.get("component_id", call.location))
+    return handler
+
+
+for _q, _what in (("shear-force", "shear force (N)"), ("shear-displacement", "shear displacement (m)")):
+    command(f"structure hybrid history {_q}",
+            keywords=[P("component-id", Num(integer=True, lo=1), "id of the dowel (as `structure hybrid list` shows)"),
+                      P("position", POINT, "the dowel nearest this point", units="m")],
+            check=_check_hist, doc=f"Record the {_what} of a hybrid bolt's dowel (its magnitude).",
+            details="The dowel is named by `component-id <i>` or by `position x y z` (the nearest dowel point). "
+                    "A leading `name '<s>'` names the history.",
+            examples=[f"structure hybrid history {_q} component-id 1"])(_hist_handler(_q))

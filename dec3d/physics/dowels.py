@@ -88,3 +88,33 @@ def gridpoint_stiffness(m, n: int) -> np.ndarray:
         if on.any():
             np.add.at(out, st["hgp"][on, side].ravel(), (st["hw"][on, side] * k[on][:, None]).ravel())
     return out
+
+
+#: ``structure hybrid history`` quantities: the dowel's shear force and shear displacement (magnitudes)
+DOWEL_QUANTITIES = ("shear-force", "shear-displacement")
+
+
+def _dowel_row(m, ident: int) -> int:
+    from dec3d.errors import CommandError
+
+    st = m.stores.get(DOWELS)
+    rows = np.flatnonzero(st["id"] == ident) if st is not None and st.n else np.zeros(0, np.int64)
+    if rows.size == 0:
+        raise CommandError(f"there is no dowel with id {ident}")
+    return int(rows[0])
+
+
+def add_dowel_history(hs, quantity: str, ident: int, name: str | None = None):
+    """Add to HistorySet ``hs`` the shear force [N] or shear displacement [m] of dowel ``ident``."""
+    m = hs.model
+    if quantity not in DOWEL_QUANTITIES:
+        raise ValueError(f"unknown dowel history quantity {quantity!r}")
+    _dowel_row(m, ident)
+    field = "fs" if quantity == "shear-force" else "us"
+
+    def value(eng) -> float:
+        st = m.stores[DOWELS]
+        rows = np.flatnonzero(st["id"] == ident)
+        # (a dowel dropped with a deleted block carries nothing)
+        return float(np.linalg.norm(st[field][rows[0]])) if rows.size else 0.0
+    return hs.add(f"dowel {ident} {quantity}", value, name, {"kind": "dowel", "quantity": quantity, "id": int(ident)})
