@@ -180,16 +180,16 @@ def _run(text, tmp_path, s=None):
 def test_cantilever_bends_about_both_axes_and_twists(tmp_path):
     """Tip load P = 100 N along z and y and a torque T = 50 N·m: w = P L³ / 3 E I_y, v = P L³ / 3 E I_z,
     twist T L / G J (small-displacement closed forms, exact at the nodes of cubic elements)."""
-    s = _run(CANTI + "structure node apply force 0 100 -100 moment-x 50 range id 11\nmodel solve ratio 1e-8\n",
+    s = _run(CANTI + "structure node apply force 0 100 -100 moment-x 50 range id 11\nmodel solve ratio 1e-6\n",
              tmp_path)
     n = s.model.stores["beam_nodes"]
     tip = np.flatnonzero(n["id"] == 11)[0]
     E, G, L = 200e9, 200e9 / 2.6, 2.0
-    assert n["disp"][tip, 2] == pytest.approx(-100 * L ** 3 / (3 * E * 1e-6), rel=1e-4)
-    assert n["disp"][tip, 1] == pytest.approx(100 * L ** 3 / (3 * E * 4e-6), rel=1e-4)
-    assert n["rot"][tip, 0] == pytest.approx(50 * L / (G * 2e-6), rel=1e-4)
+    assert n["disp"][tip, 2] == pytest.approx(-100 * L ** 3 / (3 * E * 1e-6), rel=1e-3)
+    assert n["disp"][tip, 1] == pytest.approx(100 * L ** 3 / (3 * E * 4e-6), rel=1e-3)
+    assert n["rot"][tip, 0] == pytest.approx(50 * L / (G * 2e-6), rel=1e-3)
     els = s.model.stores["beam_elements"]
-    assert els["fl"][0, 4] == pytest.approx(-100 * L, rel=1e-4)       # root moment about y: P L
+    assert els["fl"][0, 4] == pytest.approx(-100 * L, rel=1e-3)       # root moment about y: P L
 
 
 def test_beam_linked_to_a_block_carries_it(tmp_path):
