@@ -207,28 +207,3 @@ model cycle 200
     v = s.model.vertices
     np.testing.assert_allclose(v["fapp"][: v.n, :2].sum(axis=0), f[:2], rtol=1e-9)
 
-
-def test_factor_of_safety_keeps_the_dowel_strength(tmp_path):
-    """A block on a plane of dip ψ = 35° (W = 1e5 N, φ = 30°, no cohesion) held by a hybrid bolt across
-    the plane whose cable carries nothing (yield forces of 1 N) and whose dowel yields at F_y = 2e4 N.
-    The strength reduction divides the joint's tan φ only, the dowel keeping F_y (as 3DEC does with bolts):
-    FS = W cos ψ tan φ / (W sin ψ − F_y) = 47 294.0 / 37 357.6 = 1.26600."""
-    s = _run("""model new
-[gx = 10.0 * math.sin(35.0 * math.pi / 180.0)]
-[gz = -10.0 * math.cos(35.0 * math.pi / 180.0)]
-block create brick -5 10 -3 5 -2 0
-block create brick 0 2 0 2 0 1
-block property density 2500
-block fix range position-z -2 0
-block contact jmodel assign mohr
-block contact material-table default property stiffness-normal 10e6 stiffness-shear 10e6 friction 30
-structure hybrid create by-line 1 1 0.9 1 1 -1.5 segments 4
-structure hybrid property young 200e9 cross-sectional-area 5e-4 grout-stiffness 1e8 grout-cohesion 1e7 density 7800
-structure hybrid property yield-tension 1 yield-compression 1 dowel-stiffness 1e7 dowel-yield 2e4
-model gravity [gx] 0 [gz]
-model solve ratio 1e-6
-model factor-of-safety bracket 1.1 1.5 resolution 0.005 cycles 2000
-""", tmp_path)
-    w = 1e5
-    want = w * np.cos(np.radians(35)) * np.tan(np.radians(30)) / (w * np.sin(np.radians(35)) - 2e4)
-    assert s.results["fos"] == pytest.approx(want, rel=0.01)
