@@ -28,6 +28,7 @@ from dec3d.model.store import Store
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.zones import has_zones
 
+from .beams import beam_balance, has_beams
 from .cables import cable_timestep, grouted_timestep
 from .massscale import DensityScaling
 from .contact_store import contact_stores
@@ -318,6 +319,10 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
             gu, ga = zst.balance()
             un = np.concatenate((un, gu))
             A = np.concatenate((A, ga))
+        if has_beams(m):
+            # beam nodes count as bodies too (``physics.beams.beam_balance``)
+            bu, ba = beam_balance(m)
+            un, A = np.concatenate((un, bu)), np.concatenate((A, ba))
         if not len(un):
             return out
         umax = float(un.max())
@@ -431,9 +436,10 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
                           if has_zones(m) else {}),
                 "feblocks": ({k: m.store("feblocks")[k].copy() for k in ("stress", "gstress")}
                              if has_feblocks(m) else {}),
-                # cable nodes and elements (``physics.cables``): every field, rolled back with the blocks
+                # cable nodes, elements and dowels, beam nodes and elements: every field, rolled back with the blocks
                 "cables": {n: {k: m.stores[n][k].copy() for k in m.stores[n].fields}
-                           for n in ("cable_nodes", "cable_segments") if n in m.stores},
+                           for n in ("cable_nodes", "cable_segments", "cable_dowels", "beam_nodes", "beam_elements")
+                           if n in m.stores},
                 # (to_arrays gives views where it can: copy them)
                 "contacts": {k: a.copy() for k, a in self.contacts.to_arrays().items()},
                 "subcontacts": {k: a.copy() for k, a in self.subcontacts.to_arrays().items()},
