@@ -153,8 +153,10 @@ def test_save_restore_and_delete(tmp_path):
     assert h.values[-1] == pytest.approx(np.linalg.norm(b.model.stores["cable_dowels"]["fs"][0]), rel=1e-12)
     _run("block delete range id 2\nmodel cycle 10\n", tmp_path, b)
     assert b.model.stores["cable_dowels"].n == 0
-    # the dowel's force on the base went with it: what is left is the grout of the nodes in the base, along z
-    assert not b.model.blocks["fapp"][0, :2].any()
+    # the dowel's force on the base went with it: what is left is the cable's own, along z (grout) and, tiny,
+    # across it (the node links pass on the sideways part of the axial force where the cable has turned)
+    fs_before = np.linalg.norm(a.model.stores["cable_dowels"]["fs"][0])
+    assert np.abs(b.model.blocks["fapp"][0, :2]).max() < 1e-5 * fs_before
 
 
 @pytest.mark.parametrize("line, where, what", [
@@ -203,7 +205,9 @@ model cycle 200
     assert st["hz"][0].tolist() == [0, 1] and abs(st["hw"][0, 1].sum() - 1.0) < 1e-12
     f = st["fs"][0]
     assert f[0] > 100.0 and np.linalg.norm(f) == pytest.approx(1e7 * np.linalg.norm(st["us"][0]), rel=1e-9)
-    # the grout acts along the (vertical) bolt only: the horizontal load on the gridpoints is the dowel's
+    # the grout acts along the (vertical) bolt: the horizontal load on the gridpoints is the dowel's, and a
+    # little (1e-5) the cable's, whose nodes are linked across it and pass on the sideways part of its axial
+    # force where the sliding block has turned it
     v = s.model.vertices
-    np.testing.assert_allclose(v["fapp"][: v.n, :2].sum(axis=0), f[:2], rtol=1e-9)
+    np.testing.assert_allclose(v["fapp"][: v.n, :2].sum(axis=0), f[:2], rtol=1e-4)
 

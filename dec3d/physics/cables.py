@@ -27,6 +27,14 @@ Model (Itasca's, as those pages state it):
   ``gridpoint_grout_stiffness``, added in ``ZoneStepper._stiffness``), hence their scaled masses.
   FE blocks and 10-node zones are not hosts yet (``structure cable create`` refuses a node in one).
 
+Across the cable a hosted node is linked rigidly to its host (Itasca's cable nodes: only the axial
+direction of the link is deformable, through the grout): it takes the host point's velocity in the
+two directions normal to the cable (the cable's direction at the node: the mean of its elements'
+unit vectors), and the force on it across the cable (the axial forces of a bent chain, its weight,
+an applied force) goes to the host with the grout reaction. So a block sliding across a cable carries
+the cable's nodes with it (the cable turns and bends at the joint), and a cable in compression cannot
+buckle sideways through the rock. A node with held components (`structure node fix`) is not linked.
+
 Motion: the nodes carry mass and move explicitly with the blocks' central-difference scheme, as
 Itasca's structural-element nodes do, with combined damping (3DEC theory Eq. 83, the form meant for
 parts in steady motion, such as a cable being pulled out: local damping, Eq. 79, takes only the sign
