@@ -1,0 +1,199 @@
+"""`fracture compute`, `fracture intersections compute`, `fracture list`, `fracture delete`, and
+`block cut dfn` with the contact range element `jointset-id` (measures: ``dec3d.geometry.dfn_measure``;
+cutting: ``dec3d.geometry.dfn_cut``)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import CommandError
+from ..geometry import dfn_measure
+from ..geometry.dfn_cut import cut_dfn
+from ..model import fractures as FR
+from .budget import check_blocks
+from .fracture import _arrays, _box, _dfn_rows
+from .registry import command, range_element
+from .values import ANGLE, FLAG, POINT, Num, Nums, P, Text
+
+
+@command("fracture compute",
+         keywords=[P("dfn", Text(), "only this DFN"),
+                   P("scanline", Nums(6, 6), "P10 along the segment x1 y1 z1 x2 y2 z2", units="m"),
+                   P("box", Nums(6, 6), "P32 in the box x1 x2 y1 y2 z1 z2 (default: the blocks' box)", units="m"),
+                   P("plane-origin", POINT, "P21 on the plane through this point (in the box)", units="m"),
+                   P("dip", ANGLE, "dip of the P21 plane", default=0.0),
+                   P("dip-direction", ANGLE, "dip direction of the P21 plane", default=0.0)],
+         doc="Compute and print DFN intensities: count by set, P32 in a box, P10 on a scanline, P21 on a plane.",
+         details="P32 = disk area inside the box / its volume, the disks clipped to the box exactly; P10 = disks "
+                 "the scanline crosses / its length; P21 = trace length inside the box / area of the plane's "
+                 "section of the box. The keywords are dec3d's (Itasca's `fracture compute` page could not be "
+                 "read in full). Results: `fractures`, `p32`, and with their keywords `p10`, `p21`.",
+         examples=["fracture compute", "fracture compute box 0 50 0 50 0 50 scanline 0 25 25 50 25 25",
+                   "fracture compute plane-origin 25 25 25 dip 90 dip-direction 90 dfn 'rock'"])
+def fracture_compute(session, call):
+    a = call.args
+    m = session.model
+    rows, _ = _dfn_rows(session, call)
+    c, n, r = _arrays(m, rows)
+    fs = FR.fracture_store(m)
+    sets, counts = np.unique(fs["set"][rows], return_counts=True)
+    session.write(f"fractures: {len(rows)}  (by set: " + ", ".join(f"{int(s)}: {int(k)}" for s, k in zip(sets, counts))
+                  + ")")
+    session.results["fractures"] = float(len(rows))
+    box = _box(session, call, "box") if (a["box"] is not None or m.blocks.n) else None
+    if box is not None:
+        v = dfn_measure.p32(c, n, r, box)
+        session.results["p32"] = v
+        session.write(f"P32 in the box: {v:.6g} 1/m")
+    if a["scanline"] is not None:
+        v = dfn_measure.p10(c, n, r, a["scanline"][:3], a["scanline"][3:])
+        session.results["p10"] = v
+        session.write(f"P10 on the scanline: {v:.6g} 1/m")
+    if a["plane_origin"] is not None:
+        if box is None:
+            raise CommandError("P21 needs a box (`box x1 x2 y1 y2 z1 z2`)", call.location)
+        d, dd = float(a["dip"]), float(a["dip_direction"])
+        normal = [math.sin(d) * math.sin(dd), math.sin(d) * math.cos(dd), math.cos(d)]
+        try:
+            v, length, area = dfn_measure.p21(c, n, r, a["plane_origin"], normal, box)
+        except ValueError as exc:
+            raise CommandError(str(exc), call.locations.get("plane_origin", call.location)) from None
+        session.results["p21"] = v
+        session.write(f"P21 on the plane: {v:.6g} 1/m (traces {length:.6g} m on {area:.6g} m²)")
+
+
+@command("fracture intersections compute", keywords=[P("dfn", Text(), "only this DFN")],
+         doc="Find the intersections between disks and the connected clusters they form.",
+         details="Two disks intersect when their chords on the line common to their planes overlap. Clusters are "
+                 "the connected components of the intersection graph. Results: `intersections`, `clusters`, "
+                 "`largest_cluster` (fractures in the largest), `isolated` (fractures meeting no other).",
+         examples=["fracture intersections compute", "fracture intersections compute dfn 'rock'"])
+def intersections_compute(session, call):
+    m = session.model
+    rows, _ = _dfn_rows(session, call)
+    c, n, r = _arrays(m, rows)
+    lab, pairs = dfn_measure.clusters(c, n, r)
+    sizes = np.bincount(lab) if len(lab) else np.zeros(0, np.int64)
+    res = {"intersections": len(pairs), "clusters": len(sizes), "largest_cluster": int(sizes.max()) if len(sizes) else 0,
+           "isolated": int((sizes == 1).sum())}
+    for k, v in res.items():
+        session.results[k] = float(v)
+    session.write(f"{res['intersections']} intersections, {res['clusters']} clusters (largest {res['largest_cluster']}"
+                  f" fractures, {res['isolated']} isolated)")
+
+
+@command("fracture list", keywords=[P("dfn", Text(), "only this DFN")],
+         doc="List the DFNs and templates: fractures per set, sizes and orientations.",
+         examples=["fracture list", "fracture list dfn 'rock'"])
+def fracture_list(session, call):
+    m = session.model
+    st = FR.dfn_state(m)
+    fs = FR.fracture_store(m)
+    for name, t in st["templates"].items():
+        session.write(f"template '{name}': set {t.get('set')}, orientation {t['orientation']['kind']}, "
+                      f"size {t['size']['kind']}, size-limits {t['size_limits']}")
+    rows, _ = _dfn_rows(session, call)
+    for did in np.unique(fs["dfn"][rows]):
+        sel = rows[fs["dfn"][rows] == did]
+        session.write(f"DFN '{FR.dfn_name(m, did)}' (id {int(did)}): {len(sel)} fractures")
+        for s in np.unique(fs["set"][sel]):
+            q = sel[fs["set"][sel] == s]
+            d, dd = FR.dips_from_normals(fs["normal"][q])
+            session.write(f"  set {int(s)}: {len(q)} fractures, diameter {2 * fs['radius'][q].min():.4g}.."
+                          f"{2 * fs['radius'][q].max():.4g} m, mean dip {math.degrees(d.mean()):.1f}")
+
+
+@command("fracture delete", keywords=[P("dfn", Text(), "only this DFN")], range="fractures",
+         doc="Delete the fractures in range (of one DFN, or all).",
+         examples=["fracture delete", "fracture delete dfn 'rock'", "fracture delete range id-list 1 2 3"])
+def fracture_delete(session, call):
+    m = session.model
+    fs = FR.fracture_store(m)
+    mask = session.range_mask(call, "fractures")
+    rows, _ = _dfn_rows(session, call)
+    rows = rows[mask[rows]]
+    FR.delete(m, rows)
+    session.write(f"{len(rows)} fractures deleted")
+
+
+def _check_cut(call):
+    from ..errors import BindError
+
+    if (call.args["name"] is None) == (call.args["id"] is None):
+        raise BindError("`block cut dfn` needs `name s` or `id i`", call.location)
+
+
+@command("block cut dfn",
+         keywords=[P("name", Text(), "cut with the DFN of this name"),
+                   P("id", Num(integer=True, lo=1), "cut with the DFN of this id"),
+                   P("jointset-id", Num(integer=True, lo=0), "joint-set id recorded on the new faces (default: "
+                     "the DFN id); select their contacts with `range jointset-id i`"),
+                   P("join", FLAG, "join the pieces of each block", bare=True)],
+         range="block", check=_check_cut,
+         doc="Cut the visible blocks in range by the disk fractures of a DFN.",
+         details="3DEC's rule: blocks are split completely, no partial cracks; every block a disk touches is cut "
+                 "through by the disk's whole plane (the joints made are larger than the disks), blocks the disk "
+                 "does not reach are not cut. A disk touches a block when the block has corners on both sides "
+                 "of its plane (beyond the tolerance) and the block's section by the plane comes within the "
+                 "radius of the disk's centre. Disks are taken in order of generation; each cut is exact and a "
+                 "plane within the tolerance (`block tolerance`) of a corner passes through it, so no piece is "
+                 "thinner than the tolerance or of zero volume. The new faces record the joint-set id and the "
+                 "fracture id (face fields `jointset`, `fracture`); pieces of them cut later keep them. Only "
+                 "blocks whose box overlaps a disk's box are tested. Results: `blocks_made`, `fractures_used`, "
+                 "`smallest_volume`.",
+         examples=["block cut dfn name 'rock'", "block cut dfn id 1 jointset-id 3 range position-z 0 20"])
+def block_cut_dfn(session, call):
+    a = call.args
+    m = session.model
+    if a["name"] is not None:
+        did = FR.dfn_id(m, a["name"], create=False)
+        if did is None:
+            raise CommandError(f"there is no DFN '{a['name']}'", call.locations.get("name", call.location))
+    else:
+        did = int(a["id"])
+        if str(did) not in FR.dfn_state(m)["dfns"]:
+            raise CommandError(f"there is no DFN {did}", call.locations.get("id", call.location))
+    rows = FR.select(m, did)
+    check_blocks(session, len(rows), "this DFN", call.location)
+    mask = session.range_mask(call, "block")
+    c, n, r = _arrays(m, rows)
+    js = int(a["jointset_id"]) if a["jointset_id"] is not None else did
+    made, used = cut_dfn(m, c.copy(), n.copy(), r.copy(), FR.fracture_store(m)["id"][rows].copy(), js, mask=mask,
+                         join=bool(a["join"]))
+    vol = m.blocks["volume"]
+    session.results["blocks_made"] = float(made)
+    session.results["fractures_used"] = float(used)
+    session.results["smallest_volume"] = float(vol.min()) if len(vol) else 0.0
+    session.write(f"{made} new blocks from {used} of {len(rows)} fractures (smallest block {vol.min():.4g} m³)")
+
+
+@range_element("jointset-id", positional=[P("id", Num(integer=True), "joint-set id", required=True)],
+               stores=("contacts", "faces"),
+               doc="faces made by `block cut dfn` with this joint-set id, and the contacts lying on them")
+def jointset_id(session, store, args):
+    m = session.model
+    f = m.faces
+    want = int(args["id"])
+    onset = (f["jointset"] == want) if "jointset" in f else np.zeros(f.n, bool)
+    if store == "faces":
+        return onset
+    cs = m.store("contacts")
+    out = np.zeros(cs.n, bool)
+    if not onset.any() or cs.n == 0:
+        return out
+    tol = max(float(m.tolerance), 1e-9)
+    # a contact is on the joint set when a face of the set of either of its blocks holds its point
+    rows = np.flatnonzero(onset)
+    blk = f["block"][rows]
+    for side in ("a", "b"):
+        for k in range(cs.n):
+            if out[k]:
+                continue
+            sel = rows[blk == cs[side][k]]
+            if sel.size == 0:
+                continue
+            d = np.abs(np.einsum("ij,ij->i", f["normal"][sel], cs["pos"][k] - f["centroid"][sel]))
+            par = np.abs(np.abs(f["normal"][sel] @ cs["normal"][k]) - 1) < 1e-6
+            out[k] = bool(((d <= tol * 10 + 1e-6 * np.sqrt(f["area"][sel])) & par).any())
+    return out

@@ -1,0 +1,130 @@
+"""``block cut dfn``: cut blocks by the disk fractures of a DFN.
+
+3DEC's rule (block cut command page: "Blocks are split completely (i.e., no partial cracks are
+allowed) … A cut will be made from each fracture in the DFN, but be aware that the generated joints
+will generally be larger than the actual fractures"): a block that a disk touches is cut through by
+the disk's whole plane; a block the disk does not reach is not cut. So a block partly crossed by a
+disk (the disk's rim inside the block) is still split completely.
+
+A disk touches a convex block when the block has vertices strictly on both sides of the disk's plane
+(beyond the tolerance) and the block's section by that plane — the convex polygon of the points where
+the block's edges cross the plane — comes within the disk's radius of the disk's centre (the centre
+inside the polygon, or closer than r to one of its sides).
+
+Fractures are taken in order (of their rows: the order of generation). Each cut reuses
+``cutting.cut_by_planes`` (the kernel ``polycut.cut_blocks``: exact convex pieces, a plane within the
+tolerance of a corner passes through it, so no sliver thinner than the tolerance and no zero-volume
+piece). Candidate blocks of a disk come from an axis-aligned box prefilter: the disk's extent along
+axis k is r √(1 − n_k²); the blocks' boxes are kept up to date for the rows each cut changes.
+
+The new faces each disk makes are recorded in two face fields (added on first use, saved with the
+model): ``jointset`` (the joint-set id given to the cut; default the DFN id) and ``fracture`` (the
+fracture id). Pieces of those faces cut later keep them. The contact range element
+``jointset-id`` selects the contacts lying on faces of a joint set.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .cutting import _selection, cut_by_planes
+from .mass import range_index
+from dec3d.model.fractures import ensure_face_fields
+
+_F = np.float64
+
+
+def _block_boxes(model, rows):
+    b = model.blocks
+    st, cnt = b["vert_start"][rows], b["vert_count"][rows]
+    pos = model.vertices["pos"][range_index(st, cnt)]
+    offs = np.concatenate(([0], np.cumsum(cnt)[:-1])).astype(np.int64)
+    return np.minimum.reduceat(pos, offs, axis=0), np.maximum.reduceat(pos, offs, axis=0)
+
+
+def disk_touches_block(model, row: int, c, n, r: float, tol: float) -> bool:
+    """Whether the disk (c, n, r) meets block ``row`` so that its plane splits it (see the module)."""
+    b, f, fv = model.blocks, model.faces, model.face_vertices
+    vs, vc = int(b["vert_start"][row]), int(b["vert_count"][row])
+    pos = model.vertices["pos"][vs:vs + vc]
+    s = (pos - c) @ n
+    if not (s.min() < -tol and s.max() > tol):
+        return False
+    fs, fc = int(b["face_start"][row]), int(b["face_count"][row])
+    nv = f["nvert"][fs:fs + fc]
+    st = f["vstart"][fs:fs + fc]
+    loops = fv["vertex"][range_index(st, nv)] - vs
+    # next vertex of each loop entry (closing each loop)
+    ptr = np.concatenate(([0], np.cumsum(nv))).astype(np.int64)
+    nxt = np.arange(len(loops)) + 1
+    nxt[ptr[1:] - 1] = ptr[:-1]
+    a, bb = loops, loops[nxt]
+    sa, sb = s[a], s[bb]
+    cross = (sa < 0) != (sb < 0)
+    if not cross.any():
+        return False
+    t = sa[cross] / (sa[cross] - sb[cross])
+    p = pos[a[cross]] + t[:, None] * (pos[bb[cross]] - pos[a[cross]]) - c
+    u = np.cross(np.array([0.0, 0.0, 1.0]) if abs(n[2]) < 0.9 else np.array([1.0, 0.0, 0.0]), n)
+    u /= np.linalg.norm(u)
+    w = np.cross(n, u)
+    q = np.column_stack([p @ u, p @ w])
+    if (np.einsum("ij,ij->i", q, q) <= r * r).any():
+        return True
+    m = q.mean(axis=0)
+    ang = np.arctan2(q[:, 1] - m[1], q[:, 0] - m[0])
+    q = q[np.argsort(ang, kind="stable")]
+    e0, e1 = q, np.roll(q, -1, axis=0)
+    d = e1 - e0
+    crs = d[:, 0] * (-e0[:, 1]) - d[:, 1] * (-e0[:, 0])
+    if (crs >= -1e-15).all() or (crs <= 1e-15).all():
+        return True                                    # the centre is inside the section
+    dd = np.einsum("ij,ij->i", d, d)
+    tt = np.clip(np.where(dd > 0, -np.einsum("ij,ij->i", e0, d) / np.where(dd > 0, dd, 1), 0), 0, 1)
+    close = e0 + tt[:, None] * d
+    return bool((np.einsum("ij,ij->i", close, close) <= r * r).any())
+
+
+def cut_dfn(model, centers, normals, radii, frac_ids, jointset: int, mask=None, join: bool = False) -> tuple[int, int]:
+    """Cut the visible blocks in ``mask`` by the disks in order. Returns (new blocks, disks that cut)."""
+    centers, normals, radii = np.asarray(centers, _F), np.asarray(normals, _F), np.asarray(radii, _F)
+    ensure_face_fields(model)
+    tol = float(model.tolerance)
+    b, fs = model.blocks, model.faces
+    allowed = np.zeros(b.n, bool)
+    allowed[_selection(model, mask)] = True
+    if not allowed.any() or len(radii) == 0:
+        return 0, 0
+    rows = np.arange(b.n)
+    lo, hi = _block_boxes(model, rows)
+    made = used = 0
+    ext = radii[:, None] * np.sqrt(np.clip(1.0 - normals ** 2, 0.0, None))
+    dlo, dhi = centers - ext - tol, centers + ext + tol
+    for k in range(len(radii)):
+        cand = np.flatnonzero(allowed & (lo <= dhi[k]).all(axis=1) & (hi >= dlo[k]).all(axis=1))
+        if cand.size == 0:
+            continue
+        c, n, r = centers[k], normals[k], float(radii[k])
+        hit = [int(i) for i in cand if disk_touches_block(model, int(i), c, n, r, tol)]
+        if not hit:
+            continue
+        m = np.zeros(b.n, bool)
+        m[hit] = True
+        js = fs["jointset"]
+        js[js == -1] = -2                     # faces already there: not this cut's
+        n0 = b.n
+        new = cut_by_planes(model, n, [float(n @ c)], mask=m, join=join)
+        js = fs["jointset"]
+        fresh = js == -1
+        js[fresh] = int(jointset)
+        fs["fracture"][fresh] = int(frac_ids[k])
+        js[js == -2] = -1
+        if new:
+            used += 1
+            made += new
+            changed = np.concatenate([np.asarray(hit, np.int64), np.arange(n0, b.n)])
+            allowed = np.concatenate([allowed, np.ones(b.n - n0, bool)])
+            allowed[n0:] = True
+            lo = np.concatenate([lo, np.zeros((b.n - n0, 3))])
+            hi = np.concatenate([hi, np.zeros((b.n - n0, 3))])
+            lo[changed], hi[changed] = _block_boxes(model, changed)
+    return made, used
