@@ -112,8 +112,10 @@ def _template(session, call) -> dict:
     try:
         dfn_gen.check_template(t)
     except dfn_gen.GenerationError as exc:
-        key = next((k for k in ("orientation", "size", "size_limits", "dip_limits", "dip_direction_limits")
-                    if k.replace("_", "-") in str(exc) or k.split("_")[0] in str(exc)), None)
+        import re
+
+        word = re.match(r"`([a-z-]+)", str(exc))            # the messages start with the keyword
+        key = word.group(1).replace("-", "_") if word else None
         raise CommandError(str(exc), loc.get(key, call.location) if key else call.location) from None
     return t
 
@@ -243,6 +245,7 @@ def fracture_generate(session, call):
         raise CommandError(str(exc), call.locations.get(key, call.location)) from None
     did = FR.dfn_id(m, a["dfn"], create=True)
     FR.add_fractures(m, did, c, n, r, int(t.get("set") or 1))
+    st.setdefault("dfn_templates", {})[str(did)] = t
     session.results["fractures_made"] = float(len(r))
     session.write(f"DFN '{FR.dfn_name(m, did)}' (id {did}): {len(r)} fractures")
 

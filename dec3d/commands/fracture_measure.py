@@ -17,39 +17,97 @@ from .registry import command, range_element
 from .values import ANGLE, FLAG, POINT, Num, Nums, P, Text
 
 
+def _grid_lines(box, k: int):
+    """k × k scanlines across the box along each of x, y, z (cell centres): (starts, ends)."""
+    b = np.asarray(box, float)
+    f = (np.arange(k) + 0.5) / k
+    starts, ends = [], []
+    for ax in range(3):
+        o1, o2 = [a for a in range(3) if a != ax]
+        u = b[2 * o1] + f * (b[2 * o1 + 1] - b[2 * o1])
+        v = b[2 * o2] + f * (b[2 * o2 + 1] - b[2 * o2])
+        uu, vv = np.meshgrid(u, v, indexing="ij")
+        p0 = np.zeros((k * k, 3))
+        p0[:, o1], p0[:, o2], p0[:, ax] = uu.ravel(), vv.ravel(), b[2 * ax]
+        p1 = p0.copy()
+        p1[:, ax] = b[2 * ax + 1]
+        starts.append(p0)
+        ends.append(p1)
+    return np.concatenate(starts), np.concatenate(ends)
+
+
+def _put(session, key, value, suffix):
+    session.results[key] = float(value)
+    if suffix:
+        session.results[f"{key}.{suffix}"] = float(value)
+
+
 @command("fracture compute",
-         keywords=[P("dfn", Text(), "only this DFN"),
+         keywords=[P("dfn", Text(), "only this DFN (results are also stored as `<name>.<dfn>`)"),
                    P("scanline", Nums(6, 6), "P10 along the segment x1 y1 z1 x2 y2 z2", units="m"),
+                   P("scanlines", Num(integer=True, lo=1, hi=1000), "P10 on k × k scanlines across the box along "
+                     "each of x, y and z (3k² lines)"),
                    P("box", Nums(6, 6), "P32 in the box x1 x2 y1 y2 z1 z2 (default: the blocks' box)", units="m"),
                    P("plane-origin", POINT, "P21 on the plane through this point (in the box)", units="m"),
                    P("dip", ANGLE, "dip of the P21 plane", default=0.0),
                    P("dip-direction", ANGLE, "dip direction of the P21 plane", default=0.0)],
-         doc="Compute and print DFN intensities: count by set, P32 in a box, P10 on a scanline, P21 on a plane.",
+         doc="Compute and print DFN measures: count by set, P32 in a box, P10 on scanlines, P21 on a plane, "
+             "orientation and size statistics.",
          details="P32 = disk area inside the box / its volume, the disks clipped to the box exactly; P10 = disks "
-                 "the scanline crosses / its length; P21 = trace length inside the box / area of the plane's "
-                 "section of the box. The keywords are dec3d's (Itasca's `fracture compute` page could not be "
-                 "read in full). Results: `fractures`, `p32`, and with their keywords `p10`, `p21`.",
+                 "the scanline(s) cross / their length; P21 = trace length inside the box / area of the plane's "
+                 "section of the box. With P10 and P32 both, `p10_ratio` = P10 / (P32 E|cos θ|), θ between a "
+                 "fracture's normal and the line, E the area-weighted mean over the DFN's fractures (1 in theory "
+                 "for uniformly placed disks). Orientation: mean dip, mean dip direction (degrees) and Fisher's "
+                 "κ̂ = (N − 1)/(N − R); sizes: the maximum-likelihood power-law exponent of the diameters on the "
+                 "template's size limits (a DFN generated from a template). The keywords are dec3d's (Itasca's "
+                 "`fracture compute` page could not be read in full). Results: `fractures`, `p32`, `p10`, `p21`, "
+                 "`p10_ratio`, `mean_dip`, `mean_dip_direction`, `kappa`, `size_exponent`; with `dfn`, also "
+                 "each as `<name>.<dfn>`.",
          examples=["fracture compute", "fracture compute box 0 50 0 50 0 50 scanline 0 25 25 50 25 25",
+                   "fracture compute box 5 45 5 45 5 45 scanlines 10 dfn 'iso'",
                    "fracture compute plane-origin 25 25 25 dip 90 dip-direction 90 dfn 'rock'"])
 def fracture_compute(session, call):
     a = call.args
     m = session.model
-    rows, _ = _dfn_rows(session, call)
+    rows, did = _dfn_rows(session, call)
+    suffix = a["dfn"]
     c, n, r = _arrays(m, rows)
     fs = FR.fracture_store(m)
     sets, counts = np.unique(fs["set"][rows], return_counts=True)
     session.write(f"fractures: {len(rows)}  (by set: " + ", ".join(f"{int(s)}: {int(k)}" for s, k in zip(sets, counts))
                   + ")")
-    session.results["fractures"] = float(len(rows))
+    _put(session, "fractures", len(rows), suffix)
+    if len(rows) == 0:
+        return
     box = _box(session, call, "box") if (a["box"] is not None or m.blocks.n) else None
+    p32 = None
     if box is not None:
-        v = dfn_measure.p32(c, n, r, box)
-        session.results["p32"] = v
-        session.write(f"P32 in the box: {v:.6g} 1/m")
+        p32 = dfn_measure.p32(c, n, r, box)
+        _put(session, "p32", p32, suffix)
+        session.write(f"P32 in the box: {p32:.6g} 1/m")
+    lines = []
     if a["scanline"] is not None:
-        v = dfn_measure.p10(c, n, r, a["scanline"][:3], a["scanline"][3:])
-        session.results["p10"] = v
-        session.write(f"P10 on the scanline: {v:.6g} 1/m")
+        lines.append((np.asarray(a["scanline"][:3], float)[None], np.asarray(a["scanline"][3:], float)[None]))
+    if a["scanlines"] is not None:
+        if box is None:
+            raise CommandError("`scanlines` needs a box (`box x1 x2 y1 y2 z1 z2`)", call.location)
+        lines.append(_grid_lines(box, int(a["scanlines"])))
+    if lines:
+        p0 = np.concatenate([x[0] for x in lines])
+        p1 = np.concatenate([x[1] for x in lines])
+        hits = sum(int(dfn_measure.scanline_hits(c, n, r, p0[i], p1[i]).sum()) for i in range(len(p0)))
+        dirs = (p1 - p0) / np.linalg.norm(p1 - p0, axis=1)[:, None]
+        length = float(np.linalg.norm(p1 - p0, axis=1).sum())
+        p10 = hits / length
+        _put(session, "p10", p10, suffix)
+        session.write(f"P10 on {len(p0)} scanline(s) of {length:.6g} m: {p10:.6g} 1/m ({hits} crossings)")
+        if p32 is not None and p32 > 0:
+            wlen = np.linalg.norm(p1 - p0, axis=1) / length
+            area = r * r
+            ecos = float((np.abs(n @ dirs.T) @ wlen * area).sum() / area.sum())
+            ratio = p10 / (p32 * ecos)
+            _put(session, "p10_ratio", ratio, suffix)
+            session.write(f"P10 / (P32 E|cos θ|) = {ratio:.5f} (E|cos θ| = {ecos:.5f})")
     if a["plane_origin"] is not None:
         if box is None:
             raise CommandError("P21 needs a box (`box x1 x2 y1 y2 z1 z2`)", call.location)
@@ -59,8 +117,20 @@ def fracture_compute(session, call):
             v, length, area = dfn_measure.p21(c, n, r, a["plane_origin"], normal, box)
         except ValueError as exc:
             raise CommandError(str(exc), call.locations.get("plane_origin", call.location)) from None
-        session.results["p21"] = v
+        _put(session, "p21", v, suffix)
         session.write(f"P21 on the plane: {v:.6g} 1/m (traces {length:.6g} m on {area:.6g} m²)")
+    if len(rows) > 1:
+        md, mdd, kap = dfn_measure.fisher_stats(n)
+        _put(session, "mean_dip", math.degrees(md), suffix)
+        _put(session, "mean_dip_direction", math.degrees(mdd), suffix)
+        _put(session, "kappa", kap, suffix)
+        session.write(f"mean orientation {math.degrees(md):.2f}/{math.degrees(mdd):.2f}, kappa {kap:.4g}")
+    t = FR.dfn_state(m).get("dfn_templates", {}).get(str(did)) if did is not None else None
+    if t is not None and t["size"]["kind"] == "power-law" and len(rows) > 1:
+        lo, hi = t["size_limits"]
+        a_hat = dfn_measure.powerlaw_mle(2 * r, float(lo), None if hi is None else float(hi))
+        _put(session, "size_exponent", a_hat, suffix)
+        session.write(f"power-law exponent of the diameters (maximum likelihood): {a_hat:.4f}")
 
 
 @command("fracture intersections compute", keywords=[P("dfn", Text(), "only this DFN")],
@@ -159,24 +229,26 @@ def block_cut_dfn(session, call):
     mask = session.range_mask(call, "block")
     c, n, r = _arrays(m, rows)
     js = int(a["jointset_id"]) if a["jointset_id"] is not None else did
-    made, used = cut_dfn(m, c.copy(), n.copy(), r.copy(), FR.fracture_store(m)["id"][rows].copy(), js, mask=mask,
+    made, used, skipped = cut_dfn(m, c.copy(), n.copy(), r.copy(), FR.fracture_store(m)["id"][rows].copy(), js, mask=mask,
                          join=bool(a["join"]))
     vol = m.blocks["volume"]
     session.results["blocks_made"] = float(made)
     session.results["fractures_used"] = float(used)
+    session.results["slivers_skipped"] = float(skipped)
     session.results["smallest_volume"] = float(vol.min()) if len(vol) else 0.0
-    session.write(f"{made} new blocks from {used} of {len(rows)} fractures (smallest block {vol.min():.4g} m³)")
+    session.write(f"{made} new blocks from {used} of {len(rows)} fractures (smallest block {vol.min():.4g} m³; "
+                  f"{skipped} cuts not made: they would have left a sliver)")
 
 
 @range_element("jointset-id", positional=[P("id", Num(integer=True), "joint-set id", required=True)],
-               stores=("contacts", "faces"),
+               stores=("contact", "face"),
                doc="faces made by `block cut dfn` with this joint-set id, and the contacts lying on them")
 def jointset_id(session, store, args):
     m = session.model
     f = m.faces
     want = int(args["id"])
     onset = (f["jointset"] == want) if "jointset" in f else np.zeros(f.n, bool)
-    if store == "faces":
+    if store in ("face", "faces"):
         return onset
     cs = m.store("contacts")
     out = np.zeros(cs.n, bool)

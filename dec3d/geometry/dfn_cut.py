@@ -24,6 +24,8 @@ fracture id). Pieces of those faces cut later keep them. The contact range eleme
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .cutting import _selection, cut_by_planes
@@ -64,9 +66,10 @@ def disk_touches_block(model, row: int, c, n, r: float, tol: float) -> bool:
         return False
     t = sa[cross] / (sa[cross] - sb[cross])
     p = pos[a[cross]] + t[:, None] * (pos[bb[cross]] - pos[a[cross]]) - c
-    u = np.cross(np.array([0.0, 0.0, 1.0]) if abs(n[2]) < 0.9 else np.array([1.0, 0.0, 0.0]), n)
-    u /= np.linalg.norm(u)
-    w = np.cross(n, u)
+    nx, ny, nz = float(n[0]), float(n[1]), float(n[2])
+    u = np.array([-ny, nx, 0.0]) if abs(nz) < 0.9 else np.array([0.0, -nz, ny])   # (0,0,1)×n or (1,0,0)×n
+    u /= math.sqrt(u @ u)
+    w = np.array([ny * u[2] - nz * u[1], nz * u[0] - nx * u[2], nx * u[1] - ny * u[0]])
     q = np.column_stack([p @ u, p @ w])
     if (np.einsum("ij,ij->i", q, q) <= r * r).any():
         return True
@@ -84,8 +87,42 @@ def disk_touches_block(model, row: int, c, n, r: float, tol: float) -> bool:
     return bool((np.einsum("ij,ij->i", close, close) <= r * r).any())
 
 
-def cut_dfn(model, centers, normals, radii, frac_ids, jointset: int, mask=None, join: bool = False) -> tuple[int, int]:
-    """Cut the visible blocks in ``mask`` by the disks in order. Returns (new blocks, disks that cut)."""
+#: a cut that would leave a piece thinner than this fraction of the block's extent along the
+#: disk's normal is not made (the would-be sliver stays with its block); counted as skipped
+SLIVER = 1e-2
+
+
+def _prefilter(model, cand, c, n, r, tol):
+    """Of the candidate blocks, (sure: the disk touches them for certain, maybe: test exactly,
+    slivers: touched blocks left uncut because a piece would be a sliver)."""
+    b = model.blocks
+    st, cnt = b["vert_start"][cand], b["vert_count"][cand]
+    pos = model.vertices["pos"][range_index(st, cnt)]
+    offs = np.concatenate(([0], np.cumsum(cnt)[:-1])).astype(np.int64)
+    rel = pos - c
+    sv = rel @ n
+    ax2 = np.einsum("ij,ij->i", rel, rel) - sv * sv            # squared distance from the disk's axis
+    smin, smax = np.minimum.reduceat(sv, offs), np.maximum.reduceat(sv, offs)
+    straddle = (smin < -tol) & (smax > tol)
+    thin = straddle & (np.minimum(-smin, smax) < SLIVER * (smax - smin))
+    ok = straddle & ~thin
+    sure = ok & (np.maximum.reduceat(ax2, offs) <= r * r)
+    # the section lies in the block's bounding ball about its centroid: too far from the disk → no
+    cen = b["centroid"][cand]
+    d = cen - c
+    h = d @ n
+    inplane = np.sqrt(np.clip(np.einsum("ij,ij->i", d, d) - h * h, 0, None))
+    rad2 = np.maximum.reduceat(np.einsum("ij,ij->i", pos - np.repeat(cen, cnt, axis=0),
+                                         pos - np.repeat(cen, cnt, axis=0)), offs)
+    far = inplane > r + np.sqrt(np.clip(rad2 - h * h, 0, None)) + tol
+    maybe = ok & ~sure & ~far
+    return cand[sure], cand[maybe], cand[thin]
+
+
+def cut_dfn(model, centers, normals, radii, frac_ids, jointset: int, mask=None,
+            join: bool = False) -> tuple[int, int, int]:
+    """Cut the visible blocks in ``mask`` by the disks in order. Returns (new blocks, disks that cut,
+    cuts skipped as slivers)."""
     centers, normals, radii = np.asarray(centers, _F), np.asarray(normals, _F), np.asarray(radii, _F)
     ensure_face_fields(model)
     tol = float(model.tolerance)
@@ -93,10 +130,10 @@ def cut_dfn(model, centers, normals, radii, frac_ids, jointset: int, mask=None, 
     allowed = np.zeros(b.n, bool)
     allowed[_selection(model, mask)] = True
     if not allowed.any() or len(radii) == 0:
-        return 0, 0
+        return 0, 0, 0
     rows = np.arange(b.n)
     lo, hi = _block_boxes(model, rows)
-    made = used = 0
+    made = used = skipped = 0
     ext = radii[:, None] * np.sqrt(np.clip(1.0 - normals ** 2, 0.0, None))
     dlo, dhi = centers - ext - tol, centers + ext + tol
     for k in range(len(radii)):
@@ -104,7 +141,9 @@ def cut_dfn(model, centers, normals, radii, frac_ids, jointset: int, mask=None, 
         if cand.size == 0:
             continue
         c, n, r = centers[k], normals[k], float(radii[k])
-        hit = [int(i) for i in cand if disk_touches_block(model, int(i), c, n, r, tol)]
+        sure, maybe, thin = _prefilter(model, cand, c, n, r, tol)
+        hit = list(sure) + [int(i) for i in maybe if disk_touches_block(model, int(i), c, n, r, tol)]
+        skipped += sum(1 for i in thin if disk_touches_block(model, int(i), c, n, r, tol))
         if not hit:
             continue
         m = np.zeros(b.n, bool)
@@ -127,4 +166,4 @@ def cut_dfn(model, centers, normals, radii, frac_ids, jointset: int, mask=None, 
             lo = np.concatenate([lo, np.zeros((b.n - n0, 3))])
             hi = np.concatenate([hi, np.zeros((b.n - n0, 3))])
             lo[changed], hi[changed] = _block_boxes(model, changed)
-    return made, used
+    return made, used, skipped

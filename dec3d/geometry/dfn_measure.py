@@ -268,3 +268,42 @@ def clusters(c, n, r) -> tuple[np.ndarray, np.ndarray]:
     remap = np.empty(len(order), np.int64)
     remap[order] = np.arange(len(order))
     return remap[lab], pairs
+
+
+# ------------------------------------------------------------------ estimators
+def fisher_stats(normals) -> tuple[float, float, float]:
+    """(mean dip, mean dip direction [rad], κ̂) of axial unit normals: each normal is turned to the side
+    of the first estimate of the mean (the principal axis of Σ n nᵀ), R = |Σ n|, κ̂ = (N − 1) / (N − R)
+    (Fisher 1953's estimator)."""
+    n = np.asarray(normals, _F).reshape(-1, 3)
+    w, v = np.linalg.eigh(n.T @ n)
+    axis = v[:, -1]
+    s = n * np.where(n @ axis < 0, -1.0, 1.0)[:, None]
+    res = s.sum(axis=0)
+    big_r = float(np.linalg.norm(res))
+    mu = res / big_r
+    if mu[2] < 0:
+        mu = -mu
+    k = len(n)
+    kappa = (k - 1) / (k - big_r) if k > big_r else math.inf
+    return math.acos(min(1.0, mu[2])), math.atan2(mu[0], mu[1]) % (2 * math.pi), kappa
+
+
+def powerlaw_mle(sizes, lo: float, hi: float | None) -> float:
+    """Maximum-likelihood exponent a of n(l) ∝ l^−a on [lo, hi] (hi None: unbounded) from the sizes:
+    the root of d lnL/da = N/(a − 1) + N (lo^{1−a} ln lo − hi^{1−a} ln hi)/(lo^{1−a} − hi^{1−a}) − Σ ln l."""
+    from scipy.optimize import brentq
+
+    x = np.asarray(sizes, _F)
+    k, sl = len(x), float(np.log(x).sum())
+    if hi is None:
+        return 1.0 + k / float(np.log(x / lo).sum())
+
+    def dlnl(a):
+        if abs(a - 1) < 1e-9:
+            a = 1 + 1e-9
+        e = 1 - a
+        tlo, thi = lo ** e, hi ** e
+        return k / (a - 1) + k * (tlo * math.log(lo) - thi * math.log(hi)) / (tlo - thi) - sl
+
+    return float(brentq(dlnl, 1.0 + 1e-6, 50.0))
