@@ -32,8 +32,8 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--generate", type=int, default=100_000)
     ap.add_argument("--cut", type=int, default=2000)
-    ap.add_argument("--dmin", type=float, default=8.0)
-    ap.add_argument("--dmax", type=float, default=60.0)
+    ap.add_argument("--dmin", type=float, default=3.0)
+    ap.add_argument("--dmax", type=float, default=24.0)
     a = ap.parse_args()
     print(f"python {platform.python_version()}, {platform.machine()}, {os.cpu_count()} cpus "
           f"(load {os.getloadavg()[0]:.2f}), NUMBA_NUM_THREADS={os.environ['NUMBA_NUM_THREADS']}")
