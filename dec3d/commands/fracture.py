@@ -41,7 +41,7 @@ class Dist(ValueType):
 
     @property
     def label(self):
-        return "|".join(self.options)
+        return "/".join(self.options)
 
     def fits(self, tok):
         return tok.type == "WORD" and len(matches(str(tok), self.options)) == 1
@@ -71,7 +71,7 @@ class Dist(ValueType):
         return tuple([value[0], *[x if isinstance(x, str) else float(x) for x in value[1:]]])
 
     def describe(self):
-        return " | ".join(f"{k} " + ("<file>" if v == "file" else " ".join(["<f>"] * v)) for k, v in self.options.items())
+        return " / ".join(f"{k} " + ("<file>" if v == "file" else " ".join(["<f>"] * v)) for k, v in self.options.items())
 
 
 def _template(session, call) -> dict:

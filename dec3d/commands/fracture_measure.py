@@ -229,6 +229,7 @@ def block_cut_dfn(session, call):
     mask = session.range_mask(call, "block")
     c, n, r = _arrays(m, rows)
     js = int(a["jointset_id"]) if a["jointset_id"] is not None else did
+    FR.ensure_face_fields(m)
     made, used, skipped = cut_dfn(m, c.copy(), n.copy(), r.copy(), FR.fracture_store(m)["id"][rows].copy(), js, mask=mask,
                          join=bool(a["join"]))
     vol = m.blocks["volume"]

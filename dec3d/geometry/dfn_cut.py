@@ -30,7 +30,6 @@ import numpy as np
 
 from .cutting import _selection, cut_by_planes
 from .mass import range_index
-from dec3d.model.fractures import ensure_face_fields
 
 _F = np.float64
 
@@ -122,9 +121,9 @@ def _prefilter(model, cand, c, n, r, tol):
 def cut_dfn(model, centers, normals, radii, frac_ids, jointset: int, mask=None,
             join: bool = False) -> tuple[int, int, int]:
     """Cut the visible blocks in ``mask`` by the disks in order. Returns (new blocks, disks that cut,
-    cuts skipped as slivers)."""
+    cuts skipped as slivers). The faces store must hold the int64 fields ``jointset`` and ``fracture``
+    (``dec3d.model.fractures.ensure_face_fields``)."""
     centers, normals, radii = np.asarray(centers, _F), np.asarray(normals, _F), np.asarray(radii, _F)
-    ensure_face_fields(model)
     tol = float(model.tolerance)
     b, fs = model.blocks, model.faces
     allowed = np.zeros(b.n, bool)
