@@ -264,3 +264,24 @@ block contact property friction 33 range jointset-id 4
     # middle edge; the range picks the two on the joint
     assert cs.n == 6 and mask.sum() == 2
     assert np.allclose(np.abs(cs["normal"][mask][:, 2]), 1.0)
+
+
+def test_fish_intrinsics(tmp_path):
+    s = _run(_session(tmp_path), """model new
+fracture template create 'a' orientation fisher 30 200 100000 size uniform size-limits 2 4
+fracture generate template 'a' fracture-count 5 generation-box 0 1 0 1 0 1
+[n = fracture.num()]
+[d = fracture.dip(1)]
+[dd = fracture.ddir(1)]
+[dia = fracture.diameter(2)]
+[nz = fracture.normal(1)->z]
+[px = fracture.pos(3)->x]
+""")
+    fs = s.model.stores["fractures"]
+    v = s.variables
+    assert v["n"] == 5
+    assert (v["d"], v["dd"]) == (pytest.approx(30, abs=0.5), pytest.approx(200, abs=0.5))
+    assert v["dia"] == pytest.approx(2 * fs["radius"][1]) and v["px"] == pytest.approx(fs["center"][2, 0])
+    assert v["nz"] == pytest.approx(math.cos(math.radians(v["d"])))
+    with pytest.raises(Dec3dError, match="no fracture with id 9"):
+        _run(s, "[x = fracture.dip(9)]\n")

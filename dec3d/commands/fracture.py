@@ -268,7 +268,7 @@ def _arrays(m, rows):
 
 @command("fracture import",
          keywords=[P("from-file", InPath(exts=(".dat", ".csv", ".txt")), "the file: Itasca-style text (`disk id x y z "
-                     "dip dip-direction diameter [set]`) or .csv (id,x,y,z,nx,ny,nz,radius[,set])", required=True),
+                     "diameter dip dip-direction [set]`) or .csv (id,x,y,z,nx,ny,nz,radius[,set])", required=True),
                    P("dfn", Text(), "name of the new DFN (default: the file's stem)")],
          doc="Import disk fractures from a file into a new DFN.",
          details="The file is looked for beside the calling deck, then in the output folder. A malformed line "

@@ -3,10 +3,11 @@
 Itasca text format (``fracture export``/``fracture import``, any extension but .csv). The Itasca
 "DFN-Related File Formats" page specifies the data file; only its bootstrapped-distribution and
 template parts could be read (docs corpus), so the disk line below is dec3d's reading and is NOT
-confirmed against Itasca's own files:
+confirmed against Itasca's own files. Its values follow the order of Itasca's FISH
+``fracture.create(dfn, arr)`` disk format (confirmed): "disk", centre, diameter, dip, dip direction:
 
     ; header line (any text)
-    disk <id> <x> <y> <z> <dip> <dip-direction> <diameter> [<set>]
+    disk <id> <x> <y> <z> <diameter> <dip> <dip-direction> [<set>]
 
 Angles in degrees, the diameter in m (3DEC's fracture size). Separators may be spaces, tabs, commas
 or semicolons; lines starting with ``;`` or ``#`` are comments; an empty line ends the data (as in
@@ -70,19 +71,19 @@ def read_itasca(text: str):
     ids, cen, dip, ddir, rad, sets = [], [], [], [], [], []
     for ln, t in _rows(text, skip_header=False):
         if t[0].lower() not in ("disk", "fracture"):
-            raise DfnFileError(ln, f"expected `disk id x y z dip dip-direction diameter [set]`, got `{t[0][:40]}`")
+            raise DfnFileError(ln, f"expected `disk id x y z diameter dip dip-direction [set]`, got `{t[0][:40]}`")
         if len(t) not in (8, 9):
             raise DfnFileError(ln, f"a disk line has 7 or 8 values after the word, got {len(t) - 1}")
-        v = [_num(x, ln, w) for x, w in zip(t[1:], ("id", "x", "y", "z", "dip", "dip direction", "diameter", "set"))]
-        if not v[6] > 0:
-            raise DfnFileError(ln, f"the diameter must be positive, got {v[6]:g}")
-        if not 0 <= v[4] <= 90:
-            raise DfnFileError(ln, f"the dip must be in [0, 90] degrees, got {v[4]:g}")
+        v = [_num(x, ln, w) for x, w in zip(t[1:], ("id", "x", "y", "z", "diameter", "dip", "dip direction", "set"))]
+        if not v[4] > 0:
+            raise DfnFileError(ln, f"the diameter must be positive, got {v[4]:g}")
+        if not 0 <= v[5] <= 90:
+            raise DfnFileError(ln, f"the dip must be in [0, 90] degrees, got {v[5]:g}")
         ids.append(int(v[0]))
         cen.append(v[1:4])
-        dip.append(math.radians(v[4]))
-        ddir.append(math.radians(v[5]))
-        rad.append(v[6] / 2)
+        dip.append(math.radians(v[5]))
+        ddir.append(math.radians(v[6]))
+        rad.append(v[4] / 2)
         sets.append(int(v[7]) if len(v) > 7 else 1)
     if not ids:
         raise DfnFileError(0, "the file holds no disk")
@@ -95,10 +96,10 @@ def write_itasca(path, ids, c, dip_deg, ddir_deg, radius, sets) -> str:
     path = os.fspath(path)
     require_finite("fracture centres", c)
     with open(path, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write("; dec3d DFN: disk id x y z dip dip-direction diameter set\n")
+        fh.write("; dec3d DFN: disk id x y z diameter dip dip-direction set\n")
         for i in range(len(ids)):
-            fh.write(f"disk {int(ids[i])} {float(c[i, 0])!r} {float(c[i, 1])!r} {float(c[i, 2])!r} {float(dip_deg[i])!r} {float(ddir_deg[i])!r} "
-                     f"{2 * float(radius[i])!r} {int(sets[i])}\n")
+            fh.write(f"disk {int(ids[i])} {float(c[i, 0])!r} {float(c[i, 1])!r} {float(c[i, 2])!r} {2 * float(radius[i])!r} "
+                     f"{float(dip_deg[i])!r} {float(ddir_deg[i])!r} {int(sets[i])}\n")
     return path
 
 
