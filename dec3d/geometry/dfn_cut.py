@@ -28,6 +28,7 @@ import math
 
 import numpy as np
 
+from .assemble import compact_geometry
 from .cutting import _selection, cut_by_planes
 from .mass import range_index
 
@@ -147,15 +148,21 @@ def cut_dfn(model, centers, normals, radii, frac_ids, jointset: int, mask=None,
             continue
         m = np.zeros(b.n, bool)
         m[hit] = True
+        n0, f0 = b.n, fs.n
+        new = cut_by_planes(model, n, [float(n @ c)], mask=m, join=join, compact=False)
+        # the faces of this cut are appended (nothing is compacted between cuts); the new ones lie on
+        # the plane, the others are pieces of older faces and keep what those had
         js = fs["jointset"]
-        js[js == -1] = -2                     # faces already there: not this cut's
-        n0 = b.n
-        new = cut_by_planes(model, n, [float(n @ c)], mask=m, join=join)
-        js = fs["jointset"]
-        fresh = js == -1
+        cand_f = f0 + np.flatnonzero(js[f0:] == -1)
+        d0 = float(n @ c)
+        on_plane = (np.abs(np.abs(fs["normal"][cand_f] @ n) - 1.0) < 1e-9) & \
+            (np.abs(fs["centroid"][cand_f] @ n - d0) <= 10 * tol)
+        fresh = cand_f[on_plane]
         js[fresh] = int(jointset)
         fs["fracture"][fresh] = int(frac_ids[k])
-        js[js == -2] = -1
+        live = int(b["face_count"].sum())
+        if fs.n > 2 * live + 1024:            # drop the dead rows now and then
+            compact_geometry(model)
         if new:
             used += 1
             made += new
@@ -165,4 +172,5 @@ def cut_dfn(model, centers, normals, radii, frac_ids, jointset: int, mask=None,
             lo = np.concatenate([lo, np.zeros((b.n - n0, 3))])
             hi = np.concatenate([hi, np.zeros((b.n - n0, 3))])
             lo[changed], hi[changed] = _block_boxes(model, changed)
+    compact_geometry(model)
     return made, used, skipped
