@@ -256,17 +256,25 @@ def jointset_id(session, store, args):
     if not onset.any() or cs.n == 0:
         return out
     tol = max(float(m.tolerance), 1e-9)
-    # a contact is on the joint set when a face of the set of either of its blocks holds its point
+    # a contact is on the joint set when a face of the set of either of its blocks holds its point,
+    # parallel to its normal: every (contact, set face of one of its blocks) pair, vectorised
     rows = np.flatnonzero(onset)
-    blk = f["block"][rows]
+    order = np.argsort(f["block"][rows], kind="stable")
+    rows = rows[order]
+    fb = f["block"][rows]
     for side in ("a", "b"):
-        for k in range(cs.n):
-            if out[k]:
-                continue
-            sel = rows[blk == cs[side][k]]
-            if sel.size == 0:
-                continue
-            d = np.abs(np.einsum("ij,ij->i", f["normal"][sel], cs["pos"][k] - f["centroid"][sel]))
-            par = np.abs(np.abs(f["normal"][sel] @ cs["normal"][k]) - 1) < 1e-6
-            out[k] = bool(((d <= tol * 10 + 1e-6 * np.sqrt(f["area"][sel])) & par).any())
+        blk = cs[side]
+        lo = np.searchsorted(fb, blk, side="left")
+        hi = np.searchsorted(fb, blk, side="right")
+        cnt = hi - lo
+        if cnt.sum() == 0:
+            continue
+        k = np.repeat(np.arange(cs.n), cnt)
+        start = np.repeat(lo - np.concatenate(([0], np.cumsum(cnt)[:-1])), cnt)
+        fr = rows[start + np.arange(cnt.sum())]
+        nf = f["normal"][fr]
+        d = np.abs(np.einsum("ij,ij->i", nf, cs["pos"][k] - f["centroid"][fr]))
+        par = np.abs(np.abs(np.einsum("ij,ij->i", nf, cs["normal"][k])) - 1) < 1e-6
+        ok = (d <= 10 * tol + 1e-6 * np.sqrt(f["area"][fr])) & par
+        out[k[ok]] = True
     return out
