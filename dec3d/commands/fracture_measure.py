@@ -211,7 +211,8 @@ def _check_cut(call):
                  "thinner than the tolerance or of zero volume. The new faces record the joint-set id and the "
                  "fracture id (face fields `jointset`, `fracture`); pieces of them cut later keep them. Only "
                  "blocks whose box overlaps a disk's box are tested. Results: `blocks_made`, `fractures_used`, "
-                 "`smallest_volume`.",
+                 "`slivers_skipped`, `smallest_volume`, `volume_change` (relative change of the total volume of "
+                 "the blocks cut, a check: round-off only).",
          examples=["block cut dfn name 'rock'", "block cut dfn id 1 jointset-id 3 range position-z 0 20"])
 def block_cut_dfn(session, call):
     a = call.args
@@ -230,9 +231,14 @@ def block_cut_dfn(session, call):
     c, n, r = _arrays(m, rows)
     js = int(a["jointset_id"]) if a["jointset_id"] is not None else did
     FR.ensure_face_fields(m)
+    vsel = mask & ~m.blocks["hidden"]
+    v0 = float(m.blocks["volume"][vsel].sum())
     made, used, skipped = cut_dfn(m, c.copy(), n.copy(), r.copy(), FR.fracture_store(m)["id"][rows].copy(), js, mask=mask,
                          join=bool(a["join"]))
     vol = m.blocks["volume"]
+    # the pieces of the blocks cut: the blocks in range then, and the new rows
+    after = np.concatenate([vsel, np.ones(m.blocks.n - len(vsel), bool)])
+    session.results["volume_change"] = abs(float(vol[after].sum()) - v0) / v0 if v0 > 0 else 0.0
     session.results["blocks_made"] = float(made)
     session.results["fractures_used"] = float(used)
     session.results["slivers_skipped"] = float(skipped)
