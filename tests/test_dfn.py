@@ -285,3 +285,19 @@ fracture generate template 'a' fracture-count 5 generation-box 0 1 0 1 0 1
     assert v["nz"] == pytest.approx(math.cos(math.radians(v["d"])))
     with pytest.raises(Dec3dError, match="no fracture with id 9"):
         _run(s, "[x = fracture.dip(9)]\n")
+
+
+def test_intersections_command_and_cluster_in_vtk(tmp_path):
+    (tmp_path / "five.csv").write_text("id,x,y,z,nx,ny,nz,radius\n1,0,0,0,0,0,1,1\n2,0,0,0.5,1,0,0,1\n"
+                                       "3,3,0,0,0,0,1,1\n4,10,10,10,0,0,1,1\n5,0.9,0,0,0,1,0,0.05\n")
+    s = _run(_session(tmp_path), "model new\nfracture import from-file 'five.csv'\n"
+                                 "fracture intersections compute\nfracture vtk 'five'\n")
+    r = s.results
+    assert (r["intersections"], r["clusters"], r["largest_cluster"], r["isolated"]) == (2, 3, 3, 2)
+    assert s.model.stores["fractures"]["cluster"].tolist() == [0, 0, 1, 2, 0]
+    import meshio
+
+    mesh = meshio.read(tmp_path / "five_0000.vtu")
+    assert mesh.cell_data["cluster"][0].tolist() == [0, 0, 1, 2, 0]
+    assert len(mesh.points) == 5 * 24
+    np.testing.assert_allclose(np.linalg.norm(mesh.points[:24] - [0, 0, 0], axis=1), 1.0)

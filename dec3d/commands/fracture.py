@@ -321,7 +321,7 @@ def fracture_export(session, call):
                    P("dfn", Text(), "only this DFN")],
          doc="Write the disks to `<file>_0000.vtu` (polygons) listed in `<file>.pvd` (dec3d command).",
          details="Each disk is a regular polygon inscribed in it. Cell data: fracture_id, dfn_id, set, radius, "
-                 "dip, dip_direction (degrees), normal.",
+                 "dip, dip_direction (degrees), cluster (of the last `fracture intersections compute`, −1 before), normal.",
          examples=["fracture vtk", "fracture vtk 'dfn' sides 32"])
 def fracture_vtk(session, call):
     from ..io.vtk import write_pvd
@@ -336,5 +336,5 @@ def fracture_vtk(session, call):
     c, n, r = _arrays(m, rows)
     d, dd = FR.dips_from_normals(n) if len(rows) else (np.zeros(0), np.zeros(0))
     dfnfile.write_vtu(vtu, fs["id"][rows], fs["dfn"][rows], fs["set"][rows], c, n, r, np.degrees(d), np.degrees(dd),
-                      sides=int(call.args["sides"]))
+                      sides=int(call.args["sides"]), cluster=fs["cluster"][rows])
     write_pvd(pvd, [(m.time, str(vtu))])

@@ -169,9 +169,9 @@ def read_bootstrapped(text: str):
     return dip, ddir, w
 
 
-def write_vtu(path, ids, dfn, sets, c, n, radius, dip_deg, ddir_deg, sides: int = NGON) -> str:
+def write_vtu(path, ids, dfn, sets, c, n, radius, dip_deg, ddir_deg, sides: int = NGON, cluster=None) -> str:
     """Disks as ``sides``-gons (VTK_POLYGON), cell data fracture_id, dfn_id, set, radius, dip,
-    dip_direction, normal."""
+    dip_direction, cluster (−1: not computed), normal."""
     from dec3d.io.vtk import _data_array
 
     path = os.fspath(path)
@@ -185,7 +185,8 @@ def write_vtu(path, ids, dfn, sets, c, n, radius, dip_deg, ddir_deg, sides: int 
                                                     + np.sin(phi)[None, :, None] * w[:, None, :])).reshape(-1, 3)
     cell = {"fracture_id": np.asarray(ids, np.int64), "dfn_id": np.asarray(dfn, np.int64),
             "set": np.asarray(sets, np.int64), "radius": np.asarray(radius, float),
-            "dip": np.asarray(dip_deg, float), "dip_direction": np.asarray(ddir_deg, float)}
+            "dip": np.asarray(dip_deg, float), "dip_direction": np.asarray(ddir_deg, float),
+            "cluster": np.full(k, -1, np.int64) if cluster is None else np.asarray(cluster, np.int64)}
     ind = "        "
     parts = ['<?xml version="1.0"?>\n',
              '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">\n',

@@ -7,6 +7,7 @@
     center (3,) m      centre of the disk
     normal (3,) -      unit normal, upward (n_z ≥ 0; a vertical disk has n_z = 0 and n_y ≥ 0 or n_y = 0 < n_x)
     radius ()   m      radius of the disk (3DEC's fracture "size" is the diameter: 2 × radius)
+    cluster ()  int64  connected cluster (``fracture intersections compute``; −1 before), from 0
     group (1,)  int32  group code
 
 ``model.settings.fractures`` (JSON, saved with the model): ``templates`` {name: spec}, ``dfns``
@@ -31,7 +32,7 @@ _I = np.int64
 def _fields() -> dict[str, Field]:
     return {"id": Field((), _I, 0), "dfn": Field((), _I, 0), "set": Field((), _I, 0),
             "center": Field((3,), _F, 0.0), "normal": Field((3,), _F, 0.0), "radius": Field((), _F, 0.0),
-            "group": group_field()}
+            "cluster": Field((), _I, -1), "group": group_field()}
 
 
 def fracture_store(model) -> Store:
