@@ -98,7 +98,8 @@ def write_itasca(path, ids, c, dip_deg, ddir_deg, radius, sets) -> str:
     with open(path, "w", encoding="utf-8", newline="\n") as fh:
         fh.write("; dec3d DFN: disk id x y z diameter dip dip-direction set\n")
         for i in range(len(ids)):
-            fh.write(f"disk {int(ids[i])} {float(c[i, 0])!r} {float(c[i, 1])!r} {float(c[i, 2])!r} {2 * float(radius[i])!r} "
+            x, y, z = (float(v) for v in c[i])
+            fh.write(f"disk {int(ids[i])} {x!r} {y!r} {z!r} {2 * float(radius[i])!r} "
                      f"{float(dip_deg[i])!r} {float(ddir_deg[i])!r} {int(sets[i])}\n")
     return path
 
@@ -144,8 +145,8 @@ def write_csv(path, ids, c, n, radius, sets) -> str:
     with open(path, "w", encoding="utf-8", newline="\n") as fh:
         fh.write("id,x,y,z,nx,ny,nz,radius,set\n")
         for i in range(len(ids)):
-            fh.write(f"{int(ids[i])},{float(c[i, 0])!r},{float(c[i, 1])!r},{float(c[i, 2])!r},{float(n[i, 0])!r},{float(n[i, 1])!r},{float(n[i, 2])!r},"
-                     f"{float(radius[i])!r},{int(sets[i])}\n")
+            vals = [*(float(v) for v in c[i]), *(float(v) for v in n[i]), float(radius[i])]
+            fh.write(f"{int(ids[i])}," + ",".join(repr(v) for v in vals) + f",{int(sets[i])}\n")
     return path
 
 
