@@ -16,8 +16,11 @@ Itasca's bootstrapped file). ``fracture`` is accepted for ``disk``.
 CSV (``.csv``): a header ``id,x,y,z,nx,ny,nz,radius,set`` (column order free; ``set`` optional);
 the normal need not be unit nor upward (it is made so).
 
-Bootstrapped orientation list (Itasca's format, confirmed): one header line, then lines
-``id dip dip-direction [quantity]``; the quantity weights the line (1 when absent); an empty line ends it.
+Bootstrapped orientation list (Itasca's format: one header line, then per line an id, the values of
+the distribution and an optional last column, the quantity; an empty line ends it): dec3d reads
+``id dip dip-direction [quantity]``, the quantity weighting the line (1 when absent). Itasca's own
+example on that page has five columns and a "dip" of 242 under the header "id dip dipdir quant", which
+matches neither its header nor its text, so lines of another shape are refused rather than guessed.
 
 Every reader raises ``DfnFileError(line, message)``; the command adds the deck's file:line:column.
 """
