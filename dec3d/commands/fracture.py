@@ -20,12 +20,12 @@ import math
 import numpy as np
 
 from ..errors import BindError, CommandError
-from ..geometry import dfn_gen, dfn_measure
+from ..geometry import dfn_gen
 from ..io import dfnfile
 from ..lang.abbrev import matches
 from ..model import fractures as FR
 from .registry import command
-from .values import ANGLE, FLAG, Choice, Num, Nums, OutPath, InPath, P, Text, ValueType
+from .values import Choice, InPath, Num, Nums, OutPath, P, Text, ValueType
 
 _ORIENT = {"uniform": 0, "fisher": 3, "bootstrapped": "file"}
 _SIZE = {"power-law": 1, "uniform": 0, "log-normal": 2, "gauss": 2}

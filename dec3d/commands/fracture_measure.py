@@ -181,7 +181,7 @@ def fracture_list(session, call):
          examples=["fracture delete", "fracture delete dfn 'rock'", "fracture delete range id-list 1 2 3"])
 def fracture_delete(session, call):
     m = session.model
-    fs = FR.fracture_store(m)
+    FR.fracture_store(m)                      # (made empty when there is none: the range needs it)
     mask = session.range_mask(call, "fractures")
     rows, _ = _dfn_rows(session, call)
     rows = rows[mask[rows]]
