@@ -301,3 +301,16 @@ def test_intersections_command_and_cluster_in_vtk(tmp_path):
     assert mesh.cell_data["cluster"][0].tolist() == [0, 0, 1, 2, 0]
     assert len(mesh.points) == 5 * 24
     np.testing.assert_allclose(np.linalg.norm(mesh.points[:24] - [0, 0, 0], axis=1), 1.0)
+
+
+def test_cut_over_the_budget_is_refused_and_nothing_is_cut(tmp_path):
+    s = _run(_session(tmp_path), DECK)
+    before = s.model.blocks.n, s.model.vertices["pos"].copy(), s.model.next_block_id
+    with pytest.raises(Dec3dError, match=r"this DFN made \d+ blocks after \d+ of its 40 disks, over the budget of 45 "
+                                         r"blocks; nothing was cut") as exc:
+        _run(s, "model budget blocks 45\nblock cut dfn name 'rock'\n")
+    assert exc.value.location.line == 2
+    assert s.model.blocks.n == before[0] and s.model.next_block_id == before[2]
+    np.testing.assert_array_equal(s.model.vertices["pos"], before[1])
+    _run(s, "model budget blocks 100000\nblock cut dfn name 'rock'\n")
+    assert s.model.blocks.n > 45

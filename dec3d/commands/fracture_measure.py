@@ -7,11 +7,11 @@ import math
 
 import numpy as np
 
-from ..errors import CommandError
+from ..errors import CommandError, ResourceError
 from ..geometry import dfn_measure
-from ..geometry.dfn_cut import cut_dfn
+from ..geometry.dfn_cut import TooManyBlocks, cut_dfn
 from ..model import fractures as FR
-from .budget import check_blocks
+from .budget import budget, check_blocks
 from .fracture import _arrays, _box, _dfn_rows
 from .registry import command, range_element
 from .values import ANGLE, FLAG, POINT, Num, Nums, P, Text
@@ -235,8 +235,21 @@ def block_cut_dfn(session, call):
     FR.ensure_face_fields(m)
     vsel = mask & ~m.blocks["hidden"]
     v0 = float(m.blocks["volume"][vsel].sum())
-    made, used, skipped = cut_dfn(m, c.copy(), n.copy(), r.copy(), FR.fracture_store(m)["id"][rows].copy(), js, mask=mask,
-                         join=bool(a["join"]))
+    keep = {k: {f: a.copy() for f, a in m.stores[k].to_arrays().items()}     # (to_arrays may hand views)
+            for k in ("blocks", "vertices", "faces", "face_vertices")}
+    next_id = m.next_block_id
+    cap = budget(session).max_blocks()
+    try:
+        made, used, skipped = cut_dfn(m, c.copy(), n.copy(), r.copy(), FR.fracture_store(m)["id"][rows].copy(), js,
+                                      mask=mask, join=bool(a["join"]), max_blocks=cap)
+    except TooManyBlocks as exc:
+        for k, arrs in keep.items():               # the model as it was before the command
+            m.stores[k].load_arrays(arrs)
+        m.next_block_id = next_id
+        raise ResourceError(f"this DFN made {exc.blocks:,} blocks after {exc.done} of its {len(rows)} disks, over "
+                            f"the budget of {cap:,} blocks; nothing was cut", call.location,
+                            hint="raise it with `model budget blocks <n> memory <GiB>` if the machine has the "
+                                 "memory") from None
     vol = m.blocks["volume"]
     # the pieces of the blocks cut: the blocks in range then, and the new rows
     after = np.concatenate([vsel, np.ones(m.blocks.n - len(vsel), bool)])

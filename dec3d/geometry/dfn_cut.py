@@ -87,6 +87,14 @@ def disk_touches_block(model, row: int, c, n, r: float, tol: float) -> bool:
     return bool((np.einsum("ij,ij->i", close, close) <= r * r).any())
 
 
+class TooManyBlocks(ValueError):
+    """The cut made more blocks than the caller allowed (``max_blocks``); the model is part cut."""
+
+    def __init__(self, done: int, blocks: int):
+        super().__init__(f"{blocks} blocks after {done} disks")
+        self.done, self.blocks = done, blocks
+
+
 #: a cut that would leave a piece thinner than this fraction of the block's extent along the
 #: disk's normal is not made (the would-be sliver stays with its block); counted as skipped
 SLIVER = 1e-2
@@ -120,10 +128,11 @@ def _prefilter(model, cand, c, n, r, tol):
 
 
 def cut_dfn(model, centers, normals, radii, frac_ids, jointset: int, mask=None,
-            join: bool = False) -> tuple[int, int, int]:
+            join: bool = False, max_blocks: int | None = None) -> tuple[int, int, int]:
     """Cut the visible blocks in ``mask`` by the disks in order. Returns (new blocks, disks that cut,
     cuts skipped as slivers). The faces store must hold the int64 fields ``jointset`` and ``fracture``
-    (``dec3d.model.fractures.ensure_face_fields``)."""
+    (``dec3d.model.fractures.ensure_face_fields``). More than ``max_blocks`` blocks raises
+    ``TooManyBlocks`` at once (the caller puts the model back)."""
     centers, normals, radii = np.asarray(centers, _F), np.asarray(normals, _F), np.asarray(radii, _F)
     tol = float(model.tolerance)
     b, fs = model.blocks, model.faces
@@ -166,6 +175,8 @@ def cut_dfn(model, centers, normals, radii, frac_ids, jointset: int, mask=None,
         if new:
             used += 1
             made += new
+            if max_blocks is not None and b.n > max_blocks:
+                raise TooManyBlocks(k + 1, int(b.n))
             changed = np.concatenate([np.asarray(hit, np.int64), np.arange(n0, b.n)])
             allowed = np.concatenate([allowed, np.ones(b.n - n0, bool)])
             allowed[n0:] = True
