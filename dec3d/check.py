@@ -314,7 +314,10 @@ def check_file(path: str | Path, standalone: bool = False, legacy: bool = True) 
     text = p.read_text(encoding="utf-8", errors="replace")
     if not (legacy and looks_legacy(text)):
         return check_text(text, str(p), p.parent, standalone)
-    tr = translate_text(text, str(p))
+    from .commands.legacy import legacy_models
+    from .lang.legacy.translate import State
+
+    tr = translate_text(text, str(p), State(models=legacy_models()))
     out = []
     for r in check_text(tr.text, str(p), p.parent, standalone):
         if r.file == str(p):

@@ -13,13 +13,19 @@ from .lang.legacy.translate import State
 from .session import Session
 
 
+def new_state() -> State:
+    from .commands.legacy import legacy_models
+
+    return State(models=legacy_models())
+
+
 class LegacySession(Session):
     """A Session that reads 3DEC 4/5 decks through the translator (with a notice for each)."""
 
     def __init__(self, *args, notice=None, **kwargs):
         super().__init__(*args, **kwargs)
         self.legacy_maps = []
-        self.legacy_state = State()          # materials, named ranges, hidden blocks: carried from deck to deck
+        self.legacy_state = new_state()          # materials, named ranges, hidden blocks: carried from deck to deck
         self._notice = notice if notice is not None else (lambda text: print(text, file=sys.stderr))
 
     def load_text(self, text, filename="<input>", base_dir: Path | None = None, stack=()):
@@ -50,7 +56,7 @@ def translate_main(deck: str, out: str | None) -> int:
     except OSError as exc:
         print(f"dec3d translate: error: cannot read `{deck}`: {exc.strerror or exc}", file=sys.stderr)
         return 2
-    tr = translate_text(text, str(p))
+    tr = translate_text(text, str(p), new_state())
     if out:
         try:
             Path(out).write_text(tr.text, encoding="utf-8")

@@ -26,6 +26,14 @@ NOT_RUNNABLE = {
 }
 
 
+def _state():
+    """A translator state with the model numbers from the registries, as `dec3d run` and `translate` give it."""
+    from dec3d.commands.legacy import legacy_models
+    from dec3d.lang.legacy.translate import State
+
+    return State(models=legacy_models())
+
+
 def _needs_decks():
     if not LEGACY.is_dir():
         pytest.skip(NO_DECKS)
@@ -33,7 +41,7 @@ def _needs_decks():
 
 def _chain_text(names):
     """The translations of decks run one after the other in one session (3DEC 5 users ran them so)."""
-    state = State()
+    state = _state()
     return "\n".join(translate_text((LEGACY / n).read_text(errors="replace"), n, state).text for n in names)
 
 
@@ -51,7 +59,7 @@ def test_legacy_deck_translates_and_binds(name):
         assert not bad, bad
     for r in bad:
         assert "FISH" in r.what, r
-    text = translate_text((LEGACY / name).read_text(errors="replace"), name).text
+    text = translate_text((LEGACY / name).read_text(errors="replace"), name, _state()).text
     noted = {w for w in missing if f"`{w}`" in text}
     assert noted == missing
 

@@ -59,3 +59,17 @@ def legacy_hint(word: str) -> str | None:
     if len(hits) == 1:
         return f"in 3DEC 7+ write `{_LEGACY[hits[0]]}`"
     return None
+
+
+def legacy_models() -> dict:
+    """3DEC 4/5 constitutive-model numbers (`change cons=n`, `change jcons=n`) -> dec3d's model names,
+    from the models' own ``LEGACY_CODE`` (zone models: 0 is the null model); for the translator
+    (``dec3d.lang.legacy``, ``State.models``), which knows no model."""
+    from ..kernels.joints import MODELS as JOINT_KERNELS
+    from ..physics.cmodels import ZONE_MODELS
+
+    cons = {"0": "null"}
+    cons.update({str(m.kernel.LEGACY_CODE): name for name, m in ZONE_MODELS.items()
+                 if getattr(m.kernel, "LEGACY_CODE", None) is not None})
+    jcons = {str(k.LEGACY_CODE): k.NAME for k in JOINT_KERNELS if getattr(k, "LEGACY_CODE", None) is not None}
+    return {"cons": cons, "jcons": jcons}

@@ -179,13 +179,17 @@ class ZoneModel:
             with np.errstate(all="ignore"):
                 v = np.array([p.from_column(x) for x in col]) if p.kind == "angle" else col
                 bad = ~np.isfinite(v)
+                high = np.zeros_like(bad)
                 if p.lo is not None:
                     bad |= (v <= p.lo) if p.lo_open else (v < p.lo)
                 if p.hi is not None:
-                    bad |= (v >= p.hi) if p.hi_open else (v > p.hi)
+                    high = (v >= p.hi) if p.hi_open else (v > p.hi)
+                    bad |= high
             if bad.any():
                 unset = " (not set)" if p.default == 0.0 and (col[bad] == 0.0).all() else ""
-                out.append(f"{p.name} {_range_text(p)}{unset}: {which_zones(ids, bad, blocks)}")
+                # the side of the range the values break (a modulus not set breaks "> 0", not the typo limit)
+                side = "hi" if high[bad].all() else ("lo" if not high[bad].any() else None)
+                out.append(f"{p.name} {_range_text(p, side)}{unset}: {which_zones(ids, bad, blocks)}")
         warns: list[str] = []
         if not out and self.check is not None:
             more, warns = self.check(prop_rows, ids)
@@ -193,9 +197,9 @@ class ZoneModel:
         return out, warns
 
 
-def _range_text(p: Prop) -> str:
-    lo = "" if p.lo is None else (f"> {p.lo:g}" if p.lo_open else f">= {p.lo:g}")
-    hi = "" if p.hi is None else (f"< {p.hi:g}" if p.hi_open else f"<= {p.hi:g}")
+def _range_text(p: Prop, side: str | None = None) -> str:
+    lo = "" if p.lo is None or side == "hi" else (f"> {p.lo:g}" if p.lo_open else f">= {p.lo:g}")
+    hi = "" if p.hi is None or side == "lo" else (f"< {p.hi:g}" if p.hi_open else f"<= {p.hi:g}")
     rule = " and ".join(x for x in (lo, hi) if x) or "finite"
     return f"must be {rule}" + (f" {p.units}" if p.units else "")
 

@@ -59,9 +59,9 @@ def test_cmodel_null_clears_stress_and_group_range_reaches_zones_of_the_block(s)
 
 @pytest.mark.parametrize("line,msg", [
     ("block zone property", "needs a property: young, poisson, bulk, shear, density, cohesion, friction, tension, dilation"),
-    ("block zone property bulk -1e9", "`bulk` must be > 0"),
-    ("block zone property shear 0", "`shear` must be > 0"),
-    ("block zone property young -5", "`young` must be > 0"),
+    ("block zone property bulk -1e9", r"`bulk` must be in \(0, 1e\+16\]"),
+    ("block zone property shear 0", r"`shear` must be in \(0, 1e\+16\]"),
+    ("block zone property young -5", r"`young` must be in \(0, 1e\+16\]"),
     ("block zone property poisson 0.5 young 1e9", r"`poisson` must be in \(-1, 0.5\)"),
     ("block zone property poisson -1 young 1e9", r"`poisson` must be in \(-1, 0.5\)"),
     ("block zone property density 0", r"`density` must be in \(0, 1e\+09\]"),

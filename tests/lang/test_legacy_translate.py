@@ -11,8 +11,16 @@ from dec3d.lang.legacy.hull import convex_excess, hull_faces, solid_volume
 NOTE = "; dec3d translate: could not translate: "
 
 
+def _state():
+    """A translator state with the model numbers from the registries, as `dec3d run` and `translate` give it."""
+    from dec3d.commands.legacy import legacy_models
+    from dec3d.lang.legacy.translate import State
+
+    return State(models=legacy_models())
+
+
 def tr(text: str) -> str:
-    return translate_text(text, "old.dat").text
+    return translate_text(text, "old.dat", _state()).text
 
 
 @pytest.mark.parametrize("old, new", [
@@ -170,7 +178,7 @@ def test_deck_function_named_like_an_intrinsic_stays_the_decks():
 
 
 def test_lines_it_cannot_translate_become_comments():
-    t = translate_text("frobnicate 3\nprint max", "old.dat")
+    t = translate_text("frobnicate 3\nprint max", "old.dat", _state())
     assert t.text.split("\n") == [NOTE + "frobnicate 3  (the command `frobnicate`)",
                                   NOTE + "print max  (this `print`/`list`)"]
     assert t.untranslated == 2
@@ -187,7 +195,7 @@ def test_looks_legacy():
 
 
 def test_line_map_points_at_the_original_column():
-    t = translate_text("; c\nprop mat=1   dens=2300\n", "old.dat")
+    t = translate_text("; c\nprop mat=1   dens=2300\n", "old.dat", _state())
     line = t.text.split("\n")[1]
     col = line.index("2300") + 1
     assert t.map.where(2, col) == (2, 19)          # `2300` in the original line
@@ -224,7 +232,7 @@ def test_non_convex_poly_is_built_as_its_hull_with_a_note():
 
 def test_fish_line_columns_and_lines_after_an_expanded_line_map_back():
     old = "def f\n  if 1 = 2 then\n    cxi = c_cx(ci)\n  endif\n  y = 1 / zz\nend\n"
-    t = translate_text(old, "old.dat")
+    t = translate_text(old, "old.dat", _state())
     lines = t.text.split("\n")
     k = lines.index("  y = 1 / zz") + 1            # `c_cx` became five lines: this one moved down by 4
     assert k == 9

@@ -251,7 +251,7 @@ BAD_BASE = "block create brick 0 1 0 1 0 1\nblock contact jmodel assign bilinear
     ("block contact property friction-2 95", "`friction-2` must be in [0, 90], got 95", 35),
     ("block contact property f2-residual 91", "`f2-residual` must be in [0, 90], got 91", 36),
     ("block contact property dilation-2 90", "`dilation-2` must be in [0, 90), got 90", 35),
-    ("block contact property stiffness-shear -1e9", "`stiffness-shear` must be ≥ 0, got -1e+09", 40),
+    ("block contact property stiffness-shear -1e9", "`stiffness-shear` must be in [0, 1e+20], got -1e+09", 40),
     ("block contact property cohesion-2 -5", "`cohesion-2` must be ≥ 0, got -5", 35),
     ("block contact property c2-residual -1", "`c2-residual` must be ≥ 0, got -1", 36),
     ("block contact property nstress -1e6", "`nstress` must be ≥ 0, got -1e+06", 32),

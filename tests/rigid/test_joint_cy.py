@@ -205,7 +205,7 @@ BASE = "block create brick 0 1 0 1 0 1\nblock contact jmodel assign cyjm\n"
 
 
 @pytest.mark.parametrize("line, message, column", [
-    ("block contact property kn-initial -1e9", "`kn-initial` must be ≥ 0, got -1e+09", 35),
+    ("block contact property kn-initial -1e9", "`kn-initial` must be in [0, 1e+20], got -1e+09", 35),
     ("block contact property exponent-normal 1", "`exponent-normal` must be in [0, 1), got 1", 40),
     ("block contact property exponent-shear -0.1", "`exponent-shear` must be in [0, 1), got -0.1", 39),
     ("block contact property friction-initial 95", "`friction-initial` must be in [0, 90], got 95", 41),

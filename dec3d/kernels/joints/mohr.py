@@ -19,6 +19,7 @@ from ._common import P_KN, P_KS, ST_FAILED, ST_SLIP, ST_TENSION, elastic_trial, 
 
 NAME = "mohr"
 CODE = 1          # kept in save files: never renumber
+LEGACY_CODE = 1   # 3DEC 4/5 `change jcons=1` (dec3d translate)
 P_TANF = 2        # tan φ
 P_COH = 3         # cohesion c [Pa]
 P_TEN = 4         # tensile strength T [Pa]

@@ -44,6 +44,7 @@ from ._common import P_KN, P_KS, ST_FAILED, ST_SLIP, ST_TENSION, elastic_trial, 
 
 NAME = "softening-mohr"
 CODE = 4          # kept in save files: never renumber
+LEGACY_CODE = 2   # 3DEC 4/5 `change jcons=2` (dec3d translate)
 P_TANF = 2        # tan φ (peak)
 P_TANF_RES = 3    # residual tan φ (NaN: the peak value)
 P_COH = 4         # peak cohesion c [Pa]

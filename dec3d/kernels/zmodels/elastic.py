@@ -6,6 +6,7 @@ from ._common import hooke
 
 NAME = "elastic"
 CODE = 1          # kept in save files: never renumber
+LEGACY_CODE = 1   # 3DEC 4/5 `change cons=1` (dec3d translate)
 NCOLS = 3         # bulk, shear, density
 NHIST = 0
 HIST_NAMES = ()

@@ -14,6 +14,7 @@ from ._common import P_COHESION, P_TANDIL, P_TANFRIC, P_TENSION, hooke
 
 NAME = "mohr-coulomb"
 CODE = 2          # kept in save files: never renumber
+LEGACY_CODE = 2   # 3DEC 4/5 `change cons=2` (dec3d translate)
 NCOLS = 7         # bulk, shear, density, cohesion, tan friction, tension, tan dilation
 NHIST = 0
 HIST_NAMES = ()

@@ -85,12 +85,12 @@ def _change(toks, state):
             if not r:          # every contact, and the contacts made later
                 out.append([O("block contact material-table default property", k)] + cmd[1:])
         elif hit[1] == "cons":
-            model = {"0": "null", "1": "elastic", "2": "mohr-coulomb"}.get(v.text)
+            model = state.models.get("cons", {}).get(v.text)       # the zone models' LEGACY_CODE
             if model is None:
                 return None, f"`cons={v.text}`"
             out.append([O(f"block zone cmodel assign {model}", k)] + r)
         else:
-            model = {"1": "mohr", "2": "softening-mohr"}.get(v.text)
+            model = state.models.get("jcons", {}).get(v.text)      # the joint models' LEGACY_CODE
             if model is None:
                 return None, f"`jcons={v.text}`"
             out.append([O(f"block contact jmodel assign {model}", k)] + r)

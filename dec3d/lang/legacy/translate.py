@@ -38,6 +38,10 @@ class State:
     hides: list = field(default_factory=list)         # the `hide` commands in force (3DEC 7+ text)
     shown: bool = False                               # they are shown for the mechanics (since a cycle)
     untranslated: int = 0
+    #: 3DEC 4/5 model numbers -> dec3d model names: {"cons": {"1": "elastic", …}, "jcons": {…}}; given by
+    #: the caller from the model registries (``legacy_run.legacy_models``: each model's kernel declares its
+    #: ``LEGACY_CODE``); without it `cons=`/`jcons=` stay untranslated
+    models: dict = field(default_factory=dict)
 
 
 @dataclass
