@@ -30,7 +30,8 @@ def test_every_verification_problem_is_there():
                                          "FE2_fe_deformable_contacts", "F2_griffiths_lane_slope", "F3_vertical_cut",
                                          "D10_hoek_brown_triaxial", "D11_strain_softening", "D12_ubiquitous_joint",
                                          "D13_drucker_prager_triaxial", "D14_anisotropic_elastic",
-                                         "SE1_cable_pullout", "SE2_bolted_planar_slide", "SE3_cable_pullout_confined"}
+                                         "SE1_cable_pullout", "SE2_bolted_planar_slide", "SE3_cable_pullout_confined",
+                                         "W1_planar_slide_water", "W2_wedge_water", "W3_joint_opening"}
 
 
 def _demo(tmp_path, expects: str):

@@ -17,15 +17,15 @@ from .values import FLAG, POINT, VEC3, Num, P
 
 def _check_water(call):
     a = call.args
+    if (a["normal"] is not None or a["origin"] is not None) and not a["plane"]:
+        key = "normal" if a["normal"] is not None else "origin"
+        raise BindError(f"`{key}` belongs to `block water plane`", call.locations.get(key, call.location))
     given = [k for k in ("density", "plane", "clear", "list") if a[k] not in (None, False)]
     if not given:
         raise BindError("`block water` needs one of density, plane, clear, list", call.location)
     if a["plane"] and (a["normal"] is None or a["origin"] is None):
         raise BindError("`block water plane` needs `normal nx ny nz` and `origin x y z`",
                         call.locations.get("plane", call.location))
-    if (a["normal"] is not None or a["origin"] is not None) and not a["plane"]:
-        key = "normal" if a["normal"] is not None else "origin"
-        raise BindError(f"`{key}` belongs to `block water plane`", call.locations.get(key, call.location))
 
 
 @command("block water",
