@@ -93,3 +93,14 @@ def test_bad_input_is_refused_with_its_place(session, line, message):
 def test_no_contacts_refused(session):
     with pytest.raises(Dec3dError, match="no contacts"):
         _run(session, "model new\nblock create brick 0 1 0 1 0 1\nblock contact apply pore-pressure 1\n")
+
+
+def test_dam_example_factors_of_safety(tmp_path):
+    """examples/water/dam_foundation.dat: sliding FS (W − U) tan 45° / P by hand: 2.0741 without drainage
+    (U = ½ γw H B), 2.6667 with a third of the uplift; the strength reduction brackets each to 0.01."""
+    from conftest import ROOT
+    from dec3d.session import run_deck
+
+    s = run_deck(ROOT / "examples" / "water" / "dam_foundation.dat", out_dir=tmp_path)
+    assert s.results["fos.1"] == pytest.approx((1.2e6 - 360e3) / 405e3, abs=0.01)
+    assert s.results["fos.2"] == pytest.approx((1.2e6 - 120e3) / 405e3, abs=0.01)
