@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from dec3d.errors import CommandError
 from dec3d.kernels.water import pressure_areas
 
 
@@ -86,7 +87,8 @@ def refresh(eng) -> None:
     if ss.n:
         p = p + cs["pp_apply"][ss["contact"]]
     if not np.all(np.isfinite(p)):
-        raise ValueError("a pore pressure is not finite")
+        raise CommandError("a pore pressure is not finite (water density, gravity and table give "
+                           f"{p[~np.isfinite(p)][0]!r}): refused before it reaches a contact force")
     ss["pp"][...] = p
     pa = np.empty(ss.n)
     if ss.n:

@@ -104,3 +104,36 @@ def test_dam_example_factors_of_safety(tmp_path):
     s = run_deck(ROOT / "examples" / "water" / "dam_foundation.dat", out_dir=tmp_path)
     assert s.results["fos.1"] == pytest.approx((1.2e6 - 360e3) / 405e3, abs=0.01)
     assert s.results["fos.2"] == pytest.approx((1.2e6 - 120e3) / 405e3, abs=0.01)
+
+
+D7 = """model new
+block create brick 0 1 0 1 0 1
+block create brick 0 1 0 1 1 2
+block property density 2000
+block zone generate edgelength 0.5 range position-z 0 1
+block zone cmodel assign elastic
+block zone property young 1e9 poisson 0.25 density 2000
+model gravity 0 0 -10
+block contact jmodel assign elastic
+block contact material-table default property stiffness-normal 1e10 stiffness-shear 1e10
+block gridpoint apply velocity-z 0 range position-z 0
+block gridpoint apply velocity-x 0 range position-x 0
+block gridpoint apply velocity-x 0 range position-x 1
+block gridpoint apply velocity-y 0 range position-y 0
+block gridpoint apply velocity-y 0 range position-y 1
+"""
+
+
+def test_a_zoned_side_takes_the_water_on_its_gridpoints(session):
+    """A rigid cube on a zoned one (D7, the mixed-contact path): with p = 8 kPa in the joint the joint keeps
+    W − p A (the water carries the rest) and taking the pressure away gives the dry joint force back."""
+    e = _run(session, D7 + "block contact apply pore-pressure 8000\nmodel solve ratio 1e-7\n")
+    assert e.subcontacts["fn"].sum() == pytest.approx(20000 - 8000, rel=1e-4)
+    assert e.subcontacts["ppf"].sum() == pytest.approx(8000, rel=1e-12)
+    e = _run(session, "block contact apply pore-pressure -8000\nmodel solve ratio 1e-7\n")
+    assert e.subcontacts["fn"].sum() == pytest.approx(20000, rel=1e-4)
+
+
+def test_a_pressure_that_is_not_finite_is_refused(session):
+    with pytest.raises(Dec3dError, match="not finite"):
+        _run(session, STACK + "block water density 1e300\nblock water plane normal 0 0 1 origin 0 0 1e12\n")
