@@ -137,3 +137,10 @@ def test_a_zoned_side_takes_the_water_on_its_gridpoints(session):
 def test_a_pressure_that_is_not_finite_is_refused(session):
     with pytest.raises(Dec3dError, match="not finite"):
         _run(session, STACK + "block water density 1e300\nblock water plane normal 0 0 1 origin 0 0 1e12\n")
+
+
+def test_contact_history_of_the_pore_pressure(session):
+    _run(session, STACK + "block contact history name 'pw' pore-pressure position 0.5 0.5 0\nhistory interval 1\n"
+                          "model cycle 2\nblock contact apply pore-pressure 4000\nmodel cycle 2\n")
+    h = [x for x in session.model.history_set.items if x.name == "pw"][0]
+    assert h.values[0] == 0.0 and h.values[-1] == pytest.approx(4000.0)
