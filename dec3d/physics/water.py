@@ -19,7 +19,8 @@ made again at a detection gets the same pressure as the one it replaces):
     p(s) = ρw |g| h(s)  +  p_apply(contact of s)
 
 with h the depth of the sub-contact's point below the water table along gravity (`block water
-plane normal … origin …`, `block water density ρw`; zero above the table) and p_apply the sum of
+plane normal … origin …`, `block water density ρw`; zero above the table), plus p0 + g·x where
+`block insitu pore-pressure p0 gradient g` was given, and p_apply the sum of
 the `block contact apply pore-pressure` values given to the contact (contact field ``pp_apply``,
 carried by the pair through detections). ``refresh`` writes ``pp`` from these after every detection
 and whenever a source changes; it is a no-op (and ``pp`` stays zero) while the model has no water.
@@ -46,7 +47,7 @@ def water_settings(model) -> dict:
 def has_water(model) -> bool:
     """Whether any pressure source is defined (a water table or applied contact pressures)."""
     w = model.settings.mechanical.get("water")
-    if isinstance(w, dict) and (w.get("plane") is not None or w.get("applied")):
+    if isinstance(w, dict) and (w.get("plane") is not None or w.get("applied") or w.get("insitu")):
         return True
     return False
 
@@ -84,6 +85,9 @@ def refresh(eng) -> None:
     w = water_settings(m)
     cs = eng.contacts
     p = table_pressure(ss["pos"], float(w.get("density", 0.0)), w.get("plane"), m.settings.gravity)
+    ins = w.get("insitu")
+    if ins and ss.n:
+        p = p + ins[0] + ss["pos"] @ np.asarray(ins[1:], dtype=np.float64)
     if ss.n:
         p = p + cs["pp_apply"][ss["contact"]]
     if not np.all(np.isfinite(p)):
@@ -102,7 +106,7 @@ def _stamp(model) -> list:
     w = water_settings(model)
     plane = w.get("plane")
     return [float(w.get("density", 0.0)), None if plane is None else [float(x) for x in plane],
-            [float(g) for g in model.settings.gravity], int(w.get("applied", 0))]
+            [float(g) for g in model.settings.gravity], int(w.get("applied", 0)), w.get("insitu")]
 
 
 def refresh_if_stale(eng) -> None:
@@ -120,6 +124,13 @@ def total_normal_force(ss) -> np.ndarray:
     if "ppf" not in ss or not ss.n or not np.any(ss["ppf"]):
         return ss["fn"]
     return ss["fn"] + ss["ppf"]
+
+
+def set_insitu(model, p0: float, gradient) -> None:
+    """`block insitu pore-pressure p0 gradient gx gy gz`: p0 + g·x on every sub-contact (taken up by the
+    next refresh: before the next cycle, or now if the contacts exist)."""
+    g = [0.0, 0.0, 0.0] if gradient is None else [float(x) for x in gradient]
+    water_settings(model)["insitu"] = [float(p0)] + g
 
 
 def describe(model) -> str:

@@ -144,3 +144,14 @@ def test_contact_history_of_the_pore_pressure(session):
                           "model cycle 2\nblock contact apply pore-pressure 4000\nmodel cycle 2\n")
     h = [x for x in session.model.history_set.items if x.name == "pw"][0]
     assert h.values[0] == 0.0 and h.values[-1] == pytest.approx(4000.0)
+
+
+def test_insitu_pore_pressure_with_a_gradient(session):
+    """`block insitu pore-pressure p0 gradient g`: p0 + g·x on the joints (here at z = 0 and x, y in 0..1)."""
+    e = _run(session, STACK + "block insitu pore-pressure 1000 gradient 200 0 -5000\n")
+    ss = e.subcontacts
+    assert ss["pp"] == pytest.approx(1000 + 200 * ss["pos"][:, 0])
+    e = _run(session, "model solve ratio 1e-8\n")
+    assert e.subcontacts["fn"].sum() == pytest.approx(20000 - 1100, rel=1e-5)   # mean pressure 1100 Pa on 1 m²
+    with pytest.raises(Dec3dError, match="goes with `pore-pressure`"):
+        _run(session, STACK + "block insitu gradient 0 0 1\n")
