@@ -77,6 +77,8 @@ def refresh(eng) -> None:
     detection and by the commands that change a source."""
     m = eng.model
     ss = eng.subcontacts
+    if not isinstance(m.settings.mechanical.get("water"), dict):
+        return                  # (a dry model: nothing was ever set, the pressures are the fields' zeros)
     if "pp" not in ss or not has_water(m):
         if "pp" in ss and ss.n:
             ss["pp"][...] = 0.0
