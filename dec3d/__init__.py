@@ -26,4 +26,8 @@ def __getattr__(name):
         from . import session
 
         return getattr(session, name)
+    if name == "Model":             # a model driven from Python (dec3d.itasca, docs/python.md)
+        from .itasca import Model
+
+        return Model
     raise AttributeError(name)

@@ -32,7 +32,7 @@ from pathlib import Path
 from .commands import load_all
 from .commands.binder import BindContext, Binder, CommandCall, LegacySyntaxError
 from .commands.values import Deferred
-from .errors import Dec3dError, NotSupportedError, SourceLocation
+from .errors import Dec3dError, NotSupportedError, SourceLocation, UnimplementedError
 from .lang.parser import parse_deck
 
 RUNNABLE, DOES_NOTHING, NOT_SUPPORTED, LEGACY, ERROR = (
@@ -73,11 +73,11 @@ class _Walker:
     def add(self, deck, line, status, what, column=1, when="bind"):
         self.reports.append(LineReport(line, status, what, deck.filename, column, when))
 
-    def problem(self, deck, raw, status, exc):
+    def problem(self, deck, raw, status, exc, when="bind"):
         loc = exc.location
         col = loc.column if loc is not None and loc.line == raw.line and loc.file == deck.filename else 1
         self.add(deck, raw.line, status, exc.message + (f" (hint: {exc.hint})" if getattr(exc, "hint", None) else ""),
-                 col)
+                 col, when=when)
 
     def fish(self, deck, block):
         """A `fish define`: parsed, its command lines bound and its body compiled, as `dec3d run`
@@ -140,7 +140,10 @@ class _Walker:
                 self.problem(deck, raw, LEGACY, exc)
                 continue
             except NotSupportedError as exc:
-                self.problem(deck, raw, NOT_SUPPORTED, exc)
+                # a command, keyword, range element or intrinsic dec3d does not implement: the run goes up
+                # to it (dec3d.lang.unsupported); other such problems stop the deck before it runs
+                self.problem(deck, raw, NOT_SUPPORTED, exc, when="run" if isinstance(exc, UnimplementedError)
+                             else "bind")
                 continue
             except Dec3dError as exc:
                 self.problem(deck, raw, ERROR, exc)
@@ -180,6 +183,10 @@ class _Walker:
         if any(Path(s.file).resolve() == target.resolve() for s in stack) or \
                 Path(deck.filename).resolve() == target.resolve():
             self.add(deck, raw.line, ERROR, f"`{target.name}` calls itself (directly or through other files)")
+            return
+        if target.suffix.lower() == ".py":     # dec3d run refuses it unless --allow-python (docs/python.md)
+            self.add(deck, raw.line, ERROR, f"`{target.name}` is a Python file: `dec3d run` refuses it unless you "
+                                            "pass --allow-python (then it runs when the deck reaches it; not checked)")
             return
         try:
             text = target.read_text(encoding="utf-8", errors="replace")
@@ -296,9 +303,25 @@ def check_text(text: str, filename: str = "<input>", base_dir: Path | None = Non
     return w.reports
 
 
-def check_file(path: str | Path, standalone: bool = False) -> list[LineReport]:
+def check_file(path: str | Path, standalone: bool = False, legacy: bool = True) -> list[LineReport]:
+    """Reports for a deck file; a 3DEC 4/5 deck is checked as `dec3d run` runs it, through its translation
+    (dec3d.lang.legacy), its reports placed on the original lines (``legacy=False``: as written)."""
+    from dataclasses import replace
+
+    from .lang.legacy import looks_legacy, translate_text
+
     p = Path(path)
-    return check_text(p.read_text(encoding="utf-8", errors="replace"), str(p), p.parent, standalone)
+    text = p.read_text(encoding="utf-8", errors="replace")
+    if not (legacy and looks_legacy(text)):
+        return check_text(text, str(p), p.parent, standalone)
+    tr = translate_text(text, str(p))
+    out = []
+    for r in check_text(tr.text, str(p), p.parent, standalone):
+        if r.file == str(p):
+            line, col = tr.map.where(r.line, r.column)
+            r = replace(r, line=line, column=col)
+        out.append(r)
+    return out
 
 
 def _before(a: LineReport, b: LineReport, reports: list[LineReport]) -> bool:
@@ -316,8 +339,9 @@ def main(paths: list[str], verbose: bool = False) -> int:
     worst = 0
     for path in paths:
         p = Path(path)
-        if not p.is_file():
-            why = "is a folder, not a deck file" if p.is_dir() else "does not exist"
+        if not p.is_file() or p.suffix.lower() == ".py":
+            why = ("is a folder, not a deck file" if p.is_dir() else "does not exist" if not p.is_file() else
+                   "is a Python driver, not a deck (`dec3d run` runs it; docs/python.md)")
             print(f"dec3d check: error: `{path}` {why}", file=sys.stderr)
             worst = 2
             continue
@@ -353,8 +377,9 @@ def main(paths: list[str], verbose: bool = False) -> int:
                       "history calls a FISH function that cannot run)" +
                       (f", or at {first.file}:{first.line}, where one is called" if at_run else ""))
             else:
-                print(f"  dec3d run would run the lines before {first.file}:{first.line} and stop there: it calls "
-                      "a FISH function that cannot run")
+                why = ("it calls a FISH function that cannot run" if first.status != NOT_SUPPORTED else
+                       "dec3d does not implement it yet (`dec3d run --skip-unsupported` skips such lines)")
+                print(f"  dec3d run would run the lines before {first.file}:{first.line} and stop there: {why}")
         elif blockers:
             print("  dec3d run would run to the end: no line calls the FISH functions above (they stop a run "
                   "only when called)")

@@ -1,9 +1,10 @@
-"""The `dec3d` command line: run, batch, repl, verify, ssdem, docs."""
+"""The `dec3d` command line: run (decks and Python drivers), batch, repl, verify, ssdem, docs."""
 from __future__ import annotations
 
 import argparse
 import os
 import sys
+import time as _time
 from pathlib import Path
 
 from . import __version__
@@ -17,11 +18,32 @@ def _run(args) -> int:
         return _run_limited(args, limit, warmup)
 
 
+def _summary(session, seconds: float) -> str:
+    """The last line of `dec3d run`: wall time, the files written, the warnings to read."""
+    out = Path(session.out_dir)
+    names = []
+    for p in sorted(session.files.created):
+        try:
+            names.append(str(p.relative_to(out.resolve())))
+        except ValueError:
+            names.append(str(p))
+    shown = ", ".join(names[:6]) + (f" (+{len(names) - 6} more)" if len(names) > 6 else "")
+    files = f"{len(names)} file{'s' if len(names) != 1 else ''} written in {out}" + (f": {shown}" if names else "")
+    n = len(session.warnings)
+    warn = f"; {n} warning{'s' if n != 1 else ''} (below)" if n else ""
+    from .kcache import compile_seconds
+    compiled = compile_seconds()
+    kern = f" ({compiled:.0f} s of it compiling kernels, once)" if compiled >= 0.5 else ""
+    return f"dec3d run: finished in {seconds:.1f} s{kern}; {files}{warn}"
+
+
 def _run_limited(args, limit, warmup) -> int:
     session = None
+    t0 = _time.perf_counter()
     helper = warmup.start()          # cold cache: half of the kernels compile on the other core
     try:
         from .errors import Dec3dError
+        from .legacy_run import LegacySession
         from .session import Session
 
         deck = Path(args.deck)
@@ -34,9 +56,18 @@ def _run_limited(args, limit, warmup) -> int:
             what = "is a file, not a folder" if out.exists() and not out.is_dir() else (exc.strerror or str(exc))
             print(f"error: the output folder '{out}' cannot be used: {what}", file=sys.stderr)
             return 2
-        session = Session(out_dir=out, echo=not args.quiet, allow_outside_paths=args.allow_outside_paths,
-                          allow_overwrite=args.allow_overwrite)
+        session = (Session if args.no_legacy else LegacySession)(   # legacy decks: translated in memory
+            out_dir=out, echo=not args.quiet, allow_outside_paths=args.allow_outside_paths,
+            allow_overwrite=args.allow_overwrite)
         session.trust_saves = args.trust_save
+        session.skip_unsupported = args.skip_unsupported
+        session.strict = args.strict
+        session.allow_python = args.allow_python
+        if args.allow_python or deck.suffix.lower() == ".py":
+            from .itasca.driver import run_driver      # (and runs the Python files decks call)
+
+            if deck.suffix.lower() == ".py":     # a Python driver, dec3d.itasca bound to this session
+                return run_driver(session, deck)
         try:
             items = session.load_file(deck)          # parse and bind everything first
         except Dec3dError as exc:
@@ -52,6 +83,7 @@ def _run_limited(args, limit, warmup) -> int:
         finally:
             session.close_log()
             session.files.finish([session.log_path])     # the record of the files dec3d wrote (io/guard.py)
+        print(_summary(session, _time.perf_counter() - t0), file=sys.stderr)
         for w in session.warnings:
             print(f"warning: {w}", file=sys.stderr)
         return 0
@@ -140,7 +172,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="dec3d", description="3DEC-style distinct element program")
     ap.add_argument("--version", action="version", version=f"dec3d {__version__}")
     sub = ap.add_subparsers(dest="cmd", required=True)
-    r = sub.add_parser("run", help="run a deck")
+    r = sub.add_parser("run", help="run a deck, or a Python driver (script.py: `import itasca`, docs/python.md)")
     r.add_argument("deck")
     r.add_argument("--out", help="folder for outputs (default: the deck's folder)")
     r.add_argument("-q", "--quiet", action="store_true", help="do not echo commands")
@@ -155,7 +187,21 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--trust-save", action="store_true",
                    help="`model restore` installs the FISH functions and callbacks of every save it reads, "
                         "also of saves not made by you on this machine (only for saves you trust; docs/safety.md)")
+    r.add_argument("--no-legacy", action="store_true",
+                   help="refuse 3DEC 4/5 (legacy) decks instead of running their translation (docs/legacy.md)")
+    r.add_argument("--skip-unsupported", action="store_true",
+                   help="skip the lines dec3d does not implement yet (each is printed and warned about) "
+                        "instead of stopping there")
+    r.add_argument("--strict", action="store_true",
+                   help="a range that selects nothing is an error (a warning otherwise)")
+    r.add_argument("--allow-python", action="store_true",
+                   help="let decks run Python files (`program call 'x.py'`); Python is code, decks are data "
+                        "(docs/python.md)")
     r.set_defaults(fn=_run)
+    t = sub.add_parser("translate", help="write the 3DEC 7+ equivalent of a 3DEC 4/5 (legacy) deck (docs/legacy.md)")
+    t.add_argument("deck")
+    t.add_argument("--out", help="file to write (default: standard output)")
+    t.set_defaults(fn=lambda a: __import__("dec3d.legacy_run", fromlist=["translate_main"]).translate_main(a.deck, a.out))
     b = sub.add_parser("batch", help="run a deck for many parameter values (process pool or Dask) and "
                                      "collect one table")
     b.add_argument("deck")

@@ -133,3 +133,9 @@ def init_threads(environ=None) -> str | None:
 #: largest mass density dec3d accepts (kg/m³): 4e4 times osmium's, room for any density scaling a
 #: deck does by hand, while a block's mass ρ·V stays a finite number (1e308 made it infinite)
 DENSITY_LIMIT = 1e9
+#: largest stiffness (joint kn, ks in Pa/m) and elastic modulus (zones and FE blocks, Pa) a command
+#: takes: far above any rock, concrete or steel in any unit system a deck uses (steel is 2e11 Pa; a
+#: 1 mm joint of it 2e14 Pa/m). A larger value is a typo, and its time step would be too small to get
+#: anywhere (Δt ∝ 1/√k). (Strengths have no such limit: decks set `tension 1e20` for "never opens".)
+STIFFNESS_LIMIT = 1e20
+MODULUS_LIMIT = 1e16

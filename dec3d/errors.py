@@ -120,6 +120,11 @@ class NotSupportedError(Dec3dError):
     """A 3DEC command or feature dec3d knows by name but does not implement yet."""
 
 
+class UnimplementedError(NotSupportedError):
+    """A 3DEC command, keyword, range element or FISH intrinsic dec3d knows by name and does not
+    implement: a deck still binds the lines after it and runs up to it (``dec3d.lang.unsupported``)."""
+
+
 class ExpressionError(Dec3dError):
     """An inline [expression] failed to evaluate (unknown name, division by zero, ...)."""
 

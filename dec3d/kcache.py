@@ -16,8 +16,11 @@ callee's file changes. So, at the import of ``dec3d`` (``guard``):
    versions; it is kept in ``STAMP`` in each cache folder. When it differs, every cached
    kernel of the package (``*.nbi``, ``*.nbc``) there is deleted
    (``clear_stale``) and the new hash is written: one kernel edited → all recompile once.
-3. Cold start: when no cached kernel index is there (``is_cold``), the first compilation of a
-   dec3d kernel in the process prints one line on stderr (``NOTICE``).
+3. Compiling: the first compilation of a dec3d kernel in the process prints one line on stderr
+   (``NOTICE`` and the kernel's module) — on a cold cache (``is_cold``: no cached kernel index
+   there) and whenever else numba compiles (a kernel edited, a new type signature); loads from
+   the cache print nothing. ``compile_seconds()`` is the time spent compiling dec3d kernels so far
+   (`dec3d run` reports it at the end).
 """
 from __future__ import annotations
 
@@ -30,7 +33,10 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent / "kernels"
 #: file in the cache folder holding the source hash the cached kernels were built from
 STAMP = "dec3d-kernels.sha256"
-NOTICE = "dec3d: compiling kernels, first run only (a few seconds to a minute) …"
+NOTICE = "dec3d: compiling kernels"
+#: the rest of the notice line, after "for <module>"
+_NOTICE_TAIL = ("(first use: a few seconds to a minute, once; numba keeps them in its cache and later runs "
+                "load them) …")
 #: set by ``guard``: no cached kernel was found (``dec3d.warmup`` then compiles on the second core)
 COLD = False
 
@@ -128,32 +134,58 @@ def _notice_listener(stream=None, package="dec3d.kernels"):
     return cls(stream, package)
 
 
+#: seconds spent compiling kernels of the guarded package in this process (``_ColdNotice``)
+_COMPILE = [0.0]
+
+
+def compile_seconds() -> float:
+    """Wall seconds this process has spent compiling dec3d kernels (0 when all came from the cache)."""
+    return _COMPILE[0]
+
+
 class _ColdNotice:
-    """numba "compile" event listener: prints ``NOTICE`` once, at the first compilation of a
-    kernel of package ``package`` (compilations only: loads from the cache raise no event)."""
+    """numba "compile" event listener: prints the notice once, at the first compilation of a
+    kernel of package ``package`` (compilations only: loads from the cache raise no event), and
+    adds up the time spent compiling (outermost compilations only: a kernel compiles its callees
+    inside its own compilation)."""
 
     def __init__(self, stream=None, package="dec3d.kernels"):
         self.stream = stream
         self.package = package
         self.shown = False
+        self.depth = 0
+        self.t0 = 0.0
 
-    def on_start(self, event):
-        if self.shown:
-            return
+    def _ours(self, event) -> str:
         disp = (event.data or {}).get("dispatcher")
         mod = getattr(getattr(disp, "py_func", None), "__module__", "") or ""
-        if not mod.startswith(self.package):
+        return mod if mod.startswith(self.package) else ""
+
+    def on_start(self, event):
+        mod = self._ours(event)
+        if not mod:
+            return
+        if self.depth == 0:
+            import time
+            self.t0 = time.perf_counter()
+        self.depth += 1
+        if self.shown:
             return
         self.shown = True
         stream = self.stream or sys.stderr
         try:
-            stream.write(NOTICE + "\n")
+            stream.write(f"{NOTICE} for {mod} {_NOTICE_TAIL}\n")
             stream.flush()
         except (OSError, ValueError):
             pass
 
     def on_end(self, event):
-        pass
+        if not self._ours(event) or self.depth == 0:
+            return
+        self.depth -= 1
+        if self.depth == 0:
+            import time
+            _COMPILE[0] += time.perf_counter() - self.t0
 
 
 def guard(folder: Path = HERE, package: str = "dec3d.kernels") -> None:
@@ -173,7 +205,6 @@ def guard(folder: Path = HERE, package: str = "dec3d.kernels") -> None:
     clear_stale(cdir, digest, folder)
     global COLD
     COLD = is_cold(cdir, folder)
-    if COLD:
-        from numba.core import event as ev
+    from numba.core import event as ev
 
-        ev.register("numba:compile", _notice_listener(package=package))
+    ev.register("numba:compile", _notice_listener(package=package))

@@ -27,6 +27,8 @@ from .io import paths
 from .io.guard import FileRecord
 from .lang.parser import ParsedDeck, gc_paused, parse_deck
 from .lang.prepass import FishBlock
+from .lang.progress import BindProgress
+from .lang.unsupported import Unsupported, bind_or_defer, empty_range
 from .model.model import Model
 
 
@@ -48,7 +50,7 @@ class Enter:
     source: str
 
 
-Item = CommandCall | ExprStatement | FishDefine | Enter
+Item = CommandCall | ExprStatement | FishDefine | Enter | Unsupported
 
 
 #: file names of text that does not come from a file (its folder is the working folder)
@@ -131,9 +133,7 @@ class Session:
             raise exc.with_location(where)
 
     def _deck_folder(self, file: str) -> Path:
-        if file in PSEUDO_FILES:
-            return self._text_dirs.get(file) or Path.cwd()
-        return Path(file).parent
+        return (self._text_dirs.get(file) or Path.cwd()) if file in PSEUDO_FILES else Path(file).parent
 
     def _read_bases(self, where) -> list[Path]:
         loc = getattr(where, "resolve", lambda: where)()
@@ -196,6 +196,10 @@ class Session:
                 me, callers = path, []
             if me in callers:
                 raise BindError(f"`{paths.printable(path.name)}` calls itself (directly or through other files)", where)
+        if path.suffix.lower() == ".py":      # a Python file: refused unless allowed (commands.program_cmds)
+            from .commands.program_cmds import python_call
+
+            return python_call(self, path, where)
         try:
             size = path.stat().st_size
             if size > DECK_MAX_BYTES:
@@ -209,41 +213,24 @@ class Session:
         if raw.startswith(b"\xef\xbb\xbf"):
             raw = raw[3:]                   # a UTF-8 byte-order mark
         if path.suffix.lower() == ".dec":
-            return self._load_dec(raw, path, shown, where, stack)
+            from .lang.unsupported import load_dec
+            return load_dec(self, raw, path, shown, where, stack)
         text = raw.decode("utf-8", errors="replace")
         return self.load_text(text, str(path), path.parent, stack)
-
-    def _load_dec(self, raw: bytes, path: Path, shown: str, where, stack) -> list:
-        """A `.dec` file: read as a deck when it holds 3DEC commands; 3DEC's legacy binary/tabular
-        block-geometry format (not documented) is refused by name."""
-        from .errors import NotSupportedError
-
-        why = ("3DEC's legacy .dec block-geometry files are not supported (their format is not documented); "
-               "a .dec file that holds 3DEC commands is read as a deck")
-        if b"\x00" in raw[:4096]:
-            raise NotSupportedError(f"`{shown}` is a binary file, not a deck: {why}", where)
-        try:
-            return self.load_text(raw.decode("utf-8", errors="replace"), str(path), path.parent, stack)
-        except NotSupportedError:
-            raise
-        except Dec3dError as exc:
-            loc = exc.location
-            if loc is not None and loc.file == str(path):
-                raise NotSupportedError(f"`{shown}` is not a deck of commands (line {loc.line}: {exc.message}): "
-                                        f"{why}", where) from None
-            raise
 
     def _bind_deck(self, deck: ParsedDeck, base_dir: Path, stack) -> list[Item]:
         binder = Binder(deck, self.bind_context, stack)
         items: list[Item] = []
         fish = iter(deck.fish)
         next_fish = next(fish, None)
+        progress = BindProgress(self.write, paths.printable(deck.filename))
         for raw in deck.lines:
+            progress.tick(raw.line)
             while next_fish is not None and next_fish.line < raw.line:
                 items.append(self._fish_item(deck, next_fish, stack))
                 next_fish = next(fish, None)
-            call = binder.bind_line(raw)
-            if isinstance(call, ExprStatement):
+            call = bind_or_defer(self, binder, raw)
+            if isinstance(call, (ExprStatement, Unsupported)):
                 items.append(call)
                 continue
             path = call.command.path
@@ -396,6 +383,8 @@ class Session:
                 self.bind_context.assigned.update(self.variables)
             elif isinstance(item, FishDefine):
                 self.define_fish(item)
+            elif isinstance(item, Unsupported):
+                item.run(self)
         except Dec3dError as exc:
             raise exc.with_location(item.location)
         except OSError as exc:
@@ -448,9 +437,10 @@ class Session:
                 raise CommandError(f"range element `{rc.element.name}` gave {m.shape[0]} values for {n} {store}s",
                                    rc.location)
             masks.append(~m if rc.negate else m)
-        if call.range.union:
-            return np.logical_or.reduce(masks)
-        return np.logical_and.reduce(masks)
+        mask = np.logical_or.reduce(masks) if call.range.union else np.logical_and.reduce(masks)
+        if n and not mask.any():
+            empty_range(self, call, store, n)
+        return mask
 
     def _value(self, vtype, value, where, name: str = ""):
         """A deferred value evaluated and converted by its type; `name` (the keyword) is put in
@@ -574,11 +564,7 @@ class Session:
 
 
 def _contains_deferred(v) -> bool:
-    if isinstance(v, Deferred):
-        return True
-    if isinstance(v, (tuple, list)):
-        return any(_contains_deferred(x) for x in v)
-    return False
+    return isinstance(v, Deferred) or (isinstance(v, (tuple, list)) and any(_contains_deferred(x) for x in v))
 
 
 def _has_deferred(call: CommandCall) -> bool:

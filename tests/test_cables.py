@@ -23,11 +23,14 @@ def twin_step(dt, g, alpha, damp, safety, N, S, B):
     n = len(N["pos"])
     prev = [list(f) for f in N["force"]]
     rel = [[0.0, 0.0, 0.0] for _ in range(n)]
+    host_v = [None] * n             # the host point's velocity over the step
+    axis = [[0.0, 0.0, 0.0] for _ in range(n)]      # sum of the unit vectors of the node's segments
     for i in range(n):
         h = N["host"][i]
         if h < 0:
             continue
         if N["hz"][i]:          # a zoned host: its host point's velocity is given
+            host_v[i] = list(N["hvel"][i])
             rel[i] = [(N["vel"][i][k] - N["hvel"][i][k]) * dt for k in range(3)]
             continue
         c_old = [B["cen"][h][k] - B["vel"][h][k] * dt for k in range(3)]
@@ -35,6 +38,7 @@ def twin_step(dt, g, alpha, damp, safety, N, S, B):
         w = B["spin"][h]
         wxr = [w[1] * r[2] - w[2] * r[1], w[2] * r[0] - w[0] * r[2], w[0] * r[1] - w[1] * r[0]]
         vh = [B["vel"][h][k] + wxr[k] for k in range(3)]
+        host_v[i] = vh
         for k in range(3):
             N["hpos"][i][k] += vh[k] * dt
             rel[i][k] = (N["vel"][i][k] - vh[k]) * dt
@@ -58,6 +62,9 @@ def twin_step(dt, g, alpha, damp, safety, N, S, B):
             elif yc > 0 and S["fa"][e] < -yc:
                 S["fa"][e], flags = -yc, flags | 2 | 8
         S["lcur"][e] = L
+        for k in range(3):
+            axis[a][k] += t[k]
+            axis[b][k] += t[k]
         for k in range(3):
             force[a][k] += S["fa"][e] * t[k]
             force[b][k] -= S["fa"][e] * t[k]
@@ -84,6 +91,40 @@ def twin_step(dt, g, alpha, damp, safety, N, S, B):
         # density-scaled (safety > 0) or real mass; a massless node gets 1 kg
         mi = (max(N["mass"][i], rowsum[i] * (dt / (2 * safety)) ** 2) if safety else N["mass"][i]) or 1.0
         N["imass"][i] = mi
+        size = math.sqrt(sum(x * x for x in axis[i]))
+        if N["host"][i] >= 0 and N["fix"][i] == 0 and size > 0:
+            # linked to the host across the cable: Newton's law along the cable direction u only; across it
+            # the node takes the host point's velocity and the host the force
+            u = [x / size for x in axis[i]]
+            total = [force[i][k] + N["fapp"][i][k] + N["mass"][i] * g[k] for k in range(3)]
+            along = sum(total[k] * u[k] for k in range(3))
+            v_along = sum(N["vel"][i][k] * u[k] for k in range(3))
+            sv = int(v_along > 0) - int(v_along < 0)
+            F = along
+            if damp == 1:
+                F -= alpha * abs(along) * sv
+            elif damp == 2:
+                dF = along - sum(prev[i][k] * u[k] for k in range(3))
+                F -= alpha * abs(along) * (sv - (int(dF > 0) - int(dF < 0))) / 2
+            v_along += F / mi * dt
+            hv = host_v[i]
+            hv_along = sum(hv[k] * u[k] for k in range(3))
+            for k in range(3):
+                hforce[i][k] += total[k] - along * u[k]
+                force[i][k] = along * u[k]
+                N["vel"][i][k] = v_along * u[k] + hv[k] - hv_along * u[k]
+                N["pos"][i][k] += N["vel"][i][k] * dt
+                N["disp"][i][k] += N["vel"][i][k] * dt
+            N["force"][i] = force[i]
+            N["hforce"][i] = hforce[i]
+            h = N["host"][i]
+            if not N["hz"][i]:
+                r = [N["hpos"][i][k] - B["cen"][h][k] for k in range(3)]
+                f = hforce[i]
+                N["hmoment"][i] = [r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]]
+            else:
+                N["hmoment"][i] = [0.0, 0.0, 0.0]
+            continue
         for k in range(3):
             F = force[i][k] + N["fapp"][i][k] + N["mass"][i] * g[k]
             force[i][k] = F

@@ -132,7 +132,7 @@ fish define b
   out('x')
 end
 fish define a
-  a = block.gp.dsf(1)
+  a = block.gp.temperature(1)
 end
 fish define c
   c = a + 1

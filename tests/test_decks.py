@@ -34,7 +34,8 @@ def test_modern_deck_binds(path):
 
 @pytest.mark.parametrize("path", LEGACY_DECKS, ids=lambda p: p.name[:60])
 def test_legacy_deck_gets_clear_diagnostics(path):
-    reports = check_file(path, standalone=True)
+    # as written (`dec3d run --no-legacy`); their translations: tests/test_legacy_decks.py
+    reports = check_file(path, standalone=True, legacy=False)
     counts = Counter(r.status for r in reports)
     print(f"{path.name}: {dict(counts)}")
     errors = [f"line {r.line}: {r.what}" for r in reports if r.status == ERROR]
@@ -44,7 +45,7 @@ def test_legacy_deck_gets_clear_diagnostics(path):
 def test_totals(capsys):
     total = Counter()
     for p in MODERN + LEGACY_DECKS:
-        total.update(r.status for r in check_file(p, standalone=True))
+        total.update(r.status for r in check_file(p, standalone=True, legacy=False))
     with capsys.disabled():
         print(f"\nshared decks: {total[RUNNABLE]} runnable, {total[NOT_SUPPORTED]} not supported yet, "
               f"{total[LEGACY]} legacy syntax, {total[ERROR]} errors")

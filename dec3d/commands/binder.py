@@ -12,7 +12,8 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..errors import BindError, DeckSyntaxError, LazyLocation, LegacySyntaxError, NotSupportedError, SourceLocation  # noqa: F401
+from ..errors import (BindError, DeckSyntaxError, LazyLocation, LegacySyntaxError, NotSupportedError,  # noqa: F401
+                      SourceLocation, UnimplementedError)
 from ..lang.abbrev import matches, suggest
 from ..lang.expr import check_names, parse_expression
 from ..lang.parser import ParsedDeck, RawLine
@@ -165,7 +166,7 @@ class Binder:
             fn = self.ctx.fish_variables[name]
             raise NotSupportedError(f"`{name}` is set by FISH function `{fn}`; FISH functions are not supported yet", loc)
         if kind == "intrinsic":
-            raise NotSupportedError(f"FISH intrinsic `{name}` is not supported yet", loc)
+            raise UnimplementedError(f"FISH intrinsic `{name}` is not supported yet", loc)
         if kind == "unknown-function":
             raise NotSupportedError(f"`{name}` is neither a FISH function of the deck nor a FISH intrinsic dec3d "
                                     "knows", loc, hint="define the function with `fish define` before this line")
@@ -260,7 +261,7 @@ class Binder:
         if i < len(toks) and toks[i].type == "WORD" and (node.children or not path):
             tok = toks[i]
             if node.known and not node.children:
-                raise NotSupportedError(f"`{name}` is not supported yet", self.where(toks[0]))
+                raise UnimplementedError(f"`{name}` is not supported yet", self.where(toks[0]))
             cands = sorted(node.children)
             if len(path) <= 1:
                 # `hist time` (3DEC 5) resolves its first word to the modern `history` group
@@ -279,7 +280,7 @@ class Binder:
                 hint = "expected one of: " + ", ".join(cands[:12]) + (" …" if len(cands) > 12 else "")
             raise BindError(f"unknown command {where}", self.where(tok), hint=hint)
         if node.known and not any(c.command for _, c in self.reg.walk(node)):
-            raise NotSupportedError(f"`{name}` is not supported yet", self.where(toks[0]))
+            raise UnimplementedError(f"`{name}` is not supported yet", self.where(toks[0]))
         cands = sorted(node.children)
         hint = legacy_hint(str(toks[0]).lower()) if len(path) == 1 and i < len(toks) else None
         if hint:                                 # `hist @var` (3DEC 5): a value where 3DEC 7 wants a word
@@ -297,7 +298,7 @@ class Binder:
 
     def _take_value(self, param: Param, toks, i, kwtok):
         if not param.supported:
-            raise NotSupportedError(f"keyword `{param.name}` is not supported yet", self.where(kwtok))
+            raise UnimplementedError(f"keyword `{param.name}` is not supported yet", self.where(kwtok))
         vt = param.value
         if isinstance(vt, Flag):          # present means True; it takes no value
             return True, i
@@ -460,7 +461,7 @@ class Binder:
                                 f"range elements: {', '.join(names)}")
             elem = self.reg.range_elements[hits[0]]
             if not elem.supported:
-                raise NotSupportedError(f"range element `{elem.name}` is not supported yet", self.where(tok))
+                raise UnimplementedError(f"range element `{elem.name}` is not supported yet", self.where(tok))
             if elem.stores and cmd.range not in elem.stores:
                 raise BindError(f"range element `{elem.name}` does not apply to {cmd.range}s", self.where(tok))
             args, i = self._bind_element(elem, toks, i + 1, tok)

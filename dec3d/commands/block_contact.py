@@ -192,6 +192,11 @@ def contact_property(session, call):
     s = mech(session.model)
     props = _given(call)
     c = e.contacts
+    if call.range is not None and c.n == 0:
+        text = ("no contacts exist yet, so the range reaches none: these properties are lost (without a range "
+                "they become the defaults of the contacts made later)")
+        session.write(f"warning: {call.location}: {text}")
+        session.warnings.append(f"{call.location}: {text}")
     sel = np.flatnonzero(mask)
     codes = np.unique(c["jmodel"][sel]) if sel.size else np.array([JOINT_MODELS[s["jmodel"]].code])
     for code in codes:

@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import Dec3dError
-from ..geometry.polyhedron import (brick_faces, build_many, polyhedron_from_faces, prism_faces, split_faces,
-                                   tetrahedron_faces)
+from ..geometry.polyhedron import (WARP_RELATIVE, brick_faces, build_many, polyhedron_from_faces, prism_faces,
+                                   split_faces, tetrahedron_faces)
 from ..geometry.tunnel import tunnel, tunnel_block_count
 from ..model.blocks import add_blocks, add_pieces
 from .budget import check_blocks
@@ -107,7 +107,17 @@ def _shape(call, tol: float):
 def _create(session, call) -> None:
     tol = session.model.tolerance
     pts, fn = _shape(call, tol)
-    _add(session, call, [polyhedron_from_faces(split_faces(pts, fn), tol, call.command.path[-1])])
+    warped: list = []
+    poly = polyhedron_from_faces(split_faces(pts, fn), tol, call.command.path[-1], WARP_RELATIVE, warped)
+    _add(session, call, [poly])
+    if warped:          # one warning for the block, naming its most warped face
+        fi, corner, dist, limit = max(warped, key=lambda w: w[2])
+        more = f" (and {len(warped) - 1} other face(s))" if len(warped) > 1 else ""
+        bid = int(session.model.blocks["id"][session.model.blocks.n - 1])
+        session.write(f"warning: {call.location}: block {bid}: face {fi} is warped: corner {corner} lies {dist:.3g} m "
+                      f"off the face's plane{more} (tolerance {tol:g} m; accepted up to {100 * WARP_RELATIVE:g} % of "
+                      f"the block's size, {limit:.3g} m): the block is built as the convex hull of its corners, "
+                      "the warped face split into triangles")
 
 
 def _create_many(session, calls) -> int:
@@ -150,9 +160,14 @@ def create_brick(session, call):
          keywords=[P("face", Nums(9, 10**6, multiple_of=3, item=COORD), "the corners x,y,z of one face, in order around it",
                      repeat=True, units="m"), *GROUP_KW],
          doc="Create a convex block from its faces (every face given, either winding).",
-         details="Corners closer than the tolerance are merged. The faces must be planar and close the "
-                 "block; a non-planar face, an open or non-convex shape, or a zero volume is refused "
-                 "with the number of the offending face.",
+         details="Corners closer than the tolerance are merged. The faces must close the block; an open or "
+                 "non-convex shape, or a zero volume is refused with the number of the offending face. A face "
+                 "whose corners lie off its plane by more than the tolerance (`block tolerance`) but by at most "
+                 "0.5 % of the block's size (its bounding-box diagonal; the rule `block generate from-vrml` uses) "
+                 "is accepted with a warning naming the block, the face and the warp: the block is built as the "
+                 "convex hull of its corners, the warped face split into triangles, so its volume is that of the "
+                 "faces as built (dec3d's rule: 3DEC's documentation we could read states none). A face warped "
+                 "by more is refused with the distance and the limit.",
          examples=["block create polyhedron face 0,0,0 1,0,0 0,1,0 face 0,0,0 0,0,1 1,0,0 "
                    "face 0,0,0 0,1,0 0,0,1 face 1,0,0 0,0,1 0,1,0",
                    "block create group 'Supports' poly face 0 0 0 1 0 0 0 1 0 face 0 0 0 0 0 1 1 0 0 "

@@ -130,6 +130,23 @@ def block_join(session, call):
          examples=["block property density 2650", "block prop dens 1500 range group 'soft'"])
 def block_property(session, call):
     set_density(session.model, session.range_mask(call, "block"), call.args["density"])
+    density_warning(session, call, call.args["density"])
+
+
+#: densities outside these bounds are not those of a rock, soil, masonry or concrete in SI units
+PLAUSIBLE_DENSITY = (100.0, 30_000.0)
+
+
+def density_warning(session, call, rho: float) -> None:
+    """One warning for a density no rock, soil or masonry has in SI units (kg/m³): a deck in other
+    units (tonnes, MN) is right to ignore it; a deck in SI has a typo."""
+    lo, hi = PLAUSIBLE_DENSITY
+    if lo <= rho <= hi:
+        return
+    text = (f"density {rho:g} is outside {lo:g}–{hi:g} kg/m³, the range of rock, soil and masonry in SI units "
+            "(fine if the deck works in other units)")
+    session.write(f"warning: {call.location}: {text}")
+    session.warnings.append(f"{call.location}: {text}")
 
 
 def _groups_of(model, row) -> str:

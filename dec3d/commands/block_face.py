@@ -1,4 +1,4 @@
-"""`block face group`, `block face triangulate`, `block face apply` (stresses, table-driven stresses,
+"""`block face group`, `block face list`, `block face triangulate`, `block face apply` (stresses, table-driven stresses,
 quiet boundaries) and `block face apply-remove`."""
 from __future__ import annotations
 
@@ -22,6 +22,27 @@ from .values import FLAG, Num, Nums, P, Text, ValueType
 def block_face_group(session, call):
     a = call.args
     group_faces(session.model, session.range_mask(call, "face"), a["name"], a["slot"], remove=bool(a["remove"]))
+
+
+@command("block face list", range="face",
+         doc="List the block faces in range: block id, area centroid, outward normal, area and groups.",
+         details="Faces of zoned blocks are the boundary triangles of their zones.",
+         examples=["block face list range group 'wall'", "block face list range position-z 0"])
+def block_face_list(session, call):
+    m = session.model
+    f = m.faces
+    rows = np.flatnonzero(session.range_mask(call, "face") & (f["block"][: f.n] >= 0))
+    slots = m.groups.slot_names("faces")
+    session.write(f"{'face':>7} {'block':>7} {'x':>10} {'y':>10} {'z':>10} {'nx':>7} {'ny':>7} {'nz':>7} "
+                  f"{'area':>10}  groups")
+    ids = m.blocks["id"]
+    for r in rows:
+        c, n = f["centroid"][r], f["normal"][r]
+        names = [m.groups.name(int(g)) + ("" if s == "Default" else f"({s})")
+                 for g, s in zip(f["group"][r], slots) if g >= 0]
+        session.write(f"{r + 1:>7} {ids[f['block'][r]]:>7} {c[0]:>10.4g} {c[1]:>10.4g} {c[2]:>10.4g} {n[0]:>7.3f} "
+                      f"{n[1]:>7.3f} {n[2]:>7.3f} {f['area'][r]:>10.4g}  {' '.join(names)}")
+    session.write(f"{len(rows)} face(s)")
 
 
 @command("block face triangulate",

@@ -20,7 +20,7 @@ def _gridpoints(session, call, what: str) -> np.ndarray:
     zone_stores(m)
     sel = session.range_mask(call, "gridpoint")
     rows = np.flatnonzero(sel & m.vertices["zoned"])
-    if not len(rows):
+    if not len(rows) and (sel.any() or call.range is None):      # (an empty range has warned already)
         why = (" (the range holds only vertices of rigid blocks, which are not gridpoints)" if sel.any()
                else "")
         session.write(f"warning: {call.location}: `{what}` selected no gridpoint{why}")

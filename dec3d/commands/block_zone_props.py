@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..config import MODULUS_LIMIT
 from ..errors import BindError, CommandError
 from ..model.feblocks import set_material
 from ..model.zones import ZMODEL_ELASTIC, ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
@@ -115,7 +116,7 @@ _PROPS = [n for n in ALL_PROPS if n not in _ELASTIC_KEYS]
 
 @command("block zone property",
          keywords=[_keyword(ALL_PROPS["bulk"]), _keyword(ALL_PROPS["shear"]),
-                   P("young", Num(lo=0, lo_open=True), "Young's modulus E (with poisson)", units="Pa"),
+                   P("young", Num(lo=0, lo_open=True, hi=MODULUS_LIMIT), "Young's modulus E (with poisson)", units="Pa"),
                    P("poisson", Num(lo=-1, hi=0.5, lo_open=True, hi_open=True), "Poisson's ratio ν, -1 < ν < 0.5"),
                    _keyword(ALL_PROPS["density"])] + [_keyword(ALL_PROPS[n]) for n in _PROPS],
          range="zone",
@@ -146,6 +147,9 @@ def block_zone_property(session, call):
         where = loc.get("young" if a["young"] is not None else "poisson", call.location)
         raise BindError("`block zone property`: give bulk/shear or young/poisson, not both pairs in one command",
                         where)
+    if a["density"] is not None:
+        from .block_edit import density_warning
+        density_warning(session, call, float(a["density"]))
     fe = _fe_rows(session, call)
     if len(fe):
         try:

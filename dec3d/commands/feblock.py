@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..config import MODULUS_LIMIT
 from ..errors import BindError, CommandError, ResourceError
 from ..geometry.assemble import block_poly
 from ..geometry.febmesh import (MeshFileError, brick_corners, brick_mesh, complete_20, divisions, mesh_surface,
@@ -150,15 +151,16 @@ def feblock_read(session, call):
 
 
 _POS = Num(lo=0, lo_open=True)
+_MODULUS = Num(lo=0, lo_open=True, hi=MODULUS_LIMIT)     # (dec3d.config: a larger modulus is a typo)
 _CMODELS = {"elastic": ZMODEL_ELASTIC, "null": ZMODEL_NULL}
 
 
 @command("feblock change",
          keywords=[P("cmodel", Choice(tuple(_CMODELS)), "constitutive model: elastic, or null (no stress)"),
-                   P("young", _POS, "Young's modulus E", units="Pa"),
+                   P("young", _MODULUS, "Young's modulus E", units="Pa"),
                    P("poisson", Num(lo=-1, hi=0.5, lo_open=True, hi_open=True), "Poisson's ratio, -1 < nu < 0.5"),
-                   P("bulk", _POS, "bulk modulus K", units="Pa"),
-                   P("shear", _POS, "shear modulus G", units="Pa"),
+                   P("bulk", _MODULUS, "bulk modulus K", units="Pa"),
+                   P("shear", _MODULUS, "shear modulus G", units="Pa"),
                    P("density", DENSITY, "mass density", units="kg/m³"),
                    P("hourglass", Num(lo=0, hi=1), "hourglass control eps_h of 2x2x2 elements, 0 to 1 "
                      "(0: none; dec3d keyword)")],

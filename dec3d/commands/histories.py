@@ -16,7 +16,7 @@ from ..physics.history import (BLOCK_QUANTITIES, CONTACT_QUANTITIES, GRIDPOINT_Q
 from ..physics.history_lookup import nearest_block_id, nearest_gridpoint, zone_at
 from ..model.model import KIND_DEFORMABLE, KIND_FE
 from .registry import REGISTRY, command
-from .values import NUMBERISH, VEC3, Choice, Num, OutPath, P, Text, ValueType, _number_literal
+from .values import NUMBERISH, VEC3, FLAG, Choice, Num, OutPath, P, Text, ValueType, _number_literal
 
 
 class HistoryRefs(ValueType):
@@ -312,12 +312,14 @@ def _find(hs, key, call, slot):
 @command("history export",
          positional=[P("ids", HistoryRefs(), "history numbers or names", required=True)],
          keywords=[P("vs", HistoryRefs(1), "plot and tabulate against this history instead of time"),
-                   P("file", OutPath(), "CSV file (in the output folder)", required=True)],
+                   P("file", OutPath(), "CSV file (in the output folder)", required=True),
+                   P("truncate", FLAG, "replace the file if it exists (what dec3d always does: it writes the "
+                     "whole table, with its header, at every export)", bare=True)],
          doc="Write the histories to a CSV file and a PNG plot per history; report their figures.",
          details="Each history's `<name>.final`, `.min`, `.max` and `.frequency` (Hz, from the zero crossings "
                  "of the value minus its mean) go into the session results. The plots are `<file>_<name>.png`.",
          examples=["history export 1 file 'disp.csv'", "history export 1 2 vs 3 file 'h.csv'",
-                   "history export 'settle' file 'settle.csv'"])
+                   "history export 'settle' file 'settle.csv'", "history export 1 2 file 'h.csv' truncate"])
 def history_export(session, call):
     hs = histories(session.model)
     picked = []

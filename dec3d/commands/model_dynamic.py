@@ -2,6 +2,7 @@
 (dec3d.physics.dynamic says what it changes)."""
 from __future__ import annotations
 
+from ..errors import Dec3dError
 from ..physics.dynamic import damping_text, dynamic_time, is_dynamic
 from ..physics.history import histories
 from ..physics.rigid import engine, mech
@@ -50,7 +51,15 @@ def dynamic_list(session, call):
     kind = {"raised": "by body, masses only raised", "body": "by body", "eq87": "Eq. 87"}[eng.scaling()]
     session.write(f"density scaling     : {f'on ({kind})' if eng.mass_scaling() else 'off (real masses)'}")
     session.write(f"inertia             : {'full (Euler equations)' if eng.full_inertia() else 'scalar'}")
-    session.write(f"time step           : {eng.dt:.6g} s" + (" (last cycle)" if eng.dt else " (not cycled yet)"))
+    if eng.dt:
+        session.write(f"time step           : {eng.dt:.6g} s (last cycle)")
+    elif not m.blocks.n:
+        session.write("time step           : none (no blocks)")
+    else:
+        try:
+            session.write(f"time step           : {eng.predict_timestep():.6g} s (the next cycle starts with it)")
+        except Dec3dError as exc:
+            session.write(f"time step           : not known yet ({exc.message})")
 
 
 @command("model history dynamic",

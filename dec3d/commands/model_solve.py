@@ -54,7 +54,15 @@ def _run(session, call, n, stop=None, max_time=None):
                  "printed first when contacts in use have zero normal or shear stiffness.",
          examples=["model cycle 1000", "model cycle 1000 timing"])
 def model_cycle(session, call):
-    _run(session, call, int(call.args["n"]))
+    e = engine(session.model)
+    time0 = e.time
+    done = _run(session, call, int(call.args["n"]))
+    rt = getattr(session, "fish_rt", None)
+    if done and session.model.blocks.n and (rt is None or rt.depth == 0):
+        # the compact report of `model solve` (not for the short cycles FISH functions take in loops)
+        session.write(f"model cycle: {done} steps (to step {e.step}), model time {e.time - time0:.6g} s "
+                      f"(total {e.time:.6g} s)")
+        session.write(f"  {_fmt_criteria(e.criteria())}")
 
 
 def _fmt_criteria(values: dict) -> str:

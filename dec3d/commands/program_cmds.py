@@ -1,8 +1,35 @@
-"""`program call|return|exit|log|log-file|echo`: reading decks and logging."""
+"""`program call|return|exit|log|log-file|echo`, `python-reset-state`: reading decks and logging."""
 from __future__ import annotations
 
-from .registry import command
+from .registry import Command, command
 from .values import FLAG, ONOFF, InPath, OutPath, P, Text
+
+#: ``PYTHON_RUNNER[0](session, path, where)`` runs a Python file a deck calls (registered by
+#: dec3d.itasca.driver, which `dec3d run --allow-python` and dec3d.Model load; commands import no Python API)
+PYTHON_RUNNER: list = [None]
+
+
+def python_call(session, path, where) -> list:
+    """What `program call` of a Python file (``*.py``) binds to: refused at the call, before anything runs,
+    unless the session allows Python (`dec3d run --allow-python`); else one command that runs the file when
+    the deck reaches it (dec3d.itasca bound to the deck's model)."""
+    from ..errors import BindError, CommandError
+    from .binder import CommandCall
+
+    if not getattr(session, "allow_python", False):
+        raise BindError(f"`{path.name}` is a Python file: a deck runs Python only when you allow it "
+                        "(`dec3d run <deck> --allow-python`; Python is code, decks are data)", where,
+                        hint="see docs/python.md")
+    session.files.read(path, "a Python file the deck calls")
+
+    def handler(sess, call):
+        if PYTHON_RUNNER[0] is None:
+            raise CommandError("running a Python file needs dec3d.itasca loaded (`dec3d run --allow-python`)",
+                               call.location)
+        PYTHON_RUNNER[0](sess, path, call.location)
+
+    cmd = Command(("program", "call"), handler, doc="run a Python file (dec3d.itasca bound)")
+    return [CommandCall(cmd, {"file": str(path)}, (), None, where)]
 
 
 @command("program call", positional=[P("file", InPath(exts=(".dat", ".3ddat", ".fis", ".dec")),
@@ -71,3 +98,29 @@ def program_log_file(session, call):
          doc="Switch the echo of commands as they run.", examples=["program echo off"])
 def program_echo(session, call):
     session.echo = call.args["mode"]
+
+
+@command("python-reset-state", positional=[P("mode", ONOFF, "accepted: dec3d never deletes Python's state", default=True)],
+         doc="Accepted for 3DEC's Python scripts (which start with `python-reset-state false`); changes nothing.",
+         details="In 3DEC, `model new` and `model restore` delete the Python variables unless this is off. dec3d "
+                 "never touches Python's variables: objects and arrays from the model before a `model new` or "
+                 "`model restore` raise a clear error when used (docs/python.md).",
+         examples=["python-reset-state false"])
+def python_reset_state(session, call):
+    pass
+
+
+def _check_autosave(call):
+    from ..errors import NotSupportedError
+
+    if call.args["active"]:
+        raise NotSupportedError("dec3d does not save the model on its own: `program automatic-model-save active "
+                                "on` is not supported (save with `model save`)", call.location)
+
+
+@command("program automatic-model-save", keywords=[P("active", ONOFF, "off: no automatic saves (what dec3d does)",
+                                                     required=True)], check=_check_autosave,
+         doc="Accepted as `active off` (3DEC's Python drivers switch automatic saves off); dec3d never saves on its own.",
+         examples=["program automatic-model-save active off"])
+def program_autosave(session, call):
+    pass

@@ -153,9 +153,11 @@ def cable_list(session, call):
                       f"{segs['gf'][e, 1]:12.4g}  {' '.join(words) or '-'}")
 
 
-# ------------------------------------------------------------------ nodes
-_FIX = {"velocity": 7, "velocity-x": 1, "velocity-y": 2, "velocity-z": 4}
-_FIXKW = [P(k, FLAG, f"the {k} component(s)", bare=True) for k in _FIX]
+# ------------------------------------------------------------------ nodes (cables' and beams')
+_FIX = {"velocity": 7, "velocity-x": 1, "velocity-y": 2, "velocity-z": 4,
+        "rotation": 56, "rotation-x": 8, "rotation-y": 16, "rotation-z": 32}
+_FIXKW = [P(k, FLAG, f"the {k} component(s)" + (" (beam nodes)" if k.startswith("rot") else ""), bare=True)
+          for k in _FIX]
 
 
 def _bits(call) -> int:
@@ -166,24 +168,35 @@ def _bits(call) -> int:
     return bits or 7
 
 
+def _node_stores(session, call):
+    """[(store, range mask)] of the cable and beam nodes (one id space, ``model.beams.next_node_id``)."""
+    m = session.model
+    out = [(m.stores[n], session.range_mask(call, n)) for n in (NODES, "beam_nodes")
+           if n in m.stores and m.stores[n].n]
+    if not out:
+        raise CommandError("there is no structural node: make a cable or a beam first (`structure cable create "
+                           "by-line …`, `structure beam create by-line …`)", call.location)
+    return out
+
+
 @command("structure node fix", keywords=_FIXKW, range=NODES,
-         doc="Hold velocity components of the cable nodes in range (all three when none is named).",
-         examples=["structure node fix velocity range id 1"])
+         doc="Hold velocity (and, on beam nodes, rotational velocity) components of the structural nodes in "
+             "range (the three velocities when none is named).",
+         details="`rotation`, `rotation-x|y|z` hold the rotational velocity of beam nodes (cable nodes have none). "
+                 "Cable and beam nodes share one id space.",
+         examples=["structure node fix velocity range id 1", "structure node fix velocity rotation range id 1"])
 def node_fix(session, call):
-    _need_cables(session, call)
-    mask = session.range_mask(call, NODES)
-    nodes, _ = cable_stores(session.model)
-    nodes["fix"][mask] |= np.uint8(_bits(call))
+    for st, mask in _node_stores(session, call):
+        st["fix"][mask] |= np.uint8(_bits(call))
 
 
 @command("structure node free", keywords=_FIXKW, range=NODES,
-         doc="Free velocity components of the cable nodes in range (all three when none is named).",
-         examples=["structure node free velocity-x"])
+         doc="Free velocity (and rotational velocity) components of the structural nodes in range (the three "
+             "velocities when none is named).",
+         examples=["structure node free velocity-x", "structure node free rotation"])
 def node_free(session, call):
-    _need_cables(session, call)
-    mask = session.range_mask(call, NODES)
-    nodes, _ = cable_stores(session.model)
-    nodes["fix"][mask] &= np.uint8(~_bits(call) & 0xFF)
+    for st, mask in _node_stores(session, call):
+        st["fix"][mask] &= np.uint8(~_bits(call) & 0xFF)
 
 
 _VKW = [P("velocity", VEC3, "velocity", units="m/s")] + [P(f"velocity-{a}", Num(), f"{a} component of the velocity",
@@ -191,24 +204,26 @@ _VKW = [P("velocity", VEC3, "velocity", units="m/s")] + [P(f"velocity-{a}", Num(
 
 
 @command("structure node initialize", keywords=_VKW, range=NODES,
-         doc="Set the velocity of the cable nodes in range (fix the component too to hold it).",
+         doc="Set the velocity of the structural nodes in range (fix the component too to hold it).",
          examples=["structure node initialize velocity-x -1e-5 range id 1"])
 def node_initialize(session, call):
-    _need_cables(session, call)
-    mask = session.range_mask(call, NODES)
-    nodes, _ = cable_stores(session.model)
-    _set_vector(nodes["vel"], mask, call, "velocity")
+    for st, mask in _node_stores(session, call):
+        _set_vector(st["vel"], mask, call, "velocity")
 
 
 @command("structure node apply", keywords=[P("force", VEC3, "applied force", units="N")] +
-         [P(f"force-{a}", Num(), f"{a} component of the applied force", units="N") for a in "xyz"], range=NODES,
-         doc="Set the applied force of the cable nodes in range (it replaces the one applied before).",
-         examples=["structure node apply force-x 1e4 range id 1"])
+         [P(f"force-{a}", Num(), f"{a} component of the applied force", units="N") for a in "xyz"] +
+         [P("moment", VEC3, "applied moment (beam nodes)", units="N·m")] +
+         [P(f"moment-{a}", Num(), f"{a} component of the applied moment (beam nodes)", units="N·m") for a in "xyz"],
+         range=NODES,
+         doc="Set the applied force (and, on beam nodes, moment) of the structural nodes in range (it replaces "
+             "the one applied before).",
+         examples=["structure node apply force-x 1e4 range id 1", "structure node apply moment-y 500 range id 11"])
 def node_apply(session, call):
-    _need_cables(session, call)
-    mask = session.range_mask(call, NODES)
-    nodes, _ = cable_stores(session.model)
-    _set_vector(nodes["fapp"], mask, call, "force")
+    for st, mask in _node_stores(session, call):
+        _set_vector(st["fapp"], mask, call, "force")
+        if "mapp" in st.fields:
+            _set_vector(st["mapp"], mask, call, "moment")
 
 
 def _set_vector(arr, mask, call, name):

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import BindError, CommandError
-from ..model.cables import NODES, SEGMENTS, cable_stores, has_cables
+from ..model.cables import NODES, SEGMENTS, has_cables
 from ..physics.cable_history import ELEMENT_QUANTITIES, NODE_QUANTITIES, add_cable_history
 from ..physics.history import histories
 from .histories import _name
@@ -26,13 +26,20 @@ def _check(call):
 
 
 def _ident(session, call, store: str) -> int:
-    if not has_cables(session.model):
+    from ..model.beams import has_beams
+    if not has_cables(session.model) and not (store == NODES and has_beams(session.model)):
         raise CommandError("there is no cable: make one first (`structure cable create by-line …`)", call.location)
     if call.args["component_id"] is not None:
         return int(call.args["component_id"])
-    st = dict(zip((NODES, SEGMENTS), cable_stores(session.model)))[store]
-    d = np.linalg.norm(st["pos"] - np.asarray([float(x) for x in call.args["position"]]), axis=1)
-    return int(st["id"][int(np.argmin(d))])
+    p = np.asarray([float(x) for x in call.args["position"]])
+    names = (NODES, "beam_nodes") if store == NODES else (SEGMENTS,)
+    best = None
+    for st in (session.model.stores[n] for n in names if n in session.model.stores and session.model.stores[n].n):
+        d = np.linalg.norm(st["pos"] - p, axis=1)
+        k = int(np.argmin(d))
+        if best is None or d[k] < best[0]:
+            best = (float(d[k]), int(st["id"][k]))
+    return best[1]
 
 
 def _handler(kind, store, quantity):
@@ -61,6 +68,7 @@ for _q in NODE_QUANTITIES:
     _what = ("displacement" if _q.startswith("d") else "velocity") + (
         f" ({_q[-1]} component)" if _q[-2] == "-" else " (magnitude)")
     command(f"structure node history {_q}", keywords=_WHICH, check=_check,
-            doc=f"Record the {_what} of a cable node.",
-            details="The node is named by `component-id <i>` (its id) or by `position x y z` (the nearest node).",
+            doc=f"Record the {_what} of a structural node (cable or beam).",
+            details="The node is named by `component-id <i>` (its id; cable and beam nodes share one id space) or "
+                    "by `position x y z` (the nearest node).",
             examples=[f"structure node history {_q} component-id 1"])(_handler("cable-node", NODES, _q))

@@ -371,3 +371,6 @@ def _s_prop(rt, s, name):
             raise FishValueError(f"`block.subcontact.prop`: joint model `{m.name}` has no property or history "
                                  f"'{name}' (it has {', '.join(sorted(m.props) + list(m.hist_names))})")
     return _prop(rt, cs, r, name, "block.subcontact.prop")
+
+
+from . import contact_near  # noqa: E402,F401  (registers block.contact.near)

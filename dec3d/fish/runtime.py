@@ -11,7 +11,7 @@ from __future__ import annotations
 import sys
 
 from ..errors import Dec3dError, ExpressionError, NotSupportedError, SourceLocation
-from .values import FishValueError, type_name
+from .values import FishValueError, index, type_name
 
 MAX_DEPTH = 200            # nested FISH calls
 STOP_CHECK = 1023          # loops look at the stop flag every STOP_CHECK + 1 iterations
@@ -69,6 +69,15 @@ class FishFunction:
     def invoke(self, args, site):
         """Run with `args`; `site` is (FishSource, pos) or a SourceLocation of the caller."""
         rt = self.rt
+        if args and not self.nparams:
+            # `f(1)` on a function of no arguments: 3DEC runs it and indexes its value (a list, an
+            # array, a map: `local cx1 = auditContacts(1)` in SAFEGO's energy_audit_freerock.dat)
+            value = self.invoke((), site)
+            try:
+                return index(value, list(args))
+            except FishValueError as exc:
+                raise rt.error_at(site, f"`{self.name}(…)`: FISH function `{self.name}` takes no arguments, so "
+                                        f"its value is indexed: {exc}") from None
         if len(args) != self.nparams:
             want = f"{self.nparams} argument{'s' if self.nparams != 1 else ''}"
             if self.nparams:

@@ -21,15 +21,23 @@ def _row(rt, i, name, store_name, what):
         rows = np.flatnonzero(st["id"] == i)
         if rows.size:
             return st, int(rows[0])
-    raise FishValueError(f"`{name}`: there is no cable {what} with id {i}")
+    raise FishValueError(f"`{name}`: there is no {what} with id {i}")
 
 
 def _seg(rt, i, name):
-    return _row(rt, i, name, "cable_segments", "element")
+    return _row(rt, i, name, "cable_segments", "cable element")
 
 
 def _node(rt, i, name):
-    return _row(rt, i, name, "cable_nodes", "node")
+    """A structural node: a cable node or a beam node (one id space)."""
+    st = rt.session.model.stores.get("beam_nodes")
+    if type(i) is int and st is not None and st.n:
+        import numpy as np
+
+        rows = np.flatnonzero(st["id"] == i)
+        if rows.size:
+            return st, int(rows[0])
+    return _row(rt, i, name, "cable_nodes", "structural node")
 
 
 @intrinsic("struct.cable.force.axial", 1)
@@ -83,3 +91,72 @@ def _nunbal(rt, i):
     """Unbalanced force of the node at the last step [N] (at a fixed node: the reaction, sign reversed)."""
     st, r = _node(rt, i, "struct.node.force.unbal")
     return _vec(st["force"], r)
+
+
+# ------------------------------------------------------------------ hybrid bolts' dowels
+def _dowel(rt, i, name):
+    return _row(rt, i, name, "cable_dowels", "dowel")
+
+
+@intrinsic("struct.hybrid.dowel.force", 1)
+def _dforce(rt, i):
+    """Shear force of the dowel [N] (its magnitude; the force on the second block is along the slip's
+    opposite)."""
+    import math
+
+    st, r = _dowel(rt, i, "struct.hybrid.dowel.force")
+    return math.sqrt(float((st["fs"][r] ** 2).sum()))
+
+
+@intrinsic("struct.hybrid.dowel.disp", 1)
+def _ddisp(rt, i):
+    """Accumulated shear displacement across the bolt at the dowel [m] (magnitude)."""
+    import math
+
+    st, r = _dowel(rt, i, "struct.hybrid.dowel.disp")
+    return math.sqrt(float((st["us"][r] ** 2).sum()))
+
+
+@intrinsic("struct.hybrid.dowel.state", 1)
+def _dstate(rt, i):
+    """State bits of the dowel: 1 yielding now, 2 yielded in the past, 4 ruptured."""
+    st, r = _dowel(rt, i, "struct.hybrid.dowel.state")
+    return int(st["state"][r])
+
+
+# ------------------------------------------------------------------ beams
+def _beam(rt, i, end, name):
+    st, r = _row(rt, i, name, "beam_elements", "beam element")
+    if end not in (1, 2):
+        raise FishValueError(f"`{name}` takes the end as 1 or 2")
+    return st, r, 6 * (end - 1)
+
+
+@intrinsic("struct.beam.force", 2)
+def _bforce(rt, i, end):
+    """Force the node at end 1 or 2 puts on the beam element, in the element's axes (x: axial) [N]."""
+    st, r, o = _beam(rt, i, end, "struct.beam.force")
+    return Vec(*(float(x) for x in st["fl"][r, o:o + 3]))
+
+
+@intrinsic("struct.beam.moment", 2)
+def _bmoment(rt, i, end):
+    """Moment the node at end 1 or 2 puts on the beam element, in the element's axes (x: torsion) [N·m]."""
+    st, r, o = _beam(rt, i, end, "struct.beam.moment")
+    return Vec(*(float(x) for x in st["fl"][r, o + 3:o + 6]))
+
+
+@intrinsic("struct.beam.force.axial", 1)
+def _baxial(rt, i):
+    """Axial force of the beam element [N], tension positive."""
+    st, r, _ = _beam(rt, i, 1, "struct.beam.force.axial")
+    return float(st["fl"][r, 6])
+
+
+@intrinsic("struct.node.rot", 1)
+def _nrot(rt, i):
+    """Rotation of a beam node [rad] (small rotations, a vector)."""
+    st, r = _node(rt, i, "struct.node.rot")
+    if "rot" not in st.fields:
+        raise FishValueError(f"`struct.node.rot`: node {i} is a cable node (no rotation)")
+    return _vec(st["rot"], r)

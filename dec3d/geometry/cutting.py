@@ -96,11 +96,14 @@ def joint_set_estimate(model, dip: float, dip_direction: float, origin=(0.0, 0.0
     return int(total) if total < 1e18 else 10**18
 
 
-def cut_by_planes(model, normal, offsets, mask=None, join: bool = False) -> int:
+def cut_by_planes(model, normal, offsets, mask=None, join: bool = False, compact: bool = True) -> int:
     """Cut the visible blocks in ``mask`` by the planes n·x = offsets. Returns new blocks made.
 
     ``join``: the pieces of each block are joined to each other (leader/follower); without
     it, pieces of a joined block stay in its group and pieces of a free block are free.
+    ``compact=False`` leaves the parents' old vertex and face rows in the stores (unreferenced;
+    a caller cutting many times compacts once, with ``assemble.compact_geometry``); the new rows
+    are then the last ones of each store.
     """
     n = np.asarray(normal, dtype=np.float64)
     n = n / np.linalg.norm(n)
@@ -140,7 +143,8 @@ def cut_by_planes(model, normal, offsets, mask=None, join: bool = False) -> int:
     piece_rows[first] = parent[first]
     piece_rows[extra] = new_rows
     write_pieces(model, piece_rows, pos, vsrc, pnv, fn, fsrc, pnf, fv)
-    compact_geometry(model)
+    if compact:
+        compact_geometry(model)
     return int(new_rows.size)
 
 

@@ -67,13 +67,25 @@ def _merge_points(pts: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
     return pts[reps], index
 
 
-def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyhedron") -> Poly:
+#: a face may be warped (its corners off its plane) by up to this fraction of its block's size (the
+#: bounding-box diagonal): the rule `block generate from-vrml` uses too (dec3d.io.vrml.RELATIVE_TOLERANCE)
+WARP_RELATIVE = 0.005
+
+
+def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyhedron",
+                          warp: float = 0.0, warped: list | None = None) -> Poly:
     """Build and check a convex polyhedron from its faces.
 
     ``faces``: one (k, 3) array-like of corner coordinates per face, k ≥ 3, in either
     winding. Points closer than ``tol`` are merged. Raises ``GeometryError`` naming the
     first face (counted from 1) that is too small, not planar, open, not convex, or when
     the volume is zero.
+
+    With ``warp`` > 0 a face whose corners lie off its plane by more than ``tol`` but at most
+    max(tol, warp × the bounding-box diagonal) is accepted: the block is built as the convex hull of
+    its corners, so that the warped face is split into the triangles of its convex side and the
+    volume is that of the faces as built. Each such face is appended to ``warped`` as
+    (face number, corner number, distance off the plane, the limit).
     """
     tol = float(tol)
     arrays = []
@@ -106,6 +118,10 @@ def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyh
         raise GeometryError(f"{what}: a closed polyhedron needs at least 4 faces, {len(loops)} given")
 
     # planarity and area of each face
+    limit = tol
+    if warp > 0:
+        limit = max(tol, warp * float(np.linalg.norm(v.max(axis=0) - v.min(axis=0))))
+    bent = []
     normals = []
     areas = []
     for fi, loop in enumerate(loops, start=1):
@@ -117,10 +133,14 @@ def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyh
         n = av / area
         dist = (pts - pts.mean(axis=0)) @ n
         j = int(np.argmax(np.abs(dist)))
-        if abs(dist[j]) > tol:
+        if abs(dist[j]) > limit:
+            rule = (f"; a warp is accepted up to {100 * warp:g} % of the block's size, {limit:.3g} m"
+                    if warp > 0 else "")
             raise GeometryError(
                 f"{what}: face {fi} is not planar: corner {j + 1} {_fmt(pts[j])} lies "
-                f"{abs(dist[j]):.3g} m off the face's plane (tolerance {tol:g} m)")
+                f"{abs(dist[j]):.3g} m off the face's plane (tolerance {tol:g} m{rule})")
+        if abs(dist[j]) > tol:
+            bent.append((fi, j + 1, float(abs(dist[j])), limit))
         normals.append(n)
         areas.append(area)
 
@@ -154,7 +174,7 @@ def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyh
 
     # convex: no corner in front of any face's plane
     d = np.einsum("fvk,fk->fv", v[None, :, :] - centres[:, None, :], normals)
-    bad = np.flatnonzero(d.max(axis=1) > tol)
+    bad = np.flatnonzero(d.max(axis=1) > (limit if bent else tol))
     if bad.size:
         fi = int(bad[0])
         j = int(np.argmax(d[fi]))
@@ -170,6 +190,11 @@ def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyh
                 raise GeometryError(f"{what}: faces cannot be oriented consistently (face {fi})")
             seen.add((a, b))
 
+    if bent:
+        if warped is not None:
+            warped.extend(bent)
+        return polyhedron_from_faces(_hull_faces(v, tol), tol, what)
+
     ptr = np.zeros(len(loops) + 1, dtype=np.int64)
     ptr[1:] = np.cumsum([len(lp) for lp in loops])
     idx = np.array([i for lp in loops for i in lp], dtype=np.int64)
@@ -178,6 +203,31 @@ def polyhedron_from_faces(faces: Sequence, tol: float = 1e-6, what: str = "polyh
     if vol <= tol * sum(areas):
         raise GeometryError(f"{what}: zero volume ({vol:.3g} m^3): the faces enclose no space")
     return poly
+
+
+def _hull_faces(v: np.ndarray, tol: float) -> list[np.ndarray]:
+    """The faces of the convex hull of the points ``v``: the hull's triangles merged where they lie in
+    one plane (every corner within ``tol`` of it), each face's corners in order around it."""
+    from scipy.spatial import ConvexHull
+
+    hull = ConvexHull(v)
+    extreme = np.zeros(len(v), dtype=bool)
+    extreme[hull.vertices] = True
+    faces, used = [], np.zeros(len(hull.simplices), dtype=bool)
+    for k, eq in enumerate(hull.equations):
+        if used[k]:
+            continue
+        n, off = eq[:3], eq[3]
+        members = np.flatnonzero(extreme & (np.abs(v @ n + off) <= tol))
+        near = np.all(np.abs(v[hull.simplices] @ n + off) <= tol, axis=1)
+        used |= near
+        p = v[members]
+        c = p.mean(axis=0)
+        u = p[0] - c
+        u /= np.linalg.norm(u)
+        w = np.cross(n, u)
+        faces.append(p[np.argsort(np.arctan2((p - c) @ w, (p - c) @ u))])
+    return faces
 
 
 def poly_volume(poly: Poly) -> float:

@@ -19,7 +19,8 @@ class NonFiniteOutputError(Dec3dError):
 
 #: fields in which NaN is a declared marker, not a number (infinities are still refused):
 #: the residual-friction column of a contact's property row (``kernels.jointlaw``: NaN = the
-#: peak friction), kept as it is so that a restored run continues bit for bit
+#: peak friction). A save file writes them as 0 with a mask beside the array (``io.state``,
+#: ``nan_masks``), and a restore puts the NaN back, so a restored run continues bit for bit
 NAN_MARKERS = {"contacts.prop"}
 
 

@@ -35,11 +35,11 @@ import numpy as np
 
 from dec3d.config import SAVE_FORMAT_VERSION
 from dec3d.errors import Dec3dError
-from dec3d.io.finite import require_finite
+from dec3d.io.finite import NAN_MARKERS, require_finite
 from dec3d.io.savesign import MEMBER as _SIGNATURE, signature, signed_here
 from dec3d.kernels.zmodels import NZPROP
-from dec3d.io.state_meta import (_HIST, _NPY_HEADER_MAX, _expected_arrays, _known, _meta_problem, _settings_problem,
-                                  register_known)
+from dec3d.io.state_meta import (UNSET, _HIST, _NPY_HEADER_MAX, _expected_arrays, _known, _meta_problem,
+                                  _settings_problem, register_known)
 from dec3d.model.groups import GroupTable
 from dec3d.model.model import Model
 from dec3d.model.settings import Settings
@@ -83,11 +83,19 @@ def save_state(model: Model, path: str | os.PathLike, records: list[str] | None 
     path = os.fspath(path)
     arrays: dict[str, np.ndarray] = {}
     schema: dict[str, dict] = {}
+    nan_masks: dict[str, str] = {}
     for sname, store in model.stores.items():
         fields = {}
         for key, arr in store.to_arrays().items():
-            require_finite(f"{sname}.{key}", arr)
-            arrays[f"{sname}.{key}"] = arr
+            name = f"{sname}.{key}"
+            require_finite(name, arr)
+            if name in NAN_MARKERS and np.isnan(arr).any():
+                # NaN "not set" markers leave the file as 0 and a mask (no NaN in any file written)
+                unset = np.isnan(arr)
+                arrays[name + UNSET] = unset
+                nan_masks[name] = name + UNSET
+                arr = np.where(unset, 0.0, arr)
+            arrays[name] = arr
             spec = store.fields[key]
             fields[key] = {"dtype": arr.dtype.str, "shape": list(arr.shape[1:]),
                            "fill": np.asarray(spec.fill).item()}
@@ -116,6 +124,8 @@ def save_state(model: Model, path: str | os.PathLike, records: list[str] | None 
     }
     if hdesc is not None:
         meta["histories"] = hdesc
+    if nan_masks:
+        meta["nan_masks"] = nan_masks
     text = json.dumps(meta, sort_keys=True, indent=1, allow_nan=False).encode("utf-8")
     from .paths import os_error_text, replace_via_temp
 
@@ -282,10 +292,14 @@ def _build(path: str, meta: dict, blobs: dict[str, bytes]) -> Model:
             name = f"{sname}.{key}"
             shape = (int(sdesc["n"]), *fdesc["shape"])
             arr = _read_npy(path, name, blobs[name], shape, fdesc["dtype"])
+            mask = meta.get("nan_masks", {}).get(name)
             if arr.dtype.kind == "f":
-                finite = np.isfinite(arr) if name != "contacts.prop" else ~np.isinf(arr)  # NaN: "not set"
+                # NaN "not set" markers: a mask beside the array (older files: NaN in the array itself)
+                finite = np.isfinite(arr) if (name not in NAN_MARKERS or mask) else ~np.isinf(arr)
                 if not finite.all():
                     raise StateFileError(f"'{path}': array '{name}' holds a value that is not finite")
+            if mask and arr.dtype.kind == "f":
+                arr = np.where(_read_npy(path, mask, blobs[mask], shape, "|b1"), np.nan, arr)
             if key not in store:
                 store.add_field(key, Field(tuple(fdesc["shape"]), arr.dtype, fdesc["fill"]))
             elif np.dtype(store.fields[key].dtype) != arr.dtype:

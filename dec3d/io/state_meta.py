@@ -24,6 +24,10 @@ def _is_num(v) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
+#: suffix of the mask array saved beside an array holding NaN "not set" markers (io.finite.NAN_MARKERS)
+UNSET = "~unset"
+
+
 def _expected_arrays(meta: dict) -> dict[str, int]:
     """Array name -> the data bytes its schema implies (``_meta_problem`` has passed)."""
     out = {}
@@ -33,6 +37,8 @@ def _expected_arrays(meta: dict) -> dict[str, int]:
             for d in fdesc["shape"]:
                 n *= int(d)
             out[f"{sname}.{key}"] = n * np.dtype(fdesc["dtype"]).itemsize
+    for name, mask in meta.get("nan_masks", {}).items():
+        out[mask] = out[name] // 8           # one byte per float64 of the array it masks
     h = meta.get("histories")
     if h is not None:
         for it in h["items"]:
@@ -53,6 +59,12 @@ def _meta_problem(meta: dict) -> str | None:
         return "the command record holds something other than text"
     if not isinstance(meta.get("extra", {}), dict):
         return "`extra` is not an object"
+    masks = meta.get("nan_masks", {})
+    known = {f"{s}.{k}" for s, d in meta["stores"].items() if isinstance(d, dict)
+             for k in (d.get("fields") if isinstance(d.get("fields"), dict) else {})}
+    if not (isinstance(masks, dict) and all(isinstance(k, str) and k in known and v == k + UNSET
+                                            for k, v in masks.items())):
+        return "`nan_masks` does not name arrays of the file"
     tol = meta.get("tolerance")
     if not (_is_num(tol) and tol > 0):
         return f"the tolerance {tol!r} is not a finite number > 0"

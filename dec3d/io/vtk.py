@@ -336,6 +336,13 @@ class VtkSeries:
             write_cables_vtu(model, lvtu)
             part = 1 + max((e[2] if len(e) > 2 else 0) for e in self.entries[first:])
             self.entries.append((float(time), lvtu, part))
+        if "beam_elements" in model.stores and model.store("beam_elements").n:
+            # the beams as lines (``dec3d.io.beamvtk``)
+            from dec3d.io.beamvtk import write_beams_vtu
+            bvtu = self.guard(f"{self.stem}_beams_{k:04d}.vtu")
+            write_beams_vtu(model, bvtu)
+            part = 1 + max((e[2] if len(e) > 2 else 0) for e in self.entries[first:])
+            self.entries.append((float(time), bvtu, part))
         if self.contacts:
             # the sub-contacts as points (``dec3d.io.contactvtk``): the part after the others of this time
             from dec3d.io.contactvtk import write_contacts_vtu

@@ -48,7 +48,8 @@ def cable_step(dt, g, alpha, damp, safety,
                pos, vel, disp, mass, host, hpos, fix, fapp, conf, force, hforce, hmoment, imass, hz, hvel,
                na, nb, l0, lcur, prop, fa, gf, state, tapp, tact,
                bvel, bspin, bcen, scratch):
-    """One step; ``scratch (n, 7)``: work space (relative displacement, stiffness row sum, last force);
+    """One step; ``scratch (n, 13)``: work space (relative displacement, stiffness row sum, last force,
+    host-point velocity, cable direction at the node);
     ``damp``: 0 none, 1 local, 2 combined damping with coefficient ``alpha``; ``safety`` > 0: inertial
     masses max(m, R (Δt / 2 safety)²) (density scaling), 0: the real masses.
     Returns the number of nodes that are not finite after the step (0: all well)."""
@@ -62,12 +63,16 @@ def cable_step(dt, g, alpha, damp, safety,
             hforce[i, k] = 0.0
             scratch[i, k] = 0.0
         scratch[i, 3] = 0.0          # Gershgorin row sum of the stiffness at the node [N/m]
+        for k in range(6):
+            scratch[i, 7 + k] = 0.0  # host-point velocity, cable direction at the node (pass 2)
         h = host[i]
         if h >= 0 and hz[i] != 0:
             # a zoned host: the host point's velocity is given (from its zone's gridpoints)
             scratch[i, 0] = (vel[i, 0] - hvel[i, 0]) * dt
             scratch[i, 1] = (vel[i, 1] - hvel[i, 1]) * dt
             scratch[i, 2] = (vel[i, 2] - hvel[i, 2]) * dt
+            for k in range(3):
+                scratch[i, 7 + k] = hvel[i, k]
         elif h >= 0:
             # the block's centroid one step ago (the motion kernel moved it on by v dt since)
             r0 = hpos[i, 0] - bcen[h, 0] + bvel[h, 0] * dt
@@ -83,6 +88,9 @@ def cable_step(dt, g, alpha, damp, safety,
             scratch[i, 0] = (vel[i, 0] - vh0) * dt
             scratch[i, 1] = (vel[i, 1] - vh1) * dt
             scratch[i, 2] = (vel[i, 2] - vh2) * dt
+            scratch[i, 7] = vh0
+            scratch[i, 8] = vh1
+            scratch[i, 9] = vh2
     # --- pass 2, segments: axial force (elastic, perfectly plastic), grout at both ends
     for e in range(s):
         a = na[e]
@@ -107,6 +115,9 @@ def cable_step(dt, g, alpha, damp, safety,
                 fa[e] = -yc
                 st |= S_YC | S_YPAST
         lcur[e] = length
+        for k in range(3):                       # the cable's direction at its nodes (summed, pass 3 scales)
+            scratch[a, 10 + k] += d0 / length if k == 0 else (d1 / length if k == 1 else d2 / length)
+            scratch[b, 10 + k] += d0 / length if k == 0 else (d1 / length if k == 1 else d2 / length)
         f = fa[e]
         force[a, 0] += f * t0
         force[a, 1] += f * t1
@@ -151,8 +162,23 @@ def cable_step(dt, g, alpha, damp, safety,
             mi = 1.0
         imass[i] = mi
         for k in range(3):
-            fk = force[i, k] + fapp[i, k] + m * g[k]
-            force[i, k] = fk
+            force[i, k] += fapp[i, k] + m * g[k]
+        h = host[i]
+        tn = math.sqrt(scratch[i, 10] ** 2 + scratch[i, 11] ** 2 + scratch[i, 12] ** 2)
+        if h >= 0 and fix[i] == 0 and tn > 0.0:
+            # across the cable the node is linked rigidly to its host (only the axial direction has the
+            # grout's spring): it moves with the host point there, and the host takes the force across
+            _linked(i, dt, alpha, damp, mi, scratch[i, 10] / tn, scratch[i, 11] / tn, scratch[i, 12] / tn,
+                    vel, force, hforce, scratch)
+            for k in range(3):
+                pos[i, k] += vel[i, k] * dt
+                disp[i, k] += vel[i, k] * dt
+                if not math.isfinite(pos[i, k]):
+                    bad += 1
+            _moment(i, h, hz, hpos, bcen, hforce, hmoment)
+            continue
+        for k in range(3):
+            fk = force[i, k]
             if (fix[i] >> k) & 1:
                 continue
             v = vel[i, k]
@@ -167,21 +193,50 @@ def cable_step(dt, g, alpha, damp, safety,
             disp[i, k] += vel[i, k] * dt
             if not math.isfinite(pos[i, k]):
                 bad += 1
-        h = host[i]
-        if h >= 0 and hz[i] == 0:
-            r0 = hpos[i, 0] - bcen[h, 0]
-            r1 = hpos[i, 1] - bcen[h, 1]
-            r2 = hpos[i, 2] - bcen[h, 2]
-            f0, f1, f2 = hforce[i, 0], hforce[i, 1], hforce[i, 2]
-            hmoment[i, 0] = r1 * f2 - r2 * f1
-            hmoment[i, 1] = r2 * f0 - r0 * f2
-            hmoment[i, 2] = r0 * f1 - r1 * f0
-        else:
-            hmoment[i, 0] = 0.0
-            hmoment[i, 1] = 0.0
-            hmoment[i, 2] = 0.0
+        _moment(i, h, hz, hpos, bcen, hforce, hmoment)
     return bad
 
 
+@njit(cache=True)
+def _linked(i, dt, alpha, damp, mi, t0, t1, t2, vel, force, hforce, scratch):
+    """A node linked to its host across the cable (direction t): the force across goes to the host,
+    the velocity across is the host point's, the velocity along follows the force along (damped as
+    the free nodes are, on that component)."""
+    fa = force[i, 0] * t0 + force[i, 1] * t1 + force[i, 2] * t2
+    fprev = scratch[i, 4] * t0 + scratch[i, 5] * t1 + scratch[i, 6] * t2
+    va = vel[i, 0] * t0 + vel[i, 1] * t1 + vel[i, 2] * t2
+    vh0, vh1, vh2 = scratch[i, 7], scratch[i, 8], scratch[i, 9]
+    vha = vh0 * t0 + vh1 * t1 + vh2 * t2
+    f = fa
+    if damp == 1:
+        f -= alpha * abs(fa) * _sgn(va)
+    elif damp == 2:
+        f -= 0.5 * alpha * abs(fa) * (_sgn(va) - _sgn(fa - fprev))
+    va += f / mi * dt
+    for k in range(3):
+        tk = t0 if k == 0 else (t1 if k == 1 else t2)
+        vhk = vh0 if k == 0 else (vh1 if k == 1 else vh2)
+        hforce[i, k] += force[i, k] - fa * tk        # the force across the cable, onto the host
+        force[i, k] = fa * tk                        # the node's unbalanced force: along the cable
+        vel[i, k] = va * tk + (vhk - vha * tk)
+
+
+@njit(cache=True)
+def _moment(i, h, hz, hpos, bcen, hforce, hmoment):
+    """The moment about a rigid host's centroid of the force the node puts on it."""
+    if h >= 0 and hz[i] == 0:
+        r0 = hpos[i, 0] - bcen[h, 0]
+        r1 = hpos[i, 1] - bcen[h, 1]
+        r2 = hpos[i, 2] - bcen[h, 2]
+        f0, f1, f2 = hforce[i, 0], hforce[i, 1], hforce[i, 2]
+        hmoment[i, 0] = r1 * f2 - r2 * f1
+        hmoment[i, 1] = r2 * f0 - r0 * f2
+        hmoment[i, 2] = r0 * f1 - r1 * f0
+    else:
+        hmoment[i, 0] = 0.0
+        hmoment[i, 1] = 0.0
+        hmoment[i, 2] = 0.0
+
+
 def empty_scratch(n: int) -> np.ndarray:
-    return np.zeros((n, 7))
+    return np.zeros((n, 13))

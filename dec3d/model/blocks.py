@@ -88,6 +88,8 @@ def delete_blocks(model: Model, mask) -> int:
 def hide_blocks(model: Model, mask, on: bool = True) -> int:
     """Set (``on``) or clear the hidden flag. Returns the number of blocks touched."""
     rows = _rows(model, mask)
+    if not on:
+        rows = rows[~model.blocks["excavated"][rows]]      # excavated blocks come back with `block fill` only
     model.blocks["hidden"][rows] = bool(on)
     return int(rows.size)
 

@@ -154,7 +154,9 @@ def add_cable(model: Model, p1, p2, segments: int, cable_id: int | None, group: 
     hosts = host_blocks(model, pts, tol)
     cid = int(cable_id) if cable_id is not None else int(max(nodes["cable"].max(initial=0),
                                                               segs["cable"].max(initial=0)) + 1)
-    nid0 = int(nodes["id"].max(initial=0)) + 1
+    from .beams import next_node_id      # (cable and beam nodes share one id space)
+
+    nid0 = next_node_id(model)
     sid0 = int(segs["id"].max(initial=0)) + 1
     sl = nodes.append(segments + 1)
     rn = np.arange(sl.start, sl.stop)
@@ -212,6 +214,12 @@ def nodes_hosted_by(model: Model, mask) -> int:
 def remap_hosts(model: Model, remap: np.ndarray) -> None:
     """After blocks are deleted (old row -> new row, -1 gone): nodes whose block went lose their host."""
     st = model.stores
+    from .dowels import remap_dowels     # dowels with a side deleted go (hybrid bolts)
+
+    remap_dowels(model, remap)
+    from .beams import remap_beam_hosts  # beam nodes linked to a deleted block are free
+
+    remap_beam_hosts(model, remap)
     if NODES in st and st[NODES].n:
         nodes = st[NODES]
         h = nodes["host"]

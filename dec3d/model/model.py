@@ -80,9 +80,11 @@ def _block_fields() -> dict[str, Field]:
         "apply_fix": Field((), np.uint8, 0),
         "kind": Field((), np.int8, KIND_RIGID),
         "hidden": Field((), np.bool_, False),
+        "excavated": Field((), np.bool_, False),   # `block excavate`: hidden until `block fill`
         "leader": Field((), _I, -1),
         "region": Field((), _I, 0),          # 3DEC 5 region number (`r=<i>` of generators, `range region`)
         "group": group_field(),
+        "extra": Field((0,), _F, 0.0),        # FISH block.extra slots (widened on first write)
         "vert_start": Field((), _I, 0),
         "vert_count": Field((), _I, 0),
         "face_start": Field((), _I, 0),
@@ -100,6 +102,8 @@ def _vertex_fields() -> dict[str, Field]:
         "mass": Field((), _F, 0.0),
         "fixity": Field((), np.uint8, 0),
         "block": Field((), _I, -1),
+        "group": group_field(),               # gridpoint groups (`block gridpoint group`)
+        "extra": Field((0,), _F, 0.0),        # FISH block.gp.extra slots (widened on first write)
     }
 
 

@@ -148,9 +148,15 @@ def mask_group(model, store_name: str, names: str | Sequence[str],
         own = _in_groups(model, store, names, None)
         blocks = _in_groups(model, model.blocks, names, None)
         return own | blocks[store["a"]] | blocks[store["b"]]
-    if store.name in ("zones", "feblocks"):
-        # a zone (FE element) is in a group when it is, or when its block is (block groups select zones)
-        return _in_groups(model, store, names, slot) | _in_groups(model, model.blocks, names, slot)[store["block"]]
+    if store.name in ("zones", "feblocks", "vertices"):
+        # a zone (FE element, gridpoint) is in a group when it is, or when its block is (block groups
+        # select zones and gridpoints: `block gridpoint apply … range group 'foundation'`)
+        own = _in_groups(model, store, names, slot)
+        if not model.blocks.n:
+            return own
+        blocks = _in_groups(model, model.blocks, names, slot)
+        b = store["block"]
+        return own | (blocks[np.clip(b, 0, None)] & (b >= 0))
     return _in_groups(model, store, names, slot)
 
 

@@ -23,6 +23,8 @@ class Settings:
     #: rigid-block engine settings (``dec3d.physics.rigid.MECH_DEFAULTS``): CTOL, damping,
     #: time step, joint model and properties of new contacts; plain JSON values
     mechanical: dict = field(default_factory=dict)
+    #: discrete fracture networks (``dec3d.model.fractures``): templates, DFN names, next ids; plain JSON
+    fractures: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         d = asdict(self)

@@ -185,7 +185,8 @@ class Store:
 
     # ------------------------------------------------------------ save/load
     def to_arrays(self) -> dict[str, np.ndarray]:
-        """Copies of the live rows of every field (for save files)."""
+        """The live rows of every field, C-contiguous (for save files). Views where the rows already are
+        contiguous (most fields): copy them before the store changes if they must outlive that."""
         return {key: np.ascontiguousarray(self._data[key][: self.n]) for key in self._fields}
 
     def load_arrays(self, arrays: dict[str, np.ndarray]) -> None:

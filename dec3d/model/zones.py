@@ -115,6 +115,7 @@ def _zone_fields() -> dict[str, Field]:
         "hist": Field((NZHIST,), _F, 0.0),
         "state": Field((), np.int32, 0),
         "group": group_field(),
+        "extra": Field((0,), _F, 0.0),        # FISH block.zone.extra slots (widened on first write)
     }
 
 

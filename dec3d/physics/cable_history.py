@@ -16,11 +16,24 @@ NODE_QUANTITIES = tuple(f"{q}{c}" for q in ("displacement", "velocity") for c in
 
 
 def _row(model, store: str, ident: int, what: str) -> int:
+    if store == NODES and what == "node":
+        return _node(model, ident)[1]
     st = model.stores.get(store)
     rows = np.flatnonzero(st["id"] == ident) if st is not None and st.n else np.zeros(0, np.int64)
     if rows.size == 0:
         raise CommandError(f"there is no cable {what} with id {ident}")
     return int(rows[0])
+
+
+def _node(model, ident: int):
+    """(store, row) of structural node ``ident``: a cable node or a beam node (one id space)."""
+    for name in (NODES, "beam_nodes"):
+        st = model.stores.get(name)
+        if st is not None and st.n:
+            rows = np.flatnonzero(st["id"] == ident)
+            if rows.size:
+                return st, int(rows[0])
+    raise CommandError(f"there is no structural node with id {ident}")
 
 
 def add_cable_history(hs, kind: str, quantity: str, ident: int, name: str | None = None):
@@ -49,7 +62,8 @@ def add_cable_history(hs, kind: str, quantity: str, ident: int, name: str | None
         comp = "xyz".index(quantity[-1]) if quantity[-2] == "-" else None
 
         def value(eng) -> float:
-            v = model.stores[NODES][field][_row(model, NODES, ident, "node")]
+            st, r = _node(model, ident)
+            v = st[field][r]
             return float(np.linalg.norm(v)) if comp is None else float(v[comp])
-        label = f"cable node {ident} {quantity}"
+        label = f"{'cable' if _node(model, ident)[0].name == NODES else 'beam'} node {ident} {quantity}"
     return hs.add(label, value, name, {"kind": kind, "quantity": quantity, "id": int(ident)})

@@ -27,6 +27,14 @@ Model (Itasca's, as those pages state it):
   ``gridpoint_grout_stiffness``, added in ``ZoneStepper._stiffness``), hence their scaled masses.
   FE blocks and 10-node zones are not hosts yet (``structure cable create`` refuses a node in one).
 
+Across the cable a hosted node is linked rigidly to its host (Itasca's cable nodes: only the axial
+direction of the link is deformable, through the grout): it takes the host point's velocity in the
+two directions normal to the cable (the cable's direction at the node: the mean of its elements'
+unit vectors), and the force on it across the cable (the axial forces of a bent chain, its weight,
+an applied force) goes to the host with the grout reaction. So a block sliding across a cable carries
+the cable's nodes with it (the cable turns and bends at the joint), and a cable in compression cannot
+buckle sideways through the rock. A node with held components (`structure node fix`) is not linked.
+
 Motion: the nodes carry mass and move explicitly with the blocks' central-difference scheme, as
 Itasca's structural-element nodes do, with combined damping (3DEC theory Eq. 83, the form meant for
 parts in steady motion, such as a cable being pulled out: local damping, Eq. 79, takes only the sign
@@ -55,6 +63,15 @@ from dec3d.kernels.cable import C_A, C_E, C_KG, cable_step, empty_scratch
 from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, block_timestep
 from dec3d.model.cables import cable_stores, has_cables, update_masses
 
+from dec3d.model.beams import has_beams
+
+from .beams import BeamStep, beam_timestep
+from .beams import block_stiffness as beam_block_stiffness
+from .beams import gridpoint_stiffness as beam_gridpoint_stiffness
+from .dowels import advance_dowels
+from .dowels import block_stiffness as dowel_block_stiffness
+from .dowels import gridpoint_stiffness as dowel_gridpoint_stiffness
+
 #: ω_max Δt ≤ 2 s for the cable nodes (s = 0.5: ω Δt ≤ 1, as the local damping likes it)
 SAFETY = 0.5
 
@@ -78,9 +95,10 @@ def check_cables(model) -> str | None:
 
 def block_stiffness(model) -> tuple[np.ndarray, np.ndarray]:
     """Per block row: Σ k_g × tributary length of the grout springs it hosts [N/m], and the same
-    weighted by |r|² (r: host point − block centroid) [N·m] (its rotational bound)."""
+    weighted by |r|² (r: host point − block centroid) [N·m] (its rotational bound); with the dowels
+    of hybrid bolts and the links of beams."""
     b = model.blocks
-    kt, kr = np.zeros(b.n), np.zeros(b.n)
+    kt, kr = beam_block_stiffness(model)          # beam links (``physics.beams``)
     if not has_cables(model):
         return kt, kr
     nodes, segs = cable_stores(model)
@@ -93,14 +111,16 @@ def block_stiffness(model) -> tuple[np.ndarray, np.ndarray]:
     r2 = np.sum((nodes["hpos"][on] - b["centroid"][h[on]]) ** 2, axis=1)
     np.add.at(kt, h[on], kn[on])
     np.add.at(kr, h[on], kn[on] * r2)
-    return kt, kr
+    dkt, dkr = dowel_block_stiffness(model)      # dowels of hybrid bolts (``physics.dowels``)
+    return kt + dkt, kr + dkr
 
 
 def cable_timestep(model) -> float:
     """The cable nodes' critical step with their real masses, 2 s √(m / R) (R: the Gershgorin row sum
-    of the stiffness at the node, s = ``SAFETY``); inf without cables or densities."""
+    of the stiffness at the node, s = ``SAFETY``); inf without cables or densities. The beams' too
+    (``physics.beams.beam_timestep``)."""
     if not has_cables(model):
-        return np.inf
+        return beam_timestep(model)
     nodes, segs = cable_stores(model)
     p = segs["prop"]
     r = np.zeros(nodes.n)
@@ -112,7 +132,8 @@ def cable_timestep(model) -> float:
     np.add.at(r, segs["nb"], np.where(nodes["host"][segs["nb"]] >= 0, kend, 0.0))
     m = nodes["mass"]
     on = (r > 0) & (m > 0)
-    return float(2.0 * SAFETY * np.sqrt(m[on] / r[on]).min()) if on.any() else np.inf
+    dt = float(2.0 * SAFETY * np.sqrt(m[on] / r[on]).min()) if on.any() else np.inf
+    return min(dt, beam_timestep(model))
 
 
 def grouted_timestep(model, frac: float, moving=None) -> float:
@@ -155,11 +176,7 @@ class CableStep:
         r = self.run
         m, b = r.m, r.m.blocks
         nodes, segs = cable_stores(m)
-        mode, alpha = r.mode, r.alpha
-        if r.dynamic or mode not in (DAMP_LOCAL, DAMP_COMBINED, DAMP_ADAPTIVE):
-            damp, a = 0, 0.0
-        else:
-            damp, a = 2, (float(alpha) if mode in (DAMP_LOCAL, DAMP_COMBINED) else ALPHA_DEFAULT)
+        damp, a = _damping(r)
         old_f = nodes["hforce"].copy()
         old_m = nodes["hmoment"].copy()
         hz = nodes["hz"]
@@ -177,6 +194,7 @@ class CableStep:
         if bad:
             raise _run_error(f"a cable node moved off to infinity at step {m.step + 1} (Δt {r.dt:.3g} s): "
                              f"check the cable and grout properties")
+        advance_dowels(m, r.dt)   # hybrid bolts' dowels
         h = nodes["host"]
         on = (h >= 0) & (hz == 0)
         if on.any():
@@ -192,6 +210,14 @@ class CableStep:
 
     def __repr__(self) -> str:
         return "CableStep"
+
+
+def _damping(r) -> tuple[int, float]:
+    """(damping kind for the structural nodes: 0 none, 2 combined; its coefficient) of run ``r``."""
+    mode, alpha = r.mode, r.alpha
+    if r.dynamic or mode not in (DAMP_LOCAL, DAMP_COMBINED, DAMP_ADAPTIVE):
+        return 0, 0.0
+    return 2, (float(alpha) if mode in (DAMP_LOCAL, DAMP_COMBINED) else ALPHA_DEFAULT)
 
 
 def zone_host_state(m, nodes, segs, zn):
@@ -220,9 +246,10 @@ def zone_host_state(m, nodes, segs, zn):
 def gridpoint_grout_stiffness(m, n: int) -> np.ndarray:
     """Per vertex row (length n): Σ k_g × tributary length × weight of the grout springs on it [N/m]
     (a grout spring on a host point Σ wᵢ xᵢ adds wᵢ k to gridpoint i's Gershgorin row: Σ wⱼ = 1)."""
-    out = np.zeros(n)
+    out = beam_gridpoint_stiffness(m, n)          # links of beam nodes in zones (``physics.beams``)
     if not has_cables(m):
         return out
+    out += dowel_gridpoint_stiffness(m, n)
     nodes, segs = cable_stores(m)
     zn = np.flatnonzero((nodes["hz"] != 0) & (nodes["host"] >= 0))
     if not zn.size:
@@ -241,5 +268,5 @@ def _run_error(msg: str):
 
 
 def cable_steps(run) -> list:
-    """[CableStep] when the model has cables, else []."""
-    return [CableStep(run)] if has_cables(run.m) else []
+    """[CableStep] when the model has cables, [BeamStep] when it has beams (``physics.beams``)."""
+    return ([CableStep(run)] if has_cables(run.m) else []) + ([BeamStep(run)] if has_beams(run.m) else [])

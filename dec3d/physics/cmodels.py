@@ -25,7 +25,7 @@ from typing import Callable
 
 import numpy as np
 
-from dec3d.config import DENSITY_LIMIT
+from dec3d.config import DENSITY_LIMIT, MODULUS_LIMIT
 from dec3d.io.state import register_known
 from dec3d.physics.modelprops import ModelProp, atan_deg, tan_deg
 from dec3d.kernels.zmodels import MODELS as KERNELS
@@ -59,8 +59,8 @@ def table(name, column, doc) -> Prop:
 
 #: the shared properties: elastic moduli and density (``young``/``poisson`` are converted to
 #: bulk and shear by ``block zone property`` for every model that declares bulk and shear)
-ELASTIC = [Prop("bulk", P_BULK, "bulk modulus K", "Pa", lo=0.0, lo_open=True),
-           Prop("shear", P_SHEAR, "shear modulus G", "Pa", lo=0.0, lo_open=True),
+ELASTIC = [Prop("bulk", P_BULK, "bulk modulus K", "Pa", lo=0.0, lo_open=True, hi=MODULUS_LIMIT),
+           Prop("shear", P_SHEAR, "shear modulus G", "Pa", lo=0.0, lo_open=True, hi=MODULUS_LIMIT),
            Prop("density", P_DENSITY, "mass density", "kg/m³", lo=0.0, lo_open=True, hi=DENSITY_LIMIT)]
 #: the Mohr-Coulomb strength (shared columns, read by every Mohr-Coulomb-like model)
 MOHR_STRENGTH = [Prop("cohesion", P_COHESION, "cohesion c", "Pa"),

@@ -240,6 +240,10 @@ class HistorySet:
         elif kind in ("cable", "cable-node") and isinstance(spec.get("id"), int) and spec["id"] >= 1:
             from .cable_history import add_cable_history     # (raises ValueError for a quantity it has not)
             h = add_cable_history(self, kind, q, spec["id"], name)
+        elif kind in ("beam", "dowel") and isinstance(spec.get("id"), int) and spec["id"] >= 1:
+            from .beam_history import add_beam_history
+            from .dowels import add_dowel_history
+            h = (add_beam_history if kind == "beam" else add_dowel_history)(self, q, spec["id"], name)
         else:
             raise ValueError(f"history {hid}: unknown kind {kind!r} or quantity {q!r}")
         self.items.pop()

@@ -95,9 +95,10 @@ def refusal(eng) -> str | None:
         return "time functions drive loads or velocities"
     if is_active(m):
         return "energy tracking is on"
+    from dec3d.model.beams import has_beams
     from dec3d.model.cables import has_cables
-    if has_cables(m):
-        return "the model has cables (structural elements move explicitly)"
+    if has_cables(m) or has_beams(m):
+        return "the model has cables or beams (structural elements move explicitly)"
     if eng.pre_steps or any(not isinstance(h, HistorySet) for h in eng.step_hooks):
         return "FISH callbacks run during the cycle"
     return None

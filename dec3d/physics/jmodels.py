@@ -36,6 +36,7 @@ class Prop(ModelProp):
     required: bool = False
 
     def __post_init__(self):
+        super().__post_init__()
         if self.required:
             object.__setattr__(self, "default", math.nan)
 

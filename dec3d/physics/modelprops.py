@@ -7,6 +7,8 @@ import math
 from dataclasses import dataclass
 from typing import Callable
 
+from dec3d.config import STIFFNESS_LIMIT
+
 
 def tan_deg(v: float) -> float:
     return math.tan(math.radians(v))
@@ -32,3 +34,8 @@ class ModelProp:
     hi: float | None = None
     hi_open: bool = False
     lo_open: bool = False
+
+    def __post_init__(self):
+        if self.units == "Pa/m" and self.hi is None:
+            # a stiffness: bounded above by what any deck can mean (dec3d.config.STIFFNESS_LIMIT)
+            object.__setattr__(self, "hi", STIFFNESS_LIMIT)

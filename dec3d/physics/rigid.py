@@ -28,6 +28,7 @@ from dec3d.model.store import Store
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.zones import has_zones
 
+from .beams import beam_balance, has_beams
 from .cables import cable_timestep, grouted_timestep
 from .massscale import DensityScaling
 from .water import total_normal_force
@@ -320,6 +321,10 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
             gu, ga = zst.balance()
             un = np.concatenate((un, gu))
             A = np.concatenate((A, ga))
+        if has_beams(m):
+            # beam nodes count as bodies too (``physics.beams.beam_balance``)
+            bu, ba = beam_balance(m)
+            un, A = np.concatenate((un, bu)), np.concatenate((A, ba))
         if not len(un):
             return out
         umax = float(un.max())
@@ -408,6 +413,20 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
             raise CycleInterrupted(m.step)
         return done
 
+    def predict_timestep(self) -> float:
+        """The time step the next cycle would start with (detection, masses and zone steps worked
+        out as a run does), the model left exactly as it was: for listings before the first cycle
+        (3DEC's `model dynamic list` prints the step it will use). Raises RunError when the model
+        cannot cycle yet (a block without mass, properties missing)."""
+        from .steps import _Run
+
+        snap = self._snapshot()
+        try:
+            with np.errstate(over="ignore", invalid="ignore"):
+                return float(_Run(self, 0, None).dt)
+        finally:
+            self._restore(snap)
+
     def _snapshot(self) -> dict:
         m = self.model
         b, v = m.blocks, m.vertices
@@ -419,9 +438,10 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
                           if has_zones(m) else {}),
                 "feblocks": ({k: m.store("feblocks")[k].copy() for k in ("stress", "gstress")}
                              if has_feblocks(m) else {}),
-                # cable nodes and elements (``physics.cables``): every field, rolled back with the blocks
+                # cable nodes, elements and dowels, beam nodes and elements: every field, rolled back with the blocks
                 "cables": {n: {k: m.stores[n][k].copy() for k in m.stores[n].fields}
-                           for n in ("cable_nodes", "cable_segments") if n in m.stores},
+                           for n in ("cable_nodes", "cable_segments", "cable_dowels", "beam_nodes", "beam_elements")
+                           if n in m.stores},
                 # (to_arrays gives views where it can: copy them)
                 "contacts": {k: a.copy() for k, a in self.contacts.to_arrays().items()},
                 "subcontacts": {k: a.copy() for k, a in self.subcontacts.to_arrays().items()},

@@ -66,6 +66,7 @@ class _Progress:
     def __init__(self, total: int, eng=None):
         self.total = total
         self.eng = eng
+        self.step0 = eng.model.step if eng is not None else 0      # the model's step when the command began
         self.t0 = _time.perf_counter()
         self.last = self.t0
         self.bar = None
@@ -78,11 +79,14 @@ class _Progress:
             if now - self.last >= PROGRESS_SECONDS:
                 self.last = now
                 e = self.eng
-                extra = ""
                 if e is not None:
-                    extra = f", step {e.model.step}, ratio {e.ratio:.3g}"
-                of = f" of {self.total}" if self.total < _OPEN_END else ""
-                print(f"cycling: {done}{of} steps{extra} ({now - self.t0:.0f} s)", flush=True)
+                    # one step count: the model's step, and the step this command ends at
+                    end = f" of {self.step0 + self.total}" if self.total < _OPEN_END else ""
+                    text = f"cycling: step {self.step0 + done}{end}, ratio {e.ratio:.3g}"
+                else:
+                    of = f" of {self.total}" if self.total < _OPEN_END else ""
+                    text = f"cycling: {done}{of} steps"
+                print(f"{text} ({now - self.t0:.0f} s)", flush=True)
             return
         if self.bar is None:
             if now - self.t0 < 1.0:

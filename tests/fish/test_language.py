@@ -165,9 +165,9 @@ def test_huge_values_are_refused(session):
 
 
 def test_unknown_intrinsic_compiles_and_fails_when_run(session):
-    session.command("fish define f\n f = block.gp.dsf(1)\nend")     # compiles
+    session.command("fish define f\n f = block.gp.temperature(1)\nend")     # compiles
     e = err(session, "@f", NotSupportedError)
-    assert e.message == "FISH intrinsic `block.gp.dsf` is not supported yet" and e.location.line == 2
+    assert e.message == "FISH intrinsic `block.gp.temperature` is not supported yet" and e.location.line == 2
 
 
 def test_syntax_errors_stop_the_deck_before_it_runs(session):

@@ -112,5 +112,5 @@ def test_io_out_writes_to_the_session(session):
 
 def test_unsupported_intrinsic_is_named(session):
     with pytest.raises(NotSupportedError) as e:
-        session.command("[io.out(block.gp.dsf/(3600*1000))]")
-    assert "`block.gp.dsf`" in e.value.message and e.value.location.column == 9
+        session.command("[io.out(block.gp.temperature/(3600*1000))]")
+    assert "`block.gp.temperature`" in e.value.message and e.value.location.column == 9

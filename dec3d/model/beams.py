@@ -1,0 +1,181 @@
+"""The stores of beam structural elements (``structure beam …``; physics ``dec3d.physics.beams``,
+kernel ``dec3d.kernels.beam``).
+
+``beam_nodes``   one row per beam node (ids shared with the cable nodes: one `structure node` space)
+    id (), beam ()        int64
+    pos, pos0 (3,)        m      position now and as created
+    vel, disp (3,)        m/s, m
+    rot, avel (3,)        rad, rad/s  rotation (small, total) and rotational velocity
+    mass, inert ()        kg, kg·m²  real mass and rotary inertia (from the elements' density)
+    imass, iinert ()      the inertial ones of the last step (density-scaled in static runs)
+    host ()               int64  block the node is linked to (-1: free)
+    hz ()                 int8   1: the host is a zoned block, the node follows a 4-node zone: hzone () its
+                          row, hgp (4,) its gridpoint rows, hw (4,) the node's barycentric weights
+    hpos (3,)             m      host point
+    lf, lm (3,)           N, N·m link force and moment on the node
+    fix ()                uint8  bits 0-2 velocity, 3-5 rotational velocity held (``structure node fix``)
+    fapp, mapp (3,)       applied force and moment (``structure node apply``)
+    force, moment (3,)    unbalanced force and moment of the last step
+    hforce, hmoment (3,)  force of the link on the host block and its moment about the centroid
+    group (1,)
+``beam_elements`` one row per element
+    id (), beam (), na (), nb ()  int64
+    l0 ()                 m      length
+    prop (7,)             young, poisson, cross-sectional-area, moi-y, moi-z, moi-polar, density
+    ydir (3,)             the element's y axis as given (``direction-y``; 0: chosen)
+    axes (3, 3)           rows: the element's x (a → b), y, z axes
+    fl (12,)              end forces on the element in its axes: F, M at end a, F, M at end b
+    pos (3,)              midpoint as created; group (1,)
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from dec3d.kernels.beam import NBPROP
+
+from .cables import _first_block, host_blocks, zone_host
+from .groups import group_field
+from .model import Model
+from .store import Field, Store
+
+BNODES = "beam_nodes"
+BELEMS = "beam_elements"
+BPROPS = ("young", "poisson", "cross-sectional-area", "moi-y", "moi-z", "moi-polar", "density")
+assert len(BPROPS) == NBPROP
+
+
+def _node_fields():
+    v3 = Field((3,), np.float64, 0.0)
+    f = {k: v3 for k in ("pos", "pos0", "vel", "disp", "rot", "avel", "hpos", "lf", "lm", "fapp", "mapp", "force",
+                         "moment", "hforce", "hmoment")}
+    f.update({"id": Field((), np.int64, 0), "beam": Field((), np.int64, 0), "host": Field((), np.int64, -1),
+              "fix": Field((), np.uint8, 0), "group": group_field(), "hz": Field((), np.int8, 0),
+              "hzone": Field((), np.int64, -1), "hgp": Field((4,), np.int64, -1), "hw": Field((4,), np.float64, 0.0)})
+    f.update({k: Field((), np.float64, 0.0) for k in ("mass", "inert", "imass", "iinert")})
+    return f
+
+
+def _elem_fields():
+    return {"id": Field((), np.int64, 0), "beam": Field((), np.int64, 0), "na": Field((), np.int64, -1),
+            "nb": Field((), np.int64, -1), "l0": Field((), np.float64, 0.0),
+            "prop": Field((NBPROP,), np.float64, 0.0), "ydir": Field((3,), np.float64, 0.0),
+            "axes": Field((3, 3), np.float64, 0.0), "fl": Field((12,), np.float64, 0.0),
+            "pos": Field((3,), np.float64, 0.0), "group": group_field()}
+
+
+def beam_stores(model: Model) -> tuple[Store, Store]:
+    st = model.stores
+    if BNODES not in st:
+        model.add_store(Store(BNODES, _node_fields()))
+    if BELEMS not in st:
+        model.add_store(Store(BELEMS, _elem_fields()))
+    return model.stores[BNODES], model.stores[BELEMS]
+
+
+def has_beams(model: Model) -> bool:
+    return BELEMS in model.stores and model.stores[BELEMS].n > 0
+
+
+def next_node_id(model: Model) -> int:
+    """The next structural node id (cable and beam nodes share one id space)."""
+    top = 0
+    for name in ("cable_nodes", BNODES):
+        if name in model.stores and model.stores[name].n:
+            top = max(top, int(model.stores[name]["id"].max()))
+    return top + 1
+
+
+def element_axes(x: np.ndarray, ydir) -> np.ndarray:
+    """Rows x, y, z of an element along unit ``x``: y is ``ydir`` made normal to x, or (when not
+    given or along x) the global z × x — horizontal — or global y for a vertical element."""
+    y = np.asarray(ydir, float) - np.dot(ydir, x) * x if ydir is not None else np.zeros(3)
+    if np.linalg.norm(y) < 1e-9:
+        y = np.cross([0.0, 0.0, 1.0], x)
+        if np.linalg.norm(y) < 1e-9:
+            y = np.array([0.0, 1.0, 0.0])
+    y = y / np.linalg.norm(y)
+    return np.array([x, y, np.cross(x, y)])
+
+
+def add_beam(model: Model, p1, p2, segments: int, beam_id, group, tol: float) -> tuple[int, np.ndarray]:
+    """Append a straight beam of equal elements; returns (beam id, host rows of its nodes: -1 free,
+    -3 in a block that cannot host it: an FE block or 10-node zones)."""
+    nodes, els = beam_stores(model)
+    p1, p2 = np.asarray(p1, float), np.asarray(p2, float)
+    t = np.linspace(0.0, 1.0, segments + 1)[:, None]
+    pts = p1[None, :] * (1.0 - t) + p2[None, :] * t
+    hosts = host_blocks(model, pts, tol)
+    bid = int(beam_id) if beam_id is not None else int(max(nodes["beam"].max(initial=0),
+                                                            els["beam"].max(initial=0)) + 1)
+    nid0 = next_node_id(model)
+    eid0 = int(els["id"].max(initial=0)) + 1
+    sl = nodes.append(segments + 1)
+    rn = np.arange(sl.start, sl.stop)
+    nodes["id"][rn] = np.arange(nid0, nid0 + segments + 1)
+    nodes["beam"][rn] = bid
+    nodes["pos"][rn] = pts
+    nodes["pos0"][rn] = pts
+    nodes["hpos"][rn] = pts
+    for k in np.flatnonzero(hosts == -2):
+        # a node in a zoned block follows the 4-node zone that holds it (-3: none, e.g. 10-node zones)
+        r = _first_block(model, pts[k], tol)
+        z = zone_host(model, r, pts[k], max(tol, 1e-9)) if r >= 0 else None
+        if z is None:
+            hosts[k] = -3
+            continue
+        hosts[k] = r
+        nodes["hz"][rn[k]] = 1
+        nodes["hzone"][rn[k]], nodes["hgp"][rn[k]], nodes["hw"][rn[k]] = z
+    nodes["host"][rn] = np.maximum(hosts, -1)
+    sl = els.append(segments)
+    rs = np.arange(sl.start, sl.stop)
+    els["id"][rs] = np.arange(eid0, eid0 + segments)
+    els["beam"][rs] = bid
+    els["na"][rs] = rn[:-1]
+    els["nb"][rs] = rn[1:]
+    els["l0"][rs] = float(np.linalg.norm(p2 - p1)) / segments
+    els["pos"][rs] = 0.5 * (pts[:-1] + pts[1:])
+    els["axes"][rs] = element_axes((p2 - p1) / np.linalg.norm(p2 - p1), None)
+    if group:
+        model.groups.assign(nodes, rn, group)
+        model.groups.assign(els, rs, group)
+    return bid, hosts
+
+
+def update_beam_masses(model: Model) -> None:
+    """Real node mass ρ A × half of each adjacent element, rotary inertia ρ (I_y + I_z) × half length
+    + (ρ A half length) half length² / 3 (a rod of the tributary half length about its end)."""
+    nodes, els = beam_stores(model)
+    p = els["prop"]
+    half = 0.5 * els["l0"]
+    m = p[:, 6] * p[:, 2] * half
+    ri = p[:, 6] * (p[:, 3] + p[:, 4]) * half + m * half ** 2 / 3.0
+    mass, inert = np.zeros(nodes.n), np.zeros(nodes.n)
+    for arr, v in ((mass, m), (inert, ri)):
+        np.add.at(arr, els["na"], v)
+        np.add.at(arr, els["nb"], v)
+    nodes["mass"][:] = mass
+    nodes["inert"][:] = inert
+
+
+def remap_beam_hosts(model: Model, remap: np.ndarray) -> int:
+    """After blocks are deleted: nodes whose block went are free (their link forces go with it)."""
+    if BNODES not in model.stores or not model.stores[BNODES].n:
+        return 0
+    nodes = model.stores[BNODES]
+    h = nodes["host"]
+    ok = h >= 0
+    h[ok] = remap[h[ok]]
+    lost = ok & (h < 0)
+    # zone-hosted nodes of surviving blocks: the zones' and gridpoints' rows moved, find them again
+    for i in np.flatnonzero((h >= 0) & (nodes["hz"] == 1)):
+        z = zone_host(model, int(h[i]), nodes["hpos"][i], 1e-9)
+        if z is None:
+            h[i] = -1
+            lost[i] = True
+        else:
+            nodes["hzone"][i], nodes["hgp"][i], nodes["hw"][i] = z
+    nodes["hz"][lost] = 0
+    for k in ("lf", "lm", "hforce", "hmoment"):
+        nodes[k][lost] = 0.0
+    return int(lost.sum())
