@@ -402,6 +402,13 @@ class VtkSeries:
             write_contacts_vtu(model, cvtu)
             part = 1 + max((e[2] if len(e) > 2 else 0) for e in self.entries[first:])
             self.entries.append((float(time), cvtu, part))
+        from dec3d.io.jointvtk import has_joints, write_joints_vtu
+        if has_joints(model):
+            # the joints as planes (``dec3d.io.jointvtk``), always when there are contacts; the last part
+            jvtu = self.guard(f"{self.stem}_joints_{k:04d}.vtu")
+            write_joints_vtu(model, jvtu)
+            part = 1 + max((e[2] if len(e) > 2 else 0) for e in self.entries[first:])
+            self.entries.append((float(time), jvtu, part))
         self.count += 1
         write_pvd(self.guard(self.pvd_path), self.entries)
         return vtu
