@@ -156,9 +156,7 @@ class _Walker:
                 self.add(deck, raw.line, RUNNABLE, item.source)
                 continue
             path = item.command.path
-            if path == ("plot",):
-                self.add(deck, raw.line, DOES_NOTHING, "plot: display only in dec3d, skipped")
-            elif path == ("program", "call"):
+            if path == ("program", "call"):
                 self.call(deck, raw, item, base_dir, stack)
             else:
                 self.add(deck, raw.line, RUNNABLE, item.name)

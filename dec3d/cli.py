@@ -1,4 +1,4 @@
-"""The `dec3d` command line: run, batch, repl, verify, ssdem, docs."""
+"""The `dec3d` command line: run, batch, repl, verify, ssdem, check, plot, docs."""
 from __future__ import annotations
 
 import argparse
@@ -194,6 +194,8 @@ def main(argv: list[str] | None = None) -> int:
     c.add_argument("decks", nargs="+")
     c.add_argument("-v", "--verbose", action="store_true", help="list every line with what happens to it")
     c.set_defaults(fn=lambda a: __import__("dec3d.check", fromlist=["main"]).main(a.decks, a.verbose))
+    from .plot.cli import add_parser as add_plot
+    add_plot(sub)
     d = sub.add_parser("docs", help="write the command reference pages from the registry")
     d.add_argument("--dir", default="commands")
     d.set_defaults(fn=_docs)

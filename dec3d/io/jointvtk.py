@@ -2,9 +2,10 @@
 
 3DEC draws the joints as the contact areas, coloured by normal or shear stress. dec3d keeps for
 each sub-contact its point on the common plane, the plane's normal and its area (``subcontacts``);
-the cell written for it is the square of that area on that plane, centred at its point, with one
-side along the first in-plane axis (``plane_axes``). The squares of a contact together have the
-contact's area; their shape is the area's, not the exact outline of the face overlap.
+the cell written for it is its share of the contact polygon when the contact's sub-contacts are the
+corners of a convex polygon (rigid face-to-face contacts: the sub-contact, the midpoints of its two
+edges and the centroid; these tile the contact area), else the square of its area on that plane,
+centred at its point, with one side along the first in-plane axis (``plane_axes``).
 
 Written beside each ``block vtk`` snapshot of a model that has sub-contacts as
 ``<stem>_joints_<nnnn>.vtu`` (VTK_QUAD cells, type 9). Cell data: every array of
@@ -48,7 +49,9 @@ def joint_polygons(model) -> tuple[np.ndarray, dict]:
     t1, t2 = plane_axes(data["normal"])
     h = 0.5 * np.sqrt(np.maximum(area, 0.0))[:, None]
     corners = np.stack([pts - h * t1 - h * t2, pts + h * t1 - h * t2, pts + h * t1 + h * t2,
-                        pts - h * t1 + h * t2], axis=1).reshape(-1, 3)
+                        pts - h * t1 + h * t2], axis=1)
+    _tributary(pts, data["contact_id"], t1, t2, corners)
+    corners = corners.reshape(-1, 3)
     with np.errstate(divide="ignore", invalid="ignore"):
         data["shear_stress"] = np.where(area > 0, data["shear_force_magnitude"] / np.where(area > 0, area, 1.0), 0.0)
     data["opening"] = np.maximum(data["normal_displacement"], 0.0)
@@ -58,6 +61,32 @@ def joint_polygons(model) -> tuple[np.ndarray, dict]:
             data["pressure"] = _rows_of(model, s[key])
             break
     return corners, data
+
+
+def _tributary(pts, cid, t1, t2, corners) -> None:
+    """Where the sub-contacts of a contact are the corners of a convex polygon on its plane (a face-to-face
+    contact of rigid blocks), each gets its share of the polygon instead of a square: itself, the midpoint
+    of the edge to the next corner, the polygon's centroid and the midpoint of the edge from the previous
+    corner (the quadrilaterals tile the polygon). ``corners`` (n, 4, 3) is changed in place."""
+    bounds = np.flatnonzero(np.diff(cid)) + 1
+    for rows in np.split(np.arange(len(cid)), bounds):
+        if len(rows) < 3:
+            continue
+        p = pts[rows]
+        c = p.mean(axis=0)
+        u, v = (p - c) @ t1[rows[0]], (p - c) @ t2[rows[0]]
+        order = np.argsort(np.arctan2(v, u))
+        uv = np.column_stack([u, v])[order]
+        nxt, prv = np.roll(uv, -1, axis=0), np.roll(uv, 1, axis=0)
+        # convex with every point a corner: each turn goes the same way and is not straight
+        cross = (uv[:, 0] - prv[:, 0]) * (nxt[:, 1] - uv[:, 1]) - (uv[:, 1] - prv[:, 1]) * (nxt[:, 0] - uv[:, 0])
+        size = np.ptp(uv, axis=0).max()
+        if size <= 0 or not (cross > 1e-9 * size * size).all():
+            continue
+        q = p[order]
+        quad = np.stack([q, 0.5 * (q + np.roll(q, -1, axis=0)), np.broadcast_to(c, q.shape),
+                         0.5 * (q + np.roll(q, 1, axis=0))], axis=1)
+        corners[rows[order]] = quad
 
 
 def _rows_of(model, column: np.ndarray) -> np.ndarray:
