@@ -18,7 +18,12 @@ SIZE = (800, 600)
 CMAP = "jet"
 #: colours of the plastic-state categories (3DEC's legend order)
 STATE_COLOURS = {"none": "#d9d9d9", "shear-n": "#e41a1c", "tension-n": "#ff7f00", "shear-p": "#377eb8",
-                 "tension-p": "#984ea3"}
+                 "tension-p": "#984ea3", "shear-n tension-n": "#a65628", "shear-n shear-p": "#f781bf",
+                 "tension-n shear-p": "#ffd92f", "shear-n tension-n shear-p": "#8c510a",
+                 "shear-n tension-p": "#4daf4a", "tension-n tension-p": "#fdae61",
+                 "shear-n tension-n tension-p": "#762a83", "shear-p tension-p": "#66c2a5",
+                 "shear-n shear-p tension-p": "#e7298a", "tension-n shear-p tension-p": "#1b9e77",
+                 "shear-n tension-n shear-p tension-p": "#000000"}
 GROUP_COLOURS = ("#c8a878", "#7fa6c9", "#9fc98a", "#d98c8c", "#b39ddb", "#e6c96b", "#80cbc4", "#bcaaa4")
 _STRESS_COL = {"xx": 0, "yy": 1, "zz": 2, "xy": 3, "yz": 4, "xz": 5}     # VTK's order in the files
 
@@ -195,14 +200,13 @@ def _draw_state(pl, scene, grids, notices) -> None:
         lab = np.asarray(z.cell_data["plastic_label"])
         for code in np.unique(lab):
             text = PLASTIC_LABELS[int(code)]
-            # the colour of a combination is that of its first word (now before past, shear before tension)
-            colour = STATE_COLOURS[text.split()[0]]
+            colour = STATE_COLOURS[text]          # one colour per combination, as 3DEC's legend lists them
             _add(pl, z.extract_cells(np.flatnonzero(lab == code)), color=colour, show_edges=False)
             if text not in seen:
                 seen.append(text)
     order = {t: i for i, t in enumerate(PLASTIC_LABELS)}
     seen.sort(key=lambda t: order[t])
-    pl.add_legend([(t, STATE_COLOURS[t.split()[0]]) for t in seen], bcolor="white", face="rectangle",
+    pl.add_legend([(t, STATE_COLOURS[t]) for t in seen], bcolor="white", face="rectangle",
                   size=(0.3, 0.05 * len(seen) + 0.02))
 
 
