@@ -17,7 +17,7 @@ VIEW = (1.0, -1.6, 0.8)
 SIZE = (800, 600)
 CMAP = "jet"
 #: colours of the plastic-state categories (3DEC's legend order)
-STATE_COLOURS = {"none": "#d9d9d9", "shear-n": "#e41a1c", "tension-n": "#ff7f00", "shear-p": "#377eb8",
+STATE_COLOURS = {"none": "#c0c0c0", "shear-n": "#e41a1c", "tension-n": "#ff7f00", "shear-p": "#377eb8",
                  "tension-p": "#984ea3", "shear-n tension-n": "#a65628", "shear-n shear-p": "#f781bf",
                  "tension-n shear-p": "#ffd92f", "shear-n tension-n shear-p": "#8c510a",
                  "shear-n tension-p": "#4daf4a", "tension-n tension-p": "#fdae61",
@@ -48,6 +48,15 @@ def _add(pl, mesh, **kw):
     kw.setdefault("show_edges", kw.get("style") != "wireframe")
     kw.setdefault("edge_color", "#404040")
     return pl.add_mesh(mesh, lighting=False, **kw)
+
+
+def _legend(pl, entries) -> None:
+    """A legend box in the upper right corner, sized to its longest label."""
+    longest = max(len(t) for t, _ in entries)
+    w, h = min(0.5, 0.05 + 0.018 * longest), 0.045 * len(entries) + 0.02
+    actor = pl.add_legend(entries, bcolor="white", face="rectangle", size=(w, h))
+    actor.SetPosition(0.99 - w, 0.9 - h)          # inside the picture, under the title
+    actor.SetPosition2(w, h)
 
 
 def _quiet():
@@ -180,8 +189,8 @@ def _draw_groups(pl, scene, grids) -> None:
             sub = g.extract_cells(np.flatnonzero(c == code))
             _add(pl, sub, color=GROUP_COLOURS[used.index(code) % len(GROUP_COLOURS)] if code >= 0 else "#bbbbbb",
                         show_edges=True, edge_color="#555555")
-    pl.add_legend([(names[c] if c < len(names) else str(c), GROUP_COLOURS[i % len(GROUP_COLOURS)])
-                   for i, c in enumerate(used)], bcolor="white", face="rectangle", size=(0.22, 0.05 * len(used) + 0.02))
+    _legend(pl, [(names[c] if c < len(names) else str(c), GROUP_COLOURS[i % len(GROUP_COLOURS)])
+                 for i, c in enumerate(used)])
 
 
 def _draw_state(pl, scene, grids, notices) -> None:
@@ -206,8 +215,7 @@ def _draw_state(pl, scene, grids, notices) -> None:
                 seen.append(text)
     order = {t: i for i, t in enumerate(PLASTIC_LABELS)}
     seen.sort(key=lambda t: order[t])
-    pl.add_legend([(t, STATE_COLOURS[t]) for t in seen], bcolor="white", face="rectangle",
-                  size=(0.3, 0.05 * len(seen) + 0.02))
+    _legend(pl, [(t, STATE_COLOURS[t]) for t in seen])
 
 
 _JOINT_ARRAYS = {"normal-stress": "normal_stress", "shear-stress": "shear_stress", "slip": "slip",
@@ -230,8 +238,7 @@ def _draw_joints(pl, scene, grids, item, notices) -> None:
     if item.quantity == "slip":
         _add(pl, j.extract_cells(np.flatnonzero(vals == 0)), color="#377eb8") if (vals == 0).any() else None
         _add(pl, j.extract_cells(np.flatnonzero(vals != 0)), color="#e41a1c") if (vals != 0).any() else None
-        pl.add_legend([("no slip", "#377eb8"), ("slip (now or past)", "#e41a1c")], bcolor="white", face="rectangle",
-                      size=(0.3, 0.12))
+        _legend(pl, [("no slip", "#377eb8"), ("slip", "#e41a1c")])
         return
     _add(pl, j, scalars=name, preference="cell", cmap=CMAP, clim=_clim(vals),
                 scalar_bar_args=_bar(f"joint {item.quantity}" + (" (compression +)" if "normal-stress" == item.quantity
@@ -286,7 +293,7 @@ def render(scene, items: list[Item], path, title: str = "", background: str = "w
         pl.add_text(title, position="upper_edge", font_size=12, color=text_colour)
     pl.view_vector(VIEW, viewup=(0, 0, 1))
     pl.reset_camera()
-    pl.camera.zoom(1.1)
+    pl.camera.zoom(0.95)
     img = pl.screenshot(str(path), return_img=True)
     cam = pl.camera
     aspect = size[0] / size[1]
