@@ -124,6 +124,18 @@ def _verify(args) -> int:
     return verify_main(args.names, root=args.root)
 
 
+def _plot(args) -> int:
+    from .plot.cli import main as plot_main
+
+    def restore(path):                  # a save: restored in a session of its own
+        from .session import Session
+        s = Session(out_dir=path.parent)
+        s.command(f"model restore '{path.name}'")
+        return s.model
+
+    return plot_main(args, restore)
+
+
 def _docs(args) -> int:
     from .docs import write_pages
 
@@ -195,7 +207,7 @@ def main(argv: list[str] | None = None) -> int:
     c.add_argument("-v", "--verbose", action="store_true", help="list every line with what happens to it")
     c.set_defaults(fn=lambda a: __import__("dec3d.check", fromlist=["main"]).main(a.decks, a.verbose))
     from .plot.cli import add_parser as add_plot
-    add_plot(sub)
+    add_plot(sub).set_defaults(fn=_plot)
     d = sub.add_parser("docs", help="write the command reference pages from the registry")
     d.add_argument("--dir", default="commands")
     d.set_defaults(fn=_docs)

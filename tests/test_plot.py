@@ -184,11 +184,15 @@ block vtk 'p'""")
 
 
 def test_cli_plot_from_pvd(tmp_path, capsys):
-    _session(tmp_path, TWO_BLOCKS + "block vtk 'b'")
+    _session(tmp_path, TWO_BLOCKS + "block vtk 'b'\nmodel save 'b'")
     assert main(["plot", str(tmp_path / "b.pvd"), "--item", "displacement", "--item", "blocks",
                  "--out", str(tmp_path / "pics")]) == 0
     for name in ("b_displacement.png", "b_blocks.png"):
         assert _drawn(_image(tmp_path / "pics" / name)) > 10000
+    # from the save: the same model, the same picture
+    assert main(["plot", str(tmp_path / "b.sav"), "--item", "displacement", "--out", str(tmp_path / "sav")]) == 0
+    np.testing.assert_array_equal(_image(tmp_path / "sav" / "b_displacement.png"),
+                                  _image(tmp_path / "pics" / "b_displacement.png"))
     assert main(["plot", str(tmp_path / "b.pvd"), "--item", "nonsense"]) == 2
     assert "unknown item 'nonsense'" in capsys.readouterr().err
     assert main(["plot", str(tmp_path / "missing.pvd")]) == 2

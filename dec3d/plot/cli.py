@@ -5,7 +5,7 @@ import sys
 from pathlib import Path
 
 
-def main(args) -> int:
+def main(args, restore=None) -> int:
     from .items import UnknownItem, item_from_name
     from .render import render
     from .scene import scene_from_files
@@ -16,7 +16,7 @@ def main(args) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     try:
-        scene = scene_from_files(args.file)
+        scene = scene_from_files(args.file, restore)
     except (OSError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -36,7 +36,7 @@ def main(args) -> int:
     return 0
 
 
-def add_parser(sub) -> None:
+def add_parser(sub):
     p = sub.add_parser("plot", help="pictures (PNG) of a run from its .pvd/.vtu files or a save, after the run")
     p.add_argument("file", help="a .pvd (its last time is drawn), a .vtu or a .sav")
     p.add_argument("--item", action="append", metavar="ITEM",
@@ -47,4 +47,4 @@ def add_parser(sub) -> None:
     p.add_argument("--out", help="folder for the pictures (default: the current folder)")
     p.add_argument("--background", default="white")
     p.add_argument("--size", type=int, nargs=2, metavar=("W", "H"), help="pixels (default 800 600)")
-    p.set_defaults(fn=main)
+    return p

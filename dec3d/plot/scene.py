@@ -92,17 +92,15 @@ def _add_file(sc: Scene, path: Path) -> None:
         sc.group_names = sc.group_names or _names(grid)
 
 
-def scene_from_files(path) -> Scene:
-    """The scene of a ``.pvd`` (its last time, every part), a ``.vtu`` or a save (``.sav``)."""
+def scene_from_files(path, restore=None) -> Scene:
+    """The scene of a ``.pvd`` (its last time, every part), a ``.vtu`` or a save (``.sav``: ``restore(path)``
+    gives its model; the session that reads saves is above this layer)."""
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"no such file: {path}")
     suffix = path.suffix.lower()
-    if suffix == ".sav":
-        from dec3d.session import Session
-        s = Session(out_dir=path.parent, echo=False)
-        s.command(f"model restore '{path.name}'")
-        return scene_from_model(s.model)
+    if suffix == ".sav" and restore is not None:
+        return scene_from_model(restore(path))
     sc = Scene()
     if suffix == ".pvd":
         sets = ET.parse(path).getroot().iter("DataSet")
