@@ -171,6 +171,16 @@ block vtk 'p'""")
     assert np.allclose(p[:, :, 0], 1.0, atol=1e-6)
     tri = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]) + np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 0])
     assert abs(0.5 * np.linalg.norm(tri, axis=1).sum() - 1.0) < 1e-6      # the face, once
+    # the shares of the face: inside it (squares about its corners would stick out), and covering it
+    assert p[:, :, 1:].min() > -1e-9 and p[:, :, 1:].max() < 1 + 1e-9
+    grid = np.stack(np.meshgrid(np.linspace(0.05, 0.95, 7), np.linspace(0.05, 0.95, 7)), -1).reshape(-1, 2)
+
+    def inside(pt, quad):                   # a point in a convex (or degenerate-to-triangle) quadrilateral
+        q = quad[:, 1:]
+        cr = [(q[(i + 1) % 4] - q[i])[0] * (pt - q[i])[1] - (q[(i + 1) % 4] - q[i])[1] * (pt - q[i])[0]
+              for i in range(4)]
+        return all(c >= -1e-12 for c in cr) or all(c <= 1e-12 for c in cr)
+    assert all(sum(inside(g, quad) for quad in p) >= 1 for g in grid)
     from dec3d.io.contactvtk import contact_point_data
     _, data = contact_point_data(s.model)
     np.testing.assert_array_equal(m.cell_data["normal_stress"][0], data["normal_stress"])

@@ -64,29 +64,49 @@ def joint_polygons(model) -> tuple[np.ndarray, dict]:
 
 
 def _tributary(pts, cid, t1, t2, corners) -> None:
-    """Where the sub-contacts of a contact are the corners of a convex polygon on its plane (a face-to-face
+    """Where the sub-contacts of a contact sit at the corners of a convex polygon on its plane (a face-to-face
     contact of rigid blocks), each gets its share of the polygon instead of a square: itself, the midpoint
     of the edge to the next corner, the polygon's centroid and the midpoint of the edge from the previous
-    corner (the quadrilaterals tile the polygon). ``corners`` (n, 4, 3) is changed in place."""
+    corner (the quadrilaterals tile the polygon). Two sub-contacts at one corner (a vertex of each block
+    there) split that share along the corner-centroid diagonal. ``corners`` (n, 4, 3) is changed in place."""
     bounds = np.flatnonzero(np.diff(cid)) + 1
     for rows in np.split(np.arange(len(cid)), bounds):
         if len(rows) < 3:
             continue
         p = pts[rows]
-        c = p.mean(axis=0)
-        u, v = (p - c) @ t1[rows[0]], (p - c) @ t2[rows[0]]
+        size = np.ptp(p, axis=0).max()
+        if size <= 0:
+            continue
+        key = np.round((p - p.min(axis=0)) / (1e-7 * size)).astype(np.int64)
+        uniq, first, which = np.unique(key, axis=0, return_index=True, return_inverse=True)
+        which = which.ravel()
+        if len(first) < 3 or np.bincount(which).max() > 2:
+            continue
+        q = p[first]
+        c = q.mean(axis=0)
+        u, v = (q - c) @ t1[rows[0]], (q - c) @ t2[rows[0]]
         order = np.argsort(np.arctan2(v, u))
         uv = np.column_stack([u, v])[order]
         nxt, prv = np.roll(uv, -1, axis=0), np.roll(uv, 1, axis=0)
         # convex with every point a corner: each turn goes the same way and is not straight
         cross = (uv[:, 0] - prv[:, 0]) * (nxt[:, 1] - uv[:, 1]) - (uv[:, 1] - prv[:, 1]) * (nxt[:, 0] - uv[:, 0])
-        size = np.ptp(uv, axis=0).max()
-        if size <= 0 or not (cross > 1e-9 * size * size).all():
+        if not (cross > 1e-9 * size * size).all():
             continue
-        q = p[order]
-        quad = np.stack([q, 0.5 * (q + np.roll(q, -1, axis=0)), np.broadcast_to(c, q.shape),
-                         0.5 * (q + np.roll(q, 1, axis=0))], axis=1)
-        corners[rows[order]] = quad
+        qo = q[order]
+        nxt_mid, prv_mid = 0.5 * (qo + np.roll(qo, -1, axis=0)), 0.5 * (qo + np.roll(qo, 1, axis=0))
+        cc = np.broadcast_to(c, qo.shape)
+        rank = np.empty(len(order), np.int64)
+        rank[order] = np.arange(len(order))
+        seen = np.zeros(len(first), np.int64)
+        for k, r in enumerate(rows):
+            j = rank[which[k]]
+            if np.sum(which == which[k]) == 1:
+                corners[r] = [qo[j], nxt_mid[j], cc[j], prv_mid[j]]
+            elif seen[which[k]] == 0:
+                corners[r] = [qo[j], nxt_mid[j], cc[j], cc[j]]
+                seen[which[k]] = 1
+            else:
+                corners[r] = [qo[j], cc[j], prv_mid[j], prv_mid[j]]
 
 
 def _rows_of(model, column: np.ndarray) -> np.ndarray:
