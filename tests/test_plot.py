@@ -138,6 +138,8 @@ def test_items_from_words_and_names():
     assert item_from_words("block contour displacement".split()) == Item("contour", "displacement")
     assert item_from_words("zone contour stress-zz".split()) == Item("contour", "stress-zz")
     assert item_from_words("block zone contour stress-zz".split()) == Item("contour", "stress-zz")
+    assert item_from_words("zone contour stress quantity zz".split()) == Item("contour", "stress-zz")
+    assert item_from_words("zone contour stress quantity minimum".split()) == Item("contour", "stress-min")
     assert item_from_words("zone label state".split()).kind == "state"
     assert item_from_words("block contact contour shear-stress".split()) == Item("joints", "shear-stress")
     assert item_from_words("block vector velocity".split()) == Item("vector", "velocity")

@@ -93,6 +93,14 @@ def item_from_words(words: list[str]) -> Item:
         if any(x in rest for x in ("state", "plasticity", "plastic", "plastic-state")):
             left = _drop(rest, "label", "state", "plasticity", "plastic", "plastic-state", "contour", "colorby")
             return Item("state", "state", ignored=left)
+        if "stress" in rest and "quantity" in rest:              # FLAC3D's `contour stress quantity zz`
+            i = rest.index("quantity")
+            comp = rest[i + 1] if i + 1 < len(rest) else ""
+            comp = {"maximum": "max", "intermediate": "int", "minimum": "min", "von-mises": "mises"}.get(comp, comp)
+            q = "von-mises" if comp == "mises" else f"stress-{comp}"
+            if q in STRESS:
+                return Item("contour", q, ignored=[w for j, w in enumerate(rest) if w not in ("contour", "stress",
+                                                                                            "quantity") and j != i + 1])
         if "contour" in rest or "colorby" in rest:
             q, left = _quantity(_drop(rest, "contour", "colorby"), STRESS + SCALARS, "")
             if not q:
