@@ -208,3 +208,18 @@ def test_cli_plot_from_pvd(tmp_path, capsys):
     assert main(["plot", str(tmp_path / "b.pvd"), "--item", "nonsense"]) == 2
     assert "unknown item 'nonsense'" in capsys.readouterr().err
     assert main(["plot", str(tmp_path / "missing.pvd")]) == 2
+
+
+def test_a_picture_that_cannot_be_drawn_is_a_warning_not_the_end_of_the_run(tmp_path, monkeypatch):
+    """No OpenGL for VTK (a machine without one): the deck goes on, the warning names the line."""
+    import dec3d.plot.draw as draw
+
+    def broken(*a, **k):
+        raise RuntimeError("no OpenGL context")
+
+    monkeypatch.setattr(draw, "draw_plot", broken)
+    s = _session(tmp_path, "model new\nblock create brick 0 1 0 1 0 1\nplot export bitmap filename 'x.png'\n"
+                           "block create brick 2 3 0 1 0 1")
+    assert s.model.blocks.n == 2                                    # the line after ran
+    assert len(s.warnings) == 1 and "plot 'Plot01' was not drawn (RuntimeError: no OpenGL context)" in s.warnings[0]
+    assert not (tmp_path / "x.png").exists()

@@ -169,7 +169,14 @@ def _export(session, st, call, name, words) -> None:
     path = session.out_path(fname, call.location)
     path.parent.mkdir(parents=True, exist_ok=True)
     from ..plot.draw import draw_plot
-    notices = draw_plot(session.model, p, path, size)
+    try:
+        notices = draw_plot(session.model, p, path, size)
+    except (ImportError, RuntimeError, OSError) as exc:
+        # no OpenGL for VTK, a broken matplotlib backend: a picture is not worth the run
+        text = f"{call.location}: plot '{p.name}' was not drawn ({type(exc).__name__}: {exc})"
+        session.write(f"warning: {text}")
+        getattr(session, "warnings", []).append(text)
+        return
     for n in notices:
         _tell(session, st, f"draw:{n}", f"plot '{p.name}': {n}")
     if getattr(p, "undeclared", False):

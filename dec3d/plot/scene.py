@@ -23,7 +23,13 @@ class Scene:
     group_names: list = field(default_factory=list)
 
     def grids(self) -> list:
-        return [g for g in self.solids + [self.fe] if g is not None and g.n_cells]
+        """The grids to draw: blocks and zones, and FE elements in place of their blocks' polyhedra."""
+        import numpy as np
+        solids = self.solids
+        if self.fe is not None and self.fe.n_cells:
+            solids = [g.extract_cells(np.flatnonzero(np.asarray(g.cell_data["kind"]) != 2))
+                      if "kind" in g.cell_data and (np.asarray(g.cell_data["kind"]) == 2).any() else g for g in solids]
+        return [g for g in solids + [self.fe] if g is not None and g.n_cells]
 
 
 def _read_text(text: str):
