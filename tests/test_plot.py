@@ -223,3 +223,45 @@ def test_a_picture_that_cannot_be_drawn_is_a_warning_not_the_end_of_the_run(tmp_
     assert s.model.blocks.n == 2                                    # the line after ran
     assert len(s.warnings) == 1 and "plot 'Plot01' was not drawn (RuntimeError: no OpenGL context)" in s.warnings[0]
     assert not (tmp_path / "x.png").exists()
+
+
+HANG = """model new
+block create brick -0.5 0.5 -0.5 0.5 -1 0
+block property density 2000
+model gravity 0 0 -10
+structure cable create by-line 0 0 -0.9 0 0 2 segments 29
+structure cable property young 200e9 cross-sectional-area 1e-4 grout-stiffness 1e8 grout-cohesion 1e9
+structure node fix velocity range id 30
+model cycle 500
+"""
+
+BEAM = """model new
+model configure feblock
+block create brick 0 10 0 1 0 1
+feblock generate 1 1 1 integration 3
+block zone cmodel assign elastic
+block zone property density 2000 young 1e6 poisson 0.2
+block gridpoint apply velocity 0 0 0 range position-x 0
+block gridpoint apply force-z [-100.0/3.0] range position-x 10 position-z 1
+model large-strain off
+model cycle 300
+"""
+
+
+def test_cables_and_fe_blocks_are_drawn(tmp_path):
+    """A cable item draws the cable's lines coloured by axial force (the top, loaded end red); an FE
+    cantilever's stress contour draws its elements (not the polyhedron of its block as well)."""
+    s = _session(tmp_path, HANG)
+    sc = scene_from_model(s.model)
+    assert sc.cables is not None and sc.cables.n_cells == 29
+    pic, notices = render(sc, [Item("cable", "axial-force")], tmp_path / "c.png")
+    assert notices == []
+    top = np.asarray(sc.cables.points)[np.argmax(np.asarray(sc.cables.points)[:, 2])]
+    r, c = pic.pixel_of(top - [0, 0, 0.05])
+    near = pic.image[r - 3:r + 4, c - 3:c + 4].reshape(-1, 3).astype(int)
+    assert ((near[:, 0] > 100) & (near[:, 2] < 80)).any()        # red (high tension) by the fixed top node
+    f = _session(tmp_path / "fe", BEAM)
+    sf = scene_from_model(f.model)
+    assert sf.fe is not None and all((np.asarray(g.cell_data.get("kind", [0])) != 2).all() for g in sf.grids())
+    pic, notices = render(sf, [Item("contour", "stress-xx")], tmp_path / "fe.png")
+    assert notices == [] and _drawn(pic.image) > 5000
