@@ -265,3 +265,14 @@ def test_cables_and_fe_blocks_are_drawn(tmp_path):
     assert sf.fe is not None and all((np.asarray(g.cell_data.get("kind", [0])) != 2).all() for g in sf.grids())
     pic, notices = render(sf, [Item("contour", "stress-xx")], tmp_path / "fe.png")
     assert notices == [] and _drawn(pic.image) > 5000
+
+
+def test_readme_pictures_exist_and_are_small():
+    import re
+
+    from conftest import ROOT
+
+    names = re.findall(r"\]\((docs/img/[^)]+\.png)\)", (ROOT / "README.md").read_text(encoding="utf-8"))
+    assert len(names) >= 2
+    for n in names:
+        assert 10_000 < (ROOT / n).stat().st_size < 200_000, n

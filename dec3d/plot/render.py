@@ -175,7 +175,15 @@ def _draw_item(pl, scene, item: Item, notices: list, text_colour: str) -> None:
 
 def _draw_groups(pl, scene, grids) -> None:
     names = scene.group_names
-    key = "group:Default"
+    # 3DEC colours by the Default slot; when that has one group, by the first slot that has more
+    slots = ["group:Default"] + sorted({k for g in grids for k in g.cell_data.keys()
+                                        if k.startswith("group:") and k != "group:Default"})
+    key = slots[0]
+    for k in slots:
+        codes = {int(c) for g in grids if k in g.cell_data for c in np.unique(np.asarray(g.cell_data[k])) if c >= 0}
+        if len(codes) > 1:
+            key = k
+            break
     codes = np.concatenate([np.asarray(g.cell_data[key]) for g in grids if key in g.cell_data]) \
         if any(key in g.cell_data for g in grids) else np.zeros(0)
     used = sorted(set(int(c) for c in codes if c >= 0))
