@@ -125,12 +125,15 @@ plot 'J' export bitmap filename 'j.png' size 400 300
 def test_deck_plot_notices(tmp_path, capsys):
     deck = tmp_path / "d.dat"
     deck.write_text(TWO_BLOCKS + "plot 'Stress' export bitmap filename 's.png'\nplot item create ball\n"
-                    "plot item create ball\nplot view reset\n")
+                    "plot item create ball\nplot view reset\nplot cre 'B'\nplot backg 'nocolour'\n"
+                    "plot it cr block\nplot exp bitm fil 'b.png'\n")
     assert main(["run", str(deck), "--out", str(tmp_path), "-q"]) == 0
     out = capsys.readouterr().out
     assert "plot 'Stress' was not made in this deck" in out
     assert out.count("plot item `ball` is not drawn by dec3d") == 1 and "d.dat:11:1" in out
     assert "`plot view` is a view setting" in out
+    assert "background 'nocolour' is not a colour" in out and "plot 'B' written to b.png" in out   # abbreviated
+    assert _drawn(_image(tmp_path / "b.png")) > 10000
 
 
 def test_items_from_words_and_names():

@@ -9,10 +9,14 @@ import re
 from pathlib import Path
 
 from ..errors import CommandError
+from ..lang.abbrev import matches
 from .registry import command
 
 _TOKEN = re.compile(r"'[^']*'|\"[^\"]*\"|\S+")
 _IMAGE_EXTS = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
+#: the words after `plot ['name']` dec3d acts on (the rest are view settings: a notice)
+_WORDS = ("create", "current", "destroy", "delete", "item", "clear", "background", "export", "active", "view",
+          "title", "legend", "copy", "reset", "print", "movie", "hardcopy")
 
 
 class _Plot:
@@ -92,8 +96,9 @@ def plot(session, call):
         if name is not None:
             _plot_named(session, st, name)
         return
-    head = low[0]
-    if head in ("create", "cr", "crea"):
+    hits = matches(low[0], _WORDS)
+    head = hits[0] if len(hits) == 1 else low[0]          # 3DEC's abbreviations (`plot exp bitmap …`)
+    if head == "create":
         nm = words[1] if len(words) > 1 else name
         p = _plot_named(session, st, nm, create=True)
         p.items, p.background = [], "white"
@@ -122,7 +127,7 @@ def _item(session, st, call, name, words) -> None:
     from ..plot.items import UnknownItem, item_from_words
 
     low = [w.lower() for w in words]
-    if not low or low[0] not in ("create", "cr", "crea"):
+    if not low or matches(low[0], ("create", "remove", "delete", "list")) != ["create"]:
         _tell(session, st, f"item:{low[:1]}", f"`plot item {' '.join(words[:1])}` is skipped in dec3d "
                                                "(only `plot item create`)")
         return
@@ -139,13 +144,14 @@ def _item(session, st, call, name, words) -> None:
 
 def _export(session, st, call, name, words) -> None:
     low = [w.lower() for w in words]
-    if not low or low[0] not in ("bitmap", "bmp", "png"):
+    if not low or (matches(low[0], ("bitmap", "vrml", "vtk", "dxf")) != ["bitmap"] and low[0] not in ("bmp", "png")):
         _tell(session, st, f"export:{low[:1]}", f"`plot export {' '.join(words[:1])}`: dec3d exports bitmaps only; "
                                                 "skipped")
         return
     fname, size, i = None, None, 1
     while i < len(words):
         w = low[i]
+        w = {"filename": "filename", "size": "size"}.get((matches(w, ("filename", "size")) or [w])[0], w)
         if w == "filename" and i + 1 < len(words):
             fname, i = words[i + 1], i + 2
         elif w == "size" and i + 2 < len(words):

@@ -284,7 +284,13 @@ def render(scene, items: list[Item], path, title: str = "", background: str = "w
     _quiet()
     notices: list[str] = []
     pl = pv.Plotter(off_screen=True, window_size=list(size))
-    pl.set_background(background)
+    try:
+        pl.set_background(background)
+    except ValueError:
+        notices.append(f"background '{background}' is not a colour dec3d knows (a name like 'white' or "
+                       "'#rrggbb'): white")
+        background = "white"
+        pl.set_background(background)
     text_colour = "white" if background.lower() in ("black", "#000000", "k") else "black"
     pv.global_theme.font.color = text_colour
     solid = [i for i in items if i.kind != "chart"]
