@@ -156,7 +156,11 @@ class _Walker:
                 self.add(deck, raw.line, RUNNABLE, item.source)
                 continue
             path = item.command.path
-            if path == ("program", "call"):
+            if path == ("plot",):
+                from .commands.plot_cmds import does_nothing
+                why = does_nothing(item)
+                self.add(deck, raw.line, DOES_NOTHING if why else RUNNABLE, why or "plot")
+            elif path == ("program", "call"):
                 self.call(deck, raw, item, base_dir, stack)
             else:
                 self.add(deck, raw.line, RUNNABLE, item.name)

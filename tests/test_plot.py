@@ -279,3 +279,15 @@ def test_readme_pictures_exist_and_are_small():
     assert len(names) >= 2
     for n in names:
         assert 10_000 < (ROOT / n).stat().st_size < 200_000, n
+
+
+def test_check_tells_which_plot_lines_draw(tmp_path):
+    from dec3d.check import DOES_NOTHING, RUNNABLE, check_file
+
+    deck = tmp_path / "d.dat"
+    deck.write_text("model new\nplot create 'A'\nplot item create block contour displacement\nplot item create ball\n"
+                    "plot view reset\nplot 'A' export bitmap filename 'a.png'\n")
+    rep = {r.line: (r.status, r.what) for r in check_file(deck)}
+    assert rep[2] == rep[3] == rep[6] == (RUNNABLE, "plot")
+    assert rep[4][0] == DOES_NOTHING and "`ball` is not drawn by dec3d" in rep[4][1]
+    assert rep[5] == (DOES_NOTHING, "plot view: a view setting of 3DEC's plot window, skipped")

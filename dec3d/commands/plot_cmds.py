@@ -123,6 +123,29 @@ def plot(session, call):
     _tell(session, st, f"word:{head}", f"`plot {head}` is a view setting of 3DEC's plot window: skipped in dec3d")
 
 
+def does_nothing(call) -> str | None:
+    """For `dec3d check`: why this plot line does nothing in dec3d, or None when it does something."""
+    from ..plot.items import UnknownItem, item_from_words
+
+    toks = _tokens(call)
+    if toks and toks[0][1]:
+        toks = toks[1:]
+    low = [w.lower() for w, _ in toks]
+    if not low:
+        return None
+    hits = matches(low[0], _WORDS)
+    head = hits[0] if len(hits) == 1 else low[0]
+    if head in ("create", "current", "destroy", "delete", "clear", "background", "export"):
+        return None
+    if head == "item":
+        try:
+            item_from_words([w for w, _ in toks[2:]])
+            return None
+        except UnknownItem as exc:
+            return f"plot: {exc}"
+    return f"plot {head}: a view setting of 3DEC's plot window, skipped"
+
+
 def _item(session, st, call, name, words) -> None:
     from ..plot.items import UnknownItem, item_from_words
 
