@@ -292,7 +292,6 @@ def render(scene, items: list[Item], path, title: str = "", background: str = "w
         background = "white"
         pl.set_background(background)
     text_colour = "white" if background.lower() in ("black", "#000000", "k") else "black"
-    pv.global_theme.font.color = text_colour
     solid = [i for i in items if i.kind != "chart"]
     colours_geometry = any(i.kind in ("contour", "state") for i in solid)
     for it in solid:
@@ -303,6 +302,10 @@ def render(scene, items: list[Item], path, title: str = "", background: str = "w
         if not scene.grids():
             notices.append("nothing to draw: the model has no blocks")
         _draw_groups(pl, scene, scene.grids())
+    rgb = (1.0, 1.0, 1.0) if text_colour == "white" else (0.0, 0.0, 0.0)
+    for bar in pl.scalar_bars.values():          # (not the global theme: a user's own PyVista stays as it was)
+        bar.GetTitleTextProperty().SetColor(*rgb)
+        bar.GetLabelTextProperty().SetColor(*rgb)
     if title:
         pl.add_text(title, position="upper_edge", font_size=12, color=text_colour)
     pl.view_vector(VIEW, viewup=(0, 0, 1))
