@@ -157,7 +157,9 @@ class _Walker:
                 continue
             path = item.command.path
             if path == ("plot",):
-                self.add(deck, raw.line, DOES_NOTHING, "plot: display only in dec3d, skipped")
+                from .commands.plot_cmds import does_nothing
+                why = does_nothing(item)
+                self.add(deck, raw.line, DOES_NOTHING if why else RUNNABLE, why or "plot")
             elif path == ("program", "call"):
                 self.call(deck, raw, item, base_dir, stack)
             else:

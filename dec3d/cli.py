@@ -1,4 +1,5 @@
-"""The `dec3d` command line: run (decks and Python drivers), batch, repl, verify, ssdem, docs."""
+"""The `dec3d` command line: run (decks and Python drivers), translate, batch, repl, verify, ssdem, check, plot,
+docs."""
 from __future__ import annotations
 
 import argparse
@@ -155,6 +156,18 @@ def _verify(args) -> int:
     return verify_main(args.names, root=args.root)
 
 
+def _plot(args) -> int:
+    from .plot.cli import main as plot_main
+
+    def restore(path):                  # a save: restored in a session of its own
+        from .session import Session
+        s = Session(out_dir=path.parent)
+        s.command(f"model restore '{path.name}'")
+        return s.model
+
+    return plot_main(args, restore)
+
+
 def _docs(args) -> int:
     from .docs import write_pages
 
@@ -236,6 +249,8 @@ def main(argv: list[str] | None = None) -> int:
     c.add_argument("decks", nargs="+")
     c.add_argument("-v", "--verbose", action="store_true", help="list every line with what happens to it")
     c.set_defaults(fn=lambda a: __import__("dec3d.check", fromlist=["main"]).main(a.decks, a.verbose))
+    from .plot.cli import add_parser as add_plot
+    add_plot(sub).set_defaults(fn=_plot)
     d = sub.add_parser("docs", help="write the command reference pages from the registry")
     d.add_argument("--dir", default="commands")
     d.set_defaults(fn=_docs)

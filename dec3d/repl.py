@@ -68,8 +68,6 @@ class RegistryCompleter(Completer):
             for name in out:
                 if path + (name,) in READER_PAGES:
                     out[name] = "FISH function definition"
-            if node is REGISTRY.root and "plot" in out:
-                out["plot"] = "display only: skipped"
             if node is REGISTRY.root:
                 out["help"] = ""
             return out

@@ -252,3 +252,11 @@ def test_fe_static_bench_runs_and_agrees_with_calculix_when_present():
     assert 0.3 < imp < 0.45 and "converged;" in " ".join(rows["dec3d implicit"])
     if shutil.which("ccx"):
         assert abs(imp - float(rows["CalculiX C3D20"][5])) < 1e-6 * imp
+
+
+def test_water_bench_runs_and_prints_its_figures():
+    out = subprocess.run([sys.executable, str(ROOT / "bench" / "water_bench.py")], capture_output=True, text=True,
+                         timeout=300, cwd=ROOT, env={**os.environ, "PYTHONPATH": os.pathsep.join(
+                             [str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])})
+    assert out.returncode == 0, out.stderr
+    assert "channel-updates/s" in out.stdout and "steady solve: 10000 knots" in out.stdout

@@ -43,7 +43,7 @@ def test_follows_calls_and_tells_lines_that_do_nothing(tmp_path):
     assert rep[("geo.dat", 2)][0] == RUNNABLE
     assert rep[("geo.dat", 3)] == (DOES_NOTHING, "after `program return`: never read")
     assert rep[("main.dat", 6)] == (RUNNABLE, "fish define foo")     # compiled as the run compiles it
-    assert rep[("main.dat", 9)] == (DOES_NOTHING, "plot: display only in dec3d, skipped")
+    assert rep[("main.dat", 9)] == (RUNNABLE, "plot")                # a picture (dec3d.plot)
     assert rep[("main.dat", 10)] == (RUNNABLE, "model cycle")
     # and the run agrees: it runs to the end
     assert main(["run", str(tmp_path / "main.dat"), "--out", str(tmp_path / "out"), "-q"]) == 0
@@ -116,7 +116,7 @@ def test_elastic_hole_master_reports_the_called_decks(tmp_path):
     blocked = {r.file.rsplit("/", 1)[-1] for r in reports if r.status in (ERROR, NOT_SUPPORTED)}
     assert blocked == set()        # zoning (tet, hexahedra, high-order), zone properties, insitu: all bind
     plots = [r for r in reports if r.file.endswith("master.dat") and r.what.startswith("plot")]
-    assert len(plots) == 9 and {r.status for r in plots} == {DOES_NOTHING}
+    assert len(plots) == 9 and {r.status for r in plots} == {RUNNABLE}
     # `[checkError(...)]` binds (the function is defined); the FISH functions that read zones and
     # gridpoints use only intrinsics dec3d has: every define is runnable
     calls = [r for r in reports if r.file.endswith("master.dat") and r.line in (8, 16, 24)]

@@ -1,4 +1,4 @@
-"""Small CLI promises: unknown verification names are an error; the plot notice is printed once."""
+"""Small CLI promises: unknown verification names are an error; a plot notice is printed once."""
 import pytest
 
 from dec3d.cli import main
@@ -15,9 +15,11 @@ def test_verify_unknown_name_is_an_error(names, capsys):
 
 @pytest.mark.parametrize("quiet", [True, False])
 def test_plot_notice_once_per_run(tmp_path, capsys, quiet):
+    """Two pictures of a model with no blocks: both written, the notice that there is nothing to draw once."""
     deck = tmp_path / "p.dat"
     deck.write_text("model new\nplot create 'Blocks'\nplot 'Blocks' export bitmap filename 'b.png'\n"
                     "[x = 1]\nplot 'Stress' export bitmap filename 's.png'\n")
     assert main(["run", str(deck), "--out", str(tmp_path)] + (["-q"] if quiet else [])) == 0
     out = capsys.readouterr().out
-    assert out.count("notice: `plot` commands are display-only") == 1
+    assert out.count("nothing to draw") == 1
+    assert (tmp_path / "b.png").exists() and (tmp_path / "s.png").exists()

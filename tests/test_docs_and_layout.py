@@ -58,7 +58,8 @@ MAY_IMPORT = {
     "model": BASE | {"geometry", "kernels"},
     "io": BASE | {"model", "geometry", "kernels"},
     "physics": BASE | {"model", "geometry", "kernels", "io"},
-    "commands": BASE | {"lang", "fish", "model", "geometry", "kernels", "io", "physics"},
+    "commands": BASE | {"lang", "fish", "model", "geometry", "kernels", "io", "physics", "plot"},
+    "plot": BASE | {"model", "io", "physics"},    # pictures: the model's VTK data drawn off screen
     "session": BASE | {"lang", "fish", "commands", "model", "geometry", "kernels", "io", "physics"},
     "check": BASE | {"lang", "fish", "commands", "session"},
     # the itasca-compatible Python API on sessions (docs/python.md); reached from the top (cli, __init__)

@@ -7,13 +7,45 @@ from dec3d.cli import main
 # decks called by another example are run through their caller
 # the slow decks whose own tests below run them through `dec3d run` as well are not run again here
 RUN_BY_THEIR_TESTS = {"deformable/tunnel_mc.dat", "deformable/tunnel_jointed_mc.dat", "feblock/tunnel_liner.dat",
-                      "support/bolted_tunnel.dat"}
+                      "support/bolted_tunnel.dat", "tutorial/tunnel.dat"}
 EXAMPLES = sorted(p for p in (ROOT / "examples").rglob("*.dat")
                   if p.name != "settings.dat" and p.relative_to(ROOT / "examples").as_posix() not in RUN_BY_THEIR_TESTS)
 
 
 def _cli_run(deck, out):
     assert main(["run", str(deck), "--out", str(out), "-q"]) == 0
+    _check_pictures(out)
+
+
+def _check_pictures(out):
+    """Every picture an example writes shows something: more than 2 % of its pixels are not the
+    background (the colour of its corner), and it has more than two colours."""
+    import matplotlib.image as mpimg
+    import numpy as np
+
+    for png in sorted(out.rglob("*.png")):
+        img = mpimg.imread(str(png))[:, :, :3]
+        drawn = (np.abs(img - img[0, 0]).sum(axis=2) > 0.1).mean()
+        assert drawn > 0.02, f"{png.name}: blank picture"
+        assert len(np.unique(img.reshape(-1, 3), axis=0)) > 2, f"{png.name}: one colour"
+
+
+def test_tutorial_pictures(tmp_path):
+    """The tutorial decks write the pictures docs/tutorial.md shows; the tunnel's plastic-state picture
+    shows yielded zones (colours of the legend besides `none`) and its vertical stress picture a range
+    of colours."""
+    import matplotlib.image as mpimg
+    import numpy as np
+
+    from dec3d.plot.render import STATE_COLOURS
+
+    _cli_run(ROOT / "examples" / "tutorial" / "tunnel.dat", tmp_path)
+    for name in ("tunnel_szz", "tunnel_state", "tunnel_displacement", "tunnel_joints"):
+        assert (tmp_path / f"{name}.png").exists()
+    img = (mpimg.imread(str(tmp_path / "tunnel_state.png"))[:, :, :3] * 255).round()
+    yielded = [c for t, c in STATE_COLOURS.items() if t != "none"]
+    hits = sum(int((np.abs(img - [int(c[i:i + 2], 16) for i in (1, 3, 5)]).sum(axis=2) < 10).sum()) for c in yielded)
+    assert hits > 500
 
 
 @pytest.mark.parametrize("deck", EXAMPLES, ids=lambda p: str(p.relative_to(ROOT / "examples")))

@@ -109,7 +109,7 @@ def test_edited_callee_reaches_the_cached_caller(tmp_path, callee):
 
 TWINS = ["tests/rigid/test_contactmap.py", "tests/rigid/test_kernels_rigid.py", "tests/rigid/test_cellmap.py",
          "tests/rigid/test_subgeom.py", "tests/geometry/test_kernels_vs_reference.py",
-         "tests/rigid/test_bodyscale_kernel.py"]
+         "tests/rigid/test_bodyscale_kernel.py", "tests/rigid/test_water_kernels.py"]
 
 
 def test_kernel_twins_pass_as_plain_python():

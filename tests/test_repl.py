@@ -75,7 +75,7 @@ def test_completion_marks_what_does_not_run():
     assert notes["copy"] == "not supported yet"
     assert notes["create"] == "" and notes["contact"] == ""
     top = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document(""), None)}
-    assert top["plot"] == "display only: skipped" and top["model"] == ""
+    assert top["plot"] == "" and top["model"] == ""           # plots are pictures (dec3d.plot)
     kws = {c.text: c.display_meta_text for c in RegistryCompleter().get_completions(Document("block history velocity "), None)}
     assert kws["zone-id"] == "" and kws["gridpointid"] == "" and kws["block-id"] == ""
     ckws = {c.text: c.display_meta_text

@@ -31,7 +31,8 @@ def test_every_verification_problem_is_there():
                                          "D10_hoek_brown_triaxial", "D11_strain_softening", "D12_ubiquitous_joint",
                                          "D13_drucker_prager_triaxial", "D14_anisotropic_elastic",
                                          "SE1_cable_pullout", "SE2_bolted_planar_slide", "SE3_cable_pullout_confined",
-                                         "SE4_dowel_shear", "SE5_beam", "SE6_dowel_slide_fos"}
+                                         "SE4_dowel_shear", "SE5_beam", "SE6_dowel_slide_fos",
+                                         "W1_planar_slide_water", "W2_wedge_water", "W3_joint_opening"}
 
 
 def _demo(tmp_path, expects: str):

@@ -42,7 +42,15 @@ STEM = OutPath(stem=True)
                  "A model with cables (`structure cable create`) also gets `<file>_cables_<nnnn>.vtu` per snapshot: "
                  "one line cell per cable element with cell data element_id, cable_id, axial_force (N, tension "
                  "positive; colour by it), axial_stress, grout_force_a, grout_force_b, state, yield and slip, and "
-                 "point data node_id, displacement, velocity and grouted (dec3d/io/cablevtk.py).",
+                 "point data node_id, displacement, velocity and grouted (dec3d/io/cablevtk.py). "
+                 "Zones also carry the plastic state as categories (cell data shear_now, tension_now, "
+                 "shear_past, tension_past: 0/1; plastic_label: the state's code 0-15 whose text is line "
+                 "`code` of field data plastic_labels, e.g. 'shear-n shear-p') and their stress averaged to "
+                 "the gridpoints (point data stress_gp, volume-weighted, XX YY ZZ XY YZ XZ). Group names are "
+                 "field data group_names (UTF-8 text, line i = code i). A model with contacts also gets "
+                 "`<file>_joints_<nnnn>.vtu`, the joint planes: one quadrilateral per sub-contact on its "
+                 "contact plane with the contact arrays above plus shear_stress, opening and (water) pressure "
+                 "(dec3d/io/jointvtk.py). Every array: docs/outputs.md.",
          examples=["block vtk", "block vtk 'jointed' interval 100", "block vtk filename 'out/blocks'",
                    "block vtk 'stage1' contacts",
                    "block vtk off"])

@@ -255,7 +255,8 @@ def insitu_contact_forces(model, cmask, stress_at) -> tuple | None:
                        units="Pa/m") for ax in ("x", "y", "z")],
                    P("nodisplacements", FLAG, "keep displacements", bare=True, supported=False),
                    P("total", FLAG, "total stresses with pore pressure", bare=True, supported=False),
-                   P("pore-pressure", Num(), "pore pressure", supported=False),
+                   P("pore-pressure", Num(), "pore pressure of the joints at the origin (with `gradient`)", units="Pa"),
+                   P("gradient", Nums(3, 3), "the pore pressure's change per metre of x, y and z", units="Pa/m"),
                    P("fluid-temperature", Num(), "fluid temperature", supported=False)],
          range="zone",
          doc="Set an in-situ stress: the stress of the zones in range and the forces of the existing "
@@ -269,13 +270,33 @@ def insitu_contact_forces(model, cmask, stress_at) -> tuple | None:
                  "The contacts are detected first if the blocks changed since the last detection (as 3DEC "
                  "keeps them current), and those following the material-table defaults take them, so the "
                  "force is kept with the stiffness they will cycle with. Contacts made later "
-                 "start from their own gap. Displacements are not changed.",
+                 "start from their own gap. Displacements are not changed.\n\n"
+                 "`pore-pressure p0 gradient gx gy gz` sets the pore pressure of every joint sub-contact to p0 + "
+                 "gx x + gy y + gz z (3DEC's words; in dec3d it reaches the joints only, zones carry no pore "
+                 "pressure), added to a water table's and to `block contact apply pore-pressure`; the joint models "
+                 "then work on effective stress (see `block water`).",
          examples=["block insitu stress -30e6 -30e6 -15e6 0 0 0",
-                   "block insitu stress -1e6 -1e6 -2e6 0 0 0 gradient-z 1e4 1e4 2e4 0 0 0 range group 'rock'"])
+                   "block insitu stress -1e6 -1e6 -2e6 0 0 0 gradient-z 1e4 1e4 2e4 0 0 0 range group 'rock'",
+                   "block insitu pore-pressure 1e6 gradient 0 0 -9810"])
 def block_insitu(session, call):
     a = call.args
+    if a["pore_pressure"] is not None:
+        from ..physics.water import set_insitu
+        if call.range is not None:
+            raise BindError("`block insitu pore-pressure` sets every joint: a range is not supported yet", call.location)
+        set_insitu(session.model, float(a["pore_pressure"]), a["gradient"])
+        if session.model.blocks.n > 1:
+            from ..physics.rigid import engine
+            from ..physics.water import refresh
+            eng = engine(session.model)
+            eng.ensure_contacts()
+            refresh(eng)
+        if a["stress"] is None:
+            return
+    elif a["gradient"] is not None:
+        raise BindError("`gradient` goes with `pore-pressure`", call.locations.get("gradient", call.location))
     if a["stress"] is None:
-        raise BindError("`block insitu` needs stress <sxx syy szz sxy sxz syz>", call.location)
+        raise BindError("`block insitu` needs stress <sxx syy szz sxy sxz syz> or pore-pressure <p>", call.location)
     m = session.model
     s0 = np.asarray(a["stress"], float)
     grad = np.array([np.zeros(6) if a[f"gradient_{ax}"] is None else np.asarray(a[f"gradient_{ax}"], float)

@@ -262,7 +262,9 @@ for _q in CONTACT_QUANTITIES:
     _doc = {"force-normal": "the normal force [N] (compression positive), summed over its sub-contacts",
             "force-shear": "the magnitude of the shear force [N] summed over its sub-contacts",
             "displacement-normal": "the mean normal displacement [m] of its sub-contacts (gap: positive)",
-            "displacement-shear": "the magnitude of the mean accumulated shear displacement [m] of its sub-contacts"
+            "displacement-shear": "the magnitude of the mean accumulated shear displacement [m] of its sub-contacts",
+            "pore-pressure": "its mean pore pressure [Pa]: the water force on it over its area (`block water`, "
+                             "`block contact apply pore-pressure`)"
             }.get(_q, f"the {_q[-1]} component of the shear force [N] on the second block, summed over its sub-contacts")
     command(f"block contact history {_q}",
             keywords=[P("position", VEC3, "the contact whose centre is nearest this point", units="m", required=True),

@@ -306,6 +306,27 @@ def _sub_ss(rt, s):
     return _vec(ss["fs"][k] / a)
 
 
+@intrinsic("block.subcontact.pp", 1)
+def _sub_pp(rt, s):
+    """Pore pressure [Pa] of the sub-contact (`block water`, `block contact apply pore-pressure`; 0 dry).
+    Its stresses above are effective: the water pushes the faces apart on top of them."""
+    ss, k = _sub_row(rt, s, "block.subcontact.pp")
+    return float(ss["pp"][k]) if "pp" in ss else 0.0
+
+
+@intrinsic("block.contact.pp", 1)
+def _c_pp(rt, c):
+    """Mean pore pressure [Pa] of the contact: its water force over its area (0 dry or without area)."""
+    cs, r = _contact_row(rt, c, "block.contact.pp")
+    ss = _stores(rt)[1]
+    if "ppf" not in ss:
+        return 0.0
+    lo = int(cs["sub_start"][r])
+    hi = lo + int(cs["sub_count"][r])
+    a = float(ss["area"][lo:hi].sum())
+    return float(ss["ppf"][lo:hi].sum()) / a if a > 0.0 else 0.0
+
+
 # ---------------------------------------------------------------- joint-model properties
 
 #: ``JMODELS[0](code)`` -> the joint model of that code (``physics.jmodels.JointModel``: ``name``, ``props``,

@@ -58,6 +58,9 @@ def contact_point_data(model) -> tuple[np.ndarray, dict]:
         "shear_displacement_magnitude": np.linalg.norm(s["us"][rows], axis=1),
         "jmodel": c["jmodel"][ci].astype(np.int32),
     }
+    if "pp" in s:           # pore pressure [Pa] and its force on the faces [N] (physics.water)
+        data["pore_pressure"] = s["pp"][rows]
+        data["pore_force"] = s["ppf"][rows]
     if "hist" in s:
         data.update(_joint_history(c["jmodel"][ci], s["hist"][rows]))
     return s["pos"][rows], data

@@ -52,7 +52,26 @@ _TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.float32): "Float32",
           np.dtype(np.uint8): "UInt8", np.dtype(np.int8): "Int8"}
 
 
-def _data_array(name: str, arr: np.ndarray, indent: str, tuples: bool = False) -> str:
+#: component names written with the six-component stress arrays (VTK's ``ComponentName<i>`` attributes)
+STRESS_NAMES = ("XX", "YY", "ZZ", "XY", "YZ", "XZ")
+#: names of the plastic-state categories: ``plastic_label`` (= state & 15) indexes this list
+PLASTIC_LABELS = tuple(" ".join(w for b, w in ((1, "shear-n"), (2, "tension-n"), (4, "shear-p"), (8, "tension-p"))
+                                if code & b) or "none" for code in range(16))
+
+
+def text_array(items) -> np.ndarray:
+    """Strings as one UInt8 field array (UTF-8, one per line): meshio reads no String arrays, and
+    ``bytes(a).decode().split("\\n")`` gives them back (``read_text_array``)."""
+    return np.frombuffer("\n".join(items).encode("utf-8"), dtype=np.uint8).copy()
+
+
+def read_text_array(arr) -> list[str]:
+    """The strings of a ``text_array`` (as read back by meshio or PyVista)."""
+    raw = bytes(np.asarray(arr, dtype=np.uint8).ravel())
+    return raw.decode("utf-8").split("\n") if raw else []
+
+
+def _data_array(name: str, arr: np.ndarray, indent: str, tuples: bool = False, components=None) -> str:
     require_finite(name, arr)
     arr = np.ascontiguousarray(arr)
     if arr.dtype == np.bool_:
@@ -62,6 +81,8 @@ def _data_array(name: str, arr: np.ndarray, indent: str, tuples: bool = False) -
     comps = "" if arr.ndim == 1 else f'NumberOfComponents="{arr.shape[1]}" '
     if tuples:                          # field data arrays must say their length
         comps += f'NumberOfTuples="{arr.shape[0]}" '
+    for i, cname in enumerate(components or ()):      # ParaView shows these in its component menu
+        comps += f'ComponentName{i}="{cname}" '
     raw = arr.astype(arr.dtype.newbyteorder("<"), copy=False).tobytes()
     payload = base64.b64encode(np.uint64(len(raw)).astype("<u8").tobytes() + raw).decode("ascii")
     return (f'{indent}<DataArray type="{_TYPES[arr.dtype]}" Name={quoteattr(name)} '
@@ -156,8 +177,30 @@ def _zone_cell_data(model, zrows, npoly: int) -> dict:
            "mean_stress": pad(mean_stress(st)), "principal_stress": pad(principal_stresses(st)),
            "von_mises": pad(von_mises(st)), "plastic_state": pad(zs["state"][zrows]),
            "cmodel": pad(zs["cmodel"][zrows])}
+    state = zs["state"][zrows]
+    # the plastic state as categories (3DEC's legend): one 0/1 array per bit, and the label code
+    for bit, key in ((1, "shear_now"), (2, "tension_now"), (4, "shear_past"), (8, "tension_past")):
+        out[key] = pad(((state & bit) != 0).astype(np.uint8))
+    out["plastic_label"] = pad((state & 15).astype(np.uint8))
     out.update(_zone_history(zs, zrows, pad))
     return out
+
+
+def gridpoint_stress(model, zrows) -> np.ndarray:
+    """(number of vertices, 6) zone stress averaged to the gridpoints, xx yy zz xy xz yz (the zones
+    store's order), each zone weighted by its volume over the zones ``zrows`` that use the point
+    (every node of a 10-node zone); 0 at points of no zone."""
+    zs = model.store("zones")
+    nn = zs["nnode"][zrows].astype(np.int64)
+    used = np.arange(10)[None, :] < nn[:, None]
+    gp = zs["gp"][zrows][used]
+    w = np.repeat(np.abs(zs["volume"][zrows]), nn)
+    st = np.repeat(zs["stress"][zrows], nn, axis=0)
+    n = model.vertices.n
+    num = np.zeros((n, 6))
+    np.add.at(num, gp, st * w[:, None])
+    den = np.bincount(gp, weights=w, minlength=n)
+    return np.where(den[:, None] > 0, num / np.where(den > 0, den, 1.0)[:, None], 0.0)
 
 
 def _zone_history(zs, zrows, pad) -> dict:
@@ -187,8 +230,16 @@ def write_vtu(model, path: str | os.PathLike, cells: str = "all", point_data: di
 
     In a model with zones, ``cells`` picks what is written: "all" (rigid blocks as polyhedra and
     zones), "blocks" (the rigid blocks only) or "zones" (the zones only)."""
-    from dec3d.model.zones import has_zones
     path = os.fspath(path)
+    text = vtu_text(model, cells, point_data, field_data)
+    with open(path, "w", encoding="utf-8", newline="\n") as fh:
+        fh.write(text)
+    return path
+
+
+def vtu_text(model, cells: str = "all", point_data: dict | None = None, field_data: dict | None = None) -> str:
+    """The text of ``write_vtu``'s file (the pictures of ``dec3d.plot`` read it from memory)."""
+    from dec3d.model.zones import has_zones
     b, v = model.blocks, model.vertices
     require_finite("Points", v["pos"])      # the fields below derive from it: name the source
     zoned = has_zones(model)
@@ -212,12 +263,18 @@ def write_vtu(model, path: str | os.PathLike, cells: str = "all", point_data: di
              'header_type="UInt64">\n',
              '  <UnstructuredGrid>\n']
     names = list(model.groups.names)
-    if names or field_data:
-        # a numeric array per name (code = its index): meshio reads no String arrays
+    zones_here = zoned and len(zrows) > 0
+    if names or field_data or zones_here:
+        # a numeric array per name (code = its index): meshio reads no String arrays; the names again as
+        # text (UTF-8 bytes, one per line, line i = code i) for labels
         parts.append("    <FieldData>\n")
         for code, gname in enumerate(names):
             parts.append(_data_array(f"group_code:{gname}", np.array([code], dtype=np.int32), ind,
                                      tuples=True))
+        if names:
+            parts.append(_data_array("group_names", text_array(names), ind, tuples=True))
+        if zones_here:
+            parts.append(_data_array("plastic_labels", text_array(PLASTIC_LABELS), ind, tuples=True))
         for key, arr in (field_data or {}).items():
             parts.append(_data_array(key, np.atleast_1d(np.asarray(arr)), ind, tuples=True))
         parts.append("    </FieldData>\n")
@@ -230,6 +287,10 @@ def write_vtu(model, path: str | os.PathLike, cells: str = "all", point_data: di
         disp[gp], vel[gp] = v["disp"][gp], v["velocity"][gp]
     parts.append(_data_array("displacement", disp, ind + "  "))
     parts.append(_data_array("velocity", vel, ind + "  "))
+    if zones_here:
+        # zone stress averaged to the gridpoints (volume-weighted): smooth contours
+        parts.append(_data_array("stress_gp", gridpoint_stress(model, zrows)[:, VTK_TENSOR_ORDER], ind + "  ",
+                                 components=STRESS_NAMES))
     for key, arr in (point_data or {}).items():
         parts.append(_data_array(key, np.asarray(arr), ind + "  "))
     parts.append("      </PointData>\n")
@@ -249,7 +310,7 @@ def write_vtu(model, path: str | os.PathLike, cells: str = "all", point_data: di
         parts.append(_data_array(f"group:{slot}", g[:, col], ind + "  "))
     if zoned and len(zrows):
         for key, arr in _zone_cell_data(model, zrows, len(order)).items():
-            parts.append(_data_array(key, arr, ind + "  "))
+            parts.append(_data_array(key, arr, ind + "  ", components=STRESS_NAMES if key == "stress" else None))
     parts.append("      </CellData>\n")
     parts.append("      <Points>\n")
     parts.append(_data_array("Points", v["pos"], ind + "  "))
@@ -261,9 +322,7 @@ def write_vtu(model, path: str | os.PathLike, cells: str = "all", point_data: di
         parts.append(_data_array("faces", faces, ind + "  "))
         parts.append(_data_array("faceoffsets", faceoffs, ind + "  "))
     parts.append("      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n")
-    with open(path, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write("".join(parts))
-    return path
+    return "".join(parts)
 
 
 def write_pvd(path: str | os.PathLike, entries: list[tuple]) -> str:
@@ -350,6 +409,13 @@ class VtkSeries:
             write_contacts_vtu(model, cvtu)
             part = 1 + max((e[2] if len(e) > 2 else 0) for e in self.entries[first:])
             self.entries.append((float(time), cvtu, part))
+        from dec3d.io.jointvtk import has_joints, write_joints_vtu
+        if has_joints(model):
+            # the joints as planes (``dec3d.io.jointvtk``), always when there are contacts; the last part
+            jvtu = self.guard(f"{self.stem}_joints_{k:04d}.vtu")
+            write_joints_vtu(model, jvtu)
+            part = 1 + max((e[2] if len(e) > 2 else 0) for e in self.entries[first:])
+            self.entries.append((float(time), jvtu, part))
         self.count += 1
         write_pvd(self.guard(self.pvd_path), self.entries)
         return vtu

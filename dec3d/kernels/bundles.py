@@ -23,7 +23,7 @@ prop (nc, NPROP) joint properties (``kernels.joints``).
 
 ``SubContacts``: contact (ns,) owner; pos (ns, 3); area (ns,) m²; fn (ns,) N; fs (ns, 3) N;
 un (ns,) m; udil (ns,) m; us (ns, 3) m; state (ns,) joint state bits; hist (ns, NJHIST) the joint
-models' own history (``kernels.joints``).
+models' own history (``kernels.joints``); ppf (ns,) the pore-pressure force [N] (``kernels.water``).
 
 ``Damping``: mode (int, ``motion.DAMP_*``), alpha (local/combined coefficient, or Rayleigh's
 mass term [1/s]), servo (``Servo``: the adaptive global damping state, persists across runs),
@@ -56,7 +56,7 @@ import numpy as np
 Bodies = namedtuple("Bodies", "mass fixity force moment fapp mapp vel spin centroid disp vstart vcount vpos")
 Groups = namedtuple("Groups", "start member mass imass iscalar prin axes centroid")
 Contacts = namedtuple("Contacts", "a b normal pos own jmodel prop")
-SubContacts = namedtuple("SubContacts", "contact pos area fn fs un udil us state hist")
+SubContacts = namedtuple("SubContacts", "contact pos area fn fs un udil us state hist ppf")
 Servo = namedtuple("Servo", "alpha work dek nwin ratio window factor lastr hist calls")
 Damping = namedtuple("Damping", "mode alpha servo prev")
 Bounds = namedtuple("Bounds", "radius acc trigger motion")

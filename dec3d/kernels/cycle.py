@@ -37,6 +37,7 @@ from .joints import cycle_mask
 from .jointlaw import block_lists, block_sum, update_one
 from .motion import rigid_motion_groups
 from .rayleigh import contact_stiffness_damping
+from .water import any_pressure, pore_forces
 
 
 #: a model with less work per step than this (sub-contacts + 4 × bodies) runs the serial twin of
@@ -175,8 +176,9 @@ def _run_steps(models, nsteps, dt, gravity, full_inertia, beta, damping, groups,
     gstart, gmember = groups.start, groups.member
     centroid, vel, spin, force, moment = bodies.centroid, bodies.vel, bodies.spin, bodies.force, bodies.moment
     ca, cb, cn, cc, cown, cmodel, cprop = contacts
-    sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist = subs
+    sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sc_ppf = subs
     radius, acc, trigger, motion = bounds
+    wet = any_pressure(sc_ppf)   # pore pressures (fixed between detections): their force on top of the law's
     done = 0
     bad = -1
     motion[1] = 0.0
@@ -186,6 +188,8 @@ def _run_steps(models, nsteps, dt, gravity, full_inertia, beta, damping, groups,
         _contact_pass(models, pending, dt, centroid, vel, spin, ca, cb, cn, cc, cmodel, cprop, cstart,
                       sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg)
         pending = False
+        if wet:
+            pore_forces(cn, sc_contact, sc_ppf, sg)
         if beta > 0.0:
             contact_stiffness_damping(beta, centroid, vel, spin, ca, cb, cn, cmodel, cprop, sc_contact, sc_pos, sc_area,
                                       sc_fn, sc_state, sc_hist, sg)

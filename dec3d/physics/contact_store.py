@@ -39,6 +39,8 @@ CONTACT_FIELDS = {
     "ref_cb": Field((3,), _F, 0.0),
     "ref_ta": Field((), _F, 0.0),
     "ref_tb": Field((), _F, 0.0),
+    # pore pressure given by `block contact apply pore-pressure` (summed) [Pa] (physics.water)
+    "pp_apply": Field((), _F, 0.0),
 }
 
 SUBCONTACT_FIELDS = {
@@ -63,6 +65,10 @@ SUBCONTACT_FIELDS = {
     "gw_a": Field((3,), _F, 0.0),
     "gp_b": Field((3,), _I, -1),
     "gw_b": Field((3,), _F, 0.0),
+    # pore pressure [Pa], positive pushes the blocks apart; worked out from its sources (physics.water)
+    "pp": Field((), _F, 0.0),
+    # its force p·A' [N] on the faces (A' from ``kernels.water.pressure_areas``), what the cycle applies
+    "ppf": Field((), _F, 0.0),
 }
 
 

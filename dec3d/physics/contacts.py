@@ -44,6 +44,7 @@ from dec3d.model.ranges import pairs_in_groups
 
 from .contact_store import history_columns
 from .jmodels import JOINT_MODELS, MODEL_BY_CODE
+from .water import refresh as refresh_pore_pressure
 
 _I = np.int64
 
@@ -408,6 +409,8 @@ class ContactDetection:
             for code in codes:
                 prop[follow & (jcode == code)] = default_row(s, int(code))
         group[old] = cs["group"][prev_c[old]]
+        pp_apply = np.zeros(nc)
+        pp_apply[old] = cs["pp_apply"][prev_c[old]]
         if s.get("mtables") and not old.all():      # `block contact material-table add` entries
             apply_material_tables(m, s["mtables"], ~old, ra_c, rb_c, jcode, prop, own)
         # sub-contacts of the recomputed contacts (zero-area ones carry nothing and are dropped)
@@ -485,7 +488,7 @@ class ContactDetection:
         values = {"ida": ids[ra_c], "idb": ids[rb_c], "a": ra_c, "b": rb_c, "pos": cpos, "normal": normal,
                   "gap": cgap, "type": ctyp, "jmodel": jcode, "prop": prop, "own_props": own, "sub_start": starts,
                   "sub_count": counts, "group": group, "ref_ca": ref_ca, "ref_cb": ref_cb, "ref_ta": ref_ta,
-                  "ref_tb": ref_tb}
+                  "ref_tb": ref_tb, "pp_apply": pp_apply}
         rows_new = cs.blank(nc, values)         # (the other fields get their fill value)
         for key, val in values.items():
             rows_new[key][:nc] = val
@@ -494,6 +497,7 @@ class ContactDetection:
             ss["contact"][...] = np.repeat(np.arange(nc, dtype=_I), counts)
         else:
             ss.install(total, gathered)
+        refresh_pore_pressure(self)         # (the sub-contacts' pore pressure from its sources)
         # the blocks looked at are the new reference for "moved"
         if full:
             look[...] = vpos

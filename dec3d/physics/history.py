@@ -35,7 +35,8 @@ RIGID_QUANTITIES = tuple(f"angular-momentum{s}" for s, _ in _XYZ) + ("shape-erro
 #: contact quantity -> (sub-contact field, how it is reduced); ``block contact history``
 CONTACT_QUANTITIES = {"force-normal": ("fn", "sum"), "force-shear": ("fs", "norm"),
                       "force-shear-x": ("fs", 0), "force-shear-y": ("fs", 1), "force-shear-z": ("fs", 2),
-                      "displacement-normal": ("un", "mean"), "displacement-shear": ("us", "norm-mean")}
+                      "displacement-normal": ("un", "mean"), "displacement-shear": ("us", "norm-mean"),
+                      "pore-pressure": ("ppf", "per-area")}
 #: gridpoint quantity -> (vertex field, component or None for the magnitude); ``block history`` on a zoned block
 GRIDPOINT_QUANTITIES = {q: ({"centroid": "pos"}.get(fld, fld), comp) for q, (fld, comp) in BLOCK_QUANTITIES.items()
                         if fld in ("disp", "velocity", "centroid")}
@@ -392,6 +393,9 @@ class HistorySet:
                 return 0.0                     # the two blocks are no longer in contact
             k = int(hit[0])
             s0, n = int(c["sub_start"][k]), int(c["sub_count"][k])
+            if how == "per-area":               # the water force over the contact's area (physics.water)
+                a = float(sc["area"][s0:s0 + n].sum())
+                return float(sc[fld][s0:s0 + n].sum()) / a if fld in sc and a > 0.0 else 0.0
             v = sc[fld][s0:s0 + n]
             if how == "sum":
                 return float(v.sum())

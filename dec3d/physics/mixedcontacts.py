@@ -13,6 +13,7 @@ from dec3d.kernels.gpcontact import (mixed_move_points, mixed_subcontact_forces,
 from dec3d.physics.jmodels import stiffness as joint_stiffness
 from dec3d.kernels.motion import rigid_motion_groups
 from dec3d.kernels.rayleigh import mixed_stiffness_damping
+from dec3d.kernels.water import any_pressure, mixed_pore_forces
 from dec3d.model.model import KIND_DEFORMABLE, KIND_FE
 
 _I = np.int64
@@ -104,12 +105,16 @@ class MixedContactSteps:
             touched = np.ascontiguousarray(touched[touched >= 0])
         cown = np.arange(cs.n, dtype=_I)
         gstart, gmember = groups.start, groups.member
+        wet = any_pressure(ss["ppf"])         # pore pressure (physics.water): fixed between detections
         for _ in range(k):
             facc = zst.begin()
             mixed_subcontact_forces(dt, b["centroid"], b["velocity"], b["spin"], b["force"], b["moment"], gvel, gc,
                                     cs["a"], cs["b"], cs["normal"], cs["jmodel"], cs["prop"], ss["contact"], ss["pos"],
                                     ss["area"], ss["fn"], ss["fs"], ss["un"], ss["udil"], ss["us"], ss["state"], ss["hist"],
                                     *wsub)
+            if wet:
+                mixed_pore_forces(b["centroid"], b["force"], b["moment"], gc, cs["a"], cs["b"], cs["normal"],
+                                  ss["contact"], ss["pos"], ss["ppf"], *wsub)
             if zst.beta > 0.0:          # Rayleigh damping's stiffness term (physics.dynamic)
                 mixed_stiffness_damping(zst.beta, b["centroid"], b["velocity"], b["spin"], b["force"], b["moment"],
                                         gvel, gc, cs["a"], cs["b"], cs["normal"], cs["jmodel"], cs["prop"],

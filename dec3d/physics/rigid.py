@@ -31,6 +31,7 @@ from dec3d.model.zones import has_zones
 from .beams import beam_balance, has_beams
 from .cables import cable_timestep, grouted_timestep
 from .massscale import DensityScaling
+from .water import total_normal_force
 from .contact_store import contact_stores
 from .contacts import ContactDetection, default_row
 from .dynamic import DYN_DEFAULTS, rayleigh_coefficients
@@ -309,7 +310,8 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
         A = np.empty(ng)
         if ng:
             body_balance(np.asarray(m.settings.gravity, dtype=_F), gstart, gmember, b["mass"], b["fapp"], held,
-                         cs["a"], cs["b"], cs["normal"], ss["contact"], ss["fn"], ss["fs"], np.empty((b.n, 3)),
+                         cs["a"], cs["b"], cs["normal"], ss["contact"], total_normal_force(ss), ss["fs"],
+                         np.empty((b.n, 3)),
                          np.empty(b.n), un, A)
         free = (held & 7) != 7
         un = un[free]

@@ -37,6 +37,7 @@ from .history import HistorySet
 from .mixedcontacts import _deformable
 from .rigid import RigidEngine, RunError, _has_gridpoints
 from .runcontrol import _Progress, _StopFlag
+from .water import refresh_if_stale
 
 _F = np.float64
 _I = np.int64
@@ -151,6 +152,7 @@ class _Run:
         if self.mixed:
             self.wsub, self.wcon = eng._mixed_weights(self.zst, recompute=not between)
         history_columns(eng.subcontacts, eng.contacts["jmodel"])   # (a restored or edited model)
+        refresh_if_stale(eng)              # pore pressures (physics.water) after a change of their sources
         bad = eng.property_problem()
         if bad:
             raise RunError(bad)

@@ -37,8 +37,10 @@ def test_vtu_reads_back_with_cells_and_data(model, tmp_path):
     np.testing.assert_array_equal(grid.cell_data["hidden"], b["hidden"][order].astype(np.uint8))
     np.testing.assert_array_equal(grid.cell_data["group:Default"], b["group"][order, 0])
     np.testing.assert_array_equal(grid.cell_data["group:level"], b["group"][order, 1])
-    assert {k: int(grid.field_data[k][0]) for k in grid.field_data.keys()} == {"group_code:rock": 0,
-                                                                           "group_code:top": 1}
+    assert {k: int(grid.field_data[k][0]) for k in grid.field_data.keys()
+            if k.startswith("group_code:")} == {"group_code:rock": 0, "group_code:top": 1}
+    from dec3d.io.vtk import read_text_array
+    assert read_text_array(grid.field_data["group_names"]) == ["rock", "top"]      # line i: the name of code i
     np.testing.assert_array_equal(grid.point_data["displacement"], 0.0)     # nothing has moved
     np.testing.assert_array_equal(grid.point_data["velocity"], np.tile([0, 0, -1.0], (model.vertices.n, 1)))
     # VTK computes the same polyhedron volumes from the faces written

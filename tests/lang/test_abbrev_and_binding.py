@@ -59,9 +59,10 @@ def test_legacy_syntax_is_named(session):
     assert "3DEC 5" in e.value.message and "block cut joint-set" in e.value.hint
 
 
-def test_plot_is_accepted_with_a_notice(session):
+def test_plot_of_a_plot_the_deck_did_not_make_is_drawn_with_a_notice(session, tmp_path):
     session.command("plot 'Blocks' export bitmap filename \"blocks-hex.png\"")
-    assert "display-only" in session.output.getvalue()
+    assert "was not made in this deck" in session.output.getvalue()
+    assert (tmp_path / "blocks-hex.png").stat().st_size > 0
 
 
 def test_wrong_value_type_and_count(session):

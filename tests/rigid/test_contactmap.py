@@ -200,7 +200,7 @@ def test_run_steps_against_the_cycle_written_from_the_equations(session):
            "verts": m.vertices["pos"], "out": np.zeros(4),
            "contacts": dict(a=cs["a"], b=cs["b"], normal=cs["normal"], pos=cs["pos"], jmodel=cs["jmodel"],
                             prop=cs["prop"]),
-           "sub": {k: ss[k] for k in ("contact", "pos", "area", "fn", "fs", "un", "udil", "us", "state", "hist")}}
+           "sub": {k: ss[k] for k in ("contact", "pos", "area", "fn", "fs", "un", "udil", "us", "state", "hist", "ppf")}}
     st0 = copy.deepcopy(st0)                      # plain copies of every array
     fast, slow = copy.deepcopy(st0), copy.deepcopy(st0)
     g, dt, n = np.array([0.0, 0.0, -10.0]), e.timestep(), 40

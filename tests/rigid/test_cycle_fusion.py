@@ -53,7 +53,7 @@ def state(tmp_path_factory):
                                              "centroid", "disp", "vert_start", "vert_count")},
           "vpos": np.array(m.vertices["pos"]),
           "c": {k: np.array(cs[k]) for k in ("a", "b", "normal", "pos", "jmodel", "prop")},
-          "s": {k: np.array(ss[k]) for k in ("contact", "pos", "area", "fn", "fs", "un", "udil", "us", "state", "hist")},
+          "s": {k: np.array(ss[k]) for k in ("contact", "pos", "area", "fn", "fs", "un", "udil", "us", "state", "hist", "ppf")},
           "g": dict(start=gstart, member=gmember, mass=rng.uniform(2e3, 3e3, ng), imass=rng.uniform(3e3, 4e3, ng),
                     iscalar=rng.uniform(500, 900, ng), prin=rng.uniform(400, 500, (ng, 3)),
                     axes=np.repeat(np.eye(3)[None], ng, axis=0), centroid=np.zeros((ng, 3))),
