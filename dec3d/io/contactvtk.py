@@ -14,7 +14,8 @@ Point data, per sub-contact:
   ``normal_displacement`` [m], ``shear_displacement`` (accumulated vector) and
   ``shear_displacement_magnitude`` [m];
 - ``jmodel`` (the joint model's code) and each joint model's history entries under the names its
-  kernel gives them (``HIST_NAMES`` of ``kernels/joints``), 0 on the sub-contacts of other models.
+  kernel gives them (``HIST_NAMES`` of ``kernels/joints``), 0 on the sub-contacts of other models; a
+  name an array above already has gets ``_history`` after it (softening-mohr's ``slip_history``).
 
 Arrays are written like ``dec3d.io.vtk``'s (inline base64, numeric only), so ParaView, PyVista
 and meshio read them; a model with no sub-contacts gives a valid file with no points."""
@@ -62,7 +63,10 @@ def contact_point_data(model) -> tuple[np.ndarray, dict]:
         data["pore_pressure"] = s["pp"][rows]
         data["pore_force"] = s["ppf"][rows]
     if "hist" in s:
-        data.update(_joint_history(c["jmodel"][ci], s["hist"][rows]))
+        # a history entry named as an array above (softening-mohr's `slip`, its slip displacement) keeps the
+        # array and is written as `<name>_history`
+        for name, col in _joint_history(c["jmodel"][ci], s["hist"][rows]).items():
+            data[name if name not in data else f"{name}_history"] = col
     return s["pos"][rows], data
 
 

@@ -56,10 +56,8 @@ def joint_polygons(model) -> tuple[np.ndarray, dict]:
         data["shear_stress"] = np.where(area > 0, data["shear_force_magnitude"] / np.where(area > 0, area, 1.0), 0.0)
     data["opening"] = np.maximum(data["normal_displacement"], 0.0)
     s = model.store("subcontacts")
-    for key in ("pp", "pressure"):            # water in the joints, when the model has it
-        if key in s:
-            data["pressure"] = _rows_of(model, s[key])
-            break
+    if "pp" in s:                             # water in the joints (physics.water): the pore pressure [Pa]
+        data["pressure"] = _rows_of(model, s["pp"])
     return corners, data
 
 
