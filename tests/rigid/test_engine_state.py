@@ -147,10 +147,11 @@ def test_block_vtk_interval_writes_snapshots_while_cycling(session, tmp_path):
     import pyvista as pv
 
     _run(session, SPRING + f"block vtk filename '{tmp_path / 'snap'}' interval 20\nmodel cycle 100\n")
-    files = sorted(tmp_path.glob("snap_*.vtu"))
+    files = sorted(tmp_path.glob("snap_[0-9]*.vtu"))             # (the joints files are snap_joints_*)
     assert len(files) == 6                                      # step 0, then 20, 40, 60, 80, 100
+    assert len(sorted(tmp_path.glob("snap_joints_*.vtu"))) == 6
     pvd = (tmp_path / "snap.pvd").read_text()
-    assert pvd.count("<DataSet") == 6
+    assert pvd.count("<DataSet") == 12 and pvd.count('part="1"') == 6          # blocks (part 0) and joints
     last = pv.read(files[-1])
     assert np.isclose(last.points[:, 2].max(), 1.0 + session.model.blocks["disp"][1, 2], atol=1e-12)
 
