@@ -45,7 +45,7 @@ MAX_STEPS = 30
 #: 10000 steps, and a search runs several: left unbounded, a few such lines took most of the fuzz time)
 CYCLING = (("model", "solve"), ("model", "factor-of-safety"))
 #: examples per test are multiplied by DEC3D_FUZZ_SCALE (default 1, for CI); a longer local hunt:
-#: DEC3D_FUZZ_SCALE=50 DEC3D_FUZZ_RANDOM=1 python -m pytest tests/robustness/test_fuzz.py
+#: DEC3D_FUZZ_SCALE=50 DEC3D_FUZZ_RANDOM=1 python -m pytest tests/hostile/test_fuzz.py
 SCALE = max(1, int(os.environ.get("DEC3D_FUZZ_SCALE", "1")))
 # no shrinking: a failure is reported as found (shrinking a slow case could take minutes in CI)
 SETTINGS = dict(derandomize=not os.environ.get("DEC3D_FUZZ_RANDOM"), deadline=None, database=None,
