@@ -252,7 +252,7 @@ def main(argv: list[str] | None = None) -> int:
     from .plot.cli import add_parser as add_plot
     add_plot(sub).set_defaults(fn=_plot)
     d = sub.add_parser("docs", help="write the command reference pages from the registry")
-    d.add_argument("--dir", default="commands")
+    d.add_argument("--dir", default="docs/commands")
     d.set_defaults(fn=_docs)
     args = ap.parse_args(argv)
     return args.fn(args)

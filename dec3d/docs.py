@@ -1,4 +1,4 @@
-"""The `commands/` reference: one page per registered command, written from its declaration.
+"""The `docs/commands/` reference: one page per registered command, written from its declaration.
 
 `dec3d docs` rewrites the pages; a test fails when a page differs from what the
 declaration gives, so the reference can never drift from the code. The REPL's

@@ -2,7 +2,7 @@
 
 Persistent history, completion of command words, keywords and range elements from
 the registry (3DEC commands dec3d does not run yet are marked "not supported yet"),
-`help <command>` showing the `commands/` page rendered by rich, continuation lines
+`help <command>` showing the `docs/commands/` page rendered by rich, continuation lines
 (`&`, `...`) and FISH blocks read until `end`. An error is printed and the session
 goes on; Ctrl-D (or `program exit`) ends it.
 """
@@ -163,7 +163,7 @@ def _help(session, words: list[str]) -> None:
         session.write("Commands: " + ", ".join(sorted(REGISTRY.root.children)))
         session.write("Type `help <command>` (abbreviations work), e.g. `help model gravity`.")
         return
-    folder = Path(__file__).resolve().parent.parent / "commands"
+    folder = Path(__file__).resolve().parent.parent / "docs" / "commands"
     page = page_for(words, folder if folder.is_dir() else None)
     if page is None:
         session.write(f"no command `{' '.join(words)}`; type `help` for the list")

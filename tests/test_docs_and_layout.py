@@ -14,11 +14,11 @@ load_all()
 
 
 def test_every_command_has_an_up_to_date_page():
-    folder = ROOT / "commands"
+    folder = ROOT / "docs" / "commands"
     for name, text in pages().items():
         p = folder / name
-        assert p.exists(), f"commands/{name} missing: run `dec3d docs`"
-        assert p.read_text(encoding="utf-8") == text, f"commands/{name} is stale: run `dec3d docs`"
+        assert p.exists(), f"docs/commands/{name} missing: run `dec3d docs`"
+        assert p.read_text(encoding="utf-8") == text, f"docs/commands/{name} is stale: run `dec3d docs`"
     for cmd in REGISTRY.commands.values():
         assert (folder / page_name(cmd)).exists()
 
@@ -34,7 +34,7 @@ def test_page_examples_parse_and_bind_to_their_command(path):
     from dec3d.lang.parser import parse_deck
 
     cmd = REGISTRY.commands[path]
-    text = (ROOT / "commands" / page_name(cmd)).read_text(encoding="utf-8")
+    text = (ROOT / "docs" / "commands" / page_name(cmd)).read_text(encoding="utf-8")
     examples = _examples(text)
     assert examples, f"{cmd.name} has no example"
     for ex in examples:
@@ -181,3 +181,11 @@ def test_no_eval_exec_or_pickle_in_the_package():
         src = f.read_text(encoding="utf-8")
         for pat in (r"\beval\(", r"\bexec\(", r"pickle\.load", r"allow_pickle\s*=\s*True"):
             assert not re.search(pat, src), f"{f}: {pat}"
+
+
+def test_the_top_level_commands_folder_points_to_the_reference():
+    """The project's layout keeps a top-level `commands/`: an index pointing to `docs/commands/`, where the
+    generated pages are (they no longer share a folder name with the package `dec3d/commands/`)."""
+    index = (ROOT / "commands" / "README.md").read_text(encoding="utf-8")
+    assert "docs/commands/README.md" in index and (ROOT / "docs" / "commands" / "README.md").is_file()
+    assert sorted(p.name for p in (ROOT / "commands").iterdir()) == ["README.md"]

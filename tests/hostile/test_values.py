@@ -130,7 +130,7 @@ def test_cli_reports_the_value_and_exits_2(tmp_path, text, message, column):
 
 
 def test_the_range_is_on_the_command_page():
-    page = (ROOT / "commands" / "block_contact_property.md").read_text()
+    page = (ROOT / "docs" / "commands" / "block_contact_property.md").read_text()
     assert "| `friction` | <f> in [0, 90] |" in page and "| `dilation` | <f> in [0, 90) |" in page
     assert "| `stiffness-normal` | <f> in [0, 1e+20] |" in page
 
