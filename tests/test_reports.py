@@ -74,7 +74,8 @@ def test_a_range_that_selects_nothing_warns_once_and_is_an_error_when_strict(ses
     assert text.count("the range selects no block (of 2)") == 2          # once per line (two lines here)
     session.command("fish define f\n  loop i (1, 5)\n    command\n      block fix range id 99\n    endcommand\n"
                     "  endloop\nend\n@f")
-    assert session.output.getvalue().count("the range selects no block") == 3      # the loop's line once
+    # not inside FISH: a loop scanning positions or groups meets empty ones as a matter of course
+    assert session.output.getvalue().count("the range selects no block") == 2
     session.strict = True
     with pytest.raises(CommandError) as e:
         session.command("block fix range position-x 7 8")

@@ -52,7 +52,11 @@ def bind_or_defer(session, binder, raw):
 
 def empty_range(session, call, store: str, n: int) -> None:
     """A range that selects nothing: a warning naming the line (once per line), an error with
-    ``dec3d run --strict`` (``Session.strict``)."""
+    ``dec3d run --strict`` (``Session.strict``). Not for the lines of a FISH function's command
+    sections: a loop that scans positions or groups meets empty ones as a matter of course."""
+    rt = getattr(session, "fish_rt", None)
+    if rt is not None and rt.depth > 0:
+        return
     loc = call.range.elements[0].location if call.range.elements else call.location
     text = f"the range selects no {store} (of {n})"
     if getattr(session, "strict", False):
