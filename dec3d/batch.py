@@ -2,22 +2,19 @@
 
     rows = dec3d.batch.run("wedge.dat", {"phi": [32, 33, 34]}, out="runs", workers=2)
 
-Each run is a fresh ``Session`` whose ``parameters`` are the run's values: FISH variables before
-the deck is bound (so `[phi]` and `@phi` bind), kept through `model new`, and a deck's own
-`[phi = …]` (its default for `dec3d run`) does not replace them. Every run writes into its own
-folder ``<out>/run-0001-phi=32`` with ``result.json`` (its row) and ``output.txt`` (what it printed);
-a rerun skips runs whose ``result.json`` holds the same values. The table (``results.csv``, and
-``results.parquet`` when pyarrow is installed) has one row per run in run order: the parameters,
-``status`` (ok | error), ``error`` (the dec3d message with file:line:column), ``wall_s``, the
-final value of every history (``<name>.final``) and the figures the deck reported
-(``session.results``, e.g. `history export`'s ``<name>.max``).
+Each run is a fresh ``Session`` whose ``parameters`` are the run's values: FISH variables before the deck
+is bound (so `[phi]` and `@phi` bind), kept through `model new`, and a deck's own `[phi = …]` (its
+default for `dec3d run`) does not replace them. Every run writes into its own folder
+``<out>/run-0001-phi=32`` with ``result.json`` (its row) and ``output.txt`` (what it printed); a rerun
+skips runs whose ``result.json`` holds the same values. The table (``results.csv``, and
+``results.parquet`` with pyarrow) has one row per run in run order: the parameters, ``status`` (ok |
+error), ``error`` (the dec3d message with file:line:column), ``wall_s``, the final value of every
+history (``<name>.final``) and the figures the deck reported (``session.results``).
 
-Runs go to a ``concurrent.futures.ProcessPoolExecutor`` (spawn) by default, or to a Dask cluster
-(``scheduler="tcp://host:port"`` or ``"local"``; ``pip install dec3d[dask]``). For Dask the deck and
-the files it calls or reads (regular files under the deck's folder, found by binding the deck) are
-read into memory and sent with each task; the worker writes them into a temporary folder, runs there
-and sends back the row and the files the run wrote, which are put into the run's folder. Nothing
-relies on a shared file system.
+Runs go to a ``ProcessPoolExecutor`` (spawn) by default, or to a Dask cluster (``scheduler=
+"tcp://host:port"`` or ``"local"``; ``pip install dec3d[dask]``): the deck and the files it calls or
+reads (found by binding it) are sent with each task, written into a temporary folder on the worker
+and run there; the row and the files written come back. Nothing relies on a shared file system.
 """
 from __future__ import annotations
 
@@ -216,7 +213,7 @@ def run_one(deck: str, values: dict[str, Any], out_dir: str, timeout: float | No
                 items = session.load_file(deck)
                 session.run_items(items)
         except Dec3dError as exc:
-            row.update(status="error", error=exc.format().splitlines()[0])
+            row.update(status="error", error=exc.format().splitlines()[0] + (f" ({exc.hint})" if exc.hint else ""))
             print(exc.format(), file=log)
         except KeyboardInterrupt:
             if limit is not None and limit.expired:
@@ -253,7 +250,10 @@ def _run_local(task: dict) -> dict:
 def _run_shipped(task: dict) -> dict:
     """Dask task: write the shipped files into a temporary folder, run there, send back the row and
     the files written (relative name → bytes)."""
-    with tempfile.TemporaryDirectory(prefix="dec3d-batch-") as tmp:
+    from .io.paths import DASK_MISSING, missing_hint
+
+    # (a file a run names by an expression was not sent to this worker: the hint says so)
+    with tempfile.TemporaryDirectory(prefix="dec3d-batch-") as tmp, missing_hint(DASK_MISSING):
         src = Path(tmp) / "deck"
         out = Path(tmp) / "out"
         for rel, data in task["files"].items():
@@ -290,12 +290,12 @@ def run(deck: str | Path, params: dict[str, Iterable], out: str | Path = "batch"
     DataFrame when pandas is installed, else a list of dicts), also written to ``out/results.csv``.
 
     workers: processes of the local pool (default: the CPU count). scheduler: a Dask scheduler address
-    (``tcp://host:port``) or ``"local"`` (a LocalCluster of ``workers`` processes); client: a
-    ``dask.distributed.Client`` to use instead. retries: times Dask runs a task again when it raises
-    (a run lost with its worker is rescheduled by Dask itself, up to its ``allowed-failures``). progress: a bar (True), a line per run (False), None: a bar on a terminal, "off": nothing.
-    on_result(row) is called in the calling process as each run finishes, and ``results.csv`` is
-    written again with every run finished so far (a batch stopped half-way keeps its table).
-    timeout: seconds of wall time a run may take; a run stopped by it has status ``timeout``.
+    (``tcp://host:port``) or ``"local"`` (a LocalCluster of ``workers`` processes); client: a Dask
+    ``Client`` to use instead. retries: times Dask runs a failed task again (a run lost with its worker is
+    rescheduled by Dask, up to its ``allowed-failures``). progress: a bar (True), a line per run (False),
+    None: a bar on a terminal, "off": nothing. on_result(row): called as each run finishes, and
+    ``results.csv`` is written again (a batch stopped half-way keeps its table). timeout: seconds a run
+    may take (status ``timeout``).
     """
     deck = Path(deck)
     if not deck.is_file():

@@ -178,3 +178,18 @@ def test_a_local_dask_cluster_keeps_its_scratch_inside_the_output_folder(tmp_pat
                            on_result=lambda row: seen.append(any((out / batch.DASK_SCRATCH).iterdir()))))
     assert [r["status"] for r in rows] == ["ok", "ok"] and seen == [True, True]
     assert not (out / batch.DASK_SCRATCH).exists()
+
+
+def test_under_dask_a_file_named_by_an_expression_is_refused_with_the_reason(tmp_path):
+    """Issue 35 item 4: a Dask worker gets the files the deck names literally; `program call [name]` names
+    one only when the run gets there, so the worker does not have it: the row says why and what to do
+    (the same deck runs on the process pool, where the worker reads the deck's folder)."""
+    pytest.importorskip("dask.distributed")
+    deck = tmp_path / "d.dat"
+    deck.write_text("[name = 'sub' + string(a)]\nprogram call [name]\n")
+    (tmp_path / "sub1.dat").write_text("model title 'from sub1'\n")
+    rows = _rows(batch.run(deck, {"a": [1]}, tmp_path / "dask", scheduler="local", workers=1, progress=False))
+    assert rows[0]["status"] == "error" and "no such file" in rows[0]["error"]
+    assert "names literally" in rows[0]["error"] and "without --dask" in rows[0]["error"]
+    local = _rows(batch.run(deck, {"a": [1]}, tmp_path / "pool", workers=1, progress=False))
+    assert local[0]["status"] == "ok"

@@ -16,6 +16,8 @@ shows anything read from a file.
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 import os
 from pathlib import Path
 
@@ -172,7 +174,27 @@ def find_input(name, bases, roots, allow_outside: bool = False, exts: tuple[str,
         raise PathError(f"`{_short(text)}` ({odd[0]}) is {odd[1]}, not a regular file: dec3d reads only "
                         "regular files")
     looked = ", ".join(_short(str(c)) for c in cands)
-    raise PathError(f"cannot read {what} `{_short(text)}`: no such file (looked for {looked})")
+    raise PathError(f"cannot read {what} `{_short(text)}`: no such file (looked for {looked})",
+                    hint=MISSING_HINT[0])
+
+
+#: a hint for files not found, set where the reason is known: a `dec3d batch --dask` worker has only the
+#: files the deck names literally (``dec3d.batch``), not those a run names by an expression
+MISSING_HINT: list = [None]
+
+
+@contextmanager
+def missing_hint(text: str):
+    """While in the block, a file not found says ``text`` as its hint."""
+    old, MISSING_HINT[0] = MISSING_HINT[0], text
+    try:
+        yield
+    finally:
+        MISSING_HINT[0] = old
+
+
+DASK_MISSING = ("a `dec3d batch --dask` worker has only the files the deck names literally (and those they "
+                "call): name this one literally, or run the batch on the process pool (without --dask)")
 
 
 def os_error_text(exc: OSError) -> str:
