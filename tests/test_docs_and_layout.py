@@ -64,7 +64,7 @@ MAY_IMPORT = {
     "check": BASE | {"lang", "fish", "commands", "session"},
     # the itasca-compatible Python API on sessions (docs/python.md); reached from the top (cli, __init__)
     "itasca": BASE | {"lang", "fish", "commands", "session", "model", "geometry", "kernels", "io", "physics"},
-    "batch": BASE | {"lang", "commands", "session", "timelimit"},
+    "batch": BASE | {"lang", "commands", "session", "timelimit", "io"},
     "legacy_run": BASE | {"lang", "session", "commands"},    # `dec3d run` of 3DEC 4/5 decks: translated in memory
     "timelimit": BASE | {"fish", "physics"},     # stops a run: the engine's and FISH's stop flags
     "warmup": BASE | {"kcache", "session"},      # the cold-start helper process of `dec3d run`      # runs decks in sessions, in processes or on Dask
