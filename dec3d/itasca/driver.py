@@ -37,6 +37,8 @@ def alias_itasca() -> None:
         sys.modules[f"itasca.{name}"] = mod
     sys.modules["itasca.structure.cable"] = it.structure.cable
     sys.modules["itasca.structure.node"] = it.structure.node
+    sys.modules["itasca.structure.beam"] = it.structure.beam
+    sys.modules["itasca.structure.dowel"] = it.structure.dowel
 
 
 def model_of(session, base_dir: Path) -> Model:

@@ -71,3 +71,28 @@ def test_cables_read_their_stores():
     assert it.structure.node.find(99) is None
     with pytest.raises(ValueError, match="no cable element with id 99"):
         it.structure.Cable(it.current(), 99).force_axial()
+
+
+CANTILEVER = """model new
+block create brick 20 21 0 1 0 1
+block property density 1000
+block fix
+structure beam create by-line 0 0 0 4 0 0 segments 8 id 1
+structure beam property young 200e9 poisson 0.25 cross-sectional-area 1e-2 moi-y 2e-5 moi-z 5e-5 moi-polar 7e-5
+structure node fix velocity rotation range id 1
+structure node apply force-z -5000 range id 9
+model solve ratio 1e-7
+"""
+
+
+def test_beams_through_the_structure_module():
+    """A cantilever L = 4 m under P = 5 kN at its tip: the tip node sags P L³ / 3 E I, the fixed end puts
+    the moment P L on the first element; read through it.structure.node and it.structure.beam."""
+    it.command(CANTILEVER)
+    assert it.structure.beam.count() == 8 and it.structure.node.count() == 9
+    tip = it.structure.node.find(9)
+    assert -tip.disp()[2] == pytest.approx(5000.0 * 4.0 ** 3 / (3 * 200e9 * 2e-5), rel=1e-3)
+    first = it.structure.beam.find(1)
+    assert abs(first.moment(1)[1]) == pytest.approx(5000.0 * 4.0, rel=1e-3)
+    assert first.force_axial() == pytest.approx(0.0, abs=1e-3) and first.id() == 1
+    assert it.structure.beam.find(99) is None and it.structure.dowel.count() == 0
