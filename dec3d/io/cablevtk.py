@@ -29,7 +29,6 @@ def write_cables_vtu(model, path: str | os.PathLike) -> str:
     nodes, segs = cable_stores(model)
     pts = nodes["pos"]
     require_finite("cable node positions", pts)
-    n, s = nodes.n, segs.n
     area = segs["prop"][:, 1]
     with np.errstate(divide="ignore", invalid="ignore"):
         stress = np.where(area > 0, segs["fa"] / np.where(area > 0, area, 1.0), 0.0)
@@ -40,6 +39,14 @@ def write_cables_vtu(model, path: str | os.PathLike) -> str:
             "slip": ((state & 4) != 0).astype(np.uint8)}
     point = {"node_id": nodes["id"].astype(np.int64), "displacement": nodes["disp"], "velocity": nodes["vel"],
              "grouted": (nodes["host"] >= 0).astype(np.uint8)}
+    return write_line_vtu(path, pts, segs["na"], segs["nb"], point, cell)
+
+
+def write_line_vtu(path: str, pts, na, nb, point: dict, cell: dict) -> str:
+    """A ``.vtu`` of line cells between points ``pts`` (rows ``na[i]`` – ``nb[i]``), with point and cell
+    data arrays (the first of each is what ParaView colours by: displacement, axial force); cables and
+    beams (``io.beamvtk``) write theirs with it."""
+    n, s = len(pts), len(na)
     ind = "        "
     parts = ['<?xml version="1.0"?>\n',
              '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">\n',
@@ -53,7 +60,7 @@ def write_cables_vtu(model, path: str | os.PathLike) -> str:
     parts.append("      </CellData>\n      <Points>\n")
     parts.append(_data_array("Points", np.ascontiguousarray(pts, dtype=np.float64).reshape(n, 3), ind))
     parts.append("      </Points>\n      <Cells>\n")
-    conn = np.column_stack([segs["na"], segs["nb"]]).astype(np.int64).ravel()
+    conn = np.column_stack([na, nb]).astype(np.int64).ravel()
     parts.append(_data_array("connectivity", conn, ind))
     parts.append(_data_array("offsets", np.arange(2, 2 * s + 1, 2, dtype=np.int64), ind))
     parts.append(_data_array("types", np.full(s, VTK_LINE, dtype=np.uint8), ind))

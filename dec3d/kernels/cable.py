@@ -115,9 +115,13 @@ def cable_step(dt, g, alpha, damp, safety,
                 fa[e] = -yc
                 st |= S_YC | S_YPAST
         lcur[e] = length
-        for k in range(3):                       # the cable's direction at its nodes (summed, pass 3 scales)
-            scratch[a, 10 + k] += d0 / length if k == 0 else (d1 / length if k == 1 else d2 / length)
-            scratch[b, 10 + k] += d0 / length if k == 0 else (d1 / length if k == 1 else d2 / length)
+        # the cable's direction at its nodes (summed here, scaled in pass 3)
+        scratch[a, 10] += t0
+        scratch[a, 11] += t1
+        scratch[a, 12] += t2
+        scratch[b, 10] += t0
+        scratch[b, 11] += t1
+        scratch[b, 12] += t2
         f = fa[e]
         force[a, 0] += f * t0
         force[a, 1] += f * t1

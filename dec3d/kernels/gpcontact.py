@@ -32,6 +32,40 @@ from numba import literally, njit, prange
 from .joints import ST_NEW, cycle_mask, joint_law_for
 
 
+@njit(cache=True, inline="always")
+def add_to_sides(s, blk_b, blk_a, x0, x1, x2, d0, d1, d2, nodes_a, w_a, nodes_b, w_b, bpos, bforce, bmoment,
+                 gforce):
+    """The force d at the point x of sub-contact ``s`` onto side B and −d onto side A: to a rigid side's
+    centroid with its moment (x − centroid) × force, or to a zoned side's gridpoints in proportion to
+    their weights (node −1: rigid side). B first, then A. The mixed-contact kernels' one way of handing a
+    sub-contact's force to its two sides (joint force here, Rayleigh damping, pore pressure)."""
+    for side in range(2):
+        blk = blk_b if side == 0 else blk_a
+        nodes = nodes_b if side == 0 else nodes_a
+        w = w_b if side == 0 else w_a
+        sg = 1.0 if side == 0 else -1.0
+        g0 = sg * d0
+        g1 = sg * d1
+        g2 = sg * d2
+        if nodes[s, 0] < 0:
+            r0 = x0 - bpos[blk, 0]
+            r1 = x1 - bpos[blk, 1]
+            r2 = x2 - bpos[blk, 2]
+            bforce[blk, 0] += g0
+            bforce[blk, 1] += g1
+            bforce[blk, 2] += g2
+            bmoment[blk, 0] += r1 * g2 - r2 * g1
+            bmoment[blk, 1] += r2 * g0 - r0 * g2
+            bmoment[blk, 2] += r0 * g1 - r1 * g0
+        else:
+            for j in range(3):
+                g = nodes[s, j]
+                if g >= 0:
+                    gforce[g, 0] += w[s, j] * g0
+                    gforce[g, 1] += w[s, j] * g1
+                    gforce[g, 2] += w[s, j] * g2
+
+
 @njit(cache=True)
 def _closest_on_triangle(p0, p1, p2, a, b, c):
     """Barycentric (u, v, w) of the point of triangle abc nearest to p, and the squared distance."""
@@ -259,31 +293,8 @@ def _mixed_subcontact_forces(models, dt, bpos, bvel, bspin, bforce, bmoment, gve
         f1 = sc_fs[s, 1]
         f2 = sc_fs[s, 2]
         # force on B: + (Fn n + Fs), on A: - (ERRATA Eqs. 28-32); B first, then A
-        for side in range(2):
-            blk = cb[c] if side == 0 else ca[c]
-            nodes = nodes_b if side == 0 else nodes_a
-            w = w_b if side == 0 else w_a
-            sg = 1.0 if side == 0 else -1.0
-            g0 = sg * (fn * n0 + f0)
-            g1 = sg * (fn * n1 + f1)
-            g2 = sg * (fn * n2 + f2)
-            if nodes[s, 0] < 0:
-                r0 = x0 - bpos[blk, 0]
-                r1 = x1 - bpos[blk, 1]
-                r2 = x2 - bpos[blk, 2]
-                bforce[blk, 0] += g0
-                bforce[blk, 1] += g1
-                bforce[blk, 2] += g2
-                bmoment[blk, 0] += r1 * g2 - r2 * g1
-                bmoment[blk, 1] += r2 * g0 - r0 * g2
-                bmoment[blk, 2] += r0 * g1 - r1 * g0
-            else:
-                for j in range(3):
-                    g = nodes[s, j]
-                    if g >= 0:
-                        gforce[g, 0] += w[s, j] * g0
-                        gforce[g, 1] += w[s, j] * g1
-                        gforce[g, 2] += w[s, j] * g2
+        add_to_sides(s, cb[c], ca[c], x0, x1, x2, fn * n0 + f0, fn * n1 + f1, fn * n2 + f2,
+                     nodes_a, w_a, nodes_b, w_b, bpos, bforce, bmoment, gforce)
 
 
 

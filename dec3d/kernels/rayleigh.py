@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from numba import njit, prange
 
+from .gpcontact import add_to_sides
 from .joints import ST_SLIP, joint_stiffness
 
 
@@ -105,28 +106,5 @@ def mixed_stiffness_damping(beta, bpos, bvel, bspin, bforce, bmoment, gvel, gfor
         d0 = -(kn * vn * n0 + ks * (v0 - vn * n0))
         d1 = -(kn * vn * n1 + ks * (v1 - vn * n1))
         d2 = -(kn * vn * n2 + ks * (v2 - vn * n2))
-        for side in range(2):
-            blk = cb[c] if side == 0 else ca[c]
-            nodes = nodes_b if side == 0 else nodes_a
-            w = w_b if side == 0 else w_a
-            sg = 1.0 if side == 0 else -1.0
-            g0 = sg * d0
-            g1 = sg * d1
-            g2 = sg * d2
-            if nodes[s, 0] < 0:
-                r0 = x0 - bpos[blk, 0]
-                r1 = x1 - bpos[blk, 1]
-                r2 = x2 - bpos[blk, 2]
-                bforce[blk, 0] += g0
-                bforce[blk, 1] += g1
-                bforce[blk, 2] += g2
-                bmoment[blk, 0] += r1 * g2 - r2 * g1
-                bmoment[blk, 1] += r2 * g0 - r0 * g2
-                bmoment[blk, 2] += r0 * g1 - r1 * g0
-            else:
-                for j in range(3):
-                    g = nodes[s, j]
-                    if g >= 0:
-                        gforce[g, 0] += w[s, j] * g0
-                        gforce[g, 1] += w[s, j] * g1
-                        gforce[g, 2] += w[s, j] * g2
+        add_to_sides(s, cb[c], ca[c], x0, x1, x2, d0, d1, d2, nodes_a, w_a, nodes_b, w_b, bpos, bforce, bmoment,
+                     gforce)

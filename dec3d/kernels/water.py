@@ -14,6 +14,8 @@ import math
 import numpy as np
 from numba import njit
 
+from .gpcontact import add_to_sides
+
 
 @njit(cache=True)
 def any_pressure(ppf) -> bool:
@@ -50,31 +52,8 @@ def mixed_pore_forces(bpos, bforce, bmoment, gforce, ca, cb, cn, sc_contact, sc_
         if f == 0.0:
             continue
         c = sc_contact[s]
-        for side in range(2):
-            blk = cb[c] if side == 0 else ca[c]
-            nodes = nodes_b if side == 0 else nodes_a
-            w = w_b if side == 0 else w_a
-            sgn = 1.0 if side == 0 else -1.0
-            g0 = sgn * f * cn[c, 0]
-            g1 = sgn * f * cn[c, 1]
-            g2 = sgn * f * cn[c, 2]
-            if nodes[s, 0] < 0:
-                r0 = sc_pos[s, 0] - bpos[blk, 0]
-                r1 = sc_pos[s, 1] - bpos[blk, 1]
-                r2 = sc_pos[s, 2] - bpos[blk, 2]
-                bforce[blk, 0] += g0
-                bforce[blk, 1] += g1
-                bforce[blk, 2] += g2
-                bmoment[blk, 0] += r1 * g2 - r2 * g1
-                bmoment[blk, 1] += r2 * g0 - r0 * g2
-                bmoment[blk, 2] += r0 * g1 - r1 * g0
-            else:
-                for j in range(3):
-                    g = nodes[s, j]
-                    if g >= 0:
-                        gforce[g, 0] += w[s, j] * g0
-                        gforce[g, 1] += w[s, j] * g1
-                        gforce[g, 2] += w[s, j] * g2
+        add_to_sides(s, cb[c], ca[c], sc_pos[s, 0], sc_pos[s, 1], sc_pos[s, 2], f * cn[c, 0], f * cn[c, 1],
+                     f * cn[c, 2], nodes_a, w_a, nodes_b, w_b, bpos, bforce, bmoment, gforce)
 
 
 @njit(cache=True)

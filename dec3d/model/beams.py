@@ -33,7 +33,7 @@ import numpy as np
 
 from dec3d.kernels.beam import NBPROP
 
-from .cables import _first_block, host_blocks, zone_host
+from .cables import place_nodes, zone_host
 from .groups import group_field
 from .model import Model
 from .store import Field, Store
@@ -102,31 +102,12 @@ def add_beam(model: Model, p1, p2, segments: int, beam_id, group, tol: float) ->
     -3 in a block that cannot host it: an FE block or 10-node zones)."""
     nodes, els = beam_stores(model)
     p1, p2 = np.asarray(p1, float), np.asarray(p2, float)
-    t = np.linspace(0.0, 1.0, segments + 1)[:, None]
-    pts = p1[None, :] * (1.0 - t) + p2[None, :] * t
-    hosts = host_blocks(model, pts, tol)
     bid = int(beam_id) if beam_id is not None else int(max(nodes["beam"].max(initial=0),
                                                             els["beam"].max(initial=0)) + 1)
-    nid0 = next_node_id(model)
     eid0 = int(els["id"].max(initial=0)) + 1
-    sl = nodes.append(segments + 1)
-    rn = np.arange(sl.start, sl.stop)
-    nodes["id"][rn] = np.arange(nid0, nid0 + segments + 1)
+    rn, pts, hosts = place_nodes(model, nodes, p1, p2, segments, tol)
     nodes["beam"][rn] = bid
-    nodes["pos"][rn] = pts
     nodes["pos0"][rn] = pts
-    nodes["hpos"][rn] = pts
-    for k in np.flatnonzero(hosts == -2):
-        # a node in a zoned block follows the 4-node zone that holds it (-3: none, e.g. 10-node zones)
-        r = _first_block(model, pts[k], tol)
-        z = zone_host(model, r, pts[k], max(tol, 1e-9)) if r >= 0 else None
-        if z is None:
-            hosts[k] = -3
-            continue
-        hosts[k] = r
-        nodes["hz"][rn[k]] = 1
-        nodes["hzone"][rn[k]], nodes["hgp"][rn[k]], nodes["hw"][rn[k]] = z
-    nodes["host"][rn] = np.maximum(hosts, -1)
     sl = els.append(segments)
     rs = np.arange(sl.start, sl.stop)
     els["id"][rs] = np.arange(eid0, eid0 + segments)

@@ -143,25 +143,20 @@ def _first_block(model: Model, p: np.ndarray, tol: float) -> int:
     return int(rows[0]) if rows.size else -1
 
 
-def add_cable(model: Model, p1, p2, segments: int, cable_id: int | None, group: str | None,
-              tol: float) -> tuple[int, np.ndarray]:
-    """Append a straight cable of ``segments`` equal elements from p1 to p2; returns (cable id,
-    host rows of its nodes). The nodes take the block they lie in as host."""
-    nodes, segs = cable_stores(model)
-    p1, p2 = np.asarray(p1, _F), np.asarray(p2, _F)
+def place_nodes(model: Model, nodes: Store, p1, p2, segments: int, tol: float):
+    """Append the ``segments + 1`` nodes of a straight chain from p1 to p2 to ``nodes`` (cable or beam
+    nodes: one id space), each hosted by the block it lies in (a zoned block: the 4-node zone holding it;
+    -3 where none can host it). Returns (node rows, their points, host rows as ``host_blocks`` gives them,
+    -2 turned into the block row or -3)."""
+    from .beams import next_node_id      # (cable and beam nodes share one id space)
+
     t = np.linspace(0.0, 1.0, segments + 1)[:, None]
     pts = p1[None, :] * (1.0 - t) + p2[None, :] * t
     hosts = host_blocks(model, pts, tol)
-    cid = int(cable_id) if cable_id is not None else int(max(nodes["cable"].max(initial=0),
-                                                              segs["cable"].max(initial=0)) + 1)
-    from .beams import next_node_id      # (cable and beam nodes share one id space)
-
     nid0 = next_node_id(model)
-    sid0 = int(segs["id"].max(initial=0)) + 1
     sl = nodes.append(segments + 1)
     rn = np.arange(sl.start, sl.stop)
     nodes["id"][rn] = np.arange(nid0, nid0 + segments + 1)
-    nodes["cable"][rn] = cid
     nodes["pos"][rn] = pts
     nodes["hpos"][rn] = pts
     for k in np.flatnonzero(hosts == -2):
@@ -175,6 +170,20 @@ def add_cable(model: Model, p1, p2, segments: int, cable_id: int | None, group: 
         nodes["hz"][rn[k]] = 1
         nodes["hzone"][rn[k]], nodes["hgp"][rn[k]], nodes["hw"][rn[k]] = z
     nodes["host"][rn] = np.maximum(hosts, -1)
+    return rn, pts, hosts
+
+
+def add_cable(model: Model, p1, p2, segments: int, cable_id: int | None, group: str | None,
+              tol: float) -> tuple[int, np.ndarray]:
+    """Append a straight cable of ``segments`` equal elements from p1 to p2; returns (cable id,
+    host rows of its nodes). The nodes take the block they lie in as host."""
+    nodes, segs = cable_stores(model)
+    p1, p2 = np.asarray(p1, _F), np.asarray(p2, _F)
+    cid = int(cable_id) if cable_id is not None else int(max(nodes["cable"].max(initial=0),
+                                                              segs["cable"].max(initial=0)) + 1)
+    sid0 = int(segs["id"].max(initial=0)) + 1
+    rn, pts, hosts = place_nodes(model, nodes, p1, p2, segments, tol)
+    nodes["cable"][rn] = cid
     sl = segs.append(segments)
     rs = np.arange(sl.start, sl.stop)
     segs["id"][rs] = np.arange(sid0, sid0 + segments)

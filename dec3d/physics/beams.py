@@ -170,7 +170,7 @@ class BeamStep:
         pass
 
     def advance(self, n: int) -> int:
-        from .cables import _damping
+        from .cables import _damping, pass_reactions
         from .rigid import RunError
 
         r = self.run
@@ -197,16 +197,7 @@ class BeamStep:
         if bad:
             raise RunError(f"a beam node moved off to infinity at step {m.step + 1} (Δt {r.dt:.3g} s): check the "
                            f"beam properties")
-        h = nodes["host"]
-        on = (h >= 0) & (hz == 0)
-        if on.any():
-            np.add.at(b["fapp"], h[on], nodes["hforce"][on] - old_f[on])
-            np.add.at(b["mapp"], h[on], nodes["hmoment"][on] - old_m[on])
-        if zn.size:
-            # a zoned host: the link's reaction goes to the zone's gridpoints by the node's weights
-            df = nodes["hforce"][zn] - old_f[zn]
-            np.add.at(m.vertices["fapp"], nodes["hgp"][zn].ravel(),
-                      (nodes["hw"][zn][:, :, None] * df[:, None, :]).reshape(-1, 3))
+        pass_reactions(m, nodes, old_f, old_m, zn)
         return min(n, 1)
 
     def __repr__(self) -> str:

@@ -195,21 +195,29 @@ class CableStep:
             raise _run_error(f"a cable node moved off to infinity at step {m.step + 1} (Δt {r.dt:.3g} s): "
                              f"check the cable and grout properties")
         advance_dowels(m, r.dt)   # hybrid bolts' dowels
-        h = nodes["host"]
-        on = (h >= 0) & (hz == 0)
-        if on.any():
-            np.add.at(b["fapp"], h[on], nodes["hforce"][on] - old_f[on])
-            np.add.at(b["mapp"], h[on], nodes["hmoment"][on] - old_m[on])
-        if zn.size:
-            # a zoned host: the reaction goes to the zone's gridpoints by the node's weights
-            df = nodes["hforce"][zn] - old_f[zn]
-            np.add.at(m.vertices["fapp"], nodes["hgp"][zn].ravel(),
-                      (nodes["hw"][zn][:, :, None] * df[:, None, :]).reshape(-1, 3))
+        pass_reactions(m, nodes, old_f, old_m, zn)
         # (segments clear their "now" bits at the next step: the kernel rebuilds them)
         return min(n, 1)
 
     def __repr__(self) -> str:
         return "CableStep"
+
+
+def pass_reactions(m, nodes, old_f, old_m, zn) -> None:
+    """The change since the last step of the structural nodes' reactions on their hosts (``hforce``,
+    ``hmoment``; ``old_f``, ``old_m`` as they were) into the hosts' applied loads: a rigid block's
+    ``fapp``/``mapp``, a zoned host's gridpoints' ``fapp`` by the node's weights (nodes ``zn``).
+    Cables and beams (``physics.beams``) hand theirs on this way."""
+    b = m.blocks
+    h, hz = nodes["host"], nodes["hz"]
+    on = (h >= 0) & (hz == 0)
+    if on.any():
+        np.add.at(b["fapp"], h[on], nodes["hforce"][on] - old_f[on])
+        np.add.at(b["mapp"], h[on], nodes["hmoment"][on] - old_m[on])
+    if zn.size:
+        df = nodes["hforce"][zn] - old_f[zn]
+        np.add.at(m.vertices["fapp"], nodes["hgp"][zn].ravel(),
+                  (nodes["hw"][zn][:, :, None] * df[:, None, :]).reshape(-1, 3))
 
 
 def _damping(r) -> tuple[int, float]:
