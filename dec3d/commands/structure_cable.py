@@ -17,13 +17,14 @@ from .values import COORD, FLAG, ONOFF, VEC3, Num, Nums, P, Text
 _NONNEG = Num(lo=0)
 _UNITS = {"young": "Pa", "cross-sectional-area": "m²", "yield-tension": "N", "yield-compression": "N",
           "grout-stiffness": "N/m/m", "grout-cohesion": "N/m", "grout-friction": "°", "grout-perimeter": "m",
-          "density": "kg/m³"}
+          "density": "kg/m³", "tensile-failure-strain": "-"}
 _DOCS = {"young": "Young's modulus of the cable", "cross-sectional-area": "cross-sectional area",
          "yield-tension": "tensile yield force (0: no limit)", "yield-compression": "compressive yield force, "
          "given positive (0: no limit)", "grout-stiffness": "grout shear stiffness per length of cable",
          "grout-cohesion": "grout cohesive strength per length of cable",
          "grout-friction": "grout friction angle", "grout-perimeter": "grout exposed perimeter",
-         "density": "density of the cable (its nodes' mass, gravity)"}
+         "density": "density of the cable (its nodes' mass, gravity)",
+         "tensile-failure-strain": "axial strain at which an element ruptures (0: never)"}
 
 
 def _check_create(call):
@@ -101,8 +102,13 @@ def _check_property(call):
          details="Negative values are refused. `grout-friction` is in degrees. `yield-tension` and "
                  "`yield-compression` of 0 (the default) mean no limit. The grout strength per length is "
                  "`grout-cohesion` + σ_m tan(`grout-friction`) `grout-perimeter`; on rigid blocks σ_m is 0 "
-                 "(they carry no stress), so the cohesion alone bounds it there.",
+                 "(they carry no stress), so the cohesion alone bounds it there. An element whose axial strain "
+                 "(L − L0) / L0 (L0: its length as created) goes past `tensile-failure-strain` ruptures: from "
+                 "then on it carries no axial force and no grout force, for good (`structure cable list` shows "
+                 "it as ruptured; 0, the default, means it never ruptures). The name is Itasca's rockbolt "
+                 "property; here it is the total axial strain that counts, yielded or not.",
          examples=["structure cable property young 200e9 cross-sectional-area 5e-4 yield-tension 2.5e5",
+                   "structure cable property tensile-failure-strain 0.1",
                    "structure cable property grout-stiffness 1e8 grout-cohesion 2e5 range id 1"])
 def cable_property(session, call):
     _need_cables(session, call)
@@ -137,7 +143,8 @@ def cable_apply_tension(session, call):
 @command("structure cable list", range=SEGMENTS,
          doc="List the cable elements in range: nodes, axial force, grout forces, yield state.",
          details="State words: yield-t / yield-c (yielding in tension / compression now), slip (grout slipping "
-                 "now at an end), yielded, slipped (in the past).",
+                 "now at an end), yielded, slipped (in the past), ruptured (broken at its "
+                 "`tensile-failure-strain`: it carries nothing).",
          examples=["structure cable list", "structure cable list range id-list 1 2 3"])
 def cable_list(session, call):
     _need_cables(session, call)
@@ -146,7 +153,8 @@ def cable_list(session, call):
     session.write("    id  cable  node-a  node-b   axial (N)    grout-a (N)  grout-b (N)  state")
     for e in np.flatnonzero(mask):
         st = int(segs["state"][e])
-        words = [w for bit, w in ((1, "yield-t"), (2, "yield-c"), (4, "slip"), (8, "yielded"), (16, "slipped"))
+        words = [w for bit, w in ((1, "yield-t"), (2, "yield-c"), (4, "slip"), (8, "yielded"), (16, "slipped"),
+                                                   (32, "ruptured"))
                  if st & bit]
         session.write(f"{int(segs['id'][e]):6d} {int(segs['cable'][e]):6d} {int(nodes['id'][segs['na'][e]]):7d} "
                       f"{int(nodes['id'][segs['nb'][e]]):7d} {segs['fa'][e]:11.4g} {segs['gf'][e, 0]:12.4g} "

@@ -64,6 +64,15 @@ def _yield(rt, i):
     return bool(int(st["state"][r]) & 3)
 
 
+@intrinsic("struct.cable.state", 1)
+def _cstate(rt, i):
+    """State bits of the cable element: 1 yields in tension now, 2 in compression now, 4 grout slips now,
+    8 yielded in the past, 16 grout slipped in the past, 32 ruptured (at its `tensile-failure-strain`).
+    (dec3d's, as `struct.hybrid.dowel.state`: a bit set, not Itasca's.)"""
+    st, r = _seg(rt, i, "struct.cable.state")
+    return int(st["state"][r])
+
+
 def _vec(arr, r):
     return Vec(float(arr[r, 0]), float(arr[r, 1]), float(arr[r, 2]))
 

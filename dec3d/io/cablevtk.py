@@ -6,8 +6,8 @@ with cables as ``<stem>_cables_<nnnn>.vtu`` (``dec3d.io.vtk.VtkSeries.write``), 
 Cell data, per element: ``element_id``, ``cable_id``, ``axial_force`` [N, tension positive],
 ``axial_stress`` [Pa, force / cross-sectional area], ``grout_force_a``/``grout_force_b`` [N, on the
 cable at each end, along the element a → b], ``state`` (bits: 1 yields in tension now, 2 in compression
-now, 4 grout slips now, 8 yielded in the past, 16 grout slipped in the past), ``yield`` and ``slip``
-(0/1, now). Point data, per node: ``node_id``, ``displacement``, ``velocity``, ``grouted`` (0/1: has a
+now, 4 grout slips now, 8 yielded in the past, 16 grout slipped in the past, 32 ruptured), ``yield`` and
+``slip`` (0/1, now), ``ruptured`` (0/1: broken at its ``tensile-failure-strain``, carries nothing). Point data, per node: ``node_id``, ``displacement``, ``velocity``, ``grouted`` (0/1: has a
 host block). Arrays are written as ``dec3d.io.vtk``'s (inline base64)."""
 from __future__ import annotations
 
@@ -36,7 +36,7 @@ def write_cables_vtu(model, path: str | os.PathLike) -> str:
     cell = {"element_id": segs["id"].astype(np.int64), "cable_id": segs["cable"].astype(np.int64),
             "axial_force": segs["fa"], "axial_stress": stress, "grout_force_a": segs["gf"][:, 0],
             "grout_force_b": segs["gf"][:, 1], "state": state, "yield": ((state & 3) != 0).astype(np.uint8),
-            "slip": ((state & 4) != 0).astype(np.uint8)}
+            "slip": ((state & 4) != 0).astype(np.uint8), "ruptured": ((state & 32) != 0).astype(np.uint8)}
     point = {"node_id": nodes["id"].astype(np.int64), "displacement": nodes["disp"], "velocity": nodes["vel"],
              "grouted": (nodes["host"] >= 0).astype(np.uint8)}
     return write_line_vtu(path, pts, segs["na"], segs["nb"], point, cell)

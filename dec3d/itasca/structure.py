@@ -44,6 +44,14 @@ class Cable(Entity):
         """True when the element has yielded in tension or compression (FISH struct.cable.yield)."""
         return bool(self._fish("struct.cable.yield"))
 
+    def state(self) -> int:
+        """State bits (``struct.cable.state``): 32 once the element has ruptured."""
+        return int(self._fish("struct.cable.state"))
+
+    def ruptured(self) -> bool:
+        """Whether the element broke at its ``tensile-failure-strain`` (it carries nothing since)."""
+        return bool(self.state() & 32)
+
 
 class Node(Entity):
     __slots__ = ()

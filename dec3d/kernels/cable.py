@@ -19,7 +19,9 @@ Arrays (n nodes, s segments):
   (updated); ``prop (s, NPROP)`` columns below; ``fa (s,)`` axial force (+ tension, updated);
   ``gf (s, 2)`` grout force at the a and b ends along the segment axis, on the cable (updated);
   ``state (s,)`` bits: 1 yield in tension now, 2 in compression now, 4 grout slipping now,
-  8 yielded in the past, 16 grout slipped in the past; ``tapp (s,)`` applied tension; ``tact (s,)``
+  8 yielded in the past, 16 grout slipped in the past, 32 ruptured (the element's axial strain
+  (L − l0) / l0 went past ``prop[:, C_RUP]`` (> 0) once: from that step on it carries no axial and no
+  grout force and adds no stiffness); ``tapp (s,)`` applied tension; ``tact (s,)``
   1 where it is active.
 - blocks: ``bvel, bspin, bcen (nb, 3)``.
 """
@@ -31,11 +33,11 @@ import numpy as np
 from numba import njit
 
 #: property columns of a segment (``physics.cables.PROPS`` names them)
-C_E, C_A, C_YT, C_YC, C_KG, C_CG, C_FG, C_PG, C_RHO = range(9)
-NPROP = 9
+C_E, C_A, C_YT, C_YC, C_KG, C_CG, C_FG, C_PG, C_RHO, C_RUP = range(10)
+NPROP = 10
 
 #: ``state`` bits
-S_YT, S_YC, S_SLIP, S_YPAST, S_SLIPPAST = 1, 2, 4, 8, 16
+S_YT, S_YC, S_SLIP, S_YPAST, S_SLIPPAST, S_RUPT = 1, 2, 4, 8, 16, 32
 
 
 @njit(cache=True)
@@ -101,11 +103,28 @@ def cable_step(dt, g, alpha, damp, safety,
         length = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         t0, t1, t2 = d0 / length, d1 / length, d2 / length
         ka = prop[e, C_E] * prop[e, C_A] / l0[e]
-        st = state[e] & (S_YPAST | S_SLIPPAST)
+        st = state[e] & (S_YPAST | S_SLIPPAST | S_RUPT)
+        # the cable's direction at its nodes (summed here, scaled in pass 3)
+        scratch[a, 10] += t0
+        scratch[a, 11] += t1
+        scratch[a, 12] += t2
+        scratch[b, 10] += t0
+        scratch[b, 11] += t1
+        scratch[b, 12] += t2
+        dl = length - lcur[e]
+        lcur[e] = length
+        rup = prop[e, C_RUP]
+        if (st & S_RUPT) != 0 or (rup > 0.0 and length - l0[e] > rup * l0[e]):
+            # ruptured (now or before): the element is broken, it carries nothing from now on
+            fa[e] = 0.0
+            gf[e, 0] = 0.0
+            gf[e, 1] = 0.0
+            state[e] = st | S_RUPT
+            continue
         if tact[e] != 0:
             fa[e] = tapp[e]
         else:
-            fa[e] += ka * (length - lcur[e])
+            fa[e] += ka * dl
             yt = prop[e, C_YT]
             yc = prop[e, C_YC]
             if yt > 0.0 and fa[e] > yt:
@@ -114,14 +133,6 @@ def cable_step(dt, g, alpha, damp, safety,
             elif yc > 0.0 and fa[e] < -yc:
                 fa[e] = -yc
                 st |= S_YC | S_YPAST
-        lcur[e] = length
-        # the cable's direction at its nodes (summed here, scaled in pass 3)
-        scratch[a, 10] += t0
-        scratch[a, 11] += t1
-        scratch[a, 12] += t2
-        scratch[b, 10] += t0
-        scratch[b, 11] += t1
-        scratch[b, 12] += t2
         f = fa[e]
         force[a, 0] += f * t0
         force[a, 1] += f * t1

@@ -22,10 +22,11 @@
     na, nb ()      int64  node rows
     l0 ()          m      length as created; lcur () m length at the last step
     prop (NPROP,)  young, cross-sectional-area, yield-tension, yield-compression, grout-stiffness,
-                   grout-cohesion, grout-friction [rad], grout-perimeter, density
+                   grout-cohesion, grout-friction [rad], grout-perimeter, density, tensile-failure-strain
+                   (0: never ruptures)
     fa ()          N      axial force, tension positive
     gf (2,)        N      grout force on the cable at the a and b ends, along the axis a → b
-    state ()       int32  yield/slip bits (``kernels.cable``)
+    state ()       int32  yield/slip/rupture bits (``kernels.cable``)
     tapp (), tact () applied tension and whether it is active (``structure cable apply tension``)
     group (1,)     int32
 """
@@ -47,7 +48,7 @@ SEGMENTS = "cable_segments"
 
 #: property names as 3DEC spells them, in ``prop`` column order
 PROPS = ("young", "cross-sectional-area", "yield-tension", "yield-compression", "grout-stiffness",
-         "grout-cohesion", "grout-friction", "grout-perimeter", "density")
+         "grout-cohesion", "grout-friction", "grout-perimeter", "density", "tensile-failure-strain")
 assert len(PROPS) == NPROP
 
 
@@ -80,6 +81,9 @@ def cable_stores(model: Model) -> tuple[Store, Store]:
         for key, spec in fields.items():      # (a store restored from a file that had fewer fields)
             if key not in st[name]:
                 st[name].add_field(key, spec)
+    if st[SEGMENTS].fields["prop"].shape != (NPROP,):
+        # (restored from a file written before a property column was added: the new ones read 0, "none")
+        st[SEGMENTS].resize_field("prop", (NPROP,))
     return st[NODES], st[SEGMENTS]
 
 
