@@ -437,3 +437,47 @@ def test_hybrid_bolt_takes_the_strain_limit(tmp_path):
     with pytest.raises(Dec3dError) as exc:
         _run(s, "structure cable property tensile-failure-strain -0.1\n")
     assert exc.value.location.column == len("structure cable property tensile-failure-strain ") + 1
+
+
+# ------------------------------------------------------------------ excavation, dynamic mode
+def test_excavated_zoned_host_frees_its_nodes_once(tmp_path):
+    """`block excavate` of the zoned block a cable is grouted in: its 10 nodes are reported once, carry
+    no grout force from then on (never a NaN), and the grout's pull is taken back off the gridpoints."""
+    text = HANG.replace("block property density 2000\n",
+                        "block zone generate edgelength 0.5\nblock zone cmodel assign elastic\n"
+                        "block zone property young 10e9 poisson 0.25 density 2000\n")
+    s = _run(_session(tmp_path), text + "model cycle 300\n")
+    v = s.model.vertices
+    assert abs(v["fapp"][:, 2].sum()) > 100                 # the grout pulls on the gridpoints
+    _run(s, "block excavate\nmodel cycle 200\nmodel cycle 200\n")
+    out = s.stdout.getvalue()
+    assert out.count("10 cable node(s) lay in the excavated blocks") == 1
+    nodes, segs = s.model.stores["cable_nodes"], s.model.stores["cable_segments"]
+    assert (nodes["host"] == -1).all() and not nodes["hz"].any() and not nodes["hforce"].any()
+    assert not segs["gf"].any() and np.isfinite(segs["fa"]).all() and np.isfinite(nodes["pos"]).all()
+    assert abs(v["fapp"]).max() < 1e-6                       # nothing left behind for a later fill
+
+
+def test_undamped_dynamic_bar_overshoots_twice_its_static_stretch(tmp_path):
+    """Dynamic mode, real masses: a 2 m bar (grout-free, EA = 2e7 N, ρ = 7800) fixed at one end, loaded at
+    once by 1e4 N at the other swings between 0 and twice F L / EA = 1e-3 m (undamped: dynamic factor 2),
+    with the period of its first axial mode, 4 L / √(E/ρ) = 1.580 ms (20 lumped elements: within 1 %)."""
+    s = _run(_session(tmp_path), """model new
+block create brick -0.5 0.5 -0.5 0.5 -1 0
+block property density 2000
+block fix
+model dynamic active on
+structure cable create by-line 0 0 -0.5 2 0 -0.5 segments 20
+structure cable property young 200e9 cross-sectional-area 1e-4 grout-stiffness 0 density 7800
+structure node fix velocity range id 1
+structure node apply force-x 1e4 range id 21
+structure node history name 'u' displacement-x component-id 21
+history interval 1
+model solve time 3.3e-3
+""")
+    h = s.model.history_set.find("u")
+    t, u = np.array(h.times), np.array(h.values)
+    assert u.max() == pytest.approx(2 * 1e4 * 2.0 / 2e7, rel=0.02) and u.min() > -1e-6
+    up = np.flatnonzero((u[:-1] < 5e-4) & (u[1:] >= 5e-4))      # crossings of the static stretch, rising
+    assert len(up) == 2
+    assert t[up[1]] - t[up[0]] == pytest.approx(4 * 2.0 / np.sqrt(200e9 / 7800), rel=0.01)

@@ -210,4 +210,11 @@ model cycle 200
     # force where the sliding block has turned it
     v = s.model.vertices
     np.testing.assert_allclose(v["fapp"][: v.n, :2].sum(axis=0), f[:2], rtol=1e-4)
+    # excavating the zoned base: its dowel goes, the bolt's nodes there are free, the loads they had put on
+    # the sliding block and the base's gridpoints are taken back (a later `block fill` finds none)
+    fapp_b = s.model.blocks["fapp"][1].copy()
+    _run("block excavate range position-z -1 0\nmodel cycle 20\n", tmp_path, s)
+    assert "dowel(s) lay in the excavated blocks" in s.stdout.getvalue() and st.n == 0
+    assert abs(v["fapp"][: v.n]).max() < 1e-9 and abs(s.model.blocks["fapp"][1, 0]) < abs(fapp_b[0])
+    assert np.isfinite(s.model.stores["cable_segments"]["fa"]).all()
 

@@ -56,7 +56,9 @@ def _adjacent_faces(model, dug: np.ndarray, tol: float) -> np.ndarray:
          details="Rigid blocks cannot be excavated (use `block delete`). With `face-group` the faces of the "
                  "blocks left that touch the excavated blocks join that group (for `block face apply` on the "
                  "excavation's boundary). An excavated block keeps its zones, stresses and properties and stays "
-                 "where it was; `block hide off` does not show it again.",
+                 "where it was; `block hide off` does not show it again. Cable and beam nodes in the excavated "
+                 "blocks become free (no grout or link force) and hybrid bolts' dowels with a side there go, "
+                 "reported once in a notice; `block fill` does not attach them again.",
          examples=["block excavate range group 'tunnel'", "block excavate face-group 'wall' range group 'stage1'",
                    "block excavate face-group 'wall' slot 'bc' range cylinder end-1 0 -1 0 end-2 0 11 0 radius 3"])
 def block_excavate(session, call):
@@ -82,6 +84,13 @@ def block_excavate(session, call):
             session.write(f"warning: {call.location}: no face of another block touches the excavated blocks")
     b["excavated"][rows] = True
     b["hidden"][rows] = True
+    from ..model.cables import release_hosts
+
+    nc, nb, nd = release_hosts(m, sel)
+    if nc or nb or nd:
+        what = ", ".join(f"{n} {w}" for n, w in ((nc, "cable node(s)"), (nb, "beam node(s)"), (nd, "dowel(s)")) if n)
+        session.write(f"notice: {what} lay in the excavated blocks: from now on the nodes are free (no grout "
+                      "or link force) and the dowels are gone; `block fill` does not attach them again")
 
 
 @command("block fill",

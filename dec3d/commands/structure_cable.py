@@ -67,7 +67,8 @@ def cable_create(session, call):
         bad = ("a node of the cable lies in a zoned block but in none of its 4-node zones (FE blocks and "
                "10-node zones do not hold cables yet)")
     elif not (hosts >= 0).any():
-        bad = "the cable lies in no block: none of its nodes is inside a (visible, rigid) block"
+        bad = ("the cable lies in no block: none of its nodes is inside a visible block (a rigid one, or a zone "
+               "of a zoned one)")
     if bad:
         keep_n = np.arange(nodes.n) < n0
         keep_s = np.arange(segs.n) < s0

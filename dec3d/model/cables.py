@@ -255,3 +255,57 @@ def remap_hosts(model: Model, remap: np.ndarray) -> None:
         gone = np.flatnonzero(lost)
         segs["gf"][np.isin(segs["na"], gone), 0] = 0.0
         segs["gf"][np.isin(segs["nb"], gone), 1] = 0.0
+
+
+def release_hosts(model: Model, mask) -> tuple[int, int, int]:
+    """Cut the structural links into the blocks of ``mask`` (bool over block rows), as `block excavate`
+    does: cable and beam nodes hosted there become free (no grout or link force from now on) and the
+    hybrid bolts' dowels with a side there are dropped. The reactions they had put into the hosts'
+    applied loads (``physics.cables.pass_reactions``, ``physics.dowels.advance_dowels``) are taken back
+    out, so a block filled again later starts without them. Returns (cable nodes, beam nodes, dowels)
+    released."""
+    from .dowels import DOWELS, has_dowels
+
+    mask = np.asarray(mask, bool)
+    st = model.stores
+    b, v = model.blocks, model.vertices
+    out = [0, 0, 0]
+    for k, name in enumerate((NODES, "beam_nodes")):
+        if name not in st or not st[name].n:
+            continue
+        nodes = st[name]
+        h = nodes["host"]
+        lost = np.flatnonzero(h >= 0)
+        lost = lost[mask[h[lost]]]
+        if not lost.size:
+            continue
+        rig, zn = lost[nodes["hz"][lost] == 0], lost[nodes["hz"][lost] != 0]
+        np.add.at(b["fapp"], h[rig], -nodes["hforce"][rig])
+        np.add.at(b["mapp"], h[rig], -nodes["hmoment"][rig])
+        np.add.at(v["fapp"], nodes["hgp"][zn].ravel(),
+                  -(nodes["hw"][zn][:, :, None] * nodes["hforce"][zn][:, None, :]).reshape(-1, 3))
+        h[lost] = -1
+        nodes["hz"][lost] = 0
+        for key in ("hforce", "hmoment", "lf", "lm"):
+            if key in nodes:
+                nodes[key][lost] = 0.0
+        if name == NODES:
+            segs = st[SEGMENTS]
+            segs["gf"][np.isin(segs["na"], lost), 0] = 0.0
+            segs["gf"][np.isin(segs["nb"], lost), 1] = 0.0
+        out[k] = int(lost.size)
+    if has_dowels(model):
+        ds = st[DOWELS]
+        gone = mask[ds["blk"]].any(axis=1)
+        for i in np.flatnonzero(gone):
+            for side, sg in ((0, -1.0), (1, 1.0)):
+                r = int(ds["blk"][i, side])
+                if ds["hz"][i, side] == 0:
+                    b["fapp"][r] -= sg * ds["fs"][i]
+                    b["mapp"][r] -= ds["moment"][i, side]
+                else:
+                    np.add.at(v["fapp"], ds["hgp"][i, side], -sg * ds["hw"][i, side][:, None] * ds["fs"][i][None, :])
+        if gone.any():
+            ds.compact(~gone)
+        out[2] = int(gone.sum())
+    return out[0], out[1], out[2]
