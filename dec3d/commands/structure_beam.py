@@ -37,10 +37,11 @@ def _check_create(call):
          details="Each element is a 3-D Euler-Bernoulli beam (axial, torsion, bending about its y and z axes); "
                  "each node has 3 translations and 3 rotations. A node inside a visible rigid block (its boundary "
                  "counts) is linked to the block by stiff springs (translation and rotation); a node inside a zoned "
-                 "block follows the 4-node zone that holds it (its gridpoints, by barycentric weights) through a "
-                 "stiff translational spring (zones have no rotation to link to); other nodes are free (hold them "
-                 "with `structure node fix velocity rotation`). A node in an FE block or a 10-node zone is "
-                 "refused (not a beam host yet). The element's y axis is horizontal (global z × x; global y for "
+                 "or FE block follows the element that holds it (a 4-node zone by barycentric weights, a 10-node "
+                 "zone or a 20-node brick by its shape functions) through a stiff translational spring (zones "
+                 "have no rotation to link to); other nodes are free (hold them with `structure node fix velocity "
+                 "rotation`). A node in a deformable block that none of its elements holds is refused. The "
+                 "element's y axis is horizontal (global z × x; global y for "
                  "a vertical beam) unless `structure beam property direction-y` sets it.",
          examples=["structure beam create by-line 0 0 0 10 0 0 segments 20",
                    "structure beam create by-line 0 0 0 0 0 5 segments 10 id 2 group 'pile'"])
@@ -62,8 +63,8 @@ def beam_create(session, call):
     if (hosts <= -2).any():
         nodes.compact(np.arange(nodes.n) < n0)
         els.compact(np.arange(els.n) < s0)
-        raise CommandError("a node of the beam lies in a zoned block but in none of its 4-node zones (FE blocks "
-                           "and 10-node zones do not hold beams yet)", where)
+        raise CommandError("a node of the beam lies in a deformable block but in none of its zones or FE "
+                           "elements (is the block zoned or meshed?)", where)
     update_beam_masses(m)
     session.write(f"beam {bid}: {int(call.args['segments'])} elements, {int((hosts >= 0).sum())} of "
                   f"{len(hosts)} nodes linked to blocks")

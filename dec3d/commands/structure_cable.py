@@ -41,10 +41,12 @@ def _check_create(call):
          doc="Create a cable of equal elements along a straight line; each node is grouted to the block it lies in.",
          details="The nodes lie at the ends and at the segment boundaries; a node inside a rigid block (on its "
                  "boundary counts) is attached to it by the grout, a node outside every block is free (ungrouted). "
-                 "In a zoned block the node follows the 4-node zone that holds it (its gridpoints, by barycentric "
-                 "weights) and the grout is confined by that zone's stress. A cable with no node in any block is "
-                 "refused, and so is a node in an FE block or a 10-node zone (not cable hosts yet). Create cables "
-                 "after the blocks are cut and zoned: a later cut or zoning does not re-attach them.",
+                 "In a deformable block the node follows the element that holds it: a 4-node zone (its gridpoints, "
+                 "by barycentric weights), a 10-node zone or an FE block's 20-node brick (its nodes, by the shape "
+                 "functions at the node); the grout's reaction goes to those nodes by the same weights and the "
+                 "grout is confined by that element's stress. A cable with no node in any block is refused, and "
+                 "so is a node in a deformable block that no zone or element of it holds. Create cables after "
+                 "the blocks are cut and zoned (or meshed): a later cut or zoning does not re-attach them.",
          examples=["structure cable create by-line 0 0 0 0 0 -10 segments 20",
                    "structure cable create by-line 0 0 0 5 0 0 segments 10 id 2 group 'bolts'"])
 def cable_create(session, call):
@@ -64,8 +66,8 @@ def cable_create(session, call):
     cid, hosts = add_cable(m, p1, p2, int(call.args["segments"]), cid, call.args["group"], tol)
     bad = None
     if (hosts <= -2).any():
-        bad = ("a node of the cable lies in a zoned block but in none of its 4-node zones (FE blocks and "
-               "10-node zones do not hold cables yet)")
+        bad = ("a node of the cable lies in a deformable block but in none of its zones or FE elements (is "
+               "the block zoned or meshed?)")
     elif not (hosts >= 0).any():
         bad = ("the cable lies in no block: none of its nodes is inside a visible block (a rigid one, or a zone "
                "of a zoned one)")

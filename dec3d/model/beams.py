@@ -9,8 +9,9 @@ kernel ``dec3d.kernels.beam``).
     mass, inert ()        kg, kg·m²  real mass and rotary inertia (from the elements' density)
     imass, iinert ()      the inertial ones of the last step (density-scaled in static runs)
     host ()               int64  block the node is linked to (-1: free)
-    hz ()                 int8   1: the host is a zoned block, the node follows a 4-node zone: hzone () its
-                          row, hgp (4,) its gridpoint rows, hw (4,) the node's barycentric weights
+    hz ()                 int8   0: a rigid host; else the node follows an element of a deformable host
+                          (``model.hosts``: 4-node or 10-node zone, FE brick): hzone () its row, hgp (NHOST,)
+                          its node rows, hw (NHOST,) the node's weights (shape functions) in it
     hpos (3,)             m      host point
     lf, lm (3,)           N, N·m link force and moment on the node
     fix ()                uint8  bits 0-2 velocity, 3-5 rotational velocity held (``structure node fix``)
@@ -33,7 +34,8 @@ import numpy as np
 
 from dec3d.kernels.beam import NBPROP
 
-from .cables import place_nodes, zone_host
+from .cables import place_nodes
+from .hosts import NHOST, host_element, widen
 from .groups import group_field
 from .model import Model
 from .store import Field, Store
@@ -50,7 +52,8 @@ def _node_fields():
                          "moment", "hforce", "hmoment")}
     f.update({"id": Field((), np.int64, 0), "beam": Field((), np.int64, 0), "host": Field((), np.int64, -1),
               "fix": Field((), np.uint8, 0), "group": group_field(), "hz": Field((), np.int8, 0),
-              "hzone": Field((), np.int64, -1), "hgp": Field((4,), np.int64, -1), "hw": Field((4,), np.float64, 0.0)})
+              "hzone": Field((), np.int64, -1), "hgp": Field((NHOST,), np.int64, -1),
+              "hw": Field((NHOST,), np.float64, 0.0)})
     f.update({k: Field((), np.float64, 0.0) for k in ("mass", "inert", "imass", "iinert")})
     return f
 
@@ -69,6 +72,7 @@ def beam_stores(model: Model) -> tuple[Store, Store]:
         model.add_store(Store(BNODES, _node_fields()))
     if BELEMS not in st:
         model.add_store(Store(BELEMS, _elem_fields()))
+    widen(model.stores[BNODES])
     return model.stores[BNODES], model.stores[BELEMS]
 
 
@@ -99,7 +103,7 @@ def element_axes(x: np.ndarray, ydir) -> np.ndarray:
 
 def add_beam(model: Model, p1, p2, segments: int, beam_id, group, tol: float) -> tuple[int, np.ndarray]:
     """Append a straight beam of equal elements; returns (beam id, host rows of its nodes: -1 free,
-    -3 in a block that cannot host it: an FE block or 10-node zones)."""
+    -3 in a deformable block none of whose zones or FE elements holds it)."""
     nodes, els = beam_stores(model)
     p1, p2 = np.asarray(p1, float), np.asarray(p2, float)
     bid = int(beam_id) if beam_id is not None else int(max(nodes["beam"].max(initial=0),
@@ -143,19 +147,19 @@ def remap_beam_hosts(model: Model, remap: np.ndarray) -> int:
     """After blocks are deleted: nodes whose block went are free (their link forces go with it)."""
     if BNODES not in model.stores or not model.stores[BNODES].n:
         return 0
-    nodes = model.stores[BNODES]
+    nodes = beam_stores(model)[0]
     h = nodes["host"]
     ok = h >= 0
     h[ok] = remap[h[ok]]
     lost = ok & (h < 0)
     # zone-hosted nodes of surviving blocks: the zones' and gridpoints' rows moved, find them again
-    for i in np.flatnonzero((h >= 0) & (nodes["hz"] == 1)):
-        z = zone_host(model, int(h[i]), nodes["hpos"][i], 1e-9)
+    for i in np.flatnonzero((h >= 0) & (nodes["hz"] != 0)):
+        z = host_element(model, int(h[i]), nodes["hpos"][i], 1e-9)
         if z is None:
             h[i] = -1
             lost[i] = True
         else:
-            nodes["hzone"][i], nodes["hgp"][i], nodes["hw"][i] = z
+            nodes["hz"][i], nodes["hzone"][i], nodes["hgp"][i], nodes["hw"][i] = z
     nodes["hz"][lost] = 0
     for k in ("lf", "lm", "hforce", "hmoment"):
         nodes[k][lost] = 0.0

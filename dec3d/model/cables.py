@@ -8,8 +8,9 @@
     mass ()        kg     real mass: density × area × tributary length (0 without density)
     imass ()       kg     inertial mass of the last step (density-scaled to the step, see physics.cables)
     host ()        int64  row of the block the node lies in, -1 none (ungrouted)
-    hz ()          int8   1: the host is a zoned block, the node follows a 4-node zone: hzone () its row,
-                   hgp (4,) its gridpoint rows, hw (4,) the node's barycentric weights in it
+    hz ()          int8   0: a rigid host; else the node follows an element of a deformable host
+                   (``model.hosts``: 1 a 4-node zone, 2 a 10-node zone, 3 an FE brick): hzone () its row,
+                   hgp (NHOST,) its node rows, hw (NHOST,) the node's weights (shape functions) in it
     hpos (3,)      m      host point: the material point of the host block where the node sits
     fix ()         uint8  bits 0-2: velocity components held (``structure node fix``)
     fapp (3,)      N      applied force (``structure node apply``)
@@ -37,6 +38,7 @@ import numpy as np
 from dec3d.kernels.cable import NPROP
 
 from .groups import group_field
+from .hosts import NHOST, host_element, widen
 from .model import KIND_RIGID, Model
 from .store import Field, Store
 
@@ -58,7 +60,7 @@ def _node_fields() -> dict[str, Field]:
             "mass": Field((), _F, 0.0), "imass": Field((), _F, 0.0), "host": Field((), _I, -1), "hpos": v3,
             "fix": Field((), np.uint8, 0), "fapp": v3, "force": v3, "hforce": v3, "hmoment": v3,
             "group": group_field(), "hz": Field((), np.int8, 0), "hzone": Field((), _I, -1),
-            "hgp": Field((4,), _I, -1), "hw": Field((4,), _F, 0.0)}
+            "hgp": Field((NHOST,), _I, -1), "hw": Field((NHOST,), _F, 0.0)}
 
 
 def _segment_fields() -> dict[str, Field]:
@@ -81,6 +83,7 @@ def cable_stores(model: Model) -> tuple[Store, Store]:
         for key, spec in fields.items():      # (a store restored from a file that had fewer fields)
             if key not in st[name]:
                 st[name].add_field(key, spec)
+    widen(st[NODES])        # (4 host-node slots in files written before quadratic hosts)
     if st[SEGMENTS].fields["prop"].shape != (NPROP,):
         # (restored from a file written before a property column was added: the new ones read 0, "none")
         st[SEGMENTS].resize_field("prop", (NPROP,))
@@ -92,34 +95,11 @@ def has_cables(model: Model) -> bool:
     return SEGMENTS in st and st[SEGMENTS].n > 0
 
 
-def zone_host(model: Model, block: int, p: np.ndarray, tol: float):
-    """(zone row, gridpoint rows (4,), barycentric weights (4,)) of the 4-node zone of ``block`` that
-    holds ``p`` (weights ≥ −tol), or None."""
-    if "zones" not in model.stores:
-        return None
-    zs = model.stores["zones"]
-    rows = np.flatnonzero((zs["block"] == block) & (zs["nnode"] == 4))
-    if not rows.size:
-        return None
-    gp = zs["gp"][rows, :4]
-    x = model.vertices["pos"][gp]                      # (z, 4, 3)
-    a = np.transpose(x[:, 1:, :] - x[:, :1, :], (0, 2, 1))   # columns x1-x0, x2-x0, x3-x0
-    ok = np.abs(np.linalg.det(a)) > 0
-    w = np.full((len(rows), 4), -np.inf)
-    w[ok, 1:] = np.linalg.solve(a[ok], (p[None, :] - x[ok, 0, :])[:, :, None])[:, :, 0]
-    w[ok, 0] = 1.0 - w[ok, 1:].sum(axis=1)
-    inside = np.flatnonzero(w.min(axis=1) >= -tol)
-    if not inside.size:
-        return None
-    k = int(inside[0])
-    return int(rows[k]), gp[k].copy(), np.clip(w[k], 0.0, None) / np.clip(w[k], 0.0, None).sum()
-
-
 def host_blocks(model: Model, pts: np.ndarray, tol: float) -> np.ndarray:
     """Row of the visible rigid block each point lies in (on its boundary counts; the lowest row when
     several hold it), -1 for none. A point is in a convex block when it is behind every face plane
     by ``tol`` at most. Points in zoned or FE blocks are reported as -2 (the caller looks for their
-    zone, ``zone_host``)."""
+    zone or FE element, ``hosts.host_element``)."""
     b, f = model.blocks, model.faces
     out = np.full(len(pts), -1, _I)
     if not b.n:
@@ -149,8 +129,8 @@ def _first_block(model: Model, p: np.ndarray, tol: float) -> int:
 
 def place_nodes(model: Model, nodes: Store, p1, p2, segments: int, tol: float):
     """Append the ``segments + 1`` nodes of a straight chain from p1 to p2 to ``nodes`` (cable or beam
-    nodes: one id space), each hosted by the block it lies in (a zoned block: the 4-node zone holding it;
-    -3 where none can host it). Returns (node rows, their points, host rows as ``host_blocks`` gives them,
+    nodes: one id space), each hosted by the block it lies in (a deformable block: the zone or FE element
+    holding it; -3 where none can host it). Returns (node rows, their points, host rows as ``host_blocks`` gives them,
     -2 turned into the block row or -3)."""
     from .beams import next_node_id      # (cable and beam nodes share one id space)
 
@@ -164,15 +144,14 @@ def place_nodes(model: Model, nodes: Store, p1, p2, segments: int, tol: float):
     nodes["pos"][rn] = pts
     nodes["hpos"][rn] = pts
     for k in np.flatnonzero(hosts == -2):
-        # a node in a zoned block follows the 4-node zone that holds it (-3: none, e.g. 10-node zones)
+        # a node in a deformable block follows the zone or FE element that holds it (-3: none)
         r = _first_block(model, pts[k], tol)
-        z = zone_host(model, r, pts[k], max(tol, 1e-9)) if r >= 0 else None
+        z = host_element(model, r, pts[k], max(tol, 1e-9)) if r >= 0 else None
         if z is None:
             hosts[k] = -3
             continue
         hosts[k] = r
-        nodes["hz"][rn[k]] = 1
-        nodes["hzone"][rn[k]], nodes["hgp"][rn[k]], nodes["hw"][rn[k]] = z
+        nodes["hz"][rn[k]], nodes["hzone"][rn[k]], nodes["hgp"][rn[k]], nodes["hw"][rn[k]] = z
     nodes["host"][rn] = np.maximum(hosts, -1)
     return rn, pts, hosts
 
@@ -234,7 +213,7 @@ def remap_hosts(model: Model, remap: np.ndarray) -> None:
 
     remap_beam_hosts(model, remap)
     if NODES in st and st[NODES].n:
-        nodes = st[NODES]
+        nodes = cable_stores(model)[0]
         h = nodes["host"]
         ok = h >= 0
         h[ok] = remap[h[ok]]
@@ -243,13 +222,13 @@ def remap_hosts(model: Model, remap: np.ndarray) -> None:
         nodes["hforce"][lost] = 0.0
         nodes["hmoment"][lost] = 0.0
         # zone-hosted nodes of surviving blocks: the zones' and gridpoints' rows moved, find them again
-        for i in np.flatnonzero((h >= 0) & (nodes["hz"] == 1)):
-            z = zone_host(model, int(h[i]), nodes["hpos"][i], 1e-9)
+        for i in np.flatnonzero((h >= 0) & (nodes["hz"] != 0)):
+            z = host_element(model, int(h[i]), nodes["hpos"][i], 1e-9)
             if z is None:
                 h[i] = -1
                 lost[i] = True
             else:
-                nodes["hzone"][i], nodes["hgp"][i], nodes["hw"][i] = z
+                nodes["hz"][i], nodes["hzone"][i], nodes["hgp"][i], nodes["hw"][i] = z
         nodes["hz"][lost] = 0
         segs = st[SEGMENTS]
         gone = np.flatnonzero(lost)

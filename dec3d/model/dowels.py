@@ -6,8 +6,9 @@ kernel ``dec3d.kernels.dowel``.
     id (), cable ()   int64  dowel id (from 1), the bolt's cable id
     seg ()            int64  row of the cable element that holds the crossing (its axis is the bolt's)
     blk (2,)          int64  block rows of side A (where the bolt comes from) and side B
-    hz (2,)           int8   1: that side is a zoned block; hzone (2,) its 4-node zone, hgp (2, 4) the
-                      zone's gridpoint rows, hw (2, 4) the dowel point's barycentric weights
+    hz (2,)           int8   0: that side is rigid; else the code of its element (``model.hosts``: a 4-node
+                      or 10-node zone, an FE brick), hzone (2,) its row, hgp (2, NHOST) its node rows,
+                      hw (2, NHOST) the weights (shape functions) of a point just inside it
     pos (3,)          m      the dowel point (on the contact, moved with the mean of its sides)
     axis (3,)                the bolt's unit axis as created (the shear is what is across it)
     prop (3,)         dowel-stiffness [N/m], dowel-yield [N], dowel-rupture [m]
@@ -23,8 +24,8 @@ import numpy as np
 
 from dec3d.kernels.dowel import NDPROP
 
-from .cables import zone_host
 from .groups import group_field
+from .hosts import NHOST, host_element, widen
 from .model import KIND_RIGID, Model
 from .store import Field, Store
 
@@ -38,7 +39,7 @@ def _fields() -> dict[str, Field]:
     v3 = Field((3,), np.float64, 0.0)
     return {"id": Field((), np.int64, 0), "cable": Field((), np.int64, 0), "seg": Field((), np.int64, -1),
             "blk": Field((2,), np.int64, -1), "hz": Field((2,), np.int8, 0), "hzone": Field((2,), np.int64, -1),
-            "hgp": Field((2, 4), np.int64, -1), "hw": Field((2, 4), np.float64, 0.0), "pos": v3, "axis": v3,
+            "hgp": Field((2, NHOST), np.int64, -1), "hw": Field((2, NHOST), np.float64, 0.0), "pos": v3, "axis": v3,
             "prop": Field((NDPROP,), np.float64, 0.0), "fs": v3, "us": v3, "moment": Field((2, 3), np.float64, 0.0),
             "state": Field((), np.int32, 0), "group": group_field()}
 
@@ -46,6 +47,7 @@ def _fields() -> dict[str, Field]:
 def dowel_store(model: Model) -> Store:
     if DOWELS not in model.stores:
         model.add_store(Store(DOWELS, _fields()))
+    widen(model.stores[DOWELS])
     return model.stores[DOWELS]
 
 
@@ -95,8 +97,8 @@ def crossings(model: Model, p1, p2, tol: float) -> list[tuple[float, int, int]]:
 
 def add_dowels(model: Model, cable_id: int, p1, p2, seg_rows: np.ndarray, tol: float, group: str | None):
     """Dowels at every joint crossing of the straight bolt p1 → p2 whose elements are ``seg_rows``
-    (equal, in order). Returns (number added, message or None when a crossing is in an unsupported
-    block: FE blocks, 10-node zones)."""
+    (equal, in order). Returns (number added, message or None when a crossing side has no element
+    there that can hold it)."""
     st = dowel_store(model)
     p1, p2 = np.asarray(p1, float), np.asarray(p2, float)
     d = p2 - p1
@@ -122,13 +124,12 @@ def add_dowels(model: Model, cable_id: int, p1, p2, seg_rows: np.ndarray, tol: f
         for side, (blk, tt) in enumerate(((ba, t - eps), (bb, t + eps))):
             if b["kind"][blk] == KIND_RIGID:
                 continue
-            z = zone_host(model, blk, p1 + tt * d, max(tol, 1e-9))
+            z = host_element(model, blk, p1 + tt * d, max(tol, 1e-9))
             if z is None:
                 st.compact(np.arange(st.n) < sl.start)
-                return 0, ("the bolt crosses a joint into a block that cannot hold a dowel (an FE block or "
-                           "10-node zones)")
-            st["hz"][r, side] = 1
-            st["hzone"][r, side], st["hgp"][r, side], st["hw"][r, side] = z
+                return 0, ("the bolt crosses a joint into a deformable block but no zone or FE element of it "
+                           "holds the crossing (is the block zoned or meshed?)")
+            st["hz"][r, side], st["hzone"][r, side], st["hgp"][r, side], st["hw"][r, side] = z
     if group:
         model.groups.assign(st, rows, group)
     return len(found), None
@@ -139,7 +140,7 @@ def remap_dowels(model: Model, remap: np.ndarray) -> int:
     (their last forces stay with the surviving block's applied loads: removed here). Returns how many."""
     if not has_dowels(model):
         return 0
-    st = model.stores[DOWELS]
+    st = dowel_store(model)
     blk = st["blk"]
     new = remap[blk]
     gone = (new < 0).any(axis=1)
@@ -155,9 +156,9 @@ def remap_dowels(model: Model, remap: np.ndarray) -> int:
     for i in np.flatnonzero(~gone):
         for side in range(2):
             if st["hz"][i, side]:
-                z = zone_host(model, int(blk[i, side]), st["pos"][i], 1e-6)
+                z = host_element(model, int(blk[i, side]), st["pos"][i], 1e-6)
                 if z is not None:
-                    st["hzone"][i, side], st["hgp"][i, side], st["hw"][i, side] = z
+                    st["hz"][i, side], st["hzone"][i, side], st["hgp"][i, side], st["hw"][i, side] = z
     if gone.any():
         st.compact(~gone)
     return int(gone.sum())

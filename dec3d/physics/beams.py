@@ -35,6 +35,7 @@ import numpy as np
 
 from dec3d.kernels.beam import B_A, B_E, B_IY, B_IZ, B_J, B_NU, beam_step, local_stiffness
 from dec3d.model.beams import beam_stores, has_beams, update_beam_masses
+from dec3d.model.hosts import spread_stiffness
 
 #: ω_max Δt ≤ 2 s for the beam nodes
 SAFETY = 0.5
@@ -132,7 +133,8 @@ def block_stiffness(model) -> tuple[np.ndarray, np.ndarray]:
 
 
 def gridpoint_stiffness(model, n: int) -> np.ndarray:
-    """Per vertex row: Σ wᵢ k_l of the links of beam nodes in zoned blocks."""
+    """Per vertex row: the Gershgorin sums of the links of beam nodes in deformable blocks
+    (``model.hosts.spread_stiffness``)."""
     out = np.zeros(n)
     if not has_beams(model):
         return out
@@ -140,7 +142,7 @@ def gridpoint_stiffness(model, n: int) -> np.ndarray:
     zn = np.flatnonzero((nodes["hz"] != 0) & (nodes["host"] >= 0))
     if zn.size:
         klt, _ = link_stiffness(model)
-        np.add.at(out, nodes["hgp"][zn].ravel(), (nodes["hw"][zn] * klt[zn][:, None]).ravel())
+        spread_stiffness(out, nodes["hgp"][zn], nodes["hw"][zn], klt[zn])
     return out
 
 

@@ -19,13 +19,14 @@ Model (Itasca's, as those pages state it):
   as a force and a moment about its centroid (through the block's applied force and moment, as a
   change from the last step). A rigid block has no stress field, so σ_m = 0 there and only the
   cohesion bounds the grout.
-* Zoned hosts: the node follows the 4-node zone that holds it: the host point is Σ wᵢ xᵢ over the
-  zone's gridpoints (barycentric weights wᵢ fixed at creation), its velocity Σ wᵢ vᵢ, and the reaction
-  goes to the gridpoints' applied forces as wᵢ F. σ_m is the mean of the zone's normal stresses
-  across the cable, −(tr σ − tᵀ σ t) / 2 (``zone_host_state``), so friction and perimeter count
-  there. The grout stiffness enters the gridpoints' stiffness sums (wᵢ k_g × tributary length,
+* Deformable hosts: the node follows the element that holds it (``model.hosts``: a 4-node zone by
+  its barycentric weights, a 10-node zone or an FE block's 20-node brick by its shape functions at
+  the node, all fixed at creation): the host point is Σ wᵢ xᵢ over the element's nodes, its velocity
+  Σ wᵢ vᵢ, and the reaction goes to the nodes' applied forces as wᵢ F (consistent nodal forces of a
+  point load). σ_m is the mean of the element's normal stresses across the cable, −(tr σ − tᵀ σ t) / 2
+  (``zone_host_state``; a 10-node zone's or a brick's mean stress), so friction and perimeter count
+  there. The grout stiffness enters the nodes' stiffness sums (k_g × tributary length × |wᵢ| Σ|wⱼ|,
   ``gridpoint_grout_stiffness``, added in ``ZoneStepper._stiffness``), hence their scaled masses.
-  FE blocks and 10-node zones are not hosts yet (``structure cable create`` refuses a node in one).
 
 Across the cable a hosted node is linked rigidly to its host (Itasca's cable nodes: only the axial
 direction of the link is deformable, through the grout): it takes the host point's velocity in the
@@ -62,6 +63,7 @@ import numpy as np
 from dec3d.kernels.cable import C_A, C_E, C_KG, cable_step, empty_scratch
 from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, block_timestep
 from dec3d.model.cables import cable_stores, has_cables, update_masses
+from dec3d.model.hosts import host_stress, spread_stiffness
 
 from dec3d.model.beams import has_beams
 
@@ -244,10 +246,10 @@ def zone_host_state(m, nodes, segs, zn):
     e = seg[zn]
     d = nodes["pos"][segs["nb"][e]] - nodes["pos"][segs["na"][e]]
     t = d / np.linalg.norm(d, axis=1)[:, None]
-    sx = m.stores["zones"]["stress"][nodes["hzone"][zn]]      # xx yy zz xy yz xz
+    sx = host_stress(m, nodes["hz"][zn], nodes["hzone"][zn])      # xx yy zz xy xz yz
     tr = sx[:, 0] + sx[:, 1] + sx[:, 2]
     tst = (sx[:, 0] * t[:, 0] ** 2 + sx[:, 1] * t[:, 1] ** 2 + sx[:, 2] * t[:, 2] ** 2
-           + 2.0 * (sx[:, 3] * t[:, 0] * t[:, 1] + sx[:, 4] * t[:, 1] * t[:, 2] + sx[:, 5] * t[:, 0] * t[:, 2]))
+           + 2.0 * (sx[:, 3] * t[:, 0] * t[:, 1] + sx[:, 4] * t[:, 0] * t[:, 2] + sx[:, 5] * t[:, 1] * t[:, 2]))
     return -(tr - tst) / 2.0, hvel
 
 
@@ -266,7 +268,7 @@ def gridpoint_grout_stiffness(m, n: int) -> np.ndarray:
     kn = np.zeros(nodes.n)
     np.add.at(kn, segs["na"], kend)
     np.add.at(kn, segs["nb"], kend)
-    np.add.at(out, nodes["hgp"][zn].ravel(), (nodes["hw"][zn] * kn[zn][:, None]).ravel())
+    spread_stiffness(out, nodes["hgp"][zn], nodes["hw"][zn], kn[zn])
     return out
 
 

@@ -27,6 +27,7 @@ import numpy as np
 
 from dec3d.kernels.dowel import D_K, dowel_step
 from dec3d.model.dowels import DOWELS, has_dowels
+from dec3d.model.hosts import spread_stiffness
 
 
 def advance_dowels(m, dt: float) -> None:
@@ -77,7 +78,7 @@ def block_stiffness(m) -> tuple[np.ndarray, np.ndarray]:
 
 
 def gridpoint_stiffness(m, n: int) -> np.ndarray:
-    """Per vertex row: Σ wᵢ k_d of the dowels on zoned sides."""
+    """Per vertex row: the Gershgorin sums of the dowels on deformable sides (``model.hosts``)."""
     out = np.zeros(n)
     if not has_dowels(m):
         return out
@@ -86,7 +87,7 @@ def gridpoint_stiffness(m, n: int) -> np.ndarray:
     for side in range(2):
         on = st["hz"][:, side] != 0
         if on.any():
-            np.add.at(out, st["hgp"][on, side].ravel(), (st["hw"][on, side] * k[on][:, None]).ravel())
+            spread_stiffness(out, st["hgp"][on, side], st["hw"][on, side], k[on])
     return out
 
 
