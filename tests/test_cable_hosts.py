@@ -237,3 +237,17 @@ model cycle 300
     nodes = b.model.stores["beam_nodes"]
     assert nodes["hz"].tolist() == [3, 3, 3, 0, 0]
     assert np.isfinite(nodes["pos"]).all() and nodes["disp"][4, 2] < 0
+
+
+def test_confinement_reads_the_shear_stresses_in_store_order():
+    """σ_m = −(tr σ − tᵀσt)/2 with only σ_xz = −1 MPa and the cable along (1, 0, 1)/√2: tᵀσt = σ_xz, so
+    σ_m = −(0 − (−1e6))/2 = −0.5 MPa (σ_yz, which the cable does not see, stays out)."""
+    from dec3d.physics.cables import zone_host_state
+
+    s = Session(stdout=io.StringIO())
+    s.run_items(s.load_text("model new\nblock create brick 0 2 -0.5 0.5 -0.5 0.5\nblock zone generate edgelength 0.5\n"
+                            "block zone initialize stress 0 0 0 0 -1e6 0\n"
+                            "structure cable create by-line 0.6 0 -0.3 1.2 0 0.3 segments 2\n"))
+    nodes, segs = s.model.stores["cable_nodes"], s.model.stores["cable_segments"]
+    conf, _ = zone_host_state(s.model, nodes, segs, np.arange(nodes.n))
+    np.testing.assert_allclose(conf, -0.5e6, rtol=1e-12)
