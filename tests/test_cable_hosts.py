@@ -251,3 +251,16 @@ def test_confinement_reads_the_shear_stresses_in_store_order():
     nodes, segs = s.model.stores["cable_nodes"], s.model.stores["cable_segments"]
     conf, _ = zone_host_state(s.model, nodes, segs, np.arange(nodes.n))
     np.testing.assert_allclose(conf, -0.5e6, rtol=1e-12)
+
+
+def test_fe_hosted_cable_save_restore_continues_the_same_run(tmp_path):
+    a = _pullout(tmp_path, "fe", steps=150)
+    path = tmp_path / "fe.sav"
+    a.run_items(a.load_text(f"model save '{path}'\nmodel cycle 100\n"))
+    b = Session(out_dir=tmp_path, stdout=io.StringIO())
+    b.run_items(b.load_text(f"model restore '{path}'\nmodel cycle 100\n"))
+    sa, sb = a.model.stores, b.model.stores
+    assert (sb["cable_nodes"]["hz"] == 3).all()
+    for k in ("fa", "gf"):
+        np.testing.assert_array_equal(sa["cable_segments"][k], sb["cable_segments"][k])
+    np.testing.assert_array_equal(a.model.vertices["pos"], b.model.vertices["pos"])
