@@ -71,6 +71,12 @@ def test_cables_read_their_stores():
     assert it.structure.node.find(99) is None
     with pytest.raises(ValueError, match="no cable element with id 99"):
         it.structure.Cable(it.current(), 99).force_axial()
+    # the top element (it holds the block's 20 kN) breaks at its strain limit and is read as ruptured
+    assert not it.structure.cable.find(29).ruptured()
+    it.command("structure cable property tensile-failure-strain 1e-9 range id 29")
+    it.cycle(1)
+    top = it.structure.cable.find(29)
+    assert top.ruptured() and top.state() & 32 and top.force_axial() == 0.0
 
 
 CANTILEVER = """model new
