@@ -481,3 +481,19 @@ model solve time 3.3e-3
     up = np.flatnonzero((u[:-1] < 5e-4) & (u[1:] >= 5e-4))      # crossings of the static stretch, rising
     assert len(up) == 2
     assert t[up[1]] - t[up[0]] == pytest.approx(4 * 2.0 / np.sqrt(200e9 / 7800), rel=0.01)
+
+
+def test_a_save_without_the_strain_limit_column_reads_as_never_rupturing(tmp_path):
+    """Files written before `tensile-failure-strain` hold nine property columns: restored, the tenth
+    reads 0 (never ruptures) and the cable cycles as before."""
+    from dec3d.model.cables import cable_stores
+
+    s = _run(_session(tmp_path), HANG)
+    segs = s.model.stores["cable_segments"]
+    old = segs["prop"][:, :9].copy()
+    segs.resize_field("prop", (9,))
+    _, segs = cable_stores(s.model)
+    assert segs["prop"].shape[1] == 10 and not segs["prop"][:, 9].any()
+    np.testing.assert_array_equal(segs["prop"][:, :9], old)
+    _run(s, "model cycle 20\n")
+    assert not (segs["state"] & 32).any()
