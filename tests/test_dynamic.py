@@ -44,7 +44,7 @@ def test_active_list_and_time_total(session):
             "[t0 = dynamic.time.total]\nmodel dynamic list\n")
     assert s.variables["t0"] == 2.5 and m["dyn_time"] == 2.5
     text = _out(s)
-    assert "dynamic mode        : on" in text and "dynamic time-total  : 2.5 s" in text
+    assert "dynamic mode        : on" in text and "dynamic time-total  : 2.5\n" in text
     assert "density scaling     : off (real masses)" in text and "full (Euler equations)" in text
 
 

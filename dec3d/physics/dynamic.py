@@ -35,6 +35,7 @@ import numpy as np
 
 from dec3d.errors import Dec3dError
 from dec3d.io.state import register_known
+from dec3d.units import suffix
 
 #: the settings this module keeps, with their defaults (``rigid.MECH_DEFAULTS`` takes them over)
 DYN_DEFAULTS = {"dynamic": False, "dyn_time": 0.0, "rayleigh": [], "timefns": []}
@@ -99,7 +100,8 @@ def damping_text(model) -> str:
         xi, f, form = m["rayleigh"]
         a, b = rayleigh_coefficients(model)
         what = {"both": "mass and stiffness", "mass": "mass only", "stiffness": "stiffness only"}[form]
-        return (f"rayleigh, fraction {xi:g} at {f:g} Hz ({what}: α = {a:.6g} 1/s, β = {b:.6g} s)"
+        return (f"rayleigh, fraction {xi:g} at {f:g}{suffix(model, 'frequency')} ({what}: α = {a:.6g}"
+                f"{suffix(model, 'rate')}, β = {b:.6g}{suffix(model, 'time')})"
                 if a or b else "rayleigh with fraction or frequency 0: no damping")
     if mode == "none":
         return "none"

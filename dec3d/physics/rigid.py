@@ -27,6 +27,7 @@ from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_
 from dec3d.model.store import Store
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.zones import has_zones
+from dec3d.units import suffix
 
 from .beams import beam_balance, has_beams
 from .cables import cable_timestep, grouted_timestep
@@ -487,12 +488,15 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
             w0 = math.hypot(*self._spin0[bad]) if getattr(self, "_spin0", None) is not None else math.nan
             if not math.isfinite(w):
                 w = w0
-            what = (f"spins at {w:.3g} rad/s ({w * dt:.3g} rad in one step of {dt:.3g} s)" if math.isfinite(w)
+            what = (f"spins at {w:.3g}{suffix(m, 'angular-velocity')} ({w * dt:.3g} rad in one step of {dt:.3g}"
+                    f"{suffix(m, 'time')})" if math.isfinite(w)
                     else "has a spin that is not a finite number")
         elif far:
-            what = f"moved farther than its own size in one step (speed {v:.3g} m/s, time step {dt:.3g} s)"
+            what = (f"moved farther than its own size in one step (speed {v:.3g}{suffix(m, 'velocity')}, time step "
+                    f"{dt:.3g}{suffix(m, 'time')})")
         else:
-            what = f"reached velocity {v:.3g} m/s (time step {dt:.3g} s too large or stiffness too high)"
+            what = (f"reached velocity {v:.3g}{suffix(m, 'velocity')} (time step {dt:.3g}{suffix(m, 'time')} too large "
+                    "or stiffness too high)")
         tail = ": it can pass through other blocks unseen" if far and not spin else ""
         return RunError(f"the run became unstable at step {m.step if step is None else step}: block {bid} {what}{tail}; "
                         "the model is back at its state before this command")

@@ -52,6 +52,7 @@ from dec3d.model.feblocks import has_feblocks
 from dec3d.model.model import KIND_DEFORMABLE
 from dec3d.model.zones import ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
 from dec3d.physics.cmodels import MODEL_BY_CODE
+from dec3d.units import suffix
 
 from .cables import gridpoint_grout_stiffness
 
@@ -552,6 +553,7 @@ class ZoneStepper:
         bid = int(m.blocks["id"][v["block"][row]])
         x, y, z = (float(c) for c in v["pos"][row])
         return self.error(f"the run became unstable at step {m.step}: a gridpoint of block {bid} at "
-                          f"({x:.4g}, {y:.4g}, {z:.4g}) reached velocity {sp:.3g} m/s (time step {dt:.3g} s); "
+                          f"({x:.4g}, {y:.4g}, {z:.4g}) reached velocity {sp:.3g}{suffix(m, 'velocity')} (time step {dt:.3g}"
+                          f"{suffix(m, 'time')}); "
                           "the model is back at its state before this command")
 
