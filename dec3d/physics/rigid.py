@@ -435,7 +435,7 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
         return {"blocks": {k: b[k].copy() for k in b.fields},
                 "vertices": {k: v[k].copy() for k in ("pos", "map_pos", "look_pos", "turn_pos")
                              + (_GP_STATE if _has_gridpoints(m) else ()) if k in v},
-                "zones": ({k: m.store("zones")[k].copy() for k in ("stress", "gstress", "volume", "state", "hist")}
+                "zones": ({k: m.store("zones")[k].copy() for k in ("stress", "gstress", "volume", "state", "hist", "ghist")}
                           if has_zones(m) else {}),
                 "feblocks": ({k: m.store("feblocks")[k].copy() for k in ("stress", "gstress")}
                              if has_feblocks(m) else {}),

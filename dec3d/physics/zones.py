@@ -7,7 +7,9 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
 1. checks: every zoned block has zones with a model (``RunError`` naming the blocks otherwise);
    the zones of each model by its registry entry (``physics.cmodels``: every property in its
    range, then the model's own check; errors stop the run naming the zones, warnings go to the
-   engine's ``warn``); 10-node zones cycle elastic only;
+   engine's ``warn``); 10-node zones take every model: elastic ones step in ``zones_ho.tet10_step``,
+   any other model through ``zones_ho_models.tet10_model_step`` (the model's update at each Gauss
+   point, a history per Gauss point in ``zones.ghist``);
 2. lumped masses and the node stiffness of Eq. (86) (kernel ``zonestep.zone_mass_stiffness``)
    of the 4-node zones; for 10-node zones HRZ lumped masses (``zones_ho.tet10_lumped_mass``) and
    twice the Gershgorin row-sum stiffness (``zones_ho.tet10_stiffness``); summed onto link masters
@@ -158,11 +160,6 @@ class ZoneStepper:
         for code in np.unique(cm[act]):
             zm = MODEL_BY_CODE[int(code)]
             mine = zrow[cm == code]
-            if zm.name != "elastic" and (nn[mine] == 10).any():
-                ho = mine[nn[mine] == 10]
-                raise error(f"{len(ho)} {zm.name} zones of blocks {_ids(model, zs['block'][ho])} are 10-node "
-                            "tetrahedra: 10-node zones cycle elastic only (use `block zone generate edgelength` "
-                            "or `hexahedra` for these blocks, or an elastic model)")
             bad, warns = zm.problems(p[mine], zs["id"][mine], bid[zs["block"][mine]])
             problems += [f"{zm.name} zones: {x}" for x in bad]
             self.warnings += [f"{zm.name} zones: {x}" for x in warns]
@@ -192,6 +189,17 @@ class ZoneStepper:
         if len(self.rows10):
             from dec3d.kernels import zones_ho
             self.ho = zones_ho.tet10_step
+            codes10 = np.unique(zs["cmodel"][self.rows10])
+            if any(MODEL_BY_CODE[int(c)].name != "elastic" for c in codes10):
+                # some 10-node zone has a model other than isotropic elasticity: the model's update at
+                # every Gauss point (``zones_ho_models``; Hooke gives the same bits as tet10_step)
+                from dec3d.kernels.zones_ho_models import tet10_model_step_for
+                step10 = tet10_model_step_for(model_mask(codes10))
+
+                def ho(pos, vel, gp, rows, bulk, shear, dt, gstress, stress, force):
+                    bad = step10(pos, vel, gp, rows, self.material(stress=stress), zs["ghist"], dt, gstress, force)
+                    return bad
+                self.ho = ho
         # mixed-discretization sets of the 4-node zones: compact set numbers
         hx = zs["hex"][self.rows4]
         self.weight = np.where(zs["overlay"][self.rows4] >= 0, 0.5, 1.0)
