@@ -75,7 +75,8 @@ class RunError(Dec3dError):
 
 
 #: vertex fields the deformable step changes (saved before a run, put back if it fails)
-_GP_STATE = ("velocity", "disp", "force", "mass", "imass", "vapp", "fapp")   # (vapp, fapp: time functions)
+_GP_STATE = ("velocity", "disp", "force", "mass", "imass", "vapp", "fapp", "maxwell")   # (vapp, fapp: time functions;
+#                                                                     maxwell: physics.dynamic)
 
 
 def _has_gridpoints(m) -> bool:
@@ -206,7 +207,7 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
         s = self.settings()
         if s["damping"] == "rayleigh":
             return DAMP_RAYLEIGH, rayleigh_coefficients(self.model)[0]
-        if s["dynamic"]:
+        if s["dynamic"] or s["damping"] == "maxwell":
             return DAMP_NONE, 0.0
         code = {"none": DAMP_NONE, "local": DAMP_LOCAL, "combined": DAMP_COMBINED, "global": DAMP_ADAPTIVE}
         return code[s["damping"]], float(s["alpha"])
@@ -218,7 +219,7 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
     def _dynamic_style(self) -> bool:
         """Real masses and full inertia: dynamic mode, or no (or Rayleigh) damping."""
         s = self.settings()
-        return bool(s["dynamic"]) or s["damping"] in ("none", "rayleigh")
+        return bool(s["dynamic"]) or s["damping"] in ("none", "rayleigh", "maxwell")
 
     def mass_scaling(self) -> bool:
         s = self.settings()

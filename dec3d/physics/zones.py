@@ -186,6 +186,8 @@ class ZoneStepper:
         self.ho = None
         #: β [s] of Rayleigh damping's stiffness term (set by the engine's run; 0: none)
         self.beta = 0.0
+        #: Maxwell damping's components (αᵢ, τᵢ [s]) (set by the engine's run; []: none)
+        self.maxwell = []
         if len(self.rows10):
             from dec3d.kernels import zones_ho
             self.ho = zones_ho.tet10_step
@@ -471,6 +473,9 @@ class ZoneStepper:
         if self.beta > 0.0:             # Rayleigh damping's stiffness term (physics.dynamic)
             from .dynamic import zone_stiffness_damping
             zone_stiffness_damping(self, self.beta, pos, vel, facc)
+        if self.maxwell:                # Maxwell damping's components (physics.dynamic)
+            from .dynamic import zone_maxwell_damping
+            zone_maxwell_damping(self, self.maxwell, dt, pos, vel, facc)
         fe = self.fe
         if fe is not None:
             e = fe.forces(pos, vel, dt, gravity, facc, fmag)
