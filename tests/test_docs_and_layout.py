@@ -46,10 +46,11 @@ def test_page_examples_parse_and_bind_to_their_command(path):
 # The layer rules of docs/architecture.md ("Layers and the import direction"): for each part of
 # the package, the parts of dec3d it may import (itself always). Anything not listed is an upward
 # import; a new package has to be placed here before it can be imported by anyone.
-BASE = {"errors", "config"}                      # imported by every layer
+BASE = {"errors", "config", "units"}             # imported by every layer (kernels: config only)
 MAY_IMPORT = {
     "errors": set(),
     "config": set(),
+    "units": set(),                              # which units reports name (none unless declared)
     "kcache": set(),                             # run by dec3d/__init__ before any kernel loads
     "kernels": {"config"},                       # and numpy, numba, math only (next test)
     "lang": {"errors"},                          # knows no commands

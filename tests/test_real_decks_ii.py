@@ -141,7 +141,7 @@ model list
 block contact list
 block contact list information""")
     text = out.getvalue()
-    assert "title           : two cubes" in text and "gravity         : 0 0 -9.81 m/s^2" in text
+    assert "title           : two cubes" in text and "gravity         : 0 0 -9.81\n" in text
     assert "holds           : 2 blocks, 1 contacts" in text
     row = [t for t in text.splitlines() if t.strip().startswith("1 ") and "face-face" in t][0].split()
     # the normal force of the only contact carries the upper cube: m g = 2000 * 9.81 N (0.1 %)

@@ -31,9 +31,10 @@ def session(tmp_path):
 def test_model_cycle_ends_with_the_report_of_model_solve_but_not_inside_fish(session):
     session.command(TWO + "model cycle 50")
     lines = session.output.getvalue().splitlines()
-    assert lines[-2] == f"model cycle: 50 steps (to step 50), model time {session.model.time:.6g} s " \
-                        f"(total {session.model.time:.6g} s)"
-    assert re.fullmatch(r"  ratio [0-9.e+-]+, ratio-average .*, unbalanced-maximum [0-9.e+-]+ N", lines[-1])
+    # no units unless the deck declares them (issue 31 item 3): a deck may be in kN and kPa
+    assert lines[-2] == f"model cycle: 50 steps (to step 50), model time {session.model.time:.6g} " \
+                        f"(total {session.model.time:.6g})"
+    assert re.fullmatch(r"  ratio [0-9.e+-]+, ratio-average .*, unbalanced-maximum [0-9.e+-]+", lines[-1])
     n = len(lines)
     session.command("fish define f\n  loop i (1, 3)\n    command\n      model cycle 5\n    endcommand\n  endloop\n"
                     "end\n@f")
@@ -90,3 +91,52 @@ def test_contact_properties_without_contacts_and_implausible_densities_warn(sess
     text = session.output.getvalue()
     assert text.count("is outside 100–30000 kg/m³") == 1 and "density 2.65 is outside" in text
     assert len(session.warnings) == 2
+
+
+# ---------------------------------------------------------------- units (issue 31 item 3, item 2's field data)
+def test_reports_name_units_only_once_the_deck_declares_them(session):
+    session.command(TWO + "model cycle 20\nmodel list\nblock list information")
+    bare = session.output.getvalue()
+    assert "units           : not declared" in bare
+    assert "gravity         : 0 0 -9.81\n" in bare and "time step       : " in bare
+    assert not re.search(r"\d (s|N|m|kg|m³|m/s²)(\b|$|\))", bare, re.M), bare
+    n = len(bare)
+    session.command("model configure units si\nmodel cycle 20\nmodel list\nblock list information")
+    si = session.output.getvalue()[n:]
+    t = session.model.time
+    assert f"model time {t / 2:.6g} s (total {t:.6g} s)" in si
+    assert re.search(r"unbalanced-maximum [0-9.e+-]+ N$", si, re.M)
+    assert "gravity         : 0 0 -9.81 m/s²" in si and "units           : SI (m, kg, s, N, Pa)" in si
+    assert "total volume 2 m³, mass 4000 kg" in si and "tolerance" in si and si.count(" m\n") >= 2
+    # `units none` takes it back; the setting travels in save files
+    session.command("model configure units none\nmodel list units")
+    assert session.output.getvalue().rstrip().endswith("reports show no units (`model configure units si` to show "
+                                                       "SI units)")
+
+
+def test_declared_units_go_to_the_vtk_files_and_the_save(session, tmp_path):
+    import meshio
+
+    from dec3d.io.vtk import read_text_array
+
+    session.command(TWO + "model cycle 5\nblock vtk filename 'a'\nmodel configure units si\nmodel cycle 5\n"
+                    "block vtk filename 'b'\nmodel save 'u'\nmodel new\nmodel restore 'u'\nmodel list units")
+    assert "units" not in meshio.read(tmp_path / "a_0000.vtu").field_data
+    units = read_text_array(meshio.read(tmp_path / "b_0000.vtu").field_data["units"])
+    assert units[0] == "system=SI" and "displacement=m" in units and "spin=rad/s" in units
+    joints = read_text_array(meshio.read(tmp_path / "b_joints_0000.vtu").field_data["units"])
+    assert "normal_stress=Pa" in joints and "shear_displacement=m" in joints
+    assert session.output.getvalue().rstrip().endswith("reports name them")     # restored with the model
+
+
+@pytest.mark.parametrize("line, col, words", [
+    ("model configure units", 17, "needs the system: si or none"),
+    ("model configure dynamic si", 25, "takes no unit system"),
+    ("model configure units kilo", 23, "kilo"),
+])
+def test_configure_units_bad_input_names_the_column(session, line, col, words):
+    from dec3d.errors import Dec3dError
+
+    with pytest.raises(Dec3dError) as err:
+        session.command(line)
+    assert err.value.location.column == col and words in err.value.format()

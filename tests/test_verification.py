@@ -28,7 +28,7 @@ def test_every_verification_problem_is_there():
                                          "E1_eigenmodes", "DY1_rayleigh_block_on_spring", "DY2_newmark_sliding_block",
                                          "DY3_shear_wave_quiet_base", "DY5_energy", "FE1_cantilever",
                                          "FE2_fe_deformable_contacts", "F2_griffiths_lane_slope", "F3_vertical_cut",
-                                         "D10_hoek_brown_triaxial", "D11_strain_softening", "D12_ubiquitous_joint",
+                                         "D10_hoek_brown_triaxial", "D11_strain_softening", "D12_ubiquitous_joint", "D15_triaxial_ho",
                                          "D13_drucker_prager_triaxial", "D14_anisotropic_elastic",
                                          "SE1_cable_pullout", "SE2_bolted_planar_slide", "SE3_cable_pullout_confined",
                                          "SE4_dowel_shear", "SE5_beam", "SE6_dowel_slide_fos",

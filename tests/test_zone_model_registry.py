@@ -34,7 +34,7 @@ def test_every_kernel_has_its_host_and_codes_are_unique():
 def test_no_file_outside_a_models_two_files_names_it():
     """A model is its kernel and host file: no other module of dec3d names it (code literals are
     covered too: nothing imports a model's kernel module but its host). ``elastic`` is the one
-    exception, by design: FE blocks and 10-node zones cycle elastic only, and Rayleigh damping
+    exception, by design: FE blocks cycle elastic only, all-elastic 10-node zones keep their Hooke step, and Rayleigh damping
     takes plastic zones as elastic."""
     mine = {}
     for m in MODELS:

@@ -13,6 +13,7 @@ from ..geometry.polyhedron import (WARP_RELATIVE, brick_faces, build_many, polyh
                                    split_faces, tetrahedron_faces)
 from ..geometry.tunnel import tunnel, tunnel_block_count
 from ..model.blocks import add_blocks, add_pieces
+from ..units import suffix
 from .budget import check_blocks
 from .registry import command
 from .values import ANGLE, COORD, LENGTH, POINT, InPath, Nums, Num, P, Text
@@ -114,9 +115,10 @@ def _create(session, call) -> None:
         fi, corner, dist, limit = max(warped, key=lambda w: w[2])
         more = f" (and {len(warped) - 1} other face(s))" if len(warped) > 1 else ""
         bid = int(session.model.blocks["id"][session.model.blocks.n - 1])
-        session.write(f"warning: {call.location}: block {bid}: face {fi} is warped: corner {corner} lies {dist:.3g} m "
-                      f"off the face's plane{more} (tolerance {tol:g} m; accepted up to {100 * WARP_RELATIVE:g} % of "
-                      f"the block's size, {limit:.3g} m): the block is built as the convex hull of its corners, "
+        L = suffix(session, "length")
+        session.write(f"warning: {call.location}: block {bid}: face {fi} is warped: corner {corner} lies {dist:.3g}{L} "
+                      f"off the face's plane{more} (tolerance {tol:g}{L}; accepted up to {100 * WARP_RELATIVE:g} % of "
+                      f"the block's size, {limit:.3g}{L}): the block is built as the convex hull of its corners, "
                       "the warped face split into triangles")
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 from ..errors import CommandError
 from ..io.vtk import write_vtu
 from ..physics.eigen import EigenError, eigenmodes, vertex_mode_displacement
+from ..units import paren
 from .registry import command
 from .values import Num, OutPath, P
 
@@ -37,7 +38,7 @@ def eigen_modes(session, call):
     except EigenError as exc:
         raise CommandError(str(exc.args[0]), call.location) from None
     session.write(f"eigenmodes of {len(modes.bodies)} bodies, {modes.ndof} free degrees of freedom")
-    session.write("  mode  frequency (Hz)      period (s)")
+    session.write(f"  mode  {'frequency' + paren(session, 'frequency'):>14}  {'period' + paren(session, 'time'):>14}")
     for i, f in enumerate(modes.frequencies, start=1):
         period = f"{1.0 / f:14.6g}" if f > 0 else "           inf"
         session.write(f"  {i:4d}  {f:14.6g}  {period}")

@@ -5,6 +5,7 @@ import numpy as np
 
 from ..model.blocks import (delete_blocks, group_blocks, hide_blocks, join_blocks, joined_groups,
                             set_density, summary)
+from ..units import suffix
 from .registry import command
 from .values import DENSITY, FLAG, ONOFF, Choice, Num, P, Text
 
@@ -171,15 +172,16 @@ def block_list(session, call):
         session.write(f"blocks {s['blocks']} (in range {sel.size}, hidden {s['hidden']}, "
                       f"joined {s['joined']} in {len(joined_groups(m))} groups)")
         session.write(f"vertices {s['vertices']}, faces {s['faces']}")
-        session.write(f"total volume {s['volume']:.6g} m^3, mass {s['mass']:.6g} kg")
+        L, V = suffix(m, "length"), suffix(m, "volume")
+        session.write(f"total volume {s['volume']:.6g}{V}, mass {s['mass']:.6g}{suffix(m, 'mass')}")
         if sel.size:
             vol = m.blocks["volume"][sel]
-            session.write(f"volume in range: total {vol.sum():.6g}, min {vol.min():.6g}, max {vol.max():.6g} m^3")
+            session.write(f"volume in range: total {vol.sum():.6g}, min {vol.min():.6g}, max {vol.max():.6g}{V}")
         if s["extent"]:
             lo, hi = s["extent"]
-            session.write("extent x {:.6g} {:.6g}  y {:.6g} {:.6g}  z {:.6g} {:.6g} m".format(
-                lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]))
-        session.write(f"tolerance {s['tolerance']:g} m")
+            session.write("extent x {:.6g} {:.6g}  y {:.6g} {:.6g}  z {:.6g} {:.6g}".format(
+                lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]) + L)
+        session.write(f"tolerance {s['tolerance']:g}{L}")
         session.results.update({"blocks": float(s["blocks"]), "volume": s["volume"]})
         return
     b = m.blocks

@@ -4,28 +4,31 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import CommandError
+from ..physics.dynamic import MAXWELL_MAX
 from ..physics.rigid import engine, mech
 from .registry import command
 from .values import FLAG, Choice, Deferred, Num, Nums, P, ValueRangeError
 
 
-_DAMPING_NOT_YET = ("maxwell",)
 _RAYLEIGH_FORMS = ("mass", "stiffness")
 
 
 def _check_damping(call):
-    from ..errors import BindError, NotSupportedError
+    from ..errors import BindError
 
     mode = call.args["mode"]
     where = call.locations.get("alpha", call.location)
-    if mode in _DAMPING_NOT_YET:
-        raise NotSupportedError(f"`block mechanical damping {mode}` is not supported yet",
-                                call.locations.get("mode", call.location),
-                                hint="implemented: local [α], combined [α], global [ratio], none, "
-                                     "rayleigh <fraction> <frequency> [mass|stiffness]")
     if call.args["form"] is not None and mode != "rayleigh":
         raise BindError(f"`{call.args['form']}` belongs to rayleigh damping, not {mode}",
                         call.locations.get("form", call.location))
+    if mode == "maxwell":
+        vals = call.args["alpha"]
+        if not vals or len(vals) % 2:
+            raise BindError("maxwell damping takes pairs: <peak fraction of critical damping> <its frequency [Hz]> "
+                            f"…, one to {MAXWELL_MAX} of them", where)
+        if not any(isinstance(v, Deferred) for v in vals):
+            _maxwell(vals, where)
+        return
     if mode == "rayleigh":
         if len(call.args["alpha"]) != 2:
             raise BindError("rayleigh damping takes two values: <fraction of critical damping> <frequency [Hz]>",
@@ -67,6 +70,22 @@ def _rayleigh(vals, where) -> tuple[float, float]:
     return float(xi), float(f)
 
 
+def _maxwell(vals, where) -> list[list[float]]:
+    """[[ξᵢ, fᵢ], …] of maxwell damping: each peak fraction in [0, 0.5), each frequency > 0."""
+    out = []
+    for i in range(0, len(vals), 2):
+        try:
+            xi = Num(lo=0, hi=0.5, hi_open=True).convert(vals[i], where)
+        except ValueRangeError as exc:
+            raise exc.named(f"the peak fraction of maxwell component {i // 2 + 1}") from None
+        try:
+            f = Num(lo=0, lo_open=True).convert(vals[i + 1], where)
+        except ValueRangeError as exc:
+            raise exc.named(f"the frequency of maxwell component {i // 2 + 1}") from None
+        out.append([float(xi), float(f)])
+    return out
+
+
 def _alpha(mode, value, where) -> float:
     rule = _ALPHA.get(mode, Num())
     try:
@@ -78,8 +97,9 @@ def _alpha(mode, value, where) -> float:
 @command("block mechanical damping",
          positional=[P("mode", Choice(("local", "global", "combined", "none", "rayleigh", "maxwell")),
                        "damping form", required=True),
-                     P("alpha", Nums(0, 6), "coefficient α of local and combined damping, in [0, 1); target ratio "
-                       "of global, > 0; rayleigh: fraction of critical damping and frequency [Hz]", default=()),
+                     P("alpha", Nums(0, 2 * MAXWELL_MAX), "coefficient α of local and combined damping, in [0, 1); "
+                       "target ratio of global, > 0; rayleigh: fraction of critical damping and frequency [Hz]; "
+                       "maxwell: pairs of peak fraction and its frequency [Hz]", default=()),
                      P("form", Choice(_RAYLEIGH_FORMS), "rayleigh only: the mass- or stiffness-proportional term "
                        "alone")],
          check=_check_damping,
@@ -94,12 +114,18 @@ def _alpha(mode, value, where) -> float:
                  "velocities, the stiffness term every sub-contact (rigid, zoned and FE sides), the zones (4-node, "
                  "hexahedral, 10-node) and the FE elements (damping stress β D ε̇), and lowers the time step; "
                  "real masses and full inertia, as with `none`; see dec3d.physics.dynamic). In dynamic mode "
-                 "(`model dynamic active on`) only rayleigh damping is applied. `maxwell` is known and not "
-                 "supported yet.",
+                 "(`model dynamic active on`) only rayleigh and maxwell damping are applied. `maxwell ξ₁ f₁ "
+                 "[ξ₂ f₂ …]` (up to four pairs): Maxwell components, each a spring 4ξᵢ K in series with a dashpot "
+                 "of relaxation time 1/(2π fᵢ), in parallel with the zones' and FE elements' stiffness K, so "
+                 "component i damps most, ξᵢ, at fᵢ and the total ratio is Σ 2ξᵢ (f/fᵢ)/(1 + (f/fᵢ)²), nearly "
+                 "flat between the frequencies (dec3d's reading of the pairs; see dec3d.physics.dynamic); "
+                 "contacts and rigid blocks are not damped by it; real masses; the time step is lowered by "
+                 "√(1 + Σ 4ξᵢ).",
          examples=["block mechanical damping local 0.8", "block mechanical damping combined",
                    "block mechanical damping global", "block mechanical damping none",
                    "block mechanical damping rayleigh 0.05 10", "block mech damp rayleigh 0.06 10.87 mass",
-                   "block mechanical damping rayleigh 0 0"])
+                   "block mechanical damping rayleigh 0 0",
+                   "block mech damp maxwell 0.0233 0.9970 0.0195 7.1172 0.0278 50.0027"])
 def damping(session, call):
     s = mech(session.model)
     mode = call.args["mode"]
@@ -108,6 +134,10 @@ def damping(session, call):
         xi, f = _rayleigh(call.args["alpha"], where)
         s["damping"] = mode
         s["rayleigh"] = [xi, f, call.args["form"] or "both"]
+        return
+    if mode == "maxwell":
+        s["maxwell"] = _maxwell(call.args["alpha"], where)
+        s["damping"] = mode
         return
     alpha = _alpha(mode, call.args["alpha"][0], where) if call.args["alpha"] else None
     s["damping"] = mode

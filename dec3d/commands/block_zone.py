@@ -6,6 +6,7 @@ import numpy as np
 
 from ..errors import BindError, CommandError, ResourceError
 from ..model.zones import zone_stores
+from ..units import suffix
 from .registry import command
 from .values import FLAG, Choice, Num, Nums, P
 
@@ -387,9 +388,10 @@ def block_zone_list(session, call):
         session.write(f"zones {info['zones']} (of {zs.n}), gridpoints {info['gridpoints']}")
         session.results.update({"zones": float(info["zones"]), "gridpoints": float(info["gridpoints"])})
         if info["zones"]:
-            session.write(f"edge length: smallest {info['edge_min']:.6g} m, largest {info['edge_max']:.6g} m")
+            L, V = suffix(m, "length"), suffix(m, "volume")
+            session.write(f"edge length: smallest {info['edge_min']:.6g}{L}, largest {info['edge_max']:.6g}{L}")
             session.write(f"smallest dihedral angle {info['dihedral_min']:.4g} degrees")
-            session.write(f"volume: smallest {info['volume_min']:.6g} m^3, total {info['volume_total']:.6g} m^3")
+            session.write(f"volume: smallest {info['volume_min']:.6g}{V}, total {info['volume_total']:.6g}{V}")
             session.results.update({"zone_edge_min": info["edge_min"], "zone_edge_max": info["edge_max"],
                                     "zone_dihedral_min": info["dihedral_min"],
                                     "zone_volume_min": info["volume_min"], "zone_volume": info["volume_total"]})

@@ -85,6 +85,7 @@ def block_zone_cmodel_assign(session, call):
     zs["cmodel"][rows] = code
     zs["state"][rows] = 0
     zs["hist"][rows] = 0.0
+    zs["ghist"][rows] = 0.0
     if code == ZMODEL_NULL:
         zs["stress"][rows] = 0.0
         zs["gstress"][rows] = 0.0

@@ -11,6 +11,7 @@ from ..errors import CommandError, ResourceError
 from ..geometry import dfn_measure
 from ..geometry.dfn_cut import TooManyBlocks, cut_dfn
 from ..model import fractures as FR
+from ..units import suffix as unit
 from .budget import budget, check_blocks
 from .fracture import _arrays, _box, _dfn_rows
 from .registry import command, range_element
@@ -100,7 +101,8 @@ def fracture_compute(session, call):
         length = float(np.linalg.norm(p1 - p0, axis=1).sum())
         p10 = hits / length
         _put(session, "p10", p10, suffix)
-        session.write(f"P10 on {len(p0)} scanline(s) of {length:.6g} m: {p10:.6g} 1/m ({hits} crossings)")
+        L, pl = unit(m, "length"), unit(m, "per-length")
+        session.write(f"P10 on {len(p0)} scanline(s) of {length:.6g}{L}: {p10:.6g}{pl} ({hits} crossings)")
         if p32 is not None and p32 > 0:
             wlen = np.linalg.norm(p1 - p0, axis=1) / length
             area = r * r
@@ -118,7 +120,8 @@ def fracture_compute(session, call):
         except ValueError as exc:
             raise CommandError(str(exc), call.locations.get("plane_origin", call.location)) from None
         _put(session, "p21", v, suffix)
-        session.write(f"P21 on the plane: {v:.6g} 1/m (traces {length:.6g} m on {area:.6g} m²)")
+        session.write(f"P21 on the plane: {v:.6g}{unit(m, 'per-length')} (traces {length:.6g}{unit(m, 'length')} "
+                      f"on {area:.6g}{unit(m, 'area')})")
     if len(rows) > 1:
         md, mdd, kap = dfn_measure.fisher_stats(n)
         _put(session, "mean_dip", math.degrees(md), suffix)
@@ -173,7 +176,7 @@ def fracture_list(session, call):
             q = sel[fs["set"][sel] == s]
             d, dd = FR.dips_from_normals(fs["normal"][q])
             session.write(f"  set {int(s)}: {len(q)} fractures, diameter {2 * fs['radius'][q].min():.4g}.."
-                          f"{2 * fs['radius'][q].max():.4g} m, mean dip {math.degrees(d.mean()):.1f}")
+                          f"{2 * fs['radius'][q].max():.4g}{unit(m, 'length')}, mean dip {math.degrees(d.mean()):.1f}")
 
 
 @command("fracture delete", keywords=[P("dfn", Text(), "only this DFN")], range="fractures",
@@ -258,7 +261,7 @@ def block_cut_dfn(session, call):
     session.results["fractures_used"] = float(used)
     session.results["slivers_skipped"] = float(skipped)
     session.results["smallest_volume"] = float(vol.min()) if len(vol) else 0.0
-    session.write(f"{made} new blocks from {used} of {len(rows)} fractures (smallest block {vol.min():.4g} m³; "
+    session.write(f"{made} new blocks from {used} of {len(rows)} fractures (smallest block {vol.min():.4g}{unit(m, 'volume')}; "
                   f"{skipped} cuts not made: they would have left a sliver)")
 
 

@@ -15,6 +15,7 @@ from ..physics.history import (BLOCK_QUANTITIES, CONTACT_QUANTITIES, GRIDPOINT_Q
                                histories)
 from ..physics.history_lookup import nearest_block_id, nearest_gridpoint, zone_at
 from ..model.model import KIND_DEFORMABLE, KIND_FE
+from ..units import paren
 from .registry import REGISTRY, command
 from .values import NUMBERISH, VEC3, FLAG, Choice, Num, OutPath, P, Text, ValueType, _number_literal
 
@@ -332,7 +333,7 @@ def history_export(session, call):
     pngs = [session.out_path(path.with_name(f"{path.stem}_{_file_part(h.name)}.png"), where) for h in picked]
     write_csv(path, picked, vs)
     for h, png in zip(picked, pngs):
-        write_png(png, h, vs)
+        write_png(png, h, vs, paren(session, "time"))
         for key, v in figures(h.times, h.values).items():
             session.results[f"{h.name}.{key}"] = v
 

@@ -20,20 +20,29 @@ def model_title(session, call):
 
 
 CONFIGURE_OPTIONS = ("dynamic", "fluid", "thermal", "highorder", "feblock", "creep")
+UNIT_SYSTEMS = ("si", "none")
 
 
 def _check_configure(call):
     from ..errors import BindError
 
-    if call.args["option"] != "threads" and call.args["n"] is not None:
-        raise BindError(f"`model configure {call.args['option']}` takes no value",
+    opt = call.args["option"]
+    if opt != "threads" and call.args["n"] is not None:
+        raise BindError(f"`model configure {opt}` takes no number",
                         call.locations.get("n", call.location))
+    if (opt == "units") != (call.args["system"] is not None):
+        raise BindError("`model configure units` needs the system: si or none" if opt == "units" else
+                        f"`model configure {opt}` takes no unit system",
+                        call.locations.get("system", call.locations.get("option", call.location)))
 
 
 @command("model configure",
-         positional=[P("option", Choice(CONFIGURE_OPTIONS + ("threads",)), "process to enable, or `threads`",
+         positional=[P("option", Choice(CONFIGURE_OPTIONS + ("threads", "units")),
+                       "process to enable, or `threads`, or `units`",
                        required=True),
-                     P("n", Num(integer=True, lo=1), "with `threads`: the number of threads of the parallel kernels")],
+                     P("n", Num(integer=True, lo=1), "with `threads`: the number of threads of the parallel kernels"),
+                     P("system", Choice(UNIT_SYSTEMS), "with `units`: si (reports and VTK name SI units) or none "
+                       "(no units shown, the default)")],
          check=_check_configure,
          doc="Enable an optional process or element type for the rest of the model's life; or set the number "
              "of threads the calculation uses.",
@@ -44,9 +53,14 @@ def _check_configure(call):
                  "(numba's NUMBA_NUM_THREADS); `threads` alone prints the count. The environment variable "
                  "DEC3D_THREADS sets it when dec3d starts. It is a setting of the program, not of the model "
                  "(`model new` keeps it, save files do not hold it), and the results are bit-identical whatever "
-                 "the count: every sum is taken in a fixed order.",
+                 "the count: every sum is taken in a fixed order. `units si` declares that the deck is in SI units "
+                 "(m, kg, s, N, Pa): reports then name units (`axial (N)`, `Δt = 2e-05 s`) and VTK files carry a "
+                 "`units` field-data array; without it (or after `units none`) quantities print without units, "
+                 "since a deck may use any consistent system (kN, kPa, t/m³). A dec3d setting (3DEC has none), "
+                 "saved with the model.",
          examples=["model configure dynamic", "model config dyn", "model configure highorder",
-                   "model configure threads 2", "model configure threads"])
+                   "model configure threads 2", "model configure threads",
+                   "model configure units si"])
 def model_configure(session, call):
     if call.args["option"] == "threads":
         from ..config import set_threads, thread_report
@@ -59,6 +73,10 @@ def model_configure(session, call):
             except ValueError as exc:
                 raise CommandError(str(exc), call.locations.get("n", call.location)) from None
         session.write(thread_report() + "\n")
+        return
+    if call.args["option"] == "units":
+        sysname = call.args["system"]
+        session.model.settings.units = "" if sysname == "none" else sysname
         return
     opts = session.model.settings.configure
     if call.args["option"] not in opts:

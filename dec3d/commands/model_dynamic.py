@@ -6,6 +6,7 @@ from ..errors import Dec3dError
 from ..physics.dynamic import damping_text, dynamic_time, is_dynamic
 from ..physics.history import histories
 from ..physics.rigid import engine, mech
+from ..units import suffix
 from .histories import _name
 from .registry import REGISTRY, command
 from .values import ONOFF, Choice, Num, P
@@ -46,18 +47,19 @@ def dynamic_list(session, call):
     eng = engine(m)
     on = is_dynamic(m)
     session.write(f"dynamic mode        : {'on' if on else 'off'}")
-    session.write(f"dynamic time-total  : {dynamic_time(m):.6g} s")
+    t = suffix(m, "time")
+    session.write(f"dynamic time-total  : {dynamic_time(m):.6g}{t}")
     session.write(f"damping             : {damping_text(m)}")
     kind = {"raised": "by body, masses only raised", "body": "by body", "eq87": "Eq. 87"}[eng.scaling()]
     session.write(f"density scaling     : {f'on ({kind})' if eng.mass_scaling() else 'off (real masses)'}")
     session.write(f"inertia             : {'full (Euler equations)' if eng.full_inertia() else 'scalar'}")
     if eng.dt:
-        session.write(f"time step           : {eng.dt:.6g} s (last cycle)")
+        session.write(f"time step           : {eng.dt:.6g}{t} (last cycle)")
     elif not m.blocks.n:
         session.write("time step           : none (no blocks)")
     else:
         try:
-            session.write(f"time step           : {eng.predict_timestep():.6g} s (the next cycle starts with it)")
+            session.write(f"time step           : {eng.predict_timestep():.6g}{t} (the next cycle starts with it)")
         except Dec3dError as exc:
             session.write(f"time step           : not known yet ({exc.message})")
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 from ..errors import CommandError
 from ..physics.energy import QUANTITIES, energy_state, new_state, values
 from ..physics.history import histories
+from ..units import suffix
 from .registry import command
 from .values import ONOFF, Choice, P
 
@@ -77,7 +78,7 @@ def model_energy_list(session, call):
     v = values(session.model)
     lines = [f"energy tracking {'on' if e['active'] else 'off'}" + ("" if e["started"] else " (no step tracked yet)")]
     for q in QUANTITIES:
-        unit = "" if q == "error-relative" else " J"
+        unit = "" if q == "error-relative" else suffix(session, "energy")
         lines.append(f"  {q:<16}{v[q]:>16.6g}{unit}")
         session.results[f"energy.{q}"] = v[q]
     session.write("\n".join(lines) + "\n")

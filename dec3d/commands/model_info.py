@@ -6,6 +6,7 @@ import numpy as np
 from ..kernels.joints import ST_FAILED, ST_SLIP, ST_TENSION
 from ..physics.jmodels import JOINT_MODELS
 from ..physics.rigid import engine
+from ..units import describe as describe_units, suffix
 from .registry import command
 from .values import Choice, P
 
@@ -34,9 +35,9 @@ def _names() -> dict[int, str]:
 
 @command("model list",
          positional=[P("what", Choice(("information", "gravity", "title", "configure", "large-strain",
-                                       "update-interval")), "one setting only (default: all of them)")],
+                                       "update-interval", "units")), "one setting only (default: all of them)")],
          doc="Print the model-wide settings and state: title, gravity, large strain, processes configured, "
-             "time and step, time step, what the model holds.",
+             "time and step, time step, what the model holds, the units reports name (`model configure units`).",
          examples=["model list", "model list gravity"])
 def model_list(session, call):
     m = session.model
@@ -44,18 +45,20 @@ def model_list(session, call):
     w = call.args["what"]
     eng = engine(m)
     rows = [("title", s.title or "(none)"),
-            ("gravity", "{:g} {:g} {:g} m/s^2".format(*s.gravity)),
+            ("gravity", "{:g} {:g} {:g}".format(*s.gravity) + suffix(m, "acceleration")),
             ("large-strain", "on" if s.large_strain else "off"),
             ("configure", ", ".join(s.configure) or "(mechanical only)"),
             ("update-interval", f"{s.update_interval} steps"),
+            ("units", describe_units(m)),
             ("information", None)]
     for key, text in rows:
         if w is not None and w != key:
             continue
         if key == "information":
             session.write(f"{'step':<16}: {m.step}")
-            session.write(f"{'time':<16}: {m.time:.6g} s")
-            session.write(f"{'time step':<16}: " + (f"{eng.dt:.6g} s (last cycle)" if eng.dt else "not cycled yet"))
+            t = suffix(m, "time")
+            session.write(f"{'time':<16}: {m.time:.6g}{t}")
+            session.write(f"{'time step':<16}: " + (f"{eng.dt:.6g}{t} (last cycle)" if eng.dt else "not cycled yet"))
             counts = [f"{m.blocks.n} blocks", f"{eng.contacts.n} contacts"]
             for name, label in (("zones", "zones"), ("feblocks", "FE elements"), ("cable_segments",
                                                                                    "cable segments")):
@@ -109,7 +112,7 @@ def block_contact_list(session, call):
         session.write(f"open {int(np.count_nonzero(st & ST_TENSION))}, slipping "
                       f"{int(np.count_nonzero(((st & ST_SLIP) != 0) & ((st & ST_TENSION) == 0)))}, "
                       f"slipped before {int(np.count_nonzero(st & ST_FAILED))}")
-        session.write(f"normal force in range: total {fn[sel].sum():.6g} N")
+        session.write(f"normal force in range: total {fn[sel].sum():.6g}{suffix(m, 'force')}")
         session.results.update({"contacts": float(c.n)})
         return
     session.write(f"{'contact':>8} {'block A':>8} {'block B':>8} {'type':>13} {'jmodel':>14} {'subs':>5} "

@@ -12,6 +12,7 @@ import time as _time
 
 from ..errors import CommandError, _resolved
 from ..physics.rigid import RunError, engine
+from ..units import suffix
 from .registry import command
 from .values import FLAG, Num, P
 
@@ -40,7 +41,7 @@ def _run(session, call, n, stop=None, max_time=None):
     except RunError as exc:
         raise CommandError(exc.message, call.location)
     if call.args.get("timing"):
-        session.write(f"{done} steps, Δt = {e.dt:.4g} s\n{e.timing_report()}\n")
+        session.write(f"{done} steps, Δt = {e.dt:.4g}{suffix(session, 'time')}\n{e.timing_report()}\n")
     return done
 
 
@@ -60,13 +61,14 @@ def model_cycle(session, call):
     rt = getattr(session, "fish_rt", None)
     if done and session.model.blocks.n and (rt is None or rt.depth == 0):
         # the compact report of `model solve` (not for the short cycles FISH functions take in loops)
-        session.write(f"model cycle: {done} steps (to step {e.step}), model time {e.time - time0:.6g} s "
-                      f"(total {e.time:.6g} s)")
-        session.write(f"  {_fmt_criteria(e.criteria())}")
+        t = suffix(session, "time")
+        session.write(f"model cycle: {done} steps (to step {e.step}), model time {e.time - time0:.6g}{t} "
+                      f"(total {e.time:.6g}{t})")
+        session.write(f"  {_fmt_criteria(e.criteria(), suffix(session, 'force'))}")
 
 
-def _fmt_criteria(values: dict) -> str:
-    return ", ".join(f"{name} {values[key]:.4g}" + (" N" if key == "unbalanced-maximum" else "")
+def _fmt_criteria(values: dict, force_unit: str = "") -> str:
+    return ", ".join(f"{name} {values[key]:.4g}" + (force_unit if key == "unbalanced-maximum" else "")
                      for name, key in CRITERIA.values())
 
 
@@ -183,16 +185,17 @@ def model_solve(session, call):
         head = f"not converged ({want} not met): stopped by {limit or 'a limit'}"
     else:
         head = f"stopped by {limit or 'a limit'}"
-    session.write(f"model solve: {head}; {done} steps (to step {e.step}), model time {e.time - time0:.6g} s "
-                  f"(total {e.time:.6g} s)")
-    session.write(f"  {_fmt_criteria(values)}")
+    t, f = suffix(session, "time"), suffix(session, "force")
+    session.write(f"model solve: {head}; {done} steps (to step {e.step}), model time {e.time - time0:.6g}{t} "
+                  f"(total {e.time:.6g}{t})")
+    session.write(f"  {_fmt_criteria(values, f)}")
     if crit and not converged:
         where = _resolved(call.location)
         at = f"{where.file}:{where.line}: " if where is not None else ""
         warnings = getattr(session, "warnings", None)
         if warnings is not None:
             warnings.append(f"{at}model solve did not converge ({want}): stopped by {limit or 'a limit'} at step "
-                            f"{e.step}; {_fmt_criteria(values)}")
+                            f"{e.step}; {_fmt_criteria(values, f)}")
 
 
 def _implicit(session, call, e) -> None:
@@ -207,9 +210,10 @@ def _implicit(session, call, e) -> None:
         return
     except RunError as exc:
         raise CommandError(exc.message, call.location)
+    f = suffix(session, "force")
     how = (f"by conjugate gradients ({r['iterations']} iterations)" if r["iterations"] else "directly")
     session.write(f"model solve implicit: {r['unknowns']} unknowns solved {how} in {r['seconds']:.3g} CPU s "
-                  f"(largest unbalanced force {r['first']:.4g} N before, {r['left']:.3g} N after"
+                  f"(largest unbalanced force {r['first']:.4g}{f} before, {r['left']:.3g}{f} after"
                   f"{', ' + str(r['refines']) + ' refinement(s)' if r['refines'] else ''}); cycling on")
 
 

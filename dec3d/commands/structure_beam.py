@@ -10,6 +10,7 @@ from ..errors import BindError, CommandError
 from ..model.beams import BELEMS, BPROPS, add_beam, beam_stores, element_axes, has_beams, update_beam_masses
 from ..physics.beam_history import BEAM_QUANTITIES, add_beam_history
 from ..physics.history import histories
+from ..units import paren
 from .histories import _name
 from .registry import REGISTRY, command
 from .values import COORD, POINT, VEC3, Num, Nums, P, Text
@@ -127,8 +128,9 @@ def beam_list(session, call):
     _need_beams(session, call)
     mask = session.range_mask(call, BELEMS)
     nodes, els = beam_stores(session.model)
-    session.write("    id  beam  node-1  node-2   axial (N)  torsion (N·m)  M-y1 (N·m)  M-z1 (N·m)  M-y2 (N·m)  "
-                  "M-z2 (N·m)")
+    n, nm = paren(session, "force"), paren(session, "moment")
+    session.write(f"    id  beam  node-1  node-2 {'axial' + n:>11} {'torsion' + nm:>14} {'M-y1' + nm:>11} "
+                  f"{'M-z1' + nm:>11} {'M-y2' + nm:>11} {'M-z2' + nm:>11}")
     for e in np.flatnonzero(mask):
         f = els["fl"][e]
         session.write(f"{int(els['id'][e]):6d} {int(els['beam'][e]):5d} {int(nodes['id'][els['na'][e]]):7d} "

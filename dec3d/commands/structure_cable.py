@@ -11,6 +11,7 @@ import numpy as np
 
 from ..errors import BindError, CommandError
 from ..model.cables import NODES, PROPS, SEGMENTS, add_cable, cable_stores, has_cables, update_masses
+from ..units import paren
 from .registry import command
 from .values import COORD, FLAG, ONOFF, VEC3, Num, Nums, P, Text
 
@@ -153,7 +154,8 @@ def cable_list(session, call):
     _need_cables(session, call)
     mask = session.range_mask(call, SEGMENTS)
     nodes, segs = cable_stores(session.model)
-    session.write("    id  cable  node-a  node-b   axial (N)    grout-a (N)  grout-b (N)  state")
+    n = paren(session, "force")
+    session.write(f"    id  cable  node-a  node-b {'axial' + n:>11} {'grout-a' + n:>12} {'grout-b' + n:>12}  state")
     for e in np.flatnonzero(mask):
         st = int(segs["state"][e])
         words = [w for bit, w in ((1, "yield-t"), (2, "yield-c"), (4, "slip"), (8, "yielded"), (16, "slipped"),

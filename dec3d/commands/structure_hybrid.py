@@ -8,6 +8,7 @@ import numpy as np
 from ..errors import BindError, CommandError
 from ..model.cables import PROPS, SEGMENTS, cable_stores, update_masses
 from ..model.dowels import DOWELS, DPROPS, add_dowels, dowel_store, has_dowels
+from ..units import paren
 from .registry import REGISTRY, command
 from .structure_cable import _DOCS, _UNITS, cable_create
 from .values import COORD, POINT, Num, Nums, P, Text
@@ -112,7 +113,8 @@ def hybrid_list(session, call):
         return
     st = m.stores[DOWELS]
     bid = m.blocks["id"]
-    session.write("    id  bolt  block-a  block-b  shear force (N)  shear disp (m)  state")
+    session.write(f"    id  bolt  block-a  block-b {'shear force' + paren(m, 'force'):>16} "
+                  f"{'shear disp' + paren(m, 'length'):>15}  state")
     for i in range(st.n):
         s = int(st["state"][i])
         words = [w for bit, w in ((1, "yield"), (2, "yielded"), (4, "ruptured")) if s & bit]

@@ -26,8 +26,9 @@ def write_csv(path: Path, hists, vs=None) -> None:
             w.writerow([step, repr(times[step])] + [repr(v) if v == v else "" for v in vals])
 
 
-def write_png(path: Path, hist, vs=None) -> None:
-    """Plot one history against time (or against the `vs` history)."""
+def write_png(path: Path, hist, vs=None, time_unit: str = "") -> None:
+    """Plot one history against time (or against the `vs` history); ``time_unit`` is the model time's
+    unit when the deck declares one (``dec3d.units``)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -38,7 +39,7 @@ def write_png(path: Path, hist, vs=None) -> None:
     n = len(hist.values) if vs is None else min(len(hist.values), len(vs.values))
     x = hist.times[:n] if vs is None else vs.values[:n]
     ax.plot(x, hist.values[:n], lw=1.2)
-    ax.set_xlabel("time (s)" if vs is None else f"{vs.name} ({vs.label})")
+    ax.set_xlabel(f"time{time_unit}" if vs is None else f"{vs.name} ({vs.label})")
     ax.set_ylabel(f"{hist.name} ({hist.label})")
     ax.grid(True, lw=0.4, alpha=0.5)
     fig.tight_layout()

@@ -23,7 +23,8 @@ import numpy as np
 
 from dec3d.io.contactvtk import contact_point_data
 from dec3d.io.finite import require_finite
-from dec3d.io.vtk import _data_array
+from dec3d.io.vtk import _data_array, text_array
+from dec3d.units import field_lines
 
 VTK_QUAD = 9
 
@@ -122,8 +123,12 @@ def joints_vtu_text(model) -> str:
     ind = "        "
     parts = ['<?xml version="1.0"?>\n',
              '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">\n',
-             '  <UnstructuredGrid>\n', f'    <Piece NumberOfPoints="{4 * n}" NumberOfCells="{n}">\n',
-             '      <CellData Scalars="normal_stress">\n']
+             '  <UnstructuredGrid>\n']
+    units = field_lines(model, data)
+    if units:               # only when the deck declares its units (`model configure units si`)
+        parts += ["    <FieldData>\n", _data_array("units", text_array(units), "      ", tuples=True),
+                  "    </FieldData>\n"]
+    parts += [f'    <Piece NumberOfPoints="{4 * n}" NumberOfCells="{n}">\n', '      <CellData Scalars="normal_stress">\n']
     for key, arr in data.items():
         parts.append(_data_array(key, np.ascontiguousarray(arr), ind))
     parts.append("      </CellData>\n      <Points>\n")

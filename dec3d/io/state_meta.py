@@ -167,7 +167,7 @@ def _settings_problem(d: dict) -> str | None:
     m = d.get("mechanical", {})
     if not isinstance(m, dict):
         return "the mechanical settings are not an object"
-    choices = {"damping": ("local", "combined", "global", "none", "rayleigh"), "mass_scale": ("on", "off", "auto"),
+    choices = {"damping": ("local", "combined", "global", "none", "rayleigh", "maxwell"), "mass_scale": ("on", "off", "auto"),
                "scaling": ("eq87", "body", "raised", "auto"),
                "inertia": ("full", "scalar", "auto"), "jmodel": tuple(sorted(_known()["joint_models"]))}
     for k, options in choices.items():
@@ -177,11 +177,15 @@ def _settings_problem(d: dict) -> str | None:
               "frac": lambda v: _is_num(v) and v > 0,
               "servo_ratio": lambda v: _is_num(v) and v > 0,
               "dynamic": lambda v: isinstance(v, bool),
-              "dt_mode": lambda v: isinstance(v, list) and len(v) == 2 and isinstance(v[0], bool) and _is_num(v[1]),
+              "dt_mode": lambda v: (isinstance(v, list) and len(v) in (2, 3) and isinstance(v[0], bool)
+                                    and all(_is_num(x) for x in v[1:])),
               "dyn_time": lambda v: _is_num(v) and v >= 0,
               "rayleigh": lambda v: isinstance(v, list) and (v == [] or (
                   len(v) == 3 and _is_num(v[0]) and 0 <= v[0] < 1 and _is_num(v[1]) and v[1] >= 0
                   and v[2] in ("both", "mass", "stiffness"))),
+              "maxwell": lambda v: isinstance(v, list) and len(v) <= 4 and all(
+                  isinstance(p, list) and len(p) == 2 and _is_num(p[0]) and 0 <= p[0] < 0.5 and _is_num(p[1])
+                  and p[1] > 0 for p in v),
               "timefns": _timefns_ok,
               "safety": lambda v: v is None or (_is_num(v) and 0 < v < 1),
               "ctol": lambda v: v is None or (_is_num(v) and v > 0),

@@ -40,6 +40,7 @@ import numpy as np
 from dec3d.geometry.mass import range_index
 from dec3d.io.finite import require_finite
 from dec3d.model.kinematics import block_rotation, vertex_displacement, vertex_velocity
+from dec3d.units import field_lines
 
 VTK_POLYHEDRON = 42
 VTK_TETRA = 10
@@ -264,7 +265,9 @@ def vtu_text(model, cells: str = "all", point_data: dict | None = None, field_da
              '  <UnstructuredGrid>\n']
     names = list(model.groups.names)
     zones_here = zoned and len(zrows) > 0
-    if names or field_data or zones_here:
+    units = field_lines(model, ("displacement", "velocity", "density", "volume", "mass", "spin")
+                        + (("stress_gp", "stress") if zones_here else ()))
+    if names or field_data or zones_here or units:
         # a numeric array per name (code = its index): meshio reads no String arrays; the names again as
         # text (UTF-8 bytes, one per line, line i = code i) for labels
         parts.append("    <FieldData>\n")
@@ -275,6 +278,8 @@ def vtu_text(model, cells: str = "all", point_data: dict | None = None, field_da
             parts.append(_data_array("group_names", text_array(names), ind, tuples=True))
         if zones_here:
             parts.append(_data_array("plastic_labels", text_array(PLASTIC_LABELS), ind, tuples=True))
+        if units:           # only when the deck declares its units (`model configure units si`)
+            parts.append(_data_array("units", text_array(units), ind, tuples=True))
         for key, arr in (field_data or {}).items():
             parts.append(_data_array(key, np.atleast_1d(np.asarray(arr)), ind, tuples=True))
         parts.append("    </FieldData>\n")

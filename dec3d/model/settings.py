@@ -23,6 +23,9 @@ class Settings:
     #: rigid-block engine settings (``dec3d.physics.rigid.MECH_DEFAULTS``): CTOL, damping,
     #: time step, joint model and properties of new contacts; plain JSON values
     mechanical: dict = field(default_factory=dict)
+    #: `model configure units <system>`: the unit system reports and VTK name ("" = none declared:
+    #: no units shown; ``dec3d.units``)
+    units: str = ""
     #: discrete fracture networks (``dec3d.model.fractures``): templates, DFN names, next ids; plain JSON
     fractures: dict = field(default_factory=dict)
 

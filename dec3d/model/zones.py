@@ -31,6 +31,7 @@ block still owns a contiguous vertex range (which the contact code relies on).
     prop (NZPROP,)   SI     constitutive properties: columns 0-7 shared (``ZP_*``), from 8 on the model's own
     hist (NZHIST,)   -      the model's history (strain-softening's hardening parameters, …): the first
                             ``NHIST`` entries of the zone's model, zeroed when a model is assigned
+    ghist (4, NZHIST) -     a 10-node tetrahedron's Gauss-point histories (its ``hist`` is their mean)
     state ()         int32  plastic state bits (``ZSTATE_*``; a model's update returns the "now" bits)
     group (nslots,)  int32  group codes per slot, -1 none
 
@@ -113,6 +114,7 @@ def _zone_fields() -> dict[str, Field]:
         "cmodel": Field((), np.int8, ZMODEL_NULL),
         "prop": Field((NZPROP,), _F, 0.0),
         "hist": Field((NZHIST,), _F, 0.0),
+        "ghist": Field((4, NZHIST), _F, 0.0),
         "state": Field((), np.int32, 0),
         "group": group_field(),
         "extra": Field((0,), _F, 0.0),        # FISH block.zone.extra slots (widened on first write)

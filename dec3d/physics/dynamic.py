@@ -23,6 +23,24 @@ Everything is kept in ``model.settings.mechanical`` (plain JSON, so `model save|
   where a zoned or FE block takes part, its share going to the gridpoints) and on the zones (4-node,
   hexahedral, 10-node) and FE elements as a damping stress β D ε̇ (``zone_stiffness_damping``). Stiffness damping lowers the stable step: Δt = Δt₀ (√(1 + λ²) − λ), λ = β / Δt₀ (the central-difference limit 2/ω (√(1 + ξ²) − ξ)
   for the highest mode Δt₀ allows, ω = 2/Δt₀, ξ = β ω / 2).
+- ``maxwell``: [[ξ₁, f₁], [ξ₂, f₂], …] of `block mechanical damping maxwell ξ₁ f₁ ξ₂ f₂ …` (at most
+  ``MAXWELL_MAX`` pairs). Maxwell damping (a generalized Maxwell body: springs in series with dashpots, in
+  parallel with the elastic stiffness K) gives a damping ratio nearly constant over a band of
+  frequencies. Component i is a spring α_i K in series with a dashpot of relaxation time τ_i; its force
+  obeys dFᵢ/dt = αᵢ (−K v) − Fᵢ/τᵢ. For small αᵢ its damping ratio at frequency f is
+  ξᵢ(f) = (αᵢ/2) r/(1 + r²), r = 2π f τᵢ, largest, αᵢ/4, at f = 1/(2π τᵢ). dec3d reads the pair (ξᵢ, fᵢ) as
+  that peak ratio and its frequency: αᵢ = 4 ξᵢ, τᵢ = 1/(2π fᵢ), so the total ratio is about
+  Σ 2ξᵢ (f/fᵢ)/(1 + (f/fᵢ)²); with the springs' stiffening of the storage part, half the loss factor
+  (``maxwell_ratio``, within 2.5 % of the free-vibration root for the set below). (dec3d's reading, from
+  the SAFEGO deck line `maxwell 0.0233 0.9970 0.0195 7.1172 0.0278 50.0027` commented "3 % Maxwell
+  (1–50 Hz)": with it the ratio of a free vibration is 2.8–3.0 % over 1–50 Hz; Itasca's page on Maxwell
+  damping was not within reach.) Applied to the zones (4-node,
+  hexahedral, 10-node) and FE elements as nodal forces (``zone_maxwell_damping``: −K v is the same
+  elastic-force rate the Rayleigh stiffness term uses, so for linear elastic material the forces equal
+  those of Maxwell stresses σᵢ, dσᵢ/dt = αᵢ D ε̇ − σᵢ/τᵢ), integrated exactly over a step with v held:
+  Fᵢ ← Fᵢ e^(−Δt/τᵢ) + αᵢ τᵢ (1 − e^(−Δt/τᵢ)) (−K v). The forces are state (``vertices.maxwell``,
+  saved). Contacts and rigid blocks are not damped by it (the run warns). No mass term: real masses and
+  full inertia. The spring stiffens the highest mode by at most (1 + Σ αᵢ): Δt = Δt₀ / √(1 + Σ αᵢ).
 - ``timefns``: the time functions of `block apply … table|fish` and `block gridpoint apply … table|fish`
   (``TimeFunctions``).
 """
@@ -35,9 +53,12 @@ import numpy as np
 
 from dec3d.errors import Dec3dError
 from dec3d.io.state import register_known
+from dec3d.units import suffix
 
 #: the settings this module keeps, with their defaults (``rigid.MECH_DEFAULTS`` takes them over)
-DYN_DEFAULTS = {"dynamic": False, "dyn_time": 0.0, "rayleigh": [], "timefns": []}
+DYN_DEFAULTS = {"dynamic": False, "dyn_time": 0.0, "rayleigh": [], "maxwell": [], "timefns": []}
+#: most components `block mechanical damping maxwell` takes (pairs ξ f)
+MAXWELL_MAX = 4
 RAYLEIGH_FORMS = ("both", "mass", "stiffness")
 
 
@@ -83,6 +104,56 @@ def rayleigh_coefficients(model) -> tuple[float, float]:
     return xi * w, xi / w
 
 
+def maxwell_components(model) -> list[tuple[float, float]]:
+    """(αᵢ = 4 ξᵢ, τᵢ = 1/(2π fᵢ) [s]) of each Maxwell component in effect ([] unless the damping is
+    maxwell; see the module text)."""
+    m = _mech(model)
+    if m["damping"] != "maxwell":
+        return []
+    return [(4.0 * float(xi), 1.0 / (2.0 * math.pi * float(f))) for xi, f in m.get("maxwell", []) if xi > 0]
+
+
+def maxwell_timestep(dt0: float, comps) -> float:
+    """Δt₀ lowered for the Maxwell springs: Δt₀ / √(1 + Σ αᵢ)."""
+    return dt0 / math.sqrt(1.0 + sum(a for a, _ in comps)) if comps else dt0
+
+
+def maxwell_ratio(comps, f: float) -> float:
+    """The damping ratio of the Maxwell components at frequency f [Hz]: half the loss factor of the
+    complex stiffness K (1 + Σ αᵢ i r/(1 + i r)), r = 2π f τᵢ, i.e. Σ αᵢ r/(1 + r²) over
+    2 (1 + Σ αᵢ r²/(1 + r²)) (the springs stiffen the storage part; module text)."""
+    rs = [(a, 2.0 * math.pi * f * t) for a, t in comps]
+    loss = sum(a * r / (1.0 + r * r) for a, r in rs)
+    storage = 1.0 + sum(a * r * r / (1.0 + r * r) for a, r in rs)
+    return 0.5 * loss / storage
+
+
+def zone_maxwell_damping(zst, comps, dt: float, pos, vel, facc) -> None:
+    """Add the Maxwell components' forces on the gridpoints of the zones and FE elements to ``facc``,
+    after moving each on by the step dt with the current velocities (module text). ``zst`` is the
+    ``physics.zones.ZoneStepper``; the forces live in ``vertices.maxwell`` (MAXWELL_MAX, 3)."""
+    from dec3d.model.store import Field
+
+    v = zst.model.vertices
+    if "maxwell" not in v:
+        v.add_field("maxwell", Field((MAXWELL_MAX, 3), np.float64, 0.0))
+    g = getattr(zst, "_maxwell_rate", None)
+    if g is None or g.shape != facc.shape:
+        g = zst._maxwell_rate = np.zeros_like(facc)
+    rows = zst.rows
+    g[rows] = 0.0
+    zone_stiffness_damping(zst, 1.0, pos, vel, g)      # −K v: the rate of the elastic forces
+    F = v["maxwell"]
+    rate = g[rows]
+    total = np.zeros_like(rate)
+    for i, (a, tau) in enumerate(comps):
+        e = math.exp(-dt / tau)
+        Fi = F[rows, i] * e + (a * tau * (1.0 - e)) * rate
+        F[rows, i] = Fi
+        total += Fi
+    facc[rows] += total
+
+
 def stiffness_timestep(dt0: float, beta: float) -> float:
     """Δt₀ lowered for stiffness-proportional damping β [s] (see the module text)."""
     if beta <= 0.0 or not dt0 > 0.0:
@@ -99,8 +170,14 @@ def damping_text(model) -> str:
         xi, f, form = m["rayleigh"]
         a, b = rayleigh_coefficients(model)
         what = {"both": "mass and stiffness", "mass": "mass only", "stiffness": "stiffness only"}[form]
-        return (f"rayleigh, fraction {xi:g} at {f:g} Hz ({what}: α = {a:.6g} 1/s, β = {b:.6g} s)"
+        return (f"rayleigh, fraction {xi:g} at {f:g}{suffix(model, 'frequency')} ({what}: α = {a:.6g}"
+                f"{suffix(model, 'rate')}, β = {b:.6g}{suffix(model, 'time')})"
                 if a or b else "rayleigh with fraction or frequency 0: no damping")
+    if mode == "maxwell":
+        pairs = m.get("maxwell", [])
+        hz = suffix(model, "frequency")
+        return ("maxwell, " + ", ".join(f"{xi:g} at {f:g}{hz}" for xi, f in pairs) + " (peak ratio at frequency; "
+                f"on zones and FE elements only)") if pairs else "maxwell with no component: no damping"
     if mode == "none":
         return "none"
     if m["dynamic"]:

@@ -27,6 +27,7 @@ from dec3d.kernels.motion import DAMP_ADAPTIVE, DAMP_COMBINED, DAMP_LOCAL, DAMP_
 from dec3d.model.store import Store
 from dec3d.model.feblocks import has_feblocks
 from dec3d.model.zones import has_zones
+from dec3d.units import suffix
 
 from .beams import beam_balance, has_beams
 from .cables import cable_timestep, grouted_timestep
@@ -74,7 +75,8 @@ class RunError(Dec3dError):
 
 
 #: vertex fields the deformable step changes (saved before a run, put back if it fails)
-_GP_STATE = ("velocity", "disp", "force", "mass", "imass", "vapp", "fapp")   # (vapp, fapp: time functions)
+_GP_STATE = ("velocity", "disp", "force", "mass", "imass", "vapp", "fapp", "maxwell")   # (vapp, fapp: time functions;
+#                                                                     maxwell: physics.dynamic)
 
 
 def _has_gridpoints(m) -> bool:
@@ -205,7 +207,7 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
         s = self.settings()
         if s["damping"] == "rayleigh":
             return DAMP_RAYLEIGH, rayleigh_coefficients(self.model)[0]
-        if s["dynamic"]:
+        if s["dynamic"] or s["damping"] == "maxwell":
             return DAMP_NONE, 0.0
         code = {"none": DAMP_NONE, "local": DAMP_LOCAL, "combined": DAMP_COMBINED, "global": DAMP_ADAPTIVE}
         return code[s["damping"]], float(s["alpha"])
@@ -217,7 +219,7 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
     def _dynamic_style(self) -> bool:
         """Real masses and full inertia: dynamic mode, or no (or Rayleigh) damping."""
         s = self.settings()
-        return bool(s["dynamic"]) or s["damping"] in ("none", "rayleigh")
+        return bool(s["dynamic"]) or s["damping"] in ("none", "rayleigh", "maxwell")
 
     def mass_scaling(self) -> bool:
         s = self.settings()
@@ -434,7 +436,7 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
         return {"blocks": {k: b[k].copy() for k in b.fields},
                 "vertices": {k: v[k].copy() for k in ("pos", "map_pos", "look_pos", "turn_pos")
                              + (_GP_STATE if _has_gridpoints(m) else ()) if k in v},
-                "zones": ({k: m.store("zones")[k].copy() for k in ("stress", "gstress", "volume", "state", "hist")}
+                "zones": ({k: m.store("zones")[k].copy() for k in ("stress", "gstress", "volume", "state", "hist", "ghist")}
                           if has_zones(m) else {}),
                 "feblocks": ({k: m.store("feblocks")[k].copy() for k in ("stress", "gstress")}
                              if has_feblocks(m) else {}),
@@ -487,12 +489,15 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
             w0 = math.hypot(*self._spin0[bad]) if getattr(self, "_spin0", None) is not None else math.nan
             if not math.isfinite(w):
                 w = w0
-            what = (f"spins at {w:.3g} rad/s ({w * dt:.3g} rad in one step of {dt:.3g} s)" if math.isfinite(w)
+            what = (f"spins at {w:.3g}{suffix(m, 'angular-velocity')} ({w * dt:.3g} rad in one step of {dt:.3g}"
+                    f"{suffix(m, 'time')})" if math.isfinite(w)
                     else "has a spin that is not a finite number")
         elif far:
-            what = f"moved farther than its own size in one step (speed {v:.3g} m/s, time step {dt:.3g} s)"
+            what = (f"moved farther than its own size in one step (speed {v:.3g}{suffix(m, 'velocity')}, time step "
+                    f"{dt:.3g}{suffix(m, 'time')})")
         else:
-            what = f"reached velocity {v:.3g} m/s (time step {dt:.3g} s too large or stiffness too high)"
+            what = (f"reached velocity {v:.3g}{suffix(m, 'velocity')} (time step {dt:.3g}{suffix(m, 'time')} too large "
+                    "or stiffness too high)")
         tail = ": it can pass through other blocks unseen" if far and not spin else ""
         return RunError(f"the run became unstable at step {m.step if step is None else step}: block {bid} {what}{tail}; "
                         "the model is back at its state before this command")

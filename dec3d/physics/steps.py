@@ -31,7 +31,7 @@ from . import contacts as _contacts
 from .contact_store import history_columns
 from .bodies import group_properties
 from .cables import cable_steps
-from .dynamic import TimeFunctions, has_timefns, stiffness_timestep
+from .dynamic import TimeFunctions, has_timefns, maxwell_components, maxwell_timestep, stiffness_timestep
 from .energy import is_active as is_energy_active
 from .history import HistorySet
 from .mixedcontacts import _deformable
@@ -117,8 +117,11 @@ class _Run:
         self.steps = ([MixedContacts(self), RigidBatch(self, chunked=False), ZoneStep(self)] if self.zoned
                       else [RigidBatch(self, chunked=True)]) + [Clock(self), Hooks(self)]
         self.beta = eng.rayleigh_beta()
+        #: Maxwell damping's components (physics.dynamic): zones and FE elements only
+        self.maxwell = maxwell_components(m)
         if self.zst is not None:
             self.zst.beta = self.beta
+            self.zst.maxwell = self.maxwell
         self.dynamic = bool(s["dynamic"])
         # grouted cables (``physics.cables``): their forces at t go into the host blocks' applied loads
         self.steps[:0] = cable_steps(self)
@@ -147,7 +150,8 @@ class _Run:
         last = s["dt_run"]
         between = not fresh and len(last) == 2 and int(last[1]) == m.step and m.step % self.interval != 0
         # ... unless the masses or the damping's time-step rule changed since (dynamic mode, damping)
-        self.dt_mode = [bool(eng.mass_scaling()), float(eng.rayleigh_beta())]
+        self.dt_mode = [bool(eng.mass_scaling()), float(eng.rayleigh_beta())] + (
+            [sum(a for a, _ in self.maxwell)] if self.maxwell else [])
         between = between and s.get("dt_mode", self.dt_mode) == self.dt_mode
         if self.mixed:
             self.wsub, self.wcon = eng._mixed_weights(self.zst, recompute=not between)
@@ -160,6 +164,10 @@ class _Run:
             msg = eng.stiffness_warning()
             if msg:
                 warn(msg)
+            if self.maxwell and (self.ng or eng.contacts.n or not self.zoned):
+                warn("maxwell damping acts on the zones and FE elements only: "
+                     + ("this model has none, so nothing is damped" if not self.zoned else
+                        "its rigid blocks and contacts are not damped by it"))
         self.scaled = eng.mass_scaling()
         # density scaling by body works its masses out from the geometry, which moves between
         # detections: a run that starts on the step where the last one ended takes that run's
@@ -255,7 +263,8 @@ class _Run:
         dt_r = (self.eng._masses(self.gstart, self.gmember, self.gmass, self.giscalar, None, near, self.gprin)[0] if ng
                 else math.inf)
         d = ((dt_r if ng else float(self.s["scale_timestep"] or 1.0)) if self.scaled
-             else min(dt_r, stiffness_timestep(self.zst.natural_timestep(), self.beta)))
+             else min(dt_r, maxwell_timestep(stiffness_timestep(self.zst.natural_timestep(), self.beta),
+                                             self.maxwell)))
         return d if math.isfinite(d) and d > 0 else 1.0
 
     def detection_due(self) -> bool:

@@ -33,6 +33,7 @@ import numpy as np
 
 from dec3d.errors import CommandError
 from dec3d.kernels.water import pressure_areas
+from dec3d.units import suffix
 
 
 def water_settings(model) -> dict:
@@ -140,8 +141,8 @@ def describe(model) -> str:
     w = water_settings(model)
     plane = w.get("plane")
     if plane is None:
-        return f"water: density {w.get('density', 0.0):g} kg/m³, no water table"
+        return f"water: density {w.get('density', 0.0):g}{suffix(model, 'density')}, no water table"
     n, o = plane[:3], plane[3:]
-    return (f"water: density {w.get('density', 0.0):g} kg/m³, table through ({o[0]:g}, {o[1]:g}, {o[2]:g}) "
+    return (f"water: density {w.get('density', 0.0):g}{suffix(model, 'density')}, table through ({o[0]:g}, {o[1]:g}, {o[2]:g}) "
             f"normal ({n[0]:g}, {n[1]:g}, {n[2]:g})")
 

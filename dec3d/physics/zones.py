@@ -7,7 +7,9 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
 1. checks: every zoned block has zones with a model (``RunError`` naming the blocks otherwise);
    the zones of each model by its registry entry (``physics.cmodels``: every property in its
    range, then the model's own check; errors stop the run naming the zones, warnings go to the
-   engine's ``warn``); 10-node zones cycle elastic only;
+   engine's ``warn``); 10-node zones take every model: elastic ones step in ``zones_ho.tet10_step``,
+   any other model through ``zones_ho_models.tet10_model_step`` (the model's update at each Gauss
+   point, a history per Gauss point in ``zones.ghist``);
 2. lumped masses and the node stiffness of Eq. (86) (kernel ``zonestep.zone_mass_stiffness``)
    of the 4-node zones; for 10-node zones HRZ lumped masses (``zones_ho.tet10_lumped_mass``) and
    twice the Gershgorin row-sum stiffness (``zones_ho.tet10_stiffness``); summed onto link masters
@@ -52,6 +54,7 @@ from dec3d.model.feblocks import has_feblocks
 from dec3d.model.model import KIND_DEFORMABLE
 from dec3d.model.zones import ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
 from dec3d.physics.cmodels import MODEL_BY_CODE
+from dec3d.units import suffix
 
 from .cables import gridpoint_grout_stiffness
 
@@ -157,11 +160,6 @@ class ZoneStepper:
         for code in np.unique(cm[act]):
             zm = MODEL_BY_CODE[int(code)]
             mine = zrow[cm == code]
-            if zm.name != "elastic" and (nn[mine] == 10).any():
-                ho = mine[nn[mine] == 10]
-                raise error(f"{len(ho)} {zm.name} zones of blocks {_ids(model, zs['block'][ho])} are 10-node "
-                            "tetrahedra: 10-node zones cycle elastic only (use `block zone generate edgelength` "
-                            "or `hexahedra` for these blocks, or an elastic model)")
             bad, warns = zm.problems(p[mine], zs["id"][mine], bid[zs["block"][mine]])
             problems += [f"{zm.name} zones: {x}" for x in bad]
             self.warnings += [f"{zm.name} zones: {x}" for x in warns]
@@ -188,9 +186,22 @@ class ZoneStepper:
         self.ho = None
         #: β [s] of Rayleigh damping's stiffness term (set by the engine's run; 0: none)
         self.beta = 0.0
+        #: Maxwell damping's components (αᵢ, τᵢ [s]) (set by the engine's run; []: none)
+        self.maxwell = []
         if len(self.rows10):
             from dec3d.kernels import zones_ho
             self.ho = zones_ho.tet10_step
+            codes10 = np.unique(zs["cmodel"][self.rows10])
+            if any(MODEL_BY_CODE[int(c)].name != "elastic" for c in codes10):
+                # some 10-node zone has a model other than isotropic elasticity: the model's update at
+                # every Gauss point (``zones_ho_models``; Hooke gives the same bits as tet10_step)
+                from dec3d.kernels.zones_ho_models import tet10_model_step_for
+                step10 = tet10_model_step_for(model_mask(codes10))
+
+                def ho(pos, vel, gp, rows, bulk, shear, dt, gstress, stress, force):
+                    bad = step10(pos, vel, gp, rows, self.material(stress=stress), zs["ghist"], dt, gstress, force)
+                    return bad
+                self.ho = ho
         # mixed-discretization sets of the 4-node zones: compact set numbers
         hx = zs["hex"][self.rows4]
         self.weight = np.where(zs["overlay"][self.rows4] >= 0, 0.5, 1.0)
@@ -462,6 +473,9 @@ class ZoneStepper:
         if self.beta > 0.0:             # Rayleigh damping's stiffness term (physics.dynamic)
             from .dynamic import zone_stiffness_damping
             zone_stiffness_damping(self, self.beta, pos, vel, facc)
+        if self.maxwell:                # Maxwell damping's components (physics.dynamic)
+            from .dynamic import zone_maxwell_damping
+            zone_maxwell_damping(self, self.maxwell, dt, pos, vel, facc)
         fe = self.fe
         if fe is not None:
             e = fe.forces(pos, vel, dt, gravity, facc, fmag)
@@ -552,6 +566,7 @@ class ZoneStepper:
         bid = int(m.blocks["id"][v["block"][row]])
         x, y, z = (float(c) for c in v["pos"][row])
         return self.error(f"the run became unstable at step {m.step}: a gridpoint of block {bid} at "
-                          f"({x:.4g}, {y:.4g}, {z:.4g}) reached velocity {sp:.3g} m/s (time step {dt:.3g} s); "
+                          f"({x:.4g}, {y:.4g}, {z:.4g}) reached velocity {sp:.3g}{suffix(m, 'velocity')} (time step {dt:.3g}"
+                          f"{suffix(m, 'time')}); "
                           "the model is back at its state before this command")
 

@@ -199,17 +199,6 @@ def test_failed_run_puts_the_plastic_state_back(tmp_path):
     np.testing.assert_array_equal(zs["state"], keep)
 
 
-def test_ten_node_mohr_zones_are_refused(tmp_path):
-    from zone_fixtures import zone_tet10
-    s = _session(tmp_path, ["block create tetrahedron 0 0 0 1 0 0 0 1 0 0 0 1"])
-    zone_tet10(s.model, 0)
-    for line in ("block zone cmodel assign mohr-c",
-                 "block zone property young 1e9 poisson 0.2 density 2000 cohesion 1e5 friction 30"):
-        s.command(line)
-    with pytest.raises(Dec3dError, match="mohr-coulomb zones of blocks 1 are 10-node tetrahedra: 10-node zones cycle elastic only"):
-        s.command("model cycle 1")
-
-
 # ------------------------------------------------------------------ nodal mixed discretization
 def test_nmd_switch_is_kept_and_saved(tmp_path):
     s = _session(tmp_path, ["block create brick 0 1 0 1 0 1"])
