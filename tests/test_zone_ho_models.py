@@ -18,7 +18,7 @@ from test_zone_ho_kernels import b_matrix, gauss_points, random_tets
 from zmodel_twins import tensor, twin_hooke, twin_mc, vec6
 
 MC = CODES["mohr-coulomb"]
-ELASTIC = CODES["elastic"]
+SS = CODES["strain-softening"]        # without tables: Mohr-Coulomb with constant strengths
 
 
 def twin_step(pos, vel, gp, models, K, G, c, tanphi, ten, dt, gstress):
@@ -37,11 +37,8 @@ def twin_step(pos, vel, gp, models, K, G, c, tanphi, ten, dt, gstress):
             e = B @ u                                  # engineering strain increment
             d = np.array([e[0], e[1], e[2], e[3] / 2, e[4] / 2, e[5] / 2])
             trial = twin_hooke(gs[z, g], d, K[z], G[z])
-            if models[z] == MC:
-                new, mult = twin_mc(trial, K[z], G[z], c[z], tanphi[z], ten[z], 0.0)[:2]
-                yielded[z] |= bool(mult)
-            else:
-                new = trial
+            new, mult = twin_mc(trial, K[z], G[z], c[z], tanphi[z], ten[z], 0.0)[:2]
+            yielded[z] |= bool(mult)
             gs[z, g] = vec6(new)
             f -= wg * dj * B.T @ np.array([gs[z, g, 0], gs[z, g, 1], gs[z, g, 2], gs[z, g, 3], gs[z, g, 4],
                                            gs[z, g, 5]])
@@ -51,7 +48,9 @@ def twin_step(pos, vel, gp, models, K, G, c, tanphi, ten, dt, gstress):
 
 
 @pytest.mark.parametrize("curved", [0.0, 0.05])
-def test_mohr_coulomb_and_elastic_ten_node_zones_match_the_twin(curved):
+def test_mohr_coulomb_and_strain_softening_ten_node_zones_match_the_twin(curved):
+    """Mohr-Coulomb zones and strain-softening ones without tables (constant strengths: the same return)
+    in one step; the model set {mohr-coulomb, strain-softening} is D15's, so one compile serves both."""
     rng = np.random.default_rng(5)
     m = 8
     pos, gp = random_tets(rng, m, curved)
@@ -61,7 +60,7 @@ def test_mohr_coulomb_and_elastic_ten_node_zones_match_the_twin(curved):
     c = 2e5 * (0.5 + rng.random(m))
     tanphi = np.tan(np.radians(20 + 20 * rng.random(m)))
     ten = c / tanphi * rng.random(m)
-    cmodel = np.where(np.arange(m) % 4 == 3, ELASTIC, MC).astype(np.int8)
+    cmodel = np.where(np.arange(m) % 2 == 1, SS, MC).astype(np.int8)
     prop = np.zeros((m, NZPROP))
     prop[:, 0], prop[:, 1], prop[:, 2] = K, G, 2000.0
     prop[:, 3], prop[:, 4], prop[:, 5] = c, tanphi, ten
@@ -74,7 +73,7 @@ def test_mohr_coulomb_and_elastic_ten_node_zones_match_the_twin(curved):
     mat = ZoneMaterial(cmodel, prop, np.zeros((m, NZHIST)), K.copy(), G.copy(), np.zeros((m, 6)),
                        np.zeros(m, np.int32), make_tables([]))
     force = np.zeros_like(pos)
-    step = tet10_model_step_for(model_mask({MC, ELASTIC}))
+    step = tet10_model_step_for(model_mask({MC, SS}))
     assert step(pos, vel, gp, np.arange(m, dtype=np.int64), mat, np.zeros((m, 4, NZHIST)), dt, gs, force) == -1
     scale = np.abs(gs_twin).max()
     assert np.abs(gs - gs_twin).max() <= 1e-9 * scale
@@ -96,9 +95,10 @@ def _session(tmp_path, extra):
 def test_assigning_a_model_clears_the_gauss_point_histories_and_a_failed_run_puts_them_back(tmp_path):
     from dec3d.errors import Dec3dError
 
-    s = _session(tmp_path, "table 'coh' add 0 1e6 0.005 2e5\nblock zone cmodel assign strain-softening\n"
+    s = _session(tmp_path, "table 'coh' add 0 1e6 0.005 2e5\nblock zone cmodel assign mohr-coulomb\n"
+                           "block zone cmodel assign strain-softening range position-z 0 0.5\n"
                            "block zone property young 1e9 poisson 0.25 density 2000 cohesion 1e6 friction 30 "
-                           "tension 1e6 table-cohesion 'coh'\n"
+                           "tension 1e6\nblock zone property table-cohesion 'coh' range position-z 0 0.5\n"
                            "block gridpoint apply velocity 0 0 0 range position-z 0\n"
                            "block gridpoint apply velocity-z -2e-6 range position-z 1\nmodel cycle 3000")
     zs = s.model.store("zones")
@@ -112,4 +112,5 @@ def test_assigning_a_model_clears_the_gauss_point_histories_and_a_failed_run_put
     np.testing.assert_array_equal(zs["ghist"][: zs.n], gh)
     s.command("block zone cmodel assign strain-softening")
     assert not zs["ghist"][: zs.n].any() and not zs["hist"][: zs.n].any()
+    assert (zs["cmodel"][: zs.n] == SS).all()
     assert math.isfinite(float(np.abs(zs["stress"][: zs.n]).max()))
