@@ -21,9 +21,9 @@ prop columns: kn, ks for every model (``joints._common``), then the model's own 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import literally, njit, prange
 
-from .joints import ALL_MODELS, ST_NEW, joint_law_for, joint_stiffness
+from .joints import ST_NEW, joint_law_for, joint_stiffness
 
 
 @njit(cache=True, inline="always")   # (inlined into each caller's loop: the call costs as much as the work)
@@ -85,13 +85,16 @@ def update_one(models, s, c, a, b, dt, bpos, bvel, bspin, cn, cmodel, cprop,
 
 
 @njit(cache=True, parallel=True)
-def subcontact_update(dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
+def subcontact_update(models, dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
                       sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg):
     """The joint law of every sub-contact, in parallel (each writes only its own rows); the
-    force on B of sub-contact s goes to sg (ns, 3) [N] for ``block_sums``."""
+    force on B of sub-contact s goes to sg (ns, 3) [N] for ``block_sums``. ``models``: the mask of
+    the joint models among the contacts (a literal, ``joints.cycle_mask``: compiled for those laws only;
+    with every law inlined the compile took two minutes)."""
+    literally(models)
     for s in prange(sc_contact.shape[0]):
         c = sc_contact[s]
-        update_one(ALL_MODELS, s, c, ca[c], cb[c], dt, bpos, bvel, bspin, cn, cmodel, cprop,
+        update_one(models, s, c, ca[c], cb[c], dt, bpos, bvel, bspin, cn, cmodel, cprop,
                    sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg)
 
 
@@ -180,10 +183,11 @@ def block_sums(bpos, bforce, bmoment, sc_pos, sg, bstart, bent):
 
 
 @njit(cache=True)
-def subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment,
+def subcontact_forces(models, dt, bpos, bvel, bspin, bforce, bmoment,
                       ca, cb, cn, cmodel, cprop,
                       sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist):
-    """One force update of every sub-contact; adds the forces and moments to the blocks.
+    """One force update of every sub-contact; adds the forces and moments to the blocks. ``models``:
+    the joint-model mask (a literal, as ``subcontact_update``).
 
     bpos/bvel/bspin (nb, 3): centroid [m], velocity [m/s], spin [rad/s] at t − Δt/2.
     bforce/bmoment (nb, 3): accumulated in place [N], [N·m].
@@ -193,8 +197,9 @@ def subcontact_forces(dt, bpos, bvel, bspin, bforce, bmoment,
     is that of a serial loop over s adding the force on B, then on A, whatever the thread count.
     (``cycle.run_steps`` calls the passes itself, making ``block_lists`` once per call.)
     """
+    literally(models)
     sg = np.empty((sc_contact.shape[0], 3))
-    subcontact_update(dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
+    subcontact_update(models, dt, bpos, bvel, bspin, ca, cb, cn, cmodel, cprop,
                       sc_contact, sc_pos, sc_area, sc_fn, sc_fs, sc_un, sc_udil, sc_us, sc_state, sc_hist, sg)
     bstart, bent = block_lists(bpos.shape[0], ca, cb, sc_contact)
     block_sums(bpos, bforce, bmoment, sc_pos, sg, bstart, bent)

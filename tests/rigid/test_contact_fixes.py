@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from dec3d.kernels.contactmap import subcontact_gaps
+from dec3d.kernels.joints import COMMON_MODELS
 from dec3d.kernels.jointlaw import subcontact_forces
 from dec3d.kernels.joints import NPROP, P_KN, P_KS, ST_NEW
 from dec3d.physics.history import histories
@@ -146,7 +147,7 @@ def test_new_subcontact_adds_no_increment_on_its_first_update():
               state=np.array([ST_NEW], np.int64), hist=np.zeros((1, 8)))
 
     def update():
-        subcontact_forces(dt, pos, vel, spin, force, moment, np.array([0]), np.array([1]),
+        subcontact_forces(COMMON_MODELS, dt, pos, vel, spin, force, moment, np.array([0]), np.array([1]),
                           np.array([[0.0, 0.0, 1.0]]), np.array([0]), prop, *sc.values())
 
     update()

@@ -145,7 +145,8 @@ def test_contact_pass_equals_moving_the_points_then_the_joint_law(state, threads
     own = np.arange(len(c["a"]))
     cycle._move_points(dt, c["a"], c["b"], own, c["pos"], b["centroid"], b["velocity"], b["spin"])
     cycle._move_points(dt, c["a"], c["b"], s["contact"], s["pos"], b["centroid"], b["velocity"], b["spin"])
-    subcontact_update(dt, b["centroid"], b["velocity"], b["spin"], c["a"], c["b"], c["normal"], c["jmodel"],
+    subcontact_update(cycle_mask(c["jmodel"]), dt, b["centroid"], b["velocity"], b["spin"], c["a"], c["b"], c["normal"],
+                      c["jmodel"],
                       c["prop"], s["contact"], s["pos"], s["area"], s["fn"], s["fs"], s["un"], s["udil"], s["us"],
                       s["state"], s["hist"], sg)
     b, c, s = fus["b"], fus["c"], fus["s"]
