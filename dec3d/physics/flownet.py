@@ -1,0 +1,307 @@
+"""Flow in the joints, wired to the model (issue 29 item 2; 3DEC theory, "Joint Fluid Flow").
+
+State (saved and restored with the model, no pickle):
+
+- ``model.settings.mechanical["fluid"]``: {"active", "density" ρ_w, "viscosity" μ, "bulk" K_w, "size" (the
+  flow-zone size, 0: the sub-contact points), "aperture" [a0, amin, amax] (the default of the flow planes),
+  "sig" (the contacts the network was built from)}.
+- contact field ``aperture`` (3,): a flow plane's own [a0, amin, amax] (`flowplane property`), −1: the default;
+  carried by the pair through detections.
+- stores ``flowknots`` (pos, pp, fixed, p_fixed, q_in, vol, supply), ``flowzones`` (the triangles of
+  ``physics.flowgeom``: zk, zcontact, zarea, zcot, zsub, zw, zpipe, zap), ``flowpipes`` (pa, pb, c, dg, q) and
+  ``flowsubs`` (per sub-contact: its knot).
+
+The network is built again from the contacts when their set or their sub-contacts change (after a detection,
+``after_detection``); knot pressures and boundary conditions go to the new knot at the same place (within the
+contact tolerance); a new knot starts from the water table / `block insitu pore-pressure` there. While the fluid
+is active (`model configure fluid`, `model fluid active on`) the sub-contact pore pressures are the knots'
+(+ `block contact apply pore-pressure`), not the water table's.
+
+Each batch of the cycle (``FluidStep``): apertures from the sub-contacts' normal displacements, conductances and
+volumes (``kernels.jointflow.zone_update``), explicit flow steps over the batch's time with Δt ≤ the stable step
+(``network_steps``), then the knot pressures to the sub-contacts (``sub_pressures``): the joint laws see the
+effective stress at the next step.
+"""
+from __future__ import annotations
+
+import hashlib
+import math
+
+import numpy as np
+
+from dec3d.errors import CommandError
+from dec3d.kernels.jointflow import network_steps, stable_dt, sub_pressures, zone_update
+from dec3d.kernels.water import pressure_areas
+from dec3d.model.store import Field, Store
+
+from .flowgeom import build_geometry
+
+_F, _I = np.float64, np.int64
+DEFAULTS = {"active": True, "density": 1000.0, "viscosity": 1e-3, "bulk": 2e9, "size": 0.0,
+            "aperture": [0.0, 0.0, 1.0], "sig": ""}
+
+KNOT_FIELDS = {"pos": Field((3,), _F, 0.0), "pp": Field((), _F, 0.0), "fixed": Field((), np.uint8, 0),
+               "p_fixed": Field((), _F, 0.0), "q_in": Field((), _F, 0.0), "vol": Field((), _F, 0.0),
+               "supply": Field((), _F, 0.0)}
+ZONE_FIELDS = {"zk": Field((3,), _I, -1), "zcontact": Field((), _I, -1), "zarea": Field((), _F, 0.0),
+               "zcot": Field((3,), _F, 0.0), "zsub": Field((3,), _I, 0), "zw": Field((3,), _F, 0.0),
+               "zpipe": Field((3,), _I, -1), "zap": Field((), _F, 0.0)}
+PIPE_FIELDS = {"pa": Field((), _I, 0), "pb": Field((), _I, 0), "c": Field((), _F, 0.0), "dg": Field((), _F, 0.0),
+               "q": Field((), _F, 0.0)}
+SUB_FIELDS = {"knot": Field((), _I, -1)}
+STORES = {"flowknots": KNOT_FIELDS, "flowzones": ZONE_FIELDS, "flowpipes": PIPE_FIELDS, "flowsubs": SUB_FIELDS}
+
+
+def configured(model) -> bool:
+    return "fluid" in model.settings.configure
+
+
+def settings(model) -> dict:
+    """The fluid settings (made with the defaults on first use)."""
+    mech = model.settings.mechanical
+    f = mech.get("fluid")
+    if not isinstance(f, dict):
+        f = mech["fluid"] = {}
+    for k, v in DEFAULTS.items():
+        if k not in f:
+            f[k] = list(v) if isinstance(v, list) else v
+    return f
+
+
+def active(model) -> bool:
+    f = model.settings.mechanical.get("fluid")
+    return configured(model) and isinstance(f, dict) and bool(f.get("active", True))
+
+
+def stores(model) -> dict:
+    """The four flow stores (made on first use) and the contacts' ``aperture`` field."""
+    for name, fields in STORES.items():
+        if name not in model.stores:
+            model.add_store(Store(name, fields, capacity=64))
+    cs = model.store("contacts")
+    if "aperture" not in cs:
+        cs.add_field("aperture", Field((3,), _F, -1.0))
+    return {name: model.store(name) for name in STORES}
+
+
+def _signature(eng, f) -> str:
+    cs, ss = eng.contacts, eng.subcontacts
+    h = hashlib.sha1()
+    for a in (cs["ida"], cs["idb"], cs["sub_count"], ss["kind"], ss["key0"], ss["key1"]):
+        h.update(np.ascontiguousarray(a).tobytes())
+    h.update(repr((float(f["size"]), float(eng.model.tolerance))).encode())
+    return h.hexdigest()
+
+
+def _source_pressure(model, pos) -> np.ndarray:
+    """The water table's and `block insitu pore-pressure`'s pressure at points pos (a new knot's start)."""
+    from .water import table_pressure
+
+    w = model.settings.mechanical.get("water")
+    if not isinstance(w, dict) or not len(pos):
+        return np.zeros(len(pos))
+    p = table_pressure(pos, float(w.get("density", 0.0)), w.get("plane"), model.settings.gravity)
+    ins = w.get("insitu")
+    if ins:
+        p = p + ins[0] + pos @ np.asarray(ins[1:], dtype=_F)
+    return p
+
+
+def rebuild(eng, force: bool = False) -> bool:
+    """Build the network from the contacts when they changed since it was built (or ``force``). Returns
+    whether it was built."""
+    m = eng.model
+    f = settings(m)
+    st = stores(m)
+    sig = _signature(eng, f)
+    if not force and sig == f.get("sig") and st["flowsubs"].n == eng.subcontacts.n:
+        return False
+    cs, ss = eng.contacts, eng.subcontacts
+    geo = build_geometry(cs["sub_start"], cs["sub_count"], cs["normal"], ss["pos"], float(f["size"]),
+                         float(m.tolerance))
+    kn = st["flowknots"]
+    old_pos = kn["pos"].copy()
+    old = {k: kn[k].copy() for k in ("pp", "fixed", "p_fixed", "q_in")}
+    nk = len(geo["pos"])
+    pp = _source_pressure(m, geo["pos"])
+    carry = {"pp": pp, "fixed": np.zeros(nk, np.uint8), "p_fixed": np.zeros(nk), "q_in": np.zeros(nk)}
+    if len(old_pos) and nk:
+        from scipy.spatial import cKDTree
+
+        d, j = cKDTree(old_pos).query(geo["pos"])
+        hit = d <= max(eng.tolerance(), float(m.tolerance))
+        for k in carry:
+            carry[k][hit] = old[k][j[hit]]
+    kn.clear()
+    kn.append(nk)
+    kn["pos"][...] = geo["pos"]
+    for k, v in carry.items():
+        kn[k][...] = v
+    zs = st["flowzones"]
+    zs.clear()
+    zs.append(len(geo["zk"]))
+    for k in ("zk", "zcontact", "zarea", "zcot", "zsub", "zw", "zpipe"):
+        zs[k][...] = geo[k]
+    ps = st["flowpipes"]
+    ps.clear()
+    ps.append(len(geo["pa"]))
+    ps["pa"][...] = geo["pa"]
+    ps["pb"][...] = geo["pb"]
+    g = np.asarray(m.settings.gravity, dtype=_F)
+    ps["dg"][...] = -float(f["density"]) * ((geo["pos"][geo["pa"]] - geo["pos"][geo["pb"]]) @ g)
+    sb = st["flowsubs"]
+    sb.clear()
+    sb.append(ss.n)
+    sb["knot"][...] = geo["sknot"]
+    f["sig"] = sig
+    update(eng)
+    return True
+
+
+def apertures(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each contact's (a0, amin, amax): its own `flowplane property` values, else the default."""
+    f = settings(model)
+    cs = model.store("contacts")
+    own = cs["aperture"]
+    out = [np.where(own[:, i] >= 0.0, own[:, i], float(f["aperture"][i])) for i in range(3)]
+    return out[0], out[1], out[2]
+
+
+def update(eng) -> None:
+    """Apertures from the normal displacements, pipe conductances and knot volumes (``zone_update``)."""
+    m = eng.model
+    f = settings(m)
+    st = stores(m)
+    zs, ps, kn = st["flowzones"], st["flowpipes"], st["flowknots"]
+    a0, amin, amax = apertures(m)
+    zone_update(zs["zsub"], zs["zw"], zs["zcontact"], eng.subcontacts["un"], a0, amin, amax, zs["zk"], zs["zarea"],
+                zs["zcot"], zs["zpipe"], float(f["viscosity"]), zs["zap"], ps["c"], kn["vol"])
+
+
+def to_subcontacts(eng) -> None:
+    """The knots' pressures to the sub-contacts' ``pp`` (+ the contact's applied pressure) and ``ppf``."""
+    m = eng.model
+    st = stores(m)
+    ss, cs = eng.subcontacts, eng.contacts
+    p = st["flowknots"]["pp"]
+    if not np.all(np.isfinite(p)):
+        raise CommandError("a flow knot's pressure is not finite: refused before it reaches a contact force")
+    if st["flowsubs"].n != ss.n:
+        return
+    parea = np.empty(ss.n)
+    if ss.n:
+        pressure_areas(cs["sub_start"], cs["sub_count"], cs["normal"], ss["pos"], ss["area"], parea)
+    sub_pressures(st["flowsubs"]["knot"], ss["contact"], p, cs["pp_apply"], parea, ss["pp"], ss["ppf"])
+
+
+def after_detection(eng) -> None:
+    """Called where the water pressures are worked out (``water.refresh``) while the fluid is active: the
+    network follows the contacts and the sub-contacts take the knots' pressures."""
+    rebuild(eng)
+    to_subcontacts(eng)
+
+
+def _supply(kn, ps) -> None:
+    """Each fixed knot's supply [m³/s]: what its boundary puts into the network (net pipe outflow there);
+    at the others the applied discharge."""
+    net = np.zeros(kn.n)
+    np.add.at(net, ps["pa"], ps["q"])
+    np.add.at(net, ps["pb"], -ps["q"])
+    kn["supply"][...] = np.where(kn["fixed"] != 0, net, kn["q_in"])
+
+
+def advance(eng, span: float) -> int:
+    """Transient flow over ``span`` seconds: explicit steps of at most the stable Δt (never larger: a step
+    too large is reduced). Returns the flow steps taken."""
+    m = eng.model
+    f = settings(m)
+    st = stores(m)
+    kn, ps = st["flowknots"], st["flowpipes"]
+    if not kn.n or not span > 0.0:
+        return 0
+    update(eng)
+    fixed = kn["fixed"] != 0
+    p = kn["pp"]
+    p[fixed] = kn["p_fixed"][fixed]
+    kw = float(f["bulk"])
+    h = stable_dt(ps["pa"], ps["pb"], ps["c"], kn["vol"], kw, fixed)
+    n = max(1, int(math.ceil(span / h - 1e-9))) if math.isfinite(h) else 1
+    network_steps(n, span / n, ps["pa"], ps["pb"], ps["c"], ps["dg"], kn["vol"], kw, fixed, kn["q_in"], p, ps["q"])
+    _supply(kn, ps)
+    return n
+
+
+def solve_steady(eng) -> tuple[int, int]:
+    """The steady state of every part of the network that holds a pressure boundary (a sparse direct solve,
+    ``jointflow.steady``); the other parts keep their pressures. Returns (knots solved, parts left out)."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from .jointflow import steady
+
+    m = eng.model
+    st = stores(m)
+    kn, ps = st["flowknots"], st["flowpipes"]
+    update(eng)
+    nk = kn.n
+    fixed = kn["fixed"] != 0
+    if not fixed.any():
+        raise CommandError("no flow knot has a pressure boundary (`flowknot apply pore-pressure`): "
+                           "the steady state is not defined")
+    live = ps["c"] > 0.0
+    g = csr_matrix((np.ones(int(live.sum())), (ps["pa"][live], ps["pb"][live])), shape=(nk, nk))
+    ncomp, lab = connected_components(g, directed=False)
+    held = np.zeros(ncomp, bool)
+    held[lab[fixed]] = True
+    take = held[lab]
+    idx = np.flatnonzero(take)
+    remap = np.full(nk, -1, _I)
+    remap[idx] = np.arange(len(idx))
+    sel = take[ps["pa"]] & take[ps["pb"]]
+    p, q = steady(len(idx), remap[ps["pa"][sel]], remap[ps["pb"][sel]], ps["c"][sel], fixed[idx],
+                  kn["p_fixed"][idx], kn["q_in"][idx], ps["dg"][sel])
+    kn["pp"][idx] = p
+    ps["q"][...] = 0.0
+    ps["q"][sel] = q
+    _supply(kn, ps)
+    to_subcontacts(eng)
+    return len(idx), int(ncomp - held.sum())
+
+
+def zone_flux(model) -> np.ndarray:
+    """Each flow zone's specific discharge vector [m²/s] (flow per unit width): q = −a³/(12 μ) ∇ψ over the
+    triangle, ψ = p − ρ_w g·x linear between its knots."""
+    f = settings(model)
+    zs, kn = model.store("flowzones"), model.store("flowknots")
+    g = np.asarray(model.settings.gravity, dtype=_F)
+    x = kn["pos"][zs["zk"]]                                   # (nz, 3, 3)
+    psi = kn["pp"][zs["zk"]] - float(f["density"]) * (x @ g)  # (nz, 3)
+    nrm = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+    two_a = np.linalg.norm(nrm, axis=1)
+    nrm = nrm / np.where(two_a > 0, two_a, 1.0)[:, None]
+    grad = np.zeros((zs.n, 3))
+    for j in range(3):
+        e = x[:, (j + 2) % 3] - x[:, (j + 1) % 3]
+        grad += psi[:, j:j + 1] * np.cross(nrm, e)
+    grad /= np.where(two_a > 0, two_a, 1.0)[:, None]
+    return -(zs["zap"] ** 3 / (12.0 * float(f["viscosity"])))[:, None] * grad
+
+
+def contact_values(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per contact, area-weighted over its flow zones: the knots' pressure [Pa], the hydraulic aperture [m]
+    and the magnitude of the specific discharge [m²/s] (``zone_flux``); zeros while there is no network."""
+    cs = model.store("contacts")
+    nc = cs.n
+    out = np.zeros(nc), np.zeros(nc), np.zeros(nc)
+    if "flowzones" not in model.stores or not model.store("flowzones").n:
+        return out
+    zs, kn = model.store("flowzones"), model.store("flowknots")
+    zc, area = zs["zcontact"], zs["zarea"]
+    ok = zc < nc
+    zc, area = zc[ok], area[ok]
+    asum = np.bincount(zc, area, nc)
+    den = np.where(asum > 0, asum, 1.0)
+    pz = kn["pp"][zs["zk"][ok]].mean(axis=1)
+    qz = np.linalg.norm(zone_flux(model)[ok], axis=1)
+    return (np.bincount(zc, pz * area, nc) / den, np.bincount(zc, zs["zap"][ok] * area, nc) / den,
+            np.bincount(zc, qz * area, nc) / den)

@@ -1,0 +1,104 @@
+"""Flow in the joints through the commands (`model configure fluid`, `block fluid …`, `flowplane property`,
+`flowknot apply …`): the network follows the contacts, bad input refused with its place, save/restore
+continues bit for bit, outputs (VTK, FISH, histories). Numbers against closed forms: verification/W4–W6."""
+import numpy as np
+import pytest
+
+from dec3d.errors import Dec3dError
+from dec3d.physics.rigid import engine
+
+JOINT = """model new
+model configure fluid
+block create brick 0 10 0 2 -1 0
+block create brick 0 10 0 2 0 1
+block property density 2000
+block fix
+block contact jmodel assign mohr
+block contact material-table default property stiffness-normal 1e9 stiffness-shear 1e9 friction 30
+flowplane property aperture-initial 1e-4 aperture-minimum 1e-5 aperture-maximum 1e-3
+"""
+
+
+def _run(session, text):
+    session.run_items(session.load_text(text))
+    return engine(session.model)
+
+
+def test_steady_flow_reaches_the_sub_contacts_and_transient_tends_to_it(session):
+    """Steady: the sub-contacts take the knots' linear pressure; the explicit steps in the cycle run to the
+    same state (five diffusion times)."""
+    e = _run(session, JOINT + "flowknot apply pore-pressure 1e5 range position-x 0\n"
+                              "flowknot apply pore-pressure 0 range position-x 10\nblock fluid solve-steady\n")
+    ss = e.subcontacts
+    assert ss["pp"] == pytest.approx(1e5 * (1 - ss["pos"][:, 0] / 10), abs=1e-6)
+    assert ss["ppf"].sum() == pytest.approx(0.5e5 * 20, rel=1e-9)
+    steady = session.model.store("flowknots")["pp"].copy()
+    d = 2e9 * 1e-8 / 12e-3
+    _run(session, f"flowknot initialize pore-pressure 0\nblock mechanical timestep {5 * 100 / d / 50}\nmodel cycle 50\n")
+    assert session.model.store("flowknots")["pp"] == pytest.approx(steady, abs=0.01 * 1e5)
+
+
+def test_the_network_follows_the_contacts_and_keeps_its_conditions(session):
+    """A third block makes a second joint: the network is built again at the next cycle, the knots of the
+    first joint keep their pressure boundaries."""
+    e = _run(session, JOINT + "block fluid zone-size 2.5\nflowknot apply pore-pressure 1e5 range position-x 0\n"
+                              "model cycle 1\n")
+    kn = session.model.store("flowknots")
+    n0, fixed0 = kn.n, int(kn["fixed"].sum())
+    assert n0 == 5 * 2 and fixed0 == 2
+    _run(session, "block create brick 0 10 0 2 1 2\nblock property density 2000\nblock fix\nmodel cycle 1\n")
+    assert kn.n == 2 * 5 * 2 and int(kn["fixed"].sum()) == 2     # (z = 0 keeps its two; the new joint's are free)
+    assert len(session.model.store("flowsubs")["knot"]) == e.subcontacts.n
+
+
+@pytest.mark.parametrize("line, message", [
+    ("block fluid property viscosity 0\n", "viscosity"),
+    ("block fluid property bulk -1\n", "bulk"),
+    ("flowplane property aperture-initial -1e-4\n", "aperture-initial"),
+    ("flowplane property aperture-minimum 2e-3 aperture-maximum 1e-3\n", "aperture-minimum 0.002 is above"),
+    ("flowknot apply pore-pressure 1e5 range position-x 50\n", "holds no flow knot"),
+    ("flowknot apply gradient 5 discharge 1\n", "goes with `pore-pressure`"),
+    ("flowknot apply\n", "needs one of pore-pressure"),
+    ("block fluid solve-steady\n", "no flow knot has a pressure boundary"),
+])
+def test_bad_input_is_refused_with_its_place(session, line, message):
+    with pytest.raises(Dec3dError) as err:
+        _run(session, JOINT + line)
+    assert message in str(err.value)
+    assert ":10:" in err.value.format()          # the line of the command in the deck
+
+
+def test_fluid_commands_need_configure(session):
+    with pytest.raises(Dec3dError, match="needs `model configure fluid` first"):
+        _run(session, JOINT.replace("model configure fluid\n", ""))
+
+
+def test_save_restore_continues_bit_identically(session, tmp_path):
+    deck = JOINT + ("block fluid zone-size 2\nflowknot apply pore-pressure 1e5 range position-x 0\n"
+                    "block mechanical timestep 1e-3\n")
+    _run(session, deck + "model cycle 20\n")
+    whole = session.model.store("flowknots")["pp"].copy()
+    _run(session, deck + f"model cycle 10\nmodel save '{tmp_path / 'half.d3s'}'\n")
+    _run(session, f"model new\nmodel restore '{tmp_path / 'half.d3s'}'\nmodel cycle 10\n")
+    assert np.array_equal(session.model.store("flowknots")["pp"], whole)
+    assert not np.all(whole == whole[0])
+
+
+def test_fish_and_vtk_and_fluid_off(session, tmp_path):
+    _run(session, JOINT + "flowknot apply pore-pressure 1e5 range position-x 0\n"
+                          "flowknot apply pore-pressure 0 range position-x 10\nblock fluid solve-steady\n"
+                          "[c = block.contact.find(1, 2)]\n[fp = block.contact.flow.pp(c)]\n"
+                          "[fa = block.contact.flow.aperture(c)]\n[fr = block.contact.flow.rate(c)]\n"
+                          "[nk = flowknot.num]\n[v = flowknot.volume(1)]\n")
+    v = session.variables
+    assert v["fp"] == pytest.approx(5e4, rel=1e-9)
+    assert v["fa"] == pytest.approx(1e-4, rel=1e-9)
+    assert v["fr"] == pytest.approx(1e-12 / 12e-3 * 1e5 / 10, rel=1e-9)       # m²/s: q / w
+    # (a third of each triangle at its corners: the two triangles of the rectangle meet at two of the four)
+    assert v["nk"] == 4 and min(abs(v["v"] / (1e-4 * 10 / 3) - k) for k in (1, 2)) < 1e-9
+    from dec3d.io.contactvtk import contact_point_data
+
+    _pts, data = contact_point_data(session.model)
+    assert "flow_rate" in data and data["flow_pressure"] == pytest.approx(np.full(len(_pts), 5e4))
+    e = _run(session, "model fluid active off\n")
+    assert np.all(e.subcontacts["pp"] == 0.0)
