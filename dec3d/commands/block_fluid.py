@@ -6,10 +6,14 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import BindError, CommandError
+from ..fish import flow_intrinsics
+from ..io.flowvalues import contact_values
 from ..physics import flownet as F
 from ..physics.rigid import engine
 from .registry import command
-from .values import FLAG, ONOFF, Num, P
+from .values import ONOFF, Num, P
+
+flow_intrinsics.FLOW_VALUES[0] = contact_values
 
 
 def _need_fluid(session, call):

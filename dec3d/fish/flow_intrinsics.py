@@ -7,6 +7,9 @@ import numpy as np
 from .intrinsics import _number, intrinsic
 from .values import FishValueError, Vec
 
+#: ``contact_values(model)`` (dec3d.io.flowvalues), set by the commands layer (FISH knows no model layout)
+FLOW_VALUES = [None]
+
 
 def _knots(rt, name):
     m = rt.session.model
@@ -82,11 +85,12 @@ def _near(rt, x, y=None, z=None):
 
 
 def _contact_value(rt, c, name, which):
-    from ..physics.flownet import contact_values
     from .contact_intrinsics import _contact_row
 
     _cs, r = _contact_row(rt, c, name)
-    return float(contact_values(rt.session.model)[which][r])
+    if FLOW_VALUES[0] is None:
+        return 0.0
+    return float(FLOW_VALUES[0](rt.session.model)[which][r])
 
 
 @intrinsic("block.contact.flow.pp", 1)

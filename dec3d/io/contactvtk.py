@@ -65,7 +65,7 @@ def contact_point_data(model) -> tuple[np.ndarray, dict]:
     if "flowzones" in model.stores and model.store("flowzones").n:
         # flow in the joints (physics.flownet): each contact's mean knot pressure [Pa], hydraulic aperture [m]
         # and flow rate per unit width [m²/s], on each of its sub-contacts
-        from dec3d.physics.flownet import contact_values
+        from dec3d.io.flowvalues import contact_values
 
         fp, fa, fq = contact_values(model)
         data["flow_pressure"], data["hydraulic_aperture"], data["flow_rate"] = fp[ci], fa[ci], fq[ci]
