@@ -10,8 +10,9 @@ from ..fish import flow_intrinsics
 from ..io.flowvalues import contact_values
 from ..physics import flownet as F
 from ..physics.rigid import engine
-from .registry import command
-from .values import ONOFF, Num, P
+from .histories import _name
+from .registry import REGISTRY, command
+from .values import ONOFF, VEC3, Num, P, Text
 
 flow_intrinsics.FLOW_VALUES[0] = contact_values
 
@@ -247,3 +248,32 @@ def flowknot_initialize(session, call):
     free = mask & (kn["fixed"] == 0)
     kn["pp"][free] = float(call.args["pore_pressure"]) + g * kn["pos"][free, 2]
     F.to_subcontacts(eng)
+
+
+REGISTRY.node_keywords("flowknot history", [P("name", Text(), "history name")])
+
+
+def _flowknot_history(quantity):
+    def handler(session, call):
+        from ..physics.history import histories
+
+        _need_fluid(session, call)
+        name = _name(session, call)
+        label, value, spec = F.flowknot_history(session.model, quantity, call.args["position"])
+        histories(session.model).add(label, value, name, spec)
+
+    handler.__name__ = "flowknot_history_" + quantity.replace("-", "_")
+    return handler
+
+
+for _q in F.FLOWKNOT_QUANTITIES:
+    command(f"flowknot history {_q}",
+            keywords=[P("position", VEC3, "the knot nearest this point (at each sample)", units="m", required=True)],
+            doc="Record the " + ("pressure [Pa]" if _q == "pore-pressure" else "discharge [m³/s]")
+                + " of the flow knot nearest a point.",
+            details="`discharge` is what the knot's boundary puts into the network: at a pressure boundary the net "
+                    "flow out of it through the pipes, elsewhere the applied inflow. The knot is looked up at each "
+                    "sample (the network is built again when the contacts change); NaN while there is none. A "
+                    "leading `name '<s>'` names the history.",
+            examples=[f"flowknot history {_q} position 5 1 0", f"flowknot history name 'h' {_q} position 0 1 0"],
+            )(_flowknot_history(_q))

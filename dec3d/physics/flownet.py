@@ -266,3 +266,24 @@ def solve_steady(eng) -> tuple[int, int]:
     _supply(kn, ps)
     to_subcontacts(eng)
     return len(idx), int(ncomp - held.sum())
+
+
+#: `flowknot history <quantity>`: what is recorded at the knot nearest a point
+FLOWKNOT_QUANTITIES = {"pore-pressure": "pp", "discharge": "supply"}
+
+
+def flowknot_history(model, quantity: str, position) -> tuple[str, object, dict]:
+    """(label, value(eng), spec) of a history of the knot nearest ``position`` at each sample (the network is
+    built again when the contacts change): its pressure [Pa] or the discharge its boundary supplies [m³/s];
+    NaN while there is no knot."""
+    fld = FLOWKNOT_QUANTITIES[quantity]
+    pos = np.asarray(position, dtype=_F)
+
+    def value(eng) -> float:
+        kn = model.stores.get("flowknots")
+        if kn is None or not kn.n:
+            return float("nan")
+        return float(kn[fld][int(np.argmin(np.linalg.norm(kn["pos"] - pos, axis=1)))])
+
+    label = f"flow knot near ({pos[0]:g} {pos[1]:g} {pos[2]:g}) {quantity}"
+    return label, value, {"kind": "flowknot", "quantity": quantity, "position": [float(x) for x in pos]}

@@ -102,3 +102,24 @@ def test_fish_and_vtk_and_fluid_off(session, tmp_path):
     assert "flow_rate" in data and data["flow_pressure"] == pytest.approx(np.full(len(_pts), 5e4))
     e = _run(session, "model fluid active off\n")
     assert np.all(e.subcontacts["pp"] == 0.0)
+
+
+def test_histories_of_pressure_and_discharge_and_their_save(session, tmp_path):
+    """A pressure step at x = 0: the pressure at mid-joint rises towards the steady 5e4 Pa and the inflow
+    falls towards the cubic law's; both histories survive a save and restore."""
+    d = 2e9 * 1e-8 / 12e-3
+    _run(session, JOINT + "block fluid zone-size 1\nflowknot apply pore-pressure 1e5 range position-x 0\n"
+                          "flowknot apply pore-pressure 0 range position-x 10\n"
+                          f"block mechanical timestep {4 * 100 / d / 40}\nhistory interval 1\n"
+                          "flowknot history name 'pm' pore-pressure position 5 1 0\n"
+                          "flowknot history name 'qin' discharge position 0 1 0\nmodel cycle 40\n"
+                          f"model save '{tmp_path / 'h.d3s'}'\nmodel new\nmodel restore '{tmp_path / 'h.d3s'}'\n")
+    from dec3d.physics.history import histories
+
+    hs = histories(session.model)
+    pm, qin = hs.find("pm"), hs.find("qin")
+    assert len(pm.values) == 40 and pm.values[0] < pm.values[-1]
+    assert pm.values[-1] == pytest.approx(5e4, rel=0.02)
+    # the knot at (0, 1, 0) supplies its share of q = a³ w ΔP / (12 μ L): the middle one of the edge's three
+    assert qin.values[-1] == pytest.approx(0.5 * 1e-12 * 2 * 1e5 / (12e-3 * 10), rel=0.02)
+    assert qin.values[0] > qin.values[-1]
