@@ -71,7 +71,7 @@ def _delaunay(uv):
     return d
 
 
-def _hull_loop(uv, d):
+def _hull_loop(uv):
     """The convex hull's corners in order (counter-clockwise) as indices into uv."""
     from scipy.spatial import ConvexHull
     return ConvexHull(uv).vertices
@@ -108,6 +108,23 @@ def _refined_points(uv, loop, h, tol):
     return np.asarray(out, dtype=np.float64).reshape(-1, 2)
 
 
+def _locate(pts, tris, q):
+    """Barycentric weights (nq, 3) of the points q in the triangle of ``tris`` (corners in pts) each is most
+    inside of (the largest smallest weight), clipped to ≥ 0, and that triangle's index (nq,)."""
+    v = pts[tris]                                            # (nt, 3, 2)
+    lam = np.empty((len(q), len(tris), 3))
+    for j in range(3):
+        p1, p2 = v[None, :, (j + 1) % 3], v[None, :, (j + 2) % 3]
+        qq = q[:, None, :]
+        lam[:, :, j] = ((p1[..., 0] - qq[..., 0]) * (p2[..., 1] - qq[..., 1])
+                        - (p1[..., 1] - qq[..., 1]) * (p2[..., 0] - qq[..., 0]))
+    tot = lam.sum(axis=2, keepdims=True)
+    lam = lam / np.where(tot != 0.0, tot, 1.0)
+    best = np.argmax(lam.min(axis=2), axis=1)
+    w = np.clip(lam[np.arange(len(q)), best], 0.0, None)
+    return w / w.sum(axis=1, keepdims=True), best
+
+
 def build_geometry(sub_start, sub_count, normal, sc_pos, size: float, tol: float) -> dict:
     """The network (module docstring) of the contacts (CSR sub_start/sub_count into sc_pos, normal (nc, 3)).
 
@@ -137,7 +154,7 @@ def build_geometry(sub_start, sub_count, normal, sc_pos, size: float, tol: float
         if cd is None or not len(cd.simplices):
             continue
         if size > 0.0:
-            loop = keep[_hull_loop(uv[keep], cd)]
+            loop = keep[_hull_loop(uv[keep])]
             extra = _refined_points(uv, loop, size, tol)
             if len(extra):
                 # drop refinement points at a sub-contact's place
@@ -170,13 +187,10 @@ def build_geometry(sub_start, sub_count, normal, sc_pos, size: float, tol: float
             cot[:, j] = 0.5 * (p[:, 0] * q[:, 0] + p[:, 1] * q[:, 1]) / (2.0 * area)
         # each zone's centroid in the sub-contact triangulation: barycentric weights
         cen = fuv[tris].mean(axis=1)
-        simp = cd.find_simplex(cen)
-        simp = np.where(simp < 0, 0, simp)         # (round-off at the hull: the first triangle, weights clipped)
-        tr = cd.transform[simp]
-        bary2 = np.einsum("tij,tj->ti", tr[:, :2], cen - tr[:, 2])
-        bary = np.concatenate([bary2, 1.0 - bary2.sum(axis=1, keepdims=True)], axis=1)
-        bary = np.clip(bary, 0.0, None)
-        bary /= bary.sum(axis=1, keepdims=True)
+        # (by the sub-triangles' areas, each centroid in the coarse triangle it is most inside of: scipy's
+        # ``find_simplex`` and ``transform`` go through LAPACK, whose thread pool took seconds to start on a
+        # loaded machine)
+        bary, simp = _locate(uv[keep], cd.simplices, cen)
         zsub = s0 + keep[cd.simplices[simp]]
         # the knots' 3-D positions: sub-contact points exactly, refinement points on the plane
         xyz = p0 + fuv[:, :1] * t1 + fuv[:, 1:] * t2
