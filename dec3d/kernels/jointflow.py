@@ -120,11 +120,29 @@ def network_steps(nsteps, dt, pa, pb, c, dg, vol, kw, fixed, q_in, p, flow):
 
 
 @njit(cache=True)
-def sub_pressures(sknot, scontact, p, pp_apply, parea, pp, ppf):
-    """Each sub-contact's pore pressure from its knot: pp[s] = p[sknot[s]] + pp_apply[contact] (sub-contacts
-    without a knot keep theirs), and its force on the faces ppf[s] = pp[s] parea[s]."""
-    for s in range(sknot.shape[0]):
+def sub_pressures(sknot, srep, scount, scontact, p, pp_apply, parea, zk, zsub, zw, zarea, pp, ppf):
+    """The sub-contacts' pore pressures and their forces on the faces from the knots (``physics.flownet``).
+
+    pp[s] = p[sknot[s]] + pp_apply[contact] (the pressure at its point; sub-contacts without a knot keep theirs).
+    The force: each flow zone t pushes with F_t = A_t (p_a + p_b + p_c)/3 (the exact integral of the pressure,
+    linear over the zone) at its centroid, handed to the sub-contacts of the coarse triangle that holds the
+    centroid by its barycentric weights zw (so the resultant and its moment about any point in the plane are
+    kept), each point's share split equally among the sub-contacts at that place (srep: the first of them,
+    scount: how many); plus pp_apply A′ (parea). So a pressure that varies inside a contact (a drain under a
+    dam) reaches the blocks, where the corner values alone would not show it. Without a knot:
+    ppf[s] = pp[s] parea[s]."""
+    ns = sknot.shape[0]
+    acc = np.zeros(ns)
+    for t in range(zk.shape[0]):
+        f = zarea[t] * (p[zk[t, 0]] + p[zk[t, 1]] + p[zk[t, 2]]) / 3.0
+        for j in range(3):
+            acc[zsub[t, j]] += f * zw[t, j]
+    for s in range(ns):
         k = sknot[s]
         if k >= 0:
-            pp[s] = p[k] + pp_apply[scontact[s]]
-        ppf[s] = pp[s] * parea[s]
+            a = pp_apply[scontact[s]]
+            pp[s] = p[k] + a
+            r = srep[s]
+            ppf[s] = acc[r] / scount[r] + a * parea[s]
+        else:
+            ppf[s] = pp[s] * parea[s]

@@ -132,9 +132,11 @@ def build_geometry(sub_start, sub_count, normal, sc_pos, size: float, tol: float
     ``zcot`` (nz, 3) the weight cot θ / 2 of the edge opposite each corner; ``zsub`` (nz, 3) and ``zw`` (nz, 3)
     sub-contact rows and weights of the zone's centroid; ``zpipe`` (nz, 3) the pipe of the edge opposite each
     corner (−1: none); ``pa``, ``pb`` (np,) pipe knots; ``sknot`` (ns,) each sub-contact's knot (−1: its
-    contact has no zone)."""
+    contact has no zone); ``srep`` (ns,) the first sub-contact of its contact at the same place (itself when
+    none is before it; ``zsub`` names only these)."""
     ns = sc_pos.shape[0]
     sknot_local = np.full(ns, -1, dtype=np.int64)
+    srep = np.arange(ns, dtype=np.int64)
     allpts, zk_l, zc_l, za_l, zcot_l, zsub_l, zw_l = [], [], [], [], [], [], []
     base = 0
     for c in range(len(sub_start)):
@@ -197,6 +199,7 @@ def build_geometry(sub_start, sub_count, normal, sc_pos, size: float, tol: float
         xyz[: len(keep)] = sc_pos[s0 + keep]
         allpts.append(xyz)
         sknot_local[s0:s0 + k] = base + np.searchsorted(keep, rep)
+        srep[s0:s0 + k] = s0 + rep
         zk_l.append(base + tris)
         zc_l.append(np.full(len(tris), c, dtype=np.int64))
         za_l.append(area)
@@ -208,7 +211,7 @@ def build_geometry(sub_start, sub_count, normal, sc_pos, size: float, tol: float
         z3i = np.zeros((0, 3), dtype=np.int64)
         return {"pos": np.zeros((0, 3)), "zk": z3i, "zcontact": np.zeros(0, np.int64), "zarea": np.zeros(0),
                 "zcot": np.zeros((0, 3)), "zsub": z3i, "zw": np.zeros((0, 3)), "zpipe": z3i,
-                "pa": np.zeros(0, np.int64), "pb": np.zeros(0, np.int64), "sknot": sknot_local}
+                "pa": np.zeros(0, np.int64), "pb": np.zeros(0, np.int64), "sknot": sknot_local, "srep": srep}
     pts = np.concatenate(allpts)
     rep = _distinct(pts, tol)                     # knots of different planes at one place are one knot
     first = np.flatnonzero(rep == np.arange(len(pts)))
@@ -228,4 +231,5 @@ def build_geometry(sub_start, sub_count, normal, sc_pos, size: float, tol: float
     zpipe[good] = inv
     return {"pos": pts[first], "zk": zk, "zcontact": np.concatenate(zc_l), "zarea": np.concatenate(za_l),
             "zcot": np.concatenate(zcot_l), "zsub": np.concatenate(zsub_l), "zw": np.concatenate(zw_l),
-            "zpipe": zpipe.reshape(-1, 3), "pa": uniq // len(first), "pb": uniq % len(first), "sknot": sknot}
+            "zpipe": zpipe.reshape(-1, 3), "pa": uniq // len(first), "pb": uniq % len(first), "sknot": sknot,
+            "srep": srep}

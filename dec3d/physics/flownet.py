@@ -9,7 +9,7 @@ State (saved and restored with the model, no pickle):
   carried by the pair through detections.
 - stores ``flowknots`` (pos, pp, fixed, p_fixed, q_in, vol, supply), ``flowzones`` (the triangles of
   ``physics.flowgeom``: zk, zcontact, zarea, zcot, zsub, zw, zpipe, zap), ``flowpipes`` (pa, pb, c, dg, q) and
-  ``flowsubs`` (per sub-contact: its knot).
+  ``flowsubs`` (per sub-contact: its knot; the first sub-contact at its place and how many share it).
 
 The network is built again from the contacts when their set or their sub-contacts change (after a detection,
 ``after_detection``); knot pressures and boundary conditions go to the new knot at the same place (within the
@@ -19,8 +19,9 @@ is active (`model configure fluid`, `model fluid active on`) the sub-contact por
 
 Each batch of the cycle (``FluidStep``): apertures from the sub-contacts' normal displacements, conductances and
 volumes (``kernels.jointflow.zone_update``), explicit flow steps over the batch's time with Δt ≤ the stable step
-(``network_steps``), then the knot pressures to the sub-contacts (``sub_pressures``): the joint laws see the
-effective stress at the next step.
+(``network_steps``), then the knot pressures to the sub-contacts (``sub_pressures``: each zone's pressure
+force handed to the sub-contacts around it, so the pressure inside a contact reaches the blocks): the joint
+laws see the effective stress at the next step.
 """
 from __future__ import annotations
 
@@ -48,7 +49,7 @@ ZONE_FIELDS = {"zk": Field((3,), _I, -1), "zcontact": Field((), _I, -1), "zarea"
                "zpipe": Field((3,), _I, -1), "zap": Field((), _F, 0.0)}
 PIPE_FIELDS = {"pa": Field((), _I, 0), "pb": Field((), _I, 0), "c": Field((), _F, 0.0), "dg": Field((), _F, 0.0),
                "q": Field((), _F, 0.0)}
-SUB_FIELDS = {"knot": Field((), _I, -1)}
+SUB_FIELDS = {"knot": Field((), _I, -1), "rep": Field((), _I, -1), "count": Field((), _F, 1.0)}
 STORES = {"flowknots": KNOT_FIELDS, "flowzones": ZONE_FIELDS, "flowpipes": PIPE_FIELDS, "flowsubs": SUB_FIELDS}
 
 
@@ -153,6 +154,8 @@ def rebuild(eng, force: bool = False) -> bool:
     sb.clear()
     sb.append(ss.n)
     sb["knot"][...] = geo["sknot"]
+    sb["rep"][...] = geo["srep"]
+    sb["count"][...] = np.bincount(geo["srep"], minlength=ss.n).astype(_F)
     f["sig"] = sig
     update(eng)
     return True
@@ -179,7 +182,8 @@ def update(eng) -> None:
 
 
 def to_subcontacts(eng) -> None:
-    """The knots' pressures to the sub-contacts' ``pp`` (+ the contact's applied pressure) and ``ppf``."""
+    """The knots' pressures to the sub-contacts' ``pp`` (+ the contact's applied pressure) and their force on
+    the faces ``ppf`` from the flow zones (``kernels.jointflow.sub_pressures``)."""
     m = eng.model
     st = stores(m)
     ss, cs = eng.subcontacts, eng.contacts
@@ -191,7 +195,9 @@ def to_subcontacts(eng) -> None:
     parea = np.empty(ss.n)
     if ss.n:
         pressure_areas(cs["sub_start"], cs["sub_count"], cs["normal"], ss["pos"], ss["area"], parea)
-    sub_pressures(st["flowsubs"]["knot"], ss["contact"], p, cs["pp_apply"], parea, ss["pp"], ss["ppf"])
+    sb, zs = st["flowsubs"], st["flowzones"]
+    sub_pressures(sb["knot"], sb["rep"], sb["count"], ss["contact"], p, cs["pp_apply"], parea, zs["zk"], zs["zsub"],
+                  zs["zw"], zs["zarea"], ss["pp"], ss["ppf"])
 
 
 def after_detection(eng) -> None:

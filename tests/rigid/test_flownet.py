@@ -175,16 +175,45 @@ def test_a_column_of_water_at_rest_does_not_flow():
 
 
 def test_sub_pressures_against_its_twin():
+    """pp from the sub-contact's knot; the force: each zone's A (mean corner pressure) handed out by its
+    centroid's weights, shared among the sub-contacts at one place, plus the applied pressure × A′."""
+    g, pos = _network([_rect_contact(0, 4, 0, 2), _rect_contact(4, 6, 0, 2)], [[0, 0, 1], [0, 0, 1]], 0.5)
     rng = np.random.default_rng(9)
-    ns, nk, nc = 12, 5, 3
-    sknot = rng.integers(-1, nk, ns)
-    scontact = rng.integers(0, nc, ns)
+    ns, nk = len(pos), len(g["pos"])
+    sknot = g["sknot"].copy()
+    sknot[3] = -1                       # (a sub-contact without a knot keeps its pressure)
+    scontact = np.repeat([0, 1], 8)
     p = rng.uniform(0, 1e5, nk)
-    app = rng.uniform(0, 1e3, nc)
+    app = np.array([100.0, 250.0])
     parea = rng.uniform(0.1, 1.0, ns)
     pp0 = rng.uniform(0, 10, ns)
+    count = np.bincount(g["srep"], minlength=ns).astype(float)
     pp, ppf = pp0.copy(), np.zeros(ns)
-    sub_pressures(sknot, scontact, p, app, parea, pp, ppf)
-    want = np.array([p[sknot[s]] + app[scontact[s]] if sknot[s] >= 0 else pp0[s] for s in range(ns)])
-    assert pp == pytest.approx(want, rel=1e-15)
-    assert ppf == pytest.approx(want * parea, rel=1e-15)
+    sub_pressures(sknot, g["srep"], count, scontact, p, app, parea, g["zk"], g["zsub"], g["zw"], g["zarea"], pp, ppf)
+    force = np.zeros(ns)
+    for t in range(len(g["zk"])):
+        f = g["zarea"][t] * np.mean(p[g["zk"][t]])
+        for j in range(3):
+            force[g["zsub"][t, j]] += f * g["zw"][t, j]
+    for s in range(ns):
+        if sknot[s] >= 0:
+            same = [r for r in range(ns) if g["srep"][r] == g["srep"][s]]
+            assert pp[s] == pytest.approx(p[sknot[s]] + app[scontact[s]], rel=1e-15)
+            assert ppf[s] == pytest.approx(force[g["srep"][s]] / len(same) + app[scontact[s]] * parea[s], rel=1e-12)
+        else:
+            assert pp[s] == pp0[s] and ppf[s] == pytest.approx(pp0[s] * parea[s], rel=1e-15)
+
+
+def test_the_zone_forces_keep_the_resultant_and_moment_of_a_linear_pressure():
+    """A pressure linear over a 4 × 2 contact cut into 0.5 m zones: the sub-contact forces sum to ∫p dA and
+    their moment about the origin is ∫x p dA (both exact: the zones' forces are exact, their centroid
+    moments exact for a linear p to O(h²)… here checked at 1e-3)."""
+    g, pos = _network([_rect_contact(0, 4, 0, 2)], [[0, 0, 1]], 0.5)
+    ns = len(pos)
+    p = 1e5 - 2e4 * g["pos"][:, 0]
+    count = np.bincount(g["srep"], minlength=ns).astype(float)
+    pp, ppf = np.zeros(ns), np.zeros(ns)
+    sub_pressures(g["sknot"], g["srep"], count, np.zeros(ns, np.int64), p, np.zeros(1), np.zeros(ns), g["zk"],
+                  g["zsub"], g["zw"], g["zarea"], pp, ppf)
+    assert ppf.sum() == pytest.approx(2 * (1e5 * 4 - 1e4 * 16), rel=1e-12)
+    assert (ppf * pos[:, 0]).sum() == pytest.approx(2 * (0.5e5 * 16 - 2e4 * 64 / 3), rel=1e-2)

@@ -123,3 +123,16 @@ def test_histories_of_pressure_and_discharge_and_their_save(session, tmp_path):
     # the knot at (0, 1, 0) supplies its share of q = a³ w ΔP / (12 μ L): the middle one of the edge's three
     assert qin.values[-1] == pytest.approx(0.5 * 1e-12 * 2 * 1e5 / (12e-3 * 10), rel=0.02)
     assert qin.values[0] > qin.values[-1]
+
+
+def test_dam_example_with_uplift_from_flow(tmp_path):
+    """examples/water/dam_foundation_flow.dat: the uplift from the steady flow in the base joint, 360 kN
+    undrained and 120 kN with a drain at x = 2 held at 7.5 kPa (the pressure inside the contact reaches the
+    dam through the flow zones' forces); FS (W − U) tan 45° / P = 2.0741 and 2.6667 to the bracket's 0.01."""
+    from conftest import ROOT
+    from dec3d.session import run_deck
+
+    s = run_deck(ROOT / "examples" / "water" / "dam_foundation_flow.dat", out_dir=tmp_path)
+    assert s.variables["uplift_drained"] == pytest.approx(120e3, rel=1e-9)
+    assert s.results["fos.1"] == pytest.approx((1.2e6 - 360e3) / 405e3, abs=0.01)
+    assert s.results["fos.2"] == pytest.approx((1.2e6 - 120e3) / 405e3, abs=0.01)
