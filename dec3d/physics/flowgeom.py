@@ -34,6 +34,10 @@ from scipy.spatial import Delaunay, cKDTree
 from scipy.spatial import QhullError
 
 
+#: the most knots a zone size may make (a guard against a size far too small for the model)
+MAX_KNOTS = 2e6
+
+
 def _axes(n):
     """In-plane unit axes t1, t2 ⟂ n (t1 from the global axis least along n)."""
     e = np.zeros(3)
@@ -135,6 +139,7 @@ def build_geometry(sub_start, sub_count, normal, sc_pos, size: float, tol: float
     contact has no zone); ``srep`` (ns,) the first sub-contact of its contact at the same place (itself when
     none is before it; ``zsub`` names only these)."""
     ns = sc_pos.shape[0]
+    budget = [float(MAX_KNOTS)]
     sknot_local = np.full(ns, -1, dtype=np.int64)
     srep = np.arange(ns, dtype=np.int64)
     allpts, zk_l, zc_l, za_l, zcot_l, zsub_l, zw_l = [], [], [], [], [], [], []
@@ -156,6 +161,11 @@ def build_geometry(sub_start, sub_count, normal, sc_pos, size: float, tol: float
         if cd is None or not len(cd.simplices):
             continue
         if size > 0.0:
+            ext = np.ptp(uv[keep], axis=0)
+            budget[0] -= (ext[0] / size + 2.0) * (ext[1] / size + 2.0)
+            if budget[0] < 0.0:
+                raise ValueError(f"flow zones of {size:g} m would make more than {MAX_KNOTS:.0e} knots: "
+                                 "give a larger `block fluid zone-size`")
             loop = keep[_hull_loop(uv[keep])]
             extra = _refined_points(uv, loop, size, tol)
             if len(extra):

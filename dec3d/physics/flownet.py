@@ -118,8 +118,11 @@ def rebuild(eng, force: bool = False) -> bool:
     if not force and sig == f.get("sig") and st["flowsubs"].n == eng.subcontacts.n:
         return False
     cs, ss = eng.contacts, eng.subcontacts
-    geo = build_geometry(cs["sub_start"], cs["sub_count"], cs["normal"], ss["pos"], float(f["size"]),
-                         float(m.tolerance))
+    try:
+        geo = build_geometry(cs["sub_start"], cs["sub_count"], cs["normal"], ss["pos"], float(f["size"]),
+                             float(m.tolerance))
+    except ValueError as exc:
+        raise CommandError(str(exc)) from None
     kn = st["flowknots"]
     old_pos = kn["pos"].copy()
     old = {k: kn[k].copy() for k in ("pp", "fixed", "p_fixed", "q_in")}
@@ -200,9 +203,26 @@ def to_subcontacts(eng) -> None:
                   zs["zw"], zs["zarea"], ss["pp"], ss["ppf"])
 
 
+def _check(eng) -> None:
+    """The network's indices point at live rows (a restored file could hold anything): else built anew."""
+    st = stores(eng.model)
+    kn, zs, ps, sb = st["flowknots"], st["flowzones"], st["flowpipes"], st["flowsubs"]
+    nk, ns, npipe = kn.n, eng.subcontacts.n, ps.n
+
+    def inside(a, n, low=0):
+        return a.size == 0 or (int(a.min()) >= low and int(a.max()) < n)
+
+    ok = (sb.n == ns and inside(zs["zk"], nk) and inside(zs["zsub"], ns) and inside(zs["zpipe"], npipe, -1)
+          and inside(zs["zcontact"], eng.contacts.n) and inside(ps["pa"], nk) and inside(ps["pb"], nk)
+          and inside(sb["knot"], nk, -1) and inside(sb["rep"], ns) and bool(np.all(sb["count"][sb["rep"]] >= 1)))
+    if not ok:
+        settings(eng.model)["sig"] = ""
+
+
 def after_detection(eng) -> None:
     """Called where the water pressures are worked out (``water.refresh``) while the fluid is active: the
     network follows the contacts and the sub-contacts take the knots' pressures."""
+    _check(eng)
     rebuild(eng)
     to_subcontacts(eng)
 

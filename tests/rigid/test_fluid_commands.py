@@ -136,3 +136,8 @@ def test_dam_example_with_uplift_from_flow(tmp_path):
     assert s.variables["uplift_drained"] == pytest.approx(120e3, rel=1e-9)
     assert s.results["fos.1"] == pytest.approx((1.2e6 - 360e3) / 405e3, abs=0.01)
     assert s.results["fos.2"] == pytest.approx((1.2e6 - 120e3) / 405e3, abs=0.01)
+
+
+def test_a_zone_size_far_too_small_is_refused(session):
+    with pytest.raises(Dec3dError, match="larger `block fluid zone-size`"):
+        _run(session, JOINT + "block fluid zone-size 1e-4\nflowknot apply pore-pressure 1 range position-x 0\n")
