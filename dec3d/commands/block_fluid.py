@@ -78,7 +78,6 @@ def fluid_property(session, call):
     for k in ("bulk", "density", "viscosity"):
         if call.args[k] is not None:
             f[k] = float(call.args[k])
-    f["sig"] = ""                # (the gravity term of the pipes follows the density: built again)
 
 
 @command("block fluid zone-size", positional=[P("size", Num(lo=0), "edge length of the flow zones; 0: the "

@@ -90,7 +90,9 @@ def _signature(eng, f) -> str:
     h = hashlib.sha1()
     for a in (cs["ida"], cs["idb"], cs["sub_count"], ss["kind"], ss["key0"], ss["key1"]):
         h.update(np.ascontiguousarray(a).tobytes())
-    h.update(repr((float(f["size"]), float(eng.model.tolerance))).encode())
+    # (and what the pipes' gravity term and the merging depend on)
+    h.update(repr((float(f["size"]), float(eng.model.tolerance), float(f["density"]),
+                   [float(g) for g in eng.model.settings.gravity])).encode())
     return h.hexdigest()
 
 

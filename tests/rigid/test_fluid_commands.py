@@ -141,3 +141,26 @@ def test_dam_example_with_uplift_from_flow(tmp_path):
 def test_a_zone_size_far_too_small_is_refused(session):
     with pytest.raises(Dec3dError, match="larger `block fluid zone-size`"):
         _run(session, JOINT + "block fluid zone-size 1e-4\nflowknot apply pore-pressure 1 range position-x 0\n")
+
+
+def test_a_vertical_joint_open_at_its_top_holds_water_at_rest(session):
+    """A vertical joint 4 m high held at p = 0 at its top: the steady state is hydrostatic, ρ g (4 − z), once
+    gravity is given (the pipes' gravity term follows `model gravity` given after the network was built)."""
+    deck = """model new
+model configure fluid
+block create brick 0 1 0 1 0 4
+block create brick 1 2 0 1 0 4
+block property density 2000
+block fix
+block contact jmodel assign mohr
+block contact material-table default property stiffness-normal 1e9 stiffness-shear 1e9 friction 30
+block fluid zone-size 1
+flowplane property aperture-initial 1e-4 aperture-minimum 1e-5 aperture-maximum 1e-3
+flowknot apply pore-pressure 0 range position-z 4
+block fluid solve-steady
+"""
+    _run(session, deck)
+    kn = session.model.store("flowknots")
+    assert np.all(kn["pp"] == 0.0)
+    _run(session, "model gravity 0 0 -10\nblock fluid solve-steady\n")
+    assert kn["pp"] == pytest.approx(1000 * 10 * (4 - kn["pos"][:, 2]), abs=1e-6)
