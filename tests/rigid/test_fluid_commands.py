@@ -164,3 +164,29 @@ block fluid solve-steady
     assert np.all(kn["pp"] == 0.0)
     _run(session, "model gravity 0 0 -10\nblock fluid solve-steady\n")
     assert kn["pp"] == pytest.approx(1000 * 10 * (4 - kn["pos"][:, 2]), abs=1e-6)
+
+
+def test_a_zoned_block_takes_the_flow_pressure_on_its_gridpoints(session):
+    """A zoned cube on a fixed rigid base: the sub-contacts at its face gridpoints are the knots (3 × 3); the
+    pressure held on one edge fills the joint and the joint law keeps (σn − p) A."""
+    _run(session, """model new
+model configure fluid
+block create brick 0 1 0 1 0 1
+block create brick 0 1 0 1 1 2
+block property density 2000
+block zone generate edgelength 0.5 range position-z 1 2
+block zone cmodel assign elastic
+block zone property young 1e9 poisson 0.25 density 2000
+model gravity 0 0 -10
+block fix range position-z 0 1
+block contact jmodel assign elastic
+block contact material-table default property stiffness-normal 1e10 stiffness-shear 1e10
+flowplane property aperture-initial 1e-4 aperture-minimum 1e-5 aperture-maximum 1e-3
+flowknot apply pore-pressure 5000 range position-x 0
+model cycle 200
+[pfar = flowknot.pp(flowknot.near(1, 1, 1))]
+[fn = block.contact.force.norm(block.contact.find(1, 2))]
+""")
+    assert session.model.store("flowknots").n == 9
+    assert session.variables["pfar"] == pytest.approx(5000, rel=1e-6)
+    assert session.variables["fn"] == pytest.approx(20000 - 5000, rel=1e-3)
