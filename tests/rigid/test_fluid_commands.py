@@ -190,3 +190,17 @@ model cycle 200
     assert session.model.store("flowknots").n == 9
     assert session.variables["pfar"] == pytest.approx(5000, rel=1e-6)
     assert session.variables["fn"] == pytest.approx(20000 - 5000, rel=1e-3)
+
+
+def test_an_inflow_at_one_end_raises_the_pressure_by_the_cubic_law(session):
+    """1e-6 m³/s put in at x = 0 (half at each of its two knots), the far end held at 0: steady
+    p(0) = Q 12 μ L / (a³ w) = 6e4 Pa; `flowknot apply-remove` takes the inflow away again."""
+    _run(session, JOINT + "flowknot apply discharge 0.5e-6 range position-x 0\n"
+                          "flowknot apply pore-pressure 0 range position-x 10\nblock fluid solve-steady\n"
+                          "[p0 = flowknot.pp(flowknot.near(0, 0, 0))]\n[q0 = flowknot.discharge(flowknot.near(0, 0, 0))]\n"
+                          "flowknot apply-remove range position-x 0\nblock fluid solve-steady\n"
+                          "[p1 = flowknot.pp(flowknot.near(0, 0, 0))]\n")
+    v = session.variables
+    assert v["p0"] == pytest.approx(1e-6 * 12e-3 * 10 / (1e-12 * 2), rel=1e-9)
+    assert v["q0"] == pytest.approx(0.5e-6, rel=1e-12)
+    assert v["p1"] == pytest.approx(0.0, abs=1e-6)
