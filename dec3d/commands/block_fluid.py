@@ -113,7 +113,7 @@ def fluid_solve_steady(session, call):
                                                                      "left as they were" if left else ""))
 
 
-@command("block fluid list", doc="Print the fluid settings and the size of the flow network.",
+@command("block fluid list", doc="Print the fluid settings, the size of the flow network and its stable time step.",
          examples=["block fluid list"])
 def fluid_list(session, call):
     _need_fluid(session, call)
@@ -121,10 +121,11 @@ def fluid_list(session, call):
     f = F.settings(m)
     nk = m.store("flowknots").n if "flowknots" in m.stores else 0
     npipe = m.store("flowpipes").n if "flowpipes" in m.stores else 0
+    dt = F.stable_step(engine(m)) if nk else float("inf")
     session.write(f"fluid: {'active' if f['active'] else 'inactive'}, density {f['density']:g} kg/m³, viscosity "
                   f"{f['viscosity']:g} Pa s, bulk {f['bulk']:g} Pa, zone size {f['size']:g} m, apertures "
                   f"(initial, minimum, maximum) {f['aperture'][0]:g} {f['aperture'][1]:g} {f['aperture'][2]:g} m; "
-                  f"{nk} knots, {npipe} pipes")
+                  f"{nk} knots, {npipe} pipes, stable flow step {dt:.4g} s (each mechanical step takes as many)")
 
 
 def _check_aperture(call):

@@ -238,6 +238,15 @@ def _supply(kn, ps) -> None:
     kn["supply"][...] = np.where(kn["fixed"] != 0, net, kn["q_in"])
 
 
+def stable_step(eng) -> float:
+    """The stable explicit flow step of the network as it is now [s] (inf without pipes)."""
+    st = stores(eng.model)
+    kn, ps = st["flowknots"], st["flowpipes"]
+    update(eng)
+    return float(stable_dt(ps["pa"], ps["pb"], ps["c"], kn["vol"], float(settings(eng.model)["bulk"]),
+                           kn["fixed"] != 0))
+
+
 def advance(eng, span: float) -> int:
     """Transient flow over ``span`` seconds: explicit steps of at most the stable Δt (never larger: a step
     too large is reduced). Returns the flow steps taken."""
