@@ -209,5 +209,4 @@ def test_an_inflow_at_one_end_raises_the_pressure_by_the_cubic_law(session):
 def test_fluid_list_prints_the_network_and_its_stable_step(session):
     _run(session, JOINT + "flowknot apply pore-pressure 0 range position-x 10\nblock fluid list\n")
     text = session.output.getvalue()
-    # 0.5 V / (K_w Σc) at the free knots: V = a A/3 (one triangle) or 2 a A/3, Σc = T (w/L + L/w)/2 + …
     assert "4 knots, 5 pipes, stable flow step" in text
