@@ -209,4 +209,7 @@ def test_an_inflow_at_one_end_raises_the_pressure_by_the_cubic_law(session):
 def test_fluid_list_prints_the_network_and_its_stable_step(session):
     _run(session, JOINT + "flowknot apply pore-pressure 0 range position-x 10\nblock fluid list\n")
     text = session.output.getvalue()
-    assert "4 knots, 5 pipes, stable flow step" in text
+    # 0.5 V / (K_w Σc) at the free knot of x = 0 off the diagonal: V = a (wL/2)/3, Σc = T (w/(2L) + L/(2w))
+    t = 1e-12 / 12e-3
+    want = 0.5 * (1e-4 * 10 / 3) / (2e9 * t * (0.1 + 2.5))
+    assert f"4 knots, 5 pipes, stable flow step {want:.4g} s" in text
