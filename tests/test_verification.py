@@ -32,7 +32,9 @@ def test_every_verification_problem_is_there():
                                          "D13_drucker_prager_triaxial", "D14_anisotropic_elastic",
                                          "SE1_cable_pullout", "SE2_bolted_planar_slide", "SE3_cable_pullout_confined",
                                          "SE4_dowel_shear", "SE5_beam", "SE6_dowel_slide_fos",
-                                         "W1_planar_slide_water", "W2_wedge_water", "W3_joint_opening"}
+                                         "W1_planar_slide_water", "W2_wedge_water", "W3_joint_opening",
+                                         "W4_steady_joint_flow", "W5_transient_joint_diffusion",
+                                         "W6_joint_opening_flow"}
 
 
 def _demo(tmp_path, expects: str):

@@ -48,7 +48,9 @@ def _check_configure(call):
              "of threads the calculation uses.",
          details="Options: " + ", ".join(CONFIGURE_OPTIONS) + ". Each is recorded once, in the order given; "
                  "the engine reads them (dynamic: recorded only, dynamic mode is `model dynamic active on`; highorder: 10-node "
-                 "tetrahedra; feblock: 20-node brick FE blocks). `threads n` sets how many threads the parallel "
+                 "tetrahedra; feblock: 20-node brick FE blocks; fluid: flow in the joints, every contact a flow "
+                 "plane, on until `model fluid active off` — see `block fluid property`, `flowplane property`, "
+                 "`flowknot apply`). `threads n` sets how many threads the parallel "
                  "kernels (contact forces, motion, point updates) use from now on, at most the number of cores "
                  "(numba's NUMBA_NUM_THREADS); `threads` alone prints the count. The environment variable "
                  "DEC3D_THREADS sets it when dec3d starts. It is a setting of the program, not of the model "

@@ -520,3 +520,4 @@ from . import struct_intrinsics  # noqa: E402,F401  (registers struct.cable.*, s
 from . import extra_intrinsics  # noqa: E402,F401  (registers block.extra, block.gp.extra, block.gp.dsf)
 from . import file_intrinsics  # noqa: E402,F401  (registers file.open/read/write/close)
 from . import dfn_intrinsics  # noqa: E402,F401  (registers fracture.*)
+from . import flow_intrinsics  # noqa: E402,F401  (registers flowknot.*, block.contact.flow.*)

@@ -62,6 +62,13 @@ def contact_point_data(model) -> tuple[np.ndarray, dict]:
     if "pp" in s:           # pore pressure [Pa] and its force on the faces [N] (physics.water)
         data["pore_pressure"] = s["pp"][rows]
         data["pore_force"] = s["ppf"][rows]
+    if "flowzones" in model.stores and model.store("flowzones").n:
+        # flow in the joints (physics.flownet): each contact's mean knot pressure [Pa], hydraulic aperture [m]
+        # and flow rate per unit width [m²/s], on each of its sub-contacts
+        from dec3d.io.flowvalues import contact_values
+
+        fp, fa, fq = contact_values(model)
+        data["flow_pressure"], data["hydraulic_aperture"], data["flow_rate"] = fp[ci], fa[ci], fq[ci]
     if "hist" in s:
         # a history entry named as an array above (softening-mohr's `slip`, its slip displacement) keeps the
         # array and is written as `<name>_history`

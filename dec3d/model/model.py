@@ -122,7 +122,7 @@ def _face_fields() -> dict[str, Field]:
 #: other names by which commands and ranges refer to stores
 STORE_ALIASES = {"block": "blocks", "vertex": "vertices", "gridpoint": "vertices",
                  "face": "faces", "contact": "contacts", "subcontact": "subcontacts",
-                 "zone": "zones"}
+                 "zone": "zones", "flowknot": "flowknots"}
 
 
 class Model:

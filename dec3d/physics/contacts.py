@@ -411,6 +411,10 @@ class ContactDetection:
         group[old] = cs["group"][prev_c[old]]
         pp_apply = np.zeros(nc)
         pp_apply[old] = cs["pp_apply"][prev_c[old]]
+        extra = {}
+        if "aperture" in cs:                       # a flow plane's own apertures (physics.flownet)
+            extra["aperture"] = np.full((nc, 3), -1.0)
+            extra["aperture"][old] = cs["aperture"][prev_c[old]]
         if s.get("mtables") and not old.all():      # `block contact material-table add` entries
             apply_material_tables(m, s["mtables"], ~old, ra_c, rb_c, jcode, prop, own)
         # sub-contacts of the recomputed contacts (zero-area ones carry nothing and are dropped)
@@ -488,7 +492,7 @@ class ContactDetection:
         values = {"ida": ids[ra_c], "idb": ids[rb_c], "a": ra_c, "b": rb_c, "pos": cpos, "normal": normal,
                   "gap": cgap, "type": ctyp, "jmodel": jcode, "prop": prop, "own_props": own, "sub_start": starts,
                   "sub_count": counts, "group": group, "ref_ca": ref_ca, "ref_cb": ref_cb, "ref_ta": ref_ta,
-                  "ref_tb": ref_tb, "pp_apply": pp_apply}
+                  "ref_tb": ref_tb, "pp_apply": pp_apply, **extra}
         rows_new = cs.blank(nc, values)         # (the other fields get their fill value)
         for key, val in values.items():
             rows_new[key][:nc] = val

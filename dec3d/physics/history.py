@@ -16,6 +16,7 @@ import numpy as np
 from dec3d.errors import CommandError
 from dec3d.io.state import register_known
 from dec3d.model.kinematics import block_rotation, unwrap_rotation
+from .flownet import FLOWKNOT_QUANTITIES, flowknot_history
 
 _XYZ = (("", None), ("-x", 0), ("-y", 1), ("-z", 2))
 #: block quantity -> (engine field, component or None for the magnitude)
@@ -206,6 +207,9 @@ class HistorySet:
                     isinstance(x, int) and not isinstance(x, bool) for x in pair)):
                 raise ValueError(f"history {hid}: `pair` is not two block ids")
             h = self.add_contact(q, pos, name, pair=tuple(pair) if pair else None)
+        elif kind == "flowknot" and q in FLOWKNOT_QUANTITIES:
+            label, value, fspec = flowknot_history(self.model, q, num_list("position", 3))
+            h = self.add(label, value, name, fspec)
         elif kind == "rotation" and q in ROTATION_QUANTITIES:
             prev = None if spec.get("prev") is None else num_list("prev", 3)
             h = self.add_rotation(q, block_id(), name, prev=prev)

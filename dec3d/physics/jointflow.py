@@ -1,4 +1,4 @@
-"""Flow in the joints, steady state (groundwork of issue 29 item 2; not wired to commands yet).
+"""Flow in the joints, steady state (`block fluid solve-steady`, ``physics.flownet``).
 
 The network (``kernels.jointflow``: knots with pressure boundaries and inflows, pipes with the cubic-law
 conductance) at steady state: Σ_k c_k (p_i − p_j) = q_in_i at every unfixed knot, p held at the fixed ones.
@@ -31,16 +31,21 @@ def conductance(a, width, length, viscosity: float) -> np.ndarray:
     return a ** 3 * np.asarray(width, dtype=float) / (12.0 * viscosity * np.asarray(length, dtype=float))
 
 
-def steady(nk: int, pa, pb, c, fixed, p_fixed, q_in=None):
+def steady(nk: int, pa, pb, c, fixed, p_fixed, q_in=None, dg=None):
     """Steady pressures (nk,) [Pa] and pipe flows [m³/s] (from pa to pb). ``fixed`` (nk,) bool, ``p_fixed``
-    the pressures there; ``q_in`` (nk,) inflows at the others (default none). A part of the network with
-    no fixed knot makes the system singular: refused."""
+    the pressures there; ``q_in`` (nk,) inflows at the others (default none); ``dg`` (npipe,) the gravity term
+    of each pipe (Q = c (p_a − p_b + dg), ``kernels.jointflow.network_steps``; default none). A part of the
+    network with no fixed knot makes the system singular: refused."""
     pa = np.asarray(pa, dtype=np.int64)
     pb = np.asarray(pb, dtype=np.int64)
     c = np.asarray(c, dtype=float)
     fixed = np.asarray(fixed, dtype=bool)
     p = np.where(fixed, np.asarray(p_fixed, dtype=float), 0.0)
-    q = np.zeros(nk) if q_in is None else np.asarray(q_in, dtype=float)
+    q = np.zeros(nk) if q_in is None else np.array(q_in, dtype=float)
+    g = np.zeros(len(c)) if dg is None else np.asarray(dg, dtype=float)
+    if dg is not None:
+        np.add.at(q, pa, -c * g)
+        np.add.at(q, pb, c * g)
     if not fixed.any():
         raise ValueError("the network has no pressure boundary")
     rows = np.concatenate((pa, pb, pa, pb))
@@ -56,4 +61,4 @@ def steady(nk: int, pa, pb, c, fixed, p_fixed, q_in=None):
         if not np.all(np.isfinite(x)):
             raise ValueError("a part of the network has no pressure boundary")
         p[free] = x
-    return p, c * (p[pa] - p[pb])
+    return p, c * (p[pa] - p[pb] + g)

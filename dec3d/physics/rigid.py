@@ -447,6 +447,9 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
                 # (to_arrays gives views where it can: copy them)
                 "contacts": {k: a.copy() for k, a in self.contacts.to_arrays().items()},
                 "subcontacts": {k: a.copy() for k, a in self.subcontacts.to_arrays().items()},
+                # the flow network (physics.flownet): rebuilt in a run, so its row counts too
+                "flow": {n: {k: a.copy() for k, a in m.stores[n].to_arrays().items()}
+                         for n in ("flowknots", "flowzones", "flowpipes", "flowsubs") if n in m.stores},
                 "mech": copy.deepcopy(m.settings.mechanical), "time": m.time, "step": m.step,
                 "engine": (self.dt, self.kinetic, self._cand, self._criteria),
                 "histories": [(h, len(h.steps), len(h.times), len(h.values)) for h in (hs.items if hs else [])]}
@@ -467,6 +470,8 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
                 m.stores[n].full(k)[: len(a)] = a
         self.contacts.load_arrays(snap["contacts"])
         self.subcontacts.load_arrays(snap["subcontacts"])
+        for n, arrays in snap.get("flow", {}).items():
+            m.stores[n].load_arrays(arrays)
         mechanical = m.settings.mechanical
         mechanical.clear()
         mechanical.update(snap["mech"])
@@ -521,7 +526,7 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
                     else:
                         self.detect()
                         run.detected()
-                k = min(nsteps - run.done, interval - m.step % interval)
+                k = min(nsteps - run.done, interval - m.step % interval, run.fluid_cap)
                 for h in self.step_hooks:
                     hi = int(getattr(h, "interval", 0) or 0)
                     if hi > 0:

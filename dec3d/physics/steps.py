@@ -38,6 +38,8 @@ from .mixedcontacts import _deformable
 from .rigid import RigidEngine, RunError, _has_gridpoints
 from .runcontrol import _Progress, _StopFlag
 from .water import refresh_if_stale
+from .flownet import active as fluid_active, advance as fluid_advance, after_detection as fluid_after_detection
+from .flownet import to_subcontacts as fluid_to_subcontacts
 
 _F = np.float64
 _I = np.int64
@@ -157,6 +159,13 @@ class _Run:
             self.wsub, self.wcon = eng._mixed_weights(self.zst, recompute=not between)
         history_columns(eng.subcontacts, eng.contacts["jmodel"])   # (a restored or edited model)
         refresh_if_stale(eng)              # pore pressures (physics.water) after a change of their sources
+        #: steps per batch at most: 1 while flow in the joints is coupled to moving blocks (physics.flownet)
+        self.fluid_cap = 2 ** 62
+        if fluid_active(m):
+            fluid_after_detection(eng)
+            self.steps.insert(self.steps.index(next(s for s in self.steps if isinstance(s, Clock))), FluidStep(self))
+            moving = self.zoned or bool(np.any((self.fixity[~b["hidden"]] & 7) != 7))
+            self.fluid_cap = 1 if moving else 2 ** 62
         bad = eng.property_problem()
         if bad:
             raise RunError(bad)
@@ -473,6 +482,17 @@ class ZoneStep(_Step):
         zb = zst.blocks
         r.b["force"][zb] = 0.0
         r.b["moment"][zb] = 0.0
+        return n
+
+
+class FluidStep(_Step):
+    """Flow in the joints over the batch's time (``physics.flownet.advance``: apertures from the normal
+    displacements, explicit flow steps within the stable Δt), then the knot pressures to the sub-contacts."""
+
+    def advance(self, n: int) -> int:
+        r = self.run
+        fluid_advance(r.eng, n * r.dt)
+        fluid_to_subcontacts(r.eng)
         return n
 
 

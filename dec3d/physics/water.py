@@ -78,6 +78,14 @@ def refresh(eng) -> None:
     detection and by the commands that change a source."""
     m = eng.model
     ss = eng.subcontacts
+    if "fluid" in m.settings.configure:
+        from .flownet import active, after_detection
+        if active(m):
+            after_detection(eng)        # (the flow knots' pressures: physics.flownet)
+            return
+        if "pp" in ss and ss.n:         # (flow switched off: the flow pressures go, the sources' come back)
+            ss["pp"][...] = 0.0
+            ss["ppf"][...] = 0.0
     if not isinstance(m.settings.mechanical.get("water"), dict):
         return                  # (a dry model: nothing was ever set, the pressures are the fields' zeros)
     if "pp" not in ss or not has_water(m):
