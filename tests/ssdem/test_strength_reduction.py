@@ -101,3 +101,54 @@ def test_bracket_grows_down_and_up_from_the_guess():
     assert up["fs"] == down["fs"]
     assert up["trials"][0] == (1.2, True) and down["trials"][0] == (1.8, False)
     assert all(np.isclose(f * 200, round(f * 200)) for f, _ in up["trials"] + down["trials"])
+
+
+def test_a_slope_that_fails_at_full_strength_gets_its_fs_from_the_limit_state(tmp_path):
+    """c' = 2 kPa: the small slope cannot hold its weight (Bishop on the circle 0.961), so the
+    secant iteration at full strength has no equilibrium to settle on and Eq. 2.6 no converged
+    state.  The analysis brackets the strength factor F (c', tan phi' / F) at which it stops
+    holding and evaluates Eq. 2.6 with the full strengths on the converged state at the
+    largest F that holds.  Checked here by hand: the bracket with an independent run of the
+    load history, Eq. 2.6 from that run's stresses (perfectly plastic: tau_f = c' + sigma' tan phi')."""
+    from dec3d.ssdem.readers.toml_input import read_toml
+    prob = read_toml(Path("small.toml"), text=SMALL.format(extra="").replace("c = 10.0", "c = 2.0"))
+    an = run_problem(prob, compare_bishop=True)
+    q = summary_numbers(an)
+    assert an.limit["full_strength"] == "unstable blocks at step 4"   # a mechanism at F = 1
+    st = an.limit["state"]
+    lo, hi = st["factor"], st["fails_at"]
+    assert hi == pytest.approx(lo + 0.005) and hi <= 1.0
+    assert holds_by_hand(prob, lo) and not holds_by_hand(prob, hi)
+    # Eq. 2.6 by hand on the state at F = lo, full strengths
+    itf = prob.interfaces
+    saved = itf.c_p, itf.c_r, itf.tan_p, itf.tan_r
+    try:
+        itf.c_p, itf.c_r, itf.tan_p, itf.tan_r = (v / lo for v in saved)
+        run = solve.run(prob)
+    finally:
+        itf.c_p, itf.c_r, itf.tan_p, itf.tan_r = saved
+    on = itf.on_surface
+    sig = -run.kn * run.rel[:, 0]
+    tau = run.ks * run.rel[:, 1]
+    tau_f = np.maximum(saved[0] + sig * saved[2], 0.0)
+    by_hand = np.sum((tau_f * itf.length)[on]) / np.sum((np.abs(tau) * itf.length)[on])
+    assert q["fs_dem"] == pytest.approx(by_hand, rel=1e-9)
+    # every spring held within its reduced strength, so the full strengths give at least F
+    assert q["fs_dem"] >= lo
+    # both limit factors on one circle: within 1 % of Bishop's
+    assert q["fs_dem"] == pytest.approx(q["fs_bishop"], rel=0.01)
+    assert q["limit_holds_at"] == lo and q["limit_fails_at"] == hi
+    assert q["fs_dem_full_strength"] == an.safety.fs_global
+    from dec3d.ssdem.report import summary_text
+    text = summary_text(an)
+    assert "the slope does not hold at full strength: " in text
+    assert f"holds (converged in every step) at F = {lo:.3f} and not at F = {hi:.3f}" in text
+    assert f"Eq. 2.6) at the limit state: {q['fs_dem']:.3f}" in text
+
+
+def test_a_slope_that_holds_has_no_limit_search():
+    from dec3d.ssdem.readers.toml_input import read_toml
+    prob = read_toml(Path("small.toml"), text=SMALL.format(extra=""))
+    an = run_problem(prob)
+    assert an.limit is None and an.reduction is None
+    assert summary_numbers(an)["fs_dem"] == an.safety.fs_global
