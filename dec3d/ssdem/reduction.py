@@ -124,7 +124,8 @@ def limit_state(prob: Problem, search_result: dict) -> dict | None:
     instead on the converged state nearest to failure: the run with c' and tan(phi')
     divided by F_hold, the largest factor on the search grid that holds; the stresses are
     that run's, the strengths the full ones, so FS = sum(tau_f L) / sum(tau_mob L) >= F_hold
-    (every spring is within its reduced strength, tau_mob <= tau_f / F_hold).
+    (1 - tol) (every spring is within its reduced strength, tau_mob <= tau_f / F_hold, to the
+    iteration's tolerance tol).
     Returns None when no factor holds.
     """
     from . import safety                    # safety imports solve; imported here to keep reduction light

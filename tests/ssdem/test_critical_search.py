@@ -58,15 +58,16 @@ def test_acads_1a_dem_fs_at_its_limit(acads):
     0.991 from that unconverged state).  The analysis brackets the strength factor F at
     which the static DEM stops holding and evaluates Eq. 2.6 on the converged state at the
     largest F that holds.  Properties: FS >= that F (every spring is within its reduced
-    strength) and, the surface being fully mobilised at the limit, FS <= the F that fails;
-    both are limit-state factors on one circle, so FS lies within 1 % of Bishop's.  (With
+    strength, to the iteration's tolerance) and, the surface being fully mobilised at the
+    limit, FS <= the F that fails; both are limit-state factors on one circle, so FS lies
+    within 1 % of Bishop's.  (With
     the default 200 iterations per step the bracket is 0.980-0.985, the failing side being
     "no convergence"; with 2000 it is proven, 0.990-0.995 by a mechanism: docs/ssdem.md.)"""
     _, an = acads
     q = summary_numbers(an)
     lim = an.limit["state"]
     assert q["converged"] == 0.0 and lim is not None
-    assert lim["factor"] <= q["fs_dem"] <= lim["fails_at"]
+    assert lim["factor"] * (1 - 1e-3) <= q["fs_dem"] <= lim["fails_at"]      # 1e-3: the tolerance
     assert q["fs_dem"] == pytest.approx(an.bishop["on_surface"]["fs"], rel=0.01)
 
 
