@@ -130,3 +130,13 @@ def test_convergence_measure_is_the_overshoot_of_the_strength():
     # an inactive (removed) interface and a spring with no stiffness left do not count
     assert solve.stiffness_change(ks_old, ks_new, np.array([True, False])) == pytest.approx(1 - 1 / 1.0005)
     assert solve.stiffness_change(np.array([0.0]), np.array([0.0]), np.array([True])) == 0.0
+
+
+def test_blocks_freed_by_a_tension_crack_get_no_limit_search():
+    """A removal after a tension crack is the thesis's own outcome; dividing the strength
+    does not close the crack, so no strength-factor bracket is searched (analysis.run_problem)."""
+    from dec3d.ssdem.analysis import run_problem
+    p = two_block(up=6e3, kn=1e6, ks=1e6, c=20e3, phi=30, tensile=5e3, cutoff=True, n_steps=2)
+    an = run_problem(p)
+    assert an.state.removed[1] and an.state.cracked.all()
+    assert an.limit is None
