@@ -8,7 +8,12 @@ history.  It *holds* when every load step converges and no block becomes unstabl
 it *fails* otherwise (a secant iteration that does not settle within max_iterations,
 or a mechanism found by the pivot test).  F is searched on a grid of `step` (0.005):
 a bracket is grown from a first guess (Bishop's FS when known, else 1), then bisected, so that the result F_s is the smallest
-grid value that fails while F_s - step holds.  Both trials are reported.
+grid value that fails while F_s - step holds.  Both trials are reported, with what the
+failing one rests on (unstable blocks: a mechanism, a proof; or no convergence within
+max_iterations: none).
+
+The same search brackets the limit of a slope that does not hold at full strength;
+limit_state() evaluates the DEM factor of safety (Eq. 2.6) there (analysis.run_problem).
 """
 from __future__ import annotations
 
@@ -17,7 +22,7 @@ import math
 
 import numpy as np
 
-from . import solve
+from . import safety, solve
 from .model import Problem
 
 STEP = 0.005          # resolution of the reduction factor
@@ -128,8 +133,6 @@ def limit_state(prob: Problem, search_result: dict) -> dict | None:
     iteration's tolerance tol).
     Returns None when no factor holds.
     """
-    from . import safety                    # safety imports solve; imported here to keep reduction light
-
     f = search_result.get("holds_at")
     if f is None:
         return None
