@@ -239,6 +239,11 @@ class _Relaxation:
         st.ks = st.ks.copy()
         st.ks[mask] = prev[mask] * (st.ks[mask] / prev[mask]) ** self.omega
 
+    def undo(self, st: State) -> None:
+        """Drop an extrapolation not yet checked by a solve."""
+        if self.base is not None:
+            st.ks, self.base = self.base, None
+
     def overshot(self, prob: Problem, st: State, sig_eff: np.ndarray, active: np.ndarray) -> bool:
         """After the solve with extrapolated springs: True (and the plain springs restored)
         when an extrapolated spring's law asks for more stiffness than it was given."""
@@ -302,6 +307,7 @@ def run(prob: Problem, progress=None, stop_on_failure: bool = False) -> State:
                 converged = True
                 break
             relax.extrapolate(prob, st, change, active, plain=not fresh)
+        relax.undo(st)                    # out of iterations: keep the plain update's springs
         if step == cfg.n_steps:
             # the last update changed the springs a little: re-solve so that the reported
             # displacements and stresses belong to the final springs
