@@ -20,7 +20,7 @@ def test_problem_meets_its_bar(folder):
 def test_every_verification_problem_is_there():
     assert {f.name for f in FOLDERS} >= {"R1_inclined_plane", "R2_wedge", "R3_block_on_spring", "R4_bounce",
                                          "R5_stack", "R6_joint_shear", "R7_spinning_block",
-                                         "S1_fredlund_krahn_slope", "S1_ru025", "S2_kim_dam",
+                                         "S1_fredlund_krahn_slope", "S1_ru025", "S2_kim_dam", "S3_acads_1a",
                                          "D1_uniaxial_tet", "D1_uniaxial_hex", "D1_uniaxial_ho", "D2_self_weight",
                                          "D3_elastic_hole_tet", "D3_elastic_hole_hex", "D3_elastic_hole_ho",
                                          "D4_triaxial", "D5_strip_footing", "D6_mohr_hole", "D7_rigid_on_deformable",

@@ -18,7 +18,9 @@ class Analysis:
     state: solve.State
     safety: safety.Safety
     bishop: dict | None = None
-    reduction: dict | None = None     # strength-reduction search (reduction.search)
+    reduction: dict | None = None     # strength-reduction search (reduction.search), when asked for
+    limit: dict | None = None         # the run does not hold at full strength: the bracket and the
+                                      # FS at the limit state (reduction.limit_state), see run_problem
     timings: dict = field(default_factory=dict)
 
 
@@ -45,8 +47,18 @@ def run_problem(prob: Problem, compare_bishop: bool = False, progress=None,
     if compare_bishop:
         out.bishop = compare(prob, saf)
     t3 = time.perf_counter()
+    fails = reduction.verdict(prob, st)
+    if fails.startswith("unstable") and st.cracked.any():
+        fails = ""      # blocks freed by tension cracks: the thesis's own outcome, no strength factor helps
+    search = None
+    if strength_reduction or prob.settings.strength_reduction or fails:
+        search = reduction.search(prob, guess=_guess(prob, out.bishop), progress=reduction_progress)
     if strength_reduction or prob.settings.strength_reduction:
-        out.reduction = reduction.search(prob, guess=_guess(prob, out.bishop), progress=reduction_progress)
+        out.reduction = search
+    if fails:
+        # no converged state at full strength for Eq. 2.6: bracket the strength factor at
+        # which the slope stops holding and evaluate Eq. 2.6 at the last state that holds
+        out.limit = dict(full_strength=fails, bracket=search, state=reduction.limit_state(prob, search))
     out.timings = dict(solve=t2 - t1, post=t3 - t2, reduction=time.perf_counter() - t3,
                        per_step=(t2 - t1) / max(prob.settings.n_steps, 1))
     return out
@@ -96,7 +108,10 @@ def compare(prob: Problem, saf: safety.Safety) -> dict:
 def summary_numbers(an: Analysis) -> dict:
     """The headline quantities (also what verify.quantities returns)."""
     s = an.safety
-    q = dict(fs_dem=s.fs_global, fs_dem_mean=s.fs_mean, n_surface=float(s.n_averaged),
+    lim = (an.limit or {}).get("state")
+    q = dict(fs_dem=s.fs_global if lim is None else lim["fs_dem"],
+             fs_dem_mean=s.fs_mean if lim is None else lim["fs_dem_mean"],
+             n_surface=float(s.n_averaged if lim is None else lim["n_averaged"]),
              n_unstable=float(an.state.removed.sum()), n_yielded=float(np.sum(s.state == safety.YIELDED)),
              n_cracked=float(np.sum(s.state == safety.CRACKED)),
              converged=float(all(r.converged for r in an.state.steps)),
@@ -110,4 +125,8 @@ def summary_numbers(an: Analysis) -> dict:
             q["fs_bishop_min"] = b["search"]["fs"]
     if an.reduction is not None and an.reduction.get("fs") is not None:
         q["fs_reduction"] = an.reduction["fs"]
+    if lim is not None:
+        q["fs_dem_full_strength"] = s.fs_global          # on the state the run stopped in: not converged
+        q["limit_holds_at"] = lim["factor"]
+        q["limit_fails_at"] = lim["fails_at"]
     return q

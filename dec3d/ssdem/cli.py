@@ -53,8 +53,9 @@ def _positive_int(text: str) -> int:
 
 
 def _trial_line(factor: float, held: bool) -> None:
-    """One line per strength-reduction trial (each is a full analysis)."""
-    print(f"strength reduction: F = {factor:.3f} {'holds' if held else 'fails'}", flush=True)
+    """One line per trial of the strength factor (each is a full analysis): the strength
+    reduction, or the limit bracket of a slope that does not hold at full strength."""
+    print(f"strength factor trial: c', tan phi' / {factor:.3f} {'holds' if held else 'fails'}", flush=True)
 
 
 def _error(message: str) -> int:

@@ -92,7 +92,7 @@ class Settings:
     """How the analysis runs.
 
     n_steps: load increments to full load ("iterations" in the thesis)
-    tol: convergence when max |k_s change| / k_s0 < tol in a step
+    tol: convergence when max |k_s change| / k_s (the current secant) < tol in a step
     max_iter: secant iterations per load step before giving up on the step
     ru, ru_mode: pore pressure ratio and its meaning ("standard": u = r_u*gamma*h
         is in Interfaces.u_pore; "listing": sigma'_n = (1 - r_u)*sigma_n)

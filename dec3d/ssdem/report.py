@@ -93,8 +93,10 @@ def summary_text(an: Analysis) -> str:
     out.append(f"failure surface: {kinds[s.surface_kind]}; {len(ids)} interfaces, {s.n_averaged} carry stress and are averaged")
     if len(ids):
         out.append("  interfaces: " + " ".join(map(str, ids[:200])) + (" ..." if len(ids) > 200 else ""))
-    out.append(f"FS (static DEM, shear-force weighted average = Eq. 2.6): {_num(q['fs_dem'])}")
-    out.append(f"FS (static DEM, arithmetic mean of interface FS, thesis App. C): {_num(q['fs_dem_mean'])}")
+    out.extend(_limit_lines(an))
+    at = " at the limit state" if (an.limit or {}).get("state") else ""
+    out.append(f"FS (static DEM, shear-force weighted average = Eq. 2.6){at}: {_num(q['fs_dem'])}")
+    out.append(f"FS (static DEM, arithmetic mean of interface FS, thesis App. C){at}: {_num(q['fs_dem_mean'])}")
     if s.surface_kind == "yield":
         out.append("  (a yielded interface carries its full strength, so an average over yielded interfaces is 1 "
                    "by construction; for the safety of a stable slope give a [surface] - a trial or the critical circle)")
@@ -129,6 +131,26 @@ def summary_text(an: Analysis) -> str:
     return "\n".join(out) + "\n"
 
 
+def _limit_lines(an: Analysis) -> list[str]:
+    """What the summary says when the run does not hold at full strength (analysis.run_problem)."""
+    lim = an.limit
+    if lim is None:
+        return []
+    out = [f"the slope does not hold at full strength: {lim['full_strength']}"]
+    b, st = lim["bracket"], lim["state"]
+    if st is None:
+        out.append(f"  no strength factor found at which it holds: {b.get('reason', '')}; the FS below is on "
+                   "the state the run stopped in")
+        return out
+    proof = "a mechanism: proven" if st["failure_proven"] else "not proven: a larger [analysis] max_iterations may settle it"
+    out.append(f"  with c' and tan phi' divided by F it holds (converged in every step) at F = {st['factor']:.3f} "
+               f"and not at F = {st['fails_at']:.3f} ({st['fails_because']}; {proof})")
+    out.append(f"  FS below: Eq. 2.6 with the full strengths on the converged state at F = {st['factor']:.3f} "
+               f"(iterations per step {st['iterations']}); on the state the full-strength run stopped in it is "
+               f"{_num(an.safety.fs_global)}; the files hold that state")
+    return out
+
+
 def _num(v) -> str:
     return "n/a" if v is None or not np.isfinite(v) else f"{v:.3f}"
 
@@ -145,7 +167,7 @@ def record(an: Analysis) -> dict:
                              averaged=int(an.safety.n_averaged),
                              definition="fs_dem = sum(tau_available*L)/sum(tau_mobilised*L) over the failure surface"),
         steps=[vars(r) for r in st.steps], unstable_blocks=np.flatnonzero(st.removed),
-        bishop=an.bishop, strength_reduction=an.reduction, surface=p.surface, notes=p.notes,
+        bishop=an.bishop, strength_reduction=an.reduction, limit=an.limit, surface=p.surface, notes=p.notes,
         blocks=blocks, interfaces=interfaces,
     ))
 

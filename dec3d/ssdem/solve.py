@@ -7,7 +7,15 @@
             solve K u = (k/n) f  (total load: secant stiffness relates totals)
             interface stresses -> spring laws -> new k_n, k_s (never larger)
             now and then, and at convergence: the mechanism test on the tangent matrix
-        until max |k_s change| / k_s0 < tol, nothing new cracked or was removed
+        until max |k_s change| / k_s < tol, nothing new cracked or was removed
+
+The change is measured against the spring's current stiffness, not its initial one
+(thesis Sec. 4.1.4: "changes in boundary stiffness less than a user defined value").
+(k_s,old - k_s,new) / k_s,old = 1 - tau_strength / tau_trial is the fraction by which the
+shear stress of the last solve exceeds the strength: converged means every spring is
+within `tol` of its law.  Measured against k_s0 instead, a spring already softened a
+hundredfold would count its changes a hundred times smaller, and a block creeping
+towards a mechanism (its secant falling like 1/slip) would pass for converged.
 
 Two rank tests find instability (thesis Sec. 3.2.2):
   * the secant matrix: a floating block (no spring left to a fixed one), or a DOF
@@ -33,6 +41,8 @@ from .model import Problem
 
 #: secant iterations between two mechanism (tangent matrix) tests in a step
 TANGENT_EVERY = 10
+#: largest over-relaxation of a secant update (_Relaxation); 1 turns it off
+OMEGA_MAX = 64.0
 
 
 @dataclass
@@ -60,6 +70,7 @@ class State:
     u: np.ndarray
     rel: np.ndarray
     plastic: np.ndarray
+    ks_before: np.ndarray = None      # k_s before the last update (the over-relaxation needs it)
     load: float = 0.0
     steps: list = field(default_factory=list)
     factorizations: int = 0
@@ -162,6 +173,13 @@ def _mechanisms(prob, st, Ta, Tb, step, cache) -> int:
     return _remove(st, mask, step)
 
 
+def stiffness_change(ks_old: np.ndarray, ks_new: np.ndarray, active: np.ndarray) -> float:
+    """max (k_s,old - k_s,new) / k_s,old over active springs that still have stiffness:
+    by how much (as a fraction) the last solve's shear stress overshoots the strength."""
+    use = active & (ks_old > 0)
+    return float(np.max(np.abs(ks_old[use] - ks_new[use]) / ks_old[use], initial=0.0))
+
+
 def stresses(prob: Problem, st: State, load: float):
     """Midpoint (= average) stresses of every interface at the current solution.
 
@@ -172,6 +190,75 @@ def stresses(prob: Problem, st: State, load: float):
     tau = st.ks * st.rel[:, 1]
     sig_eff = springs.effective_normal(sigma_n, itf.u_pore, cfg.ru, cfg.ru_mode, load)
     return sigma_n, tau, sig_eff
+
+
+class _Relaxation:
+    """Over-relaxed secant update, undone when it softens a spring past its law.
+
+    Near a limit state the secant iteration creeps: every solve the yielding springs
+    overshoot their strength by a fraction that shrinks by a nearly constant ratio rho
+    (~0.99 and more), so hundreds of iterations pass before the overshoot is below
+    `tol`.  The springs then lose stiffness by nearly the same factor each iteration.
+    After a plain update that softened springs by k_new/k_old, the springs softened are
+    taken further, to k_old (k_new/k_old)^omega, omega = 1/(1 - rho) (Aitken's estimate of
+    the remaining steps of a geometric sequence), at most twice the last omega and
+    OMEGA_MAX, rho the ratio of the last two overshoots.  Only springs at a constant
+    strength (no softening, or past delta_res) are extrapolated.
+    The fixed point is the plain iteration's: the next solve is checked, and if any
+    extrapolated spring's law now gives a stiffness above the one it was given (softened
+    too far: it would unload), the extrapolation is undone (the plain update's springs
+    are restored and solved) and omega starts again at 1.  An accepted extrapolation
+    leaves every spring at or above its law, i.e. still on the plain iteration's side of
+    its fixed point, which the plain updates then reach.
+    """
+
+    def __init__(self, tol: float):
+        self.tol = tol
+        self.omega = 1.0
+        self.last = np.inf              # overshoot (stiffness_change) of the previous iteration
+        self.base = None                # plain-update springs under an extrapolation
+        self.mask = None
+
+    def extrapolate(self, prob: Problem, st: State, change: float, active: np.ndarray, plain: bool) -> None:
+        rho = change / self.last if self.last > 0 else np.inf
+        self.last = change
+        self.base = None
+        if not plain or not 0.0 < rho < 1.0 or OMEGA_MAX <= 1.0:
+            self.omega = 1.0
+            return
+        self.omega = min(1.0 / (1.0 - rho), 2.0 * self.omega, OMEGA_MAX)
+        prev = st.ks_before
+        itf = prob.interfaces
+        # not on a softening branch (strength falling with slip), where going further would
+        # change the path (the peak "missed", thesis Sec. 4.1.4), not only speed it up
+        plastic = ((itf.c_r == itf.c_p) & (itf.tan_r == itf.tan_p)) | (np.abs(st.rel[:, 1]) >= itf.del_res)
+        mask = active & plastic & (st.ks < prev) & (prev > 0) & (st.ks > 0)
+        if self.omega <= 1.0 or not mask.any():
+            return
+        self.base, self.mask = st.ks.copy(), mask
+        st.ks = st.ks.copy()
+        st.ks[mask] = prev[mask] * (st.ks[mask] / prev[mask]) ** self.omega
+
+    def undo(self, st: State) -> None:
+        """Drop an extrapolation not yet checked by a solve."""
+        if self.base is not None:
+            st.ks, self.base = self.base, None
+
+    def overshot(self, prob: Problem, st: State, sig_eff: np.ndarray, active: np.ndarray) -> bool:
+        """After the solve with extrapolated springs: True (and the plain springs restored)
+        when an extrapolated spring's law asks for more stiffness than it was given."""
+        if self.base is None:
+            return False
+        itf = prob.interfaces
+        tau_p, tau_r = springs.strengths(sig_eff, itf.c_p, itf.tan_p, itf.c_r, itf.tan_r)
+        ks_law, _ = springs.secant_ks(st.rel[:, 1], tau_p, tau_r, itf.ks, itf.del_res)
+        m = self.mask & active
+        bad = bool(np.any(ks_law[m] > st.ks[m] * (1.0 + self.tol)))
+        if bad:
+            st.ks = self.base
+            self.omega, self.last = 1.0, np.inf
+        self.base = None
+        return bad
 
 
 def run(prob: Problem, progress=None, stop_on_failure: bool = False) -> State:
@@ -186,22 +273,27 @@ def run(prob: Problem, progress=None, stop_on_failure: bool = False) -> State:
                removed=np.zeros(blk.n, bool), removed_step=np.full(blk.n, -1, np.int64),
                u=np.zeros((blk.n, 3)), rel=np.zeros((itf.m, 3)), plastic=np.zeros(itf.m, bool))
     cache: dict = {}
-    scale = np.where(itf.ks > 0, itf.ks, 1.0)
     for step in range(1, cfg.n_steps + 1):
         load = step / cfg.n_steps
         st.load = load
         f_total = load * blk.force
         converged, change, it = False, np.inf, 0
         fresh = True                      # a new step, a crack or a removal gets a new factor
+        relax, carried = _Relaxation(cfg.tol), 0
         for it in range(1, cfg.max_iter + 1):
-            removed = _solve_with_removal(prob, st, Ta, Tb, f_total, step, cache, refactor=fresh)
+            removed = carried + _solve_with_removal(prob, st, Ta, Tb, f_total, step, cache, refactor=fresh)
+            carried = 0
             st.rel = relative_motion(st.u, itf.a, itf.b, Ta, Tb)
             active = _active(prob, st)
             sigma_n, _, sig_eff = stresses(prob, st, load)
+            if relax.overshot(prob, st, sig_eff, active):
+                carried = removed         # springs back to the plain secant update, solved again
+                continue
             kn, ks, cracked, new_crack, plastic = springs.update(
                 st.kn, st.ks, st.cracked, itf.ks, st.rel[:, 1], sigma_n, sig_eff,
                 itf.c_p, itf.tan_p, itf.c_r, itf.tan_r, itf.del_res, itf.tensile, itf.cutoff & active)
-            change = float(np.max((np.abs(ks - st.ks) / scale)[active], initial=0.0))
+            change = stiffness_change(st.ks, ks, active)
+            st.ks_before = st.ks
             new_crack &= active
             st.kn, st.ks, st.cracked, st.plastic = kn, ks, cracked, plastic & active
             done = change < cfg.tol and not new_crack.any() and removed == 0
@@ -214,6 +306,8 @@ def run(prob: Problem, progress=None, stop_on_failure: bool = False) -> State:
             if done:
                 converged = True
                 break
+            relax.extrapolate(prob, st, change, active, plain=not fresh)
+        relax.undo(st)                    # out of iterations: keep the plain update's springs
         if step == cfg.n_steps:
             # the last update changed the springs a little: re-solve so that the reported
             # displacements and stresses belong to the final springs

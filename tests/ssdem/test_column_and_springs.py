@@ -112,3 +112,31 @@ def test_law_pieces_and_no_stiffening_on_unloading():
                                    np.full(4, 10.0), z, np.full(4, 2.0), z, dres, z, np.zeros(4, bool))
     np.testing.assert_array_equal(ks2, ks)
     assert not plastic.any()
+
+
+def test_convergence_measure_is_the_overshoot_of_the_strength():
+    """The secant iteration stops when no spring's trial stress exceeds its strength by more
+    than `tol` (as a fraction): (k_old - k_new)/k_old = 1 - tau_f/tau_trial, whatever the
+    spring has already lost.  Two springs, k_s0 = 1e5 kPa/m: one intact overshooting by
+    0.05 %, one softened to 1e2 (0.1 % of k_s0) whose trial stress is 1 % over its strength.
+    Measured against k_s0 the second would count as a change of 1e-5 and pass any tolerance."""
+    delta = np.array([1e-4, 0.5])                 # slips of the last solve, m
+    ks_old = np.array([1e5, 1e2])
+    tau_trial = ks_old * delta                   # 10 kPa and 50 kPa
+    tau_f = tau_trial / np.array([1.0005, 1.01])  # strengths at those slips
+    ks_new = tau_f / delta                       # the secant of the law
+    change = solve.stiffness_change(ks_old, ks_new, np.array([True, True]))
+    assert change == pytest.approx(1 - 1 / 1.01, rel=1e-12)
+    # an inactive (removed) interface and a spring with no stiffness left do not count
+    assert solve.stiffness_change(ks_old, ks_new, np.array([True, False])) == pytest.approx(1 - 1 / 1.0005)
+    assert solve.stiffness_change(np.array([0.0]), np.array([0.0]), np.array([True])) == 0.0
+
+
+def test_blocks_freed_by_a_tension_crack_get_no_limit_search():
+    """A removal after a tension crack is the thesis's own outcome; dividing the strength
+    does not close the crack, so no strength-factor bracket is searched (analysis.run_problem)."""
+    from dec3d.ssdem.analysis import run_problem
+    p = two_block(up=6e3, kn=1e6, ks=1e6, c=20e3, phi=30, tensile=5e3, cutoff=True, n_steps=2)
+    an = run_problem(p)
+    assert an.state.removed[1] and an.state.cracked.all()
+    assert an.limit is None

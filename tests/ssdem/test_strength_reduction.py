@@ -101,3 +101,75 @@ def test_bracket_grows_down_and_up_from_the_guess():
     assert up["fs"] == down["fs"]
     assert up["trials"][0] == (1.2, True) and down["trials"][0] == (1.8, False)
     assert all(np.isclose(f * 200, round(f * 200)) for f, _ in up["trials"] + down["trials"])
+
+
+def test_a_slope_that_fails_at_full_strength_gets_its_fs_from_the_limit_state(tmp_path):
+    """c' = 2 kPa: the small slope cannot hold its weight (Bishop on the circle 0.961), so the
+    secant iteration at full strength has no equilibrium to settle on and Eq. 2.6 no converged
+    state.  The analysis brackets the strength factor F (c', tan phi' / F) at which it stops
+    holding and evaluates Eq. 2.6 with the full strengths on the converged state at the
+    largest F that holds.  Checked here by hand: the bracket with an independent run of the
+    load history, Eq. 2.6 from that run's stresses (perfectly plastic: tau_f = c' + sigma' tan phi')."""
+    from dec3d.ssdem.readers.toml_input import read_toml
+    prob = read_toml(Path("small.toml"), text=SMALL.format(extra="").replace("c = 10.0", "c = 2.0"))
+    an = run_problem(prob, compare_bishop=True)
+    q = summary_numbers(an)
+    assert an.limit["full_strength"] == "unstable blocks at step 4"   # a mechanism at F = 1
+    st = an.limit["state"]
+    lo, hi = st["factor"], st["fails_at"]
+    assert hi == pytest.approx(lo + 0.005) and hi <= 1.0
+    assert holds_by_hand(prob, lo) and not holds_by_hand(prob, hi)
+    # Eq. 2.6 by hand on the state at F = lo, full strengths
+    itf = prob.interfaces
+    saved = itf.c_p, itf.c_r, itf.tan_p, itf.tan_r
+    try:
+        itf.c_p, itf.c_r, itf.tan_p, itf.tan_r = (v / lo for v in saved)
+        run = solve.run(prob)
+    finally:
+        itf.c_p, itf.c_r, itf.tan_p, itf.tan_r = saved
+    on = itf.on_surface
+    sig = -run.kn * run.rel[:, 0]
+    tau = run.ks * run.rel[:, 1]
+    tau_f = np.maximum(saved[0] + sig * saved[2], 0.0)
+    by_hand = np.sum((tau_f * itf.length)[on]) / np.sum((np.abs(tau) * itf.length)[on])
+    assert q["fs_dem"] == pytest.approx(by_hand, rel=1e-9)
+    # every spring held within its reduced strength (to the tolerance: the trial stress of
+    # the last solve overshoots it by less than tol), so the full strengths give at least F
+    assert q["fs_dem"] >= lo * (1 - prob.settings.tol)
+    # both limit factors on one circle: within 1 % of Bishop's
+    assert q["fs_dem"] == pytest.approx(q["fs_bishop"], rel=0.01)
+    assert q["limit_holds_at"] == lo and q["limit_fails_at"] == hi
+    assert q["fs_dem_full_strength"] == an.safety.fs_global
+    from dec3d.ssdem.report import summary_text
+    text = summary_text(an)
+    assert "the slope does not hold at full strength: " in text
+    assert f"holds (converged in every step) at F = {lo:.3f} and not at F = {hi:.3f}" in text
+    assert f"Eq. 2.6) at the limit state: {q['fs_dem']:.3f}" in text
+
+
+def test_a_slope_that_holds_has_no_limit_search():
+    from dec3d.ssdem.readers.toml_input import read_toml
+    prob = read_toml(Path("small.toml"), text=SMALL.format(extra=""))
+    an = run_problem(prob)
+    assert an.limit is None and an.reduction is None
+    assert summary_numbers(an)["fs_dem"] == an.safety.fs_global
+
+
+@pytest.mark.parametrize("factor", [0.9, 0.96])
+def test_over_relaxed_secant_update_reaches_the_plain_fixed_point_sooner(monkeypatch, factor):
+    """solve._Relaxation takes the springs a plain secant update softened further along the
+    same geometric sequence, and undoes it when it went past a spring's law: the state it
+    converges to is the plain iteration's (to the tolerance 1e-3), in fewer iterations.  The
+    small slope with c' = 2 kPa near its limit (it stops holding at F ~ 0.97)."""
+    from dec3d.ssdem.readers.toml_input import read_toml
+    prob = reduction.reduced(read_toml(Path("small.toml"), text=SMALL.format(extra="").replace("c = 10.0", "c = 2.0")),
+                             factor)
+    runs = {}
+    for omega in (1.0, solve.OMEGA_MAX):
+        monkeypatch.setattr(solve, "OMEGA_MAX", omega)
+        runs[omega] = solve.run(prob)
+    plain, fast = runs[1.0], runs[solve.OMEGA_MAX]
+    assert reduction.verdict(prob, plain) == "" and reduction.verdict(prob, fast) == ""
+    np.testing.assert_allclose(fast.u, plain.u, rtol=0, atol=2e-3 * np.abs(plain.u).max())
+    np.testing.assert_allclose(fast.ks, plain.ks, rtol=5e-3)
+    assert sum(r.iterations for r in fast.steps) < 0.8 * sum(r.iterations for r in plain.steps)

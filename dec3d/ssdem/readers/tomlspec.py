@@ -91,7 +91,7 @@ SECTIONS: dict[str, tuple[Field, ...]] = {
     ),
     "analysis": (
         Field("steps", "int", 10, lo=1, hi=MAX_STEPS, doc="load increments to full load"),
-        Field("tolerance", "float", 1e-3, positive=True, doc="convergence: max |dk_s|/k_s0 within a step"),
+        Field("tolerance", "float", 1e-3, positive=True, doc="convergence: max |dk_s|/k_s (current secant) within a step"),
         Field("max_iterations", "int", 200, lo=1, hi=MAX_ITERATIONS, doc="secant iterations per step at most"),
         Field("strength_reduction", "bool", False,
               doc="also find the factor on c' and tan(phi') at which the static solution fails"),
