@@ -30,6 +30,9 @@ from ..errors import CONTROL_CHARS, DeckSyntaxError, SourceLocation, printable
 from .prepass import FishBlock, lift_fish
 
 _GRAMMAR_DIR = Path(__file__).parent
+# the characters refused in strings and `[ ]`, but newlines: no token holds one
+_CONTROL_NOT_NL = re.compile(CONTROL_CHARS.pattern.replace("\x0a-", "\x0b-", 1))
+assert _CONTROL_NOT_NL.pattern != CONTROL_CHARS.pattern
 
 
 @dataclass(frozen=True, slots=True)
@@ -109,10 +112,11 @@ def parse_deck(text: str, filename: str = "<input>", stack=()) -> ParsedDeck:
                 lines = _lex_lark(lifted, check)
     except UnexpectedInput as exc:
         raise _syntax_error(exc, filename, source_lines, stack) from None
-    for line in lines:
-        for tok in line.tokens:
-            if tok.type in ("STRING", "EXPR"):
-                check(tok)
+    if _CONTROL_NOT_NL.search(lifted) is not None:    # else no string or `[ ]` can hold one
+        for line in lines:
+            for tok in line.tokens:
+                if tok.type in ("STRING", "EXPR"):
+                    check(tok)
     return ParsedDeck(filename, source_lines, lines, fish)
 
 
@@ -139,18 +143,22 @@ def _lex_lark(text: str, check=None) -> list[RawLine]:
 @lru_cache(maxsize=None)
 def _fast_pattern() -> tuple[re.Pattern, frozenset]:
     """One alternation of the grammar's terminals, in lark's order for its basic lexer (priority,
-    then widest, then longest pattern, then name), each a named group."""
+    then widest, then longest pattern, then name), each a named group; the delimiters before a
+    token are matched with it (half the matches). That is lark's lexing: no other terminal can
+    start with a delimiter character (space, tab, form feed, `,()=`; carriage returns are gone
+    after ``normalise``), so lark takes the whole run of them as one ignored token first."""
     lk = deck_parser()
     terms = sorted(lk.terminals, key=lambda t: (-t.priority, -t.pattern.max_width, -len(t.pattern.value), t.name))
     pattern = "|".join(f"(?P<{t.name}>{t.pattern.to_regexp()})" for t in terms)
-    return re.compile(pattern), frozenset(lk.lexer_conf.ignore)
+    delim = lk.get_terminal("DELIMITERS").pattern.to_regexp()
+    return re.compile(f"(?:{delim})?(?:{pattern})"), frozenset(lk.lexer_conf.ignore)
 
 
 def _lex_fast(text: str) -> list[RawLine] | None:
     """Token lines, the same tokens (type, text, line, column, end, offsets) lark's lexer gives;
     None when some text matches no terminal."""
     pat, ignore = _fast_pattern()
-    new = Token._future_new
+    make = str.__new__           # lark's Token._future_new written out: a call less per token
     lines: list[RawLine] = []
     current: list[Token] = []
     line, line_start, pos = 1, 0, 0
@@ -171,8 +179,13 @@ def _lex_fast(text: str) -> list[RawLine] | None:
             line += 1
             line_start = end
         else:
-            current.append(new(kind, m.group(), start, line, start - line_start + 1, line,
-                               end - line_start + 1, end))
+            value = m.group(kind)
+            start = end - len(value)
+            tok = make(Token, value)
+            tok.type, tok.value, tok.start_pos, tok.end_pos = kind, value, start, end
+            tok.line = tok.end_line = line
+            tok.column, tok.end_column = start - line_start + 1, end - line_start + 1
+            current.append(tok)
     if pos != len(text):
         return None
     if current:
