@@ -59,6 +59,10 @@ PSEUDO_FILES = ("<input>", "<command>", "<repl>")
 DECK_MAX_BYTES = 64 * 2**20
 
 
+#: id(command) -> (command, its parameters naming files): ``Session._check_paths`` runs per bound line
+_PATH_PARAMS: dict[int, tuple] = {}
+
+
 class Session:
     """One model and the decks run on it. out_dir: the output folder (default: the working folder);
     every file a deck writes stays in it. allow_outside_paths: let decks read and write anywhere
@@ -170,11 +174,17 @@ class Session:
     def load_text(self, text: str, filename: str = "<input>", base_dir: Path | None = None,
                   stack: tuple[SourceLocation, ...] = ()) -> list[Item]:
         """Parse and bind text (and the files it calls); nothing runs."""
-        deck = parse_deck(text, filename, stack)
-        if base_dir is not None and filename in PSEUDO_FILES:
-            self._text_dirs[filename] = Path(base_dir)     # where its calls and restores look first
-        with gc_paused():                   # binding makes objects per line too (lang.parser.gc_paused)
-            items = self._bind_deck(deck, base_dir or Path.cwd(), stack)
+        # the collector paused over reading and binding together (lang.parser.gc_paused): once
+        # enabled it scans every object still alive, so the token lines are let go first (what a
+        # bound line still needs, its values' tokens, stays with it)
+        with gc_paused():
+            deck = parse_deck(text, filename, stack)
+            if base_dir is not None and filename in PSEUDO_FILES:
+                self._text_dirs[filename] = Path(base_dir)     # where its calls and restores look first
+            try:
+                items = self._bind_deck(deck, base_dir or Path.cwd(), stack)
+            finally:
+                deck.lines = []
         if not stack:                       # every deck is read: no literal output may replace an input
             bind_check(self, items)
         return items
@@ -284,10 +294,13 @@ class Session:
 
     def _check_paths(self, call: CommandCall) -> None:
         """Bind time: the literal file names of a call must be allowed (``dec3d.io.paths``)."""
-        for p in call.command.positional + call.command.keywords:
+        cmd = call.command
+        hit = _PATH_PARAMS.get(id(cmd))
+        if hit is None or hit[0] is not cmd:      # the command's file parameters, found once
+            hit = _PATH_PARAMS[id(cmd)] = (cmd, tuple(p for p in cmd.positional + cmd.keywords
+                                                      if isinstance(p.value, (OutPath, InPath))))
+        for p in hit[1]:
             vt = p.value
-            if not isinstance(vt, (OutPath, InPath)):
-                continue
             value = call.args.get(p.key)
             if not isinstance(value, str):
                 continue                      # absent, or an [expr] checked when the command runs

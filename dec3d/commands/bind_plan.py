@@ -27,7 +27,7 @@ MAX_PLANS = 4096
 def shape(toks) -> tuple:
     """The line's shape: each word as written, each value by its type."""
     kinds = SHAPE_OF
-    return tuple([t if t.type == "WORD" else kinds[t.type] for t in toks])
+    return tuple([t.value if t.type == "WORD" else kinds[t.type] for t in toks])
 
 
 class Slot:
@@ -43,23 +43,19 @@ class Plan:
     """A bound call with holes; the takes that fill them (param, first token, end); token indices
     of the locations it holds (by the identity of the recorded line's tokens)."""
 
-    __slots__ = ("call", "steps", "where")
+    __slots__ = ("call", "steps", "holes", "lists", "locs", "where")
 
     def __init__(self, call, steps, toks):
         self.call = call
         self.steps = tuple(steps)
+        self.holes = tuple((k, v.n) for k, v in call.args.items() if type(v) is Slot)
+        self.lists = tuple(k for k, v in call.args.items() if type(v) is list)
         ids = {id(t): k for k, t in enumerate(toks)}
+        self.locs = tuple((k, ids[id(loc.token)]) for k, loc in call.locations.items())
         self.where = {}
-        for loc in _locations(call):
-            self.where[id(loc)] = ids[id(loc.token)]
-
-
-def _locations(call):
-    for loc in call.locations.values():
-        yield loc
-    if call.range is not None:
-        for e in call.range.elements:
-            yield e.location
+        if call.range is not None:
+            for e in call.range.elements:
+                self.where[id(e.location)] = ids[id(e.location.token)]
 
 
 def fill_value(v, values):
@@ -74,9 +70,13 @@ def fill(plan: Plan, values, toks, deck, stack, make_call, range_call, range_cla
     """The plan's call with the holes filled from ``values`` and the locations on ``toks``."""
     tpl = plan.call
     where = plan.where
-    args = {k: fill_value(v, values) for k, v in tpl.args.items()}
+    args = tpl.args.copy()                # the keys in the order binding gave them
+    for k, n in plan.holes:
+        args[k] = values[n]
+    for k in plan.lists:                  # a repeated keyword: a new list for every call
+        args[k] = fill_value(args[k], values)
     extra = {k: fill_value(v, values) for k, v in tpl.extra.items()} if tpl.extra else {}
-    locs = {k: LazyLocation(deck, toks[where[id(v)]], stack) for k, v in tpl.locations.items()}
+    locs = {k: LazyLocation(deck, toks[i], stack) for k, i in plan.locs}
     rng = tpl.range
     if rng is not None:
         rng = range_clause(tuple(range_call(e.element, {k: fill_value(v, values) for k, v in e.args.items()},
