@@ -222,10 +222,9 @@ class Binder:
         """The line bound by its shape's plan; None when a take fails or takes other tokens (the
         line is then bound the ordinary way, which reports what is wrong)."""
         values = []
-        take = self._take
         try:
             for param, i, j in plan.steps:
-                v, end = take(param, toks, i)
+                v, end = param.value.take(toks, i, self)     # as _take (its errors end the replay)
                 if end != j:
                     return None
                 values.append(v)
