@@ -156,3 +156,27 @@ def test_nums_convert_inline_as_num_does(item):
         except Dec3dError as exc:
             got = ("error", type(exc).__name__, exc.message, str(exc.location))
         assert got == want, str(tok)
+
+
+def test_what_is_made_while_reading_is_still_collected():
+    """``gc_paused`` moves what was made meanwhile to the oldest generation unscanned; a cycle among
+    it is still found by a full collection, and the collector is on again (if it was)."""
+    import gc
+    import weakref
+
+    from dec3d.lang.parser import gc_paused
+
+    class Node:
+        pass
+
+    assert gc.isenabled()
+    with gc_paused():
+        assert not gc.isenabled()
+        a, b = Node(), Node()
+        a.other, b.other = b, a
+        gone = weakref.ref(a)
+    assert gc.isenabled() and gc.get_freeze_count() == 0
+    del a, b
+    assert gone() is not None          # a cycle: only the collector frees it
+    gc.collect()
+    assert gone() is None
