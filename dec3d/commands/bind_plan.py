@@ -16,7 +16,7 @@ ordinary way, which gives its result or its error, the same as without plans. Th
 """
 from __future__ import annotations
 
-from ..errors import LazyLocation
+from ..errors import LazyLocation, frozen_instance
 
 # the shape of a non-word token: no word can be spelt with `<`
 SHAPE_OF = {"NUMBER": "<n>", "STRING": "<s>", "EXPR": "<e>", "ATNAME": "<a>"}
@@ -83,5 +83,6 @@ def fill(plan: Plan, values, toks, deck, stack, make_call, range_call, range_cla
                                             e.negate, LazyLocation(deck, toks[where[id(e.location)]], stack))
                                  for e in rng.elements), rng.union)
     first = toks[0]
-    return make_call(tpl.command, args, tpl.given, rng, deck.location(first, stack), extra, locs,
-                     (deck.source_lines, first.line, toks[-1].line))
+    return frozen_instance(make_call, {"command": tpl.command, "args": args, "given": tpl.given, "range": rng,
+                                       "location": deck.location(first, stack), "extra": extra, "locations": locs,
+                                       "span": (deck.source_lines, first.line, toks[-1].line)})

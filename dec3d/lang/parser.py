@@ -26,7 +26,7 @@ from pathlib import Path
 from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
-from ..errors import CONTROL_CHARS, DeckSyntaxError, SourceLocation, printable
+from ..errors import CONTROL_CHARS, DeckSyntaxError, SourceLocation, frozen_instance, printable
 from .prepass import FishBlock, lift_fish
 
 _GRAMMAR_DIR = Path(__file__).parent
@@ -65,8 +65,10 @@ class ParsedDeck:
     fish: list[FishBlock]
 
     def location(self, tok: Token, stack=()) -> SourceLocation:
-        text = self.source_lines[tok.line - 1] if 0 < tok.line <= len(self.source_lines) else ""
-        return SourceLocation(self.filename, tok.line, tok.column, text, max(1, len(str(tok))), tuple(stack))
+        line = tok.line
+        text = self.source_lines[line - 1] if 0 < line <= len(self.source_lines) else ""
+        return frozen_instance(SourceLocation, {"file": self.filename, "line": line, "column": tok.column,
+                                                "text": text, "length": max(1, len(tok)), "stack": tuple(stack)})
 
 
 def normalise(text: str) -> str:

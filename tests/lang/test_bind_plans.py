@@ -180,3 +180,24 @@ def test_what_is_made_while_reading_is_still_collected():
     assert gone() is not None          # a cycle: only the collector frees it
     gc.collect()
     assert gone() is None
+
+
+def test_calls_and_locations_made_field_by_field_equal_their_constructors():
+    """``errors.frozen_instance`` (bound lines' commands and locations): every field set, equal to
+    what the dataclass constructor makes."""
+    from dataclasses import fields
+
+    from dec3d.commands.binder import CommandCall
+    from dec3d.errors import SourceLocation
+
+    deck = parse_deck("model gravity 0 0 -9.81\nmodel gravity 0 0 -1\n", "g.dat")
+    binder = Binder(deck, BindContext())
+    for raw in deck.lines:
+        call = binder.bind_line(raw)
+        assert {f.name for f in fields(CommandCall)} == set(vars(call))
+        assert call == CommandCall(call.command, call.args, call.given, call.range, call.location, call.extra,
+                                   call.locations, call.span)
+        loc = call.location
+        assert {f.name for f in fields(SourceLocation)} == set(vars(loc))
+        assert loc == SourceLocation("g.dat", raw.line, 1, deck.source_lines[raw.line - 1], 5, ())
+        assert hash(loc) == hash(SourceLocation("g.dat", raw.line, 1, deck.source_lines[raw.line - 1], 5, ()))
