@@ -174,9 +174,8 @@ class Session:
     def load_text(self, text: str, filename: str = "<input>", base_dir: Path | None = None,
                   stack: tuple[SourceLocation, ...] = ()) -> list[Item]:
         """Parse and bind text (and the files it calls); nothing runs."""
-        # the collector paused over reading and binding together (lang.parser.gc_paused): once
-        # enabled it scans every object still alive, so the token lines are let go first (what a
-        # bound line still needs, its values' tokens, stays with it)
+        # the collector paused over reading and binding together (lang.parser.gc_paused); the token
+        # lines are let go once bound (what a bound line still needs, its values' tokens, stays)
         with gc_paused():
             deck = parse_deck(text, filename, stack)
             if base_dir is not None and filename in PSEUDO_FILES:
@@ -235,8 +234,9 @@ class Session:
         next_fish = next(fish, None)
         progress = BindProgress(self.write, paths.printable(deck.filename))
         for raw in deck.lines:
-            progress.tick(raw.line)
-            while next_fish is not None and next_fish.line < raw.line:
+            line = raw.tokens[0].line
+            progress.tick(line)
+            while next_fish is not None and next_fish.line < line:
                 items.append(self._fish_item(deck, next_fish, stack))
                 next_fish = next(fish, None)
             call = bind_or_defer(self, binder, raw)

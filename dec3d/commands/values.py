@@ -183,8 +183,10 @@ class Nums(ValueType):
         inline = self.item.inline
         if inline is not None:
             lo, lo_closed, hi, hi_closed, angle = inline
-        # ``Num.take`` written out: a masonry deck's `block create polyhedron` line holds 72 numbers
-        while i < n and len(out) < most:
+        # ``Num.take`` written out: a masonry deck's `block create polyhedron` line holds 72 numbers;
+        # each turn takes one token or stops, so at most `most` turns
+        stop = min(n, i + most)
+        while i < stop:
             tok = toks[i]
             kind = tok.type
             if kind == "NUMBER":
