@@ -66,10 +66,10 @@ def fill_value(v, values):
     return v
 
 
-def fill(plan: Plan, values, toks, deck, stack, make_call, range_call, range_clause):
-    """The plan's call with the holes filled from ``values`` and the locations on ``toks``."""
+def fill(plan: Plan, values, toks, deck, stack):
+    """The plan's call with the holes filled from ``values`` and the locations on ``toks`` (the
+    classes are the recorded call's own)."""
     tpl = plan.call
-    where = plan.where
     args = tpl.args.copy()                # the keys in the order binding gave them
     for k, n in plan.holes:
         args[k] = values[n]
@@ -79,10 +79,12 @@ def fill(plan: Plan, values, toks, deck, stack, make_call, range_call, range_cla
     locs = {k: LazyLocation(deck, toks[i], stack) for k, i in plan.locs}
     rng = tpl.range
     if rng is not None:
-        rng = range_clause(tuple(range_call(e.element, {k: fill_value(v, values) for k, v in e.args.items()},
-                                            e.negate, LazyLocation(deck, toks[where[id(e.location)]], stack))
-                                 for e in rng.elements), rng.union)
+        where = plan.where
+        one = type(rng.elements[0])
+        rng = type(rng)(tuple(one(e.element, {k: fill_value(v, values) for k, v in e.args.items()}, e.negate,
+                                  LazyLocation(deck, toks[where[id(e.location)]], stack))
+                              for e in rng.elements), rng.union)
     first = toks[0]
-    return frozen_instance(make_call, {"command": tpl.command, "args": args, "given": tpl.given, "range": rng,
+    return frozen_instance(type(tpl), {"command": tpl.command, "args": args, "given": tpl.given, "range": rng,
                                        "location": deck.location(first, stack), "extra": extra, "locations": locs,
                                        "span": (deck.source_lines, first.line, toks[-1].line)})

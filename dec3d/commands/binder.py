@@ -212,7 +212,7 @@ class Binder:
         if len(self.plans) >= MAX_PLANS:
             self.plans.clear()
         plan = self.plans[key] = Plan(call, [s[:3] for s in steps], toks)
-        call = self._fill(plan, values, toks)
+        call = fill(plan, values, toks, self.deck, self.stack)
         cmd = call.command
         if cmd.check is not None:
             cmd.check(call)
@@ -228,7 +228,7 @@ class Binder:
                 if end != j:
                     return None
                 values.append(v)
-            call = self._fill(plan, values, toks)
+            call = fill(plan, values, toks, self.deck, self.stack)
             cmd = call.command
             if cmd.check is not None:
                 cmd.check(call)
@@ -236,8 +236,6 @@ class Binder:
             return None
         return call
 
-    def _fill(self, plan, values, toks):
-        return fill(plan, values, toks, self.deck, self.stack, CommandCall, RangeCall, RangeClause)
 
     def _bind(self, toks) -> CommandCall:
         """The ordinary binding of a command line; with ``_steps`` set, each value is a ``Slot``
