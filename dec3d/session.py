@@ -18,9 +18,9 @@ from pathlib import Path
 from typing import Any, Iterable, TextIO
 
 from .commands import load_all
-from .commands._file_check import bind_check
+from .commands._file_check import bind_check, path_params
 from .commands.binder import BindContext, Binder, CommandCall, ExprStatement
-from .commands.values import Deferred, InPath, OutPath, ValueRangeError
+from .commands.values import Deferred, OutPath, ValueRangeError
 from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation, StopDeck, printable
 from .fish import FishRuntime, compile_function, compile_inline, inline_source, parse_block, parse_inline
 from .io import paths
@@ -57,10 +57,6 @@ Item = CommandCall | ExprStatement | FishDefine | Enter | Unsupported
 PSEUDO_FILES = ("<input>", "<command>", "<repl>")
 #: largest deck file read (bytes): a deck is text, a bigger file is not one
 DECK_MAX_BYTES = 64 * 2**20
-
-
-#: id(command) -> (command, its parameters naming files): ``Session._check_paths`` runs per bound line
-_PATH_PARAMS: dict[int, tuple] = {}
 
 
 class Session:
@@ -294,12 +290,7 @@ class Session:
 
     def _check_paths(self, call: CommandCall) -> None:
         """Bind time: the literal file names of a call must be allowed (``dec3d.io.paths``)."""
-        cmd = call.command
-        hit = _PATH_PARAMS.get(id(cmd))
-        if hit is None or hit[0] is not cmd:      # the command's file parameters, found once
-            hit = _PATH_PARAMS[id(cmd)] = (cmd, tuple(p for p in cmd.positional + cmd.keywords
-                                                      if isinstance(p.value, (OutPath, InPath))))
-        for p in hit[1]:
+        for p in path_params(call.command):
             vt = p.value
             value = call.args.get(p.key)
             if not isinstance(value, str):

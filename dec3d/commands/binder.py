@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..errors import (BindError, DeckSyntaxError, LazyLocation, LegacySyntaxError, NotSupportedError,  # noqa: F401
-                      SourceLocation, UnimplementedError)
+                      SourceLocation, UnimplementedError, frozen_instance)
 from ..lang.abbrev import matches, suggest
 from ..lang.expr import check_names, parse_expression
 from ..lang.parser import ParsedDeck, RawLine
@@ -186,7 +186,8 @@ class Binder:
             node = self.expression(first)
             if node[0] == "assign":
                 self.ctx.assigned.add(node[1])   # later lines may use the variable
-            return ExprStatement(node, self.deck.location(first, self.stack), self.source(raw))
+            return frozen_instance(ExprStatement, {"node": node, "location": self.deck.location(first, self.stack),
+                                                   "source": self.source(raw)})
         if len(toks) == 1 and first.type == "ATNAME":
             self.deferred(first)                 # checks the name; a FISH function is called when it runs
             return ExprStatement(("name", str(first)[1:].lower(), 1), self.deck.location(first, self.stack),

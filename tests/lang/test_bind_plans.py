@@ -201,3 +201,14 @@ def test_calls_and_locations_made_field_by_field_equal_their_constructors():
         assert {f.name for f in fields(SourceLocation)} == set(vars(loc))
         assert loc == SourceLocation("g.dat", raw.line, 1, deck.source_lines[raw.line - 1], 5, ())
         assert hash(loc) == hash(SourceLocation("g.dat", raw.line, 1, deck.source_lines[raw.line - 1], 5, ()))
+
+
+def test_a_statement_line_made_field_by_field_equals_its_constructor():
+    from dataclasses import fields
+
+    from dec3d.commands.binder import ExprStatement
+
+    deck = parse_deck("[x = 1 + 2] ; set x\n", "s.dat")
+    st = Binder(deck, BindContext()).bind_line(deck.lines[0])
+    assert {f.name for f in fields(ExprStatement)} == set(vars(st))
+    assert st == ExprStatement(st.node, st.location, "[x = 1 + 2]")
