@@ -49,6 +49,15 @@ class SourceLocation:
         return f"{self.file}:{self.line}:{self.column}"
 
 
+def frozen_instance(cls, fields: dict):
+    """An instance of the frozen dataclass ``cls`` with ``fields`` (every field, by name): the same
+    object its constructor makes, without a ``object.__setattr__`` call per field (binding makes a
+    location and a command per deck line: the constructors were a third of binding a line)."""
+    obj = object.__new__(cls)
+    object.__setattr__(obj, "__dict__", fields)
+    return obj
+
+
 def _resolved(location):
     """Binding keeps token positions unresolved (see `LazyLocation`); errors resolve them."""
     return location.resolve() if hasattr(location, "resolve") else location

@@ -18,9 +18,9 @@ from pathlib import Path
 from typing import Any, Iterable, TextIO
 
 from .commands import load_all
-from .commands._file_check import bind_check
+from .commands._file_check import bind_check, path_params
 from .commands.binder import BindContext, Binder, CommandCall, ExprStatement
-from .commands.values import Deferred, InPath, OutPath, ValueRangeError
+from .commands.values import Deferred, OutPath, ValueRangeError
 from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation, StopDeck, printable
 from .fish import FishRuntime, compile_function, compile_inline, inline_source, parse_block, parse_inline
 from .io import paths
@@ -170,11 +170,16 @@ class Session:
     def load_text(self, text: str, filename: str = "<input>", base_dir: Path | None = None,
                   stack: tuple[SourceLocation, ...] = ()) -> list[Item]:
         """Parse and bind text (and the files it calls); nothing runs."""
-        deck = parse_deck(text, filename, stack)
-        if base_dir is not None and filename in PSEUDO_FILES:
-            self._text_dirs[filename] = Path(base_dir)     # where its calls and restores look first
-        with gc_paused():                   # binding makes objects per line too (lang.parser.gc_paused)
-            items = self._bind_deck(deck, base_dir or Path.cwd(), stack)
+        # the collector paused over reading and binding together (lang.parser.gc_paused); the token
+        # lines are let go once bound (what a bound line still needs, its values' tokens, stays)
+        with gc_paused():
+            deck = parse_deck(text, filename, stack)
+            if base_dir is not None and filename in PSEUDO_FILES:
+                self._text_dirs[filename] = Path(base_dir)     # where its calls and restores look first
+            try:
+                items = self._bind_deck(deck, base_dir or Path.cwd(), stack)
+            finally:
+                deck.lines = []
         if not stack:                       # every deck is read: no literal output may replace an input
             bind_check(self, items)
         return items
@@ -225,8 +230,9 @@ class Session:
         next_fish = next(fish, None)
         progress = BindProgress(self.write, paths.printable(deck.filename))
         for raw in deck.lines:
-            progress.tick(raw.line)
-            while next_fish is not None and next_fish.line < raw.line:
+            line = raw.tokens[0].line
+            progress.tick(line)
+            while next_fish is not None and next_fish.line < line:
                 items.append(self._fish_item(deck, next_fish, stack))
                 next_fish = next(fish, None)
             call = bind_or_defer(self, binder, raw)
@@ -284,10 +290,8 @@ class Session:
 
     def _check_paths(self, call: CommandCall) -> None:
         """Bind time: the literal file names of a call must be allowed (``dec3d.io.paths``)."""
-        for p in call.command.positional + call.command.keywords:
+        for p in path_params(call.command):
             vt = p.value
-            if not isinstance(vt, (OutPath, InPath)):
-                continue
             value = call.args.get(p.key)
             if not isinstance(value, str):
                 continue                      # absent, or an [expr] checked when the command runs

@@ -9,7 +9,7 @@ from __future__ import annotations
 import importlib
 import pkgutil
 
-_INFRASTRUCTURE = {"registry", "binder", "values", "catalogue", "legacy"}
+_INFRASTRUCTURE = {"registry", "binder", "bind_plan", "values", "catalogue", "legacy"}
 _loaded = False
 
 

@@ -8,6 +8,19 @@ from .binder import CommandCall
 from .values import InPath, OutPath
 
 
+#: id(command) -> (command, its parameters naming files): looked up for every bound line
+_PATH_PARAMS: dict[int, tuple] = {}
+
+
+def path_params(cmd) -> tuple:
+    """The parameters of ``cmd`` whose values name files (OutPath, InPath), in declaration order."""
+    hit = _PATH_PARAMS.get(id(cmd))
+    if hit is None or hit[0] is not cmd:
+        hit = _PATH_PARAMS[id(cmd)] = (cmd, tuple(p for p in cmd.positional + cmd.keywords
+                                                  if isinstance(p.value, (OutPath, InPath))))
+    return hit[1]
+
+
 def bind_check(session, items) -> None:
     """The rules of ``FileRecord.refusal`` for the literal file names of the bound ``items`` of
     ``session``, in deck order (a save the deck writes before it restores it is the run's own file,
@@ -18,9 +31,9 @@ def bind_check(session, items) -> None:
     for item in items:
         if not isinstance(item, CommandCall):
             continue
-        for p in item.command.positional + item.command.keywords:
+        for p in path_params(item.command):
             value = item.args.get(p.key)
-            if not isinstance(value, str) or not isinstance(p.value, (InPath, OutPath)):
+            if not isinstance(value, str):
                 continue
             where = item.locations.get(p.key, item.location)
             try:

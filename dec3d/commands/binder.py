@@ -13,13 +13,14 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..errors import (BindError, DeckSyntaxError, LazyLocation, LegacySyntaxError, NotSupportedError,  # noqa: F401
-                      SourceLocation, UnimplementedError)
+                      SourceLocation, UnimplementedError, frozen_instance)
 from ..lang.abbrev import matches, suggest
 from ..lang.expr import check_names, parse_expression
 from ..lang.parser import ParsedDeck, RawLine
+from .bind_plan import MAX_PLANS, Plan, Slot, fill, shape
 from .legacy import legacy_hint
 from .registry import REGISTRY, Command, Node, RangeElement, Registry
-from .values import FLOAT, MISSING, Deferred, Flag, Param, ValueRangeError
+from .values import FLOAT, MISSING, Deferred, Flag, Param, ValueRangeError, ValueType
 
 
 # a `;` comment that is not inside a quoted string
@@ -116,6 +117,8 @@ class Binder:
         self.ctx = context
         self.stack = tuple(stack)
         self.reg = registry
+        self.plans: dict[tuple, Plan | None] = {}   # line shape -> plan (lang: bind_plan)
+        self._steps: list | None = None             # the takes of the line being planned
 
     # ------------------------------------------------------------ helpers
     def where(self, tok) -> LazyLocation:
@@ -183,7 +186,8 @@ class Binder:
             node = self.expression(first)
             if node[0] == "assign":
                 self.ctx.assigned.add(node[1])   # later lines may use the variable
-            return ExprStatement(node, self.deck.location(first, self.stack), self.source(raw))
+            return frozen_instance(ExprStatement, {"node": node, "location": self.deck.location(first, self.stack),
+                                                   "source": self.source(raw)})
         if len(toks) == 1 and first.type == "ATNAME":
             self.deferred(first)                 # checks the name; a FISH function is called when it runs
             return ExprStatement(("name", str(first)[1:].lower(), 1), self.deck.location(first, self.stack),
@@ -192,6 +196,51 @@ class Binder:
 
     def bind(self, raw: RawLine) -> CommandCall:
         toks = raw.tokens
+        key = shape(toks)
+        plan = self.plans.get(key)
+        if plan is not None:
+            call = self._replay(plan, toks)
+            if call is not None:
+                return call
+        self._steps = steps = []
+        try:
+            call = self._bind(toks)
+        finally:
+            self._steps = None
+        if call.command.accepts_anything:
+            return call
+        values = [s[3] for s in steps]
+        if len(self.plans) >= MAX_PLANS:
+            self.plans.clear()
+        plan = self.plans[key] = Plan(call, [s[:3] for s in steps], toks)
+        call = fill(plan, values, toks, self.deck, self.stack)
+        cmd = call.command
+        if cmd.check is not None:
+            cmd.check(call)
+        return call
+
+    def _replay(self, plan: Plan, toks):
+        """The line bound by its shape's plan; None when a take fails or takes other tokens (the
+        line is then bound the ordinary way, which reports what is wrong)."""
+        values = []
+        try:
+            for param, i, j in plan.steps:
+                v, end = param.value.take(toks, i, self)     # as _take (its errors end the replay)
+                if end != j:
+                    return None
+                values.append(v)
+            call = fill(plan, values, toks, self.deck, self.stack)
+            cmd = call.command
+            if cmd.check is not None:
+                cmd.check(call)
+        except Exception:
+            return None
+        return call
+
+
+    def _bind(self, toks) -> CommandCall:
+        """The ordinary binding of a command line; with ``_steps`` set, each value is a ``Slot``
+        (the command's check is left to the caller, which fills them)."""
         first = toks[0]
         if first.type == "ATNAME":
             self.deferred(first)
@@ -210,7 +259,7 @@ class Binder:
             return CommandCall(cmd, {}, (), None, loc, span=span)
         call = self._bind_args(cmd, toks, i, pre, loc, prekw)
         object.__setattr__(call, "span", span)
-        if cmd.check is not None:
+        if cmd.check is not None and self._steps is None:
             cmd.check(call)
         return call
 
@@ -290,11 +339,17 @@ class Binder:
                         hint=f"one of: {', '.join(cands)}")
 
     def _take(self, param: Param, toks, i):
-        """The value of `param` at toks[i]; an out-of-range value names its keyword."""
+        """The value of `param` at toks[i]; an out-of-range value names its keyword. While a plan is
+        made, the take is recorded and its value stands as a Slot."""
         try:
-            return param.value.take(toks, i, self)
+            value, j = param.value.take(toks, i, self)
         except ValueRangeError as exc:
             raise exc.named(param.name) from None
+        steps = self._steps
+        if steps is None:
+            return value, j
+        steps.append((param, i, j, value))
+        return Slot(len(steps) - 1), j
 
     def _take_value(self, param: Param, toks, i, kwtok):
         if not param.supported:
@@ -389,16 +444,7 @@ class Binder:
                 rng = self._bind_range(toks, i, cmd)       # `range` omitted before the first element
                 return None
             if cmd.open_keywords and i + 1 < n and toks[i + 1].type in ("NUMBER", "EXPR", "ATNAME", "STRING"):
-                vt = toks[i + 1]
-                if vt.type == "STRING":
-                    extra[word] = str(vt)[1:-1]
-                elif vt.type == "NUMBER":
-                    try:
-                        extra[word] = FLOAT.convert(float(str(vt)), self.where(vt))
-                    except ValueRangeError as exc:
-                        raise exc.named(word) from None
-                else:
-                    extra[word] = self.deferred(vt)
+                extra[word], _ = self._take(Param(word, _OPEN), toks, i + 1)
                 return i + 2
             cands = list(cmd.keyword_names) + (["range"] + sorted(self.reg.range_elements) if cmd.range else [])
             close = suggest(word, cands)
@@ -486,6 +532,21 @@ class Binder:
         i = self._bind_params(what, elem.positional, names, by_name, toks, i, args, [], {}, other)
         self._fill_defaults(what, elem.positional + elem.keywords, args, toks)
         return args, i
+
+
+class _OpenValue(ValueType):
+    """The value of an undeclared keyword (open_keywords commands): a string, a number, `[ ]`, `@`."""
+
+    def take(self, toks, i, binder):
+        vt = toks[i]
+        if vt.type == "STRING":
+            return str(vt)[1:-1], i + 1
+        if vt.type == "NUMBER":
+            return FLOAT.convert(float(str(vt)), binder.where(vt)), i + 1
+        return binder.deferred(vt), i + 1
+
+
+_OPEN = _OpenValue()
 
 
 def _fish_inline(text: str):

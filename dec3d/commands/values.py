@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 from ..config import DENSITY_LIMIT
@@ -102,6 +103,16 @@ class Num(ValueType):
     def literal(self, tok):
         return _number_literal(tok)
 
+    @cached_property
+    def inline(self):
+        """(lo, lo closed, hi, hi closed, angle) for ``Nums.take`` to convert a real number inline
+        (±inf and open for no bound); None for integers."""
+        if self.integer:
+            return None
+        lo = -math.inf if self.lo is None else self.lo
+        hi = math.inf if self.hi is None else self.hi
+        return lo, self.lo is not None and not self.lo_open, hi, self.hi is not None and not self.hi_open, self.angle
+
     def range_text(self) -> str:
         """The valid range in words: `in [0, 90) degrees`, `> 0`, `≥ 1`; "" when unbounded."""
         unit = " degrees" if self.angle else ""
@@ -169,11 +180,26 @@ class Nums(ValueType):
         start = i
         n, most = len(toks), self.most
         literal, convert = self.item.literal, self.item.convert
-        # ``Num.take`` written out: a masonry deck's `block create polyhedron` line holds 72 numbers
-        while i < n and len(out) < most:
+        inline = self.item.inline
+        if inline is not None:
+            lo, lo_closed, hi, hi_closed, angle = inline
+        # ``Num.take`` written out: a masonry deck's `block create polyhedron` line holds 72 numbers;
+        # each turn takes one token or stops, so at most `most` turns
+        stop = min(n, i + most)
+        while i < stop:
             tok = toks[i]
             kind = tok.type
             if kind == "NUMBER":
+                if inline is not None:    # Num.convert of _number_literal inline; what it refuses goes to it
+                    s = tok.value
+                    try:
+                        v = float(s) if ("." in s or "e" in s or "E" in s) else float(int(s))
+                    except OverflowError:
+                        v = math.inf
+                    if lo < v < hi or (v == lo and lo_closed) or (v == hi and hi_closed):
+                        out.append(math.radians(v) if angle else v)
+                        i += 1
+                        continue
                 try:
                     out.append(convert(literal(tok), None))
                 except BindError as exc:

@@ -34,24 +34,28 @@ class _Fail(Exception):
     pass
 
 
+# the same tokens, the blanks before each matched with it (half the matches; nothing but `ws` can
+# start with a blank, so this is the same cut)
+_TOKEN_AFTER_BLANKS = re.compile(r"[ \t\f]*(?:" + _TOKEN.pattern.split("|", 1)[1] + ")", re.X)
+
+
 def _tokens(text: str):
     """(kind, text, column) tokens; kind is num, str, name, a keyword, or the operator itself."""
     out = []
     pos, n = 0, len(text)
-    match = _TOKEN.match
-    while pos < n:
-        m = match(text, pos)
-        if m is None:
+    for m in _TOKEN_AFTER_BLANKS.finditer(text):
+        if m.start() != pos:
             raise _Fail
         kind = m.lastgroup
-        value = m.group()
+        value = m.group(kind)
+        pos = m.end()
         if kind == "name":
             kind = _KEYWORDS.get(value.lower(), "name")
         elif kind == "op":
             kind = value
-        if kind != "ws":
-            out.append((kind, value, pos + 1))
-        pos = m.end()
+        out.append((kind, value, pos - len(value) + 1))
+    if pos != n and text[pos:].strip(" \t\f"):
+        raise _Fail
     out.append(("end", "", n + 1))
     return out
 

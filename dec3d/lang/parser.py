@@ -26,10 +26,13 @@ from pathlib import Path
 from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
-from ..errors import CONTROL_CHARS, DeckSyntaxError, SourceLocation, printable
+from ..errors import CONTROL_CHARS, DeckSyntaxError, SourceLocation, frozen_instance, printable
 from .prepass import FishBlock, lift_fish
 
 _GRAMMAR_DIR = Path(__file__).parent
+# the characters refused in strings and `[ ]`, but newlines: no token holds one
+_CONTROL_NOT_NL = re.compile(CONTROL_CHARS.pattern.replace("\x0a-", "\x0b-", 1))
+assert _CONTROL_NOT_NL.pattern != CONTROL_CHARS.pattern
 
 
 @dataclass(frozen=True, slots=True)
@@ -62,8 +65,10 @@ class ParsedDeck:
     fish: list[FishBlock]
 
     def location(self, tok: Token, stack=()) -> SourceLocation:
-        text = self.source_lines[tok.line - 1] if 0 < tok.line <= len(self.source_lines) else ""
-        return SourceLocation(self.filename, tok.line, tok.column, text, max(1, len(str(tok))), tuple(stack))
+        line = tok.line
+        text = self.source_lines[line - 1] if 0 < line <= len(self.source_lines) else ""
+        return frozen_instance(SourceLocation, {"file": self.filename, "line": line, "column": tok.column,
+                                                "text": text, "length": max(1, len(tok)), "stack": tuple(stack)})
 
 
 def normalise(text: str) -> str:
@@ -84,13 +89,22 @@ def gc_paused():
     """Python's cycle collector off while a deck is read. Reading makes an object per token and
     frees none: every few hundred of them the collector scanned them all again (a 664 000-token
     masonry deck lexed in 3.9 s with it, 1.3 s without). Nothing made here forms cycles; the
-    collector is turned back on (if it was on) when reading ends, by error or not."""
+    collector is turned back on (if it was on) when reading ends, by error or not.
+
+    What was made meanwhile (tokens, bound commands: they live as long as the run) goes to the
+    oldest generation without being scanned (``gc.freeze`` then ``gc.unfreeze``; skipped if the
+    program froze objects of its own): left young, the first collection after reading would look at
+    every one of them only to promote it — a fifth of reading a 100 000-line deck. Cycles among them
+    are still found, by the next full collection."""
     was = gc.isenabled()
     gc.disable()
     try:
         yield
     finally:
         if was:
+            if gc.get_freeze_count() == 0:
+                gc.freeze()
+                gc.unfreeze()
             gc.enable()
 
 
@@ -109,10 +123,11 @@ def parse_deck(text: str, filename: str = "<input>", stack=()) -> ParsedDeck:
                 lines = _lex_lark(lifted, check)
     except UnexpectedInput as exc:
         raise _syntax_error(exc, filename, source_lines, stack) from None
-    for line in lines:
-        for tok in line.tokens:
-            if tok.type in ("STRING", "EXPR"):
-                check(tok)
+    if _CONTROL_NOT_NL.search(lifted) is not None:    # else no string or `[ ]` can hold one
+        for line in lines:
+            for tok in line.tokens:
+                if tok.type in ("STRING", "EXPR"):
+                    check(tok)
     return ParsedDeck(filename, source_lines, lines, fish)
 
 
@@ -139,18 +154,22 @@ def _lex_lark(text: str, check=None) -> list[RawLine]:
 @lru_cache(maxsize=None)
 def _fast_pattern() -> tuple[re.Pattern, frozenset]:
     """One alternation of the grammar's terminals, in lark's order for its basic lexer (priority,
-    then widest, then longest pattern, then name), each a named group."""
+    then widest, then longest pattern, then name), each a named group; the delimiters before a
+    token are matched with it (half the matches). That is lark's lexing: no other terminal can
+    start with a delimiter character (space, tab, form feed, `,()=`; carriage returns are gone
+    after ``normalise``), so lark takes the whole run of them as one ignored token first."""
     lk = deck_parser()
     terms = sorted(lk.terminals, key=lambda t: (-t.priority, -t.pattern.max_width, -len(t.pattern.value), t.name))
     pattern = "|".join(f"(?P<{t.name}>{t.pattern.to_regexp()})" for t in terms)
-    return re.compile(pattern), frozenset(lk.lexer_conf.ignore)
+    delim = lk.get_terminal("DELIMITERS").pattern.to_regexp()
+    return re.compile(f"(?:{delim})?(?:{pattern})"), frozenset(lk.lexer_conf.ignore)
 
 
 def _lex_fast(text: str) -> list[RawLine] | None:
     """Token lines, the same tokens (type, text, line, column, end, offsets) lark's lexer gives;
     None when some text matches no terminal."""
     pat, ignore = _fast_pattern()
-    new = Token._future_new
+    make = str.__new__           # lark's Token._future_new written out: a call less per token
     lines: list[RawLine] = []
     current: list[Token] = []
     line, line_start, pos = 1, 0, 0
@@ -171,8 +190,13 @@ def _lex_fast(text: str) -> list[RawLine] | None:
             line += 1
             line_start = end
         else:
-            current.append(new(kind, m.group(), start, line, start - line_start + 1, line,
-                               end - line_start + 1, end))
+            value = m.group(kind)
+            start = end - len(value)
+            tok = make(Token, value)
+            tok.type, tok.value, tok.start_pos, tok.end_pos = kind, value, start, end
+            tok.line = tok.end_line = line
+            tok.column, tok.end_column = start - line_start + 1, end - line_start + 1
+            current.append(tok)
     if pos != len(text):
         return None
     if current:

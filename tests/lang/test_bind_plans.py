@@ -1,0 +1,214 @@
+"""Bind plans (``commands/bind_plan.py``): a line bound by the plan of an earlier line of its shape
+gives what the ordinary binding gives — the same command, values, locations and range, or the same
+error at the same file:line:column — on every deck of the repository, every public deck, and lines
+made to differ from their shape's first line only where a value fails. ``Nums`` converting its
+numbers inline gives ``Num.convert``'s values and errors."""
+import math
+
+import pytest
+
+from dec3d.commands import load_all
+from dec3d.commands.bind_plan import shape
+from dec3d.commands.binder import BindContext, Binder
+from dec3d.commands.values import Num, Nums
+from dec3d.errors import Dec3dError, LazyLocation
+from dec3d.lang.deferred import Deferred
+from dec3d.lang.parser import parse_deck
+from conftest import DECKS, NO_DECKS, ROOT
+
+
+load_all()
+
+
+def _norm(v):
+    """A bound value in comparable form: floats by their bits, locations resolved."""
+    if isinstance(v, float):
+        return ("f", v.hex() if math.isfinite(v) else repr(v))
+    if isinstance(v, (list, tuple)):
+        return (type(v).__name__, tuple(_norm(x) for x in v))
+    if isinstance(v, dict):
+        return ("d", tuple((k, _norm(x)) for k, x in v.items()))
+    if isinstance(v, LazyLocation):
+        return ("loc", v.resolve())
+    if isinstance(v, Deferred):
+        return ("deferred", v.kind, _norm(v.node), str(v.token), v.token.line, v.token.column, _norm(v.where))
+    return v
+
+
+def _outcome(fn, raw):
+    try:
+        call = fn(raw)
+    except Dec3dError as exc:
+        loc = exc.location
+        return ("error", type(exc).__name__, exc.message, exc.hint, (loc.file, loc.line, loc.column, loc.length)
+                if loc is not None else None)
+    if not hasattr(call, "command"):
+        return ("statement", _norm(call.node), call.location, call.source)
+    rng = None
+    if call.range is not None:
+        rng = (call.range.union, tuple((e.element.name, _norm(e.args), e.negate, _norm(e.location))
+                                       for e in call.range.elements))
+    return ("call", call.command.path, _norm(call.args), call.given, rng, call.location, _norm(call.extra),
+            _norm(call.locations), call.span[1:], call.text)
+
+
+def _same_outcomes(text: str, name: str = "d.dat") -> int:
+    """Every line bound with plans (one binder for the deck) and the ordinary way: the same."""
+    try:
+        deck = parse_deck(text, name)
+    except Dec3dError:
+        return 0
+    planned = Binder(deck, BindContext(lenient_names=True))
+    plain = Binder(deck, BindContext(lenient_names=True))
+    for fish in deck.fish:
+        planned.ctx.define_fish(fish)
+        plain.ctx.define_fish(fish)
+
+    def ordinary(raw):
+        toks = raw.tokens
+        if len(toks) == 1 and toks[0].type in ("EXPR", "ATNAME"):
+            return plain.bind_line(raw)
+        return plain._bind(toks)
+
+    replayed = 0
+    for raw in deck.lines:
+        known = shape(raw.tokens) in planned.plans
+        a = _outcome(planned.bind_line, raw)
+        b = _outcome(ordinary, raw)
+        assert a == b, f"{name}:{raw.line}"
+        replayed += known and a[0] == "call"
+    return replayed
+
+
+def test_plans_bind_every_repository_deck_as_the_ordinary_binder():
+    decks = sorted(p for d in ("examples", "verification") for p in (ROOT / d).rglob("*.dat"))
+    assert len(decks) > 20
+    replayed = sum(_same_outcomes(p.read_text(encoding="utf-8", errors="replace"), p.name) for p in decks)
+    assert replayed > 500          # many lines were bound by a plan
+
+
+def test_plans_bind_every_public_deck_as_the_ordinary_binder():
+    if not DECKS.is_dir():
+        pytest.skip(NO_DECKS)
+    for p in sorted(DECKS.rglob("*.dat")):
+        _same_outcomes(p.read_text(encoding="utf-8", errors="replace"), p.name)
+
+
+LINES = [
+    "block create brick 0 1 0 1 0 1",
+    "block create brick 0 2 0 2.5 0 1e999",            # not finite: the plan's take fails
+    "block create brick 0 1 0 1 0 [1 + ]",               # a bad expression
+    "block create brick 0 1 0 1 0 [nothing_set]",        # an undefined name (lenient: deferred)
+    "model gravity 0 0 -9.81",
+    "model gravity 0 0 1" + "0" * 400,                   # an integer too large for a float
+    "model gravity 0 0 -0",                              # an integer zero stays +0.0
+    "model gravity 0 0 -0.0",
+    "model title 'a'",
+    "model title 'b'",
+    "block contact jmodel assign elastic range id 1",
+    "block contact jmodel assign elastic range id 2.5",  # not an integer
+    "block contact jmodel assign elastic range id 3",
+    "block contact property stiffness-normal 1e9 stiffness-shear 1e8 friction 30",
+    "block contact property stiffness-normal 1e9 stiffness-shear 1e8 friction 1e999",
+    "block contact property stiffness-normal -1 stiffness-shear 1e8 friction 30",
+    "block contact property stiffness-normal 2e9 stiffness-shear 2e8 friction 20 range id 4 not",
+    "block contact property stiffness-normal 2e9 stiffness-shear 2e8 friction 20 range id 5 not",
+    "block fix velocity range position-z 0",
+    "block fix velocity range position-z 1e999",
+    "block fix velocity range position-z 2",
+    "block fix velocity range group 'g' position-z 0 union",
+    "block fix velocity range group 'h' position-z 1 union",
+    "model cycle 10",
+    "model cycle 2.5",
+    "model cycle -1",
+    "model cycle 20",
+]
+
+
+def test_lines_of_one_shape_with_bad_values_bind_as_the_ordinary_binder():
+    text = "\n".join(LINES * 3) + "\n"
+    deck = parse_deck(text, "d.dat")
+    binder = Binder(deck, BindContext(lenient_names=True))
+    kinds = [_outcome(binder.bind_line, raw)[0] for raw in deck.lines]
+    assert kinds.count("call") > 40 and kinds.count("error") > 20      # both met
+    assert _same_outcomes(text) > 40
+
+
+ITEMS = [Num(), Num(lo=0, lo_open=True, hi=1e12), Num(lo=0, hi=90, hi_open=True), Num(angle=True),
+         Num(lo=-1, hi=1, angle=True), Num(lo=0, lo_open=True, hi=1, hi_open=True)]
+LITERALS = ["0", "-0", "+0", "-0.0", "1", "-1", "0.5", "1e3", "1E-3", ".5", "5.", "90", "89.99999", "1e12",
+            "1.0000001e12", "1e999", "-1e999", "1" + "0" * 400, "-" + "9" * 320, "007", "1e-320"]
+
+
+@pytest.mark.parametrize("item", ITEMS, ids=repr)
+def test_nums_convert_inline_as_num_does(item):
+    deck = parse_deck(" ".join(LITERALS) + "\n", "n.dat")
+    toks = deck.lines[0].tokens
+    binder = Binder(deck, BindContext())
+    for k, tok in enumerate(toks):
+        try:
+            want = ("ok", _norm(item.take(toks, k, binder)[0]))
+        except Dec3dError as exc:
+            want = ("error", type(exc).__name__, exc.message, str(exc.location))
+        try:
+            got = Nums(1, 1, item=item).take(toks, k, binder)
+            got = ("ok", _norm(got[0][0]))
+        except Dec3dError as exc:
+            got = ("error", type(exc).__name__, exc.message, str(exc.location))
+        assert got == want, str(tok)
+
+
+def test_what_is_made_while_reading_is_still_collected():
+    """``gc_paused`` moves what was made meanwhile to the oldest generation unscanned; a cycle among
+    it is still found by a full collection, and the collector is on again (if it was)."""
+    import gc
+    import weakref
+
+    from dec3d.lang.parser import gc_paused
+
+    class Node:
+        pass
+
+    assert gc.isenabled()
+    with gc_paused():
+        assert not gc.isenabled()
+        a, b = Node(), Node()
+        a.other, b.other = b, a
+        gone = weakref.ref(a)
+    assert gc.isenabled() and gc.get_freeze_count() == 0
+    del a, b
+    assert gone() is not None          # a cycle: only the collector frees it
+    gc.collect()
+    assert gone() is None
+
+
+def test_calls_and_locations_made_field_by_field_equal_their_constructors():
+    """``errors.frozen_instance`` (bound lines' commands and locations): every field set, equal to
+    what the dataclass constructor makes."""
+    from dataclasses import fields
+
+    from dec3d.commands.binder import CommandCall
+    from dec3d.errors import SourceLocation
+
+    deck = parse_deck("model gravity 0 0 -9.81\nmodel gravity 0 0 -1\n", "g.dat")
+    binder = Binder(deck, BindContext())
+    for raw in deck.lines:
+        call = binder.bind_line(raw)
+        assert {f.name for f in fields(CommandCall)} == set(vars(call))
+        assert call == CommandCall(call.command, call.args, call.given, call.range, call.location, call.extra,
+                                   call.locations, call.span)
+        loc = call.location
+        assert {f.name for f in fields(SourceLocation)} == set(vars(loc))
+        assert loc == SourceLocation("g.dat", raw.line, 1, deck.source_lines[raw.line - 1], 5, ())
+        assert hash(loc) == hash(SourceLocation("g.dat", raw.line, 1, deck.source_lines[raw.line - 1], 5, ()))
+
+
+def test_a_statement_line_made_field_by_field_equals_its_constructor():
+    from dataclasses import fields
+
+    from dec3d.commands.binder import ExprStatement
+
+    deck = parse_deck("[x = 1 + 2] ; set x\n", "s.dat")
+    st = Binder(deck, BindContext()).bind_line(deck.lines[0])
+    assert {f.name for f in fields(ExprStatement)} == set(vars(st))
+    assert st == ExprStatement(st.node, st.location, "[x = 1 + 2]")
