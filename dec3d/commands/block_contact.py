@@ -5,8 +5,9 @@ import numpy as np
 
 from ..errors import CommandError
 from ..physics.jmodels import ALIASES, ALL_PROPS, JOINT_MODELS, MODEL_BY_CODE, REFUSED
-from ..physics.contact_store import history_columns
+from ..physics.contact_store import history_columns, property_columns
 from ..physics.contacts import default_row
+from ..kernels.joints import model_mask
 from ..physics.rigid import engine, mech
 from .registry import command
 from .values import FLAG, Choice, Num, P, Text, ValueRangeError
@@ -131,7 +132,8 @@ def jmodel_assign(session, call):
     jm = JOINT_MODELS[name]
     c = e.contacts
     c["jmodel"][sel] = jm.code
-    c["prop"][sel] = default_row(mech(session.model), jm.code)
+    width = property_columns(c, model_mask(c["jmodel"]) | 1 << jm.code)
+    c["prop"][sel] = default_row(mech(session.model), jm.code, width)
     c["own_props"][sel] = 0
     ss = e.subcontacts
     history_columns(ss, c["jmodel"])
@@ -279,7 +281,7 @@ def material_add(session, call):
     e, sel = _contacts_in_range(session, call)
     c = e.contacts
     c["jmodel"][sel] = jm.code
-    c["prop"][sel] = jm.row(props)
+    c["prop"][sel] = jm.row(props, property_columns(c, model_mask(c["jmodel"]) | 1 << jm.code))
     c["own_props"][sel] = 1
     ss = e.subcontacts
     history_columns(ss, c["jmodel"])

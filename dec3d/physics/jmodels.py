@@ -63,9 +63,10 @@ class JointModel:
     #: (``model factor-of-safety``); None: the model has no strength to reduce
     reduce: object = None
 
-    def row(self, values: dict[str, float] | None = None) -> np.ndarray:
-        """Kernel property row with every column at its default, then ``values`` applied."""
-        r = np.zeros(NPROP)
+    def row(self, values: dict[str, float] | None = None, width: int = NPROP) -> np.ndarray:
+        """Kernel property row with every column at its default, then ``values`` applied; ``width``
+        columns (the contacts store's, at least the model's own; zero beyond the model's)."""
+        r = np.zeros(width)
         for p in self.props.values():
             r[p.column] = p.default
         if values:

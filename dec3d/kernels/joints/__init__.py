@@ -44,7 +44,7 @@ from ._common import NJHIST, P_KN, P_KS, ST_FAILED, ST_NEW, ST_SLIP, ST_TENSION,
 
 __all__ = ["ALL_MODELS", "CODES", "COMMON_MODELS", "HISTORY_MODELS", "MODELS", "NJHIST", "NPROP", "P_KN", "P_KS",
            "ST_FAILED", "ST_NEW", "ST_SLIP", "ST_TENSION", "cycle_mask", "joint_law", "joint_law_for",
-           "joint_stiffness", "model_mask"]
+           "joint_stiffness", "model_mask", "prop_width"]
 
 
 def _find():
@@ -70,7 +70,8 @@ def _find():
 MODELS = tuple(_find())
 #: code of each joint model by name
 CODES = {m.NAME: m.CODE for m in MODELS}
-#: property columns of the widest model (the contacts store's ``prop`` width)
+#: property columns of the widest model (the most a contacts store's ``prop`` row holds; the store
+#: holds only what the models in use read: ``prop_width``)
 NPROP = max(m.NCOLS for m in MODELS)
 
 
@@ -135,6 +136,18 @@ HISTORY_MODELS = model_mask(m.CODE for m in MODELS if m.NHIST)
 #: the models every compiled cycle holds (the two small founding laws): decks of elastic joints, of
 #: mohr joints and of both then share one compiled cycle, as before the chain was per mask
 COMMON_MODELS = model_mask(m.CODE for m in MODELS if m.NAME in ("elastic", "mohr"))
+
+
+def prop_width(mask: int) -> int:
+    """Property columns the models of the bit mask ``mask`` read: the widest one's ``NCOLS``, at least
+    2 (kn, ks, which the engine reads on every contact). The contacts store's ``prop`` is this wide,
+    not ``NPROP``: detection copies every contact's row, and MASON's 21 columns on every contact of
+    a mohr-only model cost its detection a third more time."""
+    w = 2
+    for m in MODELS:
+        if (mask >> m.CODE) & 1 and m.NCOLS > w:
+            w = m.NCOLS
+    return w
 
 
 def cycle_mask(codes) -> int:
