@@ -37,7 +37,7 @@ from dec3d.kernels import contactmap as _cm
 from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, gather_subcontacts, match_sorted,
                                       subcontact_gaps, threaded, vertex_point_areas)
 from dec3d.kernels.kept import add_turns, as_they_are, pairs_to_look_at, take_defaults
-from dec3d.kernels.joints import NPROP, model_mask
+from dec3d.kernels.joints import MODELS, NPROP, model_mask
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.model import KIND_DEFORMABLE, KIND_FE, KIND_RIGID
 from dec3d.model.ranges import pairs_in_groups
@@ -58,6 +58,8 @@ QUIET = 0.1
 #: moved (and turned) less than QUIET·CTOL relative to each other (a stack settling or sliding as one)
 RELATIVE = True
 
+#: property columns each joint-model code reads
+_NCOLS = {m.CODE: m.NCOLS for m in MODELS}
 #: the sub-contact fields a detection writes (``contactmap.gather_subcontacts``), in its order
 _GATHERED = ("contact", "kind", "key0", "key1", "pos", "area", "fn", "fs", "un", "udil", "us", "state", "hist")
 
@@ -528,8 +530,9 @@ class ContactDetection:
         s = self.settings()
         width = cs["prop"].shape[1]
         table = np.zeros((max(MODEL_BY_CODE) + 1, width))
-        for code in np.unique(cs["jmodel"]):       # (the models in use: the rows are as wide as they need)
-            table[code] = default_row(s, int(code), width)
+        for code in MODEL_BY_CODE:                 # (a model wider than the rows is not in use)
+            if _NCOLS[code] <= width:
+                table[code] = default_row(s, code, width)
         return take_defaults(cs["own_props"], cs["jmodel"], cs["prop"], table) > 0
 
     def ensure_contacts(self) -> None:
