@@ -23,7 +23,7 @@ from dec3d.physics.modelprops import ModelProp, atan_deg, tan_deg
 
 from dec3d.kernels.joints import MODELS as KERNELS
 from dec3d.kernels.joints import NJHIST, NPROP, P_KN, P_KS
-from dec3d.kernels.jointlaw import subcontact_stiffness
+from dec3d.kernels.jointlaw import raise_to_bound, subcontact_stiffness
 
 
 @dataclass(frozen=True)
@@ -126,6 +126,8 @@ STIFFNESS = [Prop("stiffness-normal", P_KN, "normal stiffness kn", "Pa/m"),
 
 #: codes of the models whose kernel has a ``stiffness`` hook
 _HOOKED = np.array(sorted(k.CODE for k in KERNELS if hasattr(k, "stiffness")), dtype=np.int64)
+#: codes of the models whose kernel has a ``stiffness_bound`` hook
+_BOUNDED = np.array(sorted(k.CODE for k in KERNELS if hasattr(k, "stiffness_bound")), dtype=np.int64)
 
 
 def changing_stiffness(cs) -> bool:
@@ -158,13 +160,18 @@ def stiffness(cs, ss, prop=None) -> tuple[np.ndarray, np.ndarray]:
 def contact_stiffness(cs, ss) -> tuple[np.ndarray, np.ndarray]:
     """(kn, ks) (nc,) [Pa/m] per contact, for the time step and the mass scaling: the larger of its
     row's columns 0, 1 and the stiffest of its sub-contacts now (``stiffness``), so that a joint
-    softer now than its stated stiffness does not lengthen the step it may need again."""
+    softer now than its stated stiffness does not lengthen the step it may need again; for a model
+    that declares the largest stiffness it reaches (``stiffness_bound``), that: a joint that
+    stiffens with its closure (barton-bandis) under a load applied at once outruns a step worked
+    out from its stiffness now before the next detection works it out again."""
     kn = cs["prop"][:, P_KN].copy()
     ks = cs["prop"][:, P_KS].copy()
     if ss.n:
         skn, sks = stiffness(cs, ss)
         np.maximum.at(kn, ss["contact"], skn)
         np.maximum.at(ks, ss["contact"], sks)
+    if _BOUNDED.size and changing_stiffness(cs) and np.isin(cs["jmodel"], _BOUNDED).any():
+        raise_to_bound(cs["jmodel"], np.ascontiguousarray(cs["prop"]), kn, ks)
     return kn, ks
 
 
