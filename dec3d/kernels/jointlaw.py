@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numba import literally, njit, prange
 
-from .joints import ST_NEW, joint_law_for, joint_stiffness
+from .joints import ST_NEW, joint_law_for, joint_stiffness, joint_stiffness_bound
 
 
 @njit(cache=True, inline="always")   # (inlined into each caller's loop: the call costs as much as the work)
@@ -212,3 +212,15 @@ def subcontact_stiffness(cmodel, cprop, sc_contact, sc_hist, kn, ks):
     for s in range(sc_contact.shape[0]):
         c = sc_contact[s]
         kn[s], ks[s] = joint_stiffness(cmodel[c], cprop, c, sc_hist, s)
+
+
+@njit(cache=True)
+def raise_to_bound(cmodel, cprop, kn, ks):
+    """Each contact's kn, ks (nc,) [Pa/m] raised, in place, to the largest stiffness its joint model
+    can reach (``joints.joint_stiffness_bound``; columns 0, 1 for a model without the hook)."""
+    for c in range(cmodel.shape[0]):
+        bn, bs = joint_stiffness_bound(cmodel[c], cprop, c)
+        if bn > kn[c]:
+            kn[c] = bn
+        if bs > ks[c]:
+            ks[c] = bs

@@ -1,12 +1,12 @@
 """The stores of the rigid engine's contacts and sub-contacts: their fields (what a contact and a
 sub-contact keep, saved with the model), making them (``contact_stores``, which also brings a store
 restored from an older save up to today's fields) and the width of the joint models' history
-(``history_columns``). Detection itself: ``physics.contacts``."""
+(``history_columns``) and of their property rows (``property_columns``). Detection itself: ``physics.contacts``."""
 from __future__ import annotations
 
 import numpy as np
 
-from dec3d.kernels.joints import HISTORY_MODELS, NJHIST, NPROP, model_mask
+from dec3d.kernels.joints import COMMON_MODELS, HISTORY_MODELS, NJHIST, model_mask, prop_width
 from dec3d.model.groups import group_field
 from dec3d.model.store import Field, Store
 
@@ -23,7 +23,8 @@ CONTACT_FIELDS = {
     "gap": Field((), _F, 0.0),           # [m], negative = overlap
     "type": Field((), _I, 0),            # CT_* (kernels.commonplane)
     "jmodel": Field((), _I, 1),          # joint model code (physics.jmodels)
-    "prop": Field((NPROP,), _F, 0.0),    # kernel property row
+    # kernel property row: as many columns as the joint models in use read (``property_columns``)
+    "prop": Field((prop_width(COMMON_MODELS),), _F, 0.0),
     "own_props": Field((), np.uint8, 0), # 1: set by `block contact property`; 0: follows the defaults
     "sub_start": Field((), _I, 0),       # CSR into subcontacts
     "sub_count": Field((), _I, 0),
@@ -81,13 +82,14 @@ def contact_stores(model) -> tuple[Store, Store]:
     if "subcontacts" not in stores:
         model.add_store(Store("subcontacts", SUBCONTACT_FIELDS, capacity=256))
     # a model restored from an older save: fields added since (the joint models' ``hist``) start at
-    # their fill value, a property row narrower than today's widest model is widened
+    # their fill value; the property rows are as wide as its contacts' models read (saves before
+    # issue 27 had 10 columns, saves of its first version one column per property of the widest model)
     for store, fields in ((model.store("contacts"), CONTACT_FIELDS), (model.store("subcontacts"), SUBCONTACT_FIELDS)):
         for key, fld in fields.items():
             if key not in store:
                 store.add_field(key, fld)
-            elif store.fields[key].shape != fld.shape and key == "prop":
-                store.resize_field(key, fld.shape)
+    cs = model.store("contacts")
+    property_columns(cs, model_mask(cs["jmodel"]))
     for key in ("map_pos", "look_pos", "turn_pos"):
         if key not in model.vertices:
             model.vertices.add_field(key, Field((3,), _F, 0.0))
@@ -105,3 +107,15 @@ def history_columns(ss, codes) -> None:
     width = NJHIST if model_mask(np.asarray(codes, dtype=np.int64)) & HISTORY_MODELS else 0
     if ss.fields["hist"].shape != (width,):
         ss.resize_field("hist", (width,))
+
+
+def property_columns(cs, mask: int) -> int:
+    """Give the contacts' ``prop`` the columns the joint models of the bit ``mask`` read
+    (``kernels.joints.prop_width``) and return that width. A column dropped is one no contact's
+    model reads (the mask must hold the model of every contact kept); a column added is zero.
+    Called by detection (the models of the contacts it makes), by the commands that change
+    contacts' models, and when a model is restored."""
+    width = prop_width(mask)
+    if cs.fields["prop"].shape != (width,):
+        cs.resize_field("prop", (width,))
+    return width

@@ -37,12 +37,12 @@ from dec3d.kernels import contactmap as _cm
 from dec3d.kernels.contactmap import (blocks_moved, carry_over, cp_batch, envelopes, gather_subcontacts, match_sorted,
                                       subcontact_gaps, threaded, vertex_point_areas)
 from dec3d.kernels.kept import add_turns, as_they_are, pairs_to_look_at, take_defaults
-from dec3d.kernels.joints import NPROP
+from dec3d.kernels.joints import MODELS, NPROP, model_mask
 from dec3d.kernels.subgeom import subcontacts_batch
 from dec3d.model.model import KIND_DEFORMABLE, KIND_FE, KIND_RIGID
 from dec3d.model.ranges import pairs_in_groups
 
-from .contact_store import history_columns
+from .contact_store import history_columns, property_columns
 from .jmodels import JOINT_MODELS, MODEL_BY_CODE
 from .water import refresh as refresh_pore_pressure
 
@@ -58,6 +58,8 @@ QUIET = 0.1
 #: moved (and turned) less than QUIET·CTOL relative to each other (a stack settling or sliding as one)
 RELATIVE = True
 
+#: property columns each joint-model code reads
+_NCOLS = {m.CODE: m.NCOLS for m in MODELS}
 #: the sub-contact fields a detection writes (``contactmap.gather_subcontacts``), in its order
 _GATHERED = ("contact", "kind", "key0", "key1", "pos", "area", "fn", "fs", "un", "udil", "us", "state", "hist")
 
@@ -179,11 +181,11 @@ def joined_zoned_inert(sc_c, area, zoned, leader, ra, rb) -> None:
     area[inert[sc_c]] = 0.0
 
 
-def default_row(s: dict, code: int) -> np.ndarray:
+def default_row(s: dict, code: int, width: int = NPROP) -> np.ndarray:
     """Property row of a contact of model ``code`` that follows the material-table defaults
-    (the default properties this model has)."""
+    (the default properties this model has), ``width`` columns (``JointModel.row``)."""
     jm = MODEL_BY_CODE[code]
-    return jm.row({k: v for k, v in s["props"].items() if k in jm.props})
+    return jm.row({k: v for k, v in s["props"].items() if k in jm.props}, width)
 
 
 def apply_material_tables(model, tables, new, ra, rb, jcode, prop, own) -> None:
@@ -196,7 +198,7 @@ def apply_material_tables(model, tables, new, ra, rb, jcode, prop, own) -> None:
             hit &= pairs_in_groups(model, ra, rb, t["groups"][0], t["groups"][1], t.get("slot"))
         if hit.any():
             jcode[hit] = jm.code
-            prop[hit] = jm.row(t["props"])
+            prop[hit] = jm.row(t["props"], prop.shape[1])
             own[hit] = 1
 
 
@@ -399,15 +401,21 @@ class ContactDetection:
         keep_row = old & (own == 1)
         follow = ~keep_row                 # new contacts and old ones that follow the defaults
         codes = np.unique(jcode[follow])
-        # (each row written once: a model of one joint model following its defaults is one broadcast;
-        # the property rows are as wide as the widest model's, so every pass over them counts)
-        prop = np.empty((nc, NPROP))
+        tables = s.get("mtables") if not old.all() else None      # `block contact material-table add` entries
+        # the property rows hold the columns the models in use read, no more (``property_columns``):
+        # every contact's row is copied here at each detection
+        mask = model_mask(jcode)
+        for t in tables or ():
+            mask |= 1 << JOINT_MODELS[t["jmodel"]].code
+        width = property_columns(cs, mask)
+        # (each row written once: a model of one joint model following its defaults is one broadcast)
+        prop = np.empty((nc, width))
         if len(codes) == 1 and follow.all():
-            prop[:] = default_row(s, int(codes[0]))
+            prop[:] = default_row(s, int(codes[0]), width)
         else:
             prop[keep_row] = cs["prop"][prev_c[keep_row]]
             for code in codes:
-                prop[follow & (jcode == code)] = default_row(s, int(code))
+                prop[follow & (jcode == code)] = default_row(s, int(code), width)
         group[old] = cs["group"][prev_c[old]]
         pp_apply = np.zeros(nc)
         pp_apply[old] = cs["pp_apply"][prev_c[old]]
@@ -415,8 +423,8 @@ class ContactDetection:
         if "aperture" in cs:                       # a flow plane's own apertures (physics.flownet)
             extra["aperture"] = np.full((nc, 3), -1.0)
             extra["aperture"][old] = cs["aperture"][prev_c[old]]
-        if s.get("mtables") and not old.all():      # `block contact material-table add` entries
-            apply_material_tables(m, s["mtables"], ~old, ra_c, rb_c, jcode, prop, own)
+        if tables:
+            apply_material_tables(m, tables, ~old, ra_c, rb_c, jcode, prop, own)
         # sub-contacts of the recomputed contacts (zero-area ones carry nothing and are dropped)
         t1 = _time.perf_counter()
         f_ra, f_rb, f_prev = ra[fresh], rb[fresh], prev[fresh]
@@ -524,9 +532,11 @@ class ContactDetection:
         if not cs.n:
             return False
         s = self.settings()
-        table = np.zeros((max(MODEL_BY_CODE) + 1, NPROP))
-        for code in MODEL_BY_CODE:
-            table[code] = default_row(s, code)
+        width = cs["prop"].shape[1]
+        table = np.zeros((max(MODEL_BY_CODE) + 1, width))
+        for code in MODEL_BY_CODE:                 # (a model wider than the rows is not in use)
+            if _NCOLS[code] <= width:
+                table[code] = default_row(s, code, width)
         return take_defaults(cs["own_props"], cs["jmodel"], cs["prop"], table) > 0
 
     def ensure_contacts(self) -> None:

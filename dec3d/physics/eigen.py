@@ -92,7 +92,7 @@ def assemble(model, tol: float | None = None):
     prop = c["prop"].copy()
     follow = c["own_props"] == 0             # contacts that follow the defaults take them now
     for code in np.unique(c["jmodel"][follow]):
-        prop[follow & (c["jmodel"] == code)] = default_row(mech(model), int(code))
+        prop[follow & (c["jmodel"] == code)] = default_row(mech(model), int(code), prop.shape[1])
     sc = np.arange(s.n)
     ci = s["contact"][sc]
     ba, bb = body[c["a"][ci]], body[c["b"][ci]]

@@ -23,7 +23,7 @@ from dec3d.physics.modelprops import ModelProp, atan_deg, tan_deg
 
 from dec3d.kernels.joints import MODELS as KERNELS
 from dec3d.kernels.joints import NJHIST, NPROP, P_KN, P_KS
-from dec3d.kernels.jointlaw import subcontact_stiffness
+from dec3d.kernels.jointlaw import raise_to_bound, subcontact_stiffness
 
 
 @dataclass(frozen=True)
@@ -63,9 +63,10 @@ class JointModel:
     #: (``model factor-of-safety``); None: the model has no strength to reduce
     reduce: object = None
 
-    def row(self, values: dict[str, float] | None = None) -> np.ndarray:
-        """Kernel property row with every column at its default, then ``values`` applied."""
-        r = np.zeros(NPROP)
+    def row(self, values: dict[str, float] | None = None, width: int = NPROP) -> np.ndarray:
+        """Kernel property row with every column at its default, then ``values`` applied; ``width``
+        columns (the contacts store's, at least the model's own; zero beyond the model's)."""
+        r = np.zeros(width)
         for p in self.props.values():
             r[p.column] = p.default
         if values:
@@ -125,6 +126,8 @@ STIFFNESS = [Prop("stiffness-normal", P_KN, "normal stiffness kn", "Pa/m"),
 
 #: codes of the models whose kernel has a ``stiffness`` hook
 _HOOKED = np.array(sorted(k.CODE for k in KERNELS if hasattr(k, "stiffness")), dtype=np.int64)
+#: codes of the models whose kernel has a ``stiffness_bound`` hook
+_BOUNDED = np.array(sorted(k.CODE for k in KERNELS if hasattr(k, "stiffness_bound")), dtype=np.int64)
 
 
 def changing_stiffness(cs) -> bool:
@@ -157,13 +160,18 @@ def stiffness(cs, ss, prop=None) -> tuple[np.ndarray, np.ndarray]:
 def contact_stiffness(cs, ss) -> tuple[np.ndarray, np.ndarray]:
     """(kn, ks) (nc,) [Pa/m] per contact, for the time step and the mass scaling: the larger of its
     row's columns 0, 1 and the stiffest of its sub-contacts now (``stiffness``), so that a joint
-    softer now than its stated stiffness does not lengthen the step it may need again."""
+    softer now than its stated stiffness does not lengthen the step it may need again; for a model
+    that declares the largest stiffness it reaches (``stiffness_bound``), that: a joint that
+    stiffens with its closure (barton-bandis) under a load applied at once outruns a step worked
+    out from its stiffness now before the next detection works it out again."""
     kn = cs["prop"][:, P_KN].copy()
     ks = cs["prop"][:, P_KS].copy()
     if ss.n:
         skn, sks = stiffness(cs, ss)
         np.maximum.at(kn, ss["contact"], skn)
         np.maximum.at(ks, ss["contact"], sks)
+    if _BOUNDED.size and changing_stiffness(cs) and np.isin(cs["jmodel"], _BOUNDED).any():
+        raise_to_bound(cs["jmodel"], np.ascontiguousarray(cs["prop"]), kn, ks)
     return kn, ks
 
 

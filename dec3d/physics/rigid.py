@@ -349,7 +349,7 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
         follow = cs["own_props"] == 0
         prop = cs["prop"].copy()
         for code in np.unique(cs["jmodel"][follow]):
-            prop[follow & (cs["jmodel"] == code)] = default_row(self.settings(), int(code))
+            prop[follow & (cs["jmodel"] == code)] = default_row(self.settings(), int(code), prop.shape[1])
         return missing(cs, prop)
 
     def stiffness_warning(self) -> str | None:
@@ -364,7 +364,7 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
             return None
         follow = cs["own_props"] == 0             # these take the defaults at the next detection
         codes = [int(code) for code in np.unique(cs["jmodel"][follow])]
-        rows = {code: default_row(self.settings(), code) for code in codes}
+        rows = {code: default_row(self.settings(), code, cs["prop"].shape[1]) for code in codes}
         if (all(r[P_KN] > 0.0 and r[P_KS] > 0.0 for r in rows.values())
                 and (cs["prop"][:, P_KN] > 0.0).all() and (cs["prop"][:, P_KS] > 0.0).all()):
             return None                           # (every stiffness set: no copy of the table)

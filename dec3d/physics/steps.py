@@ -22,13 +22,13 @@ from dec3d.io.vtk import periodic_vtk
 from dec3d.kernels.bundles import (NSERVO, Bodies, Bounds, Contacts, Groups, SubContacts, load_servo, new_damping,
                                    new_servo, servo_values)
 from dec3d.kernels.contactmap import blocks_moved
-from dec3d.kernels.joints import cycle_mask
+from dec3d.kernels.joints import cycle_mask, model_mask
 from dec3d.physics.jmodels import changing_stiffness
 from dec3d.kernels.cycle import cycle_lists, run_steps
 from dec3d.kernels.motion import DAMP_ADAPTIVE
 
 from . import contacts as _contacts
-from .contact_store import history_columns
+from .contact_store import history_columns, property_columns
 from .bodies import group_properties
 from .cables import cable_steps
 from .dynamic import TimeFunctions, has_timefns, maxwell_components, maxwell_timestep, stiffness_timestep
@@ -158,6 +158,7 @@ class _Run:
         if self.mixed:
             self.wsub, self.wcon = eng._mixed_weights(self.zst, recompute=not between)
         history_columns(eng.subcontacts, eng.contacts["jmodel"])   # (a restored or edited model)
+        property_columns(eng.contacts, model_mask(eng.contacts["jmodel"]))
         refresh_if_stale(eng)              # pore pressures (physics.water) after a change of their sources
         #: steps per batch at most: 1 while flow in the joints is coupled to moving blocks (physics.flownet)
         self.fluid_cap = 2 ** 62

@@ -204,3 +204,45 @@ def test_missing_required_properties_stop_the_cycle(session):
     with pytest.raises(Exception) as e:
         session.command("model cycle 1")
     assert "needs property 'jcs'" in str(e.value)
+
+
+#: J5's closure part without its hand-set time step: 5 MN put at once on a 1 m cube (2000 kg) over a
+#: fixed block; kni = 1 GPa/m, vm = 1 mm. Before the model declared its largest stiffness the automatic
+#: step (from kni, 1.4 ms) let the block jump 7 cm in the first step and the run stopped unstable at step 2
+SUDDEN = """model new
+block create brick -1.5 2.5 -1 2 -1 0
+block create brick 0 1 0 1 0 1
+block property density 2000
+model gravity 0 0 0
+block contact jmodel assign barton-bandis
+block contact material-table default property stiffness-normal 1e9 stiffness-shear 1e9 jrc 10 jcs 1e8 friction-residual 30 closure-maximum 1e-3
+block fix range id 1
+block fix rotation range id 2
+block apply force-z -5000000 range id 2
+block apply velocity-x 0 velocity-y 0 range id 2
+model solve ratio 1e-7
+"""
+
+
+def test_largest_stiffness_is_the_hyperbolas_tangent_at_its_cap():
+    """stiffness_bound: kn = kni / (1 − 0.99)² (10⁴ kni; kni without vm), ks as given (twin: the formula)."""
+    rows = np.array([[1e9, 4e8, 10, 1e8, 30, 1e-3], [2e9, 5e8, 10, 1e8, 30, 0.0]])
+    kn, ks = bb.stiffness_bound(rows, 0)
+    assert kn == pytest.approx(1e9 / 0.01 ** 2, rel=1e-12) and ks == 4e8
+    assert bb.stiffness_bound(rows, 1) == (2e9, 5e8)
+
+
+def test_a_load_put_at_once_runs_stable_with_the_automatic_step(session):
+    """The time step and the masses follow the largest stiffness the law reaches (stiffness_bound),
+    so the sudden load closes the joint to the hyperbola's closure, v = σn vm / (kni vm + σn), without a
+    hand-set step."""
+    from dec3d.physics.jmodels import contact_stiffness
+    from dec3d.physics.rigid import engine
+
+    session.command(SUDDEN)
+    e = engine(session.model)
+    kn, _ = contact_stiffness(e.contacts, e.subcontacts)
+    assert kn.max() == pytest.approx(1e13)
+    uz = float(session.model.blocks["disp"][1, 2])
+    sn = 5e6
+    assert uz == pytest.approx(-sn * 1e-3 / (1e9 * 1e-3 + sn), rel=1e-3)

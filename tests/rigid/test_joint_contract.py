@@ -107,3 +107,12 @@ def test_jmodel_load_of_anything_else_is_refused_with_where_and_why(session, nam
     msg = str(err.value)
     assert "cannot be loaded" in msg and "runs no compiled plugins" in msg
     assert "deck.dat:2:27" in msg or (err.value.location is not None and err.value.location.line == 2)
+
+
+def test_power_law_creep_is_refused_saying_what_is_missing(session):
+    """3DEC's `power` joint: the reference text stops before its creep-rate law and its keywords."""
+    with pytest.raises(Dec3dError) as err:
+        session.run_items(session.load_text("model new\nblock contact jmodel assign power", filename="deck.dat"))
+    msg = str(err.value)
+    assert "`power` is not supported yet" in msg and "creep-rate law" in msg and "property keywords" in msg
+    assert "deck.dat:2" in msg or (err.value.location is not None and err.value.location.line == 2)

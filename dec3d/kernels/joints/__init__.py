@@ -19,10 +19,15 @@ A model's kernel file (any ``<name>.py`` here not starting with ``_``) declares
 - optionally ``stiffness(p, c, h, s) -> (kn, ks)``: the sub-contact's current normal and shear
   stiffness [Pa/m], finite and ≥ 0, wherever the engine needs one (time step, mass scaling,
   strain energy, Rayleigh damping, eigenmodes, zoned contacts). Without it, columns 0 and 1.
+- optionally ``stiffness_bound(p, c) -> (kn, ks)``: the largest normal and shear stiffness [Pa/m]
+  the law can reach with contact c's properties (finite, ≥ 0), for a model whose stiffness grows
+  with its state: the time step and the mass scaling take it instead of the stiffness now, so that
+  a load applied at once cannot stiffen the joint beyond what the step was worked out for between
+  two detections. Without it, the larger of columns 0, 1 and the stiffness now.
 
 Its host file of the same name in ``dec3d/physics/joints`` declares the user-facing properties.
-``joint_law(code, ...)`` calls the law of the model with that code and ``joint_stiffness(code,
-...)`` its stiffness; each is a chain of small numba functions, one per model, built here at
+``joint_law(code, ...)`` calls the law of the model with that code, ``joint_stiffness(code,
+...)`` its stiffness and ``joint_stiffness_bound(code, ...)`` its bound; each is a chain of small numba functions, one per model, built here at
 import from the files found, so adding a model adds two files and edits none. The rigid cycle
 and the zoned-contact pass take the law through ``joint_law_for(mask, …)``: a chain of the models
 in use only (``cycle_mask``: theirs, elastic and mohr), compiled once per mask, so that a new law
@@ -42,9 +47,9 @@ from numba.extending import overload
 
 from ._common import NJHIST, P_KN, P_KS, ST_FAILED, ST_NEW, ST_SLIP, ST_TENSION, constant_stiffness
 
-__all__ = ["ALL_MODELS", "CODES", "COMMON_MODELS", "HISTORY_MODELS", "MODELS", "NJHIST", "NPROP", "P_KN", "P_KS",
+__all__ = ["ALL_MODELS", "BOUNDED_MODELS", "CODES", "COMMON_MODELS", "HISTORY_MODELS", "MODELS", "NJHIST", "NPROP", "P_KN", "P_KS",
            "ST_FAILED", "ST_NEW", "ST_SLIP", "ST_TENSION", "cycle_mask", "joint_law", "joint_law_for",
-           "joint_stiffness", "model_mask"]
+           "joint_stiffness", "joint_stiffness_bound", "model_mask", "prop_width"]
 
 
 def _find():
@@ -61,6 +66,9 @@ def _find():
     if max(codes) > 62:
         raise ImportError(f"joint-law kernels: codes {codes} must be below 63 (bits of one int64 mask)")
     for m in mods:
+        if hasattr(m, "stiffness_bound") and not hasattr(m, "stiffness"):
+            raise ImportError(f"joint model {m.NAME}: a stiffness_bound needs a stiffness hook (a model without "
+                              f"one is linear: columns 0, 1 are its stiffness and its bound)")
         if not 0 <= m.NHIST <= NJHIST or len(m.HIST_NAMES) != m.NHIST:
             raise ImportError(f"joint model {m.NAME}: NHIST {m.NHIST} must be at most {NJHIST}, with one name "
                               f"each in HIST_NAMES")
@@ -70,7 +78,8 @@ def _find():
 MODELS = tuple(_find())
 #: code of each joint model by name
 CODES = {m.NAME: m.CODE for m in MODELS}
-#: property columns of the widest model (the contacts store's ``prop`` width)
+#: property columns of the widest model (the most a contacts store's ``prop`` row holds; the store
+#: holds only what the models in use read: ``prop_width``)
 NPROP = max(m.NCOLS for m in MODELS)
 
 
@@ -113,8 +122,34 @@ def _stiffness_link(i):
     return link
 
 
+def _bound_link(i):
+    """``joint_stiffness_bound`` from model i on (as ``_link``); a model without the hook answers
+    columns 0, 1."""
+    code = MODELS[i].CODE
+    hook = getattr(MODELS[i], "stiffness_bound", _columns)
+    if i == len(MODELS) - 1:
+        @njit(inline="always")
+        def last(model, p, c):
+            return hook(p, c)
+        return last
+    rest = _bound_link(i + 1)
+
+    @njit(inline="always")
+    def link(model, p, c):
+        if model == code:
+            return hook(p, c)
+        return rest(model, p, c)
+    return link
+
+
+@njit(cache=True, inline="always")
+def _columns(p, c):
+    return p[c, P_KN], p[c, P_KS]
+
+
 joint_law = _link(0)
 joint_stiffness = _stiffness_link(0)
+joint_stiffness_bound = _bound_link(0)
 
 
 def model_mask(codes) -> int:
@@ -132,9 +167,23 @@ def model_mask(codes) -> int:
 ALL_MODELS = model_mask(m.CODE for m in MODELS)
 #: the mask of the models that keep a history (detection carries ``hist`` only when one is in use)
 HISTORY_MODELS = model_mask(m.CODE for m in MODELS if m.NHIST)
+#: the mask of the models that declare the largest stiffness they reach (``stiffness_bound``)
+BOUNDED_MODELS = model_mask(m.CODE for m in MODELS if hasattr(m, "stiffness_bound"))
 #: the models every compiled cycle holds (the two small founding laws): decks of elastic joints, of
 #: mohr joints and of both then share one compiled cycle, as before the chain was per mask
 COMMON_MODELS = model_mask(m.CODE for m in MODELS if m.NAME in ("elastic", "mohr"))
+
+
+def prop_width(mask: int) -> int:
+    """Property columns the models of the bit mask ``mask`` read: the widest one's ``NCOLS``, at least
+    2 (kn, ks, which the engine reads on every contact). The contacts store's ``prop`` is this wide,
+    not ``NPROP``: detection copies every contact's row, and MASON's 21 columns on every contact of
+    a mohr-only model cost its detection a third more time."""
+    w = 2
+    for m in MODELS:
+        if (mask >> m.CODE) & 1 and m.NCOLS > w:
+            w = m.NCOLS
+    return w
 
 
 def cycle_mask(codes) -> int:

@@ -23,7 +23,8 @@ IJRMMS 20(6), 249-268), the hyperbola
 with v = −(uⁿ − u_dil) the closure (≥ 0), kni the initial normal stiffness and vm the maximum
 closure. The hyperbola is followed up to v = 0.99 vm (σn = 99 kni vm, kn = 10⁴ kni there) and
 continues with that tangent beyond: stress and stiffness stay finite for any closure, and the
-closure stays below vm while σn < 199 kni vm (a bound on the stiffness the time step must take). An open joint
+closure stays below vm while σn < 199 kni vm; 10⁴ kni is the largest stiffness the law reaches
+(``stiffness_bound``: the automatic time step and the mass scaling take it). An open joint
 (v ≤ 0) carries nothing; no tensile strength. Shear stiffness ks constant (column 1).
 No dilation (u_dil unchanged); JRC, JCS are not scale-corrected (give the field-scale values).
 
@@ -94,6 +95,17 @@ def stiffness(p, c, h, s):
     """Current kn from the hyperbola at the stored closure, ks constant [Pa/m]."""
     sn, kn = closure_stress(p[c, P_KN], p[c, P_VM], h[s, H_V])
     return kn, p[c, P_KS]
+
+
+@njit(cache=True, inline="always")
+def stiffness_bound(p, c):
+    """The largest kn the law reaches: the hyperbola's tangent at VCAP vm, kni/(1 − VCAP)² (10⁴ kni;
+    kni without a maximum closure), and ks [Pa/m]: the time step holds for any closure a load reaches."""
+    kni = p[c, P_KN]
+    if not p[c, P_VM] > 0.0:
+        return kni, p[c, P_KS]
+    q = 1.0 - VCAP
+    return kni / (q * q), p[c, P_KS]
 
 
 @njit(cache=True, inline="always")

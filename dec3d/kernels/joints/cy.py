@@ -38,7 +38,10 @@ Our choice where the published law leaves it open: |τ| never exceeds τm. Once 
 τ lag above the falling bound (by ~|dτm/du|/ks: 40 % for R = 0.5 mm, ks = 1 GPa/m) with Δuᵖ > |Δuˢ|.
 
 Not implemented: the model's dilation (the normal displacement of the roughness); u_dil is
-passed through unchanged.
+passed through unchanged. No ``stiffness_bound``: kn = a_n σn^e_n has no largest value short of the
+σn cap (10³⁰ Pa), and 3DEC's keywords give no largest normal stress; a load put at once on a joint at
+zero stress (kn = 0: the automatic step then follows columns 0, 1, the multipliers a_n, a_s) still
+needs `block mechanical timestep` set for the stiffest state the deck reaches (J1 does).
 
 History h[s, :7]: plastic shear displacement uᵖ [m], normal stress σn [Pa], mobilised friction
 φm [deg] (the one this step's bound used: from uᵖ before the step; output only), the factor r,
