@@ -28,7 +28,7 @@ def _check_configure(call):
 
     opt = call.args["option"]
     if opt != "threads" and call.args["n"] is not None:
-        raise BindError(f"`model configure {opt}` takes no number",
+        raise BindError(f"`model configure {opt}` takes no value",
                         call.locations.get("n", call.location))
     if (opt == "units") != (call.args["system"] is not None):
         raise BindError("`model configure units` needs the system: si or none" if opt == "units" else

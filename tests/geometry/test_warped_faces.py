@@ -80,8 +80,8 @@ def test_block_create_warns_once_naming_block_face_and_warp(tmp_path, batch_min)
     assert s.model.blocks.n == 3
     warnings = [line for line in out.getvalue().splitlines() if line.startswith("warning:")]
     assert warnings == [
-        "warning: warp.dat:3:1: block 2: face 2 is warped: corner 1 lies 0.00025 m off the face's plane "
-        "(tolerance 1e-06 m; accepted up to 0.5 % of the block's size, 0.00866 m): the block is built as the "
+        "warning: warp.dat:3:1: block 2: face 2 is warped: corner 1 lies 0.00025 off the face's plane "
+        "(tolerance 1e-06; accepted up to 0.5 % of the block's size, 0.00866): the block is built as the "
         "convex hull of its corners, the warped face split into triangles"]
     assert np.allclose(s.model.blocks["volume"][:3], [1.0, _triangulated_volume(1e-3), 1.0], rtol=1e-12, atol=0)
 

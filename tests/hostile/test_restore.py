@@ -111,7 +111,7 @@ def _set(path, value):
 
 META_CASES = [
     (("settings", "mechanical", "damping"), "bogus",
-     "mechanical setting `damping` is 'bogus', not one of local, combined, global, none, rayleigh"),
+     "mechanical setting `damping` is 'bogus', not one of local, combined, global, none, rayleigh, maxwell"),
     (("settings", "mechanical", "jmodel"), "magic",
      "mechanical setting `jmodel` is 'magic', not one of " + ", ".join(sorted(JOINT_MODELS))),
     (("settings", "mechanical", "frac"), "abc",
