@@ -211,7 +211,7 @@ def _constants(K, G, coh, tf, ten, td, wf):
     return npf, csn, ft, nps, a1, a2, sp, wf[28], a1 * (1.0 + npf * nps) - a2 * (npf + nps)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
     coh, tf, ten, td = strengths(p, h, z, tab)
     e0, e1, e2, e3, e4, e5 = hooke(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5)
