@@ -263,7 +263,7 @@ def _two_cutoffs(p1, p2, p3, K, G, q0, n0, st, mar):
 
 
 @njit(cache=True, inline="always")
-def _fast(p, z, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a, sci, st):
+def _fast(flag, tandil, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a, sci, st):
     """The return of the trial s0..s5 in scalars for the common case (``update``'s fast path):
     principal values well apart (``GAP_REL``, as ``zone_mohr._fast_return``), a clear shear
     return onto the σ1-σ3 surface leaving σ2 between them, or Itasca's tension return. Given
@@ -321,7 +321,7 @@ def _fast(p, z, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, 
         ck = (a - 1.0) * mb * (n0 - 1.0) / (sci * (mb * x0 / sci + s))
     else:
         ck = math.nan
-    nps = _nps(p[z, C_FLAGDIL], p[z, C_TANDIL], n0)
+    nps = _nps(flag, tandil, n0)
     a1 = K + 4.0 * G / 3.0
     a2 = K - 2.0 * G / 3.0
     dm1 = a2 * nps - a1                          # dσ1/dλ
@@ -406,16 +406,29 @@ def fast_update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, t
     m, l1, l2, l3 = _dev_principal(s0, s1, s2, s3, s4, s5)
     x0 = max(-(m + l3), 0.0)
     q0, n0 = hb_strength(x0, mb, s, a, sci)
-    return _fast(p, z, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a, sci, s * sci / mb)
+    return _fast(p[z, C_FLAGDIL], p[z, C_TANDIL], K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a,
+                 sci, s * sci / mb)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
-    s0, s1, s2, s3, s4, s5 = hooke(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5)
     mb = p[z, C_MB]
     s = p[z, C_S]
     a = p[z, C_A]
     sci = p[z, C_SCI]
+    # (inlined into the zone step: the scalar path is one call on scalars, no array arguments
+    # whose reference counts a call would pay for every zone; the arrays go only to ``_slow``)
+    r = _scalar(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, mb, s, a, sci, p[z, C_FLAGDIL], p[z, C_TANDIL])
+    if r[0] >= 0:
+        return r
+    return _slow(p, z, K, G, r[1], r[2], r[3], r[4], r[5], r[6], mb, s, a, sci, s * sci / mb, wf, mw, r[0])
+
+
+@njit(cache=True)
+def _scalar(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, mb, s, a, sci, flag, tandil):
+    """The elastic trial, the yield test and the scalar returns (``_fast``) of ``update``: (code,
+    t0..t5, dsp), code < 0 (``_fast``'s) with t the trial where ``_slow`` must finish."""
+    s0, s1, s2, s3, s4, s5 = hooke(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5)
     if not (mb > 0.0 and sci > 0.0 and a > 0.0 and s >= 0.0):
         return 0, s0, s1, s2, s3, s4, s5, 0.0          # (refused by the host; never cycled)
     st = s * sci / mb
@@ -427,11 +440,7 @@ def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, w
     q0, n0 = hb_strength(x0, mb, s, a, sci)       # the envelope's tangent there
     if m + l3 - st < -margin and -(m + l1) - (q0 + n0 * (-(m + l3) - x0)) < -margin:
         return 0, s0, s1, s2, s3, s4, s5, 0.0
-    r = _fast(p, z, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a, sci, st)
-    if r[0] >= 0:
-        return r
-    # (one call passing the arrays: each such call costs reference counts on every zone)
-    return _slow(p, z, K, G, s0, s1, s2, s3, s4, s5, mb, s, a, sci, st, wf, mw, r[0])
+    return _fast(flag, tandil, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a, sci, st)
 
 
 @njit(cache=True)

@@ -212,12 +212,25 @@ def _constants(K, G, coh, tf, ten, td, wf):
 
 
 @njit(cache=True)
+def _scalar_return(e0, e1, e2, e3, e4, e5, coh, npf, csn, ft, nps, a1, a2, sp, ap, den):
+    """``zone_mohr.mohr_scalar`` as one call on scalars: ``update`` is inlined into the zone step
+    (no array arguments to count references of), this part is compiled once, not into each step."""
+    return mohr_scalar(e0, e1, e2, e3, e4, e5, coh, npf, csn, ft, nps, a1, a2, sp, ap, den)
+
+
+@njit(cache=True)
+def _increments(bits, one_plane, a0, a1, a2, a3, a4, a5, K, G, nps):
+    """``hardening_increments`` as one call on scalars (as ``_scalar_return``)."""
+    return hardening_increments(bits, one_plane, a0, a1, a2, a3, a4, a5, K, G, nps)
+
+
+@njit(cache=True, inline="always")
 def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
     coh, tf, ten, td = strengths(p, h, z, tab)
     e0, e1, e2, e3, e4, e5 = hooke(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5)
     npf, csn, ft, nps, a1, a2, sp, ap, den = _constants(K, G, coh, tf, ten, td, wf)
-    code, t0, t1, t2, t3, t4, t5, dp = mohr_scalar(e0, e1, e2, e3, e4, e5, coh, npf, csn, ft, nps, a1, a2, sp,
-                                                   ap, den)
+    code, t0, t1, t2, t3, t4, t5, dp = _scalar_return(e0, e1, e2, e3, e4, e5, coh, npf, csn, ft, nps, a1, a2, sp,
+                                                      ap, den)
     one_plane = code >= 0
     if code < 0:
         s = wf[16:22]
@@ -225,7 +238,7 @@ def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, w
         code, dp = mohr_plastic(s, K, G, coh, tf, ten, td, mw)
         t0 = s[0]; t1 = s[1]; t2 = s[2]; t3 = s[3]; t4 = s[4]; t5 = s[5]
     if code != 0:
-        dks, dkt = hardening_increments(code, one_plane, e0 - t0, e1 - t1, e2 - t2, e3 - t3, e4 - t4, e5 - t5,
+        dks, dkt = _increments(code, one_plane, e0 - t0, e1 - t1, e2 - t2, e3 - t3, e4 - t4, e5 - t5,
                                         K, G, nps)
         h[z, 0] += dks
         h[z, 1] += dkt
