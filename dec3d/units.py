@@ -12,7 +12,7 @@ Wall-clock times (``finished in 3.2 s``) are real seconds and always say so.
 """
 from __future__ import annotations
 
-#: the systems ``model configure units`` accepts; "none" (the default) shows no units
+#: the unit systems reports can name (``model configure units``; "none", the default, names none)
 SYSTEMS = {
     "si": {
         "length": "m", "area": "m²", "volume": "m³", "mass": "kg", "time": "s", "force": "N",
@@ -21,7 +21,8 @@ SYSTEMS = {
         "per-length": "1/m", "energy": "J", "pressure": "Pa", "flow": "m³/s",
     },
 }
-NAMES = ("si", "none")
+#: the words ``model configure units`` takes
+NAMES = tuple(SYSTEMS) + ("none",)
 
 #: the physical dimension of each array dec3d writes to VTK (what ``units`` field data names)
 ARRAY_DIMS = {

@@ -1,6 +1,7 @@
 """`model new|title|configure|large-strain|gravity`: model-wide settings."""
 from __future__ import annotations
 
+from ..units import NAMES as UNIT_SYSTEMS
 from .registry import command
 from .values import FLAG, ONOFF, Choice, Num, Nums, P, Text
 
@@ -20,7 +21,6 @@ def model_title(session, call):
 
 
 CONFIGURE_OPTIONS = ("dynamic", "fluid", "thermal", "highorder", "feblock", "creep")
-UNIT_SYSTEMS = ("si", "none")
 
 
 def _check_configure(call):
