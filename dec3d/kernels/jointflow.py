@@ -34,27 +34,11 @@ def stable_dt(pa, pb, c, vol, kw, fixed):
     return dt
 
 
-@njit(cache=True)
 def flow_steps(nsteps, dt, pa, pb, c, vol, kw, fixed, q_in, p, flow):
     """``nsteps`` explicit steps of Δt [s] (reduced to ``stable_dt`` if larger: never blown up); p (nk,)
-    updated in place, flow (npipe,) the last step's pipe flows [m³/s]. Returns the Δt used."""
-    h = stable_dt(pa, pb, c, vol, kw, fixed)
-    if dt > h:
-        dt = h
-    nk = p.shape[0]
-    net = np.empty(nk)
-    for _ in range(nsteps):
-        for i in range(nk):
-            net[i] = q_in[i]
-        for k in range(c.shape[0]):
-            q = c[k] * (p[pa[k]] - p[pb[k]])
-            flow[k] = q
-            net[pa[k]] -= q
-            net[pb[k]] += q
-        for i in range(nk):
-            if not fixed[i]:
-                p[i] += kw * dt / vol[i] * net[i]
-    return dt
+    updated in place, flow (npipe,) the last step's pipe flows [m³/s]. Returns the Δt used.
+    ``network_steps`` without gravity (dg = 0)."""
+    return network_steps(nsteps, dt, pa, pb, c, np.zeros(c.shape[0]), vol, kw, fixed, q_in, p, flow)
 
 
 # ------------------------------------------------------------------ the network built from the contacts

@@ -138,6 +138,21 @@ def _zone_force(dn4, wd4, s4, fz):
             fz[a, 2] -= wd * (s[4] * dn[a, 0] + s[5] * dn[a, 1] + s[2] * dn[a, 2])
 
 
+@njit(cache=True, inline="always")
+def vel_grad(dn, vel, nodes):
+    """The velocity gradient L[i, j] = dv_i/dx_j at one Gauss point (dn (10, 3) the shape-function
+    gradients there), summed over the nodes in order: (l00, l01, l02, l10, …, l22)."""
+    l00 = 0.0; l01 = 0.0; l02 = 0.0
+    l10 = 0.0; l11 = 0.0; l12 = 0.0
+    l20 = 0.0; l21 = 0.0; l22 = 0.0
+    for a in range(10):
+        v = vel[nodes[a]]
+        l00 += v[0] * dn[a, 0]; l01 += v[0] * dn[a, 1]; l02 += v[0] * dn[a, 2]
+        l10 += v[1] * dn[a, 0]; l11 += v[1] * dn[a, 1]; l12 += v[1] * dn[a, 2]
+        l20 += v[2] * dn[a, 0]; l21 += v[2] * dn[a, 1]; l22 += v[2] * dn[a, 2]
+    return l00, l01, l02, l10, l11, l12, l20, l21, l22
+
+
 @njit(cache=True)
 def _zone_step(z, pos, vel, gp, bulk, shear, dt, gstress, stress, dref, dn4, wd4, nodes, fz):
     """Stress update and nodal forces (into fz (10, 3)) of zone row z. False, changing
@@ -151,16 +166,7 @@ def _zone_step(z, pos, vel, gp, bulk, shear, dt, gstress, stress, dref, dn4, wd4
     for c in range(6):
         stress[z, c] = 0.0
     for g in range(4):
-        dn = dn4[g]
-        # velocity gradient L[i, j] = dv_i/dx_j
-        l00 = 0.0; l01 = 0.0; l02 = 0.0
-        l10 = 0.0; l11 = 0.0; l12 = 0.0
-        l20 = 0.0; l21 = 0.0; l22 = 0.0
-        for a in range(10):
-            v = vel[nodes[a]]
-            l00 += v[0] * dn[a, 0]; l01 += v[0] * dn[a, 1]; l02 += v[0] * dn[a, 2]
-            l10 += v[1] * dn[a, 0]; l11 += v[1] * dn[a, 1]; l12 += v[1] * dn[a, 2]
-            l20 += v[2] * dn[a, 0]; l21 += v[2] * dn[a, 1]; l22 += v[2] * dn[a, 2]
+        l00, l01, l02, l10, l11, l12, l20, l21, l22 = vel_grad(dn4[g], vel, nodes)
         exx = l00 * dt; eyy = l11 * dt; ezz = l22 * dt
         exy = 0.5 * (l01 + l10) * dt
         exz = 0.5 * (l02 + l20) * dt

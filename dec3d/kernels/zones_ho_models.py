@@ -20,7 +20,7 @@ from numba import literally, njit
 from .gather import scatter
 from .zmodels import NWORK, merge_state, zone_update_for
 from .zone_mohr import mohr_work
-from .zones_ho import _zone_force, _zone_grads, ref_derivs
+from .zones_ho import _zone_force, _zone_grads, ref_derivs, vel_grad
 
 
 @njit(cache=True)
@@ -62,15 +62,7 @@ def tet10_model_step(pos, vel, gp, rows, mat, ghist, dt, models, gstress, force)
         for j in range(nh):
             hist[z, j] = 0.0
         for g in range(4):
-            dn = dn4[g]
-            l00 = 0.0; l01 = 0.0; l02 = 0.0
-            l10 = 0.0; l11 = 0.0; l12 = 0.0
-            l20 = 0.0; l21 = 0.0; l22 = 0.0
-            for a in range(10):
-                v = vel[nodes[a]]
-                l00 += v[0] * dn[a, 0]; l01 += v[0] * dn[a, 1]; l02 += v[0] * dn[a, 2]
-                l10 += v[1] * dn[a, 0]; l11 += v[1] * dn[a, 1]; l12 += v[1] * dn[a, 2]
-                l20 += v[2] * dn[a, 0]; l21 += v[2] * dn[a, 1]; l22 += v[2] * dn[a, 2]
+            l00, l01, l02, l10, l11, l12, l20, l21, l22 = vel_grad(dn4[g], vel, nodes)
             s = gstress[z, g]
             bits, t0, t1, t2, t3, t4, t5, dsp = zone_update_for(
                 models, code, pz, ghist[z, g:g + 1], 0, K, G,
