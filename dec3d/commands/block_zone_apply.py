@@ -71,7 +71,9 @@ def _rows(session, call, what: str) -> np.ndarray:
                  "stay with the zones (saved and restored with the model) until `block zone apply-remove`; "
                  "zones made again by `block zone generate` start without. `source` (heat) and `well` (fluid) "
                  "need thermal analysis or fluid flow in zones, which dec3d does not have: they are refused where "
-                 "they are written. Itasca's value modifiers (time and space variation) are not supported.",
+                 "they are written. Itasca's value modifiers (time and space variation) are not supported. (The keywords "
+                 "are those of Itasca's `zone apply` page of FLAC3D 7, part of the 3DEC 7 documentation set; "
+                 "3DEC's own `block zone apply` page was not at hand.)",
          examples=["block zone apply force 0 0 -2e4",
                    "block zone apply force-z -1e4 range group 'fill'",
                    "block zone apply force-x 5e3 range position-z 0 2"])

@@ -191,3 +191,31 @@ def test_not_finite_is_refused(tmp_path):
     s = _session(tmp_path, [*_SETUP.strip().split("\n")])
     with pytest.raises(Dec3dError, match="not a finite number|must be finite"):
         s.command("block zone apply force-x [1e308*10]")
+
+
+def test_the_implicit_solve_takes_the_body_force(tmp_path):
+    """`model solve … implicit` (its residual sums the same loads): the explicit answer of the z column."""
+    out = {}
+    for how in ("implicit", ""):
+        s = _session(tmp_path, ["block create brick 0 1 0 1 0 2", "block zone generate edgelength 0.25", *_ELASTIC,
+                                "block gridpoint apply velocity 0 0 0 range position-z 0",
+                                "block gridpoint apply velocity-x 0", "block gridpoint apply velocity-y 0",
+                                "block zone apply force-z -2e4", f"model solve ratio 1e-9 {how}"])
+        out[how] = s.model.vertices["disp"][:, 2].copy()
+    want = -2e4 * H * H / (2 * (K + 4 * G / 3))
+    assert out["implicit"].min() == pytest.approx(want, rel=1e-2)
+    assert np.abs(out["implicit"] - out[""]).max() <= 1e-5 * abs(want)
+
+
+def test_energy_counts_the_work_of_the_body_force_as_gravity_s(tmp_path):
+    """`model energy`: the `body` work of `force 0 0 −ρg` is gravity's, and the balance closes."""
+    from dec3d.physics.energy import values
+
+    def run(load):
+        s = _session(tmp_path, ["block create brick 0 1 0 1 0 1", "block zone generate edgelength 0.5", *_ELASTIC,
+                                "block gridpoint apply velocity 0 0 0 range position-z 0", load,
+                                "model energy active on", "model cycle 100"])
+        return values(s.model)
+    grav, body = run("model gravity 0 0 -10"), run("block zone apply force 0 0 -2e4")
+    assert body["body"] > 0 and body["body"] == pytest.approx(grav["body"], rel=1e-12)
+    assert abs(body["error-relative"]) < 1e-9
