@@ -34,6 +34,8 @@ block still owns a contiguous vertex range (which the contact code relies on).
     ghist (4, NZHIST) -     a 10-node tetrahedron's Gauss-point histories (its ``hist`` is their mean)
     state ()         int32  plastic state bits (``ZSTATE_*``; a model's update returns the "now" bits)
     group (nslots,)  int32  group codes per slot, -1 none
+    fbody (3,)       N/m³   body force per unit volume (``block zone apply force``); added by the first such
+                            command (``body_force_field``): a model without the field has none
 
 Gridpoint fields added to ``vertices`` (rigid-block vertices leave them at their fill):
     link ()          int64  -1: this row is its own master; else the master row (a shared gridpoint)
@@ -147,6 +149,15 @@ def zone_stores(model) -> Store:
     if "source" not in model.faces:
         model.faces.add_field("source", Field((), _I, -1))
     return model.add_store(Store("zones", _zone_fields(), capacity=256))
+
+
+def body_force_field(model) -> np.ndarray:
+    """``zones.fbody`` (live rows), the field added with zeros if this model has none yet (a model made, or a
+    save file written, before the first `block zone apply`)."""
+    zs = zone_stores(model)
+    if "fbody" not in zs:
+        zs.add_field("fbody", Field((3,), _F, 0.0))
+    return zs["fbody"]
 
 
 def has_zones(model) -> bool:

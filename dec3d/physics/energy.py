@@ -28,7 +28,7 @@ The components (running sums since tracking was switched on or reset, joules):
 - ``block-plastic``  work done on the zones less the change of their elastic energy (plastic flow);
 - ``contact-slip``   work done on the springs less the change of their elastic energy: what Coulomb slip
   and the tension cut-off dissipated;
-- ``body``           work done by gravity;
+- ``body``           work done by gravity and by the body forces of `block zone apply`;
 - ``boundary``       work of the applied forces, moments and face stresses and of the reactions of fixed
   velocity or rotation components (applied velocities);
 - ``damping``        work of all forces on the free components less the change of kinetic energy: what the
@@ -352,6 +352,8 @@ class _Tracker:
         grav = np.zeros((v.n, 3))
         app = np.zeros((v.n, 3))
         grav[rows] = zst.gmass[rows, None] * np.asarray(r.g, _F)[None, :]
+        if zst.zb is not None:                  # body forces of `block zone apply` work as gravity does
+            grav[zst.zb[0]] += zst.zb[1]
         app[rows] = v["fapp"][rows] + v["fface"][rows]
         grav, app = self._to_masters(grav), self._to_masters(app)
         vm0 = bf["vm"]

@@ -206,8 +206,8 @@ class _Solve:
 
     def residual(self) -> np.ndarray:
         """The unbalanced force (nm, 3) of the master gridpoints at rest, as ``ZoneStepper.step`` sums it
-        before the motion (zone and element forces, gravity, applied and face forces, linked rows onto
-        masters, slave forces by Eq. 9); held components zero."""
+        before the motion (zone and element forces, gravity, zone body forces, applied and face forces, linked
+        rows onto masters, slave forces by Eq. 9); held components zero."""
         from dec3d.kernels.zone_step import zone_step_for
 
         zst, fe, v = self.zst, self.fe, self.m.vertices
@@ -224,6 +224,8 @@ class _Solve:
         if len(zst.r10):
             zst._body_force10(g)
             facc[zst.r10] += zst.fb10
+        if zst.zb is not None:
+            facc[zst.zb[0]] += zst.zb[1]
         gp_externals(zst.rows, v["link"], zst.gmass, g, v["fapp"], v["fface"], facc, zst.fmag)
         if fe is not None:
             fe.slave_forces(facc)

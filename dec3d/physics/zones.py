@@ -29,7 +29,8 @@ model with zones (state is the model's: ``zones`` store and the gridpoint fields
    by ``zones_ho.tet10_step``), gravity (m g
    on the gridpoints of 4-node zones, the consistent loads of ``zones_ho.tet10_body_force`` on
    those of 10-node zones, both counted in the applied-force magnitudes of the equilibrium
-   ratio), applied and face forces (``model.face_loads``: 6-node faces of 10-node zones by
+   ratio), body forces of `block zone apply` (``physics.zone_loads``), applied and face forces
+   (``model.face_loads``: 6-node faces of 10-node zones by
    ``zones_ho.tri6_traction_loads``, hexahedral zone faces as quadrilaterals) and the sum onto masters (``gp_externals``), damping and
    motion (``gp_motion_ws``, the bits of ``gp_motion`` on threads).
 
@@ -57,6 +58,7 @@ from dec3d.physics.cmodels import MODEL_BY_CODE
 from dec3d.units import suffix
 
 from .cables import gridpoint_grout_stiffness
+from .zone_loads import body_loads
 
 _F = np.float64
 _I = np.int64
@@ -279,6 +281,8 @@ class ZoneStepper:
         lk = self.linked
         np.add.at(mtot, link[lk], mass[lk])
         self.mtot = mtot
+        #: body forces of `block zone apply` on the gridpoints, (rows, forces, magnitudes) or None (``zone_loads``)
+        self.zb = body_loads(model, self.ref, self.rows4, self.rows10)
         #: contact stiffness of the joint term of Eq. (85) per master (``set_contact_stiffness``)
         self.kj = None
         self._stiffness(geo, fe=False)
@@ -490,6 +494,9 @@ class ZoneStepper:
             fmag[self.r10] += self.fb10mag
         if self.quiet is not None or self.dyn:
             self._boundary_forces(vel, dt)
+        if self.zb is not None:
+            facc[self.zb[0]] += self.zb[1]
+            fmag[self.zb[0]] += self.zb[2]
         gp_externals(self.rows, v["link"], self.gmass, gravity, v["fapp"], v["fface"], facc, fmag)
         if fe is not None:
             fe.slave_forces(facc)
