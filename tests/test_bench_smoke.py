@@ -260,3 +260,33 @@ def test_water_bench_runs_and_prints_its_figures():
                              [str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])})
     assert out.returncode == 0, out.stderr
     assert "channel-updates/s" in out.stdout and "steady solve: 10000 knots" in out.stdout
+
+
+@pytest.mark.parametrize("nmd", [False, True])
+def test_zone_roofline_kernels_do_the_engines_arithmetic(nmd):
+    """bench/zone_roofline.py's minimal kernels are a fair roofline only if they compute what the
+    engine's zone step computes: from zero stress, one step of the same random velocities gives
+    the same stresses and nodal forces (1e-9 of the largest), with and without nodal mixed
+    discretization."""
+    sys.path.insert(0, str(ROOT / "bench"))
+    try:
+        import zone_roofline as zr
+    finally:
+        sys.path.remove(str(ROOT / "bench"))
+    from zone_step_run import Stepper
+    pos, gp, prop = zr._mesh(300)
+    nz, nv = len(gp), len(pos)
+    vel = np.random.default_rng(3).normal(size=(nv, 3))
+    K, G = np.ascontiguousarray(prop[:, 0]), np.ascontiguousarray(prop[:, 1])
+    s_min, f_min = np.zeros((nz, 6)), np.zeros((nv, 3))
+    if nmd:
+        zr.minimal_nmd_step(pos, vel, gp, K, G, 1e-3, s_min, f_min, np.zeros(nv), np.zeros(nv), np.zeros((nz, 10)))
+    else:
+        zr.minimal_step(pos, vel, gp, K, G, 1e-3, s_min, f_min)
+    st = Stepper(gp, np.arange(nz, dtype=np.int64), np.full(nz, -1, np.int64), np.ones(nz),
+                 np.arange(nv, dtype=np.int64), nv, np.ones(nz, np.int8), prop)
+    s_eng, f_eng = np.zeros((nz, 6)), np.zeros((nv, 3))
+    st.step(pos, vel, s_eng, np.zeros(nz, np.int32), f_eng, np.zeros(nv), 1e-3, False, nmd)
+    assert nz > 100 and np.abs(s_eng).max() > 0
+    np.testing.assert_allclose(s_min, s_eng, rtol=0, atol=1e-9 * np.abs(s_eng).max())
+    np.testing.assert_allclose(f_min, f_eng, rtol=0, atol=1e-9 * np.abs(f_eng).max())

@@ -106,5 +106,6 @@ ZonePlan = namedtuple("ZonePlan", "pstart pk fbits fbase fpstart fptgt fpslot nb
 #: bulk, shear (nz,) Pa, stress (nz, 6) Pa, state (nz,) plastic bits; tab the ``Tables`` bundle.
 ZoneMaterial = namedtuple("ZoneMaterial", "cmodel prop hist bulk shear stress state tab")
 #: ``ZoneScratch``: nodesum, nodevol, nodedsp (nvert,); sa (slots, 2), sb (slots, 4); evs, vols
-#: (entries in sets); dsp (nr,).
-ZoneScratch = namedtuple("ZoneScratch", "nodesum nodevol nodedsp sa sb evs vols dsp")
+#: (entries in sets); dsp (nr,); geo (nr, 13) each entry's face area vectors and volume, worked
+#: out by the step's first sweep and read by the later ones (empty: a step of one sweep).
+ZoneScratch = namedtuple("ZoneScratch", "nodesum nodevol nodedsp sa sb evs vols dsp geo")

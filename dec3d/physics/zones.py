@@ -81,7 +81,7 @@ def zone_bundles(plan: ElasticPlan, nset: int, plastic: bool):
     mesh = ZoneMesh(plan.g4, plan.n4, plan.rows, plan.zset, plan.weight, int(nset))
     zplan = ZonePlan(plan.pstart, plan.pk, *plan.fplan, *plan.nplan)
     scratch = ZoneScratch(plan.nodesum, plan.nodevol, np.empty(nv if plastic else 0), plan.sa, plan.sb, plan.evs,
-                          plan.vols, np.empty(nr if plastic else 0))
+                          plan.vols, np.empty(nr if plastic else 0), np.empty((nr, 13)))
     return mesh, zplan, scratch
 
 
