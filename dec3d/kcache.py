@@ -21,6 +21,12 @@ callee's file changes. So, at the import of ``dec3d`` (``guard``):
    there) and whenever else numba compiles (a kernel edited, a new type signature); loads from
    the cache print nothing. ``compile_seconds()`` is the time spent compiling dec3d kernels so far
    (`dec3d run` reports it at the end).
+4. A process that compiles after another process has stamped different sources (the files were
+   edited or upgraded while it ran: its kernels are the old code) does not write them to the
+   cache: the listener reads the stamp at each compilation's end and, when it no longer holds the
+   digest this process started from, gives the kernel numba's ``NullCache`` before numba saves it
+   (one line on stderr says so). Without this such a process wrote old code under the new stamp,
+   where every later process loaded it.
 """
 from __future__ import annotations
 
@@ -126,12 +132,16 @@ def is_cold(cdir: Path, folder: Path = HERE) -> bool:
         return True
 
 
-def _notice_listener(stream=None, package="dec3d.kernels"):
+def _notice_listener(stream=None, package="dec3d.kernels", stamp=None, digest=""):
     """A ``_ColdNotice`` that is a numba event ``Listener`` (numba imported only here)."""
     from numba.core.event import Listener
 
     cls = type("ColdNotice", (_ColdNotice, Listener), {})
-    return cls(stream, package)
+    return cls(stream, package, stamp, digest)
+
+
+#: the line printed (once) when a process stops caching because the sources moved on under it
+MOVED = "dec3d: the kernel sources changed on disk since this process started: what it compiles now is not cached"
 
 
 #: seconds spent compiling kernels of the guarded package in this process (``_ColdNotice``)
@@ -149,12 +159,34 @@ class _ColdNotice:
     adds up the time spent compiling (outermost compilations only: a kernel compiles its callees
     inside its own compilation)."""
 
-    def __init__(self, stream=None, package="dec3d.kernels"):
+    def __init__(self, stream=None, package="dec3d.kernels", stamp=None, digest=""):
         self.stream = stream
         self.package = package
         self.shown = False
         self.depth = 0
         self.t0 = 0.0
+        #: the cache folder's stamp file and the digest of this process's sources (``guard``)
+        self.stamp = stamp
+        self.digest = digest
+        self.moved = False
+
+    def _write(self, line: str):
+        stream = self.stream or sys.stderr
+        try:
+            stream.write(line + "\n")
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+
+    def _sources_moved(self) -> bool:
+        """True when the stamp holds another digest than this process's (another process stamped
+        other sources). No stamp to read (a cache folder that cannot be written) is not a move."""
+        if self.stamp is None:
+            return False
+        try:
+            return self.stamp.read_text().strip() != self.digest
+        except OSError:
+            return False
 
     def _ours(self, event) -> str:
         disp = (event.data or {}).get("dispatcher")
@@ -172,16 +204,17 @@ class _ColdNotice:
         if self.shown:
             return
         self.shown = True
-        stream = self.stream or sys.stderr
-        try:
-            stream.write(f"{NOTICE} for {mod} {_NOTICE_TAIL}\n")
-            stream.flush()
-        except (OSError, ValueError):
-            pass
+        self._write(f"{NOTICE} for {mod} {_NOTICE_TAIL}")
 
     def on_end(self, event):
         if not self._ours(event) or self.depth == 0:
             return
+        if self._sources_moved():            # numba saves after this event: let it save nothing
+            from numba.core.caching import NullCache
+            event.data["dispatcher"]._cache = NullCache()
+            if not self.moved:
+                self.moved = True
+                self._write(MOVED)
         self.depth -= 1
         if self.depth == 0:
             import time
@@ -207,4 +240,4 @@ def guard(folder: Path = HERE, package: str = "dec3d.kernels") -> None:
     COLD = is_cold(cdir, folder)
     from numba.core import event as ev
 
-    ev.register("numba:compile", _notice_listener(package=package))
+    ev.register("numba:compile", _notice_listener(package=package, stamp=cdir / STAMP, digest=digest))

@@ -107,6 +107,46 @@ def test_edited_callee_reaches_the_cached_caller(tmp_path, callee):
     assert run() == (12, 0)
 
 
+_MOVED_RUN = """
+import sys
+from pathlib import Path
+import fakedec
+from fakedec.kernels.caller import f
+from dec3d import kcache
+stamp = kcache.cache_dir(Path(fakedec.__file__).parent / 'kernels') / kcache.STAMP
+if sys.argv[1] == 'moved':           # another process stamped other sources meanwhile
+    stamp.write_text('0' * 64 + chr(10))
+print(f())
+print(sorted(p.name for p in stamp.parent.iterdir() if p.suffix == '.nbi'))
+"""
+
+
+@pytest.mark.parametrize("moved", [False, True])
+def test_a_process_whose_sources_moved_on_caches_nothing(tmp_path, moved):
+    """A process that imported the kernels, then saw another process stamp different sources
+    (an edit or upgrade while it ran), compiles its own (old) code but writes none of it to the
+    cache, and says so once; with the stamp unchanged it caches as usual."""
+    pkg = tmp_path / "fakedec" / "kernels"
+    pkg.mkdir(parents=True)
+    (tmp_path / "fakedec" / "__init__.py").write_text(
+        "from pathlib import Path\nfrom dec3d.kcache import guard\n"
+        "guard(Path(__file__).parent / 'kernels', 'fakedec.kernels')\n")
+    (pkg / "__init__.py").write_text("")
+    (pkg / "caller.py").write_text(_CALLER.format("callee"))
+    (pkg / "callee.py").write_text(_CALLEE.format(1))
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+    env["PYTHONPATH"] = os.pathsep.join([str(tmp_path), str(ROOT)])
+    out = subprocess.run([sys.executable, "-c", _MOVED_RUN, "moved" if moved else "same"], capture_output=True,
+                         text=True, env=env, cwd=tmp_path, timeout=300)
+    assert out.returncode == 0, out.stderr
+    value, names = out.stdout.splitlines()[-2:]
+    assert value == "11"
+    if moved:
+        assert names == "[]" and out.stderr.count(K.MOVED) == 1
+    else:
+        assert "caller" in names and "callee" in names and K.MOVED not in out.stderr
+
+
 TWINS = ["tests/rigid/test_contactmap.py", "tests/rigid/test_kernels_rigid.py", "tests/rigid/test_cellmap.py",
          "tests/rigid/test_subgeom.py", "tests/geometry/test_kernels_vs_reference.py",
          "tests/rigid/test_bodyscale_kernel.py", "tests/rigid/test_water_kernels.py"]
