@@ -24,10 +24,11 @@ i.e. (N, T, M) = -K_C rel with the symmetric local matrix
     K_C = [[k_n a, 0, -k_n S1], [0, k_s a, 0], [-k_n S1, 0, k_n S2]]
 
 (full contact: a = L, S1 = 0, S2 = L^3/12, the linear K_L).  The compressive
-resultant |N| sits at e = -M/N... from P, and |M| <= |N| L/2: the resultant stays on
-the interface (a footing on tensionless springs: contact a = 3 (L/2 - e) once
-e > L/6).  The contact is found by iterating: solve with the last contact, new contact
-from the solution, until it no longer changes (solve.run).
+resultant lies on the contact, so its eccentricity e = |M|/|N| from P stays below L/2:
+the moment an interface can carry is bounded by |N| L/2 (a footing on tensionless
+springs: contact a = L while e <= L/6, a = 3 (L/2 - e) beyond, edge stress 2 |N|/a).
+The contact is found by iterating: solve with the last contact, new contact from the
+solution, until it no longer changes (solve.run).
 
 Stresses on the contact: sigma_n = -N/a (compression +) is the average over the
 contact, the shear stress k_s delta_s acts on the contact only, and the strength

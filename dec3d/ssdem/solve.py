@@ -25,6 +25,12 @@ Two rank tests find instability (thesis Sec. 3.2.2):
     resisting spring at its strength.  The secant matrix alone would not show it (a
     block overloaded in shear just softens and slides further every iteration).
 Pivots are compared with the intact stiffness of the same DOF (Factor's scale).
+With no-tension interfaces (settings.interfaces, contact.py) the contact of every
+interface is a third thing the iteration settles: each solve uses the last contact,
+the next contact comes from its motion, and a step converges only when the contacts
+stop moving (by less than `tol` of the interface length).  The tangent test then holds
+open interfaces shut (an opening can widen, not close through), so what it finds is
+still a mechanism; a block whose contacts are all open when the step settles is removed.
 Unstable blocks are removed as the thesis does: their DOFs and every interface
 touching them leave the system, their loads go with them, and the analysis goes on.
 """
