@@ -256,6 +256,30 @@ def stresses(prob: Problem, st: State, load: float):
     return sigma_n, tau, sig_eff
 
 
+class _ContactDamping:
+    """Under-relaxed contact updates where the contact iteration oscillates.
+
+    The contacts of partly open interfaces can cycle (open a little, close, open more,
+    ..., several interfaces in turn) instead of settling.  Each time an interface's
+    contact length changes direction within a load step its step is cut: after r
+    reversals the new contact is s + theta (s_computed - s), theta = 1/(1 + r) (at least
+    1/64), a diminishing step that ends a cycle however many interfaces take part.
+    The fixed point is the same (converged means s_computed = s), only the path to it
+    changes.
+    """
+
+    def __init__(self, m: int):
+        self.reversals = np.zeros(m)
+        self.last = np.zeros(m)
+
+    def step(self, s1, s2, n1, n2, length, tol):
+        da = (n2 - n1) - (s2 - s1)
+        self.reversals += (da * self.last < 0) & (np.abs(da) > tol * length)
+        self.last = da
+        theta = np.maximum(1.0 / (1.0 + self.reversals), 1.0 / 64.0)
+        return s1 + theta * (n1 - s1), s2 + theta * (n2 - s2)
+
+
 class _Relaxation:
     """Over-relaxed secant update, undone when it softens a spring past its law.
 
@@ -347,6 +371,7 @@ def run(prob: Problem, progress=None, stop_on_failure: bool = False) -> State:
         converged, change, it = False, np.inf, 0
         fresh = True                      # a new step, a crack or a removal gets a new factor
         relax, carried = _Relaxation(cfg.tol), 0
+        damp = _ContactDamping(itf.m) if nt is not None else None
         for it in range(1, cfg.max_iter + 1):
             removed = carried + _solve_with_removal(prob, st, Ta, Tb, f_total, step, cache, refactor=fresh)
             carried = 0
@@ -367,7 +392,7 @@ def run(prob: Problem, progress=None, stop_on_failure: bool = False) -> State:
                 ks, plastic = np.where(shut, st.ks, ks), plastic & ~shut
                 s1, s2 = contact.zone(st.rel, itf.length, nt)
                 moved = float(np.max(((np.abs(s1 - st.s1) + np.abs(s2 - st.s2)) / itf.length)[active], initial=0.0))
-                st.s1, st.s2 = s1, s2
+                st.s1, st.s2 = damp.step(st.s1, st.s2, s1, s2, itf.length, cfg.tol)
             change = stiffness_change(st.ks, ks, active)
             st.ks_before = st.ks
             new_crack &= active

@@ -170,3 +170,20 @@ def test_no_tension_with_a_tensile_strength_is_an_error_at_its_line():
     assert err.line == SLOPE.splitlines().index("tensile_strength = 5.0") + 1
     p = read_toml("slope.toml", text=SLOPE.replace("tensile_strength = 5.0\n", ""))
     assert p.settings.interfaces == "no-tension"
+
+
+def test_contact_damping_ends_a_cycle_and_keeps_the_fixed_point():
+    """A contact update that overshoots by -1.5 x its error (the plain iteration runs away
+    in an alternating cycle) settles on the same fixed point once damped."""
+    L = np.array([1.0])
+    fixed = 0.2                                     # s1 of the fixed point; s2 = L/2 throughout
+    s1 = np.array([-0.5])
+    damp = solve._ContactDamping(1)
+    for _ in range(200):
+        n1 = fixed - 1.5 * (s1 - fixed)
+        s1, _ = damp.step(s1, np.array([0.5]), n1, np.array([0.5]), L, 1e-9)
+    assert s1[0] == pytest.approx(fixed, abs=1e-9)
+    plain = -0.5
+    for _ in range(20):
+        plain = fixed - 1.5 * (plain - fixed)
+    assert abs(plain - fixed) > 100
