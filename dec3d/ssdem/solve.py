@@ -47,7 +47,7 @@ from .model import Problem
 
 #: secant iterations between two mechanism (tangent matrix) tests in a step
 TANGENT_EVERY = 10
-#: stiffness left to the open part of a no-tension interface, relative to k_n (solve.local)
+#: normal stiffness left to a wholly open no-tension interface, relative to k_n (solve.local)
 EPS_OPEN = 1e-6
 #: largest over-relaxation of a secant update (_Relaxation); 1 turns it off
 OMEGA_MAX = 64.0
