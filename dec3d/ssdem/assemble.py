@@ -87,8 +87,14 @@ class Assembler:
         self.diag_pos = None
 
     def blocks(self, kl: np.ndarray) -> list[np.ndarray]:
-        """C_aa, C_ab, C_ba, C_bb (m, 3, 3) for local stiffness diagonals kl (m, 3)."""
+        """C_aa, C_ab, C_ba, C_bb (m, 3, 3) for local stiffness diagonals kl (m, 3), or full
+        symmetric local matrices kl (m, 3, 3) (a partly open no-tension interface, contact.py)."""
         Ta, Tb = self.Ta, self.Tb
+        if kl.ndim == 3:
+            Caa = np.einsum("mki,mkl,mlj->mij", Ta, kl, Ta)
+            Cab = -np.einsum("mki,mkl,mlj->mij", Ta, kl, Tb)
+            Cbb = np.einsum("mki,mkl,mlj->mij", Tb, kl, Tb)
+            return [Caa, Cab, Cab.transpose(0, 2, 1), Cbb]
         Caa = np.einsum("mki,mk,mkj->mij", Ta, kl, Ta)
         Cab = -np.einsum("mki,mk,mkj->mij", Ta, kl, Tb)
         Cbb = np.einsum("mki,mk,mkj->mij", Tb, kl, Tb)

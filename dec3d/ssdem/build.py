@@ -88,7 +88,7 @@ def from_slope(slope: Slope, mesh: dict, surface: dict | None, settings: Setting
 
 def from_polygons(polygons, fixed, *, kn, ks, c=0.0, phi=0.0, c_res=None, phi_res=None, delta_res=np.inf,
                   tensile=0.0, cutoff=False, gamma=0.0, force=None, n_steps=1, tol=1e-6, max_iter=500,
-                  ru=0.0, ru_mode="standard", title="polygons") -> Problem:
+                  ru=0.0, ru_mode="standard", interfaces="linear", title="polygons") -> Problem:
     """A problem from explicit polygons with one set of interface properties (SI units).
 
     For scripts and tests: polygons is a list of (k, 2) counter-clockwise vertex arrays,
@@ -114,5 +114,5 @@ def from_polygons(polygons, fixed, *, kn, ks, c=0.0, phi=0.0, c_res=None, phi_re
     itf.del_res, itf.tensile = full(delta_res), full(tensile)
     itf.cutoff = np.full(m, bool(cutoff))
     itf.u_pore, itf.on_surface = np.zeros(m), np.zeros(m, bool)
-    settings = Settings(n_steps=n_steps, tol=tol, max_iter=max_iter, ru=ru, ru_mode=ru_mode)
+    settings = Settings(n_steps=n_steps, tol=tol, max_iter=max_iter, ru=ru, ru_mode=ru_mode, interfaces=interfaces)
     return Problem(title=title, blocks=blocks, interfaces=itf, settings=settings, fmt="polygons")

@@ -98,6 +98,7 @@ class Settings:
         is in Interfaces.u_pore; "listing": sigma'_n = (1 - r_u)*sigma_n)
     pivot_tol: a pivot d_j with d_j / K_jj below this marks DOF j as unstable
     strength_reduction: also search the strength-reduction factor (reduction.py)
+    interfaces: "linear" (springs carry tension, the thesis) or "no-tension" (contact.py)
     """
 
     n_steps: int = 10
@@ -107,6 +108,7 @@ class Settings:
     ru_mode: str = "standard"
     pivot_tol: float = 1e-9
     strength_reduction: bool = False
+    interfaces: str = "linear"
 
 
 @dataclass

@@ -11,6 +11,7 @@ import numpy as np
 from ..errors import printable
 from .analysis import Analysis, summary_numbers
 from .safety import STATE_NAMES
+from .solve import contact_length
 from .units import factors, labels
 
 
@@ -48,6 +49,7 @@ def tables(an: Analysis) -> tuple[dict, dict]:
         "interface": np.arange(itf.m), "block_a": itf.a, "block_b": itf.b,
         "side_a": itf.side_a, "side_b": itf.side_b,
         "x": itf.mid[:, 0] / L, "y": itf.mid[:, 1] / L, "length": itf.length / L,
+        "contact_length": contact_length(p, st) / L,
         "normal_angle_deg": np.degrees(np.arctan2(itf.normal[:, 1], itf.normal[:, 0])),
         "sigma_n": s.sigma_n / S, "tau": s.tau / S, "sigma_n_eff": s.sig_eff / S,
         "tau_available": s.tau_avail / S, "fs": s.fs, "yield_pct": s.yield_pct,
@@ -87,6 +89,10 @@ def summary_text(an: Analysis) -> str:
     rm = np.flatnonzero(st.removed)
     out.append(f"unstable blocks removed: {len(rm)}" + (": " + ", ".join(f"{i} (step {st.removed_step[i]})" for i in rm[:50]) if len(rm) else ""))
     out.append(f"yielded interfaces: {int(q['n_yielded'])}, cracked: {int(q['n_cracked'])}")
+    if st.s1 is not None:
+        lc, live = contact_length(p, st), ~(st.removed[p.interfaces.a] | st.removed[p.interfaces.b])
+        part = live & (lc > 0) & (lc < p.interfaces.length * (1 - 1e-9))
+        out.append(f"no-tension interfaces: {int(np.sum(live & (lc <= 0)))} open, {int(part.sum())} partly open")
     ids = np.flatnonzero(s.failure)
     kinds = {"prescribed": "the prescribed slip surface", "yield": "yielded/cracked interfaces and edges of removed blocks",
              "none": "none formed (no interface yielded)"}

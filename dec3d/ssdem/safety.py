@@ -27,7 +27,7 @@ import numpy as np
 
 from . import springs
 from .model import Problem
-from .solve import State, stresses
+from .solve import State, contact_length, stresses
 
 ELASTIC, YIELDED, CRACKED, REMOVED = 0, 1, 2, 3
 STATE_NAMES = {ELASTIC: "elastic", YIELDED: "yielded", CRACKED: "cracked", REMOVED: "removed"}
@@ -58,7 +58,8 @@ def evaluate(prob: Problem, st: State) -> Safety:
     tau_p, tau_r = springs.strengths(sig_eff, itf.c_p, itf.tan_p, itf.c_r, itf.tan_r)
     tau_av, _ = springs.strength_at(st.rel[:, 1], tau_p, tau_r, itf.ks, itf.del_res)
     tau_av = np.where(st.cracked, 0.0, tau_av)
-    tau_mob = np.abs(tau)
+    lc = contact_length(prob, st)          # the length in contact (no-tension interfaces may open)
+    tau_mob = np.where(lc > 0, np.abs(tau), 0.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         fs = np.where(tau_mob > 0, tau_av / tau_mob, np.inf)
         yield_pct = np.where(itf.ks > 0, 100.0 * (1.0 - st.ks / itf.ks), 0.0)
@@ -82,12 +83,12 @@ def evaluate(prob: Problem, st: State) -> Safety:
     tvec = np.column_stack([-itf.normal[:, 1], itf.normal[:, 0]])
     slip_x = up * st.rel[:, 1] * tvec[:, 0]
     use = failure & active & ~st.cracked
-    dominant = np.sign(np.sum((tau_mob * itf.length * np.sign(slip_x))[use])) or 1.0
+    dominant = np.sign(np.sum((tau_mob * lc * np.sign(slip_x))[use])) or 1.0
     slide_sign = np.where(np.sign(slip_x) * dominant < 0, -1.0, 1.0)
 
     if use.any():
-        num = np.sum((tau_av * itf.length)[use])
-        den = np.sum((slide_sign * tau_mob * itf.length)[use])
+        num = np.sum((tau_av * lc)[use])
+        den = np.sum((slide_sign * tau_mob * lc)[use])
         fs_global = float(num / den) if den > 0 else float("inf")
         finite = use & np.isfinite(fs)
         fs_mean = float(np.mean(fs[finite])) if finite.any() else float("nan")

@@ -25,6 +25,12 @@ Two rank tests find instability (thesis Sec. 3.2.2):
     resisting spring at its strength.  The secant matrix alone would not show it (a
     block overloaded in shear just softens and slides further every iteration).
 Pivots are compared with the intact stiffness of the same DOF (Factor's scale).
+With no-tension interfaces (settings.interfaces, contact.py) the contact of every
+interface is a third thing the iteration settles: each solve uses the last contact,
+the next contact comes from its motion, and a step converges only when the contacts
+stop moving (by less than `tol` of the interface length).  The tangent test then holds
+open interfaces shut (an opening can widen, not close through), so what it finds is
+still a mechanism; a block whose contacts are all open when the step settles is removed.
 Unstable blocks are removed as the thesis does: their DOFs and every interface
 touching them leave the system, their loads go with them, and the analysis goes on.
 """
@@ -34,13 +40,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import springs
+from . import contact, springs
 from .assemble import Assembler, local_stiffness, relative_motion, transfer_matrices
 from .linsolve import Factor, floating_blocks
 from .model import Problem
 
 #: secant iterations between two mechanism (tangent matrix) tests in a step
 TANGENT_EVERY = 10
+#: normal stiffness left to a wholly open no-tension interface, relative to k_n (solve.local)
+EPS_OPEN = 1e-6
 #: largest over-relaxation of a secant update (_Relaxation); 1 turns it off
 OMEGA_MAX = 64.0
 
@@ -71,6 +79,8 @@ class State:
     rel: np.ndarray
     plastic: np.ndarray
     ks_before: np.ndarray = None      # k_s before the last update (the over-relaxation needs it)
+    s1: np.ndarray = None             # contact [s1, s2] of each interface along t from its midpoint
+    s2: np.ndarray = None             # (contact.py; the whole length unless no-tension and open)
     load: float = 0.0
     steps: list = field(default_factory=list)
     factorizations: int = 0
@@ -91,6 +101,34 @@ class _Context:
         intact = local_stiffness(itf.kn, itf.ks, itf.length) * active[:, None]
         self.scale = self.asm.matrix(intact).diagonal() if self.asm.ndof else np.zeros(0)
         self.factor = None
+
+
+def no_tension(prob: Problem) -> np.ndarray | None:
+    """(m,) True where the interface cannot pull (settings.interfaces), None when none is."""
+    if prob.settings.interfaces != "no-tension":
+        return None
+    return np.ones(prob.interfaces.m, bool)
+
+
+def local(prob: Problem, st: State, active: np.ndarray, ks: np.ndarray | None = None) -> np.ndarray:
+    """Local stiffness of every interface: diagonals (m, 3) when every contact is the whole
+    interface, else the contact matrices (m, 3, 3) of contact.local_matrix; 0 where inactive."""
+    itf = prob.interfaces
+    ks = st.ks if ks is None else ks
+    if st.s1 is None:
+        return local_stiffness(st.kn, ks, itf.length) * active[:, None]
+    h = 0.5 * itf.length
+    # an open interface keeps EPS_OPEN of its normal springs: a block whose contacts the
+    # last solve all opened is held (far off) instead of floating, and the next solve
+    # closes them again if it falls back on them (_open_blocks removes it if they stay open)
+    shut = st.s2 - st.s1 <= 0
+    gap = contact.local_matrix(np.where(shut, EPS_OPEN * st.kn, 0.0), 0.0 * ks, -h, h)
+    return (contact.local_matrix(st.kn, ks, st.s1, st.s2) + gap) * active[:, None, None]
+
+
+def contact_length(prob: Problem, st: State) -> np.ndarray:
+    """Length of each interface in contact (the whole length unless no-tension and open)."""
+    return prob.interfaces.length if st.s1 is None else st.s2 - st.s1
 
 
 def _active(prob: Problem, st: State) -> np.ndarray:
@@ -133,7 +171,7 @@ def _solve_with_removal(prob, st, Ta, Tb, f_total, step, cache, refactor=True) -
         if ctx.asm.ndof == 0:
             st.u = u
             return n_removed
-        K = ctx.asm.matrix(local_stiffness(st.kn, st.ks, itf.length) * active[:, None])
+        K = ctx.asm.matrix(local(prob, st, active))
         if not refactor and ctx.factor is not None:
             x = ctx.factor.pcg(K, f_total[ctx.live], st.u[ctx.live])
             if x is not None:
@@ -153,6 +191,14 @@ def _solve_with_removal(prob, st, Ta, Tb, f_total, step, cache, refactor=True) -
         return n_removed
 
 
+def _open_blocks(prob, st, step) -> int:
+    """Remove the groups of blocks that no closed contact ties to a fixed block."""
+    blk, itf = prob.blocks, prob.interfaces
+    carries = _active(prob, st) & ((st.kn > 0) | (st.ks > 0)) & (contact_length(prob, st) > 0)
+    floating = floating_blocks(blk.n, itf.a, itf.b, carries, blk.fix.any(axis=1))
+    return _remove(st, floating & ~blk.fixed & ~st.removed, step)
+
+
 def _mechanisms(prob, st, Ta, Tb, step, cache) -> int:
     """Rank test of the tangent matrix; removes the blocks of plastic mechanisms."""
     itf, cfg = prob.interfaces, prob.settings
@@ -163,7 +209,18 @@ def _mechanisms(prob, st, Ta, Tb, step, cache) -> int:
     if ctx.asm.ndof == 0:
         return 0
     ks_t = np.where(st.plastic, 0.0, st.ks)
-    Kt = ctx.asm.matrix(local_stiffness(st.kn, ks_t, itf.length) * active[:, None])
+    if st.s1 is None:
+        Kt = ctx.asm.matrix(local(prob, st, active, ks_t))
+    else:
+        # an open no-tension interface may open further but not close through: the test
+        # holds it shut (normal and rotation springs over its whole length, no shear), so
+        # a mechanism found is one that moves no open interface, admissible and a proof;
+        # one that would open them further is left to the secant iteration
+        shut = (st.s2 - st.s1) <= 0
+        h = 0.5 * itf.length
+        Kl = contact.local_matrix(st.kn, np.where(shut, 0.0, ks_t), np.where(shut, -h, st.s1),
+                                  np.where(shut, h, st.s2))
+        Kt = ctx.asm.matrix(Kl * active[:, None, None])
     fac = Factor(Kt, cfg.pivot_tol, ctx.scale)
     st.factorizations += 1
     if not len(fac.bad):
@@ -184,12 +241,43 @@ def stresses(prob: Problem, st: State, load: float):
     """Midpoint (= average) stresses of every interface at the current solution.
 
     Returns sigma_n (compression +), tau (along t, sign of the slip of b on a), sigma'_n.
+    On a partly open no-tension interface they are the stresses on its contact (averaged
+    over it: sigma_n = -N/a); on an open one sigma_n = 0.
     """
     itf, cfg = prob.interfaces, prob.settings
-    sigma_n = -st.kn * st.rel[:, 0]
+    if st.s1 is None:
+        sigma_n = -st.kn * st.rel[:, 0]
+    else:
+        a, S1, _ = contact.moments(st.s1, st.s2)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sigma_n = np.where(a > 0, -st.kn * (st.rel[:, 0] - np.where(a > 0, S1 / a, 0.0) * st.rel[:, 2]), 0.0)
     tau = st.ks * st.rel[:, 1]
     sig_eff = springs.effective_normal(sigma_n, itf.u_pore, cfg.ru, cfg.ru_mode, load)
     return sigma_n, tau, sig_eff
+
+
+class _ContactDamping:
+    """Under-relaxed contact updates where the contact iteration oscillates.
+
+    The contacts of partly open interfaces can cycle (open a little, close, open more,
+    ..., several interfaces in turn) instead of settling.  Each time an interface's
+    contact length changes direction within a load step its step is cut: after r
+    reversals the new contact is s + theta (s_computed - s), theta = 1/(1 + r) (at least
+    1/64), a diminishing step that ends a cycle however many interfaces take part.
+    The fixed point is the same (converged means s_computed = s), only the path to it
+    changes.
+    """
+
+    def __init__(self, m: int):
+        self.reversals = np.zeros(m)
+        self.last = np.zeros(m)
+
+    def step(self, s1, s2, n1, n2, length, tol):
+        da = (n2 - n1) - (s2 - s1)
+        self.reversals += (da * self.last < 0) & (np.abs(da) > tol * length)
+        self.last = da
+        theta = np.maximum(1.0 / (1.0 + self.reversals), 1.0 / 64.0)
+        return s1 + theta * (n1 - s1), s2 + theta * (n2 - s2)
 
 
 class _Relaxation:
@@ -272,6 +360,9 @@ def run(prob: Problem, progress=None, stop_on_failure: bool = False) -> State:
     st = State(kn=itf.kn.copy(), ks=itf.ks.copy(), cracked=np.zeros(itf.m, bool),
                removed=np.zeros(blk.n, bool), removed_step=np.full(blk.n, -1, np.int64),
                u=np.zeros((blk.n, 3)), rel=np.zeros((itf.m, 3)), plastic=np.zeros(itf.m, bool))
+    nt = no_tension(prob)
+    if nt is not None:
+        st.s1, st.s2 = -0.5 * itf.length, 0.5 * itf.length
     cache: dict = {}
     for step in range(1, cfg.n_steps + 1):
         load = step / cfg.n_steps
@@ -280,6 +371,7 @@ def run(prob: Problem, progress=None, stop_on_failure: bool = False) -> State:
         converged, change, it = False, np.inf, 0
         fresh = True                      # a new step, a crack or a removal gets a new factor
         relax, carried = _Relaxation(cfg.tol), 0
+        damp = _ContactDamping(itf.m) if nt is not None else None
         for it in range(1, cfg.max_iter + 1):
             removed = carried + _solve_with_removal(prob, st, Ta, Tb, f_total, step, cache, refactor=fresh)
             carried = 0
@@ -292,11 +384,24 @@ def run(prob: Problem, progress=None, stop_on_failure: bool = False) -> State:
             kn, ks, cracked, new_crack, plastic = springs.update(
                 st.kn, st.ks, st.cracked, itf.ks, st.rel[:, 1], sigma_n, sig_eff,
                 itf.c_p, itf.tan_p, itf.c_r, itf.tan_r, itf.del_res, itf.tensile, itf.cutoff & active)
+            moved = 0.0
+            if nt is not None:
+                # an open interface carries no shear: its spring keeps its state; then the
+                # contact of the next solve comes from this one's motion
+                shut = contact_length(prob, st) <= 0
+                ks, plastic = np.where(shut, st.ks, ks), plastic & ~shut
+                s1, s2 = contact.zone(st.rel, itf.length, nt)
+                moved = float(np.max(((np.abs(s1 - st.s1) + np.abs(s2 - st.s2)) / itf.length)[active], initial=0.0))
+                st.s1, st.s2 = damp.step(st.s1, st.s2, s1, s2, itf.length, cfg.tol)
             change = stiffness_change(st.ks, ks, active)
             st.ks_before = st.ks
             new_crack &= active
             st.kn, st.ks, st.cracked, st.plastic = kn, ks, cracked, plastic & active
-            done = change < cfg.tol and not new_crack.any() and removed == 0
+            done = change < cfg.tol and moved < cfg.tol and not new_crack.any() and removed == 0
+            if done and nt is not None:
+                # settled with every contact of some blocks open: nothing holds them
+                removed += _open_blocks(prob, st, step)
+                done = removed == 0
             if done or it % TANGENT_EVERY == 0:
                 removed += _mechanisms(prob, st, Ta, Tb, step, cache)
                 done = done and removed == 0

@@ -107,7 +107,13 @@ def read_toml(path: str | Path, text: str | None = None, max_blocks: int = DEFAU
         slope.kh = sections["loads"]["kh"]
     an = sections["analysis"] or bind(loc, "analysis", 0, {}, fac)
     settings = Settings(n_steps=an["steps"], tol=an["tolerance"], max_iter=an["max_iterations"],
-                        ru=slope.ru, ru_mode=slope.ru_mode, strength_reduction=an["strength_reduction"])
+                        ru=slope.ru, ru_mode=slope.ru_mode, strength_reduction=an["strength_reduction"],
+                        interfaces=an["interfaces"])
+    if an["interfaces"] == "no-tension":
+        for i, lay in enumerate(slope.layers):
+            if lay.tensile > 0:
+                raise loc.error("layer", i, "tensile_strength", "no-tension interfaces carry no tension",
+                                "give tensile_strength = 0, or interfaces = \"linear\" in [analysis]")
     mesh = sections["mesh"] or bind(loc, "mesh", 0, {}, fac)
     surface = _surface(loc, slope, sections["surface"], mesh)
     if surface is None:

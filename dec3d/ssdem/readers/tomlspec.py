@@ -95,6 +95,8 @@ SECTIONS: dict[str, tuple[Field, ...]] = {
         Field("max_iterations", "int", 200, lo=1, hi=MAX_ITERATIONS, doc="secant iterations per step at most"),
         Field("strength_reduction", "bool", False,
               doc="also find the factor on c' and tan(phi') at which the static solution fails"),
+        Field("interfaces", "str", "linear", choices=("linear", "no-tension"),
+              doc="linear: springs carry tension (thesis); no-tension: they open, partly or fully, and close again"),
     ),
 }
 ARRAY_TABLES = {"layer", "surcharge"}
