@@ -230,7 +230,7 @@ class Session:
         next_fish = next(fish, None)
         progress = BindProgress(self.write, paths.printable(deck.filename))
         for raw in deck.lines:
-            line = raw.tokens[0].line
+            line = raw.line
             progress.tick(line)
             while next_fish is not None and next_fish.line < line:
                 items.append(self._fish_item(deck, next_fish, stack))

@@ -17,7 +17,7 @@ from ..errors import (BindError, DeckSyntaxError, LazyLocation, LegacySyntaxErro
 from ..lang.abbrev import matches, suggest
 from ..lang.expr import check_names, parse_expression
 from ..lang.parser import ParsedDeck, RawLine
-from .bind_plan import MAX_PLANS, Plan, Slot, fill, shape
+from .bind_plan import MAX_PLANS, Plan, Slot, fill, replay_compact, shape
 from .legacy import legacy_hint
 from .registry import REGISTRY, Command, Node, RangeElement, Registry
 from .values import FLOAT, MISSING, Deferred, Flag, Param, ValueRangeError, ValueType
@@ -180,7 +180,7 @@ class Binder:
     # ------------------------------------------------------------ commands
     def bind_line(self, raw: RawLine) -> "CommandCall | ExprStatement":
         """Any line: a `[ ... ]` statement, an `@name` call, or a command."""
-        toks = raw.tokens
+        toks = raw.items
         first = toks[0]
         if len(toks) == 1 and first.type == "EXPR":
             node = self.expression(first)
@@ -195,13 +195,14 @@ class Binder:
         return self.bind(raw)
 
     def bind(self, raw: RawLine) -> CommandCall:
-        toks = raw.tokens
-        key = shape(toks)
+        items = raw.items
+        key = shape(items)
         plan = self.plans.get(key)
         if plan is not None:
-            call = self._replay(plan, toks)
+            call = self._replay(plan, raw, items)
             if call is not None:
                 return call
+        toks = raw.tokens
         self._steps = steps = []
         try:
             call = self._bind(toks)
@@ -212,16 +213,28 @@ class Binder:
         values = [s[3] for s in steps]
         if len(self.plans) >= MAX_PLANS:
             self.plans.clear()
-        plan = self.plans[key] = Plan(call, [s[:3] for s in steps], toks)
+        plan = self.plans[key] = Plan(call, [s[:3] for s in steps], toks, items)
         call = fill(plan, values, toks, self.deck, self.stack)
         cmd = call.command
         if cmd.check is not None:
             cmd.check(call)
         return call
 
-    def _replay(self, plan: Plan, toks):
+    def _replay(self, plan: Plan, raw, items):
         """The line bound by its shape's plan; None when a take fails or takes other tokens (the
-        line is then bound the ordinary way, which reports what is wrong)."""
+        line is then bound the ordinary way, which reports what is wrong). A line with runs of
+        numbers is replayed on its items first (``bind_plan.replay_compact``), else on its tokens."""
+        if plan.compact is not None:
+            try:
+                call = replay_compact(plan, items, self)
+                if call is not None:
+                    cmd = call.command
+                    if cmd.check is not None:
+                        cmd.check(call)
+                    return call
+            except Exception:
+                pass
+        toks = raw.tokens
         values = []
         try:
             for param, i, j in plan.steps:
@@ -264,7 +277,8 @@ class Binder:
         return call
 
     def source(self, raw: RawLine) -> str:
-        return source_text(self.deck.source_lines, raw.tokens[0].line, raw.tokens[-1].line)
+        items = raw.items
+        return source_text(self.deck.source_lines, items[0].line, items[-1].line)
 
     def _resolve(self, toks):
         node = self.reg.root
