@@ -229,18 +229,23 @@ class Session:
         fish = iter(deck.fish)
         next_fish = next(fish, None)
         progress = BindProgress(self.write, paths.printable(deck.filename))
+        count = 0
         for raw in deck.lines:
             line = raw.line
-            progress.tick(line)
+            count += 1
+            if not count & 1023:            # progress.tick's own test, written out
+                progress.tick_at(line)
             while next_fish is not None and next_fish.line < line:
                 items.append(self._fish_item(deck, next_fish, stack))
                 next_fish = next(fish, None)
             call = bind_or_defer(self, binder, raw)
-            if isinstance(call, (ExprStatement, Unsupported)):
+            if type(call) is not CommandCall and isinstance(call, (ExprStatement, Unsupported)):
                 items.append(call)
                 continue
-            path = call.command.path
-            self._check_paths(call)
+            cmd = call.command
+            path = cmd.path
+            if cmd.file_params:
+                self._check_paths(call)
             if path == ("program", "call") and not isinstance(call.args["file"], Deferred):
                 # a literal name: the called file is read and bound now, in place of the call
                 target = self.find_deck(call.args["file"], call.locations.get("file", call.location))

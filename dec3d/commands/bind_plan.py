@@ -24,15 +24,19 @@ from __future__ import annotations
 
 import math
 
-from ..errors import LazyLocation, frozen_instance
-from .values import Num, Nums, ValueType
+from ..errors import LazyLocation
+from .values import Choice, InPath, Num, Nums, OnOff, OutPath, Text, ValueType
 
 # the shape of a non-word token: no word can be spelt with `<`; a run of numbers is its count
 SHAPE_OF = {"NUMBER": "<n>", "STRING": "<s>", "EXPR": "<e>", "ATNAME": "<a>", "NUMRUN": None}
 #: plans kept per binder (a deck whose every line has its own words has no use for more)
 MAX_PLANS = 4096
 _take_one = ValueType.take
+_new, _set = object.__new__, object.__setattr__
 _radians = math.radians
+#: value types whose value of a word depends on the word alone (a string or a bool): a plan keeps
+#: the value its line gave (the word is part of the shape)
+_WORD_VALUES = frozenset((Choice, OnOff, Text, OutPath, InPath))
 
 
 def shape(toks) -> tuple:
@@ -84,10 +88,10 @@ def run_values(strs, inline, text):
 
 
 def _compact(steps, toks, items):
-    """What replaying on ``items`` needs: per take (0, param, segments, inline, one value) for real
+    """What replaying on ``items`` needs: per take (0, n, segments, inline, one value) for real
     numbers — a segment (item, first, end) of a run or (item, None, None) of a token — or
-    (1, param, item) for a take of one token; the item (and number of a run, or None) of each token.
-    None when a take is neither, or the line does not start with a token."""
+    (1, n, param, item) for a take of one token (n: the value's number); the item (and number of a
+    run, or None) of each token. None when a take is neither, or the line does not start with a token."""
     where = []
     for a, it in enumerate(items):
         if it.type == "NUMRUN":
@@ -97,7 +101,7 @@ def _compact(steps, toks, items):
     if len(where) != len(toks) or where[0][1] is not None:
         return None
     out = []
-    for param, i, j in steps:
+    for n, param, i, j in steps:
         vt = param.value
         kind = type(vt)
         inline = vt.inline if kind is Num else vt.item.inline if kind is Nums else None
@@ -108,24 +112,36 @@ def _compact(steps, toks, items):
                     segs[-1][2] = o + 1
                 else:
                     segs.append([a, o, None if o is None else o + 1])
-            out.append((0, param, tuple(map(tuple, segs)), inline, kind is Num))
+            out.append((0, n, tuple(map(tuple, segs)), inline, kind is Num))
         elif j == i + 1 and where[i][1] is None and kind.take is _take_one:
-            out.append((1, param, where[i][0]))
+            out.append((1, n, param, where[i][0]))
         else:
             return None
     return tuple(out), where
 
 
 class Plan:
-    """A bound call with holes; the takes that fill them (param, first token, end); token indices
-    of the locations it holds (by the identity of the recorded line's tokens); for a line with runs
-    of numbers, the same on its items (``compact``, ``clocs``, ``cwhere``), or None."""
+    """A bound call with holes; the takes that fill them (param, first token, end), of which those
+    of a word by a type in ``_WORD_VALUES`` keep their value (``values``; ``vsteps``: the others, with
+    their value's number); token indices of the locations it holds (by the identity of the recorded
+    line's tokens); for a line with runs of numbers, the same on its items (``compact``, ``clocs``,
+    ``cwhere``), or None."""
 
-    __slots__ = ("call", "steps", "holes", "lists", "locs", "where", "compact", "clocs", "cwhere")
+    __slots__ = ("call", "steps", "vsteps", "values", "holes", "lists", "locs", "where", "compact", "clocs",
+                 "cwhere")
 
-    def __init__(self, call, steps, toks, items=None):
+    def __init__(self, call, steps, toks, items=None, values=None):
         self.call = call
         self.steps = tuple(steps)
+        self.values = [None] * len(self.steps)
+        vsteps = []
+        for n, (param, i, j) in enumerate(self.steps):
+            if (values is not None and j == i + 1 and toks[i].type == "WORD"
+                    and type(param.value) in _WORD_VALUES):
+                self.values[n] = values[n]
+            else:
+                vsteps.append((n, param, i, j))
+        self.vsteps = tuple(vsteps)
         self.holes = tuple((k, v.n) for k, v in call.args.items() if type(v) is Slot)
         self.lists = tuple(k for k, v in call.args.items() if type(v) is list)
         ids = {id(t): k for k, t in enumerate(toks)}
@@ -136,7 +152,7 @@ class Plan:
                 self.where[id(e.location)] = ids[id(e.location.token)]
         self.compact = self.clocs = self.cwhere = None
         if items is not None and items is not toks:
-            got = _compact(self.steps, toks, items)
+            got = _compact(self.vsteps, toks, items)
             if got is not None:
                 self.compact, where = got
                 self.clocs = tuple((k, *where[i]) for k, i in self.locs)
@@ -169,13 +185,12 @@ def _at(deck, items, a, o, stack):
 def replay_compact(plan: Plan, items, binder):
     """The plan's call made from the line's items (``Plan.compact``), or None when a number is out of
     its bounds (the caller replays on the tokens, whose take reports it). Other errors propagate."""
-    values = []
-    add = values.append
+    values = plan.values.copy()
     for step in plan.compact:
         if step[0]:
-            add(_take_one(step[1].value, items, step[2], binder)[0])
+            values[step[1]] = _take_one(step[2].value, items, step[3], binder)[0]
             continue
-        _, param, segs, inline, one = step
+        _, n, segs, inline, one = step
         out = []
         for a, o0, o1 in segs:
             it = items[a]
@@ -190,7 +205,7 @@ def replay_compact(plan: Plan, items, binder):
             if nums is None:
                 return None
             out.extend(nums)
-        add(out[0] if one else tuple(out))
+        values[n] = out[0] if one else tuple(out)
     deck, stack = binder.deck, binder.stack
     locs = {k: _at(deck, items, a, o, stack) for k, a, o in plan.clocs}
     rng = plan.call.range
@@ -214,6 +229,8 @@ def _call(plan: Plan, values, locs, rng, first, last_line, deck, stack):
     for k in plan.lists:                  # a repeated keyword: a new list for every call
         args[k] = fill_value(args[k], values)
     extra = {k: fill_value(v, values) for k, v in tpl.extra.items()} if tpl.extra else {}
-    return frozen_instance(type(tpl), {"command": tpl.command, "args": args, "given": tpl.given, "range": rng,
-                                       "location": deck.location(first, stack), "extra": extra, "locations": locs,
-                                       "span": (deck.source_lines, first.line, last_line)})
+    call = _new(type(tpl))                # errors.frozen_instance written out
+    _set(call, "__dict__", {"command": tpl.command, "args": args, "given": tpl.given, "range": rng,
+                            "location": deck.location(first, stack), "extra": extra, "locations": locs,
+                            "span": (deck.source_lines, first.line, last_line)})
+    return call

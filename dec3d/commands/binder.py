@@ -213,7 +213,7 @@ class Binder:
         values = [s[3] for s in steps]
         if len(self.plans) >= MAX_PLANS:
             self.plans.clear()
-        plan = self.plans[key] = Plan(call, [s[:3] for s in steps], toks, items)
+        plan = self.plans[key] = Plan(call, [s[:3] for s in steps], toks, items, values)
         call = fill(plan, values, toks, self.deck, self.stack)
         cmd = call.command
         if cmd.check is not None:
@@ -235,13 +235,13 @@ class Binder:
             except Exception:
                 pass
         toks = raw.tokens
-        values = []
+        values = plan.values.copy()
         try:
-            for param, i, j in plan.steps:
+            for n, param, i, j in plan.vsteps:
                 v, end = param.value.take(toks, i, self)     # as _take (its errors end the replay)
                 if end != j:
                     return None
-                values.append(v)
+                values[n] = v
             call = fill(plan, values, toks, self.deck, self.stack)
             cmd = call.command
             if cmd.check is not None:

@@ -26,10 +26,11 @@ from pathlib import Path
 from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
-from ..errors import CONTROL_CHARS, DeckSyntaxError, SourceLocation, frozen_instance, printable
+from ..errors import CONTROL_CHARS, DeckSyntaxError, SourceLocation, printable
 from .prepass import FishBlock, lift_fish
 
 _GRAMMAR_DIR = Path(__file__).parent
+_new, _set = object.__new__, object.__setattr__
 # the characters refused in strings and `[ ]`, but newlines: no token holds one
 _CONTROL_NOT_NL = re.compile(CONTROL_CHARS.pattern.replace("\x0a-", "\x0b-", 1))
 assert _CONTROL_NOT_NL.pattern != CONTROL_CHARS.pattern
@@ -121,9 +122,13 @@ class ParsedDeck:
 
     def location(self, tok: Token, stack=()) -> SourceLocation:
         line = tok.line
-        text = self.source_lines[line - 1] if 0 < line <= len(self.source_lines) else ""
-        return frozen_instance(SourceLocation, {"file": self.filename, "line": line, "column": tok.column,
-                                                "text": text, "length": max(1, len(tok)), "stack": tuple(stack)})
+        lines = self.source_lines
+        text = lines[line - 1] if 0 < line <= len(lines) else ""
+        # errors.frozen_instance written out (a location per bound line)
+        loc = _new(SourceLocation)
+        _set(loc, "__dict__", {"file": self.filename, "line": line, "column": tok.column, "text": text,
+                               "length": len(tok) or 1, "stack": stack if type(stack) is tuple else tuple(stack)})
+        return loc
 
 
 def normalise(text: str) -> str:
