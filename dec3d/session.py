@@ -21,14 +21,15 @@ from .commands import load_all
 from .commands._file_check import bind_check, path_params
 from .commands.binder import BindContext, Binder, CommandCall, ExprStatement
 from .commands.values import Deferred, OutPath, ValueRangeError
-from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation, StopDeck, printable
+from .errors import (BindError, CommandError, Dec3dError, ExpressionError, SourceLocation, StopDeck,
+                     UnimplementedError, printable)
 from .fish import FishRuntime, compile_function, compile_inline, inline_source, parse_block, parse_inline
 from .io import paths
 from .io.guard import FileRecord
 from .lang.parser import ParsedDeck, gc_paused, parse_deck
 from .lang.prepass import FishBlock
 from .lang.progress import BindProgress
-from .lang.unsupported import Unsupported, bind_or_defer, empty_range
+from .lang.unsupported import Unsupported, empty_range, unsupported
 from .model.model import Model
 
 
@@ -230,6 +231,7 @@ class Session:
         next_fish = next(fish, None)
         progress = BindProgress(self.write, paths.printable(deck.filename))
         count = 0
+        bind_line = binder.bind_line
         for raw in deck.lines:
             line = raw.line
             count += 1
@@ -238,7 +240,10 @@ class Session:
             while next_fish is not None and next_fish.line < line:
                 items.append(self._fish_item(deck, next_fish, stack))
                 next_fish = next(fish, None)
-            call = bind_or_defer(self, binder, raw)
+            try:                            # lang.unsupported.bind_or_defer, written out
+                call = bind_line(raw)
+            except UnimplementedError as exc:
+                call = unsupported(exc)
             if type(call) is not CommandCall and isinstance(call, (ExprStatement, Unsupported)):
                 items.append(call)
                 continue

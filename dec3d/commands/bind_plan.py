@@ -174,8 +174,46 @@ def fill(plan: Plan, values, toks, deck, stack):
     rng = plan.call.range
     if rng is not None:
         where = plan.where
-        rng = _range(rng, values, [LazyLocation(deck, toks[where[id(e.location)]], stack) for e in rng.elements])
-    return _call(plan, values, locs, rng, toks[0], toks[-1].line, deck, stack)
+        rng = fill_range(rng, values, [LazyLocation(deck, toks[where[id(e.location)]], stack) for e in rng.elements])
+    return fill_call(plan, values, locs, rng, toks[0], toks[-1].line, deck, stack)
+
+
+def replay(plan: Plan, raw, items, binder):
+    """``raw`` bound by its shape's plan; None when a take fails or takes other tokens (the line is
+    then bound the ordinary way, which reports what is wrong). A line with runs of numbers is
+    replayed on its items first (``replay_compact``), then on its tokens."""
+    if plan.compact is not None:
+        try:
+            call = replay_compact(plan, items, binder)
+            if call is not None:
+                cmd = call.command
+                if cmd.check is not None:
+                    cmd.check(call)
+                return call
+        except Exception:
+            pass
+    toks = raw.tokens
+    values = plan.values.copy()
+    try:
+        for n, param, i, j in plan.vsteps:
+            v, end = param.value.take(toks, i, binder)     # as Binder._take (its errors end the replay)
+            if end != j:
+                return None
+            values[n] = v
+        deck, stack = binder.deck, binder.stack            # fill, written out
+        locs = {k: LazyLocation(deck, toks[i], stack) for k, i in plan.locs}
+        rng = plan.call.range
+        if rng is not None:
+            where = plan.where
+            rng = fill_range(rng, values, [LazyLocation(deck, toks[where[id(e.location)]], stack)
+                                           for e in rng.elements])
+        call = fill_call(plan, values, locs, rng, toks[0], toks[-1].line, deck, stack)
+        cmd = call.command
+        if cmd.check is not None:
+            cmd.check(call)
+    except Exception:
+        return None
+    return call
 
 
 def _at(deck, items, a, o, stack):
@@ -211,17 +249,17 @@ def replay_compact(plan: Plan, items, binder):
     rng = plan.call.range
     if rng is not None:
         where = plan.cwhere
-        rng = _range(rng, values, [_at(deck, items, *where[id(e.location)], stack) for e in rng.elements])
-    return _call(plan, values, locs, rng, items[0], items[-1].line, deck, stack)
+        rng = fill_range(rng, values, [_at(deck, items, *where[id(e.location)], stack) for e in rng.elements])
+    return fill_call(plan, values, locs, rng, items[0], items[-1].line, deck, stack)
 
 
-def _range(rng, values, locations):
+def fill_range(rng, values, locations):
     one = type(rng.elements[0])
     return type(rng)(tuple(one(e.element, {k: fill_value(v, values) for k, v in e.args.items()}, e.negate, loc)
                            for e, loc in zip(rng.elements, locations)), rng.union)
 
 
-def _call(plan: Plan, values, locs, rng, first, last_line, deck, stack):
+def fill_call(plan: Plan, values, locs, rng, first, last_line, deck, stack):
     tpl = plan.call
     args = tpl.args.copy()                # the keys in the order binding gave them
     for k, n in plan.holes:

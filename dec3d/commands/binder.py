@@ -17,7 +17,7 @@ from ..errors import (BindError, DeckSyntaxError, LazyLocation, LegacySyntaxErro
 from ..lang.abbrev import matches, suggest
 from ..lang.expr import check_names, parse_expression
 from ..lang.parser import ParsedDeck, RawLine
-from .bind_plan import MAX_PLANS, Plan, Slot, fill, replay_compact, shape
+from .bind_plan import MAX_PLANS, Plan, Slot, fill, replay, shape
 from .legacy import legacy_hint
 from .registry import REGISTRY, Command, Node, RangeElement, Registry
 from .values import FLOAT, MISSING, Deferred, Flag, Param, ValueRangeError, ValueType
@@ -192,16 +192,27 @@ class Binder:
             self.deferred(first)                 # checks the name; a FISH function is called when it runs
             return ExprStatement(("name", str(first)[1:].lower(), 1), self.deck.location(first, self.stack),
                                  str(first))
-        return self.bind(raw)
+        key = shape(toks)                        # self.bind, written out
+        plan = self.plans.get(key)
+        if plan is not None:
+            call = replay(plan, raw, toks, self)
+            if call is not None:
+                return call
+        return self._plan(raw, key)
 
     def bind(self, raw: RawLine) -> CommandCall:
         items = raw.items
         key = shape(items)
         plan = self.plans.get(key)
         if plan is not None:
-            call = self._replay(plan, raw, items)
+            call = replay(plan, raw, items, self)
             if call is not None:
                 return call
+        return self._plan(raw, key)
+
+    def _plan(self, raw: RawLine, key) -> CommandCall:
+        """The line bound the ordinary way, and the plan of its shape ``key`` made from it."""
+        items = raw.items
         toks = raw.tokens
         self._steps = steps = []
         try:
@@ -219,37 +230,6 @@ class Binder:
         if cmd.check is not None:
             cmd.check(call)
         return call
-
-    def _replay(self, plan: Plan, raw, items):
-        """The line bound by its shape's plan; None when a take fails or takes other tokens (the
-        line is then bound the ordinary way, which reports what is wrong). A line with runs of
-        numbers is replayed on its items first (``bind_plan.replay_compact``), else on its tokens."""
-        if plan.compact is not None:
-            try:
-                call = replay_compact(plan, items, self)
-                if call is not None:
-                    cmd = call.command
-                    if cmd.check is not None:
-                        cmd.check(call)
-                    return call
-            except Exception:
-                pass
-        toks = raw.tokens
-        values = plan.values.copy()
-        try:
-            for n, param, i, j in plan.vsteps:
-                v, end = param.value.take(toks, i, self)     # as _take (its errors end the replay)
-                if end != j:
-                    return None
-                values[n] = v
-            call = fill(plan, values, toks, self.deck, self.stack)
-            cmd = call.command
-            if cmd.check is not None:
-                cmd.check(call)
-        except Exception:
-            return None
-        return call
-
 
     def _bind(self, toks) -> CommandCall:
         """The ordinary binding of a command line; with ``_steps`` set, each value is a ``Slot``
