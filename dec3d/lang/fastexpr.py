@@ -40,35 +40,6 @@ _TOKEN_GROUPS = re.compile(r"([ \t\f]*)(?:" + re.sub(r"\(\?P<\w+>", "(", _TOKEN.
 assert _TOKEN_GROUPS.groups == 5
 
 
-def _tokens(text: str):
-    """(kind, text, column) tokens; kind is num, str, name, a keyword, or the operator itself."""
-    out = []
-    add = out.append
-    pos = 0
-    keywords = _KEYWORDS
-    for ws, num, st, name, op in _TOKEN_GROUPS.findall(text):
-        if ws:
-            pos += len(ws)
-        if num:
-            add(("num", num, pos + 1))
-            pos += len(num)
-        elif name:
-            add((keywords.get(name.lower(), "name"), name, pos + 1))
-            pos += len(name)
-        elif op:
-            add((op, op, pos + 1))
-            pos += len(op)
-        else:
-            add(("str", st, pos + 1))
-            pos += len(st)
-    # findall skips text no token takes: then the tokens' lengths do not add up to the text's (the
-    # rest from ``pos`` holds the text of a later token, or the text skipped at the end)
-    if pos != len(text) and text[pos:].strip(" \t\f"):
-        raise _Fail
-    add(("end", "", len(text) + 1))
-    return out
-
-
 class _Parser:
     __slots__ = ("toks", "i")
 
@@ -207,17 +178,54 @@ def _refill(node, nums, cols):
     raise AssertionError(tag)
 
 
+def _shaped_tokens(text: str):
+    """(kind, text, column) tokens — kind is num, str, name, a keyword, or the operator itself — and,
+    made in the same pass, the token shape (``_SHAPES``' key: each token's text, a number as whether it
+    is written as a float), the numbers' texts and the names' columns."""
+    toks, key, nums, cols = [], [], [], []
+    add, shape = toks.append, key.append
+    pos = 0
+    keywords = _KEYWORDS
+    for ws, num, st, name, op in _TOKEN_GROUPS.findall(text):
+        if ws:
+            pos += len(ws)
+        if num:
+            add(("num", num, pos + 1))
+            shape("\0f" if "." in num or "e" in num or "E" in num else "\0i")   # no token's text starts so
+            nums.append(num)
+            pos += len(num)
+        elif name:
+            kind = keywords.get(name.lower(), "name")
+            add((kind, name, pos + 1))
+            shape(name)
+            if kind == "name":
+                cols.append(pos + 1)
+            pos += len(name)
+        elif op:
+            add((op, op, pos + 1))
+            shape(op)
+            pos += len(op)
+        else:
+            add(("str", st, pos + 1))
+            shape(st)
+            pos += len(st)
+    # findall skips text no token takes: then the tokens' lengths do not add up to the text's (the
+    # rest from ``pos`` holds the text of a later token, or the text skipped at the end)
+    if pos != len(text) and text[pos:].strip(" \t\f"):
+        raise _Fail
+    add(("end", "", len(text) + 1))
+    return toks, tuple(key), nums, cols
+
+
 def parse_fast(text: str):
     """The expression tree of ``text``, or None when it is not one (or nests too deep for this parser)."""
     try:
-        toks = _tokens(text)
+        toks, key, nums, cols = _shaped_tokens(text)
     except _Fail:
         return None
-    key = tuple([(k, "." in v or "e" in v or "E" in v) if k == "num" else (k, v) for k, v, _ in toks])
     tree = _SHAPES.get(key)
     if tree is not None:
-        return _refill(tree, iter([_const(v) for k, v, _ in toks if k == "num"]),
-                       iter([c for k, _, c in toks if k == "name"]))
+        return _refill(tree, iter([_const(v) for v in nums]), iter(cols))
     try:
         p = _Parser(toks)
         tree = p.statement()
