@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 
 from ..errors import LazyLocation
+from ..lang.parser import run_tokens
 from .values import Choice, InPath, Num, Nums, OnOff, OutPath, Text, ValueType
 
 # the shape of a non-word token: no word can be spelt with `<`; a run of numbers is its count
@@ -56,16 +57,18 @@ class Slot:
 
 
 class RunLocation(LazyLocation):
-    """The location of the k-th number of a run: its token is made only when asked for."""
+    """The location of the k-th number of a run: its token is made only when asked for (from the
+    run's text and place, not the run: what a bound call keeps stays small)."""
 
-    __slots__ = ("run", "k")
+    __slots__ = ("text", "start", "line", "line_start", "k")
 
     def __init__(self, deck, run, k, stack=()):
-        self.deck, self.run, self.k, self.stack = deck, run, k, stack
+        self.deck, self.k, self.stack = deck, k, stack
+        self.text, self.start, self.line, self.line_start = run.text, run.start, run.line, run.line_start
 
     @property
     def token(self):
-        return self.run.tokens()[self.k]
+        return run_tokens(self.text, self.start, self.line, self.line_start)[self.k]
 
     def resolve(self):
         return self.deck.location(self.token, self.stack)

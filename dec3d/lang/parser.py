@@ -58,18 +58,25 @@ class NumRun:
         """The run's NUMBER tokens (type, text, line, column, end, offsets as lark's lexer makes them)."""
         toks = self._tokens
         if toks is None:
-            make, line, base, start = str.__new__, self.line, self.line_start, self.start
-            toks = self._tokens = []
-            for m in _NUMBER_IN_RUN.finditer(self.text):
-                value = m.group()
-                s, e = start + m.start(), start + m.end()
-                tok = make(Token, value)
-                tok.type, tok.value, tok.start_pos, tok.end_pos = "NUMBER", value, s, e
-                tok.line = tok.end_line = line
-                tok.column, tok.end_column = s - base + 1, e - base + 1
-                toks.append(tok)
+            toks = self._tokens = run_tokens(self.text, self.start, self.line, self.line_start)
             assert len(toks) == len(self.nums)
         return toks
+
+
+def run_tokens(text: str, start: int, line: int, line_start: int) -> list:
+    """The NUMBER tokens of the run of numbers ``text`` found at offset ``start`` of the deck, on
+    ``line``, which starts at offset ``line_start``."""
+    make = str.__new__
+    toks = []
+    for m in _NUMBER_IN_RUN.finditer(text):
+        value = m.group()
+        s, e = start + m.start(), start + m.end()
+        tok = make(Token, value)
+        tok.type, tok.value, tok.start_pos, tok.end_pos = "NUMBER", value, s, e
+        tok.line = tok.end_line = line
+        tok.column, tok.end_column = s - line_start + 1, e - line_start + 1
+        toks.append(tok)
+    return toks
 
 
 class RawLine:
