@@ -232,6 +232,15 @@ def replay_compact(plan: Plan, items, binder):
             values[step[1]] = _take_one(step[2].value, items, step[3], binder)[0]
             continue
         _, n, segs, inline, one = step
+        if len(segs) == 1 and segs[0][1] == 0:       # the numbers of one run, from its first
+            a, _, o1 = segs[0]
+            it = items[a]
+            nums = it.nums
+            nums = run_values(nums if o1 == len(nums) else nums[:o1], inline, it.text)
+            if nums is None:
+                return None
+            values[n] = nums[0] if one else tuple(nums)
+            continue
         out = []
         for a, o0, o1 in segs:
             it = items[a]
@@ -248,7 +257,8 @@ def replay_compact(plan: Plan, items, binder):
             out.extend(nums)
         values[n] = out[0] if one else tuple(out)
     deck, stack = binder.deck, binder.stack
-    locs = {k: _at(deck, items, a, o, stack) for k, a, o in plan.clocs}
+    locs = {k: LazyLocation(deck, items[a], stack) if o is None else RunLocation(deck, items[a], o, stack)
+            for k, a, o in plan.clocs}
     rng = plan.call.range
     if rng is not None:
         where = plan.cwhere
