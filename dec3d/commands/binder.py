@@ -192,7 +192,7 @@ class Binder:
             self.deferred(first)                 # checks the name; a FISH function is called when it runs
             return ExprStatement(("name", str(first)[1:].lower(), 1), self.deck.location(first, self.stack),
                                  str(first))
-        key = shape(toks)                        # self.bind, written out
+        key = shape(toks)                        # a command: by its shape's plan, if any
         plan = self.plans.get(key)
         if plan is not None:
             call = replay(plan, raw, toks, self)
@@ -201,14 +201,11 @@ class Binder:
         return self._plan(raw, key)
 
     def bind(self, raw: RawLine) -> CommandCall:
-        items = raw.items
-        key = shape(items)
+        """A command line (``bind_line`` for any line)."""
+        key = shape(raw.items)
         plan = self.plans.get(key)
-        if plan is not None:
-            call = replay(plan, raw, items, self)
-            if call is not None:
-                return call
-        return self._plan(raw, key)
+        call = replay(plan, raw, raw.items, self) if plan is not None else None
+        return call if call is not None else self._plan(raw, key)
 
     def _plan(self, raw: RawLine, key) -> CommandCall:
         """The line bound the ordinary way, and the plan of its shape ``key`` made from it."""
