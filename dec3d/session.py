@@ -21,14 +21,15 @@ from .commands import load_all
 from .commands._file_check import bind_check, path_params
 from .commands.binder import BindContext, Binder, CommandCall, ExprStatement
 from .commands.values import Deferred, OutPath, ValueRangeError
-from .errors import BindError, CommandError, Dec3dError, ExpressionError, SourceLocation, StopDeck, printable
+from .errors import (BindError, CommandError, Dec3dError, ExpressionError, SourceLocation, StopDeck,
+                     UnimplementedError, printable)
 from .fish import FishRuntime, compile_function, compile_inline, inline_source, parse_block, parse_inline
 from .io import paths
 from .io.guard import FileRecord
 from .lang.parser import ParsedDeck, gc_paused, parse_deck
 from .lang.prepass import FishBlock
 from .lang.progress import BindProgress
-from .lang.unsupported import Unsupported, bind_or_defer, empty_range
+from .lang.unsupported import Unsupported, empty_range, unsupported
 from .model.model import Model
 
 
@@ -229,18 +230,27 @@ class Session:
         fish = iter(deck.fish)
         next_fish = next(fish, None)
         progress = BindProgress(self.write, paths.printable(deck.filename))
+        count = 0
+        bind_line = binder.bind_line
         for raw in deck.lines:
-            line = raw.tokens[0].line
-            progress.tick(line)
+            line = raw.line
+            count += 1
+            if not count & 1023:            # progress.tick's own test, written out
+                progress.tick_at(line)
             while next_fish is not None and next_fish.line < line:
                 items.append(self._fish_item(deck, next_fish, stack))
                 next_fish = next(fish, None)
-            call = bind_or_defer(self, binder, raw)
-            if isinstance(call, (ExprStatement, Unsupported)):
+            try:                            # lang.unsupported.bind_or_defer, written out
+                call = bind_line(raw)
+            except UnimplementedError as exc:
+                call = unsupported(exc)
+            if type(call) is not CommandCall and isinstance(call, (ExprStatement, Unsupported)):
                 items.append(call)
                 continue
-            path = call.command.path
-            self._check_paths(call)
+            cmd = call.command
+            path = cmd.path
+            if cmd.file_params:
+                self._check_paths(call)
             if path == ("program", "call") and not isinstance(call.args["file"], Deferred):
                 # a literal name: the called file is read and bound now, in place of the call
                 target = self.find_deck(call.args["file"], call.locations.get("file", call.location))

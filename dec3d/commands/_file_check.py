@@ -8,17 +8,9 @@ from .binder import CommandCall
 from .values import InPath, OutPath
 
 
-#: id(command) -> (command, its parameters naming files): looked up for every bound line
-_PATH_PARAMS: dict[int, tuple] = {}
-
-
 def path_params(cmd) -> tuple:
     """The parameters of ``cmd`` whose values name files (OutPath, InPath), in declaration order."""
-    hit = _PATH_PARAMS.get(id(cmd))
-    if hit is None or hit[0] is not cmd:
-        hit = _PATH_PARAMS[id(cmd)] = (cmd, tuple(p for p in cmd.positional + cmd.keywords
-                                                  if isinstance(p.value, (OutPath, InPath))))
-    return hit[1]
+    return cmd.file_params
 
 
 def bind_check(session, items) -> None:
@@ -29,9 +21,9 @@ def bind_check(session, items) -> None:
     created = set(record.created)
     inputs, keys = dict(record.inputs), dict(record.input_keys)
     for item in items:
-        if not isinstance(item, CommandCall):
+        if type(item) is not CommandCall and not isinstance(item, CommandCall):
             continue
-        for p in path_params(item.command):
+        for p in item.command.file_params:
             value = item.args.get(p.key)
             if not isinstance(value, str):
                 continue

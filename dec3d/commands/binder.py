@@ -17,7 +17,7 @@ from ..errors import (BindError, DeckSyntaxError, LazyLocation, LegacySyntaxErro
 from ..lang.abbrev import matches, suggest
 from ..lang.expr import check_names, parse_expression
 from ..lang.parser import ParsedDeck, RawLine
-from .bind_plan import MAX_PLANS, Plan, Slot, fill, shape
+from .bind_plan import MAX_PLANS, Plan, Slot, fill, replay, shape
 from .legacy import legacy_hint
 from .registry import REGISTRY, Command, Node, RangeElement, Registry
 from .values import FLOAT, MISSING, Deferred, Flag, Param, ValueRangeError, ValueType
@@ -180,7 +180,7 @@ class Binder:
     # ------------------------------------------------------------ commands
     def bind_line(self, raw: RawLine) -> "CommandCall | ExprStatement":
         """Any line: a `[ ... ]` statement, an `@name` call, or a command."""
-        toks = raw.tokens
+        toks = raw.items
         first = toks[0]
         if len(toks) == 1 and first.type == "EXPR":
             node = self.expression(first)
@@ -192,16 +192,25 @@ class Binder:
             self.deferred(first)                 # checks the name; a FISH function is called when it runs
             return ExprStatement(("name", str(first)[1:].lower(), 1), self.deck.location(first, self.stack),
                                  str(first))
-        return self.bind(raw)
-
-    def bind(self, raw: RawLine) -> CommandCall:
-        toks = raw.tokens
-        key = shape(toks)
+        key = shape(toks)                        # a command: by its shape's plan, if any
         plan = self.plans.get(key)
         if plan is not None:
-            call = self._replay(plan, toks)
+            call = replay(plan, raw, toks, self)
             if call is not None:
                 return call
+        return self._plan(raw, key)
+
+    def bind(self, raw: RawLine) -> CommandCall:
+        """A command line (``bind_line`` for any line)."""
+        key = shape(raw.items)
+        plan = self.plans.get(key)
+        call = replay(plan, raw, raw.items, self) if plan is not None else None
+        return call if call is not None else self._plan(raw, key)
+
+    def _plan(self, raw: RawLine, key) -> CommandCall:
+        """The line bound the ordinary way, and the plan of its shape ``key`` made from it."""
+        items = raw.items
+        toks = raw.tokens
         self._steps = steps = []
         try:
             call = self._bind(toks)
@@ -212,31 +221,12 @@ class Binder:
         values = [s[3] for s in steps]
         if len(self.plans) >= MAX_PLANS:
             self.plans.clear()
-        plan = self.plans[key] = Plan(call, [s[:3] for s in steps], toks)
+        plan = self.plans[key] = Plan(call, [s[:3] for s in steps], toks, items, values)
         call = fill(plan, values, toks, self.deck, self.stack)
         cmd = call.command
         if cmd.check is not None:
             cmd.check(call)
         return call
-
-    def _replay(self, plan: Plan, toks):
-        """The line bound by its shape's plan; None when a take fails or takes other tokens (the
-        line is then bound the ordinary way, which reports what is wrong)."""
-        values = []
-        try:
-            for param, i, j in plan.steps:
-                v, end = param.value.take(toks, i, self)     # as _take (its errors end the replay)
-                if end != j:
-                    return None
-                values.append(v)
-            call = fill(plan, values, toks, self.deck, self.stack)
-            cmd = call.command
-            if cmd.check is not None:
-                cmd.check(call)
-        except Exception:
-            return None
-        return call
-
 
     def _bind(self, toks) -> CommandCall:
         """The ordinary binding of a command line; with ``_steps`` set, each value is a ``Slot``
@@ -264,7 +254,8 @@ class Binder:
         return call
 
     def source(self, raw: RawLine) -> str:
-        return source_text(self.deck.source_lines, raw.tokens[0].line, raw.tokens[-1].line)
+        items = raw.items
+        return source_text(self.deck.source_lines, items[0].line, items[-1].line)
 
     def _resolve(self, toks):
         node = self.reg.root

@@ -1,6 +1,7 @@
 """`model new|title|configure|large-strain|gravity`: model-wide settings."""
 from __future__ import annotations
 
+from ..errors import BindError
 from ..units import NAMES as UNIT_SYSTEMS
 from .registry import command
 from .values import FLAG, ONOFF, Choice, Num, Nums, P, Text
@@ -24,8 +25,6 @@ CONFIGURE_OPTIONS = ("dynamic", "fluid", "thermal", "highorder", "feblock", "cre
 
 
 def _check_configure(call):
-    from ..errors import BindError
-
     opt = call.args["option"]
     if opt != "threads" and call.args["n"] is not None:
         raise BindError(f"`model configure {opt}` takes no value",

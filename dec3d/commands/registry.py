@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from typing import Callable, Iterable, Sequence
 
 from ..lang.abbrev import matches
-from .values import Param
+from .values import InPath, OutPath, Param
 
 
 @dataclass
@@ -42,6 +42,9 @@ class Command:
         self.keyword_names: tuple[str, ...] = tuple(p.name for p in self.keywords)
         self.by_name: dict[str, Param] = {p.name: p for p in self.keywords}
         self.by_key: dict[str, Param] = {p.key: p for p in self.positional + self.keywords}
+        # the parameters naming files (OutPath, InPath), in declaration order: checked at bind time
+        self.file_params: tuple[Param, ...] = tuple(p for p in self.positional + self.keywords
+                                                    if isinstance(p.value, (OutPath, InPath)))
 
     @property
     def name(self) -> str:

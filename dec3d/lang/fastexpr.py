@@ -34,30 +34,10 @@ class _Fail(Exception):
     pass
 
 
-# the same tokens, the blanks before each matched with it (half the matches; nothing but `ws` can
-# start with a blank, so this is the same cut)
-_TOKEN_AFTER_BLANKS = re.compile(r"[ \t\f]*(?:" + _TOKEN.pattern.split("|", 1)[1] + ")", re.X)
-
-
-def _tokens(text: str):
-    """(kind, text, column) tokens; kind is num, str, name, a keyword, or the operator itself."""
-    out = []
-    pos, n = 0, len(text)
-    for m in _TOKEN_AFTER_BLANKS.finditer(text):
-        if m.start() != pos:
-            raise _Fail
-        kind = m.lastgroup
-        value = m.group(kind)
-        pos = m.end()
-        if kind == "name":
-            kind = _KEYWORDS.get(value.lower(), "name")
-        elif kind == "op":
-            kind = value
-        out.append((kind, value, pos - len(value) + 1))
-    if pos != n and text[pos:].strip(" \t\f"):
-        raise _Fail
-    out.append(("end", "", n + 1))
-    return out
+# the same tokens, each a tuple of groups (the blanks before it, then one of num, str, name, op) made by
+# ``findall`` (nothing but `ws` can start with a blank, so this is the same cut)
+_TOKEN_GROUPS = re.compile(r"([ \t\f]*)(?:" + re.sub(r"\(\?P<\w+>", "(", _TOKEN.pattern.split("|", 1)[1]) + ")", re.X)
+assert _TOKEN_GROUPS.groups == 5
 
 
 class _Parser:
@@ -163,13 +143,97 @@ class _Parser:
         raise _Fail
 
 
+#: token shape (kinds, words, operators, numbers by int or float; no columns) -> a tree parsed from
+#: it: the parse depends on nothing else, so a later expression of the shape takes its numbers and
+#: columns into the tree (``_refill``) instead of being parsed (a deck's `[x = 0.53 * 2.5 + ...]`
+#: lines differ in their numbers only)
+_SHAPES: dict = {}
+_NUMERIC = (int, float)
+
+
+def _const(value: str):
+    return float(value) if "." in value or "e" in value or "E" in value else int(value)
+
+
+def _refill(node, nums, cols):
+    """``node`` with its numbers (constants that are int or float, in the text's order) and its
+    columns (of names, calls, assignments) taken from the iterators ``nums`` and ``cols``."""
+    tag = node[0]
+    if tag == "const":
+        return ("const", next(nums)) if type(node[1]) in _NUMERIC else node
+    if tag == "name":
+        return ("name", node[1], next(cols))
+    if tag == "bin" or tag == "cmp":
+        return (tag, node[1], _refill(node[2], nums, cols), _refill(node[3], nums, cols))
+    if tag == "neg" or tag == "not":
+        return (tag, _refill(node[1], nums, cols))
+    if tag == "and" or tag == "or":
+        return (tag, _refill(node[1], nums, cols), _refill(node[2], nums, cols))
+    if tag == "call":
+        col = next(cols)
+        return ("call", node[1], tuple(_refill(a, nums, cols) for a in node[2]), col)
+    if tag == "assign":
+        col = next(cols)
+        return ("assign", node[1], node[2], _refill(node[3], nums, cols), col)
+    raise AssertionError(tag)
+
+
+def _shaped_tokens(text: str):
+    """(kind, text, column) tokens — kind is num, str, name, a keyword, or the operator itself — and,
+    made in the same pass, the token shape (``_SHAPES``' key: each token's text, a number as whether it
+    is written as a float), the numbers' texts and the names' columns."""
+    toks, key, nums, cols = [], [], [], []
+    add, shape = toks.append, key.append
+    pos = 0
+    keywords = _KEYWORDS
+    for ws, num, st, name, op in _TOKEN_GROUPS.findall(text):
+        if ws:
+            pos += len(ws)
+        if num:
+            add(("num", num, pos + 1))
+            shape("\0f" if "." in num or "e" in num or "E" in num else "\0i")   # no token's text starts so
+            nums.append(num)
+            pos += len(num)
+        elif name:
+            kind = keywords.get(name.lower(), "name")
+            add((kind, name, pos + 1))
+            shape(name)
+            if kind == "name":
+                cols.append(pos + 1)
+            pos += len(name)
+        elif op:
+            add((op, op, pos + 1))
+            shape(op)
+            pos += len(op)
+        else:
+            add(("str", st, pos + 1))
+            shape(st)
+            pos += len(st)
+    # findall skips text no token takes: then the tokens' lengths do not add up to the text's (the
+    # rest from ``pos`` holds the text of a later token, or the text skipped at the end)
+    if pos != len(text) and text[pos:].strip(" \t\f"):
+        raise _Fail
+    add(("end", "", len(text) + 1))
+    return toks, tuple(key), nums, cols
+
+
 def parse_fast(text: str):
     """The expression tree of ``text``, or None when it is not one (or nests too deep for this parser)."""
     try:
-        p = _Parser(_tokens(text))
+        toks, key, nums, cols = _shaped_tokens(text)
+    except _Fail:
+        return None
+    tree = _SHAPES.get(key)
+    if tree is not None:
+        return _refill(tree, iter([_const(v) for v in nums]), iter(cols))
+    try:
+        p = _Parser(toks)
         tree = p.statement()
         if p.kind() != "end":
             return None
-        return tree
     except (_Fail, IndexError, RecursionError):
         return None
+    if len(_SHAPES) >= 4096:
+        _SHAPES.clear()
+    _SHAPES[key] = tree
+    return tree

@@ -26,24 +26,86 @@ from pathlib import Path
 from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
-from ..errors import CONTROL_CHARS, DeckSyntaxError, SourceLocation, frozen_instance, printable
+from ..errors import CONTROL_CHARS, DeckSyntaxError, SourceLocation, printable
 from .prepass import FishBlock, lift_fish
 
 _GRAMMAR_DIR = Path(__file__).parent
+_new, _set = object.__new__, object.__setattr__
 # the characters refused in strings and `[ ]`, but newlines: no token holds one
 _CONTROL_NOT_NL = re.compile(CONTROL_CHARS.pattern.replace("\x0a-", "\x0b-", 1))
 assert _CONTROL_NOT_NL.pattern != CONTROL_CHARS.pattern
+# the numbers of a run (``NumRun``): NUMBER without its look-ahead (a run holds numbers and
+# delimiters only); a run is split at its delimiters
+_NUMBER_IN_RUN = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+_RUN_SPLIT = re.compile(r"[ \t\f\r,()=]+")
 
 
-@dataclass(frozen=True, slots=True)
+class NumRun:
+    """Two or more numbers in a row on one physical line (only delimiters between them), lexed as one
+    match: their texts (``nums``), not a token each. A `block create polyhedron` line of 72 numbers is
+    one run; the binder converts a run's numbers in one pass (``bind_plan``) and asks for the tokens
+    (``tokens()``, the ones lark's lexer gives) only when a line is bound the ordinary way or a
+    location inside the run is resolved."""
+
+    __slots__ = ("text", "nums", "start", "line", "line_start", "_tokens")
+    type = "NUMRUN"
+
+    def __init__(self, text: str, nums: list, start: int, line: int, line_start: int):
+        self.text, self.nums, self.start, self.line, self.line_start = text, nums, start, line, line_start
+        self._tokens = None
+
+    def tokens(self) -> list:
+        """The run's NUMBER tokens (type, text, line, column, end, offsets as lark's lexer makes them)."""
+        toks = self._tokens
+        if toks is None:
+            toks = self._tokens = run_tokens(self.text, self.start, self.line, self.line_start)
+            assert len(toks) == len(self.nums)
+        return toks
+
+
+def run_tokens(text: str, start: int, line: int, line_start: int) -> list:
+    """The NUMBER tokens of the run of numbers ``text`` found at offset ``start`` of the deck, on
+    ``line``, which starts at offset ``line_start``."""
+    make = str.__new__
+    toks = []
+    for m in _NUMBER_IN_RUN.finditer(text):
+        value = m.group()
+        s, e = start + m.start(), start + m.end()
+        tok = make(Token, value)
+        tok.type, tok.value, tok.start_pos, tok.end_pos = "NUMBER", value, s, e
+        tok.line = tok.end_line = line
+        tok.column, tok.end_column = s - line_start + 1, e - line_start + 1
+        toks.append(tok)
+    return toks
+
+
 class RawLine:
-    """One command line: its tokens (lark Tokens: type, value, line, column)."""
+    """One command line: its tokens (lark Tokens: type, value, line, column). ``items`` is the same
+    line as the lexer gave it, each run of numbers one ``NumRun``; ``tokens`` is made from it the
+    first time it is asked for (the same Token objects, a run's numbers each a token)."""
 
-    tokens: tuple[Token, ...]
+    __slots__ = ("items", "_tokens")
+
+    def __init__(self, items: tuple, runs: bool = False):
+        self.items = items
+        self._tokens = None if runs else items
+
+    @property
+    def tokens(self) -> tuple:
+        toks = self._tokens
+        if toks is None:
+            out = []
+            for it in self.items:
+                if it.type == "NUMRUN":
+                    out.extend(it.tokens())
+                else:
+                    out.append(it)
+            toks = self._tokens = tuple(out)
+        return toks
 
     @property
     def line(self) -> int:
-        return self.tokens[0].line
+        return self.items[0].line
 
 
 @lru_cache(maxsize=None)
@@ -66,9 +128,13 @@ class ParsedDeck:
 
     def location(self, tok: Token, stack=()) -> SourceLocation:
         line = tok.line
-        text = self.source_lines[line - 1] if 0 < line <= len(self.source_lines) else ""
-        return frozen_instance(SourceLocation, {"file": self.filename, "line": line, "column": tok.column,
-                                                "text": text, "length": max(1, len(tok)), "stack": tuple(stack)})
+        lines = self.source_lines
+        text = lines[line - 1] if 0 < line <= len(lines) else ""
+        # errors.frozen_instance written out (a location per bound line)
+        loc = _new(SourceLocation)
+        _set(loc, "__dict__", {"file": self.filename, "line": line, "column": tok.column, "text": text,
+                               "length": len(tok) or 1, "stack": stack if type(stack) is tuple else tuple(stack)})
+        return loc
 
 
 def normalise(text: str) -> str:
@@ -125,7 +191,7 @@ def parse_deck(text: str, filename: str = "<input>", stack=()) -> ParsedDeck:
         raise _syntax_error(exc, filename, source_lines, stack) from None
     if _CONTROL_NOT_NL.search(lifted) is not None:    # else no string or `[ ]` can hold one
         for line in lines:
-            for tok in line.tokens:
+            for tok in line.items:
                 if tok.type in ("STRING", "EXPR"):
                     check(tok)
     return ParsedDeck(filename, source_lines, lines, fish)
@@ -162,22 +228,27 @@ def _fast_pattern() -> tuple[re.Pattern, frozenset]:
     terms = sorted(lk.terminals, key=lambda t: (-t.priority, -t.pattern.max_width, -len(t.pattern.value), t.name))
     pattern = "|".join(f"(?P<{t.name}>{t.pattern.to_regexp()})" for t in terms)
     delim = lk.get_terminal("DELIMITERS").pattern.to_regexp()
-    return re.compile(f"(?:{delim})?(?:{pattern})"), frozenset(lk.lexer_conf.ignore)
+    # a run of numbers (``NumRun``) before the rest: NUMBER is the first terminal tried, so lark
+    # lexes this text as NUMBER, DELIMITERS, NUMBER, ... (a NUMBER never starts with a delimiter,
+    # so the run ends exactly where the next token is not a number)
+    number = lk.get_terminal("NUMBER").pattern.to_regexp()
+    assert terms[0].name == "NUMBER"
+    run = f"(?P<NUMRUN>{number}(?:(?:{delim}){number})+)"
+    return re.compile(f"(?:{delim})?(?:{run}|{pattern})"), frozenset(lk.lexer_conf.ignore)
 
 
 def _lex_fast(text: str) -> list[RawLine] | None:
     """Token lines, the same tokens (type, text, line, column, end, offsets) lark's lexer gives;
-    None when some text matches no terminal."""
+    None when some text matches no terminal. A run of numbers is one ``NumRun`` item."""
     pat, ignore = _fast_pattern()
     make = str.__new__           # lark's Token._future_new written out: a call less per token
     lines: list[RawLine] = []
     current: list[Token] = []
-    line, line_start, pos = 1, 0, 0
-    for m in pat.finditer(text):
-        start, end = m.span()
-        if start != pos:
-            return None
-        pos = end
+    runs = False
+    line, line_start, end = 1, 0, 0
+    # each match where the previous one ended (``scanner.match``: None at text no terminal takes)
+    for m in iter(pat.scanner(text).match, None):
+        end = m.end()
         kind = m.lastgroup
         if kind in ignore:
             if kind == "CONTINUATION":
@@ -185,10 +256,19 @@ def _lex_fast(text: str) -> list[RawLine] | None:
                 line_start = end
         elif kind == "_NL":
             if current:
-                lines.append(RawLine(tuple(current)))
+                lines.append(RawLine(tuple(current), runs))
                 current = []
+                runs = False
             line += 1
             line_start = end
+        elif kind == "NUMRUN":
+            value = m.group(kind)
+            if "(" in value or ")" in value or "=" in value:
+                nums = _RUN_SPLIT.split(value)
+            else:                   # blanks and commas only (str.split is a third of re.split)
+                nums = value.replace(",", " ").split()
+            current.append(NumRun(value, nums, end - len(value), line, line_start))
+            runs = True
         else:
             value = m.group(kind)
             start = end - len(value)
@@ -197,10 +277,10 @@ def _lex_fast(text: str) -> list[RawLine] | None:
             tok.line = tok.end_line = line
             tok.column, tok.end_column = start - line_start + 1, end - line_start + 1
             current.append(tok)
-    if pos != len(text):
+    if end != len(text):
         return None
     if current:
-        lines.append(RawLine(tuple(current)))
+        lines.append(RawLine(tuple(current), runs))
     return lines
 
 

@@ -24,6 +24,10 @@ class BindProgress:
         self.count += 1
         if self.count & 1023:
             return
+        self.tick_at(line)
+
+    def tick_at(self, line: int) -> None:
+        """Look at the clock (a caller counting lines itself calls this every 1024 lines)."""
         now = _time.perf_counter()
         if now >= self.next:
             self.next = now + EVERY

@@ -42,12 +42,17 @@ def bind_or_defer(session, binder, raw):
     try:
         return binder.bind_line(raw)
     except UnimplementedError as exc:
-        loc = exc.location
-        text = loc.text.strip() if loc is not None and loc.text else ""
-        if loc is None:
-            raise
-        line = SourceLocation(loc.file, loc.line, 1, loc.text, len(loc.text.rstrip()), loc.stack)
-        return Unsupported(line, text, exc)
+        return unsupported(exc)
+
+
+def unsupported(exc: UnimplementedError) -> Unsupported:
+    """The ``Unsupported`` item of a line whose binding raised ``exc`` (raised again without a location)."""
+    loc = exc.location
+    text = loc.text.strip() if loc is not None and loc.text else ""
+    if loc is None:
+        raise exc
+    line = SourceLocation(loc.file, loc.line, 1, loc.text, len(loc.text.rstrip()), loc.stack)
+    return Unsupported(line, text, exc)
 
 
 def empty_range(session, call, store: str, n: int) -> None:

@@ -72,7 +72,7 @@ def _same_outcomes(text: str, name: str = "d.dat") -> int:
 
     replayed = 0
     for raw in deck.lines:
-        known = shape(raw.tokens) in planned.plans
+        known = shape(raw.items) in planned.plans      # plans are keyed by the lexer items
         a = _outcome(planned.bind_line, raw)
         b = _outcome(ordinary, raw)
         assert a == b, f"{name}:{raw.line}"
@@ -212,3 +212,38 @@ def test_a_statement_line_made_field_by_field_equals_its_constructor():
     st = Binder(deck, BindContext()).bind_line(deck.lines[0])
     assert {f.name for f in fields(ExprStatement)} == set(vars(st))
     assert st == ExprStatement(st.node, st.location, "[x = 1 + 2]")
+
+
+def test_runs_of_numbers_replayed_on_items_bind_as_the_ordinary_binder():
+    """Lines whose numbers are lexed as runs (``NumRun``) and replayed on them (``bind_plan.replay_compact``):
+    random numbers of every written form, in and out of bounds, next to `[ ]`, continuations and other
+    delimiters, give what the ordinary binding gives."""
+    import random
+
+    rng = random.Random(5)
+    forms = ["0", "-0", "+0", "-0.0", "0.0", "1", "-1", "2.5", ".5", "5.", "007", "1e3", "-2E-4", "1e999", "-1e999",
+             "1" + "0" * 30, "1e12", "1.0000001e12", "-1e12", "89.9", "90", "[1 + 1]"]
+
+    def n():
+        return rng.choice(forms)
+
+    shapes = [
+        lambda: f"block create brick {n()} {n()} {n()} {n()} {n()} {n()}",
+        lambda: f"block create brick ({n()},{n()}) ({n()},{n()}) ({n()},{n()})",
+        lambda: f"block create brick {n()} {n()} ...\n  {n()} {n()} {n()} {n()}",
+        lambda: f"model gravity {n()} {n()} {n()}",
+        lambda: f"model gravity {n()},{n()} &\n {n()}",
+        lambda: f"block contact property stiffness-normal {n()} stiffness-shear {n()} friction {n()}",
+        lambda: f"block fix velocity range position-z {n()} {n()} position-x {n()} {n()}",
+        lambda: f"block initialize velocity {n()} {n()} {n()} range position-x {n()} {n()}",
+        lambda: "block create polyhedron " + " ".join(f"face {n()},{n()},{n()} {n()},{n()},{n()} {n()},{n()},{n()}"
+                                                     for _ in range(2)),
+    ]
+    text = "\n".join(rng.choice(shapes)() for _ in range(1500)) + "\n"
+    deck = parse_deck(text, "r.dat")
+    assert sum(it.type == "NUMRUN" for raw in deck.lines for it in raw.items) > 1000
+    binder = Binder(deck, BindContext(lenient_names=True))
+    kinds = [_outcome(binder.bind_line, raw)[0] for raw in deck.lines]
+    assert kinds.count("call") > 300 and kinds.count("error") > 300      # both met
+    assert any(p.compact is not None for p in binder.plans.values())
+    assert _same_outcomes(text, "r.dat") > 300

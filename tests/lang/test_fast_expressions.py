@@ -72,3 +72,26 @@ def test_deep_nesting_is_left_to_lark_and_errors_keep_their_columns():
     with pytest.raises(DeckSyntaxError) as e:
         parse_expression("1 + * 2")
     assert e.value.column_in_expr == 5 and "unexpected '*'" in e.value.message
+
+
+def test_expressions_of_one_shape_with_other_numbers_give_lark_s_tree():
+    """``parse_fast`` parses a token shape once and fills later expressions of that shape with their own
+    numbers and columns (``fastexpr._refill``): the trees are lark's, numbers of every width and kind."""
+    from dec3d.lang import fastexpr
+
+    rng = np.random.default_rng(11)
+    hits = 0
+    for _ in range(600):
+        form = _gen(rng)
+        for n in NUMBERS:                       # every number a slot (longest first: `12` holds `1`... no)
+            form = form.replace(n, "{}") if n in ("3.5", "2.E-4", "1e3") else form
+        slots = form.count("{}")
+        for k in range(3):
+            nums = [str(rng.choice(["7", "1234567", "0.5", "12.25e-3", ".5", "3.", "9" * 30, "2E5", "0"]))
+                    for _ in range(slots)]
+            text = form.format(*nums)
+            before = len(fastexpr._SHAPES)
+            got = parse_fast(text)
+            assert got == _lark(text), text
+            hits += k > 0 and got is not None and len(fastexpr._SHAPES) == before
+    assert hits > 100, hits

@@ -28,6 +28,12 @@ def _both(text: str):
         return None
     assert fast is not None, "fast lexer gave up on text lark accepts"
     assert _tokens(fast) == _tokens(ref)
+    for raw in fast:                       # a run of numbers: its texts are its tokens' (binding reads them)
+        for it in raw.items:
+            if it.type == "NUMRUN":
+                assert it.nums == [t.value for t in it.tokens()] and len(it.nums) >= 2
+                assert (it.line, it.start, it.text) == (it.tokens()[0].line, it.tokens()[0].start_pos,
+                                                        lifted[it.start:it.tokens()[-1].end_pos])
     return len(ref)
 
 
