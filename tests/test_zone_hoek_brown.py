@@ -329,7 +329,7 @@ def test_scalar_path_equals_general_path_on_random_yielding_states():
     most of them (single-plane shear, tension, apex; edges, close principal values and two
     cut-offs in ``_slow``)."""
     rng = np.random.default_rng(77)
-    settled = {1: 0, 2: 0, "slow": 0}
+    settled = {1: 0, 2: 0, 3: 0, "slow": 0}
     left = 0
     worst = 0.0
     n = 0
@@ -348,8 +348,8 @@ def test_scalar_path_equals_general_path_on_random_yielding_states():
         if rf[0] >= 0:
             assert ru == rf                            # update takes the scalar path's result
             settled[rf[0]] += 1
-        elif rf[0] in (-2, -3, -4):
-            settled["slow"] += 1                       # (edge, close principal values, two cut-offs)
+        elif rf[0] in (-2, -3, -4, -5):
+            settled["slow"] += 1                       # (edge, close values, the line's returns on Jacobi's axes)
         else:
             left += 1
             assert ru == rg                            # (update is the general path there)
@@ -382,7 +382,7 @@ def test_scalar_path_on_bench_like_states_and_flow_rules():
                 ru = hbk.update(*args, np.full(NWORK, np.nan), _MW)
                 if rg[0]:
                     total += 1
-                    settled += rf[0] >= 0 or rf[0] in (-2, -3, -4)
+                    settled += rf[0] >= 0 or rf[0] in (-2, -3, -4, -5)
                 assert ru[0] == rg[0]
                 scale = max(abs(x) for x in rg[1:7]) + 1e5
                 assert max(abs(x - y) for x, y in zip(ru[1:8], rg[1:8])) <= 1e-10 * scale
