@@ -70,6 +70,7 @@ from numba import njit
 from ..principal import GAP_REL, _dev_principal, principal_axes
 from ..zone_mohr import SHEAR_NOW, TENSION_NOW, _fast_return, _rotate_back, mohr_plastic
 from ._common import P_OWN, hooke
+from ._hoek_edge import edge_sum_return
 from ._hoek_line import _two_cutoffs, line_return, line_values
 from ._hoek_envelope import NPHI_MAX, _envelope, _tangent, hb_strength  # noqa: F401 (NPHI_MAX: the tests')
 
@@ -420,14 +421,24 @@ def _scalar(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, mb, s, a, sci,
     if m + l3 - st < -margin and -(m + l1) - (q0 + n0 * (-(m + l3) - x0)) < -margin:
         return 0, s0, s1, s2, s3, s4, s5, 0.0
     r = _fast(flag, tandil, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a, sci, st)
-    if r[0] == -1 or r[0] == -4:
+    code = r[0]
+    if code < 0 and G > 0.0:
+        scale = abs(m + l1) + abs(m + l2) + abs(m + l3) + sci
+        mar = FAST_MARGIN * scale
+        nps = _nps(flag, tandil, n0)
+        a1 = K + 4.0 * G / 3.0
+        a2 = K - 2.0 * G / 3.0
         # a trial with p3 > 0 starts on the envelope's line: its corner and edge returns there
-        mar = FAST_MARGIN * (abs(m + l1) + abs(m + l2) + abs(m + l3) + sci)
-        if m + l3 > mar and st > mar and q0 - (n0 - 1.0) * st > mar and G > 0.0:
-            rl = line_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, n0, q0, st, _nps(flag, tandil, n0),
-                             K + 4.0 * G / 3.0, K - 2.0 * G / 3.0, mar)
+        if (code == -1 or code == -4) and m + l3 > mar and st > mar and q0 - (n0 - 1.0) * st > mar:
+            rl = line_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, n0, q0, st, nps, a1, a2, mar)
             if rl[0] != -1:
                 return rl
+        # edges on the curve (also from trials in tension), one projector
+        if code == -1 or code == -2 or code == -3:
+            re = edge_sum_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, nps, a1, a2, mb, s, a, sci, st,
+                                 RTOL * scale, mar, EDGE_REL, MAXIT)
+            if re[0] >= 0:
+                return re
     return r
 
 
