@@ -36,7 +36,8 @@ directions and the flow direction fixed, the return is one scalar equation in th
 multiplier, solved by Halley's steps (``_fast``, ``_edge``); the last step and the rotation back
 are ``zone_mohr._fast_return``'s (or ``principal_axes`` and ``zone_mohr._rotate_back`` for
 edges, close values and two cut-offs). A trial with p3 > 0 whose return stays at p3 >= 0 is one
-Mohr-Coulomb return on the envelope's line: its corners and edges in closed form (``_hoek_line``).
+Mohr-Coulomb return on the envelope's line: its corners and edges in closed form (``_hoek_line``);
+edges on the curve are solved on sums of the two values that meet (``_hoek_edge``, no Jacobi).
 Whatever they do not settle clearly (decisions within FAST_MARGIN of a threshold) goes to the
 general path.
 
