@@ -35,8 +35,11 @@ axes as the general path), two cut-offs, and the apex of the three (σ = σt I).
 directions and the flow direction fixed, the return is one scalar equation in the plastic
 multiplier, solved by Halley's steps (``_fast``, ``_edge``); the last step and the rotation back
 are ``zone_mohr._fast_return``'s (or ``principal_axes`` and ``zone_mohr._rotate_back`` for
-edges, close values and two cut-offs). Whatever they do not settle clearly (corners of shear
-and tension, decisions within FAST_MARGIN of a threshold) goes to the general path.
+edges, close values and two cut-offs). A trial with p3 > 0 whose return stays at p3 >= 0 is one
+Mohr-Coulomb return on the envelope's line: its corners and edges in closed form (``_hoek_line``);
+edges on the curve are solved on sums of the two values that meet (``_hoek_edge``, no Jacobi).
+Whatever they do not settle clearly (decisions within FAST_MARGIN of a threshold) goes to the
+general path.
 
 The property keywords, the dilation rule and the trial-state tangent are taken from Itasca's
 published source of the model (``modelhoek.cpp``: ``ModelHoek::getProperties`` lists
@@ -68,6 +71,8 @@ from numba import njit
 from ..principal import GAP_REL, _dev_principal, principal_axes
 from ..zone_mohr import SHEAR_NOW, TENSION_NOW, _fast_return, _rotate_back, mohr_plastic
 from ._common import P_OWN, hooke
+from ._hoek_edge import edge_sum_return
+from ._hoek_line import _two_cutoffs, line_return, line_values
 from ._hoek_envelope import NPHI_MAX, _envelope, _tangent, hb_strength  # noqa: F401 (NPHI_MAX: the tests')
 
 NAME = "hoek-brown"
@@ -246,23 +251,6 @@ def _plane(p1, p3, nps, a1, a2, mb, s, a, sci, tol, mar):
 
 
 @njit(cache=True, inline="always")
-def _two_cutoffs(p1, p2, p3, K, G, q0, n0, st, mar):
-    """The return onto the cut-offs of p2 and p3 together (tension positive p1 <= p2 <= p3, the
-    envelope's line at σ3 = 0 through q0 with slope n0): [α1 α2; α2 α1] (λ2, λ3) = (p2 - σt,
-    p3 - σt), p1 lowered by α2 (λ2 + λ3). (settled, new p1): settled where both multipliers
-    are clearly positive and the result clearly inside the third cut-off and the shear line."""
-    a1 = K + 4.0 * G / 3.0
-    a2 = K - 2.0 * G / 3.0
-    v2 = p2 - st
-    v3 = p3 - st
-    det = (a1 - a2) * (a1 + a2)
-    n1 = p1 - a2 * (v2 + v3) / (a1 + a2)
-    ok = (a1 * v2 - a2 * v3) * a1 > mar * det and (a1 * v3 - a2 * v2) * a1 > mar * det
-    ok = ok and n1 < st - mar and -n1 - (q0 - n0 * st) < -mar
-    return ok, n1
-
-
-@njit(cache=True, inline="always")
 def _fast(flag, tandil, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a, sci, st):
     """The return of the trial s0..s5 in scalars for the common case (``update``'s fast path):
     principal values well apart (``GAP_REL``, as ``zone_mohr._fast_return``), a clear shear
@@ -303,8 +291,9 @@ def _fast(flag, tandil, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0,
     if (ten > mar and x0 == 0.0 and K > 0.0 and (p1 - st) - (1.0 - 2.0 * G / (3.0 * K)) * (m - st) > mar
             and q0 - (n0 - 1.0) * st > mar):
         return TENSION_NOW, st, st, st, 0.0, 0.0, 0.0, m - st
-    if ten > mar and x0 == 0.0 and q0 - (n0 - 1.0) * st > mar and _two_cutoffs(p1, p2, p3, K, G, q0, n0, st, mar)[0]:
-        return -4, s0, s1, s2, s3, s4, s5, 0.0    # (two cut-offs: ``_slow``)
+    if (ten > mar and x0 == 0.0 and q0 - (n0 - 1.0) * st > mar
+            and _two_cutoffs(p1, p2, p3, K + 4.0 * G / 3.0, K - 2.0 * G / 3.0, q0, n0, st, mar)[0]):
+        return -4, s0, s1, s2, s3, s4, s5, 0.0    # (two cut-offs: ``_hoek_line``)
     if not (l3 - l1 > 0.0 and min(l2 - l1, l3 - l2) >= GAP_REL * (l3 - l1)):
         if ten < -mar and g > mar:
             return -3, s0, s1, s2, s3, s4, s5, 0.0    # (a clear shear return: ``_slow``)
@@ -395,19 +384,11 @@ def _fast(flag, tandil, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0,
 
 @njit(cache=True)
 def fast_update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, wf, mw):
-    """``update``'s scalar path alone (for the tests): (code, t0..t5, dsp) of ``_fast``; code
-    -1 where ``update`` takes the general path, -2 where it takes ``_edge`` (and the general
+    """``update``'s scalar paths alone (for the tests): (code, t0..t5, dsp) of ``_scalar``; code
+    -1 where ``update`` takes the general path, below -1 where it takes ``_slow`` (and the general
     path if that does not settle)."""
-    s0, s1, s2, s3, s4, s5 = hooke(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5)
-    mb = p[z, C_MB]
-    s = p[z, C_S]
-    a = p[z, C_A]
-    sci = p[z, C_SCI]
-    m, l1, l2, l3 = _dev_principal(s0, s1, s2, s3, s4, s5)
-    x0 = max(-(m + l3), 0.0)
-    q0, n0 = hb_strength(x0, mb, s, a, sci)
-    return _fast(p[z, C_FLAGDIL], p[z, C_TANDIL], K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a,
-                 sci, s * sci / mb)
+    return _scalar(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, p[z, C_MB], p[z, C_S], p[z, C_A],
+                   p[z, C_SCI], p[z, C_FLAGDIL], p[z, C_TANDIL])
 
 
 @njit(cache=True, inline="always")
@@ -440,30 +421,54 @@ def _scalar(K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, mb, s, a, sci,
     q0, n0 = hb_strength(x0, mb, s, a, sci)       # the envelope's tangent there
     if m + l3 - st < -margin and -(m + l1) - (q0 + n0 * (-(m + l3) - x0)) < -margin:
         return 0, s0, s1, s2, s3, s4, s5, 0.0
-    return _fast(flag, tandil, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a, sci, st)
+    r = _fast(flag, tandil, K, G, s0, s1, s2, s3, s4, s5, m, l1, l2, l3, x0, q0, n0, mb, s, a, sci, st)
+    code = r[0]
+    if code < 0 and G > 0.0:
+        scale = abs(m + l1) + abs(m + l2) + abs(m + l3) + sci
+        mar = FAST_MARGIN * scale
+        nps = _nps(flag, tandil, n0)
+        a1 = K + 4.0 * G / 3.0
+        a2 = K - 2.0 * G / 3.0
+        # a trial with p3 > 0 starts on the envelope's line: its corner and edge returns there
+        if (code == -1 or code == -4) and m + l3 > mar and st > mar and q0 - (n0 - 1.0) * st > mar:
+            rl = line_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, n0, q0, st, nps, a1, a2, mar)
+            if rl[0] != -1:
+                return rl
+        # edges on the curve (also from trials in tension), one projector
+        if code == -1 or code == -2 or code == -3:
+            re = edge_sum_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, nps, a1, a2, mb, s, a, sci, st,
+                                 RTOL * scale, mar, EDGE_REL, MAXIT)
+            if re[0] >= 0:
+                return re
+    return r
 
 
 @njit(cache=True)
 def _slow(p, z, K, G, s0, s1, s2, s3, s4, s5, mb, s, a, sci, st, wf, mw, code):
-    """What ``_fast`` leaves (its code): the edge return (-2), the shear return with principal
-    values not well apart (-3) or the return onto two cut-offs (-4) in scalars, on ``principal_axes``' values and projectors
-    (cyclic Jacobi for close values, as the general path) and rotated back by
+    """What ``_scalar`` leaves (its code): the edge return (-2), the shear return with close
+    values (-3), the line's returns (-4 two cut-offs, -5 ``_hoek_line``) on ``principal_axes``'
+    values and projectors (Jacobi for close values, as the general path), rotated back by
     ``zone_mohr._rotate_back`` (chunk scratch as the general path's: trial wf[0:6], projectors
-    wf[12:24], values wf[24:27], new values wf[27:30]); else, or when they do not settle, the
-    general path."""
-    if code == -4:
+    wf[12:24], values wf[24:27], new values wf[27:30]); else the general path."""
+    if code == -4 or code == -5:
+        # (the line's corners, edges and cut-offs on Jacobi's axes: ``_hoek_line``)
         t = wf[0:6]
         t[0] = s0; t[1] = s1; t[2] = s2; t[3] = s3; t[4] = s4; t[5] = s5
         lam = wf[24:27]
         pr = wf[12:24]
         principal_axes(t, lam, pr, mw[6])
-        scale = abs(lam[0]) + abs(lam[1]) + abs(lam[2]) + sci
+        mar = FAST_MARGIN * (abs(lam[0]) + abs(lam[1]) + abs(lam[2]) + sci)
         q0, n0 = hb_strength(0.0, mb, s, a, sci)
-        ok, n1 = _two_cutoffs(lam[0], lam[1], lam[2], K, G, q0, n0, st, FAST_MARGIN * scale)
-        if ok and lam[2] - st > FAST_MARGIN * scale:
+        bits = -1
+        n1 = n2 = n3 = 0.0
+        if lam[2] > mar and st > mar and q0 - (n0 - 1.0) * st > mar and G > 0.0:
+            bits, n1, n2, n3, _kind = line_values(lam[0], lam[1], lam[2], n0, q0, st,
+                                                  _nps(p[z, C_FLAGDIL], p[z, C_TANDIL], n0),
+                                                  K + 4.0 * G / 3.0, K - 2.0 * G / 3.0, mar)
+        if bits >= 0:
             sn = wf[27:30]
-            sn[0] = n1; sn[1] = st; sn[2] = st
-            bits, dsp = _rotate_back(t, lam, pr, sn, TENSION_NOW)
+            sn[0] = n1; sn[1] = n2; sn[2] = n3
+            bits, dsp = _rotate_back(t, lam, pr, sn, bits)
             t0 = t[0]; t1 = t[1]; t2 = t[2]; t3 = t[3]; t4 = t[4]; t5 = t[5]
             wf[0] = math.nan
             return bits, t0, t1, t2, t3, t4, t5, dsp
