@@ -2,7 +2,8 @@
 non-associated flow (the return and its sources: ``dec3d/kernels/zone_mohr.py``).
 
 The update is the elastic trial (Hooke), the yield test and Itasca's single-plane return in
-scalars (``zone_mohr.mohr_scalar``), and the general return on arrays (``zone_mohr.mohr_plastic``:
+scalars (``zone_mohr.mohr_scalar``), then Itasca's plane with one other and nearly repeated
+principal values in scalars (``zone_mohr_pair.mohr_pair``), and the general return on arrays (``zone_mohr.mohr_plastic``:
 corners, edges, nearly equal principal values) for what the scalar path leaves. The return's
 constants (N_φ, N_ψ, …) are kept in the chunk scratch ``wf`` while neighbouring zones share their
 properties: wf[0:6] the properties they were made from, wf[6:15] the constants, wf[16:22] the trial handed to the general return.
@@ -10,6 +11,7 @@ properties: wf[0:6] the properties they were made from, wf[6:15] the constants, 
 from numba import njit
 
 from ..zone_mohr import mohr_constants, mohr_plastic, mohr_scalar
+from ..zone_mohr_pair import mohr_pair
 from ._common import P_COHESION, P_TANDIL, P_TANFRIC, P_TENSION, hooke
 
 NAME = "mohr-coulomb"
@@ -35,6 +37,9 @@ def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, w
         wf[12] = sp; wf[13] = ap; wf[14] = den
     code, s0, s1, s2, s3, s4, s5, dp = mohr_scalar(s0, s1, s2, s3, s4, s5, coh, wf[6], wf[7], wf[8], wf[9],
                                                    wf[10], wf[11], wf[12], wf[13], wf[14])
+    if code < 0:
+        code, s0, s1, s2, s3, s4, s5, dp = mohr_pair(s0, s1, s2, s3, s4, s5, coh, wf[6], wf[7], wf[8], wf[9],
+                                                     wf[10], wf[11], wf[12], wf[13], wf[14])
     if code < 0:
         s = wf[16:22]                    # (the chunk scratch past the constants)
         s[0] = s0; s[1] = s1; s[2] = s2; s[3] = s3; s[4] = s4; s[5] = s5
