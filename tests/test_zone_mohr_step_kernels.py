@@ -216,3 +216,59 @@ def test_model_runs_give_the_same_bits_with_either_kernel_and_thread_count(tmp_p
         got = _model_run(tmp_path, monkeypatch, nt, True)
         for a, b in zip(ref, got):
             assert np.array_equal(a, b), nt
+
+
+def _trials(rng, n, gap):
+    """n trial stresses (6,) about yield, principal values spread at random; with ``gap``, σ2 within
+    gap × spread of σ1 or of σ3 (0: exactly repeated in exact arithmetic), random axes."""
+    out = []
+    for _ in range(n):
+        lam = np.sort(rng.normal(size=3)) * rng.uniform(1e3, 1e5)
+        if gap is not None:
+            sp = lam[2] - lam[0]
+            lam[1] = lam[0] + gap * sp * rng.random() if rng.random() < 0.5 else lam[2] - gap * sp * rng.random()
+        q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        t = q @ np.diag(lam + rng.uniform(-1e5, 2e4)) @ q.T
+        out.append(np.array([t[0, 0], t[1, 1], t[2, 2], t[0, 1], t[0, 2], t[1, 2]]))
+    return out
+
+
+@pytest.mark.parametrize("gap", [None, 2e-2, 1e-6, 0.0])
+def test_mohr_pair_is_mohr_plastic(gap):
+    """``zone_mohr_pair.mohr_pair`` (what the scalar path leaves: Itasca's plane with one other,
+    nearly repeated values) gives ``mohr_plastic``'s code and, for values well apart, its bits;
+    with σ2 near σ1 or σ3 (Jacobi in ``mohr_plastic``), its stress and dsp to 1e-12 of the stress
+    scale; the slow twin's stress (tests/test_zone_mohr_kernels.py) to 1e-9; and settles most such
+    zones (the rest: -1, the stress untouched)."""
+    from dec3d.kernels.zone_mohr_pair import mohr_pair
+    from tests.test_zone_mohr_kernels import twin_mohr
+
+    rng = np.random.default_rng(11)
+    K, G = 6.7e9, 4e9
+    work = zm.mohr_work()
+    general = settled = 0
+    for coh, phi, ten, psi in ((1e4, 30, 5e3, 0), (2e4, 39, 1e3, 11), (1e3, 17, 1e4, 17)):
+        tf, td = math.tan(math.radians(phi)), math.tan(math.radians(psi))
+        cst = zm.mohr_constants(K, G, coh, tf, ten, td)
+        for tr in _trials(rng, 400, gap):
+            if zm.mohr_scalar(*tr, coh, *cst)[0] >= 0:
+                continue
+            general += 1
+            s = tr.copy()
+            code, dsp = zm.mohr_plastic(s, K, G, coh, tf, ten, td, work)
+            got = mohr_pair(*tr, coh, *cst)
+            if got[0] < 0:
+                assert np.array_equal(np.array(got[1:7]), tr) and got[7] == 0.0
+                continue
+            settled += 1
+            assert got[0] == code
+            t6 = np.array(got[1:7])
+            s_t, _, dsp_t, *_ = twin_mohr(tr, np.zeros(6), K, G, coh, tf, ten, td)
+            assert np.abs(t6 - s_t).max() <= 1e-9 * (np.abs(tr).max() + coh) and abs(got[7] - dsp_t) <= 1e-9 * coh
+            lam = np.linalg.eigvalsh(np.array([[tr[0], tr[3], tr[4]], [tr[3], tr[1], tr[5]], [tr[4], tr[5], tr[2]]]))
+            if min(lam[1] - lam[0], lam[2] - lam[1]) > 0.021 * (lam[2] - lam[0]):
+                assert np.array_equal(t6, s) and got[7] == dsp
+            else:
+                scale = np.abs(tr).sum() + coh
+                assert np.abs(t6 - s).max() <= 1e-12 * scale and abs(got[7] - dsp) <= 1e-12 * scale
+    assert settled >= 0.6 * general and general >= 300, (settled, general)

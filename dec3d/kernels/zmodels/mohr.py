@@ -2,14 +2,17 @@
 non-associated flow (the return and its sources: ``dec3d/kernels/zone_mohr.py``).
 
 The update is the elastic trial (Hooke), the yield test and Itasca's single-plane return in
-scalars (``zone_mohr.mohr_scalar``), and the general return on arrays (``zone_mohr.mohr_plastic``:
-corners, edges, nearly equal principal values) for what the scalar path leaves. The return's
-constants (N_φ, N_ψ, …) are kept in the chunk scratch ``wf`` while neighbouring zones share their
-properties: wf[0:6] the properties they were made from, wf[6:15] the constants, wf[16:22] the trial handed to the general return.
+scalars (``zone_mohr.mohr_scalar``); then, in scalars too, Itasca's plane with one other (edge or
+corner) and nearly repeated principal values (``zone_mohr_pair.mohr_pair``); and the general
+return on arrays (``zone_mohr.mohr_plastic``) for what these leave. The return's constants (N_φ,
+N_ψ, …) are kept in the chunk scratch ``wf`` while neighbouring zones share their properties:
+wf[0:6] the properties they were made from, wf[6:15] the constants, wf[16:22] the trial handed
+to the general return.
 """
 from numba import njit
 
 from ..zone_mohr import mohr_constants, mohr_plastic, mohr_scalar
+from ..zone_mohr_pair import mohr_pair
 from ._common import P_COHESION, P_TANDIL, P_TANFRIC, P_TENSION, hooke
 
 NAME = "mohr-coulomb"
@@ -36,7 +39,19 @@ def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, w
     code, s0, s1, s2, s3, s4, s5, dp = mohr_scalar(s0, s1, s2, s3, s4, s5, coh, wf[6], wf[7], wf[8], wf[9],
                                                    wf[10], wf[11], wf[12], wf[13], wf[14])
     if code < 0:
-        s = wf[16:22]                    # (the chunk scratch past the constants)
+        code, s0, s1, s2, s3, s4, s5, dp = _rest(s0, s1, s2, s3, s4, s5, K, G, coh, tf, ten, td, wf, mw)
+    return code, s0, s1, s2, s3, s4, s5, dp
+
+
+@njit(cache=True)
+def _rest(s0, s1, s2, s3, s4, s5, K, G, coh, tf, ten, td, wf, mw):
+    """What ``mohr_scalar`` leaves (code -1) of the trial s0..s5: ``mohr_pair``, else ``mohr_plastic``
+    on the chunk scratch past the constants (one call out of the step for both: the step's common
+    path stays as short)."""
+    code, s0, s1, s2, s3, s4, s5, dp = mohr_pair(s0, s1, s2, s3, s4, s5, coh, wf[6], wf[7], wf[8], wf[9],
+                                                 wf[10], wf[11], wf[12], wf[13], wf[14])
+    if code < 0:
+        s = wf[16:22]
         s[0] = s0; s[1] = s1; s[2] = s2; s[3] = s3; s[4] = s4; s[5] = s5
         code, dp = mohr_plastic(s, K, G, coh, tf, ten, td, mw)
         s0 = s[0]; s1 = s[1]; s2 = s[2]; s3 = s[3]; s4 = s[4]; s5 = s[5]
