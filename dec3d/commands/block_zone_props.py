@@ -85,10 +85,12 @@ def block_zone_cmodel_assign(session, call):
     zs["cmodel"][rows] = code
     zs["state"][rows] = 0
     zs["hist"][rows] = 0.0
-    zs["ghist"][rows] = 0.0
+    if "ghist" in zs:                       # (a model with 10-node zones: ``model.zones.ho_fields``)
+        zs["ghist"][rows] = 0.0
     if code == ZMODEL_NULL:
         zs["stress"][rows] = 0.0
-        zs["gstress"][rows] = 0.0
+        if "gstress" in zs:
+            zs["gstress"][rows] = 0.0
 
 
 def _value_type(p):

@@ -26,7 +26,8 @@ block still owns a contiguous vertex range (which the contact code relies on).
     overlay ()       int8   0 or 1: which of the two 5-tetrahedron sets of its hexahedron; -1 none
     volume ()        m³     volume (reference configuration; updated in large strain)
     stress (6,)      Pa     xx yy zz xy xz yz, tension positive (3DEC sign convention)
-    gstress (4, 6)   Pa     Gauss-point stresses of a 10-node tetrahedron (zone stress = their mean)
+    gstress (4, 6)   Pa     Gauss-point stresses of a 10-node tetrahedron (zone stress = their mean);
+                            added with the first 10-node zone (``ho_fields``), as ghist
     cmodel ()        int8   constitutive model code (``kernels/zmodels``: each model's ``CODE``); 0: null
     prop (NZPROP,)   SI     constitutive properties: columns 0-7 shared (``ZP_*``), from 8 on the model's own
     hist (NZHIST,)   -      the model's history (strain-softening's hardening parameters, …): the first
@@ -112,11 +113,9 @@ def _zone_fields() -> dict[str, Field]:
         "overlay": Field((), np.int8, -1),
         "volume": Field((), _F, 0.0),
         "stress": Field((6,), _F, 0.0),
-        "gstress": Field((4, 6), _F, 0.0),
         "cmodel": Field((), np.int8, ZMODEL_NULL),
         "prop": Field((NZPROP,), _F, 0.0),
         "hist": Field((NZHIST,), _F, 0.0),
-        "ghist": Field((4, NZHIST), _F, 0.0),
         "state": Field((), np.int32, 0),
         "group": group_field(),
         "extra": Field((0,), _F, 0.0),        # FISH block.zone.extra slots (widened on first write)
@@ -149,6 +148,18 @@ def zone_stores(model) -> Store:
     if "source" not in model.faces:
         model.faces.add_field("source", Field((), _I, -1))
     return model.add_store(Store("zones", _zone_fields(), capacity=256))
+
+
+#: fields only 10-node zones use, added to the store with the first such zone (``ho_fields``): 320 bytes a
+#: zone that a model of 4-node zones does not carry
+_HO_FIELDS = {"gstress": Field((4, 6), _F, 0.0), "ghist": Field((4, NZHIST), _F, 0.0)}
+
+
+def ho_fields(zs: Store) -> None:
+    """Add ``gstress`` and ``ghist`` (filled with zeros) to the zones store ``zs`` when it has none."""
+    for key, spec in _HO_FIELDS.items():
+        if key not in zs:
+            zs.add_field(key, spec)
 
 
 def body_force_field(model) -> np.ndarray:
@@ -244,6 +255,8 @@ def install_block_mesh(model, row: int, points: np.ndarray, tets: np.ndarray, tr
     m = len(tets)
     sl = zs.append(m)
     nn = tets.shape[1]
+    if nn == 10:
+        ho_fields(zs)
     zs["gp"][sl, :nn] = tets + v0
     zs["nnode"][sl] = nn
     zs["block"][sl] = row

@@ -316,7 +316,7 @@ def implicit_static(eng, warn=None) -> dict:
     for name in ("feblocks", "zones"):
         if name in m.stores:
             st = m.store(name)
-            keep.append((st, {k: st[k].copy() for k in ("gstress", "stress")}))
+            keep.append((st, {k: st[k].copy() for k in ("gstress", "stress") if k in st}))
     try:
         with np.errstate(over="ignore", invalid="ignore"):
             out = _Solve(m, zst).solve()
