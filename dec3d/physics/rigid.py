@@ -436,8 +436,8 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
         return {"blocks": {k: b[k].copy() for k in b.fields},
                 "vertices": {k: v[k].copy() for k in ("pos", "map_pos", "look_pos", "turn_pos")
                              + (_GP_STATE if _has_gridpoints(m) else ()) if k in v},
-                "zones": ({k: m.store("zones")[k].copy() for k in ("stress", "gstress", "volume", "state", "hist", "ghist")}
-                          if has_zones(m) else {}),
+                "zones": ({k: m.store("zones")[k].copy() for k in ("stress", "gstress", "volume", "state", "hist", "ghist")
+                           if k in m.store("zones")} if has_zones(m) else {}),
                 "feblocks": ({k: m.store("feblocks")[k].copy() for k in ("stress", "gstress")}
                              if has_feblocks(m) else {}),
                 # cable nodes, elements and dowels, beam nodes and elements: every field, rolled back with the blocks
@@ -550,6 +550,11 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
                     break
         finally:
             run.finish()
+            # the steps hold their run (``self.run``) and the run its steps: left so, each `model cycle`
+            # command's run (with its zone stepper, hundreds of MB at 1e6 zones) would live on until
+            # Python's cyclic collector happened to run
+            self.steps = []
+            run.steps = []
         return run.done
 
     def timing_report(self) -> str:
