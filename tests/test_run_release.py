@@ -14,7 +14,7 @@ def _alive(kind):
     return sum(isinstance(o, kind) for o in gc.get_objects())
 
 
-def test_each_cycle_command_frees_its_run_and_keeps_one_zone_stepper(tmp_path):
+def test_each_cycle_command_frees_the_previous_run_and_its_zone_stepper(tmp_path):
     s = dec3d.Session(out_dir=tmp_path, stdout=io.StringIO())
     s.command("model new\nblock create brick 0 1 0 1 0 1\nblock zone generate edgelength 0.5\n"
               "block zone cmodel assign elastic\nblock zone property bulk 5e9 shear 3e9 density 2500\n"
@@ -26,8 +26,10 @@ def test_each_cycle_command_frees_its_run_and_keeps_one_zone_stepper(tmp_path):
         before_runs, before_steppers = _alive(_Run), _alive(ZoneStepper)
         for _ in range(4):
             s.command("model cycle 2")
-        assert _alive(_Run) == before_runs == 0
-        assert _alive(ZoneStepper) == before_steppers + 1      # the engine's latest (``_zstep``)
+        # the last command's run only (the engine keeps its steps, ``RigidEngine.steps``), and its stepper
+        assert before_runs == 0 and _alive(_Run) == 1
+        assert _alive(ZoneStepper) == before_steppers + 1
+        assert s.model.rigid_engine.steps[0].run.done == 2
     finally:
         gc.enable()
     assert s.model.step == 8

@@ -552,8 +552,8 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
             run.finish()
             # the steps hold their run (``self.run``) and the run its steps: left so, each `model cycle`
             # command's run (with its zone stepper, hundreds of MB at 1e6 zones) would live on until
-            # Python's cyclic collector happened to run
-            self.steps = []
+            # Python's cyclic collector happened to run. The engine keeps the last run's steps
+            # (``self.steps``, and through them that run) until the next command replaces them
             run.steps = []
         return run.done
 
