@@ -13,7 +13,7 @@ the two multipliers, the new values are, tension positive,
 and the multipliers' difference is fixed by the two values meeting: (p2 - p1)/2G (E12),
 (p3 - p2)/(2G N_ψ) (E23); the edge holds where S exceeds it (both multipliers positive). The
 return solves σ1(S) = q(σ3(S)) on the envelope (``_envelope``; g(S) = σ1 - q(σ3) is convex and
-decreasing) by ``hoek_brown._edge_values``' Halley steps from that point, ending with a Newton
+decreasing) by ``_hoek_envelope.edge_root`` from that point (``hoek_brown._edge_values``' root too), ending with a Newton
 step: the general path's fixed point (its last Mohr-Coulomb return onto the tangent at the
 result is this two-plane return; that return being unique, whichever plane Itasca's rule tries
 first). ``hoek_brown._edge_values`` solves the same equation on each value (accurate with Jacobi's
@@ -25,7 +25,7 @@ from numba import njit
 
 from ..principal import GAP_REL, _deviator, dev_square
 from ._common import SHEAR_NOW
-from ._hoek_envelope import _envelope
+from ._hoek_envelope import edge_root
 from ._hoek_line import KIND12, KIND23, _projector
 
 
@@ -53,36 +53,9 @@ def edge_sum_values(p1, p2, p3, nps, a1, a2, mb, s, a, sci, st, tol, mar, erel, 
         k1 = b - g2
         c3 = -0.5 * (p2 + p3)
         k3 = b + 0.5 * g2 * nps
-    S = d
-    y3 = c3 + k3 * S
-    q, n, c = _envelope(y3, mb, s, a, sci)
-    g = c1 + k1 * S - q
-    if not g > mar:
-        return -1, p1, p2, p3, kind
-    done = False
-    dn = 0.0
-    for _it in range(maxit):
-        if not c > -1e300:
-            break
-        den = n * k3 - k1
-        if not den > 0.0:
-            break
-        dn = g / den
-        y3n = y3 + dn * k3
-        if 0.5 * (-c) * (k3 * k3) * (dn * dn) <= 0.01 * tol and not (y3 < 0.0 and y3n > 0.0):
-            done = True
-            break
-        step = dn
-        dd = 2.0 * den * den + g * c * (k3 * k3)
-        if dd > den * den:
-            step = 2.0 * g * den / dd
-        S += step
-        y3 = c3 + k3 * S
-        q, n, c = _envelope(y3, mb, s, a, sci)
-        g = c1 + k1 * S - q
+    done, S = edge_root(c1, k1, c3, k3, d, mb, s, a, sci, tol, mar, maxit)
     if not done:
         return -1, p1, p2, p3, kind
-    S += dn                              # the last Newton step
     if not S - d > erel * (S + d):
         return -1, p1, p2, p3, kind
     na = -(c1 + k1 * S)                  # p1

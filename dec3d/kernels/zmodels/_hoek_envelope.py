@@ -55,3 +55,41 @@ def _tangent(x, mb, s, a, sci):
     if csn < 0.0:
         csn = 0.0
     return 0.5 * csn / rn, 0.5 * (n - 1.0) / rn
+
+
+@njit(cache=True, inline="always")
+def edge_root(c1, k1, c3, k3, x, mb, s, a, sci, tol, mar, maxit):
+    """The root of g(x) = c1 + k1 x - q(c3 + k3 x) (σ1 and σ3 of an edge return, linear in the
+    multiplier x; g convex and decreasing) from x on: (converged, root). Newton steps, shortened
+    by Halley's where g's curvature would overshoot, until the quadratic term of the next step is
+    below 0.01 tol (and that step does not carry σ3 across zero), then that Newton step; not
+    converged when g(x) <= mar at the start, the envelope fails or ``maxit`` steps pass."""
+    y3 = c3 + k3 * x
+    q, n, c = _envelope(y3, mb, s, a, sci)
+    g = c1 + k1 * x - q
+    if not g > mar:
+        return False, x
+    done = False
+    dn = 0.0
+    for _it in range(maxit):
+        if not c > -1e300:
+            break
+        den = n * k3 - k1
+        if not den > 0.0:
+            break
+        dn = g / den
+        y3n = y3 + dn * k3
+        if 0.5 * (-c) * (k3 * k3) * (dn * dn) <= 0.01 * tol and not (y3 < 0.0 and y3n > 0.0):
+            done = True
+            break
+        step = dn
+        dd = 2.0 * den * den + g * c * (k3 * k3)
+        if dd > den * den:
+            step = 2.0 * g * den / dd
+        x += step
+        y3 = c3 + k3 * x
+        q, n, c = _envelope(y3, mb, s, a, sci)
+        g = c1 + k1 * x - q
+    if not done:
+        return False, x
+    return True, x + dn                  # the last Newton step

@@ -73,7 +73,7 @@ from ..zone_mohr import SHEAR_NOW, TENSION_NOW, _fast_return, _rotate_back, mohr
 from ._common import P_OWN, hooke
 from ._hoek_edge import edge_sum_return
 from ._hoek_line import _two_cutoffs, line_return, line_values
-from ._hoek_envelope import NPHI_MAX, _envelope, _tangent, hb_strength  # noqa: F401 (NPHI_MAX: the tests')
+from ._hoek_envelope import NPHI_MAX, _envelope, _tangent, edge_root, hb_strength  # noqa: F401 (NPHI_MAX: the tests')
 
 NAME = "hoek-brown"
 CODE = 4          # kept in save files: never renumber
@@ -166,36 +166,9 @@ def _edge_values(p1, p2, p3, nps, a1, a2, mb, s, a, sci, st, tol, mar):
         k1 = dm1 + b
         c3 = -p3 - d1 * dm3
         k3 = 2.0 * dm3
-    mu = d
-    y3 = c3 + k3 * mu
-    q, n, c = _envelope(y3, mb, s, a, sci)
-    g = c1 + k1 * mu - q
-    if not g > mar:
-        return False, p1, p2, p3
-    done = False
-    dn = 0.0
-    for _it in range(MAXIT):
-        if not c > -1e300:
-            break
-        den = n * k3 - k1
-        if not den > 0.0:
-            break
-        dn = g / den
-        y3n = y3 + dn * k3
-        if 0.5 * (-c) * (k3 * k3) * (dn * dn) <= 0.01 * tol and not (y3 < 0.0 and y3n > 0.0):
-            done = True
-            break
-        step = dn
-        dd = 2.0 * den * den + g * c * (k3 * k3)
-        if dd > den * den:
-            step = 2.0 * g * den / dd
-        mu += step
-        y3 = c3 + k3 * mu
-        q, n, c = _envelope(y3, mb, s, a, sci)
-        g = c1 + k1 * mu - q
+    done, mu = edge_root(c1, k1, c3, k3, d, mb, s, a, sci, tol, mar, MAXIT)
     if not done:
         return False, p1, p2, p3
-    mu += dn                             # the last Newton step
     if not mu - d > EDGE_REL * mu:
         return False, p1, p2, p3
     if e3:
