@@ -31,64 +31,6 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
-def minimal_step(pos, vel, gp, K, G, dt, stress, force):
-    """One elastic step of every zone of gp (nz, 4): the least a 4-node step must do."""
-    for z in range(gp.shape[0]):
-        i0 = gp[z, 0]; i1 = gp[z, 1]; i2 = gp[z, 2]; i3 = gp[z, 3]
-        x0 = pos[i0, 0]; y0 = pos[i0, 1]; z0 = pos[i0, 2]
-        e1x = pos[i1, 0] - x0; e1y = pos[i1, 1] - y0; e1z = pos[i1, 2] - z0
-        e2x = pos[i2, 0] - x0; e2y = pos[i2, 1] - y0; e2z = pos[i2, 2] - z0
-        e3x = pos[i3, 0] - x0; e3y = pos[i3, 1] - y0; e3z = pos[i3, 2] - z0
-        # gradients of the shape functions of nodes 1-3: rows of the inverse of [e1 e2 e3]ᵀ
-        c1x = e2y * e3z - e2z * e3y; c1y = e2z * e3x - e2x * e3z; c1z = e2x * e3y - e2y * e3x
-        c2x = e3y * e1z - e3z * e1y; c2y = e3z * e1x - e3x * e1z; c2z = e3x * e1y - e3y * e1x
-        c3x = e1y * e2z - e1z * e2y; c3y = e1z * e2x - e1x * e2z; c3z = e1x * e2y - e1y * e2x
-        det = e1x * c1x + e1y * c1y + e1z * c1z
-        inv = 1.0 / det
-        g1x = c1x * inv; g1y = c1y * inv; g1z = c1z * inv
-        g2x = c2x * inv; g2y = c2y * inv; g2z = c2z * inv
-        g3x = c3x * inv; g3y = c3y * inv; g3z = c3z * inv
-        g0x = -(g1x + g2x + g3x); g0y = -(g1y + g2y + g3y); g0z = -(g1z + g2z + g3z)
-        # velocity gradient L_ij = Σ v_i dN/dx_j
-        lxx = vel[i0, 0] * g0x + vel[i1, 0] * g1x + vel[i2, 0] * g2x + vel[i3, 0] * g3x
-        lyy = vel[i0, 1] * g0y + vel[i1, 1] * g1y + vel[i2, 1] * g2y + vel[i3, 1] * g3y
-        lzz = vel[i0, 2] * g0z + vel[i1, 2] * g1z + vel[i2, 2] * g2z + vel[i3, 2] * g3z
-        lxy = vel[i0, 0] * g0y + vel[i1, 0] * g1y + vel[i2, 0] * g2y + vel[i3, 0] * g3y
-        lyx = vel[i0, 1] * g0x + vel[i1, 1] * g1x + vel[i2, 1] * g2x + vel[i3, 1] * g3x
-        lxz = vel[i0, 0] * g0z + vel[i1, 0] * g1z + vel[i2, 0] * g2z + vel[i3, 0] * g3z
-        lzx = vel[i0, 2] * g0x + vel[i1, 2] * g1x + vel[i2, 2] * g2x + vel[i3, 2] * g3x
-        lyz = vel[i0, 1] * g0z + vel[i1, 1] * g1z + vel[i2, 1] * g2z + vel[i3, 1] * g3z
-        lzy = vel[i0, 2] * g0y + vel[i1, 2] * g1y + vel[i2, 2] * g2y + vel[i3, 2] * g3y
-        exx = lxx * dt; eyy = lyy * dt; ezz = lzz * dt
-        exy = 0.5 * (lxy + lyx) * dt; exz = 0.5 * (lxz + lzx) * dt; eyz = 0.5 * (lyz + lzy) * dt
-        ev = exx + eyy + ezz
-        lam = K[z] - 2.0 * G[z] / 3.0
-        g2 = 2.0 * G[z]
-        sxx = stress[z, 0] + lam * ev + g2 * exx
-        syy = stress[z, 1] + lam * ev + g2 * eyy
-        szz = stress[z, 2] + lam * ev + g2 * ezz
-        sxy = stress[z, 3] + g2 * exy
-        sxz = stress[z, 4] + g2 * exz
-        syz = stress[z, 5] + g2 * eyz
-        stress[z, 0] = sxx; stress[z, 1] = syy; stress[z, 2] = szz
-        stress[z, 3] = sxy; stress[z, 4] = sxz; stress[z, 5] = syz
-        # nodal forces −V σ ∇N
-        vol = abs(det) / 6.0
-        for n in range(4):
-            if n == 0:
-                gx = g0x; gy = g0y; gz = g0z; r = i0
-            elif n == 1:
-                gx = g1x; gy = g1y; gz = g1z; r = i1
-            elif n == 2:
-                gx = g2x; gy = g2y; gz = g2z; r = i2
-            else:
-                gx = g3x; gy = g3y; gz = g3z; r = i3
-            force[r, 0] -= vol * (sxx * gx + sxy * gy + sxz * gz)
-            force[r, 1] -= vol * (sxy * gx + syy * gy + syz * gz)
-            force[r, 2] -= vol * (sxz * gx + syz * gy + szz * gz)
-
-
 @njit(cache=True, inline="always")
 def _grads(pos, i0, i1, i2, i3):
     """Shape-function gradients g0..g3 (rows of the inverse of [e1 e2 e3]ᵀ) and the determinant."""
@@ -106,6 +48,64 @@ def _grads(pos, i0, i1, i2, i3):
     g3x = c3x * inv; g3y = c3y * inv; g3z = c3z * inv
     g0x = -(g1x + g2x + g3x); g0y = -(g1y + g2y + g3y); g0z = -(g1z + g2z + g3z)
     return g0x, g0y, g0z, g1x, g1y, g1z, g2x, g2y, g2z, g3x, g3y, g3z, det
+
+
+@njit(cache=True, inline="always")
+def _strain(vel, i0, i1, i2, i3, g0x, g0y, g0z, g1x, g1y, g1z, g2x, g2y, g2z, g3x, g3y, g3z, dt):
+    """Strain increment (xx yy zz xy xz yz) from the velocity gradient L_ij = Σ v_i dN/dx_j."""
+    lxx = vel[i0, 0] * g0x + vel[i1, 0] * g1x + vel[i2, 0] * g2x + vel[i3, 0] * g3x
+    lyy = vel[i0, 1] * g0y + vel[i1, 1] * g1y + vel[i2, 1] * g2y + vel[i3, 1] * g3y
+    lzz = vel[i0, 2] * g0z + vel[i1, 2] * g1z + vel[i2, 2] * g2z + vel[i3, 2] * g3z
+    lxy = vel[i0, 0] * g0y + vel[i1, 0] * g1y + vel[i2, 0] * g2y + vel[i3, 0] * g3y
+    lyx = vel[i0, 1] * g0x + vel[i1, 1] * g1x + vel[i2, 1] * g2x + vel[i3, 1] * g3x
+    lxz = vel[i0, 0] * g0z + vel[i1, 0] * g1z + vel[i2, 0] * g2z + vel[i3, 0] * g3z
+    lzx = vel[i0, 2] * g0x + vel[i1, 2] * g1x + vel[i2, 2] * g2x + vel[i3, 2] * g3x
+    lyz = vel[i0, 1] * g0z + vel[i1, 1] * g1z + vel[i2, 1] * g2z + vel[i3, 1] * g3z
+    lzy = vel[i0, 2] * g0y + vel[i1, 2] * g1y + vel[i2, 2] * g2y + vel[i3, 2] * g3y
+    return (lxx * dt, lyy * dt, lzz * dt,
+            0.5 * (lxy + lyx) * dt, 0.5 * (lxz + lzx) * dt, 0.5 * (lyz + lzy) * dt)
+
+
+@njit(cache=True, inline="always")
+def _hooke_forces(stress, force, z, K, G, exx, eyy, ezz, exy, exz, eyz, det, i0, i1, i2, i3,
+                  g0x, g0y, g0z, g1x, g1y, g1z, g2x, g2y, g2z, g3x, g3y, g3z):
+    """Incremental Hooke on zone z's stress, then its nodal forces −V σ ∇N onto the four corners."""
+    ev = exx + eyy + ezz
+    lam = K[z] - 2.0 * G[z] / 3.0
+    g2 = 2.0 * G[z]
+    sxx = stress[z, 0] + lam * ev + g2 * exx
+    syy = stress[z, 1] + lam * ev + g2 * eyy
+    szz = stress[z, 2] + lam * ev + g2 * ezz
+    sxy = stress[z, 3] + g2 * exy
+    sxz = stress[z, 4] + g2 * exz
+    syz = stress[z, 5] + g2 * eyz
+    stress[z, 0] = sxx; stress[z, 1] = syy; stress[z, 2] = szz
+    stress[z, 3] = sxy; stress[z, 4] = sxz; stress[z, 5] = syz
+    vol = abs(det) / 6.0
+    for n in range(4):
+        if n == 0:
+            gx = g0x; gy = g0y; gz = g0z; r = i0
+        elif n == 1:
+            gx = g1x; gy = g1y; gz = g1z; r = i1
+        elif n == 2:
+            gx = g2x; gy = g2y; gz = g2z; r = i2
+        else:
+            gx = g3x; gy = g3y; gz = g3z; r = i3
+        force[r, 0] -= vol * (sxx * gx + sxy * gy + sxz * gz)
+        force[r, 1] -= vol * (sxy * gx + syy * gy + syz * gz)
+        force[r, 2] -= vol * (sxz * gx + syz * gy + szz * gz)
+
+
+@njit(cache=True)
+def minimal_step(pos, vel, gp, K, G, dt, stress, force):
+    """One elastic step of every zone of gp (nz, 4): the least a 4-node step must do."""
+    for z in range(gp.shape[0]):
+        i0 = gp[z, 0]; i1 = gp[z, 1]; i2 = gp[z, 2]; i3 = gp[z, 3]
+        g0x, g0y, g0z, g1x, g1y, g1z, g2x, g2y, g2z, g3x, g3y, g3z, det = _grads(pos, i0, i1, i2, i3)
+        exx, eyy, ezz, exy, exz, eyz = _strain(vel, i0, i1, i2, i3, g0x, g0y, g0z, g1x, g1y, g1z, g2x, g2y, g2z,
+                                               g3x, g3y, g3z, dt)
+        _hooke_forces(stress, force, z, K, G, exx, eyy, ezz, exy, exz, eyz, det, i0, i1, i2, i3,
+                      g0x, g0y, g0z, g1x, g1y, g1z, g2x, g2y, g2z, g3x, g3y, g3z)
 
 
 @njit(cache=True)
@@ -139,44 +139,11 @@ def minimal_nmd_step(pos, vel, gp, K, G, dt, stress, force, nsum, nvol, geo):
         g1x = geo[z, 0]; g1y = geo[z, 1]; g1z = geo[z, 2]; g2x = geo[z, 3]; g2y = geo[z, 4]
         g2z = geo[z, 5]; g3x = geo[z, 6]; g3y = geo[z, 7]; g3z = geo[z, 8]; det = geo[z, 9]
         g0x = -(g1x + g2x + g3x); g0y = -(g1y + g2y + g3y); g0z = -(g1z + g2z + g3z)
-        lxx = vel[i0, 0] * g0x + vel[i1, 0] * g1x + vel[i2, 0] * g2x + vel[i3, 0] * g3x
-        lyy = vel[i0, 1] * g0y + vel[i1, 1] * g1y + vel[i2, 1] * g2y + vel[i3, 1] * g3y
-        lzz = vel[i0, 2] * g0z + vel[i1, 2] * g1z + vel[i2, 2] * g2z + vel[i3, 2] * g3z
-        lxy = vel[i0, 0] * g0y + vel[i1, 0] * g1y + vel[i2, 0] * g2y + vel[i3, 0] * g3y
-        lyx = vel[i0, 1] * g0x + vel[i1, 1] * g1x + vel[i2, 1] * g2x + vel[i3, 1] * g3x
-        lxz = vel[i0, 0] * g0z + vel[i1, 0] * g1z + vel[i2, 0] * g2z + vel[i3, 0] * g3z
-        lzx = vel[i0, 2] * g0x + vel[i1, 2] * g1x + vel[i2, 2] * g2x + vel[i3, 2] * g3x
-        lyz = vel[i0, 1] * g0z + vel[i1, 1] * g1z + vel[i2, 1] * g2z + vel[i3, 1] * g3z
-        lzy = vel[i0, 2] * g0y + vel[i1, 2] * g1y + vel[i2, 2] * g2y + vel[i3, 2] * g3y
-        exx = lxx * dt; eyy = lyy * dt; ezz = lzz * dt
-        exy = 0.5 * (lxy + lyx) * dt; exz = 0.5 * (lxz + lzx) * dt; eyz = 0.5 * (lyz + lzy) * dt
-        ev = exx + eyy + ezz
-        shift = (0.25 * (nsum[i0] + nsum[i1] + nsum[i2] + nsum[i3]) - ev) / 3.0
-        exx += shift; eyy += shift; ezz += shift
-        ev = exx + eyy + ezz
-        lam = K[z] - 2.0 * G[z] / 3.0
-        g2 = 2.0 * G[z]
-        sxx = stress[z, 0] + lam * ev + g2 * exx
-        syy = stress[z, 1] + lam * ev + g2 * eyy
-        szz = stress[z, 2] + lam * ev + g2 * ezz
-        sxy = stress[z, 3] + g2 * exy
-        sxz = stress[z, 4] + g2 * exz
-        syz = stress[z, 5] + g2 * eyz
-        stress[z, 0] = sxx; stress[z, 1] = syy; stress[z, 2] = szz
-        stress[z, 3] = sxy; stress[z, 4] = sxz; stress[z, 5] = syz
-        vol = abs(det) / 6.0
-        for n in range(4):
-            if n == 0:
-                gx = g0x; gy = g0y; gz = g0z; r = i0
-            elif n == 1:
-                gx = g1x; gy = g1y; gz = g1z; r = i1
-            elif n == 2:
-                gx = g2x; gy = g2y; gz = g2z; r = i2
-            else:
-                gx = g3x; gy = g3y; gz = g3z; r = i3
-            force[r, 0] -= vol * (sxx * gx + sxy * gy + sxz * gz)
-            force[r, 1] -= vol * (sxy * gx + syy * gy + syz * gz)
-            force[r, 2] -= vol * (sxz * gx + syz * gy + szz * gz)
+        exx, eyy, ezz, exy, exz, eyz = _strain(vel, i0, i1, i2, i3, g0x, g0y, g0z, g1x, g1y, g1z, g2x, g2y, g2z,
+                                               g3x, g3y, g3z, dt)
+        shift = (0.25 * (nsum[i0] + nsum[i1] + nsum[i2] + nsum[i3]) - (exx + eyy + ezz)) / 3.0
+        _hooke_forces(stress, force, z, K, G, exx + shift, eyy + shift, ezz + shift, exy, exz, eyz, det,
+                      i0, i1, i2, i3, g0x, g0y, g0z, g1x, g1y, g1z, g2x, g2y, g2z, g3x, g3y, g3z)
 
 
 def _mesh(zones: float):

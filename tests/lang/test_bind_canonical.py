@@ -10,7 +10,6 @@ anything); a change meant to change binding rewrites the file the same way and s
 """
 import hashlib
 import json
-import math
 import sys
 from pathlib import Path
 
@@ -23,27 +22,13 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 from dec3d.commands import load_all  # noqa: E402
 from dec3d.commands.binder import BindContext, Binder  # noqa: E402
-from dec3d.errors import Dec3dError, LazyLocation  # noqa: E402
-from dec3d.lang.deferred import Deferred  # noqa: E402
+from dec3d.errors import Dec3dError  # noqa: E402
 from dec3d.lang.parser import parse_deck  # noqa: E402
+from bound_form import norm as _norm  # noqa: E402
 from conftest import DECKS, NO_DECKS  # noqa: E402
 
 STORED = HERE / "bind_canonical.json"
 load_all()
-
-
-def _norm(v):
-    if isinstance(v, float):
-        return ("f", v.hex() if math.isfinite(v) else repr(v))
-    if isinstance(v, (list, tuple)):
-        return (type(v).__name__, tuple(_norm(x) for x in v))
-    if isinstance(v, dict):
-        return ("d", tuple((k, _norm(x)) for k, x in v.items()))
-    if isinstance(v, LazyLocation):
-        return ("loc", v.resolve())
-    if isinstance(v, Deferred):
-        return ("deferred", v.kind, _norm(v.node), str(v.token), v.token.line, v.token.column, _norm(v.where))
-    return v
 
 
 def _line(binder, raw):

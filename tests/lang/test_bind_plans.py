@@ -3,7 +3,6 @@ gives what the ordinary binding gives — the same command, values, locations an
 error at the same file:line:column — on every deck of the repository, every public deck, and lines
 made to differ from their shape's first line only where a value fails. ``Nums`` converting its
 numbers inline gives ``Num.convert``'s values and errors."""
-import math
 
 import pytest
 
@@ -11,28 +10,13 @@ from dec3d.commands import load_all
 from dec3d.commands.bind_plan import shape
 from dec3d.commands.binder import BindContext, Binder
 from dec3d.commands.values import Num, Nums
-from dec3d.errors import Dec3dError, LazyLocation
-from dec3d.lang.deferred import Deferred
+from dec3d.errors import Dec3dError
 from dec3d.lang.parser import parse_deck
+from bound_form import norm as _norm
 from conftest import DECKS, NO_DECKS, ROOT
 
 
 load_all()
-
-
-def _norm(v):
-    """A bound value in comparable form: floats by their bits, locations resolved."""
-    if isinstance(v, float):
-        return ("f", v.hex() if math.isfinite(v) else repr(v))
-    if isinstance(v, (list, tuple)):
-        return (type(v).__name__, tuple(_norm(x) for x in v))
-    if isinstance(v, dict):
-        return ("d", tuple((k, _norm(x)) for k, x in v.items()))
-    if isinstance(v, LazyLocation):
-        return ("loc", v.resolve())
-    if isinstance(v, Deferred):
-        return ("deferred", v.kind, _norm(v.node), str(v.token), v.token.line, v.token.column, _norm(v.where))
-    return v
 
 
 def _outcome(fn, raw):
