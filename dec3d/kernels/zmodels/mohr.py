@@ -39,17 +39,19 @@ def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, w
     code, s0, s1, s2, s3, s4, s5, dp = mohr_scalar(s0, s1, s2, s3, s4, s5, coh, wf[6], wf[7], wf[8], wf[9],
                                                    wf[10], wf[11], wf[12], wf[13], wf[14])
     if code < 0:
-        code, s0, s1, s2, s3, s4, s5, dp = _rest(s0, s1, s2, s3, s4, s5, K, G, coh, tf, ten, td, wf, mw)
+        code, s0, s1, s2, s3, s4, s5, dp = rest(s0, s1, s2, s3, s4, s5, K, G, coh, tf, ten, td, wf[6], wf[7], wf[8],
+                                                wf[9], wf[10], wf[11], wf[12], wf[13], wf[14], wf, mw)
     return code, s0, s1, s2, s3, s4, s5, dp
 
 
 @njit(cache=True)
-def _rest(s0, s1, s2, s3, s4, s5, K, G, coh, tf, ten, td, wf, mw):
-    """What ``mohr_scalar`` leaves (code -1) of the trial s0..s5: ``mohr_pair``, else ``mohr_plastic``
-    on the chunk scratch past the constants (one call out of the step for both: the step's common
-    path stays as short)."""
-    code, s0, s1, s2, s3, s4, s5, dp = mohr_pair(s0, s1, s2, s3, s4, s5, coh, wf[6], wf[7], wf[8], wf[9],
-                                                 wf[10], wf[11], wf[12], wf[13], wf[14])
+def rest(s0, s1, s2, s3, s4, s5, K, G, coh, tf, ten, td, npf, csn, ft, nps, a1, a2, sp, ap, den, wf, mw):
+    """What ``mohr_scalar`` leaves (code -1) of the trial s0..s5, with the return's constants
+    (``zone_mohr.mohr_constants``): ``mohr_pair``, else ``mohr_plastic`` on the chunk scratch past
+    the constants (one call out of the step for both: the step's common path stays as short).
+    Strain-softening's update takes the same way on."""
+    code, s0, s1, s2, s3, s4, s5, dp = mohr_pair(s0, s1, s2, s3, s4, s5, coh, npf, csn, ft, nps, a1, a2, sp, ap,
+                                                 den)
     if code < 0:
         s = wf[16:22]
         s[0] = s0; s[1] = s1; s[2] = s2; s[3] = s3; s[4] = s4; s[5] = s5

@@ -63,8 +63,8 @@ import math
 from numba import njit
 
 from ..principal import _deviator, _invariants, _values
-from ..zone_mohr import mohr_plastic, mohr_scalar
-from ..zone_mohr_pair import mohr_pair
+from ..zone_mohr import mohr_scalar
+from .mohr import rest
 from ._common import (P_COHESION, P_OWN, P_SRF, P_TANDIL, P_TANFRIC, P_TENSION, SHEAR_NOW, TENSION_NOW, hooke,
                       table_value)
 
@@ -213,20 +213,6 @@ def _constants(K, G, coh, tf, ten, td, wf):
 
 
 @njit(cache=True)
-def _general(e0, e1, e2, e3, e4, e5, K, G, coh, tf, ten, td, npf, csn, ft, nps, a1, a2, sp, ap, den, wf, mw):
-    """What the single-plane return leaves, as Mohr-Coulomb's update takes it on (``mohr._rest``: the
-    close-pair and edge returns in scalars, ``zone_mohr_pair.mohr_pair``, then the general return on
-    the chunk scratch): without tables this model gives Mohr-Coulomb's bits."""
-    code, t0, t1, t2, t3, t4, t5, dp = mohr_pair(e0, e1, e2, e3, e4, e5, coh, npf, csn, ft, nps, a1, a2, sp, ap, den)
-    if code < 0:
-        s = wf[16:22]
-        s[0] = e0; s[1] = e1; s[2] = e2; s[3] = e3; s[4] = e4; s[5] = e5
-        code, dp = mohr_plastic(s, K, G, coh, tf, ten, td, mw)
-        t0 = s[0]; t1 = s[1]; t2 = s[2]; t3 = s[3]; t4 = s[4]; t5 = s[5]
-    return code, t0, t1, t2, t3, t4, t5, dp
-
-
-@njit(cache=True)
 def _scalar_return(e0, e1, e2, e3, e4, e5, coh, npf, csn, ft, nps, a1, a2, sp, ap, den):
     """``zone_mohr.mohr_scalar`` as one call on scalars: ``update`` is inlined into the zone step
     (no array arguments to count references of), this part is compiled once, not into each step."""
@@ -248,8 +234,9 @@ def update(p, h, z, K, G, d0, d1, d2, d3, d4, d5, s0, s1, s2, s3, s4, s5, tab, w
                                                       ap, den)
     one_plane = code >= 0
     if code < 0:
-        code, t0, t1, t2, t3, t4, t5, dp = _general(e0, e1, e2, e3, e4, e5, K, G, coh, tf, ten, td, npf, csn, ft,
-                                                    nps, a1, a2, sp, ap, den, wf, mw)
+        # as Mohr-Coulomb's update goes on (``mohr.rest``): without tables this model gives its bits
+        code, t0, t1, t2, t3, t4, t5, dp = rest(e0, e1, e2, e3, e4, e5, K, G, coh, tf, ten, td, npf, csn, ft, nps,
+                                                a1, a2, sp, ap, den, wf, mw)
     if code != 0:
         dks, dkt = _increments(code, one_plane, e0 - t0, e1 - t1, e2 - t2, e3 - t3, e4 - t4, e5 - t5,
                                         K, G, nps)
