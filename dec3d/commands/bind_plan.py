@@ -131,7 +131,7 @@ class Plan:
     ``cwhere``), or None."""
 
     __slots__ = ("call", "steps", "vsteps", "values", "holes", "lists", "locs", "where", "compact", "clocs",
-                 "cwhere")
+                 "cwhere", "batch")
 
     def __init__(self, call, steps, toks, items=None, values=None):
         self.call = call
@@ -153,13 +153,27 @@ class Plan:
         if call.range is not None:
             for e in call.range.elements:
                 self.where[id(e.location)] = ids[id(e.location.token)]
-        self.compact = self.clocs = self.cwhere = None
+        self.compact = self.clocs = self.cwhere = self.batch = None
         if items is not None and items is not toks:
             got = _compact(self.vsteps, toks, items)
             if got is not None:
                 self.compact, where = got
                 self.clocs = tuple((k, *where[i]) for k, i in self.locs)
                 self.cwhere = {k: where[i] for k, i in self.where.items()}
+                self.compact, self.batch = _batched(self.compact, items)
+
+
+def _batched(compact, items):
+    """``compact`` without its takes of numbers that are each one whole run of numbers under the same
+    bounds, when there are two or more (a polyhedron's six faces): those are converted in one
+    ``run_values`` (``batch``: bounds, then (value number, item, count) per take), not one each."""
+    whole = [st for st in compact
+             if not st[0] and not st[4] and len(st[2]) == 1 and st[2][0][1] == 0
+             and st[2][0][2] == len(items[st[2][0][0]].nums)]
+    if len(whole) < 2 or len({st[3] for st in whole}) != 1:
+        return compact, None
+    batch = (whole[0][3], tuple((st[1], st[2][0][0], st[2][0][2]) for st in whole))
+    return tuple(st for st in compact if not any(st is w for w in whole)), batch
 
 
 def fill_value(v, values):
@@ -227,6 +241,18 @@ def replay_compact(plan: Plan, items, binder):
     """The plan's call made from the line's items (``Plan.compact``), or None when a number is out of
     its bounds (the caller replays on the tokens, whose take reports it). Other errors propagate."""
     values = plan.values.copy()
+    batch = plan.batch
+    if batch is not None:                            # whole runs under one set of bounds: one pass
+        strs: list = []
+        for _, a, _ in batch[1]:
+            strs += items[a].nums
+        nums = run_values(strs, batch[0], " ".join([items[a].text for _, a, _ in batch[1]]))
+        if nums is None:
+            return None
+        o = 0
+        for n, _, count in batch[1]:
+            values[n] = tuple(nums[o:o + count])
+            o += count
     for step in plan.compact:
         if step[0]:
             values[step[1]] = _take_one(step[2].value, items, step[3], binder)[0]

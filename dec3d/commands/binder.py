@@ -118,6 +118,9 @@ class Binder:
         self.stack = tuple(stack)
         self.reg = registry
         self.plans: dict[tuple, Plan | None] = {}   # line shape -> plan (lang: bind_plan)
+        # a line's lexer key -> a plan of its shape (``RawLine.key``: lines of one key have one shape;
+        # a string's hash is kept, a shape's is not)
+        self.by_key: dict[str, Plan] = {}
         self._steps: list | None = None             # the takes of the line being planned
 
     # ------------------------------------------------------------ helpers
@@ -192,13 +195,26 @@ class Binder:
             self.deferred(first)                 # checks the name; a FISH function is called when it runs
             return ExprStatement(("name", str(first)[1:].lower(), 1), self.deck.location(first, self.stack),
                                  str(first))
-        key = shape(toks)                        # a command: by its shape's plan, if any
+        lkey = raw.key                           # a command: by its lexer key's plan, if any
+        tried = None
+        if lkey is not None:
+            tried = self.by_key.get(lkey)
+            if tried is not None:
+                call = replay(tried, raw, toks, self)
+                if call is not None:
+                    return call
+        key = shape(toks)                        # by its shape's plan, if any
         plan = self.plans.get(key)
-        if plan is not None:
+        if plan is not None and plan is not tried:
             call = replay(plan, raw, toks, self)
             if call is not None:
+                if lkey is not None:
+                    self.by_key[lkey] = plan
                 return call
-        return self._plan(raw, key)
+        call = self._plan(raw, key)
+        if lkey is not None and key in self.plans:
+            self.by_key[lkey] = self.plans[key]
+        return call
 
     def bind(self, raw: RawLine) -> CommandCall:
         """A command line (``bind_line`` for any line)."""
@@ -221,6 +237,7 @@ class Binder:
         values = [s[3] for s in steps]
         if len(self.plans) >= MAX_PLANS:
             self.plans.clear()
+            self.by_key.clear()
         plan = self.plans[key] = Plan(call, [s[:3] for s in steps], toks, items, values)
         call = fill(plan, values, toks, self.deck, self.stack)
         cmd = call.command

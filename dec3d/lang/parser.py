@@ -84,13 +84,16 @@ def run_tokens(text: str, start: int, line: int, line_start: int) -> list:
 class RawLine:
     """One command line: its tokens (lark Tokens: type, value, line, column). ``items`` is the same
     line as the lexer gave it, each run of numbers one ``NumRun``; ``tokens`` is made from it the
-    first time it is asked for (the same Token objects, a run's numbers each a token)."""
+    first time it is asked for (the same Token objects, a run's numbers each a token). ``key``: the
+    line's key (``_lex_fast``) when it was cut by its template and its words hold no digit — lines of
+    one such key have one shape (the binder looks their plan up by it) — else None."""
 
-    __slots__ = ("items", "_tokens")
+    __slots__ = ("items", "_tokens", "key")
 
-    def __init__(self, items: tuple, runs: bool = False):
+    def __init__(self, items: tuple, runs: bool = False, key: str | None = None):
         self.items = items
         self._tokens = None if runs else items
+        self.key = key
 
     @property
     def tokens(self) -> tuple:
@@ -273,6 +276,7 @@ def _lex_fast(text: str) -> list[RawLine] | None:
         if fresh:
             tpl = templates.get(key)
             if tpl is not None:  # cut as the line of its key was
+                tpl, same_words = tpl
                 items = []
                 for kind, s, e in tpl:
                     value = text[pos + s:pos + e]
@@ -290,7 +294,7 @@ def _lex_fast(text: str) -> list[RawLine] | None:
                         tok.column, tok.end_column = s + 1, e + 1
                         items.append(tok)
                 if items:
-                    lines.append(RawLine(tuple(items), runs))
+                    lines.append(RawLine(tuple(items), runs, key if same_words else None))
                     runs = False
                 pos = stop + 1
                 continue
@@ -302,9 +306,11 @@ def _lex_fast(text: str) -> list[RawLine] | None:
                 continue         # a continuation ends the physical line: the next one goes on
             if kind == "_NL":
                 if fresh and len(templates) < MAX_TEMPLATES:      # the template of the line's key
-                    templates[key] = tuple((it.type, it.start - pos, it.start - pos + len(it.text))
-                                           if it.type == "NUMRUN" else (it.type, it.start_pos - pos, it.end_pos - pos)
-                                           for it in current)
+                    templates[key] = (tuple((it.type, it.start - pos, it.start - pos + len(it.text))
+                                            if it.type == "NUMRUN" else (it.type, it.start_pos - pos, it.end_pos - pos)
+                                            for it in current),
+                                      not any(it.type == "WORD" and it.value != it.value.translate(_DIGITS_AS_0)
+                                              for it in current))
                 if current:
                     lines.append(RawLine(tuple(current), runs))
                     current = []

@@ -231,3 +231,49 @@ def test_runs_of_numbers_replayed_on_items_bind_as_the_ordinary_binder():
     assert kinds.count("call") > 300 and kinds.count("error") > 300      # both met
     assert any(p.compact is not None for p in binder.plans.values())
     assert _same_outcomes(text, "r.dat") > 300
+
+
+def test_lines_of_one_lexer_key_bind_as_the_ordinary_binder():
+    """Lines of one lexer key (the same text but their digits) are cut by the lexer's template and bound
+    by the plan found through the key (``RawLine.key``, ``Binder.by_key``); a polyhedron's whole runs
+    are converted in one pass (``Plan.batch``). Abbreviations, keyword values, signs, exponents, leading
+    zeros, values out of bounds, words holding digits (no key), continuations and `[ ]`: the ordinary
+    binding's results and errors."""
+    import random
+
+    rng = random.Random(9)
+
+    def fill(t):
+        return "".join(str(rng.randrange(10)) if c == "#" else c for c in t)
+
+    templates = [
+        "block create brick # #.# -# ## #e# #E-#",
+        "bl cr br # # # # # #",
+        "block create brick -# +# 0# .# #. -0",
+        "block create brick #e99# # # # # #",
+        "block create brick (#,#) (#,#) (#,#) ; a comment #",
+        "block contact property stiffness-normal #e# stiffness-shear #e# friction ##",
+        "block contact prop stiff-n #e# fric #",
+        "block create polyhedron face #,#,# #,#,# #,#,# face -#,#,# #,#,# #,#,# group 'g#'",
+        "block create polyhedron face #,#,# #,#,# #,#,# face #,#,# #,#,# ##,#,# group g#",
+        "block create polyhedron face ## # # # # # # # # face # # # # # # # # #",
+        "model gravity # # -#.##",
+        "model gravity (#,#,#) ; g",
+        "block fix velocity range position-z # # position-x -# #",
+        "block initialize velocity # # # range position-x #.# #.#",
+        "model title 'stage #'",
+        "model large-strain on",
+        "[x# = #.# * #]",
+        "block create brick # # # # # # &\n  ; continued\n",
+        "model gravity # # &\n -#",
+        "block create brick # # # # # x#",
+    ]
+    text = "\n".join(fill(rng.choice(templates)) for _ in range(3000)) + "\n"
+    deck = parse_deck(text, "k.dat")
+    keyed = sum(raw.key is not None for raw in deck.lines)
+    assert keyed > 2000
+    binder = Binder(deck, BindContext(lenient_names=True))
+    kinds = [_outcome(binder.bind_line, raw)[0] for raw in deck.lines]
+    assert kinds.count("call") > 1000 and kinds.count("error") > 100      # both met
+    assert len(binder.by_key) > 10 and any(p.batch is not None for p in binder.plans.values())
+    assert _same_outcomes(text, "k.dat") > 1000
