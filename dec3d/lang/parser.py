@@ -10,8 +10,8 @@ parser's per-token reductions were about 40 % of the time). The lexing itself is
 regular expression made of the grammar's own terminals, in the order lark tries them,
 run with ``re.finditer`` (lark's lexer object costs about 5 µs a token, this about 1 µs:
 a 70-number masonry `block create polyhedron` line is lexed in a tenth of a millisecond).
-A physical line with the key (its ASCII digits as `0`) of a line lexed before is cut where that
-one was, without the regular expression (``_lex_fast``: generated decks repeat a few dozen keys).
+A physical line with the key (its ASCII digits as `0`) of lines lexed before is cut where they
+were, without the regular expression (``_lex_fast``: generated decks repeat a few dozen keys).
 Text it cannot lex goes through lark's lexer, which reports the bad character
 (UnexpectedCharacters) with its line and column; tests/lang compares the two lexers'
 tokens on every public deck.
@@ -254,15 +254,19 @@ def _lex_fast(text: str) -> list[RawLine] | None:
     """Token lines, the same tokens (type, text, line, column, end, offsets) lark's lexer gives;
     None when some text matches no terminal. A run of numbers is one ``NumRun`` item.
 
-    Physical lines are lexed one by one. A line neither continued nor continuing one that has the
-    key (``_DIGITS_AS_0``) of such a line lexed before is cut where that one was (its *template*:
-    each item's kind and place) without the regular expression: 8 000 `block create brick` lines
-    have 29 keys, a generated deck of 100 000 lines a few hundred."""
+    Physical lines are lexed one by one. Of lines neither continued nor continuing one, the second
+    of a key (``_DIGITS_AS_0``) leaves its *template* (each item's kind and place), and the later
+    ones are cut by it without the regular expression: 8 000 `block create brick` lines have 29 keys,
+    a generated deck of 100 000 lines a few hundred. (A key seen once costs a set entry: a deck of
+    lines each of its own key is lexed as before.)"""
     pat, ignore = _fast_pattern()
     make = str.__new__           # lark's Token._future_new written out: a call less per token
     lines: list[RawLine] = []
     current: list[Token] = []
     templates: dict[str, tuple] = {}
+    seen: set[str] = set()       # keys of one line so far
+    scan = None
+    scan_at = -1                 # where ``scan`` matches next
     runs = False
     n_text = len(text)
     pos = 0                      # where the physical line starts
@@ -272,8 +276,8 @@ def _lex_fast(text: str) -> list[RawLine] | None:
         stop = pos + len(key)    # the line's newline (or the end of the text)
         if pos >= n_text:
             break
-        fresh = not current and stop < n_text     # starts a command, ends at a newline
-        if fresh:
+        record = False
+        if not current and stop < n_text:         # the line starts a command and ends at a newline
             tpl = templates.get(key)
             if tpl is not None:  # cut as the line of its key was
                 tpl, same_words = tpl
@@ -298,14 +302,27 @@ def _lex_fast(text: str) -> list[RawLine] | None:
                     runs = False
                 pos = stop + 1
                 continue
+            if key in seen:      # the second line of its key: the template is made from it
+                record = len(templates) < MAX_TEMPLATES
+            elif len(seen) < 4 * MAX_TEMPLATES:
+                seen.add(key)
+        if scan_at != pos:       # after lines cut by templates: the scanner goes on from here
+            scan = pat.scanner(text, pos).match
         end = line_start = pos
-        for m in iter(pat.scanner(text, pos, stop + 1).match, None):
+        while True:              # the physical line's tokens, up to its newline
+            m = scan()
+            if m is None:        # text no terminal takes (or the end of a text without a final newline)
+                if end != n_text:
+                    return None
+                break
             end = m.end()
             kind = m.lastgroup
             if kind in ignore:
-                continue         # a continuation ends the physical line: the next one goes on
+                if kind == "CONTINUATION":
+                    break        # the command goes on on the next physical line
+                continue
             if kind == "_NL":
-                if fresh and len(templates) < MAX_TEMPLATES:      # the template of the line's key
+                if record:       # the template of the line's key
                     templates[key] = (tuple((it.type, it.start - pos, it.start - pos + len(it.text))
                                             if it.type == "NUMRUN" else (it.type, it.start_pos - pos, it.end_pos - pos)
                                             for it in current),
@@ -315,7 +332,8 @@ def _lex_fast(text: str) -> list[RawLine] | None:
                     lines.append(RawLine(tuple(current), runs))
                     current = []
                     runs = False
-            elif kind == "NUMRUN":
+                break
+            if kind == "NUMRUN":
                 value = m.group(kind)
                 if "(" in value or ")" in value or "=" in value:
                     nums = _RUN_SPLIT.split(value)
@@ -331,9 +349,9 @@ def _lex_fast(text: str) -> list[RawLine] | None:
                 tok.line = tok.end_line = line
                 tok.column, tok.end_column = start - line_start + 1, end - line_start + 1
                 current.append(tok)
-        if end != min(stop + 1, n_text):
-            return None
-        pos = stop + 1
+        if end != stop + 1 and end != n_text:
+            return None          # not reached: a physical line's tokens end at its newline
+        pos = scan_at = end
     if current:
         lines.append(RawLine(tuple(current), runs))
     return lines
