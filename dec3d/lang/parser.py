@@ -246,6 +246,7 @@ def _fast_pattern() -> tuple[re.Pattern, frozenset]:
 #: from another (``\\d``, ``[0-9]`` and classes holding all ten), so lines of one key are lexed alike:
 #: the same token types at the same places, only the digits in their texts differ
 _DIGITS_AS_0 = str.maketrans("123456789", "000000000")
+_ASCII_DIGIT = re.compile("[0-9]").search
 #: keys remembered per deck (a deck whose lines are each of their own key has no use for more)
 MAX_TEMPLATES = 4096
 
@@ -326,7 +327,7 @@ def _lex_fast(text: str) -> list[RawLine] | None:
                     templates[key] = (tuple((it.type, it.start - pos, it.start - pos + len(it.text))
                                             if it.type == "NUMRUN" else (it.type, it.start_pos - pos, it.end_pos - pos)
                                             for it in current),
-                                      not any(it.type == "WORD" and it.value != it.value.translate(_DIGITS_AS_0)
+                                      not any(it.type == "WORD" and _ASCII_DIGIT(it.value) is not None
                                               for it in current))
                 if current:
                     lines.append(RawLine(tuple(current), runs))

@@ -267,6 +267,8 @@ def test_lines_of_one_lexer_key_bind_as_the_ordinary_binder():
         "block create brick # # # # # # &\n  ; continued\n",
         "model gravity # # &\n -#",
         "block create brick # # # # # x#",
+        "block create brick # # # # # # group g#",
+        "block create brick # # # # # # group g0",
     ]
     text = "\n".join(fill(rng.choice(templates)) for _ in range(3000)) + "\n"
     deck = parse_deck(text, "k.dat")
@@ -277,3 +279,17 @@ def test_lines_of_one_lexer_key_bind_as_the_ordinary_binder():
     assert kinds.count("call") > 1000 and kinds.count("error") > 100      # both met
     assert len(binder.by_key) > 10 and any(p.batch is not None for p in binder.plans.values())
     assert _same_outcomes(text, "k.dat") > 1000
+
+
+def test_words_holding_digits_are_not_found_by_their_key():
+    """Lines whose words differ only in their digits (`g0`, `g5`) share a lexer key but not a shape:
+    each binds its own word (the key finds no plan for them, ``RawLine.key`` is None)."""
+    for word in ("g0", "g5", "x0y"):
+        for later in ("g5", "g0", "x9y"):
+            text = f"block create brick 0 1 0 1 0 1 group {word}\n" * 3 + f"block create brick 2 3 0 1 0 1 group {later}\n"
+            deck = parse_deck(text, "g.dat")
+            assert all(raw.key is None for raw in deck.lines)
+            binder = Binder(deck, BindContext())
+            assert [binder.bind_line(raw).args["group"] for raw in deck.lines] == [word] * 3 + [later]
+    text = "block create brick 0 1 0 1 0 1 group g\n" * 3 + "block create brick 2 3 0 1 0 1 group g\n"
+    assert parse_deck(text, "g.dat").lines[-1].key is not None      # no digit in its words: found by its key
