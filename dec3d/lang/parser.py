@@ -281,7 +281,7 @@ def _lex_fast(text: str) -> list[RawLine] | None:
         if not current and stop < n_text:         # the line starts a command and ends at a newline
             tpl = templates.get(key)
             if tpl is not None:  # cut as the line of its key was
-                tpl, same_words = tpl
+                tpl, shape_key = tpl
                 items = []
                 for kind, s, e in tpl:
                     value = text[pos + s:pos + e]
@@ -299,7 +299,7 @@ def _lex_fast(text: str) -> list[RawLine] | None:
                         tok.column, tok.end_column = s + 1, e + 1
                         items.append(tok)
                 if items:
-                    lines.append(RawLine(tuple(items), runs, key if same_words else None))
+                    lines.append(RawLine(tuple(items), runs, shape_key))
                     runs = False
                 pos = stop + 1
                 continue
@@ -327,8 +327,8 @@ def _lex_fast(text: str) -> list[RawLine] | None:
                     templates[key] = (tuple((it.type, it.start - pos, it.start - pos + len(it.text))
                                             if it.type == "NUMRUN" else (it.type, it.start_pos - pos, it.end_pos - pos)
                                             for it in current),
-                                      not any(it.type == "WORD" and _ASCII_DIGIT(it.value) is not None
-                                              for it in current))
+                                      None if any(it.type == "WORD" and _ASCII_DIGIT(it.value) is not None
+                                                  for it in current) else key)
                 if current:
                     lines.append(RawLine(tuple(current), runs))
                     current = []
