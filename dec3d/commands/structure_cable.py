@@ -182,13 +182,14 @@ def _bits(call) -> int:
 
 
 def _node_stores(session, call):
-    """[(store, range mask)] of the cable and beam nodes (one id space, ``model.beams.next_node_id``)."""
+    """[(store, range mask)] of the cable, beam and liner nodes (one id space, ``model.beams.next_node_id``)."""
     m = session.model
-    out = [(m.stores[n], session.range_mask(call, n)) for n in (NODES, "beam_nodes")
+    out = [(m.stores[n], session.range_mask(call, n)) for n in (NODES, "beam_nodes", "liner_nodes")
            if n in m.stores and m.stores[n].n]
     if not out:
-        raise CommandError("there is no structural node: make a cable or a beam first (`structure cable create "
-                           "by-line …`, `structure beam create by-line …`)", call.location)
+        raise CommandError("there is no structural node: make a cable, a beam or a liner first (`structure cable "
+                           "create by-line …`, `structure beam create by-line …`, `structure liner create …`)",
+                           call.location)
     return out
 
 

@@ -27,12 +27,14 @@ def _check(call):
 
 def _ident(session, call, store: str) -> int:
     from ..model.beams import has_beams
-    if not has_cables(session.model) and not (store == NODES and has_beams(session.model)):
+    from ..model.liners import has_liners
+    if not has_cables(session.model) and not (store == NODES and (has_beams(session.model)
+                                                                   or has_liners(session.model))):
         raise CommandError("there is no cable: make one first (`structure cable create by-line …`)", call.location)
     if call.args["component_id"] is not None:
         return int(call.args["component_id"])
     p = np.asarray([float(x) for x in call.args["position"]])
-    names = (NODES, "beam_nodes") if store == NODES else (SEGMENTS,)
+    names = (NODES, "beam_nodes", "liner_nodes") if store == NODES else (SEGMENTS,)
     best = None
     for st in (session.model.stores[n] for n in names if n in session.model.stores and session.model.stores[n].n):
         d = np.linalg.norm(st["pos"] - p, axis=1)

@@ -212,6 +212,9 @@ def remap_hosts(model: Model, remap: np.ndarray) -> None:
     from .beams import remap_beam_hosts  # beam nodes linked to a deleted block are free
 
     remap_beam_hosts(model, remap)
+    from .liners import remap_liner_hosts  # liner nodes coupled to a deleted block are free
+
+    remap_liner_hosts(model, remap)
     if NODES in st and st[NODES].n:
         nodes = cable_stores(model)[0]
         h = nodes["host"]
