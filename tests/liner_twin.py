@@ -7,7 +7,7 @@ sharing no code or constants with it:
   cubic w along the side, β_s = −(3/2 (w_j − w_i)/l − ¼ (w,s_i + w,s_j)), and the normal one the mean
   of the corners' — fitted by a full quadratic polynomial in (x, y) through the six points, its
   curvatures integrated at the three mid-side points (weights A/3);
-* drilling: the spring 10⁻³ E t³ (I − 11ᵀ/3) on the rotations about the normal (written out).
+* drilling: the penalty 10⁻³ E t³ Σ (θz − ω)², ω = ½ (v,x − u,y) the in-plane rotation (written out).
 """
 from __future__ import annotations
 
@@ -79,7 +79,8 @@ def bending_b(xy, x, y):
 
 
 def bending_k(xy, e, nu, t):
-    area = 0.5 * abs(np.cross(xy[1] - xy[0], xy[2] - xy[0]))
+    e1, e2 = xy[1] - xy[0], xy[2] - xy[0]
+    area = 0.5 * abs(e1[0] * e2[1] - e1[1] * e2[0])
     db = dmat(e, nu) * t ** 3 / 12.0
     k = np.zeros((9, 9))
     for i, j in ((0, 1), (1, 2), (2, 0)):
@@ -98,8 +99,16 @@ def local_k(xy, e, nu, t):
     bi = [6 * n + c for n in range(3) for c in (2, 3, 4)]
     k[np.ix_(mi, mi)] += km
     k[np.ix_(bi, bi)] += kb
-    di = [5, 11, 17]
-    k[np.ix_(di, di)] += 1e-3 * e * t ** 3 * (np.eye(3) - np.ones((3, 3)) / 3.0)
+    # drilling: 1e-3 E t³ Σ (θz_i − ω)², ω = ½ (v,x − u,y) from the linear functions' gradients
+    g = np.linalg.inv(np.column_stack([np.ones(3), xy]))[1:, :]
+    omega = np.zeros(18)
+    for n in range(3):
+        omega[6 * n] = -0.5 * g[1, n]
+        omega[6 * n + 1] = 0.5 * g[0, n]
+    for n in range(3):
+        r = -omega.copy()
+        r[6 * n + 5] += 1.0
+        k += 1e-3 * e * t ** 3 * np.outer(r, r)
     return k
 
 

@@ -17,9 +17,10 @@ e_k = (¼y_ij² − ½x_ij²)/l², k = 4, 5, 6 for sides 23, 31, 12); curvatures
 βx,y + βy,x), K_b = ∫ Bᵀ D_b B dA with D_b = t³/12 D, integrated at the three interior Gauss points
 (1/6, 1/6), (2/3, 1/6), (1/6, 2/3) (exact: B is linear).
 
-Drilling: the rotations about z have no stiffness in this element; a weak spring k_d (I − 11ᵀ/3)
-ties each node's θz to the element's mean (k_d = ``DRILL`` × E t³: zero for a rigid-body rotation,
-and 10⁻³ of the bending stiffness scale, so it does not stiffen the element noticeably).
+Drilling: the rotations about z have no stiffness in the DKT and CST; a weak penalty
+k_d Σᵢ (θzᵢ − ω)² ties each node's θz to the membrane's in-plane rotation ω = ½ (v,x − u,y) (constant
+over the CST): zero for a rigid-body rotation, so the element keeps exactly six zero-energy modes, with
+k_d = ``DRILL`` × E t³, 10⁻³ of the bending stiffness scale (it does not stiffen the element noticeably).
 """
 from __future__ import annotations
 
@@ -145,11 +146,23 @@ def shell_local_stiffness(x2, x3, y3, e, nu, t, k):
                     for s in range(3):
                         acc += bb[r, p] * d[r, s] * bb[s, q]
                 k[bi[p], bi[q]] += wgt * acc
-    # drilling: k_d (I - 11ᵀ/3) on θz
+    # drilling: k_d Σᵢ (θzᵢ − ω)², ω = ½ (v,x − u,y) the CST's in-plane rotation
     kd = DRILL * e * t * t * t
-    for p in range(3):
-        for q in range(3):
-            k[6 * p + 5, 6 * q + 5] += kd * ((1.0 if p == q else 0.0) - 1.0 / 3.0)
+    om = np.zeros(18)
+    dnx = (y23 / a2, y31 / a2, y12 / a2)
+    dny = (x32 / a2, x13 / a2, x21 / a2)
+    for j in range(3):
+        om[6 * j] = -0.5 * dny[j]
+        om[6 * j + 1] = 0.5 * dnx[j]
+    r = np.empty(18)
+    for i in range(3):
+        for p in range(18):
+            r[p] = -om[p]
+        r[6 * i + 5] += 1.0
+        for p in range(18):
+            if r[p] != 0.0:
+                for q in range(18):
+                    k[p, q] += kd * r[p] * r[q]
 
 
 def element_frame(p1, p2, p3) -> tuple[np.ndarray, float, float, float]:
