@@ -15,10 +15,11 @@ material point (rigid) or Σ wᵢ xᵢ of the zone holding the node (zoned: the 
 the reaction goes to the block's ``fapp``/``mapp`` or to the gridpoints (``cables.pass_reactions``).
 
 Nodes: mass ρ t A/3 per element, rotary inertia ``model.liners.update_liner_masses``, moving with the
-blocks' central-difference scheme and damping (``kernels.beam.move_nodes``, as the beam nodes); in static
-runs each node's inertial mass and rotary inertia are max(real, R (Δt / 2s)²), R the Gershgorin row
-sum of the assembled stiffness (coupling springs included) over its translational / rotational rows,
-so liners never cut the blocks' Δt; with real masses they bound it (``liner_timestep``).
+blocks' central-difference scheme and damping (``kernels.liner.move_dofs``, the beam nodes' law of
+motion); in static runs the inertia of each degree of freedom is max(real, R (Δt / 2s)²), R the
+Gershgorin row sum of the assembled stiffness (coupling springs included) over that global
+translation or rotation, so liners never cut the blocks' Δt (and their bending, much softer than their
+membrane, is not slowed by it); with real masses they bound it (``liner_timestep``).
 """
 from __future__ import annotations
 
@@ -88,8 +89,9 @@ def coupling_table(model) -> np.ndarray:
 
 
 def row_sums(model, kg=None, cpl=None) -> tuple[np.ndarray, np.ndarray]:
-    """Per liner node: the largest Gershgorin row sum of the assembled stiffness over its translational
-    rows and over its rotational rows (coupling springs included)."""
+    """Per liner node (n, 3) each: the Gershgorin row sums of the assembled stiffness over its three
+    translational rows and its three rotational rows (global axes; coupling springs included:
+    k_n n nᵀ + k_s (I − n nᵀ) on the translations)."""
     nodes, els = liner_stores(model)
     kg = element_stiffness(model) if kg is None else kg
     cpl = coupling_table(model) if cpl is None else cpl
@@ -98,7 +100,10 @@ def row_sums(model, kg=None, cpl=None) -> tuple[np.ndarray, np.ndarray]:
         ks = np.abs(kg[e]).sum(axis=1)
         for c in range(3):
             rows[els["nodes"][e, c]] += ks[6 * c:6 * c + 6]
-    return rows[:, :3].max(axis=1) + np.maximum(cpl[:, 0], cpl[:, 1]), rows[:, 3:].max(axis=1)
+    n = nodes["nrm"]
+    nn = n[:, :, None] * n[:, None, :]
+    spring = cpl[:, 0, None, None] * nn + cpl[:, 1, None, None] * (np.eye(3)[None] - nn)
+    return rows[:, :3] + np.abs(spring).sum(axis=2), rows[:, 3:].copy()
 
 
 def liner_timestep(model) -> float:
@@ -109,7 +114,7 @@ def liner_timestep(model) -> float:
     nodes, _ = liner_stores(model)
     rt, rr = row_sums(model)
     out = np.inf
-    for m, r in ((nodes["mass"], rt), (nodes["inert"], rr)):
+    for m, r in ((nodes["mass"], rt.max(axis=1)), (nodes["inert"], rr.max(axis=1))):
         on = (m > 0) & (r > 0)
         if on.any():
             out = min(out, float(2.0 * SAFETY * np.sqrt(m[on] / r[on]).min()))
