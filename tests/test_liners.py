@@ -227,6 +227,16 @@ model solve ratio 1e-7
     d = 200e9 * 0.01 ** 3 / 12.0
     want = -20.0 * 1.0 / (3.0 * d * 0.25)
     np.testing.assert_allclose(nodes["disp"][tip, 2], want, rtol=0.01)
+    # the bending moment per unit width P (L − x) / b at the centroids of the elements along x, to 3 % of
+    # the root moment (one element across, the load at two corners: the DKT's centroid values are off
+    # by about 1.6 N·m/m of 80 here)
+    from dec3d.physics.liner_output import element_resultants
+
+    els = s.model.stores["liner_elements"]
+    along = np.isclose(els["axes"][:, 0, 0], 1.0)
+    m = element_resultants(s.model)[along]
+    np.testing.assert_allclose(m[:, 3], 20.0 * (1.0 - els["pos"][along, 0]) / 0.25, rtol=0, atol=0.03 * 80.0)
+    assert np.abs(m[:, :3]).max() < 1e-6 * np.abs(m[:, 3]).max()         # no membrane force
 
 
 def test_liner_on_a_rigid_block_face_pulls_off_at_its_strength(tmp_path):
@@ -300,7 +310,7 @@ def test_liner_without_properties_is_refused_at_cycle(tmp_path):
         _run("model cycle 1\n", tmp_path, s)
 
 
-def test_list_and_save_restore(tmp_path):
+def test_list_save_restore_vtk(tmp_path):
     text = PLATE + ("structure node fix velocity rotation range position-x 0\n"
                     "structure node apply force-z -10 range position-x 1\nmodel cycle 300\n")
     out = io.StringIO()
@@ -309,9 +319,16 @@ def test_list_and_save_restore(tmp_path):
     _run(f"model save '{p}'\nmodel cycle 200\nstructure liner list range id 1\n", tmp_path, a)
     listing = out.getvalue()
     assert "M-xx" in listing and len(listing.split("M-xx")[1].strip().splitlines()) == 2
-    b = _run(f"model restore '{p}'\nmodel cycle 200\n", tmp_path)
+    b = _run(f"model restore '{p}'\nmodel cycle 200\nblock vtk 'lv'\n", tmp_path)
     for k in ("disp", "rot", "force"):
         np.testing.assert_array_equal(a.model.stores["liner_nodes"][k], b.model.stores["liner_nodes"][k])
+    meshio = pytest.importorskip("meshio")
+    from dec3d.physics.liner_output import element_resultants
+
+    m = meshio.read(tmp_path / "lv_liners_0000.vtu")
+    assert m.cells[0].type == "triangle" and m.cells[0].data.shape == (32, 3)
+    np.testing.assert_array_equal(m.cell_data["M_xx"][0], element_resultants(b.model)[:, 3])
+    np.testing.assert_array_equal(m.point_data["displacement"], b.model.stores["liner_nodes"]["disp"])
 
 
 @pytest.mark.parametrize("damp, safety", [(0, 0.0), (2, 0.5), (1, 0.5)])
