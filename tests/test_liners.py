@@ -371,3 +371,32 @@ def test_motion_kernel_matches_twin(damp, safety):
                 assert (a["vel"] if lin else a["avel"])[i, k] == pytest.approx(v, rel=1e-14, abs=1e-300)
             assert a["disp"][i, k] == pytest.approx(b["disp"][i, k] + a["vel"][i, k] * dt, rel=1e-14)
             assert a["rot"][i, k] == pytest.approx(b["rot"][i, k] + a["avel"][i, k] * dt, rel=1e-14)
+
+
+def test_liner_weight_goes_into_the_zoned_blocks_gridpoints(tmp_path):
+    """A liner (ρ t = 250 kg/m², 1 m²) on a zoned block standing on its held base, under gravity: its
+    nodes rest on the gridpoints through the normal springs (compression), whose reactions, Σ = the
+    liner's weight 2500 N, go into the gridpoints' applied loads; the liner follows them, k_n-soft."""
+    s = _run("""model new
+model gravity 0 0 -10
+block create brick 0 1 0 1 0 1
+block zone generate edgelength 0.5
+block zone cmodel assign elastic
+block zone property young 1e9 poisson 0.25 density 2000
+block gridpoint fix velocity range position-z 0
+structure liner create by-block-face range position-z 1
+structure liner property isotropic 30e9 0.2 thickness 0.1 density 2500 coupling-stiffness-normal 1e10 coupling-stiffness-shear 1e10 coupling-cohesion-shear 1e5
+model solve ratio 1e-6
+""", tmp_path)
+    nodes = s.model.stores["liner_nodes"]
+    v = s.model.vertices
+    assert (nodes["hz"] == 1).all() and (nodes["fn"] > 0).all()
+    assert v["fapp"][: v.n, 2].sum() == pytest.approx(-2500.0, rel=1e-3)
+    assert nodes["fn"].sum() == pytest.approx(2500.0, rel=1e-3)
+    # the liner's nodes moved with the top of the block, plus the springs' give 2500 / 1e10 m
+    from dec3d.model.liners import node_areas
+
+    sink = np.einsum("kj,kj->k", nodes["hw"], v["disp"][nodes["hgp"], 2])   # the host points (gridpoints) sank
+    assert (sink < -1e-6).all()
+    np.testing.assert_allclose(nodes["un"], -nodes["fn"] / (1e10 * node_areas(s.model)), rtol=1e-9)
+    np.testing.assert_allclose(nodes["disp"][:, 2], sink + nodes["un"], rtol=0, atol=1e-3 * abs(sink).max())
