@@ -230,7 +230,7 @@ model solve ratio 1e-7
     # the bending moment per unit width P (L − x) / b at the centroids of the elements along x, to 3 % of
     # the root moment (one element across, the load at two corners: the DKT's centroid values are off
     # by about 1.6 N·m/m of 80 here)
-    from dec3d.physics.liner_output import element_resultants
+    from dec3d.model.liner_output import element_resultants
 
     els = s.model.stores["liner_elements"]
     along = np.isclose(els["axes"][:, 0, 0], 1.0)
@@ -312,7 +312,9 @@ def test_liner_without_properties_is_refused_at_cycle(tmp_path):
 
 def test_list_save_restore_vtk(tmp_path):
     text = PLATE + ("structure node fix velocity rotation range position-x 0\n"
-                    "structure node apply force-z -10 range position-x 1\nmodel cycle 300\n")
+                    "structure node apply force-z -10 range position-x 1\n"
+                    "structure node history name 'w' displacement-z position 1 1 0\nhistory interval 10\n"
+                    "model cycle 300\n")
     out = io.StringIO()
     a = _run(text, tmp_path, Session(out_dir=tmp_path, stdout=out))
     p = tmp_path / "l.sav"
@@ -322,8 +324,11 @@ def test_list_save_restore_vtk(tmp_path):
     b = _run(f"model restore '{p}'\nmodel cycle 200\nblock vtk 'lv'\n", tmp_path)
     for k in ("disp", "rot", "force"):
         np.testing.assert_array_equal(a.model.stores["liner_nodes"][k], b.model.stores["liner_nodes"][k])
+    hs = b.model.history_set
+    corner = np.flatnonzero(np.all(np.isclose(b.model.stores["liner_nodes"]["pos0"], [1, 1, 0]), axis=1))[0]
+    assert hs.items[0].values[-1] == b.model.stores["liner_nodes"]["disp"][corner, 2] < 0
     meshio = pytest.importorskip("meshio")
-    from dec3d.physics.liner_output import element_resultants
+    from dec3d.model.liner_output import element_resultants
 
     m = meshio.read(tmp_path / "lv_liners_0000.vtu")
     assert m.cells[0].type == "triangle" and m.cells[0].data.shape == (32, 3)

@@ -70,7 +70,8 @@ for _q in NODE_QUANTITIES:
     _what = ("displacement" if _q.startswith("d") else "velocity") + (
         f" ({_q[-1]} component)" if _q[-2] == "-" else " (magnitude)")
     command(f"structure node history {_q}", keywords=_WHICH, check=_check,
-            doc=f"Record the {_what} of a structural node (cable or beam).",
-            details="The node is named by `component-id <i>` (its id; cable and beam nodes share one id space) or "
+            doc=f"Record the {_what} of a structural node (cable, beam or liner).",
+            details="The node is named by `component-id <i>` (its id; cable, beam and liner nodes share one id "
+                    "space) or "
                     "by `position x y z` (the nearest node).",
             examples=[f"structure node history {_q} component-id 1"])(_handler("cable-node", NODES, _q))

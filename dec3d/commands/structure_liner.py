@@ -173,7 +173,7 @@ def _need_liners(session, call):
                  "rotations (constant over the element for the membrane, at the centroid for bending).",
          examples=["structure liner list", "structure liner list range id 1"])
 def liner_list(session, call):
-    from ..physics.liner_output import element_resultants
+    from ..model.liner_output import element_resultants
 
     _need_liners(session, call)
     mask = session.range_mask(call, LELEMS)

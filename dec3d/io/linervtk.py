@@ -1,7 +1,7 @@
 """VTK output of the liners: one ``.vtu`` of triangle cells (VTK_TRIANGLE, type 5), one per liner
 element, written beside each ``block vtk`` snapshot of a model with liners as ``<stem>_liners_<nnnn>.vtu``.
 
-Cell data, per element (``physics.liner_output``: in the element's axes, per unit length):
+Cell data, per element (``model.liner_output``: in the element's axes, per unit length):
 ``element_id``, ``liner_id``, ``N_xx``, ``N_yy``, ``N_xy`` [N/m, tension positive], ``M_xx``, ``M_yy``,
 ``M_xy`` [N·m/m], ``normal`` (the element's z axis). Point data, per node: ``node_id``,
 ``displacement``, ``rotation``, ``velocity``, ``coupled`` (0/1: coupled to a block), ``coupling_state``
@@ -20,7 +20,7 @@ VTK_TRIANGLE = 5
 
 def write_liners_vtu(model, path: str | os.PathLike) -> str:
     from dec3d.model.liners import liner_stores
-    from dec3d.physics.liner_output import element_resultants
+    from dec3d.model.liner_output import element_resultants
 
     path = os.fspath(path)
     nodes, els = liner_stores(model)
