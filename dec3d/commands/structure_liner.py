@@ -63,8 +63,10 @@ def _check_create(call):
                  "the corners counter-clockwise seen from outside a block the liner lies on: the coupling "
                  "springs' normal is the z axis). A node inside or on a visible block is coupled to it (a zoned "
                  "block: to the zone holding it), others are free.\n\n"
-                 "Corners within `tolerance` (default 10⁻⁶ of the model size, at least the block tolerance) are "
-                 "one node; a node is coupled to the block of the first face that made it. Each node has 3 "
+                 "Corners within `tolerance` of each other are one node (default: the block tolerance, at least "
+                 "10⁻³ of the median element edge for `by-block-face` — blocks that have moved since they were "
+                 "cut no longer share their corners exactly — and 10⁻⁶ of the quadrilateral's size for "
+                 "`by-quadrilateral`); a node is coupled to the block of the first face that made it. Each node has 3 "
                  "translations and 3 rotations; liner, beam and cable nodes share one id space.",
          examples=["structure liner create by-block-face range group 'tunnel'",
                    "structure liner create by-quadrilateral 0 0 0 1 0 0 1 1 0 0 1 0 size 8 8 id 2"])
@@ -88,11 +90,12 @@ def liner_create(session, call):
         hosts = _corner_hosts(m, tris, tol)
     else:
         mask = session.range_mask(call, "face")
-        span = np.ptp(m.vertices["pos"][: m.vertices.n], axis=0).max() if m.vertices.n else 1.0
-        tol = float(a["tolerance"]) if a["tolerance"] is not None else max(m.tolerance, 1e-6 * float(span))
-        tris, hosts = surface_triangles(m, mask, tol)
+        tris, hosts = surface_triangles(m, mask, max(m.tolerance, 1e-9))
         if not len(tris):
             raise CommandError("no surface face of a visible rigid or zoned block is in range", call.location)
+        # blocks that moved apart a little since they were cut: corners within 10⁻³ of the typical edge
+        edge = float(np.median(np.linalg.norm(tris - np.roll(tris, 1, axis=1), axis=2)))
+        tol = float(a["tolerance"]) if a["tolerance"] is not None else max(m.tolerance, 1e-3 * edge)
     lid = add_liner(m, tris, hosts, lid, a["group"], a["slot"], tol)
     update_liner_masses(m)
     new = nodes["liner"] == lid

@@ -2,7 +2,7 @@
 (``by-block-face``) or a quadrilateral split into a grid (``by-quadrilateral``).
 
 Block faces: a face is on the surface when no face of another visible block lies on it (same
-centroid within the tolerance, opposite normal). A rigid block's face polygon is fanned about its
+centroid within the tolerance or 10⁻³ of the face's size, opposite normal). A rigid block's face polygon is fanned about its
 centroid (triangles counter-clockwise seen from outside: their normals point out of the block); a
 zoned block's surface triangles (``model.face_loads.loadable_faces``: the boundary triangles of its
 zones, not shared inside a joined continuum) are taken as they are, so the liner's nodes are its
@@ -24,7 +24,8 @@ def _loop(model, r: int) -> np.ndarray:
 
 def covered_faces(model, rows: np.ndarray, tol: float) -> np.ndarray:
     """Mask over ``rows`` (face rows): a face of another visible block lies on it (same centroid within
-    ``tol``, opposite normal)."""
+    ``tol`` or 10⁻³ of the face's size, opposite normal: blocks that have moved since they were cut no
+    longer meet exactly)."""
     f, b = model.faces, model.blocks
     live = np.flatnonzero((f["block"][: f.n] >= 0))
     live = live[~b["hidden"][f["block"][live]]]
@@ -32,7 +33,7 @@ def covered_faces(model, rows: np.ndarray, tol: float) -> np.ndarray:
     out = np.zeros(len(rows), bool)
     for k, r in enumerate(rows):
         d = np.linalg.norm(cen - f["centroid"][r], axis=1)
-        hit = (d <= tol) & (blk != f["block"][r]) & (nrm @ f["normal"][r] < -0.99)
+        hit = (d <= max(tol, 1e-3 * np.sqrt(f["area"][r]))) & (blk != f["block"][r]) & (nrm @ f["normal"][r] < -0.99)
         out[k] = bool(hit.any())
     return out
 

@@ -98,13 +98,14 @@ def add_liner(model: Model, tris: np.ndarray, hosts: np.ndarray, liner_id, group
     nodes, els = liner_stores(model)
     lid = int(liner_id) if liner_id is not None else int(max(nodes["liner"].max(initial=0),
                                                               els["liner"].max(initial=0)) + 1)
+    hosts = np.asarray(hosts, np.int64)
+    edges = np.linalg.norm(tris - np.roll(tris, 1, axis=1), axis=2)
+    keep = edges.min(axis=1) > 2.0 * tol                  # (a sliver under the tolerance is no element)
+    tris, hosts = tris[keep], hosts[keep]
     pts = tris.reshape(-1, 3)
-    key = np.round(pts / max(tol, 1e-300)).astype(np.int64)
-    _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
-    inv = inv.ravel()
-    order = np.argsort(first, kind="stable")              # nodes in order of first appearance
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
+    first, inv = merge_points(pts, tol)
+    order = np.arange(len(first))                         # nodes in order of first appearance
+    rank = order
     nn = len(order)
     nid0 = next_node_id(model)
     sl = nodes.append(nn)
@@ -116,7 +117,6 @@ def add_liner(model: Model, tris: np.ndarray, hosts: np.ndarray, liner_id, group
     nodes["pos0"][rn] = upts
     nodes["hpos"][rn] = upts
     conn = rn[rank[inv].reshape(-1, 3)]
-    hosts = np.asarray(hosts, np.int64)
     corner = hosts.reshape(-1) if hosts.ndim == 2 else np.repeat(hosts, 3)
     node_block = corner[first[order]]
     kinds = model.blocks["kind"]
@@ -146,6 +146,29 @@ def add_liner(model: Model, tris: np.ndarray, hosts: np.ndarray, liner_id, group
         model.groups.assign(nodes, rn, group, slot)
         model.groups.assign(els, rs, group, slot)
     return lid
+
+
+def merge_points(pts: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """Points within ``tol`` of each other (chains of them too) are one: (row in ``pts`` of each merged
+    point's first member, in order of first appearance; merged point of each row of ``pts``)."""
+    from scipy.spatial import cKDTree
+
+    n = len(pts)
+    parent = np.arange(n)
+
+    def root(a):
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+
+    for a, b in sorted(cKDTree(pts).query_pairs(max(tol, 0.0))):
+        ra, rb = root(a), root(b)
+        if ra != rb:
+            parent[max(ra, rb)] = min(ra, rb)            # the lowest row leads: deterministic
+    roots = np.array([root(i) for i in range(n)])
+    first, inv = np.unique(roots, return_inverse=True)   # roots are first members, ascending
+    return first, inv.ravel()
 
 
 def update_liner_normals(model: Model) -> None:
