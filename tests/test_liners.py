@@ -464,3 +464,26 @@ def test_lined_tunnel_example_holds_the_crown(tmp_path):
     liner_weight = (els["area"] * 0.1 * 2400 * 9.81).sum()
     assert b["fapp"][: b.n, 2].sum() == pytest.approx(-liner_weight, rel=2e-3)
     assert (tmp_path / "tunnel_lined_liners_0000.vtu").exists()
+
+
+def test_excavating_the_host_frees_the_liner(tmp_path):
+    """`block excavate` of the zoned block a liner is coupled to: its nodes are reported, free from then
+    on (no coupling force, never a NaN) and the coupling's pull is taken back off the gridpoints."""
+    out = io.StringIO()
+    s = _run("""model new
+block create brick 0 1 0 1 0 1
+block zone generate edgelength 0.5
+block zone cmodel assign elastic
+block zone property young 1e9 poisson 0.25 density 2000
+block gridpoint fix velocity range position-z 0
+structure liner create by-block-face range position-z 1
+structure liner property isotropic 30e9 0.2 thickness 0.1 density 2400 coupling-stiffness-normal 1e9 coupling-stiffness-shear 1e9 coupling-yield-normal 2e5 coupling-cohesion-shear 1e5
+structure node apply force-z 100
+model cycle 300
+""", tmp_path, Session(out_dir=tmp_path, stdout=out))
+    nodes, v = s.model.stores["liner_nodes"], s.model.vertices
+    assert abs(v["fapp"][: v.n, 2].sum()) > 100
+    _run("block excavate\nmodel cycle 100\n", tmp_path, s)
+    assert f"{nodes.n} liner node(s) lay in the excavated blocks" in out.getvalue()
+    assert (nodes["host"] == -1).all() and not nodes["hforce"].any() and not nodes["fs"].any()
+    assert np.isfinite(nodes["pos"]).all() and abs(v["fapp"][: v.n]).max() < 1e-9
