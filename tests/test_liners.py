@@ -487,3 +487,23 @@ model cycle 300
     assert f"{nodes.n} liner node(s) lay in the excavated blocks" in out.getvalue()
     assert (nodes["host"] == -1).all() and not nodes["hforce"].any() and not nodes["fs"].any()
     assert np.isfinite(nodes["pos"]).all() and abs(v["fapp"][: v.n]).max() < 1e-9
+
+
+def test_quadrilateral_mesh_and_its_hosts(tmp_path):
+    """`by-quadrilateral … size n1 n2`: 2 n1 n2 triangles (4 n1 n2 with `cross-diagonal`, a node at each
+    cell's centre), z by the right-hand rule; nodes on or in a visible block are coupled to it, the
+    others free."""
+    s = _run("""model new
+block create brick 0 1 0 1 0 1
+structure liner create by-quadrilateral 0 0 1 2 0 1 2 1 1 0 1 1 size 4 2
+structure liner create by-quadrilateral 0 0 3 1 0 3 1 1 3 0 1 3 size 2 2 cross-diagonal id 7
+""", tmp_path)
+    nodes, els = s.model.stores["liner_nodes"], s.model.stores["liner_elements"]
+    a, b = els["liner"] == 1, els["liner"] == 7
+    assert a.sum() == 16 and b.sum() == 16
+    assert (nodes["liner"] == 1).sum() == 15 and (nodes["liner"] == 7).sum() == 9 + 4
+    np.testing.assert_allclose(els["axes"][:, 2], [[0, 0, 1]] * els.n, atol=1e-12)
+    np.testing.assert_allclose(els["area"][a].sum(), 2.0) and np.testing.assert_allclose(els["area"][b].sum(), 1.0)
+    on_block = (nodes["liner"] == 1) & (nodes["pos0"][:, 0] <= 1.0 + 1e-9)
+    assert (nodes["host"][on_block] == 0).all() and (nodes["host"][~on_block] == -1).all()
+    assert list(nodes["id"]) == list(range(1, nodes.n + 1))
