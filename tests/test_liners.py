@@ -507,3 +507,20 @@ structure liner create by-quadrilateral 0 0 3 1 0 3 1 1 3 0 1 3 size 2 2 cross-d
     on_block = (nodes["liner"] == 1) & (nodes["pos0"][:, 0] <= 1.0 + 1e-9)
     assert (nodes["host"][on_block] == 0).all() and (nodes["host"][~on_block] == -1).all()
     assert list(nodes["id"]) == list(range(1, nodes.n + 1))
+
+
+def test_block_faces_against_another_block_are_not_lined(tmp_path):
+    """Two rigid bricks stacked: `by-block-face` lines the ten outer faces (fans of four triangles about
+    their centroids), not the two that touch; one closed mesh of 12 corners + 10 centroids."""
+    s = _run("""model new
+block create brick 0 1 0 1 0 1
+block create brick 0 1 0 1 1 2
+structure liner create by-block-face
+""", tmp_path)
+    nodes, els = s.model.stores["liner_nodes"], s.model.stores["liner_elements"]
+    assert els.n == 40 and nodes.n == 22
+    assert not np.isclose(els["pos"][:, 2], 1.0).any() or (np.abs(els["axes"][:, 2, 2]) < 1e-12)[
+        np.isclose(els["pos"][:, 2], 1.0)].all()
+    # outward normals: from the middle of the pair to each element's centroid
+    assert (np.einsum("ij,ij->i", els["axes"][:, 2], els["pos"] - [0.5, 0.5, 1.0]) > 0).all()
+    assert set(nodes["host"]) == {0, 1}

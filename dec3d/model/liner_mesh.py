@@ -29,12 +29,18 @@ def covered_faces(model, rows: np.ndarray, tol: float) -> np.ndarray:
     f, b = model.faces, model.blocks
     live = np.flatnonzero((f["block"][: f.n] >= 0))
     live = live[~b["hidden"][f["block"][live]]]
+    from scipy.spatial import cKDTree
+
     cen, nrm, blk = f["centroid"][live], f["normal"][live], f["block"][live]
     out = np.zeros(len(rows), bool)
+    if not len(rows) or not len(live):
+        return out
+    radius = np.maximum(tol, 1e-3 * np.sqrt(f["area"][rows]))
+    near = cKDTree(cen).query_ball_point(f["centroid"][rows], radius)
     for k, r in enumerate(rows):
-        d = np.linalg.norm(cen - f["centroid"][r], axis=1)
-        hit = (d <= max(tol, 1e-3 * np.sqrt(f["area"][r]))) & (blk != f["block"][r]) & (nrm @ f["normal"][r] < -0.99)
-        out[k] = bool(hit.any())
+        j = np.asarray(near[k], np.int64)
+        if j.size:
+            out[k] = bool(((blk[j] != f["block"][r]) & (nrm[j] @ f["normal"][r] < -0.99)).any())
     return out
 
 
