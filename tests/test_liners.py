@@ -524,3 +524,35 @@ structure liner create by-block-face
     # outward normals: from the middle of the pair to each element's centroid
     assert (np.einsum("ij,ij->i", els["axes"][:, 2], els["pos"] - [0.5, 0.5, 1.0]) > 0).all()
     assert set(nodes["host"]) == {0, 1}
+
+
+def test_coupling_histories(tmp_path):
+    """`structure liner history coupling-…`: a liner on a fixed block pulled up uniformly by σ (node
+    forces σ × tributary area): normal displacement σ / k_n, normal stress σ (tension positive), no
+    shear; the histories survive save/restore."""
+    from dec3d.model.liners import node_areas
+
+    s = _run("""model new
+block create brick 0 1 0 1 0 1
+block property density 1000
+block fix
+structure liner create by-block-face range position-z 1
+structure liner property isotropic 30e9 0.2 thickness 0.1 coupling-stiffness-normal 1e9 coupling-stiffness-shear 1e9 coupling-yield-normal 2e5 coupling-cohesion-shear 1e5
+structure liner history name 'un' coupling-displacement-normal component-id 2 node 3
+structure liner history coupling-stress-normal position 0.5 0.9 1 node 1
+structure liner history coupling-displacement-shear component-id 1
+structure liner history coupling-stress-shear component-id 1 node 2
+history interval 10
+""", tmp_path)
+    nodes = s.model.stores["liner_nodes"]
+    nodes["fapp"][:, 2] = 0.9e5 * node_areas(s.model)
+    p = tmp_path / "h.sav"
+    _run(f"model cycle 2000\nmodel save '{p}'\n", tmp_path, s)
+    v = [h.values[-1] for h in s.model.history_set.items]
+    assert v[0] == pytest.approx(0.9e5 / 1e9, rel=1e-3) and v[1] == pytest.approx(0.9e5, rel=1e-3)
+    assert abs(v[2]) < 1e-9 and abs(v[3]) < 1.0
+    b = _run(f"model restore '{p}'\nmodel cycle 10\n", tmp_path)
+    assert [h.label for h in b.model.history_set.items] == [h.label for h in s.model.history_set.items]
+    assert b.model.history_set.items[0].values[-1] == pytest.approx(v[0], rel=1e-6)
+    with pytest.raises(Dec3dError, match="nodes 1, 2 and 3|3"):
+        _run("structure liner history coupling-stress-shear component-id 1 node 4\n", tmp_path, b)

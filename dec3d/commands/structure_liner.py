@@ -12,8 +12,8 @@ from ..model.liner_mesh import quadrilateral_triangles, surface_triangles
 from ..model.liners import (L_E, L_NU, LELEMS, LPROPS, add_liner, has_liners, liner_stores,
                             update_liner_masses)
 from ..units import paren
-from .registry import command
-from .values import COORD, FLAG, Num, Nums, P, Text
+from .registry import REGISTRY, command
+from .values import COORD, FLAG, POINT, Num, Nums, P, Text
 
 _SINGLE = {"thickness": ("thickness", "m", Num(lo=0, lo_open=True)),
            "density": ("density (node masses, gravity)", "kg/m³", Num(lo=0)),
@@ -191,3 +191,50 @@ def liner_list(session, call):
         r = res[e]
         session.write(f"{int(els['id'][e]):6d} {int(els['liner'][e]):5d}  {int(ids[c[0]]):6d} {int(ids[c[1]]):6d} "
                       f"{int(ids[c[2]]):6d} " + " ".join(f"{x:11.4g}" for x in r))
+
+
+# ------------------------------------------------------------------ histories
+_WHICH = [P("component-id", Num(integer=True, lo=1), "id of the element"),
+          P("position", POINT, "the element whose centroid (as created) is nearest this point", units="m"),
+          P("node", Num(integer=True, lo=1, hi=3), "the element's node 1, 2 or 3", default=1)]
+REGISTRY.node_keywords("structure liner history", [P("name", Text(), "history name")])
+_HDOC = {"coupling-displacement-normal": "normal displacement of the node from its host point (m, separation "
+                                         "positive)",
+         "coupling-displacement-shear": "shear displacement of the node from its host point (m, magnitude)",
+         "coupling-stress-normal": "normal coupling stress (Pa, tension positive: force over the node's area)",
+         "coupling-stress-shear": "shear coupling stress (Pa, magnitude: force over the node's area)"}
+
+
+def _check_hist(call):
+    if (call.args["component_id"] is None) == (call.args["position"] is None):
+        raise BindError("give either `component-id <i>` or `position <x y z>`", call.location)
+
+
+def _handler(quantity):
+    def handler(session, call):
+        from ..physics.history import histories
+        from ..physics.liner_history import add_liner_history
+        from .histories import _name
+
+        _need_liners(session, call)
+        name = _name(session, call)
+        if call.args["component_id"] is not None:
+            ident = int(call.args["component_id"])
+        else:
+            _, els = liner_stores(session.model)
+            d = np.linalg.norm(els["pos"] - np.asarray([float(x) for x in call.args["position"]]), axis=1)
+            ident = int(els["id"][int(np.argmin(d))])
+        try:
+            add_liner_history(histories(session.model), quantity, ident, int(call.args["node"]), name)
+        except CommandError as exc:
+            raise exc.with_location(call.locations.get("component_id", call.location))
+    return handler
+
+
+for _q in _HDOC:
+    command(f"structure liner history {_q}", keywords=_WHICH, check=_check_hist,
+            doc=f"Record the {_HDOC[_q]} at a node of a liner element.",
+            details="The element is named by `component-id <i>` or by `position x y z` (nearest centroid as "
+                    "created), the node by `node 1|2|3` (default 1). A free node records 0. A leading "
+                    "`name '<s>'` names the history.",
+            examples=[f"structure liner history {_q} component-id 1 node 2"])(_handler(_q))
