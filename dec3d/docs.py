@@ -50,8 +50,8 @@ def render(cmd: Command) -> str:
         out += [_row(p) for p in params]
         out.append("")
     if cmd.range:
-        what = {"cable_segments": "cable elements", "cable_nodes": "structural nodes (cable and beam nodes)",
-                "beam_elements": "beam elements"}.get(cmd.range, f"{cmd.range}s")
+        what = {"cable_segments": "cable elements", "cable_nodes": "structural nodes (cable, beam and liner nodes)",
+                "beam_elements": "beam elements", "liner_elements": "liner elements"}.get(cmd.range, f"{cmd.range}s")
         out += [f"Takes a range over {what}; `range` may be omitted before the first element. "
                 "See [range elements](range.md).", ""]
     if cmd.open_keywords:

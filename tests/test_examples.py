@@ -7,7 +7,7 @@ from dec3d.cli import main
 # decks called by another example are run through their caller
 # the slow decks whose own tests below run them through `dec3d run` as well are not run again here
 RUN_BY_THEIR_TESTS = {"deformable/tunnel_mc.dat", "deformable/tunnel_jointed_mc.dat", "feblock/tunnel_liner.dat",
-                      "support/bolted_tunnel.dat", "tutorial/tunnel.dat"}
+                      "support/bolted_tunnel.dat", "support/lined_tunnel.dat", "tutorial/tunnel.dat"}
 EXAMPLES = sorted(p for p in (ROOT / "examples").rglob("*.dat")
                   if p.name != "settings.dat" and p.relative_to(ROOT / "examples").as_posix() not in RUN_BY_THEIR_TESTS)
 

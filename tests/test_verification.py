@@ -31,7 +31,7 @@ def test_every_verification_problem_is_there():
                                          "D10_hoek_brown_triaxial", "D11_strain_softening", "D12_ubiquitous_joint", "D15_triaxial_ho",
                                          "D13_drucker_prager_triaxial", "D14_anisotropic_elastic",
                                          "SE1_cable_pullout", "SE2_bolted_planar_slide", "SE3_cable_pullout_confined",
-                                         "SE4_dowel_shear", "SE5_beam", "SE6_dowel_slide_fos",
+                                         "SE4_dowel_shear", "SE5_beam", "SE6_dowel_slide_fos", "SE7_liner",
                                          "W1_planar_slide_water", "W2_wedge_water", "W3_joint_opening",
                                          "W4_steady_joint_flow", "W5_transient_joint_diffusion",
                                          "W6_joint_opening_flow"}

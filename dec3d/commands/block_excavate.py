@@ -86,9 +86,10 @@ def block_excavate(session, call):
     b["hidden"][rows] = True
     from ..model.cables import release_hosts
 
-    nc, nb, nd = release_hosts(m, sel)
-    if nc or nb or nd:
-        what = ", ".join(f"{n} {w}" for n, w in ((nc, "cable node(s)"), (nb, "beam node(s)"), (nd, "dowel(s)")) if n)
+    nc, nb, nd, nl = release_hosts(m, sel)
+    if nc or nb or nd or nl:
+        what = ", ".join(f"{n} {w}" for n, w in ((nc, "cable node(s)"), (nb, "beam node(s)"), (nd, "dowel(s)"),
+                                                 (nl, "liner node(s)")) if n)
         session.write(f"notice: {what} lay in the excavated blocks: from now on the nodes are free (no grout "
                       "or link force) and the dowels are gone; `block fill` does not attach them again")
 

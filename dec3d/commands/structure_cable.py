@@ -169,7 +169,7 @@ def cable_list(session, call):
 # ------------------------------------------------------------------ nodes (cables' and beams')
 _FIX = {"velocity": 7, "velocity-x": 1, "velocity-y": 2, "velocity-z": 4,
         "rotation": 56, "rotation-x": 8, "rotation-y": 16, "rotation-z": 32}
-_FIXKW = [P(k, FLAG, f"the {k} component(s)" + (" (beam nodes)" if k.startswith("rot") else ""), bare=True)
+_FIXKW = [P(k, FLAG, f"the {k} component(s)" + (" (beam and liner nodes)" if k.startswith("rot") else ""), bare=True)
           for k in _FIX]
 
 
@@ -182,21 +182,22 @@ def _bits(call) -> int:
 
 
 def _node_stores(session, call):
-    """[(store, range mask)] of the cable and beam nodes (one id space, ``model.beams.next_node_id``)."""
+    """[(store, range mask)] of the cable, beam and liner nodes (one id space, ``model.beams.next_node_id``)."""
     m = session.model
-    out = [(m.stores[n], session.range_mask(call, n)) for n in (NODES, "beam_nodes")
+    out = [(m.stores[n], session.range_mask(call, n)) for n in (NODES, "beam_nodes", "liner_nodes")
            if n in m.stores and m.stores[n].n]
     if not out:
-        raise CommandError("there is no structural node: make a cable or a beam first (`structure cable create "
-                           "by-line …`, `structure beam create by-line …`)", call.location)
+        raise CommandError("there is no structural node: make a cable, a beam or a liner first (`structure cable "
+                           "create by-line …`, `structure beam create by-line …`, `structure liner create …`)",
+                           call.location)
     return out
 
 
 @command("structure node fix", keywords=_FIXKW, range=NODES,
-         doc="Hold velocity (and, on beam nodes, rotational velocity) components of the structural nodes in "
-             "range (the three velocities when none is named).",
-         details="`rotation`, `rotation-x|y|z` hold the rotational velocity of beam nodes (cable nodes have none). "
-                 "Cable and beam nodes share one id space.",
+         doc="Hold velocity (and, on beam and liner nodes, rotational velocity) components of the structural "
+             "nodes in range (the three velocities when none is named).",
+         details="`rotation`, `rotation-x|y|z` hold the rotational velocity of beam and liner nodes (cable nodes "
+                 "have none). Cable, beam and liner nodes share one id space.",
          examples=["structure node fix velocity range id 1", "structure node fix velocity rotation range id 1"])
 def node_fix(session, call):
     for st, mask in _node_stores(session, call):
@@ -226,11 +227,12 @@ def node_initialize(session, call):
 
 @command("structure node apply", keywords=[P("force", VEC3, "applied force", units="N")] +
          [P(f"force-{a}", Num(), f"{a} component of the applied force", units="N") for a in "xyz"] +
-         [P("moment", VEC3, "applied moment (beam nodes)", units="N·m")] +
-         [P(f"moment-{a}", Num(), f"{a} component of the applied moment (beam nodes)", units="N·m") for a in "xyz"],
+         [P("moment", VEC3, "applied moment (beam and liner nodes)", units="N·m")] +
+         [P(f"moment-{a}", Num(), f"{a} component of the applied moment (beam and liner nodes)", units="N·m")
+          for a in "xyz"],
          range=NODES,
-         doc="Set the applied force (and, on beam nodes, moment) of the structural nodes in range (it replaces "
-             "the one applied before).",
+         doc="Set the applied force (and, on beam and liner nodes, moment) of the structural nodes in range (it "
+             "replaces the one applied before).",
          examples=["structure node apply force-x 1e4 range id 1", "structure node apply moment-y 500 range id 11"])
 def node_apply(session, call):
     for st, mask in _node_stores(session, call):

@@ -27,12 +27,14 @@ def _check(call):
 
 def _ident(session, call, store: str) -> int:
     from ..model.beams import has_beams
-    if not has_cables(session.model) and not (store == NODES and has_beams(session.model)):
+    from ..model.liners import has_liners
+    if not has_cables(session.model) and not (store == NODES and (has_beams(session.model)
+                                                                   or has_liners(session.model))):
         raise CommandError("there is no cable: make one first (`structure cable create by-line …`)", call.location)
     if call.args["component_id"] is not None:
         return int(call.args["component_id"])
     p = np.asarray([float(x) for x in call.args["position"]])
-    names = (NODES, "beam_nodes") if store == NODES else (SEGMENTS,)
+    names = (NODES, "beam_nodes", "liner_nodes") if store == NODES else (SEGMENTS,)
     best = None
     for st in (session.model.stores[n] for n in names if n in session.model.stores and session.model.stores[n].n):
         d = np.linalg.norm(st["pos"] - p, axis=1)
@@ -68,7 +70,8 @@ for _q in NODE_QUANTITIES:
     _what = ("displacement" if _q.startswith("d") else "velocity") + (
         f" ({_q[-1]} component)" if _q[-2] == "-" else " (magnitude)")
     command(f"structure node history {_q}", keywords=_WHICH, check=_check,
-            doc=f"Record the {_what} of a structural node (cable or beam).",
-            details="The node is named by `component-id <i>` (its id; cable and beam nodes share one id space) or "
+            doc=f"Record the {_what} of a structural node (cable, beam or liner).",
+            details="The node is named by `component-id <i>` (its id; cable, beam and liner nodes share one id "
+                    "space) or "
                     "by `position x y z` (the nearest node).",
             examples=[f"structure node history {_q} component-id 1"])(_handler("cable-node", NODES, _q))

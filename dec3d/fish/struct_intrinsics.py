@@ -29,14 +29,15 @@ def _seg(rt, i, name):
 
 
 def _node(rt, i, name):
-    """A structural node: a cable node or a beam node (one id space)."""
-    st = rt.session.model.stores.get("beam_nodes")
-    if type(i) is int and st is not None and st.n:
-        import numpy as np
+    """A structural node: a cable, beam or liner node (one id space)."""
+    for sname in ("beam_nodes", "liner_nodes"):
+        st = rt.session.model.stores.get(sname)
+        if type(i) is int and st is not None and st.n:
+            import numpy as np
 
-        rows = np.flatnonzero(st["id"] == i)
-        if rows.size:
-            return st, int(rows[0])
+            rows = np.flatnonzero(st["id"] == i)
+            if rows.size:
+                return st, int(rows[0])
     return _row(rt, i, name, "cable_nodes", "structural node")
 
 

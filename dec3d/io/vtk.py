@@ -407,6 +407,13 @@ class VtkSeries:
             write_beams_vtu(model, bvtu)
             part = 1 + max((e[2] if len(e) > 2 else 0) for e in self.entries[first:])
             self.entries.append((float(time), bvtu, part))
+        if "liner_elements" in model.stores and model.store("liner_elements").n:
+            # the liners as triangles (``dec3d.io.linervtk``)
+            from dec3d.io.linervtk import write_liners_vtu
+            nvtu = self.guard(f"{self.stem}_liners_{k:04d}.vtu")
+            write_liners_vtu(model, nvtu)
+            part = 1 + max((e[2] if len(e) > 2 else 0) for e in self.entries[first:])
+            self.entries.append((float(time), nvtu, part))
         if self.contacts:
             # the sub-contacts as points (``dec3d.io.contactvtk``): the part after the others of this time
             from dec3d.io.contactvtk import write_contacts_vtu

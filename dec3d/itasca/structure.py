@@ -2,7 +2,7 @@
 (``dec3d.model.cables``, ``dec3d.model.dowels``) and beams (``dec3d.model.beams``).
 
 ``it.structure.cable``: the cable elements (hybrid bolts' too); ``it.structure.beam``: the beam elements;
-``it.structure.node``: the nodes of both (one id space); ``it.structure.dowel``: the hybrid bolts' dowels
+``it.structure.node``: the nodes of both and of the liners (one id space); ``it.structure.dowel``: the hybrid bolts' dowels
 at the joints they cross. Ids as FISH struct.* and `structure … list` give them (from 1). Names follow
 Itasca's FLAC3D ``itasca.structure`` pattern (3DEC's are not documented): Cable.force_axial(),
 Beam.force(end), moment(end), force_axial(), Node.pos(), disp(), vel(), force_unbal(), Dowel.force(),
@@ -135,7 +135,7 @@ def _module(name, cls, store):
 
 
 cable = _module("cable", Cable, "cable_segments")
-node = _module("node", Node, ("cable_nodes", "beam_nodes"))
+node = _module("node", Node, ("cable_nodes", "beam_nodes", "liner_nodes"))
 beam = _module("beam", Beam, "beam_elements")
 dowel = _module("dowel", Dowel, "cable_dowels")
 

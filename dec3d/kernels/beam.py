@@ -164,7 +164,18 @@ def beam_step(dt, g, alpha, damp, safety,
             moment[a, k] -= ma
             force[b, k] -= fb
             moment[b, k] -= mb
-    # --- nodes: law of motion
+    return move_nodes(dt, g, alpha, damp, safety, pos, vel, disp, rot, avel, mass, inert, rt, rr, fix, fapp, mapp,
+                      force, moment, imass, iinert, last)
+
+
+@njit(cache=True)
+def move_nodes(dt, g, alpha, damp, safety, pos, vel, disp, rot, avel, mass, inert, rt, rr, fix, fapp, mapp,
+               force, moment, imass, iinert, last):
+    """The law of motion of structural nodes with 6 degrees of freedom (beams', liners'): ``force``,
+    ``moment`` hold the internal and link forces, gravity and ``fapp``/``mapp`` are added here (the
+    unbalanced force is left in them); ``last (n, 6)`` the last step's for the combined damping.
+    Returns the number of non-finite nodes."""
+    n = pos.shape[0]
     bad = 0
     q = (dt / (2.0 * safety)) ** 2 if safety > 0.0 else 0.0
     for i in range(n):

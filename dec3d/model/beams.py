@@ -81,9 +81,9 @@ def has_beams(model: Model) -> bool:
 
 
 def next_node_id(model: Model) -> int:
-    """The next structural node id (cable and beam nodes share one id space)."""
+    """The next structural node id (cable, beam and liner nodes share one id space)."""
     top = 0
-    for name in ("cable_nodes", BNODES):
+    for name in ("cable_nodes", BNODES, "liner_nodes"):
         if name in model.stores and model.stores[name].n:
             top = max(top, int(model.stores[name]["id"].max()))
     return top + 1

@@ -212,6 +212,9 @@ def remap_hosts(model: Model, remap: np.ndarray) -> None:
     from .beams import remap_beam_hosts  # beam nodes linked to a deleted block are free
 
     remap_beam_hosts(model, remap)
+    from .liners import remap_liner_hosts  # liner nodes coupled to a deleted block are free
+
+    remap_liner_hosts(model, remap)
     if NODES in st and st[NODES].n:
         nodes = cable_stores(model)[0]
         h = nodes["host"]
@@ -236,20 +239,20 @@ def remap_hosts(model: Model, remap: np.ndarray) -> None:
         segs["gf"][np.isin(segs["nb"], gone), 1] = 0.0
 
 
-def release_hosts(model: Model, mask) -> tuple[int, int, int]:
+def release_hosts(model: Model, mask) -> tuple[int, int, int, int]:
     """Cut the structural links into the blocks of ``mask`` (bool over block rows), as `block excavate`
     does: cable and beam nodes hosted there become free (no grout or link force from now on) and the
     hybrid bolts' dowels with a side there are dropped. The reactions they had put into the hosts'
     applied loads (``physics.cables.pass_reactions``, ``physics.dowels.advance_dowels``) are taken back
-    out, so a block filled again later starts without them. Returns (cable nodes, beam nodes, dowels)
-    released."""
+    out, so a block filled again later starts without them. Liner nodes coupled there become free too.
+    Returns (cable nodes, beam nodes, dowels, liner nodes) released."""
     from .dowels import DOWELS, has_dowels
 
     mask = np.asarray(mask, bool)
     st = model.stores
     b, v = model.blocks, model.vertices
-    out = [0, 0, 0]
-    for k, name in enumerate((NODES, "beam_nodes")):
+    out = [0, 0, 0, 0]
+    for k, name in ((0, NODES), (1, "beam_nodes"), (3, "liner_nodes")):
         if name not in st or not st[name].n:
             continue
         nodes = st[name]
@@ -265,7 +268,7 @@ def release_hosts(model: Model, mask) -> tuple[int, int, int]:
                   -(nodes["hw"][zn][:, :, None] * nodes["hforce"][zn][:, None, :]).reshape(-1, 3))
         h[lost] = -1
         nodes["hz"][lost] = 0
-        for key in ("hforce", "hmoment", "lf", "lm"):
+        for key in ("hforce", "hmoment", "lf", "lm", "fs", "fn"):
             if key in nodes:
                 nodes[key][lost] = 0.0
         if name == NODES:
@@ -287,4 +290,4 @@ def release_hosts(model: Model, mask) -> tuple[int, int, int]:
         if gone.any():
             ds.compact(~gone)
         out[2] = int(gone.sum())
-    return out[0], out[1], out[2]
+    return out[0], out[1], out[2], out[3]

@@ -26,8 +26,8 @@ def _row(model, store: str, ident: int, what: str) -> int:
 
 
 def _node(model, ident: int):
-    """(store, row) of structural node ``ident``: a cable node or a beam node (one id space)."""
-    for name in (NODES, "beam_nodes"):
+    """(store, row) of structural node ``ident``: a cable, beam or liner node (one id space)."""
+    for name in (NODES, "beam_nodes", "liner_nodes"):
         st = model.stores.get(name)
         if st is not None and st.n:
             rows = np.flatnonzero(st["id"] == ident)
@@ -65,5 +65,6 @@ def add_cable_history(hs, kind: str, quantity: str, ident: int, name: str | None
             st, r = _node(model, ident)
             v = st[field][r]
             return float(np.linalg.norm(v)) if comp is None else float(v[comp])
-        label = f"{'cable' if _node(model, ident)[0].name == NODES else 'beam'} node {ident} {quantity}"
+        kind_name = {NODES: "cable", "liner_nodes": "liner"}.get(_node(model, ident)[0].name, "beam")
+        label = f"{kind_name} node {ident} {quantity}"
     return hs.add(label, value, name, {"kind": kind, "quantity": quantity, "id": int(ident)})

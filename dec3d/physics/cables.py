@@ -71,6 +71,10 @@ from .beams import BeamStep, beam_timestep
 from .beams import block_stiffness as beam_block_stiffness
 from .beams import gridpoint_stiffness as beam_gridpoint_stiffness
 from .dowels import advance_dowels
+from .liners import LinerStep, liner_timestep
+from .liners import block_stiffness as liner_block_stiffness
+from .liners import gridpoint_stiffness as liner_gridpoint_stiffness
+from dec3d.model.liners import has_liners
 from .dowels import block_stiffness as dowel_block_stiffness
 from .dowels import gridpoint_stiffness as dowel_gridpoint_stiffness
 
@@ -101,6 +105,9 @@ def block_stiffness(model) -> tuple[np.ndarray, np.ndarray]:
     of hybrid bolts and the links of beams."""
     b = model.blocks
     kt, kr = beam_block_stiffness(model)          # beam links (``physics.beams``)
+    if has_liners(model):                         # liner couplings (``physics.liners``)
+        lt, lr = liner_block_stiffness(model)
+        kt, kr = kt + lt, kr + lr
     if not has_cables(model):
         return kt, kr
     nodes, segs = cable_stores(model)
@@ -122,7 +129,7 @@ def cable_timestep(model) -> float:
     of the stiffness at the node, s = ``SAFETY``); inf without cables or densities. The beams' too
     (``physics.beams.beam_timestep``)."""
     if not has_cables(model):
-        return beam_timestep(model)
+        return min(beam_timestep(model), liner_timestep(model))
     nodes, segs = cable_stores(model)
     p = segs["prop"]
     r = np.zeros(nodes.n)
@@ -135,7 +142,7 @@ def cable_timestep(model) -> float:
     m = nodes["mass"]
     on = (r > 0) & (m > 0)
     dt = float(2.0 * SAFETY * np.sqrt(m[on] / r[on]).min()) if on.any() else np.inf
-    return min(dt, beam_timestep(model))
+    return min(dt, beam_timestep(model), liner_timestep(model))
 
 
 def grouted_timestep(model, frac: float, moving=None) -> float:
@@ -257,6 +264,8 @@ def gridpoint_grout_stiffness(m, n: int) -> np.ndarray:
     """Per vertex row (length n): Σ k_g × tributary length × weight of the grout springs on it [N/m]
     (a grout spring on a host point Σ wᵢ xᵢ adds wᵢ k to gridpoint i's Gershgorin row: Σ wⱼ = 1)."""
     out = beam_gridpoint_stiffness(m, n)          # links of beam nodes in zones (``physics.beams``)
+    if has_liners(m):
+        out += liner_gridpoint_stiffness(m, n)    # couplings of liner nodes on zoned blocks
     if not has_cables(m):
         return out
     out += dowel_gridpoint_stiffness(m, n)
@@ -278,5 +287,7 @@ def _run_error(msg: str):
 
 
 def cable_steps(run) -> list:
-    """[CableStep] when the model has cables, [BeamStep] when it has beams (``physics.beams``)."""
-    return ([CableStep(run)] if has_cables(run.m) else []) + ([BeamStep(run)] if has_beams(run.m) else [])
+    """[CableStep] when the model has cables, [BeamStep] when it has beams (``physics.beams``), [LinerStep]
+    when it has liners (``physics.liners``)."""
+    return (([CableStep(run)] if has_cables(run.m) else []) + ([BeamStep(run)] if has_beams(run.m) else [])
+            + ([LinerStep(run)] if has_liners(run.m) else []))

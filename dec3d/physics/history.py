@@ -244,6 +244,9 @@ class HistorySet:
         elif kind in ("cable", "cable-node") and isinstance(spec.get("id"), int) and spec["id"] >= 1:
             from .cable_history import add_cable_history     # (raises ValueError for a quantity it has not)
             h = add_cable_history(self, kind, q, spec["id"], name)
+        elif kind == "liner" and isinstance(spec.get("id"), int) and spec["id"] >= 1 and spec.get("node") in (1, 2, 3):
+            from .liner_history import add_liner_history     # (raises ValueError for a quantity it has not)
+            h = add_liner_history(self, q, spec["id"], spec["node"], name)
         elif kind in ("beam", "dowel") and isinstance(spec.get("id"), int) and spec["id"] >= 1:
             from .beam_history import add_beam_history
             from .dowels import add_dowel_history

@@ -97,8 +97,9 @@ def refusal(eng) -> str | None:
         return "energy tracking is on"
     from dec3d.model.beams import has_beams
     from dec3d.model.cables import has_cables
-    if has_cables(m) or has_beams(m):
-        return "the model has cables or beams (structural elements move explicitly)"
+    from dec3d.model.liners import has_liners
+    if has_cables(m) or has_beams(m) or has_liners(m):
+        return "the model has cables, beams or liners (structural elements move explicitly)"
     if eng.pre_steps or any(not isinstance(h, HistorySet) for h in eng.step_hooks):
         return "FISH callbacks run during the cycle"
     return None

@@ -30,6 +30,7 @@ from dec3d.model.zones import has_zones
 from dec3d.units import suffix
 
 from .beams import beam_balance, has_beams
+from .liners import has_liners, liner_balance
 from .cables import cable_timestep, grouted_timestep
 from .massscale import DensityScaling
 from .water import total_normal_force
@@ -327,6 +328,10 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
             # beam nodes count as bodies too (``physics.beams.beam_balance``)
             bu, ba = beam_balance(m)
             un, A = np.concatenate((un, bu)), np.concatenate((A, ba))
+        if has_liners(m):
+            # liner nodes too (``physics.liners.liner_balance``)
+            lu, la = liner_balance(m)
+            un, A = np.concatenate((un, lu)), np.concatenate((A, la))
         if not len(un):
             return out
         umax = float(un.max())
@@ -442,7 +447,8 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
                              if has_feblocks(m) else {}),
                 # cable nodes, elements and dowels, beam nodes and elements: every field, rolled back with the blocks
                 "cables": {n: {k: m.stores[n][k].copy() for k in m.stores[n].fields}
-                           for n in ("cable_nodes", "cable_segments", "cable_dowels", "beam_nodes", "beam_elements")
+                           for n in ("cable_nodes", "cable_segments", "cable_dowels", "beam_nodes", "beam_elements",
+                                     "liner_nodes", "liner_elements")
                            if n in m.stores},
                 # (to_arrays gives views where it can: copy them)
                 "contacts": {k: a.copy() for k, a in self.contacts.to_arrays().items()},
