@@ -85,9 +85,10 @@ class _Run:
             raise RunError("a block has no mass: set `block property density` before cycling")
         self.zst = None
         if self.zoned:
+            from .zone_cache import stepper_cache
             from .zones import ZoneStepper
 
-            self.zst = eng._zstep = ZoneStepper(m, RunError, warn)
+            self.zst = eng._zstep = ZoneStepper(m, RunError, warn, stepper_cache(eng))
         s = self.s = eng.settings()
         self.g = np.asarray(m.settings.gravity, dtype=_F)
         self.mode, self.alpha = eng.damping()
