@@ -12,7 +12,8 @@ engine's snapshot (rollback copy), the zone stepper's set-up (``ZoneStepper.__in
 of the run's set-up (``_Run.__init__`` less the stepper), the steps, the run's end.
 ``--no-cache`` sets DEC3D_NO_STEPPER_CACHE=1 (the zone stepper built anew at every command).
 
-    python bench/cycle_setup_bench.py [--zones 1e5 1e6] [--k 10] [--threads 1] [--no-cache]
+    python bench/cycle_setup_bench.py [--zones 1e5 1e6] [--k 10] [--threads 1] [--no-cache] [--profile]
+    python bench/cycle_setup_bench.py --rigid --zones 10 20     # rigid_bench.py's n³ stack of cubes
 
 Each size runs in a fresh process; the machine and /proc/loadavg before and after are printed
 (the machine is shared: read the figures with the load).
@@ -56,7 +57,7 @@ def _phase_times(prof: cProfile.Profile) -> dict:
     return out
 
 
-def child(zones: float, k: int, threads: int) -> dict:
+def child(zones: float, k: int, threads: int, rigid: bool = False) -> dict:
     sys.path.insert(0, ROOT)
     sys.path.insert(0, HERE)
     import numba
@@ -66,13 +67,21 @@ def child(zones: float, k: int, threads: int) -> dict:
     import dec3d
     from zone_bench import deck, edge_length
 
+    if rigid:                         # rigid_bench.py's stack of n × n × n cubes (n = ``zones``)
+        from rigid_bench import deck as rdeck
+
+        def scene(n):
+            return rdeck(int(n), "mohr")
+        small, size = 2, zones
+    else:
+        scene, small, size = deck, 0.5, edge_length(zones)
     with tempfile.TemporaryDirectory() as d:
         w = dec3d.Session(out_dir=d, stdout=io.StringIO())
-        w.command(deck(0.5))
+        w.command(scene(small))
         w.command("model cycle 3")
         del w
         s = dec3d.Session(out_dir=d, stdout=io.StringIO())
-        s.command(deck(edge_length(zones)))
+        s.command(scene(size))
         s.command("model cycle 3")
         s.command("model cycle 1")                   # (a second command: what a cache keeps is made)
         t0 = time.perf_counter()
@@ -87,7 +96,7 @@ def child(zones: float, k: int, threads: int) -> dict:
         prof.disable()
         buf = io.StringIO()
         pstats.Stats(prof, stream=buf).sort_stats("cumulative").print_stats(25)
-        nz = s.model.store("zones").n
+        nz = s.model.blocks.n if rigid else s.model.store("zones").n
         return dict(zones=nz, threads=numba.get_num_threads(), k=k, t_ones=t1 - t0, t_k=t2 - t1,
                     phases=_phase_times(prof), profile=buf.getvalue())
 
@@ -107,10 +116,12 @@ def main(argv=None) -> int:
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--no-cache", action="store_true", help="build the zone stepper anew at every command")
     ap.add_argument("--profile", action="store_true", help="print the cProfile listing of one command")
+    ap.add_argument("--rigid", action="store_true",
+                    help="rigid_bench.py's stack of n x n x n rigid cubes instead (--zones gives n)")
     ap.add_argument("--child", type=float, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
-        print(json.dumps(child(args.child, args.k, args.threads)))
+        print(json.dumps(child(args.child, args.k, args.threads, args.rigid)))
         return 0
     sys.path.insert(0, HERE)
     from rigid_bench import machine
@@ -123,14 +134,14 @@ def main(argv=None) -> int:
     print(f"stepper cache: {'off' if args.no_cache else 'on'}; threads {args.threads}; K = {args.k}")
     for n in args.zones:
         out = subprocess.run([sys.executable, os.path.abspath(__file__), "--child", str(n), "--k", str(args.k),
-                              "--threads", str(args.threads)], env=env, capture_output=True, text=True)
+                              "--threads", str(args.threads)] + (["--rigid"] if args.rigid else []), env=env, capture_output=True, text=True)
         if out.returncode:
             print(out.stderr)
             return 1
         r = json.loads(out.stdout.strip().splitlines()[-1])
         k = r["k"]
         per = (r["t_ones"] - r["t_k"]) / (k - 1)
-        print(f"zones {r['zones']}: {k} x `model cycle 1` {r['t_ones']:.3f} s, `model cycle {k}` {r['t_k']:.3f} s: "
+        print(f"{'blocks' if args.rigid else 'zones'} {r['zones']}: {k} x `model cycle 1` {r['t_ones']:.3f} s, `model cycle {k}` {r['t_k']:.3f} s: "
               f"overhead per command {per * 1e3:.1f} ms (step {r['t_k'] / k * 1e3:.1f} ms); loadavg {loadavg()}")
         print("  one `model cycle 1` under cProfile, by phase (s):")
         for name, t in r["phases"].items():

@@ -10,7 +10,9 @@ every `model cycle 10` of a deck's FISH loop. The engine keeps a ``StepperCache`
 Nothing is trusted to say that an input changed: the cache keeps an exact copy of every input
 (``see``: the zones' block, model, properties, node lists, overlay and set numbers, the links,
 the positions the masses and stiffness are worked out on, the thread count, ...) and compares
-the model's arrays with it bit for bit (same shape, dtype and bytes; ``same``) at each command.
+the model's arrays with it bit for bit (same shape, dtype and bytes; ``same``) at each command
+(the zones' properties, 160 B per zone, are kept as runs of equal rows, ``Runs``: a few rows
+for a whole model whose properties were set by group or block).
 An input that differs gets a new version; a derived entry (``get``) is made again unless the
 versions of all it was made from are those it was made with. Whatever is cheap to derive (the
 held components, applied velocities, the tables, quiet boundaries, body loads, gravity loads of
@@ -47,7 +49,9 @@ def _bits(a: np.ndarray) -> np.ndarray:
 
 def same(a, b) -> bool:
     """``a`` and ``b`` are the same value: arrays of one shape and dtype with the same bytes, or
-    equal scalars / tuples of one type."""
+    equal scalars / tuples of one type (``a`` may be kept ``Runs``)."""
+    if isinstance(a, Runs):
+        return a.same(b)
     if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
         if not (isinstance(a, np.ndarray) and isinstance(b, np.ndarray)):
             return False
@@ -58,6 +62,37 @@ def same(a, b) -> bool:
         return (type(a) is type(b) and len(a) == len(b)
                 and all(same(x, y) for x, y in zip(a, b)))
     return type(a) is type(b) and a == b
+
+
+#: most runs of equal rows ``Runs`` keeps (beyond: a plain copy)
+MAX_RUNS = 256
+
+
+class Runs:
+    """An exact copy of a 2-D array kept as runs of equal rows (the zones' properties: a few
+    distinct rows, set per group or block, for 1e6 zones): the start of each run and its row, in
+    the bits of ``_bits``. ``of`` gives None when the array has more than MAX_RUNS runs."""
+
+    def __init__(self, shape, dtype, starts, rows):
+        self.shape, self.dtype, self.starts, self.rows = shape, dtype, starts, rows
+
+    @classmethod
+    def of(cls, a: np.ndarray):
+        if a.ndim != 2 or not len(a):
+            return None
+        bits = _bits(a)
+        new = np.flatnonzero((bits[1:] != bits[:-1]).any(axis=1)) + 1
+        if len(new) >= MAX_RUNS:
+            return None
+        starts = np.concatenate(([0], new, [len(a)])).astype(np.int64)
+        return cls(a.shape, a.dtype, starts, bits[starts[:-1]].copy())
+
+    def same(self, a) -> bool:
+        if not isinstance(a, np.ndarray) or a.shape != self.shape or a.dtype != self.dtype:
+            return False
+        bits = _bits(a)
+        st = self.starts
+        return all(bool((bits[st[i]:st[i + 1]] == self.rows[i]).all()) for i in range(len(st) - 1))
 
 
 def _copy(x):
@@ -88,14 +123,16 @@ class StepperCache:
         """A new command: every input must be seen again before an entry made from it is taken."""
         self.now = set()
 
-    def see(self, name: str, value) -> None:
-        """The input ``name`` is ``value`` now: a new version when it differs from the kept copy."""
+    def see(self, name: str, value, runs: bool = False) -> None:
+        """The input ``name`` is ``value`` now: a new version when it differs from the kept copy.
+        ``runs``: keep a 2-D array as runs of equal rows (``Runs``) when it has few."""
         if self.off:
             return
         self.now.add(name)
         old = self.kept.get(name, _MISSING)
         if old is _MISSING or not same(old, value):
-            self.kept[name] = _copy(value)
+            kept = Runs.of(value) if runs else None
+            self.kept[name] = kept if kept is not None else _copy(value)
             self.version[name] = next(_COUNT)
 
     def get(self, key: str, deps: tuple, build, keep=None):

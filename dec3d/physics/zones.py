@@ -87,8 +87,9 @@ class ZoneStepper:
         c = self._cache = cache if cache is not None else StepperCache(off=True)
         self.blocks = zoned_blocks(model)
         c.see("blocks", (self.blocks, b.n))
-        for k in ("block", "cmodel", "prop", "nnode", "hex", "overlay"):
+        for k in ("block", "cmodel", "nnode", "hex", "overlay"):
             c.see(k, zs[k])
+        c.see("prop", zs["prop"], runs=True)
         c.see("gp4", zs["gp"][:, :4])
         c.see("link", v["link"])
         zm = c.get("zones", ("blocks", "block", "cmodel", "prop", "nnode"),

@@ -187,3 +187,37 @@ def test_same_compares_bits():
     assert not zone_cache.same(a, a.astype(np.float32))              # and the dtype
     assert not zone_cache.same(a, a[:1])                             # and the shape
     assert zone_cache.same((a, 3), (a.copy(), 3)) and not zone_cache.same((a, 3), (a, 4))
+
+
+def test_runs_of_rows_are_an_exact_copy():
+    rng = np.random.default_rng(3)
+    a = np.repeat(rng.normal(size=(4, 20)), [5, 1, 300, 7], axis=0)
+    a[6:100, 3] = np.nan
+    r = zone_cache.Runs.of(a)
+    assert r is not None and len(r.starts) - 1 == 5          # (the NaN rows one run of their own)
+    assert r.same(a.copy())
+    for i, j in [(0, 0), (5, 19), (150, 3), (311, 0), (312, 19)]:
+        b = a.copy()
+        b[i, j] = -b[i, j] if b[i, j] != 0 else 1.0
+        assert not r.same(b), (i, j)
+    b = a.copy()
+    b[200, 2] = np.copysign(0.0, -1.0) if a[200, 2] == 0.0 else np.nextafter(a[200, 2], np.inf)
+    assert not r.same(b)                                                 # one ulp
+    assert not r.same(a[:-1]) and not r.same(a.astype(np.float32))
+    assert zone_cache.Runs.of(rng.normal(size=(zone_cache.MAX_RUNS + 1, 3))) is None   # (kept as a plain copy)
+
+
+def test_a_property_of_one_zone_written_from_python_is_seen(tmp_path, monkeypatch, cache_on):
+    """The kept runs of the properties see a change of one value of one zone in a run of equal rows."""
+    def run():
+        s = dec3d.Session(out_dir=tmp_path, stdout=io.StringIO())
+        s.command(DECK)
+        s.command("model cycle 5")
+        zs = s.model.store("zones")
+        zs["prop"][zs.n // 2, ZP_BULK] *= 3.0
+        s.command("model cycle 5")
+        return _state(s)
+
+    cached = run()
+    monkeypatch.setattr(zone_cache, "ENABLED", False)
+    assert _same(cached, run())
