@@ -221,3 +221,37 @@ def test_a_property_of_one_zone_written_from_python_is_seen(tmp_path, monkeypatc
     cached = run()
     monkeypatch.setattr(zone_cache, "ENABLED", False)
     assert _same(cached, run())
+
+
+#: other meshes and models: hexahedral zones (mixed discretization sets), 10-node tetrahedra,
+#: Mohr-Coulomb zones that yield (the plastic step's scratch in the kept plan)
+SCENES = {
+    "hexahedra": DECK.replace("block zone generate edgelength 0.4", "block zone generate hexahedra divisions 2 2 2"),
+    "ten-node": DECK.replace("model new\n", "model new\nmodel configure highorder\n").replace(
+        "block zone generate edgelength 0.4", "block zone generate edgelength 0.5\nblock zone generate high-order-tetra"),
+    "mohr": DECK.replace("block zone property young 10e9 poisson 0.25 density 2500",
+                         "block zone cmodel assign mohr-coulomb\nblock zone property young 10e9 poisson 0.25 density 2500 "
+                         "cohesion 2e3 friction 30 tension 1e3"),
+}
+
+
+@pytest.mark.parametrize("scene", list(SCENES))
+@pytest.mark.parametrize("change", ["block zone property density 6000 range position-z 1 2",
+                                    "block zone cmodel assign null range position-z 1.5 2"])
+def test_other_meshes_and_models(tmp_path, monkeypatch, cache_on, scene, change):
+    def run(apply=True):
+        s = dec3d.Session(out_dir=tmp_path, stdout=io.StringIO())
+        s.command(SCENES[scene])
+        s.command("model cycle 4")
+        if apply:
+            s.command(change)
+        s.command("model cycle 4")
+        s.command("model cycle 4")
+        return _state(s), s
+
+    cached, s = run()
+    assert "plan" in s.model.rigid_engine._zcache.hits or scene == "ten-node"
+    ignored, _ = run(apply=False)
+    monkeypatch.setattr(zone_cache, "ENABLED", False)
+    fresh, _ = run()
+    assert _same(cached, fresh) and not _same(cached, ignored)
