@@ -2,7 +2,9 @@
 
 ``ZoneStepper`` is made by ``RigidEngine`` at the start of every ``model cycle`` / ``solve`` on a
 model with zones (state is the model's: ``zones`` store and the gridpoint fields of
-``vertices``, see ``dec3d.model.zones``; the stepper holds only what it can rebuild):
+``vertices``, see ``dec3d.model.zones``; the stepper holds only what it can rebuild; what it
+derives from the mesh and the zones' models and properties is taken from the engine's
+``zone_cache.StepperCache`` when its inputs are bit for bit those of the command that made it):
 
 1. checks: every zoned block has zones with a model (``RunError`` naming the blocks otherwise);
    the zones of each model by its registry entry (``physics.cmodels``: every property in its
@@ -58,7 +60,6 @@ from dec3d.units import suffix
 from .cables import gridpoint_grout_stiffness
 from .zone_cache import StepperCache
 from .zone_loads import body_loads
-from .zone_setup import _ids, block_elements, zone_bundles  # noqa: F401  (their home was here)
 from .zone_setup import _zone_models, _zone_plan, zone_tables, zoned_blocks
 
 _F = np.float64
@@ -131,10 +132,11 @@ class ZoneStepper:
         #: the 4-node step (``zone_step.zone_step``): chunks (one per thread from PARALLEL_MIN_ZONES
         #: zones on; any count gives the same bits), plans and scratch, made once per mesh
         import numba
-        c.see("nch", numba.get_num_threads() if len(self.rows4) >= PARALLEL_MIN_ZONES else 1)
+        nch = numba.get_num_threads() if len(self.rows4) >= PARALLEL_MIN_ZONES else 1
+        c.see("nch", nch)
         c.see("rows4", (self.rows4, self.plastic))         # (what the plan takes of the zones entry)
         pl = c.get("plan", ("rows4", "gp4", "hex", "overlay", "link", "nch"),
-                   lambda: _zone_plan(zs, v, self.rows4, self.plastic, c.kept.get("nch", 1)))
+                   lambda: _zone_plan(zs, v, self.rows4, self.plastic, nch))
         #: NMD averaging node of each vertex row: its link master (one gridpoint of a joined set) or itself
         self.node = pl["node"]
         # mixed-discretization sets of the 4-node zones: compact set numbers
