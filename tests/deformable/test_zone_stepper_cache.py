@@ -255,3 +255,33 @@ def test_other_meshes_and_models(tmp_path, monkeypatch, cache_on, scene, change)
     monkeypatch.setattr(zone_cache, "ENABLED", False)
     fresh, _ = run()
     assert _same(cached, fresh) and not _same(cached, ignored)
+
+
+@pytest.mark.skipif(__import__("numba").config.NUMBA_NUM_THREADS < 2, reason="needs two numba threads")
+def test_a_new_thread_count_makes_the_plan_again(tmp_path, monkeypatch, cache_on):
+    """The plan's chunks follow the thread count (one chunk per thread; any count gives the same bits)."""
+    import numba
+
+    import dec3d.physics.zones as pz
+
+    monkeypatch.setattr(pz, "PARALLEL_MIN_ZONES", 0)
+    keep = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        s = dec3d.Session(out_dir=tmp_path, stdout=io.StringIO())
+        s.command(DECK)
+        s.command("model cycle 3")
+        assert len(s.model.rigid_engine._zstep.fast.pstart) == 2
+        numba.set_num_threads(2)
+        s.command("model cycle 3")
+        assert len(s.model.rigid_engine._zstep.fast.pstart) == 3
+        numba.set_num_threads(1)
+        s.command("model cycle 3")
+        cached = _state(s)
+    finally:
+        numba.set_num_threads(keep)
+    monkeypatch.setattr(zone_cache, "ENABLED", False)
+    s = dec3d.Session(out_dir=tmp_path, stdout=io.StringIO())
+    s.command(DECK)
+    s.command("model cycle 9")
+    assert _same(cached, _state(s))
