@@ -57,6 +57,25 @@ def _phase_times(prof: cProfile.Profile) -> dict:
     return out
 
 
+def _kept_bytes(model) -> int:
+    """Bytes of the copies the engine's zone stepper cache keeps (``physics.zone_cache``)."""
+    import numpy as np
+
+    c = getattr(getattr(model, "rigid_engine", None), "_zcache", None)
+    if c is None:
+        return 0
+
+    def size(x):
+        if isinstance(x, np.ndarray):
+            return x.nbytes
+        if isinstance(x, tuple):
+            return sum(size(y) for y in x)
+        if hasattr(x, "starts") and hasattr(x, "rows"):
+            return x.starts.nbytes + x.rows.nbytes
+        return 0
+    return int(sum(size(x) for x in c.kept.values()))
+
+
 def child(zones: float, k: int, threads: int, rigid: bool = False) -> dict:
     sys.path.insert(0, ROOT)
     sys.path.insert(0, HERE)
@@ -97,7 +116,7 @@ def child(zones: float, k: int, threads: int, rigid: bool = False) -> dict:
         buf = io.StringIO()
         pstats.Stats(prof, stream=buf).sort_stats("cumulative").print_stats(25)
         nz = s.model.blocks.n if rigid else s.model.store("zones").n
-        return dict(zones=nz, threads=numba.get_num_threads(), k=k, t_ones=t1 - t0, t_k=t2 - t1,
+        return dict(zones=nz, kept_b=_kept_bytes(s.model), gridpoints=s.model.vertices.n, threads=numba.get_num_threads(), k=k, t_ones=t1 - t0, t_k=t2 - t1,
                     phases=_phase_times(prof), profile=buf.getvalue())
 
 
@@ -143,6 +162,9 @@ def main(argv=None) -> int:
         per = (r["t_ones"] - r["t_k"]) / (k - 1)
         print(f"{'blocks' if args.rigid else 'zones'} {r['zones']}: {k} x `model cycle 1` {r['t_ones']:.3f} s, `model cycle {k}` {r['t_k']:.3f} s: "
               f"overhead per command {per * 1e3:.1f} ms (step {r['t_k'] / k * 1e3:.1f} ms); loadavg {loadavg()}")
+        if r["kept_b"]:
+            print(f"  kept copies of the stepper cache: {r['kept_b'] / r['zones']:.0f} B per zone "
+                  f"({r['gridpoints']} gridpoints)")
         print("  one `model cycle 1` under cProfile, by phase (s):")
         for name, t in r["phases"].items():
             print(f"    {name:<34}{t:8.3f}")

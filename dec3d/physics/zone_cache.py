@@ -135,10 +135,11 @@ class StepperCache:
             self.kept[name] = kept if kept is not None else _copy(value)
             self.version[name] = next(_COUNT)
 
-    def get(self, key: str, deps: tuple, build, keep=None):
+    def get(self, key: str, deps: tuple, build, keep=None, valid=None):
         """The entry ``key`` made by ``build()`` from the inputs (or entries) ``deps``: the kept one
-        when every dep has the version it was made with, else made now (and kept unless
-        ``keep(value)`` says no). Each dep must have been ``see``-n (or made) in this command."""
+        when every dep has the version it was made with (and ``valid(value)``, when given, says
+        it still fits what else it was made from), else made now (and kept unless ``keep(value)``
+        says no). Each dep must have been ``see``-n (or made) in this command."""
         if self.off or not ENABLED:
             self.builds.append(key)
             return build()
@@ -148,7 +149,7 @@ class StepperCache:
         self.now.add(key)
         vers = tuple(self.version[d] for d in deps)
         e = self.entries.get(key)
-        if e is not None and e[0] == vers:
+        if e is not None and e[0] == vers and (valid is None or valid(e[1])):
             self.hits.append(key)
             return e[1]
         self.entries.pop(key, None)

@@ -122,7 +122,8 @@ def _zone_plan(zs, v, rows4, plastic: bool, nch: int) -> dict:
     """The NMD averaging node of each vertex row (``node``: its link master, or itself), the
     mixed-discretization weights and compact set numbers of the 4-node zones ``rows4``
     (``weight``, ``zset``, ``nset``), and their step's ``ElasticPlan`` (``fast``; None without
-    4-node zones) in ``nch`` chunks with its bundles (``zone_bundles``)."""
+    4-node zones) in ``nch`` chunks with its bundles (``zone_bundles``); ``rows4`` and ``plastic``
+    as given (the cache compares them)."""
     link0 = v["link"]
     node = np.ascontiguousarray(np.where(link0 >= 0, link0, np.arange(v.n, dtype=_I)))
     hx = zs["hex"][rows4]
@@ -132,7 +133,8 @@ def _zone_plan(zs, v, rows4, plastic: bool, nch: int) -> dict:
         _, inv = np.unique(hx[hx >= 0], return_inverse=True)
         zset[hx >= 0] = inv.ravel()
     nset = int(zset.max()) + 1 if len(zset) else 0
-    out = {"node": node, "weight": weight, "zset": zset, "nset": nset, "fast": None, "bundles": None}
+    out = {"node": node, "weight": weight, "zset": zset, "nset": nset, "fast": None, "bundles": None,
+           "rows4": rows4, "plastic": plastic}
     if len(rows4):
         fast = ElasticPlan(zs["gp"], rows4, node, zset, weight, v.n, nch)
         out.update(fast=fast, bundles=zone_bundles(fast, nset, plastic))

@@ -58,7 +58,7 @@ from dec3d.physics.cmodels import MODEL_BY_CODE
 from dec3d.units import suffix
 
 from .cables import gridpoint_grout_stiffness
-from .zone_cache import StepperCache
+from .zone_cache import StepperCache, same
 from .zone_loads import body_loads
 from .zone_setup import _zone_models, _zone_plan, zone_tables, zoned_blocks
 
@@ -134,9 +134,10 @@ class ZoneStepper:
         import numba
         nch = numba.get_num_threads() if len(self.rows4) >= PARALLEL_MIN_ZONES else 1
         c.see("nch", nch)
-        c.see("rows4", (self.rows4, self.plastic))         # (what the plan takes of the zones entry)
-        pl = c.get("plan", ("rows4", "gp4", "hex", "overlay", "link", "nch"),
-                   lambda: _zone_plan(zs, v, self.rows4, self.plastic, nch))
+        # (of the zones entry the plan takes the 4-node rows and the plastic flag: compared with its own)
+        pl = c.get("plan", ("gp4", "hex", "overlay", "link", "nch"),
+                   lambda: _zone_plan(zs, v, self.rows4, self.plastic, nch),
+                   valid=lambda p: p["plastic"] == self.plastic and same(p["rows4"], self.rows4))
         #: NMD averaging node of each vertex row: its link master (one gridpoint of a joined set) or itself
         self.node = pl["node"]
         # mixed-discretization sets of the 4-node zones: compact set numbers
