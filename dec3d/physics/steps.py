@@ -216,7 +216,8 @@ class _Run:
             servo.alpha[0] = 2.0 * float(s["servo_ratio"]) * (2.0 * eng.body_safety() / dt) / math.pi
         # detection also runs as soon as a block has moved CTOL/2 since the last one, so
         # that two blocks approaching each other cannot close more than CTOL unseen
-        self.radius = eng._radii()
+        # (the rigid kernel's motion bounds: no rigid body, no use for them — a pass over every gridpoint)
+        self.radius = eng._radii() if self.ng else np.zeros(b.n)
         self.acc = np.zeros(b.n)
         self.motion = np.zeros(2)
         self.trigger = 0.5 * eng.tolerance()
