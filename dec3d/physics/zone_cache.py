@@ -3,7 +3,9 @@
 Every ``model cycle`` / ``model solve`` makes its own ``ZoneStepper`` (``physics.zones``). Most
 of what it derives depends only on the mesh and the zones' models and properties — the property
 checks and the moduli, the plans of the 4-node step (``kernels.zone_elastic.ElasticPlan``), the
-real lumped masses — and at 1e6 zones making them again cost 0.3-0.5 s per command, paid by
+real lumped masses, the zones' node stiffness (on the positions it is worked out on: in small
+strain the positions, which the step leaves as they are; in large strain those of the last
+detection step) — and at 1e6 zones making them again cost 0.3-0.5 s per command, paid by
 every `model cycle 10` of a deck's FISH loop. The engine keeps a ``StepperCache`` (its
 ``_zcache``) and the stepper takes these parts from it when what they were made from is the same.
 
@@ -16,9 +18,9 @@ for a whole model whose properties were set by group or block).
 An input that differs gets a new version; a derived entry (``get``) is made again unless the
 versions of all it was made from are those it was made with. Whatever is cheap to derive (the
 held components, applied velocities, the tables, quiet boundaries, body loads, gravity loads of
-10-node zones) is made again at every command, as are the parts that depend on the positions
-in small strain (the stiffness). Models with FE blocks take no cache (their stepper is made
-anew). Entries hold arrays the stepper shares: the stepper copies those it changes.
+10-node zones, the grout stiffness of cables, the totals over linked gridpoints) is made again
+at every command. Models with FE blocks take no cache (their stepper is made anew). Entries
+hold arrays the stepper shares: the stepper copies those it changes (masses, stiffness).
 
 The environment variable ``DEC3D_NO_STEPPER_CACHE=1`` (read at import) or ``ENABLED = False``
 turns it off: every command then derives everything anew (tests compare the two, bench/
