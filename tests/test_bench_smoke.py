@@ -290,3 +290,18 @@ def test_zone_roofline_kernels_do_the_engines_arithmetic(nmd):
     assert nz > 100 and np.abs(s_eng).max() > 0
     np.testing.assert_allclose(s_min, s_eng, rtol=0, atol=1e-9 * np.abs(s_eng).max())
     np.testing.assert_allclose(f_min, f_eng, rtol=0, atol=1e-9 * np.abs(f_eng).max())
+
+
+def test_cycle_setup_bench_runs_and_prints_its_figures():
+    """bench/cycle_setup_bench.py on a tiny cube (no timing asserted): the overhead line, the kept
+    bytes of the stepper cache and the phases of one profiled command."""
+    out = subprocess.run([sys.executable, str(ROOT / "bench" / "cycle_setup_bench.py"), "--zones", "300", "--k", "2"],
+                         capture_output=True, text=True, timeout=300, cwd=ROOT,
+                         env={**os.environ, "PYTHONPATH": os.pathsep.join(
+                             [str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])})
+    assert out.returncode == 0, out.stderr
+    text = out.stdout
+    assert text.startswith("machine: ") and "stepper cache: on" in text
+    assert "overhead per command" in text and "kept copies of the stepper cache" in text
+    for phase in ("snapshot (rollback copy)", "zone stepper set-up", "command total"):
+        assert phase in text

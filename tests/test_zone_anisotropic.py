@@ -332,7 +332,7 @@ def _assembled_stiffness(symmetrize):
     constants and axes), NMD on: column j the nodal forces of a unit velocity on freedom j over a
     unit step from zero stress. ``symmetrize`` False runs the step without its averaging sweep
     (the dsp ignored), as a non-plastic model would be stepped."""
-    from dec3d.physics.zones import zone_bundles
+    from dec3d.physics.zone_setup import zone_bundles
     from tests.test_zone_elastic_kernels import _case
     from tests.zone_step_run import Stepper
 

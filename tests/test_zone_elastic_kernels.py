@@ -115,7 +115,7 @@ def _run(case, large, nmd, nparts, identity_node=False, plastic=False):
         node = np.arange(nv, dtype=np.int64)
     zs = Stepper(gp, rows, zset, weight, node, nv, np.full(len(gp), mz.ZMODEL_ELASTIC, np.int8), prop, nparts)
     if plastic:                           # the three-sweep path, its correction zero on elastic zones
-        from dec3d.physics.zones import zone_bundles
+        from dec3d.physics.zone_setup import zone_bundles
         zs.plastic = True
         zs.mesh, zs.zplan, zs.scr = zone_bundles(zs.plan, int(zset.max()) + 1, True)
     st, f, fm = stress.copy(), np.ones((nv, 3)), np.full(nv, 0.5)

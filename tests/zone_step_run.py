@@ -1,6 +1,6 @@
 """Driving ``dec3d.kernels.zone_step.zone_step`` from the arrays the tests build (a zone table, the
 rows stepped, sets, weights, averaging nodes, model codes, properties), as the engine's
-``ZoneStepper`` does: ``ElasticPlan`` for the chunks and plans, ``physics.zones.zone_bundles``."""
+``ZoneStepper`` does: ``ElasticPlan`` for the chunks and plans, ``physics.zone_setup.zone_bundles``."""
 import numpy as np
 
 from dec3d.kernels.bundles import ZoneMaterial
@@ -8,7 +8,7 @@ from dec3d.kernels.zmodels import CORRECTING_CODES, NZHIST, model_mask, no_table
 from dec3d.kernels.zone_elastic import ElasticPlan
 from dec3d.kernels.zone_step import zone_step_for
 from dec3d.model import zones as mz
-from dec3d.physics.zones import zone_bundles
+from dec3d.physics.zone_setup import zone_bundles
 
 
 class Stepper:

@@ -36,7 +36,7 @@ from dec3d.kernels.feblock import (_slave_weights, feb_body_force, feb_element_p
 from dec3d.model.feblocks import feblock_store
 from dec3d.model.model import KIND_FE
 from dec3d.model.zones import ZMODEL_ELASTIC, ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR
-from dec3d.physics.zones import block_elements
+from dec3d.physics.zone_setup import block_elements
 
 _F = np.float64
 _I = np.int64

@@ -309,9 +309,10 @@ def implicit_static(eng, warn=None) -> dict:
     if eng._zone_contacts_check():
         raise Refusal("contacts act on deformable blocks")
     from .rigid import RunError
+    from .zone_cache import stepper_cache
     from .zones import ZoneStepper
 
-    zst = ZoneStepper(m, RunError, warn)
+    zst = ZoneStepper(m, RunError, warn, stepper_cache(eng))
     v = m.vertices
     keep = [(v, {k: v[k].copy() for k in ("disp", "velocity", "force")})]
     for name in ("feblocks", "zones"):

@@ -120,6 +120,8 @@ class RigidEngine(DensityScaling, ContactDetection, MixedContactSteps):
         self.detections = 0
         #: the deformable step of the last run on a model with zones (``physics.zones``), or None
         self._zstep = None
+        #: what zone steppers derived from the model, kept for the next command's (``physics.zone_cache``)
+        self._zcache = None
         #: the steps of the last run's cycle, in order (``_Run``: RigidBatch, Clock, Hooks, ...)
         self.steps: list = []
         #: the last detection kept every contact as it was (``ContactDetection.detect``)

@@ -85,9 +85,10 @@ class _Run:
             raise RunError("a block has no mass: set `block property density` before cycling")
         self.zst = None
         if self.zoned:
+            from .zone_cache import stepper_cache
             from .zones import ZoneStepper
 
-            self.zst = eng._zstep = ZoneStepper(m, RunError, warn)
+            self.zst = eng._zstep = ZoneStepper(m, RunError, warn, stepper_cache(eng))
         s = self.s = eng.settings()
         self.g = np.asarray(m.settings.gravity, dtype=_F)
         self.mode, self.alpha = eng.damping()
@@ -215,7 +216,8 @@ class _Run:
             servo.alpha[0] = 2.0 * float(s["servo_ratio"]) * (2.0 * eng.body_safety() / dt) / math.pi
         # detection also runs as soon as a block has moved CTOL/2 since the last one, so
         # that two blocks approaching each other cannot close more than CTOL unseen
-        self.radius = eng._radii()
+        # (the rigid kernel's motion bounds: no rigid body, no use for them — a pass over every gridpoint)
+        self.radius = eng._radii() if self.ng else np.zeros(b.n)
         self.acc = np.zeros(b.n)
         self.motion = np.zeros(2)
         self.trigger = 0.5 * eng.tolerance()

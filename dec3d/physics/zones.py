@@ -2,7 +2,9 @@
 
 ``ZoneStepper`` is made by ``RigidEngine`` at the start of every ``model cycle`` / ``solve`` on a
 model with zones (state is the model's: ``zones`` store and the gridpoint fields of
-``vertices``, see ``dec3d.model.zones``; the stepper holds only what it can rebuild):
+``vertices``, see ``dec3d.model.zones``; the stepper holds only what it can rebuild; what it
+derives from the mesh and the zones' models and properties is taken from the engine's
+``zone_cache.StepperCache`` when its inputs are bit for bit those of the command that made it):
 
 1. checks: every zoned block has zones with a model (``RunError`` naming the blocks otherwise);
    the zones of each model by its registry entry (``physics.cmodels``: every property in its
@@ -46,19 +48,19 @@ import math
 import numpy as np
 
 from dec3d.errors import Dec3dError
-from dec3d.kernels.bundles import ZoneMaterial, ZoneMesh, ZonePlan, ZoneScratch
-from dec3d.kernels.zmodels import CORRECTING_CODES, make_tables, model_mask, no_tables
-from dec3d.kernels.zone_elastic import ElasticPlan
+from dec3d.kernels.bundles import ZoneMaterial
+from dec3d.kernels.zmodels import model_mask
 from dec3d.kernels.zone_step import zone_step_for
 from dec3d.kernels.zonestep import gp_externals, gp_motion, gp_motion_ws, zone_mass_stiffness
 from dec3d.model.feblocks import has_feblocks
-from dec3d.model.model import KIND_DEFORMABLE
-from dec3d.model.zones import ZMODEL_NULL, ZP_BULK, ZP_DENSITY, ZP_SHEAR, zone_stores
+from dec3d.model.zones import zone_stores
 from dec3d.physics.cmodels import MODEL_BY_CODE
 from dec3d.units import suffix
 
 from .cables import gridpoint_grout_stiffness
+from .zone_cache import StepperCache, same
 from .zone_loads import body_loads
+from .zone_setup import _zone_models, _zone_plan, zone_tables, zoned_blocks
 
 _F = np.float64
 _I = np.int64
@@ -73,118 +75,41 @@ TET10_STIFFNESS_MARGIN = 2.0
 PARALLEL_MIN_ZONES = 20000
 
 
-def zone_bundles(plan: ElasticPlan, nset: int, plastic: bool):
-    """(``ZoneMesh``, ``ZonePlan``, ``ZoneScratch``) of ``zone_step`` from a plan (scratch of the
-    plastic correction only when ``plastic``)."""
-    nr = plan.g4.shape[0]
-    nv = plan.nodesum.shape[0]
-    mesh = ZoneMesh(plan.g4, plan.n4, plan.rows, plan.zset, plan.weight, int(nset))
-    zplan = ZonePlan(plan.pstart, plan.pk, *plan.fplan, *plan.nplan)
-    scratch = ZoneScratch(plan.nodesum, plan.nodevol, np.empty(nv if plastic else 0), plan.sa, plan.sb, plan.evs,
-                          plan.vols, np.empty(nr if plastic else 0), np.empty((nr, 13)))
-    return mesh, zplan, scratch
-
-
-def zone_tables(model, error=Dec3dError):
-    """The ``Tables`` bundle of the tables zone properties name (``settings.mechanical
-    ["zone_tables"]``, table t + 1 in a table column is its entry t), read from the FISH tables
-    as they are now; a table that is gone stops the run."""
-    ids = model.settings.mechanical.get("zone_tables", [])
-    if not ids:
-        return no_tables()
-    get = getattr(model, "fish_table", None)
-    points = []
-    for tid in ids:
-        tab = get(tid) if get is not None else None
-        if tab is None:
-            raise error(f"zone properties name table {tid!r}, which does not exist (any more): make it with "
-                        "`table` before cycling")
-        points.append((list(tab.xs), list(tab.ys)))
-    return make_tables(points)
-
-
-def _ids(model, rows) -> str:
-    ids = sorted(set(int(i) for i in model.blocks["id"][np.asarray(rows, _I)]))
-    head = ", ".join(str(i) for i in ids[:10])
-    return head + (f" … ({len(ids)} blocks)" if len(ids) > 10 else "")
-
-
-def block_elements(model, store, blocks, allowed, error, what: str, only: str):
-    """The elements (zones or FE elements) of ``blocks`` in ``store``: (on (nblocks,) bool mask
-    of the blocks, rows int64, their constitutive model codes). Raises ``error`` naming the
-    blocks when an element has a model code not in ``allowed`` (``only`` says which cycle)."""
-    on = np.zeros(model.blocks.n, bool)
-    on[blocks] = True
-    rows = np.flatnonzero(on[store["block"]]).astype(_I)
-    cm = store["cmodel"][rows]
-    bad = ~np.isin(cm, allowed)
-    if bad.any():
-        raise error(f"{what} of blocks {_ids(model, store['block'][rows[bad]])} have a constitutive model that "
-                    f"does not cycle {only}")
-    return on, rows, cm
-
-
-def zoned_blocks(model) -> np.ndarray:
-    """Rows of the live zoned (deformable) blocks."""
-    b = model.blocks
-    return np.flatnonzero((b["kind"] == KIND_DEFORMABLE) & ~b["hidden"]).astype(_I)
-
-
 class ZoneStepper:
-    def __init__(self, model, error, warn=None):
+    def __init__(self, model, error, warn=None, cache=None):
         """``error``: the exception class to raise (the engine's ``RunError``); ``warn``: where the
-        warnings of the property checks go (the engine's warn callback), or None."""
+        warnings of the property checks go (the engine's warn callback), or None; ``cache``: the
+        engine's ``zone_cache.StepperCache`` (what an earlier command derived from the same
+        inputs is taken from it), or None (everything derived anew)."""
         self.model = model
         self.error = error
         zs = zone_stores(model)
         b, v = model.blocks, model.vertices
+        c = self._cache = cache if cache is not None else StepperCache(off=True)
         self.blocks = zoned_blocks(model)
-        on, zrow, cm = block_elements(model, zs, self.blocks, [ZMODEL_NULL] + list(MODEL_BY_CODE), error,
-                                      "zones", "(unknown model code)")
-        act = cm != ZMODEL_NULL
-        live = np.zeros(b.n, bool)
-        live[zs["block"][zrow[act]]] = True
-        none = self.blocks[~live[self.blocks]]
-        if len(none):
-            raise error(f"zoned blocks {_ids(model, none)} have no zone with a constitutive model: use "
-                        "`block zone cmodel assign elastic` (and `block zone property`) before cycling")
-        el = zrow[act]
-        p = zs["prop"]
+        c.see("blocks", (self.blocks, b.n))
+        for k in ("block", "cmodel", "nnode", "hex", "overlay"):
+            c.see(k, zs[k])
+        c.see("prop", zs["prop"], runs=True)
+        c.see("gp4", zs["gp"][:, :4])
+        c.see("link", v["link"])
+        zm = c.get("zones", ("blocks", "block", "cmodel", "prop", "nnode"),
+                   lambda: _zone_models(model, zs, self.blocks, error), keep=lambda z: not z["warnings"])
         #: warnings of the property checks (also given to ``warn`` when there is one)
-        self.warnings = []
-        problems = []
-        #: the zone moduli the mass scaling and time step take (each model's ``moduli``)
-        self.bulk = np.ascontiguousarray(p[:, ZP_BULK])
-        self.shear = np.ascontiguousarray(p[:, ZP_SHEAR])
-        self.density = np.ascontiguousarray(p[:, ZP_DENSITY])
-        nn = zs["nnode"]
-        bid = model.blocks["id"]
-        for code in np.unique(cm[act]):
-            zm = MODEL_BY_CODE[int(code)]
-            mine = zrow[cm == code]
-            bad, warns = zm.problems(p[mine], zs["id"][mine], bid[zs["block"][mine]])
-            problems += [f"{zm.name} zones: {x}" for x in bad]
-            self.warnings += [f"{zm.name} zones: {x}" for x in warns]
-            if zm.moduli is not None and not bad:
-                self.bulk[mine], self.shear[mine] = zm.bulk_shear(p[mine])
-        if problems:
-            raise error("zone properties: " + "; ".join(problems)
-                        + " (set them with `block zone property` before cycling)")
+        self.warnings = list(zm["warnings"])
         if warn is not None:
             for w in self.warnings:
                 warn(w)
-        nn = nn[el]
-        self.rows4 = np.ascontiguousarray(el[nn == 4])
-        self.rows10 = np.ascontiguousarray(el[nn == 10])
+        on = zm["on"].copy()
+        #: the zone moduli the mass scaling and time step take (each model's ``moduli``)
+        self.bulk, self.shear, self.density = zm["bulk"], zm["shear"], zm["density"]
+        self.rows4, self.rows10 = zm["rows4"], zm["rows10"]
         self.nmd = bool(model.settings.mechanical.get("nmd", True))
         #: some 4-node zone's model returns a mean-stress correction (a plastic model, or an
         #: anisotropic one): the step's third sweep averages it
-        self.plastic = bool(np.isin(zs["cmodel"][self.rows4], sorted(CORRECTING_CODES)).any())
+        self.plastic = zm["plastic"]
         #: the models among the 4-node zones: the step is compiled for these (``model_mask``)
-        self.models = model_mask(np.unique(zs["cmodel"][self.rows4]), self.plastic)
-        link0 = v["link"]
-        #: NMD averaging node of each vertex row: its link master (one gridpoint of a joined set) or itself
-        self.node = np.ascontiguousarray(np.where(link0 >= 0, link0, np.arange(v.n, dtype=_I)))
+        self.models = zm["models"]
         self.ho = None
         #: β [s] of Rayleigh damping's stiffness term (set by the engine's run; 0: none)
         self.beta = 0.0
@@ -204,23 +129,21 @@ class ZoneStepper:
                     bad = step10(pos, vel, gp, rows, self.material(stress=stress), zs["ghist"], dt, gstress, force)
                     return bad
                 self.ho = ho
-        # mixed-discretization sets of the 4-node zones: compact set numbers
-        hx = zs["hex"][self.rows4]
-        self.weight = np.where(zs["overlay"][self.rows4] >= 0, 0.5, 1.0)
-        self.zset = np.full(len(self.rows4), -1, _I)
-        if (hx >= 0).any():
-            _, inv = np.unique(hx[hx >= 0], return_inverse=True)
-            self.zset[hx >= 0] = inv.ravel()
-        self.nset = int(self.zset.max()) + 1 if len(self.zset) else 0
         #: the 4-node step (``zone_step.zone_step``): chunks (one per thread from PARALLEL_MIN_ZONES
-        #: zones on; any count gives the same bits), plans and scratch, made once per stepper
-        self.fast = None
-        if len(self.rows4):
-            import numba
-
-            nch = numba.get_num_threads() if len(self.rows4) >= PARALLEL_MIN_ZONES else 1
-            self.fast = ElasticPlan(zs["gp"], self.rows4, self.node, self.zset, self.weight, v.n, nch)
-            self.zmesh, self.zplan, self.zscratch = zone_bundles(self.fast, self.nset, self.plastic)
+        #: zones on; any count gives the same bits), plans and scratch, made once per mesh
+        import numba
+        nch = numba.get_num_threads() if len(self.rows4) >= PARALLEL_MIN_ZONES else 1
+        c.see("nch", nch)
+        # (of the zones entry the plan takes the 4-node rows and the plastic flag: compared with its own)
+        pl = c.get("plan", ("gp4", "hex", "overlay", "link", "nch"),
+                   lambda: _zone_plan(zs, v, self.rows4, self.plastic, nch),
+                   valid=lambda p: p["plastic"] == self.plastic and same(p["rows4"], self.rows4))
+        #: NMD averaging node of each vertex row: its link master (one gridpoint of a joined set) or itself
+        self.node = pl["node"]
+        # mixed-discretization sets of the 4-node zones: compact set numbers
+        self.weight, self.zset, self.nset, self.fast = pl["weight"], pl["zset"], pl["nset"], pl["fast"]
+        if self.fast is not None:
+            self.zmesh, self.zplan, self.zscratch = pl["bundles"]
         #: the tables the zone models read (``table`` ids named by table properties)
         self.tables = zone_tables(model, error)
         # FE blocks (issue 12): their nodes move with the gridpoints; forces, masses and slave
@@ -258,20 +181,16 @@ class ZoneStepper:
         self.held = np.ascontiguousarray(held)
         # real masses on the reference positions, stiffness on the geometry of the last update
         n = v.n
-        mass = np.zeros(n)
-        stiff = np.zeros(n)
-        zone_mass_stiffness(self.ref, zs["gp"], zs["nnode"], zs["overlay"], self.rows4, self.bulk, self.shear,
-                            self.density, mass, stiff)
+        c.see("rows", (self.rows, n))
+        c.see("ref", self.ref[self.rows])
+        c.see("gp10", zs["gp"][self.rows10])
+        ms = c.get("mass", ("zones", "gp4", "gp10", "overlay", "rows", "ref"), lambda: self._real_masses(zs, n),
+                   keep=lambda x: x["inside"])
+        mass = ms["mass"].copy()
         #: mass whose weight is lumped (m g per gridpoint): that of the 4-node zones; 10-node zones
         #: load their gridpoints with the consistent body force instead (``tet10_body_force``)
-        self.gmass = mass.copy()
-        self.r10 = np.zeros(0, _I)
+        self.gmass, self.r10 = ms["gmass"], ms["r10"]
         self._g10 = None
-        if len(self.rows10):
-            from dec3d.kernels import zones_ho
-            self._bad10(zones_ho.tet10_lumped_mass(self.ref, zs["gp"], self.rows10, self.density, mass))
-            g10 = zs["gp"][self.rows10]
-            self.r10 = np.unique(g10[g10 >= 0]).astype(_I)
         if self.fe is not None:
             mass += self.fe.mass
         v["mass"][self.rows] = mass[self.rows]
@@ -293,6 +212,26 @@ class ZoneStepper:
         self.mwork = np.empty((len(self.masters) if len(self.rows4) >= PARALLEL_MIN_ZONES else 0, 5))
         self.fmag = np.zeros(n)
         self.out = np.zeros(4)
+
+    def _real_masses(self, zs, n) -> dict:
+        """The real lumped masses on ``ref`` (4-node zones, then with the 10-node zones'), the mass
+        whose weight is lumped (``gmass``), the gridpoints of 10-node zones, and whether every
+        gridpoint of the zones is a row of ``rows`` (what the cache compares: else not kept)."""
+        mass = np.zeros(n)
+        zone_mass_stiffness(self.ref, zs["gp"], zs["nnode"], zs["overlay"], self.rows4, self.bulk, self.shear,
+                            self.density, mass, np.zeros(n))
+        gmass = mass.copy()
+        r10 = np.zeros(0, _I)
+        inside = np.zeros(n, bool)
+        inside[self.rows] = True
+        ok = bool(inside[zs["gp"][self.rows4, :4]].all())
+        if len(self.rows10):
+            from dec3d.kernels import zones_ho
+            self._bad10(zones_ho.tet10_lumped_mass(self.ref, zs["gp"], self.rows10, self.density, mass))
+            g10 = zs["gp"][self.rows10]
+            r10 = np.unique(g10[g10 >= 0]).astype(_I)
+            ok = ok and bool(inside[r10].all())
+        return {"mass": mass, "gmass": gmass, "r10": r10, "inside": ok}
 
     def _references(self, on) -> tuple[np.ndarray, np.ndarray]:
         """(positions of the real masses, positions of the stiffness), each (nv, 3), for the
@@ -335,16 +274,12 @@ class ZoneStepper:
         the positions ``geo``, summed onto masters (``kzone``, ``ktot`` with the contacts' joint
         term), and the quiet dashpots and table face loads on them."""
         m = self.model
-        zs, v = m.store("zones"), m.vertices
+        v = m.vertices
         n = v.n
-        stiff = np.zeros(n)
-        zone_mass_stiffness(geo, zs["gp"], zs["nnode"], zs["overlay"], self.rows4, self.bulk, self.shear,
-                            self.density, np.zeros(n), stiff)
-        if len(self.rows10):
-            from dec3d.kernels import zones_ho
-            k10 = np.zeros(n)
-            self._bad10(zones_ho.tet10_stiffness(geo, zs["gp"], self.rows10, self.bulk, self.shear, k10))
-            stiff += TET10_STIFFNESS_MARGIN * k10
+        c = self._cache
+        c.see("geo", geo[self.rows])
+        stiff = c.get("stiff", ("zones", "gp4", "gp10", "overlay", "rows", "geo"), lambda: self._zone_stiffness(geo))
+        stiff = stiff.copy()
         if self.fe is not None:
             if fe:
                 self.fe.stiffness(geo)
@@ -365,6 +300,20 @@ class ZoneStepper:
                 self._quiet_setup(m)
             finally:
                 pos[:] = now
+
+    def _zone_stiffness(self, geo) -> np.ndarray:
+        """The node stiffness of the 4- and 10-node zones on the positions ``geo`` (per vertex row)."""
+        zs = self.model.store("zones")
+        n = len(geo)
+        stiff = np.zeros(n)
+        zone_mass_stiffness(geo, zs["gp"], zs["nnode"], zs["overlay"], self.rows4, self.bulk, self.shear,
+                            self.density, np.zeros(n), stiff)
+        if len(self.rows10):
+            from dec3d.kernels import zones_ho
+            k10 = np.zeros(n)
+            self._bad10(zones_ho.tet10_stiffness(geo, zs["gp"], self.rows10, self.bulk, self.shear, k10))
+            stiff += TET10_STIFFNESS_MARGIN * k10
+        return stiff
 
     def regeometry(self) -> None:
         """Large strain, at a detection step: stiffness, dashpots and table face loads on the
