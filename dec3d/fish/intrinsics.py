@@ -517,6 +517,7 @@ from . import contact_intrinsics  # noqa: E402,F401  (registers block.contact.*,
 from . import table_intrinsics  # noqa: E402,F401  (registers table.*)
 from . import zone_intrinsics  # noqa: E402,F401  (registers block.zone.*)
 from . import struct_intrinsics  # noqa: E402,F401  (registers struct.cable.*, struct.node.*)
+from . import liner_intrinsics  # noqa: E402,F401  (registers struct.liner.*, struct.shell.resultant)
 from . import extra_intrinsics  # noqa: E402,F401  (registers block.extra, block.gp.extra, block.gp.dsf)
 from . import file_intrinsics  # noqa: E402,F401  (registers file.open/read/write/close)
 from . import dfn_intrinsics  # noqa: E402,F401  (registers fracture.*)

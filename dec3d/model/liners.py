@@ -24,6 +24,9 @@ element ``dec3d.kernels.dkt``).
     force, moment (3,)    unbalanced force and moment of the last step
     hforce, hmoment (3,)  force of the coupling on the host block and its moment about the centroid
     group (1,)
+    sx (3,)               surface-system x axis (``structure liner recover surface``; zero: none)
+    nres (6,), nresok ()  recovered resultants M_x, M_y, M_xy, N_x, N_y, N_xy in the surface system, valid
+                          (``model.liner_recover``)
 ``liner_elements`` one row per flat 3-node element
     id (), liner ()       int64
     nodes (3,)            int64  node rows, counter-clockwise seen from the element's +z side
@@ -32,6 +35,8 @@ element ``dec3d.kernels.dkt``).
     lxy (3,)              m      local corners (0, 0), (x2, 0), (x3, y3): x2, x3, y3
     area ()               m²
     pos (3,)              centroid as created; group (1,)
+    eres (4, 8), eresok ()  recovered resultants at the centroid and nodes 1-3 (M_x, M_y, M_xy, N_x, N_y,
+                          N_xy, Q_x, Q_y), valid (``model.liner_recover``)
 """
 from __future__ import annotations
 
@@ -63,6 +68,7 @@ def _node_fields():
               "hz": Field((), np.int8, 0), "hzone": Field((), np.int64, -1), "hgp": Field((NHOST,), np.int64, -1),
               "hw": Field((NHOST,), np.float64, 0.0)})
     f.update({k: Field((), np.float64, 0.0) for k in ("mass", "inert", "imass", "iinert", "un", "fn")})
+    f.update({"sx": v3, "nres": Field((6,), np.float64, 0.0), "nresok": Field((), np.uint8, 0)})
     return f
 
 
@@ -70,7 +76,8 @@ def _elem_fields():
     return {"id": Field((), np.int64, 0), "liner": Field((), np.int64, 0), "nodes": Field((3,), np.int64, -1),
             "prop": Field((NLPROP,), np.float64, 0.0), "axes": Field((3, 3), np.float64, 0.0),
             "lxy": Field((3,), np.float64, 0.0), "area": Field((), np.float64, 0.0),
-            "pos": Field((3,), np.float64, 0.0), "group": group_field()}
+            "pos": Field((3,), np.float64, 0.0), "group": group_field(),
+            "eres": Field((4, 8), np.float64, 0.0), "eresok": Field((), np.uint8, 0)}
 
 
 def liner_stores(model: Model) -> tuple[Store, Store]:
@@ -79,6 +86,11 @@ def liner_stores(model: Model) -> tuple[Store, Store]:
         model.add_store(Store(LNODES, _node_fields()))
     if LELEMS not in st:
         model.add_store(Store(LELEMS, _elem_fields()))
+    for name, fields in ((LNODES, _node_fields()), (LELEMS, _elem_fields())):
+        store = model.stores[name]
+        for key, spec in fields.items():          # (a store restored from a file of an older dec3d)
+            if key not in store:
+                store.add_field(key, spec)
     widen(model.stores[LNODES])
     return model.stores[LNODES], model.stores[LELEMS]
 
