@@ -22,7 +22,9 @@ def _need(session, call):
          range=LELEMS,
          doc="Put the liner elements in range in a group (one group per slot; the old one is replaced).",
          details="`remove` takes them out of the group: in `slot` if given, else in every slot. Liner ranges "
-                 "(`structure liner list`, `property`, `delete`, `recover`) can then select the group.",
+                 "(`structure liner list`, `property`, `delete`, `recover`) can then select the group. (The form of "
+                 "Itasca's `structure pile group` and `structure node group` pages; the liner page itself was not "
+                 "among the pages found.)",
          examples=["structure liner group 'crown' range position-z 1.5 3", "structure liner group 'stage1' slot 'seq'",
                    "structure liner group 'crown' remove"])
 def liner_group(session, call):
@@ -52,7 +54,9 @@ def _histories_on(model, elem_ids, node_ids):
                  "the block (or the zone's gridpoints) is taken back out, as `block excavate` does. Nodes still "
                  "used by a remaining element stay as they are (masses and normals are recomputed from the "
                  "remaining elements). Element and node ids of what remains do not change. A history that "
-                 "records a deleted element or node is refused: `history delete` it first.",
+                 "records a deleted element or node is refused: `history delete` it first. (Itasca's `structure liner "
+                 "delete` page was not among the documentation pages found; the form here, a range and no keyword, "
+                 "is that of `block delete`.)",
          examples=["structure liner delete range group 'stage1'", "structure liner delete range id 2"])
 def liner_delete(session, call):
     _need(session, call)
@@ -116,8 +120,9 @@ def liner_recover_surface(session, call):
                  "each element (constant Q per element). Moments: M_x = −D (w,xx + ν w,yy), M_xy = −D (1 − ν) "
                  "w,xy in the surface axes (positive M_x makes +z concave). Read them with FISH "
                  "`struct.shell.resultant(id, iloc <, ires>)` (iloc 0 the centroid, 1-3 the nodes) and "
-                 "`struct.node.resultant(node-id <, ires>)`. Values stay as recovered until the next recovery.",
-         examples=["structure liner recover surface 1 0 0\nstructure liner recover resultants"])
+                 "`struct.node.resultant(node-id <, ires>)`. Values stay as recovered until the next recovery. Itasca's "
+                 "`recover stress depth-factor f` (a stress tensor at a depth) is not built.",
+         examples=["structure liner recover resultants", "structure liner recover resultants range group 'crown'"])
 def liner_recover_resultants(session, call):
     from ..model.liner_recover import recover
 
