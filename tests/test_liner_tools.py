@@ -187,3 +187,44 @@ structure liner history coupling-stress-normal component-id 1 node 1
     _run("structure liner delete\n", tmp_path, b)
     assert b.model.stores["liner_nodes"].n == 0 and abs(b.model.blocks["fapp"][0, 2]) < 1e-6
     _run("model cycle 10\n", tmp_path, b)
+
+
+def test_delete_on_a_zoned_block_gives_the_gridpoints_their_loads_back(tmp_path):
+    """A liner on a zoned block's top pulled up by 100 N per node: the springs load the top gridpoints
+    (their applied loads sum to the pull); deleting the liner takes all of it back off them."""
+    s = _run("""model new
+block create brick 0 1 0 1 0 1
+block zone generate edgelength 0.5
+block zone cmodel assign elastic
+block zone property young 1e9 poisson 0.25 density 2000
+block gridpoint fix velocity range position-z 0
+structure liner create by-block-face range position-z 1
+structure liner property isotropic 30e9 0.2 thickness 0.1 density 2400 coupling-stiffness-normal 1e9 coupling-stiffness-shear 1e9 coupling-yield-normal 2e7 coupling-cohesion-shear 1e7
+structure node apply force-z 100
+model cycle 300
+""", tmp_path)
+    nodes, v = s.model.stores["liner_nodes"], s.model.vertices
+    assert (nodes["hz"] == 1).all()
+    assert v["fapp"][: v.n, 2].sum() == pytest.approx(nodes["hforce"][: nodes.n, 2].sum(), rel=1e-12)
+    assert abs(v["fapp"][: v.n, 2].sum()) > 100
+    _run("structure liner delete\nmodel cycle 10\n", tmp_path, s)
+    assert nodes.n == 0 and abs(v["fapp"][: v.n]).max() < 1e-9
+
+
+def test_stores_from_an_older_file_get_the_recovery_fields():
+    """A liner store restored from a file written before recovery existed (no ``sx``/``nres``/``eres``
+    columns) gets them, unset, on first use."""
+    from dec3d.model.liners import LELEMS, LNODES, _elem_fields, _node_fields, liner_stores
+    from dec3d.model.model import Model
+    from dec3d.model.store import Store
+
+    m = Model()
+    old_n = {k: f for k, f in _node_fields().items() if k not in ("sx", "nres", "nresok")}
+    old_e = {k: f for k, f in _elem_fields().items() if k not in ("eres", "eresok")}
+    m.add_store(Store(LNODES, old_n))
+    m.add_store(Store(LELEMS, old_e))
+    m.stores[LNODES].append(2)
+    m.stores[LELEMS].append(1)
+    nodes, els = liner_stores(m)
+    assert nodes["sx"].shape == (2, 3) and not nodes["sx"].any() and not nodes["nresok"].any()
+    assert els["eres"].shape == (1, 4, 8) and not els["eresok"].any()
