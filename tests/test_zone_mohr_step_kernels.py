@@ -272,3 +272,42 @@ def test_mohr_pair_is_mohr_plastic(gap):
                 scale = np.abs(tr).sum() + coh
                 assert np.abs(t6 - s).max() <= 1e-12 * scale and abs(got[7] - dsp) <= 1e-12 * scale
     assert settled >= 0.6 * general and general >= 300, (settled, general)
+
+
+def _single_plane_twin(p1, p2, p3, coh, npf, csn, ft, nps, a1, a2, sp, ap, den):
+    """Itasca's single-plane return (zone_mohr's module text) in plain Python, operation for
+    operation as written there: (code, n1, n2, n3, admissible)."""
+    tol = 1e-10 * (abs(p1) + abs(p3) + abs(p2) + coh + abs(ft))
+    fs = p3 * npf - p1 - csn
+    ften = p3 - ft
+    if fs <= tol and ften <= tol:
+        return 0, p1, p2, p3, True
+    if fs > tol and (p3 - ft + ap * (p1 - sp) <= 0.0 or ften <= tol):
+        lam_s = fs / den
+        n = (p1 + lam_s * (a1 - a2 * nps), p2 + lam_s * a2 * (1.0 - nps), p3 + lam_s * (a2 - a1 * nps))
+        code = 1
+    else:
+        lam_t = ften / a1
+        n = (p1 - lam_t * a2, p2 - lam_t * a2, ft)
+        code = 2
+    lo, hi = min(n), max(n)
+    return (code, *n, hi * npf - lo - csn <= tol and hi - ft <= tol)
+
+
+def test_plane_return_is_the_single_plane_return():
+    """``zone_mohr.plane_return`` (the one copy of the single-plane return that ``_fast_return``,
+    ``mohr_plastic`` and ``mohr_pair`` share) gives the bits of the module text's formulas, for
+    elastic, shear, tension and inadmissible (corner / edge) trials."""
+    rng = np.random.default_rng(23)
+    seen = {}
+    for _ in range(3000):
+        coh = rng.uniform(1e3, 2e6)
+        tf, td = math.tan(math.radians(rng.uniform(5, 45))), math.tan(math.radians(rng.uniform(0, 20)))
+        ten = rng.uniform(0, 1.0) * coh / tf
+        cst = zm.mohr_constants(rng.uniform(1e8, 1e10), rng.uniform(1e8, 1e10), coh, tf, ten, td)
+        p = np.sort(rng.uniform(-3, 1) * coh * 5 + rng.normal(size=3) * coh * 10 ** rng.uniform(-1, 1))
+        got = zm.plane_return(p[0], p[1], p[2], coh, *cst)
+        want = _single_plane_twin(float(p[0]), float(p[1]), float(p[2]), coh, *cst)
+        assert got[0] == want[0] and got[1:4] == want[1:4] and got[4] == want[4]
+        seen[(want[0], want[4])] = seen.get((want[0], want[4]), 0) + 1
+    assert all(seen.get(k, 0) >= 30 for k in ((0, True), (1, True), (2, True), (1, False), (2, False))), seen

@@ -213,24 +213,20 @@ def mohr_constants(bulk, shear, coh, tanfric, ten, tandil):
 
 
 @njit(cache=True, inline="always")
-def _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, coh, npf, csn, ft, nps, a1, a2, sp, ap, den):
-    """``mohr_plastic`` in scalars for the common case: principal values well apart (closed
-    form, ``GAP_REL``) and Itasca's single plane giving an admissible stress. The trial stress
-    s0..s5 with its deviatoric principal values l1 <= l2 <= l3 about the mean m
-    (``_dev_principal``), the zone's cohesion and ``mohr_constants``. Returns (code, t0..t5,
-    dsp): code 0 elastic (t = s, dsp = 0), SHEAR_NOW or TENSION_NOW (t the returned stress, dsp
-    as ``mohr_return``), -1 not settled here (t = s: ``mohr_plastic``'s general path must do it).
-    The formulas of ``mohr_plastic``'s array path (``principal_axes``' projectors, ``_rotate_back``),
-    arranged for one division instead of three; a stress takes one path or the other, never both."""
-    if not (l3 - l1 > 0.0 and min(l2 - l1, l3 - l2) >= GAP_REL * (l3 - l1)):
-        return -1, s0, s1, s2, s3, s4, s5, 0.0
-    p1 = m + l1; p2 = m + l2; p3 = m + l3
+def plane_return(p1, p2, p3, coh, npf, csn, ft, nps, a1, a2, sp, ap, den):
+    """Itasca's single-plane return of the principal stresses p1 <= p2 <= p3 (the module text),
+    with the zone's cohesion and ``mohr_constants``: (code, n1, n2, n3, admissible, tol). code 0:
+    clearly elastic (n = p); SHEAR_NOW or TENSION_NOW: the plane Itasca's h picks, n the returned
+    values and admissible whether they violate no plane (to tol, 1e-10 of the stresses'
+    scale). The one copy of this return for ``_fast_return``, ``mohr_plastic`` and
+    ``zone_mohr_pair.mohr_pair`` (so their bits agree)."""
     scale = abs(p1) + abs(p3) + abs(p2) + coh + abs(ft)
     tol = 1e-10 * scale
-    fs13 = p3 * npf - p1 - csn
+    fs13 = p3 * npf - p1 - csn          # = -f_s (Itasca), > 0 violated
     ft3 = p3 - ft
     if fs13 <= tol and ft3 <= tol:
-        return 0, s0, s1, s2, s3, s4, s5, 0.0
+        return 0, p1, p2, p3, True, tol
+    # Itasca's choice of the plane: h decides between shear and tension
     h = p3 - ft + ap * (p1 - sp)
     if fs13 > tol and (h <= 0.0 or ft3 <= tol):
         ls = fs13 / den
@@ -246,7 +242,26 @@ def _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, coh, npf, csn, ft, nps, 
         code = TENSION_NOW
     lo = min(n1, min(n2, n3))
     hi = max(n1, max(n2, n3))
-    if not (hi * npf - lo - csn <= tol and hi - ft <= tol):
+    return code, n1, n2, n3, hi * npf - lo - csn <= tol and hi - ft <= tol, tol
+
+
+@njit(cache=True, inline="always")
+def _fast_return(s0, s1, s2, s3, s4, s5, m, l1, l2, l3, coh, npf, csn, ft, nps, a1, a2, sp, ap, den):
+    """``mohr_plastic`` in scalars for the common case: principal values well apart (closed
+    form, ``GAP_REL``) and Itasca's single plane giving an admissible stress. The trial stress
+    s0..s5 with its deviatoric principal values l1 <= l2 <= l3 about the mean m
+    (``_dev_principal``), the zone's cohesion and ``mohr_constants``. Returns (code, t0..t5,
+    dsp): code 0 elastic (t = s, dsp = 0), SHEAR_NOW or TENSION_NOW (t the returned stress, dsp
+    as ``mohr_return``), -1 not settled here (t = s: ``mohr_plastic``'s general path must do it).
+    The formulas of ``mohr_plastic``'s array path (``principal_axes``' projectors, ``_rotate_back``),
+    arranged for one division instead of three; a stress takes one path or the other, never both."""
+    if not (l3 - l1 > 0.0 and min(l2 - l1, l3 - l2) >= GAP_REL * (l3 - l1)):
+        return -1, s0, s1, s2, s3, s4, s5, 0.0
+    p1 = m + l1; p2 = m + l2; p3 = m + l3
+    code, n1, n2, n3, ok, _tol = plane_return(p1, p2, p3, coh, npf, csn, ft, nps, a1, a2, sp, ap, den)
+    if code == 0:
+        return 0, s0, s1, s2, s3, s4, s5, 0.0
+    if not ok:
         return -1, s0, s1, s2, s3, s4, s5, 0.0
     # projectors P1, P3 (``principal_axes``' formulas) and the rotation back (``_rotate_back``)
     d0, d1, d2 = _deviator(s0, s1, s2)
@@ -291,32 +306,12 @@ def mohr_plastic(s, bulk, shear, coh, tanfric, ten, tandil, work):
         return code, dsp
     lam, pr, nn, dm, rr, act, mm, bb, x, sn = work
     principal_axes(s, lam, pr, mm)
-    s1 = lam[0]; s3 = lam[2]
-    scale = abs(s1) + abs(s3) + abs(lam[1]) + coh + abs(ft)
-    tol = 1e-10 * scale
-    fs13 = s3 * npf - s1 - csn          # = -f_s (Itasca), > 0 violated
-    ft3 = s3 - ft
-    if fs13 <= tol and ft3 <= tol:
+    # Itasca's single-plane return in closed form, kept when it violates no plane
+    fast, n1, n2, n3, ok, tol = plane_return(lam[0], lam[1], lam[2], coh, npf, csn, ft, nps, a1, a2, sp, ap, den)
+    if fast == 0:
         return 0, 0.0
-    # Itasca's choice of the plane: h decides between shear and tension
-    h = s3 - ft + ap * (s1 - sp)
-    first = 0 if (fs13 > tol and (h <= 0.0 or ft3 <= tol)) else 8
-    # fast path: Itasca's single-plane return in closed form, kept when it violates no plane
-    if first == 0:
-        ls = fs13 / den
-        n1 = s1 + ls * (a1 - a2 * nps)
-        n2 = lam[1] + ls * a2 * (1.0 - nps)
-        n3 = s3 + ls * (a2 - a1 * nps)
-        fast = SHEAR_NOW
-    else:
-        lt = ft3 / a1
-        n1 = s1 - lt * a2
-        n2 = lam[1] - lt * a2
-        n3 = ft
-        fast = TENSION_NOW
-    lo = min(n1, min(n2, n3))
-    hi = max(n1, max(n2, n3))
-    if hi * npf - lo - csn <= tol and hi - ft <= tol:
+    first = 0 if fast == SHEAR_NOW else 8
+    if ok:
         sn[0] = n1; sn[1] = n2; sn[2] = n3
         return _rotate_back(s, lam, pr, sn, fast)
     # the nine planes: n (normal of F), dm (D times the flow direction), r

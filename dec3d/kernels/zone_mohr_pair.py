@@ -28,6 +28,7 @@ import math
 from numba import njit
 
 from .principal import GAP_REL, _deviator, _dev_principal, dev_square
+from .zone_mohr import plane_return
 from .zones import SHEAR_NOW, TENSION_NOW
 
 #: shear planes k < 6: (i, j) = (more compressive, less compressive) index (``zone_mohr._SH_I/_SH_J``);
@@ -161,30 +162,11 @@ def mohr_pair(s0, s1, s2, s3, s4, s5, coh, npf, csn, ft, nps, a1, a2, sp, ap, de
         r3 = -0.5 * p3 + h * e3; r4 = -0.5 * p4 + h * e4; r5 = -0.5 * p5 + h * e5
     lam0 = m + l1; lam1 = m + l2; lam2 = m + l3
     # ``mohr_plastic`` from here, on these values and projectors
-    scale = abs(lam0) + abs(lam2) + abs(lam1) + coh + abs(ft)
-    tol = 1e-10 * scale
-    fs13 = lam2 * npf - lam0 - csn
-    ft3 = lam2 - ft
-    if fs13 <= tol and ft3 <= tol:
+    bits, n1, n2, n3, ok, tol = plane_return(lam0, lam1, lam2, coh, npf, csn, ft, nps, a1, a2, sp, ap, den)
+    if bits == 0:
         return 0, s0, s1, s2, s3, s4, s5, 0.0
-    hh = lam2 - ft + ap * (lam0 - sp)
-    first = 0 if (fs13 > tol and (hh <= 0.0 or ft3 <= tol)) else 8
-    if first == 0:
-        ls = fs13 / den
-        n1 = lam0 + ls * (a1 - a2 * nps)
-        n2 = lam1 + ls * a2 * (1.0 - nps)
-        n3 = lam2 + ls * (a2 - a1 * nps)
-        bits = SHEAR_NOW
-    else:
-        lt = ft3 / a1
-        n1 = lam0 - lt * a2
-        n2 = lam1 - lt * a2
-        n3 = ft
-        bits = TENSION_NOW
-    lo = min(n1, min(n2, n3))
-    hi = max(n1, max(n2, n3))
-    if not (hi * npf - lo - csn <= tol and hi - ft <= tol):
-        ok = False
+    first = 0 if bits == SHEAR_NOW else 8
+    if not ok:
         for k in range(9):
             if k != first:
                 ok, x0, x1, n1, n2, n3 = _pair(first, k, lam0, lam1, lam2, npf, csn, ft, nps, a1, a2, tol)
