@@ -35,7 +35,7 @@ import numpy as np
 from dec3d.kernels.beam import NBPROP
 
 from .cables import place_nodes
-from .hosts import NHOST, host_element, widen
+from .hosts import NHOST, host_element, widen, zone_hosted
 from .groups import group_field
 from .model import Model
 from .store import Field, Store
@@ -153,7 +153,7 @@ def remap_beam_hosts(model: Model, remap: np.ndarray) -> int:
     h[ok] = remap[h[ok]]
     lost = ok & (h < 0)
     # zone-hosted nodes of surviving blocks: the zones' and gridpoints' rows moved, find them again
-    for i in np.flatnonzero((h >= 0) & (nodes["hz"] != 0)):
+    for i in zone_hosted(model, h, nodes["hz"]):
         z = host_element(model, int(h[i]), nodes["hpos"][i], 1e-9)
         if z is None:
             h[i] = -1

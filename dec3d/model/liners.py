@@ -37,10 +37,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from dec3d.errors import CommandError
 from dec3d.kernels.dkt import element_frame
 
 from .groups import group_field
-from .hosts import NHOST, host_element, widen
+from .hosts import NHOST, host_element, widen, zone_hosted
 from .model import Model
 from .store import Field, Store
 
@@ -101,6 +102,9 @@ def add_liner(model: Model, tris: np.ndarray, hosts: np.ndarray, liner_id, group
     hosts = np.asarray(hosts, np.int64)
     edges = np.linalg.norm(tris - np.roll(tris, 1, axis=1), axis=2)
     keep = edges.min(axis=1) > 2.0 * tol                  # (a sliver under the tolerance is no element)
+    if not keep.any():
+        raise CommandError(f"every element has an edge shorter than twice the tolerance {tol:g} m: no liner made "
+                           "(give a smaller `tolerance`)")
     tris, hosts = tris[keep], hosts[keep]
     pts = tris.reshape(-1, 3)
     first, inv = merge_points(pts, tol)
@@ -214,7 +218,7 @@ def remap_liner_hosts(model: Model, remap: np.ndarray) -> int:
     ok = h >= 0
     h[ok] = remap[h[ok]]
     lost = ok & (h < 0)
-    for i in np.flatnonzero((h >= 0) & (nodes["hz"] != 0)):
+    for i in zone_hosted(model, h, nodes["hz"]):
         z = host_element(model, int(h[i]), nodes["hpos"][i], 1e-9)
         if z is None:
             h[i] = -1
