@@ -125,21 +125,32 @@ STRUCT = {"liner": QUAD + "\n" + PROPS + "\n",
                    "young 2e11 cross-sectional-area 1e-4 grout-stiffness 1e9 grout-cohesion 1e6 density 7800\n"}
 
 
-@pytest.mark.parametrize("kind", list(STRUCT))
+FE = """feblock generate 0.5 0.5 0.5
+block zone cmodel assign elastic
+block zone property young 1e7 poisson 0.25 density 2000
+block gridpoint fix velocity range position-z 0
+"""
+
+
+@pytest.mark.parametrize("kind", list(STRUCT) + ["liner-fe"])
 def test_structural_nodes_made_before_zoning_follow_the_zones(session, tmp_path, kind):
-    """A liner or cable made in a rigid block that is zoned afterwards is coupled to the zones (was: to the
-    block's rigid motion, which a zoned block has not: the liner stayed where it was while the zones under
-    it settled); the run gives the bits of the same deck with the structure made after the zoning."""
+    """A liner or cable made in a rigid block that is zoned (or made an FE block) afterwards is coupled to
+    the zones (was: to the block's rigid motion, which a zoned block has not: the liner stayed where it was
+    while the zones under it settled); the run gives the bits of the same deck with the structure made after
+    the zoning."""
     head = "model new\nmodel gravity 0 0 -10\nblock create brick 0 1 0 1 0 1\nblock property density 2000\n"
-    store = "liner_nodes" if kind == "liner" else "cable_nodes"
+    store = "cable_nodes" if kind == "cable" else "liner_nodes"
+    code, zone = (3, FE) if kind == "liner-fe" else (1, ZONE)        # (an FE block: a brick of FE elements)
+    head = head.replace("model new\n", "model new\nmodel configure feblock\n") if kind == "liner-fe" else head
+    struct = STRUCT[kind.split("-")[0]]
     out = []
-    for text in (head + ZONE + STRUCT[kind], head + STRUCT[kind] + ZONE):
+    for text in (head + zone + struct, head + struct + zone):
         from dec3d.session import Session
         import io
         s = Session(out_dir=tmp_path, stdout=io.StringIO())
         s.run_items(s.load_text(text + "model cycle 100\n"))
         nodes = s.model.stores[store]
-        assert (nodes["hz"] == 1).all()
+        assert (nodes["hz"] == code).all()
         out.append({k: nodes[k].copy() for k in ("hz", "hzone", "hgp", "hw", "disp", "hforce")}
                    | {"gp": s.model.vertices["disp"].copy()})
     assert np.abs(out[0]["disp"][:, 2]).max() > 1e-4        # (the zones settle under gravity, and the structure)
