@@ -38,7 +38,7 @@ import numpy as np
 from dec3d.kernels.cable import NPROP
 
 from .groups import group_field
-from .hosts import NHOST, host_element, widen, zone_hosted
+from .hosts import NHOST, host_element, next_id, widen, zone_hosted
 from .model import KIND_RIGID, Model
 from .store import Field, Store
 
@@ -162,8 +162,7 @@ def add_cable(model: Model, p1, p2, segments: int, cable_id: int | None, group: 
     host rows of its nodes). The nodes take the block they lie in as host."""
     nodes, segs = cable_stores(model)
     p1, p2 = np.asarray(p1, _F), np.asarray(p2, _F)
-    cid = int(cable_id) if cable_id is not None else int(max(nodes["cable"].max(initial=0),
-                                                              segs["cable"].max(initial=0)) + 1)
+    cid = int(cable_id) if cable_id is not None else next_id("cable", nodes["cable"], segs["cable"])
     sid0 = int(segs["id"].max(initial=0)) + 1
     rn, pts, hosts = place_nodes(model, nodes, p1, p2, segments, tol)
     nodes["cable"][rn] = cid

@@ -41,7 +41,7 @@ from dec3d.errors import CommandError
 from dec3d.kernels.dkt import element_frame
 
 from .groups import group_field
-from .hosts import NHOST, host_element, widen, zone_hosted
+from .hosts import NHOST, host_element, next_id, widen, zone_hosted
 from .model import Model
 from .store import Field, Store
 
@@ -97,8 +97,7 @@ def add_liner(model: Model, tris: np.ndarray, hosts: np.ndarray, liner_id, group
     from .beams import next_node_id
 
     nodes, els = liner_stores(model)
-    lid = int(liner_id) if liner_id is not None else int(max(nodes["liner"].max(initial=0),
-                                                              els["liner"].max(initial=0)) + 1)
+    lid = int(liner_id) if liner_id is not None else next_id("liner", nodes["liner"], els["liner"])
     hosts = np.asarray(hosts, np.int64)
     edges = np.linalg.norm(tris - np.roll(tris, 1, axis=1), axis=2)
     keep = edges.min(axis=1) > 2.0 * tol                  # (a sliver under the tolerance is no element)

@@ -156,3 +156,19 @@ def test_structural_nodes_made_before_zoning_follow_the_zones(session, tmp_path,
     assert np.abs(out[0]["disp"][:, 2]).max() > 1e-4        # (the zones settle under gravity, and the structure)
     for k in out[0]:
         assert np.array_equal(out[0][k], out[1][k]), k
+
+
+@pytest.mark.parametrize("kind, first, then", [
+    ("liner", "structure liner create by-quadrilateral 0 0 1 1 0 1 1 1 1 0 1 1 id 9223372036854775807",
+     "structure liner create by-quadrilateral 0 0 1 1 0 1 1 1 1 0 1 1"),
+    ("cable", "structure cable create by-line 0.5 0.5 0.1 0.5 0.5 0.9 id 9223372036854775807",
+     "structure cable create by-line 0.2 0.2 0.1 0.2 0.2 0.9"),
+])
+def test_the_id_after_the_largest_64_bit_one_is_refused(session, tmp_path, kind, first, then):
+    # was: the next liner took id -9223372036854775808 (the int64 sum wrapped round), silently
+    with pytest.raises(CommandError) as e:
+        session.call(_deck(tmp_path, RIGID + first + "\n" + then + "\n"))
+    assert e.value.message == f"{kind} ids are used up to 9223372036854775807: give the new {kind}'s `id`"
+    assert e.value.location.line == 6
+    store = session.model.stores["liner_elements" if kind == "liner" else "cable_segments"]
+    assert (store[kind] == 2 ** 63 - 1).all()
