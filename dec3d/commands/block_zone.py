@@ -37,7 +37,9 @@ _TETS_PER_CELL = 6.0
                  "after a joined neighbour takes over the neighbour's gridpoints on their common faces, "
                  "and the copies are linked to one master gridpoint; a warning names the blocks when "
                  "shared faces do not end up with the same triangles (tetrahedra against hexahedra, "
-                 "different divisions). A zoning that would make more than "
+                 "different divisions). Cable, beam and liner nodes made on a block before it was zoned are "
+                 "coupled to its zones from then on (to the zone holding each; a node outside every zone is "
+                 "freed). A zoning that would make more than "
                  "20 million zones is refused before anything is allocated.",
          examples=["block zone generate edgelength 0.5", "block zone generate edge-length 0.2 range pos-x 0 1",
                    "block zone generate hexahedra divisions 2 5 12", "block zone generate high-order-tetra"])
@@ -85,6 +87,8 @@ def block_zone_generate(session, call):
             convert_high_order(model, [int(r) for r in inrange])
     except Dec3dError as exc:
         raise exc.with_location(call.location)
+    from ..model.cables import rehost
+    rehost(model)           # cable, beam and liner nodes made on these blocks before: on their zones now
     rep = conformity(model)
     if rep["unmatched"]:
         pairs = ", ".join(f"{a} / {b} ({n})" for a, b, n in rep["unmatched"][:4])

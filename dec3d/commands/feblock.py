@@ -47,7 +47,8 @@ def _need_configured(session, call, what: str) -> None:
                  "miss, at the six face centres), which leaves uniform, linear and bilinear strain fields alone. "
                  "`feblock change hourglass` sets it per element. FE blocks of one joined set (`block join`, "
                  "before or after meshing) share their coincident nodes and carry no contact between them: "
-                 "one body, as joined zoned blocks.",
+                 "one body, as joined zoned blocks. Cable, beam and liner nodes made on a block before it was "
+                 "meshed are coupled to its elements from then on.",
          examples=["feblock generate 1 1 1", "feblock generate 20 2.5 20 range group 'liner'",
                    "feblock generate 0.5 0.5 0.5 integration 3"])
 def feblock_generate(session, call):
@@ -94,8 +95,10 @@ def feblock_generate(session, call):
         if (model.store("feblocks")["hourglass"][sl] > 0).any():
             thin.append(bid)
     if plans:
+        from ..model.cables import rehost
         from ..model.zone_mesh import relink
         relink(model)       # FE blocks joined before they were meshed share their coincident nodes
+        rehost(model)       # cable, beam and liner nodes made on these blocks before: on their elements now
     if thin:
         session.write(f"note: {call.location}: blocks {', '.join(str(i) for i in thin[:10])} are one element "
                       "thick in two directions: with 2x2x2 integration their cross-sections have a zero-energy "

@@ -28,6 +28,9 @@ from .beam import _sgn
 
 #: ``cpl`` columns
 C_KN, C_KS, C_TY, C_COH, C_COHR, C_TAN = range(6)
+#: a node faster than this [m/s] is unstable (the limit blocks and gridpoints have, ``physics.steps``): a
+#: force of 1e200 N on a node pushed it to 1e190 m/s, finite, and the equilibrium ratio to NaN
+VMAX = 1e6
 
 
 @njit(cache=True)
@@ -123,7 +126,7 @@ def liner_step(dt, g, alpha, damp, safety,
                pos, vel, disp, rot, avel, mass, inert, rt, rr, host, hz, hvel, hpos, nrm, cpl, un, fn, fs, cstate,
                fix, fapp, mapp, force, moment, hforce, hmoment, imass, iinert, kg, conn, bvel, bspin, bcen, last):
     """One step; arguments as ``kernels.beam.beam_step`` (motion) and the module docstring. Returns
-    the number of non-finite nodes."""
+    the number of non-finite or runaway node components (``move_dofs``)."""
     n = pos.shape[0]
     for i in range(n):
         for k in range(3):
@@ -145,7 +148,8 @@ def move_dofs(dt, g, alpha, damp, safety, pos, vel, disp, rot, avel, mass, inert
     by degree of freedom: ``rt, rr (n, 3)`` the Gershgorin row sums of the stiffness over each global
     translation and rotation, inertia max(real, R (Δt / 2 safety)²) on each (stable: Gershgorin's bound
     on M⁻¹K). A shell is far stiffer in its plane than across it; one mass per node would make its
-    bending crawl. ``imass``/``iinert`` get the largest of the three. Returns the non-finite count."""
+    bending crawl. ``imass``/``iinert`` get the largest of the three. Returns the count of
+    non-finite or runaway (speed over ``VMAX``) node components."""
     n = pos.shape[0]
     bad = 0
     q = (dt / (2.0 * safety)) ** 2 if safety > 0.0 else 0.0
@@ -183,6 +187,6 @@ def move_dofs(dt, g, alpha, damp, safety, pos, vel, disp, rot, avel, mass, inert
             pos[i, k] += vel[i, k] * dt
             disp[i, k] += vel[i, k] * dt
             rot[i, k] += avel[i, k] * dt
-            if not (math.isfinite(pos[i, k]) and math.isfinite(rot[i, k])):
+            if not (math.isfinite(pos[i, k]) and math.isfinite(rot[i, k]) and abs(vel[i, k]) <= VMAX):
                 bad += 1
     return bad

@@ -35,7 +35,7 @@ import numpy as np
 from dec3d.kernels.beam import NBPROP
 
 from .cables import place_nodes
-from .hosts import NHOST, host_element, widen
+from .hosts import NHOST, host_element, next_id, widen, zone_hosted
 from .groups import group_field
 from .model import Model
 from .store import Field, Store
@@ -106,8 +106,7 @@ def add_beam(model: Model, p1, p2, segments: int, beam_id, group, tol: float) ->
     -3 in a deformable block none of whose zones or FE elements holds it)."""
     nodes, els = beam_stores(model)
     p1, p2 = np.asarray(p1, float), np.asarray(p2, float)
-    bid = int(beam_id) if beam_id is not None else int(max(nodes["beam"].max(initial=0),
-                                                            els["beam"].max(initial=0)) + 1)
+    bid = int(beam_id) if beam_id is not None else next_id("beam", nodes["beam"], els["beam"])
     eid0 = int(els["id"].max(initial=0)) + 1
     rn, pts, hosts = place_nodes(model, nodes, p1, p2, segments, tol)
     nodes["beam"][rn] = bid
@@ -153,7 +152,7 @@ def remap_beam_hosts(model: Model, remap: np.ndarray) -> int:
     h[ok] = remap[h[ok]]
     lost = ok & (h < 0)
     # zone-hosted nodes of surviving blocks: the zones' and gridpoints' rows moved, find them again
-    for i in np.flatnonzero((h >= 0) & (nodes["hz"] != 0)):
+    for i in zone_hosted(model, h, nodes["hz"]):
         z = host_element(model, int(h[i]), nodes["hpos"][i], 1e-9)
         if z is None:
             h[i] = -1

@@ -38,7 +38,7 @@ import numpy as np
 from dec3d.kernels.cable import NPROP
 
 from .groups import group_field
-from .hosts import NHOST, host_element, widen
+from .hosts import NHOST, host_element, next_id, widen, zone_hosted
 from .model import KIND_RIGID, Model
 from .store import Field, Store
 
@@ -162,8 +162,7 @@ def add_cable(model: Model, p1, p2, segments: int, cable_id: int | None, group: 
     host rows of its nodes). The nodes take the block they lie in as host."""
     nodes, segs = cable_stores(model)
     p1, p2 = np.asarray(p1, _F), np.asarray(p2, _F)
-    cid = int(cable_id) if cable_id is not None else int(max(nodes["cable"].max(initial=0),
-                                                              segs["cable"].max(initial=0)) + 1)
+    cid = int(cable_id) if cable_id is not None else next_id("cable", nodes["cable"], segs["cable"])
     sid0 = int(segs["id"].max(initial=0)) + 1
     rn, pts, hosts = place_nodes(model, nodes, p1, p2, segments, tol)
     nodes["cable"][rn] = cid
@@ -203,6 +202,28 @@ def nodes_hosted_by(model: Model, mask) -> int:
     return int(np.asarray(mask, bool)[h[on]].sum())
 
 
+def rehost(model: Model) -> None:
+    """After blocks were zoned: structural nodes on them find the zone holding them (``remap_hosts`` with
+    no block gone; ``hosts.zone_hosted``). The reaction a node coupled to the block's rigid motion left in
+    the block's applied loads is taken back: from the next step it goes to the zone's gridpoints."""
+    from .beams import BNODES
+    from .liners import LNODES
+
+    b = model.blocks
+    for name in (NODES, BNODES, LNODES):
+        nodes = model.stores.get(name)
+        if nodes is None or not nodes.n:
+            continue
+        h = nodes["host"]
+        moved = zone_hosted(model, h, nodes["hz"])
+        moved = moved[nodes["hz"][moved] == 0]          # (rigid hosts zoned since)
+        np.add.at(b["fapp"], h[moved], -nodes["hforce"][moved])
+        np.add.at(b["mapp"], h[moved], -nodes["hmoment"][moved])
+        nodes["hforce"][moved] = 0.0
+        nodes["hmoment"][moved] = 0.0
+    remap_hosts(model, np.arange(b.n, dtype=np.int64))
+
+
 def remap_hosts(model: Model, remap: np.ndarray) -> None:
     """After blocks are deleted (old row -> new row, -1 gone): nodes whose block went lose their host."""
     st = model.stores
@@ -225,7 +246,7 @@ def remap_hosts(model: Model, remap: np.ndarray) -> None:
         nodes["hforce"][lost] = 0.0
         nodes["hmoment"][lost] = 0.0
         # zone-hosted nodes of surviving blocks: the zones' and gridpoints' rows moved, find them again
-        for i in np.flatnonzero((h >= 0) & (nodes["hz"] != 0)):
+        for i in zone_hosted(model, h, nodes["hz"]):
             z = host_element(model, int(h[i]), nodes["hpos"][i], 1e-9)
             if z is None:
                 h[i] = -1

@@ -96,6 +96,27 @@ def host_element(model, block: int, p: np.ndarray, tol: float):
     return None
 
 
+def zone_hosted(model, host: np.ndarray, hz: np.ndarray) -> np.ndarray:
+    """Rows of the structural nodes (block row ``host``, -1 none; element code ``hz``, 0 a rigid host)
+    whose host element must be found (again): those on an element, whose rows move when blocks go or
+    zones are made again, and those on a block made deformable since (a rigid block zoned after the
+    node was made: it would stay coupled to the block's rigid motion, which a zoned block has not)."""
+    rows = np.flatnonzero(host >= 0)
+    return rows[(hz[rows] != 0) | (model.blocks["kind"][host[rows]] != 0)]
+
+
+def next_id(what: str, *ids: np.ndarray) -> int:
+    """The id after the largest of ``ids`` (a cable's, beam's or liner's: 1 when there are none); a
+    CommandError when that is past 64 bits (an `id 9223372036854775807` given before: the next one
+    wrapped round to a negative id)."""
+    from dec3d.errors import CommandError
+
+    top = max([0] + [int(a.max()) for a in ids if len(a)])
+    if top >= 2 ** 63 - 1:
+        raise CommandError(f"{what} ids are used up to {top}: give the new {what}'s `id`")
+    return top + 1
+
+
 def widen(store, hgp: str = "hgp", hw: str = "hw") -> None:
     """A store restored from a file written when hosts had 4 node slots: widen its ``hgp``/``hw`` to
     NHOST (trailing axis), the new slots repeating the first node with weight 0."""

@@ -42,10 +42,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from dec3d.errors import CommandError
 from dec3d.kernels.dkt import element_frame
 
 from .groups import group_field
-from .hosts import NHOST, host_element, widen
+from .hosts import NHOST, host_element, next_id, widen, zone_hosted
 from .model import Model
 from .store import Field, Store
 
@@ -108,11 +109,13 @@ def add_liner(model: Model, tris: np.ndarray, hosts: np.ndarray, liner_id, group
     from .beams import next_node_id
 
     nodes, els = liner_stores(model)
-    lid = int(liner_id) if liner_id is not None else int(max(nodes["liner"].max(initial=0),
-                                                              els["liner"].max(initial=0)) + 1)
+    lid = int(liner_id) if liner_id is not None else next_id("liner", nodes["liner"], els["liner"])
     hosts = np.asarray(hosts, np.int64)
     edges = np.linalg.norm(tris - np.roll(tris, 1, axis=1), axis=2)
     keep = edges.min(axis=1) > 2.0 * tol                  # (a sliver under the tolerance is no element)
+    if not keep.any():
+        raise CommandError(f"every element has an edge shorter than twice the tolerance {tol:g} m: no liner made "
+                           "(give a smaller `tolerance`)")
     tris, hosts = tris[keep], hosts[keep]
     pts = tris.reshape(-1, 3)
     first, inv = merge_points(pts, tol)
@@ -226,7 +229,7 @@ def remap_liner_hosts(model: Model, remap: np.ndarray) -> int:
     ok = h >= 0
     h[ok] = remap[h[ok]]
     lost = ok & (h < 0)
-    for i in np.flatnonzero((h >= 0) & (nodes["hz"] != 0)):
+    for i in zone_hosted(model, h, nodes["hz"]):
         z = host_element(model, int(h[i]), nodes["hpos"][i], 1e-9)
         if z is None:
             h[i] = -1

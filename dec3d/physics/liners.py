@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from dec3d.kernels.dkt import global_stiffness
-from dec3d.kernels.liner import liner_step
+from dec3d.kernels.liner import VMAX, liner_step
 from dec3d.model.hosts import spread_stiffness
 from dec3d.model.liners import (L_C, L_CR, L_E, L_KN, L_KS, L_NU, L_PHI, L_T, L_TY, has_liners, liner_stores,
                                 node_areas, update_liner_masses)
@@ -205,8 +205,8 @@ class LinerStep:
                          nodes["hmoment"], nodes["imass"], nodes["iinert"], self.kg, self.conn,
                          b["velocity"], b["spin"], b["centroid"], self.last)
         if bad:
-            raise RunError(f"a liner node moved off to infinity at step {m.step + 1} (Δt {r.dt:.3g} s): check the "
-                           f"liner properties")
+            raise RunError(f"a liner node ran away (a speed over {VMAX:g} m/s, or off to infinity) at step "
+                           f"{m.step + 1} (Δt {r.dt:.3g} s): check the liner properties and the loads on its nodes")
         pass_reactions(m, nodes, old_f, old_m, zn)
         return min(n, 1)
 
