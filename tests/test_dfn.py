@@ -314,3 +314,26 @@ def test_cut_over_the_budget_is_refused_and_nothing_is_cut(tmp_path):
     np.testing.assert_array_equal(s.model.vertices["pos"], before[1])
     _run(s, "model budget blocks 100000\nblock cut dfn name 'rock'\n")
     assert s.model.blocks.n > 45
+
+
+def test_cuts_that_would_split_zoned_blocks_are_refused_and_change_nothing(tmp_path):
+    """A joint set or a disk through a zoned block is refused before anything is cut (its zones would
+    not follow the cut: the piece left without zones and the other holding zones past its faces);
+    blocks out of the cut's reach are still cut, and a zoned block the planes miss is no obstacle."""
+    (tmp_path / "two.csv").write_text("id,x,y,z,nx,ny,nz,radius\n1,0.5,0.5,0.5,0,0,1,5.0\n2,2.5,0.5,0.3,0,0,1,5.0\n")
+    base = ("model new\nblock create brick 0 1 0 1 0 1\nblock create brick 2 3 0 1 0 1\n"
+            "block zone generate edgelength 0.5 range position-x 2 3\n")
+    s = _run(_session(tmp_path), base)
+    before = {k: a.copy() for k, a in s.model.blocks.to_arrays().items()}
+    nz = s.model.store("zones").n
+    for line, col in (("block cut joint-set dip 0 origin 0 0 0.5", 1),
+                      ("fracture import from-file 'two.csv'\nblock cut dfn id 1", 1)):
+        with pytest.raises(Dec3dError, match=r"would split zoned or FE blocks \(2\)") as e:
+            _run(s, line)
+        assert e.value.location.column == col
+        after = s.model.blocks.to_arrays()
+        assert all(np.array_equal(before[k], after[k]) for k in before) and s.model.store("zones").n == nz
+    _run(s, "block cut joint-set dip 0 origin 0 0 0.5 range position-x 0 1")   # the rigid block only
+    assert s.model.blocks.n == 3 and s.model.store("zones").n == nz
+    _run(s, "block cut joint-set dip 90 dip-direction 90 origin 1.5 0 0")       # between the blocks: no split
+    assert s.model.blocks.n == 3

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from ..geometry.cutting import cut_joint_set, joint_set_estimate
+from ..model.model import KIND_RIGID
 from .budget import check_blocks
 from .registry import command
 from .values import ANGLE, FLAG, LENGTH, POINT, Num, P
@@ -35,7 +36,8 @@ def block_cut_joint_set(session, call):
                              number=a["number"], mask=mask)
     check_blocks(session, new, "this joint set", call.location)
     made = cut_joint_set(session.model, a["dip"], a["dip_direction"], origin=a["origin"], spacing=a["spacing"],
-                         number=a["number"], mask=mask, join=bool(a["join"]))
+                         number=a["number"], mask=mask, join=bool(a["join"]),
+                         keep_whole=session.model.blocks["kind"] != KIND_RIGID)
     session.results["blocks_made"] = float(made)
 
 

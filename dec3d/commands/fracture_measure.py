@@ -10,6 +10,8 @@ import numpy as np
 from ..errors import CommandError, ResourceError
 from ..geometry import dfn_measure
 from ..geometry.dfn_cut import TooManyBlocks, cut_dfn
+from ..geometry.errors import GeometryError
+from ..model.model import KIND_RIGID
 from ..model import fractures as FR
 from ..units import suffix as unit
 from .budget import budget, check_blocks
@@ -244,7 +246,13 @@ def block_cut_dfn(session, call):
     cap = budget(session).max_blocks()
     try:
         made, used, skipped = cut_dfn(m, c.copy(), n.copy(), r.copy(), FR.fracture_store(m)["id"][rows].copy(), js,
-                                      mask=mask, join=bool(a["join"]), max_blocks=cap)
+                                      mask=mask, join=bool(a["join"]), max_blocks=cap,
+                                      keep_whole=m.blocks["kind"] != KIND_RIGID)
+    except GeometryError as exc:                   # a disk would split a zoned or FE block
+        for k, arrs in keep.items():
+            m.stores[k].load_arrays(arrs)
+        m.next_block_id = next_id
+        raise CommandError(f"{exc}; nothing was cut", call.location) from None
     except TooManyBlocks as exc:
         for k, arrs in keep.items():               # the model as it was before the command
             m.stores[k].load_arrays(arrs)

@@ -96,14 +96,17 @@ def joint_set_estimate(model, dip: float, dip_direction: float, origin=(0.0, 0.0
     return int(total) if total < 1e18 else 10**18
 
 
-def cut_by_planes(model, normal, offsets, mask=None, join: bool = False, compact: bool = True) -> int:
+def cut_by_planes(model, normal, offsets, mask=None, join: bool = False, compact: bool = True,
+                  keep_whole=None) -> int:
     """Cut the visible blocks in ``mask`` by the planes n·x = offsets. Returns new blocks made.
 
     ``join``: the pieces of each block are joined to each other (leader/follower); without
     it, pieces of a joined block stay in its group and pieces of a free block are free.
     ``compact=False`` leaves the parents' old vertex and face rows in the stores (unreferenced;
     a caller cutting many times compacts once, with ``assemble.compact_geometry``); the new rows
-    are then the last ones of each store.
+    are then the last ones of each store. ``keep_whole`` (bool per block row, or None): blocks that must
+    not be split (zoned and FE blocks: their meshes would not follow); ``GeometryError`` before any
+    change when the planes would split one.
     """
     n = np.asarray(normal, dtype=np.float64)
     n = n / np.linalg.norm(n)
@@ -123,6 +126,12 @@ def cut_by_planes(model, normal, offsets, mask=None, join: bool = False, compact
     first[1:] = parent[1:] != parent[:-1]
     extra = ~first
     src = parent[extra]
+    if keep_whole is not None and keep_whole[src].any():     # refused before anything changes
+        bad = np.unique(src[keep_whole[src]])
+        ids = ", ".join(str(int(i)) for i in b["id"][bad[:10]]) + (" …" if bad.size > 10 else "")
+        raise GeometryError(f"the cut would split zoned or FE blocks ({ids}), whose zones or elements would not "
+                            "follow it: cut before `block zone generate` / `feblock generate`, or leave these "
+                            "blocks out of the range")
     # joined parents (followers, or leaders of others), before new rows copy their leader
     lead = b["leader"]
     has_followers = np.zeros(b.n, dtype=bool)
@@ -150,8 +159,9 @@ def cut_by_planes(model, normal, offsets, mask=None, join: bool = False, compact
 
 def cut_joint_set(model, dip: float, dip_direction: float, origin=(0.0, 0.0, 0.0),
                   spacing: float | None = None, number: int | None = None,
-                  mask=None, join: bool = False) -> int:
-    """``block cut joint-set``: dip and dip direction in radians, origin and spacing in m.
+                  mask=None, join: bool = False, keep_whole=None) -> int:
+    """``block cut joint-set``: dip and dip direction in radians, origin and spacing in m;
+    ``keep_whole`` as ``cut_by_planes``'.
 
     Returns the number of new blocks.
     """
@@ -166,4 +176,4 @@ def cut_joint_set(model, dip: float, dip_direction: float, origin=(0.0, 0.0, 0.0
                                 float(s.min()), float(s.max()))
     if offsets.size == 0:
         return 0
-    return cut_by_planes(model, n, offsets, mask=mask, join=join)
+    return cut_by_planes(model, n, offsets, mask=mask, join=join, keep_whole=keep_whole)

@@ -128,11 +128,12 @@ def _prefilter(model, cand, c, n, r, tol):
 
 
 def cut_dfn(model, centers, normals, radii, frac_ids, jointset: int, mask=None,
-            join: bool = False, max_blocks: int | None = None) -> tuple[int, int, int]:
+            join: bool = False, max_blocks: int | None = None, keep_whole=None) -> tuple[int, int, int]:
     """Cut the visible blocks in ``mask`` by the disks in order. Returns (new blocks, disks that cut,
     cuts skipped as slivers). The faces store must hold the int64 fields ``jointset`` and ``fracture``
     (``dec3d.model.fractures.ensure_face_fields``). More than ``max_blocks`` blocks raises
-    ``TooManyBlocks`` at once (the caller puts the model back)."""
+    ``TooManyBlocks`` at once, and a disk that would split a block of ``keep_whole`` (``cutting.cut_by_planes``)
+    ``GeometryError`` (the caller puts the model back after either)."""
     centers, normals, radii = np.asarray(centers, _F), np.asarray(normals, _F), np.asarray(radii, _F)
     tol = float(model.tolerance)
     b, fs = model.blocks, model.faces
@@ -158,7 +159,7 @@ def cut_dfn(model, centers, normals, radii, frac_ids, jointset: int, mask=None,
         m = np.zeros(b.n, bool)
         m[hit] = True
         n0, f0 = b.n, fs.n
-        new = cut_by_planes(model, n, [float(n @ c)], mask=m, join=join, compact=False)
+        new = cut_by_planes(model, n, [float(n @ c)], mask=m, join=join, compact=False, keep_whole=keep_whole)
         # the faces of this cut are appended (nothing is compacted between cuts); the new ones lie on
         # the plane, the others are pieces of older faces and keep what those had
         js = fs["jointset"]
