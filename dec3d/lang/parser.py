@@ -113,6 +113,52 @@ class RawLine:
         return self.items[0].line
 
 
+class KeyLine(RawLine):
+    """A line cut by the template of its key (``_lex_fast``): where it starts in the text (``pos``), its
+    line number and the template ``tpl`` ((kind, start, end) per item, relative to ``pos``; the shape
+    key or None; whether it holds runs of numbers). Its items are made the first time they are asked
+    for: a binder that has the line's plan by its key reads its values from the text itself
+    (``commands.bind_direct``) and most lines of a generated deck never make their tokens."""
+
+    __slots__ = ("text", "pos", "line", "tpl", "_items")
+
+    def __init__(self, text: str, pos: int, line: int, tpl: tuple):
+        self.text, self.pos, self.line, self.tpl = text, pos, line, tpl
+        self.key = tpl[1]
+        self._items = self._tokens = None
+
+    @property
+    def items(self) -> tuple:
+        items = self._items
+        if items is None:
+            items = self._items = _cut(self.text, self.pos, self.line, self.tpl[0])
+            if not self.tpl[2]:
+                self._tokens = items
+        return items
+
+
+def _cut(text: str, pos: int, line: int, tpl: tuple) -> tuple:
+    """The items of the line at ``pos`` of ``text`` by the template of its key (kinds and places)."""
+    return tuple([item_at(text, pos, line, kind, s, e) for kind, s, e in tpl])
+
+
+def item_at(text: str, pos: int, line: int, kind: str, s: int, e: int):
+    """The item of ``kind`` (a Token as lark's lexer makes it, or a ``NumRun``) at ``s:e`` of the line
+    at ``pos`` of ``text``, line number ``line``."""
+    value = text[pos + s:pos + e]
+    if kind == "NUMRUN":
+        if "(" in value or ")" in value or "=" in value:
+            nums = _RUN_SPLIT.split(value)
+        else:
+            nums = value.replace(",", " ").split()
+        return NumRun(value, nums, pos + s, line, pos)
+    tok = str.__new__(Token, value)      # lark's Token._future_new written out
+    tok.type, tok.value, tok.start_pos, tok.end_pos = kind, value, pos + s, pos + e
+    tok.line = tok.end_line = line
+    tok.column, tok.end_column = s + 1, e + 1
+    return tok
+
+
 @lru_cache(maxsize=None)
 def deck_parser() -> Lark:
     return Lark.open(
@@ -280,27 +326,9 @@ def _lex_fast(text: str) -> list[RawLine] | None:
         record = False
         if not current and stop < n_text:         # the line starts a command and ends at a newline
             tpl = templates.get(key)
-            if tpl is not None:  # cut as the line of its key was
-                tpl, shape_key = tpl
-                items = []
-                for kind, s, e in tpl:
-                    value = text[pos + s:pos + e]
-                    if kind == "NUMRUN":
-                        if "(" in value or ")" in value or "=" in value:
-                            nums = _RUN_SPLIT.split(value)
-                        else:
-                            nums = value.replace(",", " ").split()
-                        items.append(NumRun(value, nums, pos + s, line, pos))
-                        runs = True
-                    else:
-                        tok = make(Token, value)
-                        tok.type, tok.value, tok.start_pos, tok.end_pos = kind, value, pos + s, pos + e
-                        tok.line = tok.end_line = line
-                        tok.column, tok.end_column = s + 1, e + 1
-                        items.append(tok)
-                if items:
-                    lines.append(RawLine(tuple(items), runs, shape_key))
-                    runs = False
+            if tpl is not None:  # cut as the line of its key was (its items made when asked for)
+                if tpl[0]:
+                    lines.append(KeyLine(text, pos, line, tpl))
                 pos = stop + 1
                 continue
             if key in seen:      # the second line of its key: the template is made from it
@@ -328,7 +356,8 @@ def _lex_fast(text: str) -> list[RawLine] | None:
                                             if it.type == "NUMRUN" else (it.type, it.start_pos - pos, it.end_pos - pos)
                                             for it in current),
                                       None if any(it.type == "WORD" and _ASCII_DIGIT(it.value) is not None
-                                                  for it in current) else key)
+                                                  for it in current) else key,
+                                      runs)
                 if current:
                     lines.append(RawLine(tuple(current), runs))
                     current = []
