@@ -20,8 +20,8 @@ import math
 
 from ..errors import LazyLocation, SourceLocation
 from ..lang.parser import _NUMBER_IN_RUN, item_at
-from .bind_plan import RunLocation, fill_range, make_call
-from .values import ValueType
+from .bind_plan import RunLocation, Slot, fill_range, fill_value
+from .values import Text, ValueType
 
 _take_one = ValueType.take
 _new, _set = object.__new__, object.__setattr__
@@ -29,17 +29,21 @@ _radians = math.radians
 #: the most digits before the point for which a take's bounds are told by its key (10**15 is exact)
 _STATIC_DIGITS = 15
 _GAP = frozenset(" \t\f,")
+#: number texts whose values a binder remembers (``Binder.numbers``; about 100 bytes each)
+MAX_NUMBERS = 1 << 16
 
 
 class Direct:
-    """A plan's replay on the text of the lines of one key: the stretch ``rs:re`` of the line split
-    into pieces; per take of numbers (value number, first piece, end piece); ``simple``: tuples of
-    numbers known within bounds, ``other``: (n, p0, p1, bounds or None, pieces of negative integers,
-    angle, one value); ``ones``: (n, value type, item) takes of one token; ``need``: items made as
-    tokens (for ``ones`` and locations); locations as ``Plan.clocs`` and ``Plan.cwhere``."""
+    """A plan's replay on the text of the lines of one key (template ``tpl``): the stretch ``rs:re`` of
+    a line split into pieces; per take of numbers (value number, first piece, end piece): ``simple``,
+    tuples of numbers known within bounds, ``other``: (n, p0, p1, bounds or None, pieces of negative
+    integers, angle, one value); ``texts``: (n, item, start, end) takes of a string by ``Text``;
+    ``ones``: (n, value type, item) other takes of one token; locations as ``Plan.clocs`` and the
+    range's element locations, with the items' places; ``lists``: (key, value numbers) of repeated
+    keywords; the first token's column and length (the call's location)."""
 
-    __slots__ = ("plan", "tpl", "rs", "re", "simple", "other", "ones", "need", "n_items", "clocs", "cwhere",
-                 "column", "length")
+    __slots__ = ("plan", "tpl", "rs", "re", "simple", "other", "texts", "ones", "n_items", "clocs", "cwhere",
+                 "lists", "column", "length")
 
 
 def make_direct(plan, raw) -> Direct | None:
@@ -109,10 +113,21 @@ def make_direct(plan, raw) -> Direct | None:
     else:
         d.rs = d.re = 0
     d.simple, d.other = tuple(d.simple), tuple(d.other)
-    d.ones = tuple((st[1], st[2].value, st[3]) for st in plan.compact if st[0])
-    d.clocs, d.cwhere = plan.clocs, plan.cwhere
-    d.need = tuple(sorted({a for _, _, a in d.ones} | {a for _, a, o in d.clocs if o is None}
-                          | {a for a, o in (d.cwhere or {}).values() if o is None}))
+    ones = [(st[1], st[2].value, st[3]) for st in plan.compact if st[0]]
+    d.texts = tuple((n, a, tpl[a][1], tpl[a][2]) for n, vt, a in ones if type(vt) is Text and tpl[a][0] == "STRING")
+    d.ones = tuple(st for st in ones if not (type(st[1]) is Text and tpl[st[2]][0] == "STRING"))
+    d.clocs = tuple((k, tpl[a], o) for k, a, o in plan.clocs)
+    rng = plan.call.range
+    d.cwhere = None if rng is None else tuple((tpl[a], o) for a, o in (plan.cwhere[id(e.location)]
+                                                                       for e in rng.elements))
+    lists = []
+    for k in plan.lists:
+        v = plan.call.args[k]
+        if not all(type(x) is Slot for x in v):
+            lists = None
+            break
+        lists.append((k, tuple(x.n for x in v)))
+    d.lists = None if lists is None else tuple(lists)
     d.column, d.length = tpl[0][1] + 1, (tpl[0][2] - tpl[0][1]) or 1
     return d
 
@@ -141,10 +156,22 @@ def replay_direct(d: Direct, raw, binder):
     values = plan.values.copy()
     try:
         pieces = text[pos + d.rs:pos + d.re].replace(",", " ").split()
+        numbers = binder.numbers
+        known = numbers.__getitem__
         for n, p0, p1 in d.simple:
-            values[n] = tuple(map(float, pieces[p0:p1]))
+            strs = pieces[p0:p1]
+            try:
+                values[n] = tuple(map(known, strs))
+            except KeyError:
+                values[n] = vals = tuple(map(float, strs))
+                _remember(numbers, strs, vals)
         for n, p0, p1, bounds, negint, angle, one in d.other:
-            vals = list(map(float, pieces[p0:p1]))
+            strs = pieces[p0:p1]
+            try:
+                vals = list(map(known, strs))
+            except KeyError:
+                vals = list(map(float, strs))
+                _remember(numbers, strs, vals)
             for k in negint:                 # an integer zero is +0.0 (`-0` is float(int('-0')))
                 if vals[k - p0] == 0.0:
                     vals[k - p0] = 0.0
@@ -157,30 +184,43 @@ def replay_direct(d: Direct, raw, binder):
                 vals = [_radians(v) for v in vals]
             values[n] = vals[0] if one else tuple(vals)
         deck, stack = binder.deck, binder.stack
-        tpl = d.tpl[0]
-        items = None
-        if d.need:
+        for n, a, s, e in d.texts:           # Text.take of a STRING, written out
+            values[n] = text[pos + s + 1:pos + e - 1]
+        if d.ones:
+            tpl = d.tpl[0]
             items = [None] * d.n_items
-            for a in d.need:
+            for n, vt, a in d.ones:
                 kind, s, e = tpl[a]
                 items[a] = item_at(text, pos, line, kind, s, e)
-            for n, vt, a in d.ones:
                 values[n] = _take_one(vt, items, a, binder)[0]
-        locs = {k: LazyLocation(deck, items[a], stack) if o is None else _run_location(deck, raw, tpl[a], o, stack)
-                for k, a, o in d.clocs}
+        locs = {}
+        for k, item, o in d.clocs:
+            locs[k] = _location(deck, raw, item, o, stack)
         rng = plan.call.range
         if rng is not None:
-            where = d.cwhere
-            rng = fill_range(rng, values, [LazyLocation(deck, items[a], stack) if o is None
-                                           else _run_location(deck, raw, tpl[a], o, stack)
-                                           for a, o in (where[id(e.location)] for e in rng.elements)])
+            rng = fill_range(rng, values, [_location(deck, raw, item, o, stack) for item, o in d.cwhere])
         lines = deck.source_lines
         loc = _new(SourceLocation)           # ParsedDeck.location of the line's first token, written out
         _set(loc, "__dict__", {"file": deck.filename, "line": line, "column": d.column,
                                "text": lines[line - 1] if 0 < line <= len(lines) else "", "length": d.length,
                                "stack": stack if type(stack) is tuple else tuple(stack)})
-        call = make_call(plan, values, locs, rng, loc, (lines, line, line))
-        cmd = call.command
+        # bind_plan.make_call, written out
+        tcall = plan.call
+        args = tcall.args.copy()
+        for k, n in plan.holes:
+            args[k] = values[n]
+        if d.lists is not None:              # repeated keywords: a new list for every call
+            get = values.__getitem__
+            for k, ns in d.lists:
+                args[k] = list(map(get, ns))
+        else:
+            for k in plan.lists:
+                args[k] = fill_value(args[k], values)
+        extra = {k: fill_value(v, values) for k, v in tcall.extra.items()} if tcall.extra else {}
+        call = _new(type(tcall))
+        _set(call, "__dict__", {"command": tcall.command, "args": args, "given": tcall.given, "range": rng,
+                                "location": loc, "extra": extra, "locations": locs, "span": (lines, line, line)})
+        cmd = tcall.command
         if cmd.check is not None:
             cmd.check(call)
     except Exception:
@@ -188,10 +228,31 @@ def replay_direct(d: Direct, raw, binder):
     return call
 
 
-def _run_location(deck, raw, item, k, stack) -> RunLocation:
-    """``RunLocation`` of the k-th number of the run at ``item`` (kind, start, end) of the line ``raw``."""
+def _remember(numbers: dict, strs, vals) -> None:
+    """``numbers`` learns the values of the texts ``strs`` (emptied when it has ``MAX_NUMBERS``)."""
+    if len(numbers) >= MAX_NUMBERS:
+        numbers.clear()
+    numbers.update(zip(strs, vals))
+
+
+def _location(deck, raw, item, o, stack):
+    """The location of the item (kind, start, end) of the line ``raw``, or of its o-th number."""
     pos = raw.pos
+    if o is None:
+        loc = _new(ItemLocation)
+        loc.deck, loc.stack, loc.text, loc.pos, loc.line, loc.item = deck, stack, raw.text, pos, raw.line, item
+        return loc
     loc = _new(RunLocation)
-    loc.deck, loc.k, loc.stack = deck, k, stack
+    loc.deck, loc.k, loc.stack = deck, o, stack
     loc.text, loc.start, loc.line, loc.line_start = raw.text[pos + item[1]:pos + item[2]], pos + item[1], raw.line, pos
     return loc
+
+
+class ItemLocation(LazyLocation):
+    """The location of an item of a line bound from its text: its token is made only when asked for."""
+
+    __slots__ = ("text", "pos", "line", "item")
+
+    @property
+    def token(self):
+        return item_at(self.text, self.pos, self.line, *self.item)

@@ -122,6 +122,9 @@ class Binder:
         # a line's lexer key -> a plan of its shape (``RawLine.key``: lines of one key have one shape;
         # a string's hash is kept, a shape's is not)
         self.by_key: dict[str, Plan] = {}
+        # number text -> its float, for lines bound from their text (bind_direct): a polyhedron's
+        # line writes each corner three times, and neighbouring blocks share corners
+        self.numbers: dict[str, float] = {}
         self._steps: list | None = None             # the takes of the line being planned
 
     # ------------------------------------------------------------ helpers

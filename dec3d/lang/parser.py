@@ -36,6 +36,8 @@ _new, _set = object.__new__, object.__setattr__
 # the characters refused in strings and `[ ]`, but newlines: no token holds one
 _CONTROL_NOT_NL = re.compile(CONTROL_CHARS.pattern.replace("\x0a-", "\x0b-", 1))
 assert _CONTROL_NOT_NL.pattern != CONTROL_CHARS.pattern
+#: the bytes of ASCII text that are none of those characters (deleted, what is left is the controls)
+_NOT_CONTROL_ASCII = bytes(b for b in range(256) if b > 127 or _CONTROL_NOT_NL.match(chr(b)) is None)
 # the numbers of a run (``NumRun``): NUMBER without its look-ahead (a run holds numbers and
 # delimiters only); a run is split at its delimiters
 _NUMBER_IN_RUN = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
@@ -240,12 +242,20 @@ def parse_deck(text: str, filename: str = "<input>", stack=()) -> ParsedDeck:
                 lines = _lex_lark(lifted, check)
     except UnexpectedInput as exc:
         raise _syntax_error(exc, filename, source_lines, stack) from None
-    if _CONTROL_NOT_NL.search(lifted) is not None:    # else no string or `[ ]` can hold one
+    if _has_control(lifted):            # else no string or `[ ]` can hold one
         for line in lines:
             for tok in line.items:
                 if tok.type in ("STRING", "EXPR"):
                     check(tok)
     return ParsedDeck(filename, source_lines, lines, fish)
+
+
+def _has_control(text: str) -> bool:
+    """Whether ``text`` holds a character of ``_CONTROL_NOT_NL`` (ASCII text by ``bytes.translate``,
+    a quarter of the time of the regular expression's search)."""
+    if text.isascii():
+        return len(text.encode("ascii").translate(None, _NOT_CONTROL_ASCII)) > 0
+    return _CONTROL_NOT_NL.search(text) is not None
 
 
 def _lex_lark(text: str, check=None) -> list[RawLine]:
