@@ -244,6 +244,11 @@ def parse_deck(text: str, filename: str = "<input>", stack=()) -> ParsedDeck:
         raise _syntax_error(exc, filename, source_lines, stack) from None
     if _has_control(lifted):            # else no string or `[ ]` can hold one
         for line in lines:
+            if type(line) is KeyLine:   # its strings only (its other items are not made for this)
+                for kind, s, e in line.tpl[0]:
+                    if kind == "STRING" or kind == "EXPR":
+                        check(item_at(line.text, line.pos, line.line, kind, s, e))
+                continue
             for tok in line.items:
                 if tok.type in ("STRING", "EXPR"):
                     check(tok)
