@@ -20,7 +20,7 @@ import math
 
 from ..errors import LazyLocation, SourceLocation
 from ..lang.parser import _NUMBER_IN_RUN, item_at
-from .bind_plan import RunLocation, Slot, fill_range, fill_value
+from .bind_plan import RunLocation, Slot, _compact, fill_range, fill_value
 from .values import Text, ValueType
 
 _take_one = ValueType.take
@@ -49,14 +49,23 @@ class Direct:
 def make_direct(plan, raw) -> Direct | None:
     """The direct replay of ``plan`` on lines of the key of ``raw`` (a ``KeyLine``), or None when the
     plan takes something other than numbers, whole tokens and runs split by blanks and commas."""
-    if plan.compact is None:
-        return None
     tpl, key = raw.tpl[0], raw.key
     if key is None or len(tpl) == 0:
         return None
+    compact, batch, clocs, cwhere = plan.compact, plan.batch, plan.clocs, plan.cwhere
+    if compact is None:
+        if raw.tpl[2]:
+            return None
+        items = raw.items                # no runs: the plan's tokens are the line's items
+        got = _compact(plan.vsteps, items, items)
+        if got is None:
+            return None
+        compact, where = got
+        clocs = tuple((k, *where[i]) for k, i in plan.locs)
+        cwhere = {k: where[i] for k, i in plan.where.items()}
     used = set()                         # items whose numbers are taken
     steps = []                           # (n, segments, inline, one)
-    for st in plan.compact:
+    for st in compact:
         if st[0]:
             continue
         _, n, segs, inline, one = st
@@ -65,8 +74,8 @@ def make_direct(plan, raw) -> Direct | None:
                 return None              # `[ ]` or `@name` among the numbers
             used.add(a)
         steps.append((n, segs, inline, one))
-    if plan.batch is not None:
-        inline, takes = plan.batch
+    if batch is not None:
+        inline, takes = batch
         for n, a, count in takes:
             if tpl[a][0] != "NUMRUN":
                 return None
@@ -113,12 +122,12 @@ def make_direct(plan, raw) -> Direct | None:
     else:
         d.rs = d.re = 0
     d.simple, d.other = tuple(d.simple), tuple(d.other)
-    ones = [(st[1], st[2].value, st[3]) for st in plan.compact if st[0]]
+    ones = [(st[1], st[2].value, st[3]) for st in compact if st[0]]
     d.texts = tuple((n, a, tpl[a][1], tpl[a][2]) for n, vt, a in ones if type(vt) is Text and tpl[a][0] == "STRING")
     d.ones = tuple(st for st in ones if not (type(st[1]) is Text and tpl[st[2]][0] == "STRING"))
-    d.clocs = tuple((k, tpl[a], o) for k, a, o in plan.clocs)
+    d.clocs = tuple((k, tpl[a], o) for k, a, o in clocs)
     rng = plan.call.range
-    d.cwhere = None if rng is None else tuple((tpl[a], o) for a, o in (plan.cwhere[id(e.location)]
+    d.cwhere = None if rng is None else tuple((tpl[a], o) for a, o in (cwhere[id(e.location)]
                                                                        for e in rng.elements))
     lists = []
     for k in plan.lists:

@@ -141,7 +141,23 @@ class KeyLine(RawLine):
 
 def _cut(text: str, pos: int, line: int, tpl: tuple) -> tuple:
     """The items of the line at ``pos`` of ``text`` by the template of its key (kinds and places)."""
-    return tuple([item_at(text, pos, line, kind, s, e) for kind, s, e in tpl])
+    make = str.__new__           # lark's Token._future_new written out (item_at, inline)
+    items = []
+    for kind, s, e in tpl:
+        value = text[pos + s:pos + e]
+        if kind == "NUMRUN":
+            if "(" in value or ")" in value or "=" in value:
+                nums = _RUN_SPLIT.split(value)
+            else:
+                nums = value.replace(",", " ").split()
+            items.append(NumRun(value, nums, pos + s, line, pos))
+        else:
+            tok = make(Token, value)
+            tok.type, tok.value, tok.start_pos, tok.end_pos = kind, value, pos + s, pos + e
+            tok.line = tok.end_line = line
+            tok.column, tok.end_column = s + 1, e + 1
+            items.append(tok)
+    return tuple(items)
 
 
 def item_at(text: str, pos: int, line: int, kind: str, s: int, e: int):
