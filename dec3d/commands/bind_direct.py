@@ -30,7 +30,8 @@ _radians = math.radians
 _STATIC_DIGITS = 15
 _GAP = frozenset(" \t\f,")
 #: number texts whose values a binder remembers (``Binder.numbers``; about 100 bytes each)
-MAX_NUMBERS = 1 << 16
+MAX_NUMBERS = 1 << 14
+MIN_LOOKS = 512
 
 
 class Direct:
@@ -43,7 +44,7 @@ class Direct:
     keywords; the first token's column and length (the call's location)."""
 
     __slots__ = ("plan", "tpl", "rs", "re", "simple", "other", "texts", "ones", "n_items", "clocs", "cwhere",
-                 "lists", "column", "length")
+                 "lists", "column", "length", "looks")
 
 
 def make_direct(plan, raw) -> Direct | None:
@@ -122,6 +123,7 @@ def make_direct(plan, raw) -> Direct | None:
     else:
         d.rs = d.re = 0
     d.simple, d.other = tuple(d.simple), tuple(d.other)
+    d.looks = len(d.simple) + len(d.other)
     ones = [(st[1], st[2].value, st[3]) for st in compact if st[0]]
     d.texts = tuple((n, a, tpl[a][1], tpl[a][2]) for n, vt, a in ones if type(vt) is Text and tpl[a][0] == "STRING")
     d.ones = tuple(st for st in ones if not (type(st[1]) is Text and tpl[st[2]][0] == "STRING"))
@@ -166,21 +168,27 @@ def replay_direct(d: Direct, raw, binder):
     try:
         pieces = text[pos + d.rs:pos + d.re].replace(",", " ").split()
         numbers = binder.numbers
-        known = numbers.__getitem__
-        for n, p0, p1 in d.simple:
-            strs = pieces[p0:p1]
-            try:
-                values[n] = tuple(map(known, strs))
-            except KeyError:
-                values[n] = vals = tuple(map(float, strs))
-                _remember(numbers, strs, vals)
+        if numbers is None:              # the table is off (``_remember``)
+            for n, p0, p1 in d.simple:
+                values[n] = tuple(map(float, pieces[p0:p1]))
+            known = float
+        else:
+            known = numbers.__getitem__
+            binder.looked += d.looks
+            for n, p0, p1 in d.simple:
+                strs = pieces[p0:p1]
+                try:
+                    values[n] = tuple(map(known, strs))
+                except KeyError:
+                    values[n] = vals = tuple(map(float, strs))
+                    _remember(binder, strs, vals)
         for n, p0, p1, bounds, negint, angle, one in d.other:
             strs = pieces[p0:p1]
             try:
                 vals = list(map(known, strs))
             except KeyError:
                 vals = list(map(float, strs))
-                _remember(numbers, strs, vals)
+                _remember(binder, strs, vals)
             for k in negint:                 # an integer zero is +0.0 (`-0` is float(int('-0')))
                 if vals[k - p0] == 0.0:
                     vals[k - p0] = 0.0
@@ -237,8 +245,17 @@ def replay_direct(d: Direct, raw, binder):
     return call
 
 
-def _remember(numbers: dict, strs, vals) -> None:
-    """``numbers`` learns the values of the texts ``strs`` (emptied when it has ``MAX_NUMBERS``)."""
+def _remember(binder, strs, vals) -> None:
+    """The binder's table of numbers learns the values of the texts ``strs`` (emptied when it holds
+    ``MAX_NUMBERS``); it is given up (None) when more than a third of the takes looked up there
+    missed it, after the first ``MIN_LOOKS`` takes: a take that misses costs its look-ups, an exception
+    and the insertions (twice what the hit of one saves), numbers that seldom come back are faster
+    converted every time."""
+    numbers = binder.numbers
+    binder.missed += 1
+    if binder.looked >= MIN_LOOKS and binder.missed * 3 > binder.looked:
+        binder.numbers = None
+        return
     if len(numbers) >= MAX_NUMBERS:
         numbers.clear()
     numbers.update(zip(strs, vals))

@@ -124,7 +124,8 @@ class Binder:
         self.by_key: dict[str, Plan] = {}
         # number text -> its float, for lines bound from their text (bind_direct): a polyhedron's
         # line writes each corner three times, and neighbouring blocks share corners
-        self.numbers: dict[str, float] = {}
+        self.numbers: dict[str, float] | None = {}
+        self.looked = self.missed = 0             # takes of numbers looked up there, and missed
         self._steps: list | None = None             # the takes of the line being planned
 
     # ------------------------------------------------------------ helpers

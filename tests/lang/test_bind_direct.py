@@ -100,12 +100,34 @@ def test_every_number_form_in_a_polyhedron_run():
         assert _direct_count(text) > 0 or form in ("#" * 30, "#e99#", "-#e99#")
 
 
+def _binder_after(text: str) -> Binder:
+    deck = parse_deck(text, "t.dat")
+    binder = Binder(deck, BindContext(lenient_names=True))
+    for raw in deck.lines:
+        _outcome(binder.bind_line, raw)
+    return binder
+
+
 def test_the_table_of_numbers_when_full(monkeypatch):
     """The table of number texts (``Binder.numbers``) emptied when full gives the same values."""
     monkeypatch.setattr(bind_direct, "MAX_NUMBERS", 7)
+    monkeypatch.setattr(bind_direct, "MIN_LOOKS", 10**9)       # never given up
     text = _deck(17, 1500, forms=["#", "-#", "#.#", "-0", "-0.0", ".#", "#.", "##"])
+    assert _binder_after(text).numbers is not None
     assert _direct_count(text) > 300
     assert _same_outcomes(text, "t.dat") > 600
+
+
+def test_the_table_of_numbers_given_up():
+    """Numbers that seldom come back: the table is given up (the values converted each time), and
+    where it was kept, the same values."""
+    text = _deck(19, 3000, forms=["#.######", "-##.#####", "#e-#", "##.####"])
+    assert _binder_after(text).numbers is None
+    assert _direct_count(text) > 1000
+    assert _same_outcomes(text, "t.dat") > 1500
+    kept = _deck(19, 3000, forms=["#", "-#"])
+    assert _binder_after(kept).numbers is not None
+    assert _same_outcomes(kept, "t.dat") > 1500
 
 
 @pytest.mark.parametrize("key, inline, within", [
