@@ -100,7 +100,7 @@ def make_direct(plan, raw) -> Direct | None:
                 return None
             text = key[s:e]
             cnt = len(text.replace(",", " ").split())
-            if kind == "NUMRUN" and cnt != len(_NUMBER_IN_RUN.findall(text)) or kind in ("NUMBER", "WORD") and cnt != 1:
+            if kind in ("NUMBER", "WORD") and cnt != 1:     # a run's pieces are its numbers (``NumRun.nums``)
                 return None
             start[a] = p
             p, at = p + cnt, e
@@ -111,11 +111,13 @@ def make_direct(plan, raw) -> Direct | None:
             for a, o0, o1 in segs:
                 idx.extend([start[a]] if o0 is None else range(start[a] + o0, start[a] + o1))
             p0, p1 = idx[0], idx[-1] + 1
-            if idx != list(range(p0, p1)) or not all(_NUMBER_IN_RUN.fullmatch(q) for q in pieces[p0:p1]):
+            forms = set(pieces[p0:p1])   # digits are 0 in the key: a few forms
+            if idx != list(range(p0, p1)) or not all(_NUMBER_IN_RUN.fullmatch(q) for q in forms):
                 return None
             lo, lo_closed, hi, hi_closed, angle = inline
-            negint = tuple(k for k in range(p0, p1) if pieces[k][0] == "-" and not any(c in pieces[k] for c in ".eE"))
-            bounds = None if _within(pieces[p0:p1], inline) else (lo, lo_closed, hi, hi_closed)
+            negint = tuple(k for k in range(p0, p1) if pieces[k][0] == "-" and "." not in pieces[k]
+                           and "e" not in pieces[k] and "E" not in pieces[k])
+            bounds = None if _within(forms, inline) else (lo, lo_closed, hi, hi_closed)
             if bounds is None and not negint and not angle and not one:
                 d.simple.append((n, p0, p1))
             else:
