@@ -213,7 +213,8 @@ def normalise(text: str) -> str:
         text = text[1:]
     if text.endswith("\x1a"):            # a DOS end-of-file mark (Ctrl-Z) after the last line
         text = text[:-1]
-    text = text.replace("\r\n", "\n").replace("\r", "\n")
+    if "\r" in text:
+        text = text.replace("\r\n", "\n").replace("\r", "\n")
     if not text.endswith("\n"):
         text += "\n"
     return text
@@ -339,6 +340,7 @@ def _lex_fast(text: str) -> list[RawLine] | None:
     lines each of its own key is lexed as before.)"""
     pat, ignore = _fast_pattern()
     make = str.__new__           # lark's Token._future_new written out: a call less per token
+    new_line = object.__new__
     lines: list[RawLine] = []
     current: list[Token] = []
     templates: dict[str, tuple] = {}
@@ -358,8 +360,11 @@ def _lex_fast(text: str) -> list[RawLine] | None:
         if not current and stop < n_text:         # the line starts a command and ends at a newline
             tpl = templates.get(key)
             if tpl is not None:  # cut as the line of its key was (its items made when asked for)
-                if tpl[0]:
-                    lines.append(KeyLine(text, pos, line, tpl))
+                if tpl[0]:       # KeyLine(text, pos, line, tpl), written out
+                    kl = new_line(KeyLine)
+                    kl.text, kl.pos, kl.line, kl.tpl, kl.key = text, pos, line, tpl, tpl[1]
+                    kl._items = kl._tokens = None
+                    lines.append(kl)
                 pos = stop + 1
                 continue
             if key in seen:      # the second line of its key: the template is made from it
