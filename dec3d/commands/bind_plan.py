@@ -131,7 +131,7 @@ class Plan:
     ``cwhere``), or None."""
 
     __slots__ = ("call", "steps", "vsteps", "values", "holes", "lists", "locs", "where", "compact", "clocs",
-                 "cwhere", "batch")
+                 "cwhere", "batch", "direct")
 
     def __init__(self, call, steps, toks, items=None, values=None):
         self.call = call
@@ -154,6 +154,7 @@ class Plan:
             for e in call.range.elements:
                 self.where[id(e.location)] = ids[id(e.location.token)]
         self.compact = self.clocs = self.cwhere = self.batch = None
+        self.direct = {}                  # lexer key -> its replay on the text (``bind_direct``), or False
         if items is not None and items is not toks:
             got = _compact(self.vsteps, toks, items)
             if got is not None:
@@ -299,6 +300,11 @@ def fill_range(rng, values, locations):
 
 
 def fill_call(plan: Plan, values, locs, rng, first, last_line, deck, stack):
+    return make_call(plan, values, locs, rng, deck.location(first, stack), (deck.source_lines, first.line, last_line))
+
+
+def make_call(plan: Plan, values, locs, rng, location, span):
+    """The plan's call with the holes filled from ``values``, at ``location``, spanning ``span``."""
     tpl = plan.call
     args = tpl.args.copy()                # the keys in the order binding gave them
     for k, n in plan.holes:
@@ -308,6 +314,5 @@ def fill_call(plan: Plan, values, locs, rng, first, last_line, deck, stack):
     extra = {k: fill_value(v, values) for k, v in tpl.extra.items()} if tpl.extra else {}
     call = _new(type(tpl))                # errors.frozen_instance written out
     _set(call, "__dict__", {"command": tpl.command, "args": args, "given": tpl.given, "range": rng,
-                            "location": deck.location(first, stack), "extra": extra, "locations": locs,
-                            "span": (deck.source_lines, first.line, last_line)})
+                            "location": location, "extra": extra, "locations": locs, "span": span})
     return call

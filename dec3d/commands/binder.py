@@ -16,7 +16,8 @@ from ..errors import (BindError, DeckSyntaxError, LazyLocation, LegacySyntaxErro
                       SourceLocation, UnimplementedError, frozen_instance)
 from ..lang.abbrev import matches, suggest
 from ..lang.expr import check_names, parse_expression
-from ..lang.parser import ParsedDeck, RawLine
+from ..lang.parser import KeyLine, ParsedDeck, RawLine
+from .bind_direct import make_direct, replay_direct
 from .bind_plan import MAX_PLANS, Plan, Slot, fill, replay, shape
 from .legacy import legacy_hint
 from .registry import REGISTRY, Command, Node, RangeElement, Registry
@@ -121,6 +122,10 @@ class Binder:
         # a line's lexer key -> a plan of its shape (``RawLine.key``: lines of one key have one shape;
         # a string's hash is kept, a shape's is not)
         self.by_key: dict[str, Plan] = {}
+        # number text -> its float, for lines bound from their text (bind_direct): a polyhedron's
+        # line writes each corner three times, and neighbouring blocks share corners
+        self.numbers: dict[str, float] | None = {}
+        self.looked = self.missed = 0             # takes of numbers looked up there, and missed
         self._steps: list | None = None             # the takes of the line being planned
 
     # ------------------------------------------------------------ helpers
@@ -183,6 +188,17 @@ class Binder:
     # ------------------------------------------------------------ commands
     def bind_line(self, raw: RawLine) -> "CommandCall | ExprStatement":
         """Any line: a `[ ... ]` statement, an `@name` call, or a command."""
+        lkey = raw.key
+        if lkey is not None and type(raw) is KeyLine:     # by its key's plan, from the text (bind_direct)
+            plan = self.by_key.get(lkey)
+            if plan is not None:
+                d = plan.direct.get(lkey)
+                if d is None:
+                    d = plan.direct[lkey] = make_direct(plan, raw) or False
+                if d and d.tpl is raw.tpl:
+                    call = replay_direct(d, raw, self)
+                    if call is not None:
+                        return call
         toks = raw.items
         first = toks[0]
         if len(toks) == 1 and first.type == "EXPR":
@@ -195,8 +211,7 @@ class Binder:
             self.deferred(first)                 # checks the name; a FISH function is called when it runs
             return ExprStatement(("name", str(first)[1:].lower(), 1), self.deck.location(first, self.stack),
                                  str(first))
-        lkey = raw.key                           # a command: by its lexer key's plan, if any
-        tried = None
+        tried = None                             # a command: by its lexer key's plan, if any
         if lkey is not None:
             tried = self.by_key.get(lkey)
             if tried is not None:

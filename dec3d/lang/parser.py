@@ -36,6 +36,8 @@ _new, _set = object.__new__, object.__setattr__
 # the characters refused in strings and `[ ]`, but newlines: no token holds one
 _CONTROL_NOT_NL = re.compile(CONTROL_CHARS.pattern.replace("\x0a-", "\x0b-", 1))
 assert _CONTROL_NOT_NL.pattern != CONTROL_CHARS.pattern
+#: the bytes of ASCII text that are none of those characters (deleted, what is left is the controls)
+_NOT_CONTROL_ASCII = bytes(b for b in range(256) if b > 127 or _CONTROL_NOT_NL.match(chr(b)) is None)
 # the numbers of a run (``NumRun``): NUMBER without its look-ahead (a run holds numbers and
 # delimiters only); a run is split at its delimiters
 _NUMBER_IN_RUN = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
@@ -113,6 +115,68 @@ class RawLine:
         return self.items[0].line
 
 
+class KeyLine(RawLine):
+    """A line cut by the template of its key (``_lex_fast``): where it starts in the text (``pos``), its
+    line number and the template ``tpl`` ((kind, start, end) per item, relative to ``pos``; the shape
+    key or None; whether it holds runs of numbers). Its items are made the first time they are asked
+    for: a binder that has the line's plan by its key reads its values from the text itself
+    (``commands.bind_direct``) and most lines of a generated deck never make their tokens."""
+
+    __slots__ = ("text", "pos", "line", "tpl", "_items")
+
+    def __init__(self, text: str, pos: int, line: int, tpl: tuple):
+        self.text, self.pos, self.line, self.tpl = text, pos, line, tpl
+        self.key = tpl[1]
+        self._items = self._tokens = None
+
+    @property
+    def items(self) -> tuple:
+        items = self._items
+        if items is None:
+            items = self._items = _cut(self.text, self.pos, self.line, self.tpl[0])
+            if not self.tpl[2]:
+                self._tokens = items
+        return items
+
+
+def _cut(text: str, pos: int, line: int, tpl: tuple) -> tuple:
+    """The items of the line at ``pos`` of ``text`` by the template of its key (kinds and places)."""
+    make = str.__new__           # lark's Token._future_new written out (item_at, inline)
+    items = []
+    for kind, s, e in tpl:
+        value = text[pos + s:pos + e]
+        if kind == "NUMRUN":
+            if "(" in value or ")" in value or "=" in value:
+                nums = _RUN_SPLIT.split(value)
+            else:
+                nums = value.replace(",", " ").split()
+            items.append(NumRun(value, nums, pos + s, line, pos))
+        else:
+            tok = make(Token, value)
+            tok.type, tok.value, tok.start_pos, tok.end_pos = kind, value, pos + s, pos + e
+            tok.line = tok.end_line = line
+            tok.column, tok.end_column = s + 1, e + 1
+            items.append(tok)
+    return tuple(items)
+
+
+def item_at(text: str, pos: int, line: int, kind: str, s: int, e: int):
+    """The item of ``kind`` (a Token as lark's lexer makes it, or a ``NumRun``) at ``s:e`` of the line
+    at ``pos`` of ``text``, line number ``line``."""
+    value = text[pos + s:pos + e]
+    if kind == "NUMRUN":
+        if "(" in value or ")" in value or "=" in value:
+            nums = _RUN_SPLIT.split(value)
+        else:
+            nums = value.replace(",", " ").split()
+        return NumRun(value, nums, pos + s, line, pos)
+    tok = str.__new__(Token, value)      # lark's Token._future_new written out
+    tok.type, tok.value, tok.start_pos, tok.end_pos = kind, value, pos + s, pos + e
+    tok.line = tok.end_line = line
+    tok.column, tok.end_column = s + 1, e + 1
+    return tok
+
+
 @lru_cache(maxsize=None)
 def deck_parser() -> Lark:
     return Lark.open(
@@ -149,7 +213,8 @@ def normalise(text: str) -> str:
         text = text[1:]
     if text.endswith("\x1a"):            # a DOS end-of-file mark (Ctrl-Z) after the last line
         text = text[:-1]
-    text = text.replace("\r\n", "\n").replace("\r", "\n")
+    if "\r" in text:
+        text = text.replace("\r\n", "\n").replace("\r", "\n")
     if not text.endswith("\n"):
         text += "\n"
     return text
@@ -194,12 +259,25 @@ def parse_deck(text: str, filename: str = "<input>", stack=()) -> ParsedDeck:
                 lines = _lex_lark(lifted, check)
     except UnexpectedInput as exc:
         raise _syntax_error(exc, filename, source_lines, stack) from None
-    if _CONTROL_NOT_NL.search(lifted) is not None:    # else no string or `[ ]` can hold one
+    if _has_control(lifted):            # else no string or `[ ]` can hold one
         for line in lines:
+            if type(line) is KeyLine:   # its strings only (its other items are not made for this)
+                for kind, s, e in line.tpl[0]:
+                    if kind == "STRING" or kind == "EXPR":
+                        check(item_at(line.text, line.pos, line.line, kind, s, e))
+                continue
             for tok in line.items:
                 if tok.type in ("STRING", "EXPR"):
                     check(tok)
     return ParsedDeck(filename, source_lines, lines, fish)
+
+
+def _has_control(text: str) -> bool:
+    """Whether ``text`` holds a character of ``_CONTROL_NOT_NL`` (ASCII text by ``bytes.translate``,
+    a quarter of the time of the regular expression's search)."""
+    if text.isascii():
+        return len(text.encode("ascii").translate(None, _NOT_CONTROL_ASCII)) > 0
+    return _CONTROL_NOT_NL.search(text) is not None
 
 
 def _lex_lark(text: str, check=None) -> list[RawLine]:
@@ -262,6 +340,7 @@ def _lex_fast(text: str) -> list[RawLine] | None:
     lines each of its own key is lexed as before.)"""
     pat, ignore = _fast_pattern()
     make = str.__new__           # lark's Token._future_new written out: a call less per token
+    new_line = object.__new__
     lines: list[RawLine] = []
     current: list[Token] = []
     templates: dict[str, tuple] = {}
@@ -280,27 +359,12 @@ def _lex_fast(text: str) -> list[RawLine] | None:
         record = False
         if not current and stop < n_text:         # the line starts a command and ends at a newline
             tpl = templates.get(key)
-            if tpl is not None:  # cut as the line of its key was
-                tpl, shape_key = tpl
-                items = []
-                for kind, s, e in tpl:
-                    value = text[pos + s:pos + e]
-                    if kind == "NUMRUN":
-                        if "(" in value or ")" in value or "=" in value:
-                            nums = _RUN_SPLIT.split(value)
-                        else:
-                            nums = value.replace(",", " ").split()
-                        items.append(NumRun(value, nums, pos + s, line, pos))
-                        runs = True
-                    else:
-                        tok = make(Token, value)
-                        tok.type, tok.value, tok.start_pos, tok.end_pos = kind, value, pos + s, pos + e
-                        tok.line = tok.end_line = line
-                        tok.column, tok.end_column = s + 1, e + 1
-                        items.append(tok)
-                if items:
-                    lines.append(RawLine(tuple(items), runs, shape_key))
-                    runs = False
+            if tpl is not None:  # cut as the line of its key was (its items made when asked for)
+                if tpl[0]:       # KeyLine(text, pos, line, tpl), written out
+                    kl = new_line(KeyLine)
+                    kl.text, kl.pos, kl.line, kl.tpl, kl.key = text, pos, line, tpl, tpl[1]
+                    kl._items = kl._tokens = None
+                    lines.append(kl)
                 pos = stop + 1
                 continue
             if key in seen:      # the second line of its key: the template is made from it
@@ -328,7 +392,8 @@ def _lex_fast(text: str) -> list[RawLine] | None:
                                             if it.type == "NUMRUN" else (it.type, it.start_pos - pos, it.end_pos - pos)
                                             for it in current),
                                       None if any(it.type == "WORD" and _ASCII_DIGIT(it.value) is not None
-                                                  for it in current) else key)
+                                                  for it in current) else key,
+                                      runs)
                 if current:
                     lines.append(RawLine(tuple(current), runs))
                     current = []
