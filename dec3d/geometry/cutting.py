@@ -126,8 +126,11 @@ def cut_by_planes(model, normal, offsets, mask=None, join: bool = False, compact
     first[1:] = parent[1:] != parent[:-1]
     extra = ~first
     src = parent[extra]
-    if keep_whole is not None and keep_whole[src].any():     # refused before anything changes
-        bad = np.unique(src[keep_whole[src]])
+    # refused before anything changes (rows past keep_whole: pieces of this command's earlier cuts,
+    # so of blocks it let be cut)
+    old = src[src < len(keep_whole)] if keep_whole is not None else src[:0]
+    if keep_whole is not None and keep_whole[old].any():
+        bad = np.unique(old[keep_whole[old]])
         ids = ", ".join(str(int(i)) for i in b["id"][bad[:10]]) + (" …" if bad.size > 10 else "")
         raise GeometryError(f"the cut would split zoned or FE blocks ({ids}), whose zones or elements would not "
                             "follow it: cut before `block zone generate` / `feblock generate`, or leave these "
