@@ -339,7 +339,7 @@ def test_list_save_restore_vtk(tmp_path):
 @pytest.mark.parametrize("damp, safety", [(0, 0.0), (2, 0.5), (1, 0.5)])
 def test_motion_kernel_matches_twin(damp, safety):
     """The liner nodes' law of motion, density-scaled per degree of freedom, against a plain loop."""
-    from dec3d.kernels.liner import move_dofs
+    from dec3d.kernels.beam import move_nodes
 
     rng = np.random.default_rng(7)
     n = 5
@@ -352,7 +352,7 @@ def test_motion_kernel_matches_twin(damp, safety):
     g, dt, alpha = np.array([0.0, 0.0, -9.81]), 1e-3, 0.7
     b = {k: v.copy() for k, v in a.items()}
     im, ii = np.zeros(n), np.zeros(n)
-    move_dofs(dt, g, alpha, damp, safety, a["pos"], a["vel"], a["disp"], a["rot"], a["avel"], mass, inert, rt, rr,
+    move_nodes(dt, g, alpha, damp, safety, a["pos"], a["vel"], a["disp"], a["rot"], a["avel"], mass, inert, rt, rr,
               fix, a["fapp"], a["mapp"], a["force"], a["moment"], im, ii, last)
     q = (dt / (2 * safety)) ** 2 if safety else 0.0
 

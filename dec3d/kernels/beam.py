@@ -11,7 +11,8 @@ incremental forces). The tests hold a plain-Python twin (``tests/test_beams.py``
 Arrays (n nodes, s elements):
 
 - nodes: ``pos, vel, disp, rot, avel (n, 3)``; ``mass, inert (n,)`` real mass and rotary inertia;
-  ``rt, rr (n,)`` Gershgorin row sums of the stiffness at the node (translational, rotational rows);
+  ``rt, rr (n, 3)`` Gershgorin row sums of the stiffness at the node (translational, rotational rows;
+  a beam node's three are equal: ``move_nodes`` takes each degree of freedom's);
   ``host (n,)`` block row or -1; ``hz (n,)`` 1 where the host is a zoned block, whose host-point
   velocity ``hvel (n, 3)`` the caller gives (translational link only); ``hpos (n, 3)`` host point;
   ``klt, klr (n,)`` link stiffnesses;
@@ -29,6 +30,9 @@ import math
 
 import numpy as np
 from numba import njit
+
+#: a structural node faster than this [m/s] has run away (the limit blocks and gridpoints have, ``physics.steps``)
+VMAX = 1e6
 
 #: ``prop`` columns
 B_E, B_NU, B_A, B_IY, B_IZ, B_J, B_RHO = range(7)
@@ -171,23 +175,30 @@ def beam_step(dt, g, alpha, damp, safety,
 @njit(cache=True)
 def move_nodes(dt, g, alpha, damp, safety, pos, vel, disp, rot, avel, mass, inert, rt, rr, fix, fapp, mapp,
                force, moment, imass, iinert, last):
-    """The law of motion of structural nodes with 6 degrees of freedom (beams', liners'): ``force``,
-    ``moment`` hold the internal and link forces, gravity and ``fapp``/``mapp`` are added here (the
-    unbalanced force is left in them); ``last (n, 6)`` the last step's for the combined damping.
-    Returns the number of non-finite nodes."""
+    """The law of motion of structural nodes with 6 degrees of freedom (beams', liners'): central
+    differences, gravity and ``fapp``/``mapp`` added to ``force``/``moment`` (which hold the internal
+    and link forces and are left holding the unbalanced ones), local or combined damping (``last (n,
+    6)``: the last step's), density-scaled degree of freedom by degree of freedom: ``rt, rr (n, 3)`` the
+    Gershgorin row sums of the stiffness over each global translation and rotation, inertia
+    max(real, R (Δt / 2 safety)²) on each (stable: Gershgorin's bound on M⁻¹K; a beam's three rows are
+    equal, a shell is far stiffer in its plane than across it and one mass per node would make its
+    bending crawl). ``imass``/``iinert`` get the largest of the three. Returns the count of non-finite
+    or runaway (speed over ``VMAX``, the blocks' and gridpoints' limit) node components."""
     n = pos.shape[0]
     bad = 0
     q = (dt / (2.0 * safety)) ** 2 if safety > 0.0 else 0.0
     for i in range(n):
-        m = max(mass[i], rt[i] * q) if safety > 0.0 else mass[i]
-        ri = max(inert[i], rr[i] * q) if safety > 0.0 else inert[i]
-        if m <= 0.0:
-            m = 1.0
-        if ri <= 0.0:
-            ri = 1.0
-        imass[i] = m
-        iinert[i] = ri
+        imass[i] = 0.0
+        iinert[i] = 0.0
         for k in range(3):
+            m = max(mass[i], rt[i, k] * q) if safety > 0.0 else mass[i]
+            ri = max(inert[i], rr[i, k] * q) if safety > 0.0 else inert[i]
+            if m <= 0.0:
+                m = 1.0
+            if ri <= 0.0:
+                ri = 1.0
+            imass[i] = max(imass[i], m)
+            iinert[i] = max(iinert[i], ri)
             fk = force[i, k] + fapp[i, k] + mass[i] * g[k]
             force[i, k] = fk
             mk = moment[i, k] + mapp[i, k]
@@ -210,6 +221,6 @@ def move_nodes(dt, g, alpha, damp, safety, pos, vel, disp, rot, avel, mass, iner
             pos[i, k] += vel[i, k] * dt
             disp[i, k] += vel[i, k] * dt
             rot[i, k] += avel[i, k] * dt
-            if not (math.isfinite(pos[i, k]) and math.isfinite(rot[i, k])):
+            if not (math.isfinite(pos[i, k]) and math.isfinite(rot[i, k]) and abs(vel[i, k]) <= VMAX):
                 bad += 1
     return bad

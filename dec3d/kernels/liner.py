@@ -24,13 +24,12 @@ import math
 import numpy as np
 from numba import njit
 
-from .beam import _sgn
+from .beam import VMAX, _sgn, move_nodes
 
 #: ``cpl`` columns
 C_KN, C_KS, C_TY, C_COH, C_COHR, C_TAN = range(6)
-#: a node faster than this [m/s] is unstable (the limit blocks and gridpoints have, ``physics.steps``): a
-#: force of 1e200 N on a node pushed it to 1e190 m/s, finite, and the equilibrium ratio to NaN
-VMAX = 1e6
+#: ``VMAX`` (``kernels.beam``): a liner node faster is unstable (a force of 1e200 N on a node pushed it to
+#: 1e190 m/s, finite, and the equilibrium ratio to NaN)
 
 
 @njit(cache=True)
@@ -126,7 +125,7 @@ def liner_step(dt, g, alpha, damp, safety,
                pos, vel, disp, rot, avel, mass, inert, rt, rr, host, hz, hvel, hpos, nrm, cpl, un, fn, fs, cstate,
                fix, fapp, mapp, force, moment, hforce, hmoment, imass, iinert, kg, conn, bvel, bspin, bcen, last):
     """One step; arguments as ``kernels.beam.beam_step`` (motion) and the module docstring. Returns
-    the number of non-finite or runaway node components (``move_dofs``)."""
+    the number of non-finite or runaway node components (``kernels.beam.move_nodes``)."""
     n = pos.shape[0]
     for i in range(n):
         for k in range(3):
@@ -136,57 +135,5 @@ def liner_step(dt, g, alpha, damp, safety,
             moment[i, k] = 0.0
     coupling(dt, vel, host, hz, hvel, hpos, nrm, cpl, un, fn, fs, cstate, force, hforce, hmoment, bvel, bspin, bcen)
     element_forces(kg, conn, disp, rot, force, moment)
-    return move_dofs(dt, g, alpha, damp, safety, pos, vel, disp, rot, avel, mass, inert, rt, rr, fix, fapp, mapp,
+    return move_nodes(dt, g, alpha, damp, safety, pos, vel, disp, rot, avel, mass, inert, rt, rr, fix, fapp, mapp,
                      force, moment, imass, iinert, last)
-
-
-@njit(cache=True)
-def move_dofs(dt, g, alpha, damp, safety, pos, vel, disp, rot, avel, mass, inert, rt, rr, fix, fapp, mapp,
-              force, moment, imass, iinert, last):
-    """The law of motion of the liner nodes: as ``kernels.beam.move_nodes`` (central differences,
-    gravity and ``fapp``/``mapp`` added, local or combined damping) but density-scaled degree of freedom
-    by degree of freedom: ``rt, rr (n, 3)`` the Gershgorin row sums of the stiffness over each global
-    translation and rotation, inertia max(real, R (Δt / 2 safety)²) on each (stable: Gershgorin's bound
-    on M⁻¹K). A shell is far stiffer in its plane than across it; one mass per node would make its
-    bending crawl. ``imass``/``iinert`` get the largest of the three. Returns the count of
-    non-finite or runaway (speed over ``VMAX``) node components."""
-    n = pos.shape[0]
-    bad = 0
-    q = (dt / (2.0 * safety)) ** 2 if safety > 0.0 else 0.0
-    for i in range(n):
-        imass[i] = 0.0
-        iinert[i] = 0.0
-        for k in range(3):
-            m = max(mass[i], rt[i, k] * q) if safety > 0.0 else mass[i]
-            ri = max(inert[i], rr[i, k] * q) if safety > 0.0 else inert[i]
-            if m <= 0.0:
-                m = 1.0
-            if ri <= 0.0:
-                ri = 1.0
-            imass[i] = max(imass[i], m)
-            iinert[i] = max(iinert[i], ri)
-            fk = force[i, k] + fapp[i, k] + mass[i] * g[k]
-            force[i, k] = fk
-            mk = moment[i, k] + mapp[i, k]
-            moment[i, k] = mk
-            if not (fix[i] >> k) & 1:
-                v = vel[i, k]
-                if damp == 1:
-                    fk -= alpha * abs(fk) * _sgn(v)
-                elif damp == 2:
-                    fk -= 0.5 * alpha * abs(fk) * (_sgn(v) - _sgn(fk - last[i, k]))
-                vel[i, k] = v + fk / m * dt
-            if not (fix[i] >> (3 + k)) & 1:
-                w = avel[i, k]
-                if damp == 1:
-                    mk -= alpha * abs(mk) * _sgn(w)
-                elif damp == 2:
-                    mk -= 0.5 * alpha * abs(mk) * (_sgn(w) - _sgn(mk - last[i, 3 + k]))
-                avel[i, k] = w + mk / ri * dt
-        for k in range(3):
-            pos[i, k] += vel[i, k] * dt
-            disp[i, k] += vel[i, k] * dt
-            rot[i, k] += avel[i, k] * dt
-            if not (math.isfinite(pos[i, k]) and math.isfinite(rot[i, k]) and abs(vel[i, k]) <= VMAX):
-                bad += 1
-    return bad

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dec3d.kernels.beam import B_A, B_E, B_IY, B_IZ, B_J, B_NU, beam_step, local_stiffness
+from dec3d.kernels.beam import B_A, B_E, B_IY, B_IZ, B_J, B_NU, VMAX, beam_step, local_stiffness
 from dec3d.model.beams import beam_stores, has_beams, update_beam_masses
 from dec3d.model.hosts import spread_stiffness
 
@@ -164,7 +164,9 @@ class BeamStep:
         if not self.scaled and ((nodes["mass"] <= 0) | (nodes["inert"] <= 0)).any():
             raise RunError("a beam has no density: without density scaling (dynamic mode, or damping none/rayleigh) "
                            "its nodes move with their real mass: set `structure beam property density <f>`")
-        self.rt, self.rr = row_sums(run.m)
+        rt, rr = row_sums(run.m)
+        # (the law of motion takes a row sum per degree of freedom: a beam node's three are equal)
+        self.rt, self.rr = np.repeat(rt[:, None], 3, axis=1), np.repeat(rr[:, None], 3, axis=1)
         self.klt, self.klr = link_stiffness(run.m)
         self.last = np.zeros((nodes.n, 6))
 
@@ -172,23 +174,15 @@ class BeamStep:
         pass
 
     def advance(self, n: int) -> int:
-        from .cables import _damping, pass_reactions
+        from .cables import _damping, host_motion, pass_reactions
         from .rigid import RunError
 
         r = self.run
         m, b = r.m, r.m.blocks
         nodes, els = beam_stores(m)
         damp, a = _damping(r)
-        old_f = nodes["hforce"].copy()
-        old_m = nodes["hmoment"].copy()
+        old_f, old_m, zn, hvel = host_motion(m, nodes)
         hz = nodes["hz"]
-        zn = np.flatnonzero((hz != 0) & (nodes["host"] >= 0))
-        hvel = np.zeros((nodes.n, 3))
-        if zn.size:
-            v = m.vertices
-            w, gp = nodes["hw"][zn], nodes["hgp"][zn]
-            nodes["hpos"][zn] = np.einsum("kj,kjc->kc", w, v["pos"][gp])
-            hvel[zn] = np.einsum("kj,kjc->kc", w, v["velocity"][gp])
         bad = beam_step(float(r.dt), self.g, a, damp, SAFETY if self.scaled else 0.0,
                         nodes["pos"], nodes["vel"], nodes["disp"], nodes["rot"], nodes["avel"], nodes["mass"],
                         nodes["inert"], self.rt, self.rr, nodes["host"], hz, hvel, nodes["hpos"], self.klt, self.klr,
@@ -197,7 +191,7 @@ class BeamStep:
                         els["na"], els["nb"], els["l0"], els["prop"], els["axes"], els["fl"],
                         b["velocity"], b["spin"], b["centroid"], self.last)
         if bad:
-            raise RunError(f"a beam node moved off to infinity at step {m.step + 1} (Δt {r.dt:.3g} s): check the "
+            raise RunError(f"a beam node ran away (a speed over {VMAX:g} m/s, or off to infinity) at step {m.step + 1} (Δt {r.dt:.3g} s): check the "
                            f"beam properties")
         pass_reactions(m, nodes, old_f, old_m, zn)
         return min(n, 1)

@@ -229,6 +229,23 @@ def pass_reactions(m, nodes, old_f, old_m, zn) -> None:
                   (nodes["hw"][zn][:, :, None] * df[:, None, :]).reshape(-1, 3))
 
 
+def host_motion(m, nodes) -> tuple:
+    """Before a step of 6-degree-of-freedom structural nodes (beams, liners): (the reactions on the
+    hosts as they are, ``hforce`` and ``hmoment`` copied for ``pass_reactions``; the rows ``zn`` of the
+    nodes held by zones; each node's host velocity ``hvel`` (n, 3), Σ wᵢ vᵢ over its zone's gridpoints,
+    zero for the others), with ``hpos`` of the nodes in zones brought to Σ wᵢ xᵢ."""
+    old_f = nodes["hforce"].copy()
+    old_m = nodes["hmoment"].copy()
+    zn = np.flatnonzero((nodes["hz"] != 0) & (nodes["host"] >= 0))
+    hvel = np.zeros((nodes.n, 3))
+    if zn.size:
+        v = m.vertices
+        w, gp = nodes["hw"][zn], nodes["hgp"][zn]
+        nodes["hpos"][zn] = np.einsum("kj,kjc->kc", w, v["pos"][gp])
+        hvel[zn] = np.einsum("kj,kjc->kc", w, v["velocity"][gp])
+    return old_f, old_m, zn, hvel
+
+
 def _damping(r) -> tuple[int, float]:
     """(damping kind for the structural nodes: 0 none, 2 combined; its coefficient) of run ``r``."""
     mode, alpha = r.mode, r.alpha

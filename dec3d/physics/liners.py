@@ -15,8 +15,8 @@ material point (rigid) or Σ wᵢ xᵢ of the zone holding the node (zoned: the 
 the reaction goes to the block's ``fapp``/``mapp`` or to the gridpoints (``cables.pass_reactions``).
 
 Nodes: mass ρ t A/3 per element, rotary inertia ``model.liners.update_liner_masses``, moving with the
-blocks' central-difference scheme and damping (``kernels.liner.move_dofs``, the beam nodes' law of
-motion); in static runs the inertia of each degree of freedom is max(real, R (Δt / 2s)²), R the
+blocks' central-difference scheme and damping (``kernels.beam.move_nodes``, the beam nodes' law of
+motion too); in static runs the inertia of each degree of freedom is max(real, R (Δt / 2s)²), R the
 Gershgorin row sum of the assembled stiffness (coupling springs included) over that global
 translation or rotation, so liners never cut the blocks' Δt (and their bending, much softer than their
 membrane, is not slowed by it); with real masses they bound it (``liner_timestep``).
@@ -180,23 +180,15 @@ class LinerStep:
         pass
 
     def advance(self, n: int) -> int:
-        from .cables import _damping, pass_reactions
+        from .cables import _damping, host_motion, pass_reactions
         from .rigid import RunError
 
         r = self.run
         m, b = r.m, r.m.blocks
         nodes, _ = liner_stores(m)
         damp, a = _damping(r)
-        old_f = nodes["hforce"].copy()
-        old_m = nodes["hmoment"].copy()
+        old_f, old_m, zn, hvel = host_motion(m, nodes)
         hz = nodes["hz"]
-        zn = np.flatnonzero((hz != 0) & (nodes["host"] >= 0))
-        hvel = np.zeros((nodes.n, 3))
-        if zn.size:
-            v = m.vertices
-            w, gp = nodes["hw"][zn], nodes["hgp"][zn]
-            nodes["hpos"][zn] = np.einsum("kj,kjc->kc", w, v["pos"][gp])
-            hvel[zn] = np.einsum("kj,kjc->kc", w, v["velocity"][gp])
         bad = liner_step(float(r.dt), self.g, a, damp, SAFETY if self.scaled else 0.0,
                          nodes["pos"], nodes["vel"], nodes["disp"], nodes["rot"], nodes["avel"], nodes["mass"],
                          nodes["inert"], self.rt, self.rr, nodes["host"], hz, hvel, nodes["hpos"], nodes["nrm"],

@@ -98,9 +98,9 @@ def test_a_runaway_liner_node_stops_the_run_with_the_model_kept(session, tmp_pat
 
 
 def test_the_motion_kernel_counts_runaway_components():
-    """``move_dofs`` returns the number of node components off to infinity or faster than VMAX (plain
+    """``move_nodes`` returns the number of node components off to infinity or faster than VMAX (plain
     count against the kernel's)."""
-    from dec3d.kernels.liner import VMAX, move_dofs
+    from dec3d.kernels.beam import VMAX, move_nodes
 
     n = 4
     z = lambda: np.zeros((n, 3))        # noqa: E731
@@ -109,7 +109,7 @@ def test_the_motion_kernel_counts_runaway_components():
     force[2, 0] = 0.5e6      # 0.5e6 m/s: under it
     moment[3, 1] = np.inf    # a rotation off to infinity
     ones = np.ones(n)
-    bad = move_dofs(1.0, np.zeros(3), 0.0, 0, 0.0, pos, vel, disp, rot, avel, ones, ones, z(), z(),
+    bad = move_nodes(1.0, np.zeros(3), 0.0, 0, 0.0, pos, vel, disp, rot, avel, ones, ones, z(), z(),
                     np.zeros(n, np.uint8), fapp, mapp, force, moment, np.zeros(n), np.zeros(n), np.zeros((n, 6)))
     want = int((np.abs(vel) > VMAX).sum() + (~np.isfinite(rot)).sum())
     assert bad == want == 2
