@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..config import DENSITY_LIMIT, MODULUS_LIMIT
 from ..errors import BindError, CommandError
 from ..model.beams import BELEMS, BPROPS, add_beam, beam_stores, element_axes, has_beams, update_beam_masses
 from ..physics.beam_history import BEAM_QUANTITIES, add_beam_history
@@ -13,7 +14,7 @@ from ..physics.history import histories
 from ..units import paren
 from .histories import _name
 from .registry import REGISTRY, command
-from .values import COORD, POINT, VEC3, Num, Nums, P, Text
+from .values import COORD, COORD_LIMIT, POINT, VEC3, Num, Nums, P, Text
 
 _UNITS = {"young": "Pa", "poisson": "", "cross-sectional-area": "m²", "moi-y": "m⁴", "moi-z": "m⁴",
           "moi-polar": "m⁴", "density": "kg/m³"}
@@ -72,8 +73,10 @@ def beam_create(session, call):
 
 
 def _prop_keywords():
-    out = [P(name, Num(lo=0, hi=0.5, hi_open=True) if name == "poisson" else Num(lo=0), _DOCS[name],
-             units=_UNITS[name]) for name in BPROPS]
+    # the limits of blocks, zones and liners (beyond them node masses or stiffnesses were infinite)
+    hi = {"young": MODULUS_LIMIT, "density": DENSITY_LIMIT}
+    out = [P(name, Num(lo=0, hi=0.5, hi_open=True) if name == "poisson" else Num(lo=0, hi=hi.get(name, COORD_LIMIT)),
+             _DOCS[name], units=_UNITS[name]) for name in BPROPS]
     return out + [P("direction-y", VEC3, "the elements' y axis (made normal to the element)")]
 
 

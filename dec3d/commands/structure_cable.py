@@ -9,13 +9,19 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..config import DENSITY_LIMIT, MODULUS_LIMIT, STIFFNESS_LIMIT
 from ..errors import BindError, CommandError
 from ..model.cables import NODES, PROPS, SEGMENTS, add_cable, cable_stores, has_cables, update_masses
 from ..units import paren
 from .registry import command
-from .values import COORD, FLAG, ONOFF, VEC3, Num, Nums, P, Text
+from .values import COORD, COORD_LIMIT, FLAG, ONOFF, VEC3, Num, Nums, P, Text
 
 _NONNEG = Num(lo=0)
+#: the limits of blocks, zones and liners (a modulus, stiffness, density or size beyond them made node
+#: masses or stiffnesses infinite); strengths stay unlimited
+_BOUNDED = {"young": Num(lo=0, hi=MODULUS_LIMIT), "cross-sectional-area": Num(lo=0, hi=COORD_LIMIT),
+            "grout-stiffness": Num(lo=0, hi=STIFFNESS_LIMIT), "grout-perimeter": Num(lo=0, hi=COORD_LIMIT),
+            "density": Num(lo=0, hi=DENSITY_LIMIT)}
 _UNITS = {"young": "Pa", "cross-sectional-area": "m²", "yield-tension": "N", "yield-compression": "N",
           "grout-stiffness": "N/m/m", "grout-cohesion": "N/m", "grout-friction": "°", "grout-perimeter": "m",
           "density": "kg/m³", "tensile-failure-strain": "-"}
@@ -86,7 +92,7 @@ def cable_create(session, call):
 def _prop_keywords():
     out = []
     for name in PROPS:
-        v = Num(angle=True, lo=0, hi=90, hi_open=True) if name == "grout-friction" else _NONNEG
+        v = Num(angle=True, lo=0, hi=90, hi_open=True) if name == "grout-friction" else _BOUNDED.get(name, _NONNEG)
         out.append(P(name, v, _DOCS[name], units=_UNITS[name]))
     return out
 

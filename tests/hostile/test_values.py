@@ -30,6 +30,11 @@ def _fail(session, tmp_path, line, kind=ValueRangeError):
     ("block contact property stiffness-shear -5", "`stiffness-shear` must be in [0, 1e+20], got -5", 40),
     ("block contact property stiffness-normal 1e300", "`stiffness-normal` must be in [0, 1e+20], got 1e+300", 41),
     ("block zone property bulk 1e300", "`bulk` must be in (0, 1e+16], got 1e+300", 26),
+    # structural elements: the limits of blocks, zones and liners (infinite node masses or stiffnesses)
+    ("structure cable property young 1e300", "`young` must be in [0, 1e+16], got 1e+300", 32),
+    ("structure cable property grout-stiffness 1e300", "`grout-stiffness` must be in [0, 1e+20], got 1e+300", 42),
+    ("structure beam property density 1e300", "`density` must be in [0, 1e+09], got 1e+300", 33),
+    ("structure beam property moi-y 1e300", "`moi-y` must be in [0, 1e+12], got 1e+300", 31),
     ("block contact property friction 95", "`friction` must be in [0, 90], got 95", 33),
     ("block contact property friction 90.5", "`friction` must be in [0, 90], got 90.5", 33),
     ("block contact property friction -1", "`friction` must be in [0, 90], got -1", 33),
