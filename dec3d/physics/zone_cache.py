@@ -124,6 +124,9 @@ class StepperCache:
     def begin(self) -> None:
         """A new command: every input must be seen again before an entry made from it is taken."""
         self.now = set()
+        for log in (self.hits, self.builds):     # (bookkeeping: the last commands' only, in a long FISH loop)
+            if len(log) > 4096:
+                del log[:-1024]
 
     def see(self, name: str, value, runs: bool = False) -> None:
         """The input ``name`` is ``value`` now: a new version when it differs from the kept copy.
