@@ -52,8 +52,9 @@ def _check_create(call):
                  "by barycentric weights), a 10-node zone or an FE block's 20-node brick (its nodes, by the shape "
                  "functions at the node); the grout's reaction goes to those nodes by the same weights and the "
                  "grout is confined by that element's stress. A cable with no node in any block is refused, and "
-                 "so is a node in a deformable block that no zone or element of it holds. Create cables after "
-                 "the blocks are cut and zoned (or meshed): a later cut or zoning does not re-attach them.",
+                 "so is a node in a deformable block that no zone or element of it holds. A block zoned (or meshed) "
+                 "later takes its cable nodes and dowels onto the zones or elements holding them; a cut through "
+                 "a zoned block is refused (cut first).",
          examples=["structure cable create by-line 0 0 0 0 0 -10 segments 20",
                    "structure cable create by-line 0 0 0 5 0 0 segments 10 id 2 group 'bolts'"])
 def cable_create(session, call):

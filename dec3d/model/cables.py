@@ -204,7 +204,7 @@ def nodes_hosted_by(model: Model, mask) -> int:
 
 def rehost(model: Model) -> None:
     """After blocks were zoned: structural nodes on them find the zone holding them (``remap_hosts`` with
-    no block gone; ``hosts.zone_hosted``). The reaction a node coupled to the block's rigid motion left in
+    no block gone; ``hosts.zone_hosted``), and so do the dowels' sides (``dowels.rehost_dowels``). The reaction a node coupled to the block's rigid motion left in
     the block's applied loads is taken back: from the next step it goes to the zone's gridpoints."""
     from .beams import BNODES
     from .liners import LNODES
@@ -221,6 +221,9 @@ def rehost(model: Model) -> None:
         np.add.at(b["mapp"], h[moved], -nodes["hmoment"][moved])
         nodes["hforce"][moved] = 0.0
         nodes["hmoment"][moved] = 0.0
+    from .dowels import rehost_dowels
+
+    rehost_dowels(model)
     remap_hosts(model, np.arange(b.n, dtype=np.int64))
 
 

@@ -135,6 +135,47 @@ def add_dowels(model: Model, cable_id: int, p1, p2, seg_rows: np.ndarray, tol: f
     return len(found), None
 
 
+def _side_host(model: Model, st, i: int, side: int):
+    """``host_element`` of side ``side`` of dowel ``i`` at the point ``add_dowels`` took: just inside that
+    side of the joint, by its tolerance and offset from the bolt's length as made (its end nodes' first
+    positions)."""
+    nodes = model.stores.get("cable_nodes")
+    at = np.flatnonzero(nodes["cable"] == st["cable"][i]) if nodes is not None else np.zeros(0, np.int64)
+    p0 = nodes["pos"][at] - nodes["disp"][at] if at.size else np.zeros((1, 3))
+    size = float(np.linalg.norm(p0[-1] - p0[0]))
+    tol = max(float(model.tolerance), 1e-9 * size)
+    off = max(10 * tol, 1e-6 * size)
+    x = st["pos"][i] + (off if side else -off) * st["axis"][i]
+    return host_element(model, int(st["blk"][i, side]), x, max(tol, 1e-9))
+
+
+def rehost_dowels(model: Model) -> int:
+    """After blocks were zoned (or made FE blocks): a dowel side held by such a block as a rigid body
+    (``hz`` 0) takes the zone or element holding a point just inside that side of the joint (as
+    ``add_dowels`` does), and the load it left in the block's applied force and moment is taken back
+    (from the next step it goes to the element's nodes). Returns the sides moved; a side no element
+    holds stays as it was."""
+    if not has_dowels(model):
+        return 0
+    st = dowel_store(model)
+    b = model.blocks
+    moved = 0
+    for i in range(st.n):
+        for side in range(2):
+            blk = int(st["blk"][i, side])
+            if blk < 0 or st["hz"][i, side] != 0 or b["kind"][blk] == KIND_RIGID:
+                continue
+            z = _side_host(model, st, i, side)
+            if z is None:
+                continue
+            sg = -1.0 if side == 0 else 1.0
+            b["fapp"][blk] -= sg * st["fs"][i]
+            b["mapp"][blk] -= st["moment"][i, side]
+            st["hz"][i, side], st["hzone"][i, side], st["hgp"][i, side], st["hw"][i, side] = z
+            moved += 1
+    return moved
+
+
 def remap_dowels(model: Model, remap: np.ndarray) -> int:
     """After blocks are deleted (old row -> new row, -1 gone): dowels with a side gone are dropped
     (their last forces stay with the surviving block's applied loads: removed here). Returns how many."""
@@ -156,7 +197,7 @@ def remap_dowels(model: Model, remap: np.ndarray) -> int:
     for i in np.flatnonzero(~gone):
         for side in range(2):
             if st["hz"][i, side]:
-                z = host_element(model, int(blk[i, side]), st["pos"][i], 1e-6)
+                z = _side_host(model, st, i, side)
                 if z is not None:
                     st["hz"][i, side], st["hzone"][i, side], st["hgp"][i, side], st["hw"][i, side] = z
     if gone.any():
