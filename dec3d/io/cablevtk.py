@@ -46,7 +46,15 @@ def write_line_vtu(path: str, pts, na, nb, point: dict, cell: dict) -> str:
     """A ``.vtu`` of line cells between points ``pts`` (rows ``na[i]`` – ``nb[i]``), with point and cell
     data arrays (the first of each is what ParaView colours by: displacement, axial force); cables and
     beams (``io.beamvtk``) write theirs with it."""
-    n, s = len(pts), len(na)
+    return write_cells_vtu(path, pts, np.column_stack([na, nb]), VTK_LINE, point, cell, "axial_force")
+
+
+def write_cells_vtu(path: str, pts, conn, vtk_type: int, point: dict, cell: dict, scalars: str) -> str:
+    """A ``.vtu`` of cells of one VTK type, each of the points ``pts`` in a row of ``conn`` (s, k), with
+    point and cell data arrays (displacement and ``scalars`` the ones ParaView colours by): the line
+    cells of cables and beams, the triangles of liners (``io.linervtk``)."""
+    conn = np.asarray(conn)
+    n, s, k = len(pts), len(conn), conn.shape[1]
     ind = "        "
     parts = ['<?xml version="1.0"?>\n',
              '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">\n',
@@ -54,16 +62,15 @@ def write_line_vtu(path: str, pts, na, nb, point: dict, cell: dict) -> str:
              '      <PointData Vectors="displacement">\n']
     for key, arr in point.items():
         parts.append(_data_array(key, np.ascontiguousarray(arr), ind))
-    parts.append('      </PointData>\n      <CellData Scalars="axial_force">\n')
+    parts.append(f'      </PointData>\n      <CellData Scalars="{scalars}">\n')
     for key, arr in cell.items():
         parts.append(_data_array(key, np.ascontiguousarray(arr), ind))
     parts.append("      </CellData>\n      <Points>\n")
     parts.append(_data_array("Points", np.ascontiguousarray(pts, dtype=np.float64).reshape(n, 3), ind))
     parts.append("      </Points>\n      <Cells>\n")
-    conn = np.column_stack([na, nb]).astype(np.int64).ravel()
-    parts.append(_data_array("connectivity", conn, ind))
-    parts.append(_data_array("offsets", np.arange(2, 2 * s + 1, 2, dtype=np.int64), ind))
-    parts.append(_data_array("types", np.full(s, VTK_LINE, dtype=np.uint8), ind))
+    parts.append(_data_array("connectivity", np.ascontiguousarray(conn, dtype=np.int64).ravel(), ind))
+    parts.append(_data_array("offsets", np.arange(k, k * s + 1, k, dtype=np.int64), ind))
+    parts.append(_data_array("types", np.full(s, vtk_type, dtype=np.uint8), ind))
     parts.append("      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n")
     with open(path, "w", encoding="utf-8", newline="\n") as fh:
         fh.write("".join(parts))

@@ -13,7 +13,7 @@ import os
 import numpy as np
 
 from dec3d.io.finite import require_finite
-from dec3d.io.vtk import _data_array
+from dec3d.io.cablevtk import write_cells_vtu
 
 VTK_TRIANGLE = 5
 
@@ -34,24 +34,4 @@ def write_liners_vtu(model, path: str | os.PathLike) -> str:
     point = {"displacement": nodes["disp"], "node_id": nodes["id"].astype(np.int64), "rotation": nodes["rot"],
              "velocity": nodes["vel"], "coupled": (nodes["host"] >= 0).astype(np.uint8),
              "coupling_state": nodes["cstate"].astype(np.uint8)}
-    n, s = len(pts), els.n
-    ind = "        "
-    parts = ['<?xml version="1.0"?>\n',
-             '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">\n',
-             '  <UnstructuredGrid>\n', f'    <Piece NumberOfPoints="{n}" NumberOfCells="{s}">\n',
-             '      <PointData Vectors="displacement">\n']
-    for key, arr in point.items():
-        parts.append(_data_array(key, np.ascontiguousarray(arr), ind))
-    parts.append('      </PointData>\n      <CellData Scalars="M_xx">\n')
-    for key, arr in cell.items():
-        parts.append(_data_array(key, np.ascontiguousarray(arr), ind))
-    parts.append("      </CellData>\n      <Points>\n")
-    parts.append(_data_array("Points", np.ascontiguousarray(pts, dtype=np.float64).reshape(n, 3), ind))
-    parts.append("      </Points>\n      <Cells>\n")
-    parts.append(_data_array("connectivity", np.ascontiguousarray(els["nodes"], dtype=np.int64).ravel(), ind))
-    parts.append(_data_array("offsets", np.arange(3, 3 * s + 1, 3, dtype=np.int64), ind))
-    parts.append(_data_array("types", np.full(s, VTK_TRIANGLE, dtype=np.uint8), ind))
-    parts.append("      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n")
-    with open(path, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write("".join(parts))
-    return path
+    return write_cells_vtu(path, pts, els["nodes"], VTK_TRIANGLE, point, cell, "M_xx")

@@ -35,7 +35,7 @@ import numpy as np
 from dec3d.kernels.beam import NBPROP
 
 from .cables import place_nodes
-from .hosts import NHOST, host_element, next_id, widen, zone_hosted
+from .hosts import NHOST, next_id, remap_node_hosts, widen
 from .groups import group_field
 from .model import Model
 from .store import Field, Store
@@ -147,19 +147,7 @@ def remap_beam_hosts(model: Model, remap: np.ndarray) -> int:
     if BNODES not in model.stores or not model.stores[BNODES].n:
         return 0
     nodes = beam_stores(model)[0]
-    h = nodes["host"]
-    ok = h >= 0
-    h[ok] = remap[h[ok]]
-    lost = ok & (h < 0)
-    # zone-hosted nodes of surviving blocks: the zones' and gridpoints' rows moved, find them again
-    for i in zone_hosted(model, h, nodes["hz"]):
-        z = host_element(model, int(h[i]), nodes["hpos"][i], 1e-9)
-        if z is None:
-            h[i] = -1
-            lost[i] = True
-        else:
-            nodes["hz"][i], nodes["hzone"][i], nodes["hgp"][i], nodes["hw"][i] = z
-    nodes["hz"][lost] = 0
+    lost = remap_node_hosts(model, nodes, remap)
     for k in ("lf", "lm", "hforce", "hmoment"):
         nodes[k][lost] = 0.0
     return int(lost.sum())

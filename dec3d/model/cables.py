@@ -38,7 +38,7 @@ import numpy as np
 from dec3d.kernels.cable import NPROP
 
 from .groups import group_field
-from .hosts import NHOST, host_element, next_id, widen, zone_hosted
+from .hosts import NHOST, host_element, next_id, remap_node_hosts, widen, zone_hosted
 from .model import KIND_RIGID, Model
 from .store import Field, Store
 
@@ -242,21 +242,11 @@ def remap_hosts(model: Model, remap: np.ndarray) -> None:
     if NODES in st and st[NODES].n:
         nodes = cable_stores(model)[0]
         h = nodes["host"]
-        ok = h >= 0
-        h[ok] = remap[h[ok]]
-        lost = ok & (h < 0)
-        # (the grout force went with the block's applied force; the node carries none from now on)
-        nodes["hforce"][lost] = 0.0
-        nodes["hmoment"][lost] = 0.0
-        # zone-hosted nodes of surviving blocks: the zones' and gridpoints' rows moved, find them again
-        for i in zone_hosted(model, h, nodes["hz"]):
-            z = host_element(model, int(h[i]), nodes["hpos"][i], 1e-9)
-            if z is None:
-                h[i] = -1
-                lost[i] = True
-            else:
-                nodes["hz"][i], nodes["hzone"][i], nodes["hgp"][i], nodes["hw"][i] = z
-        nodes["hz"][lost] = 0
+        gone = (h >= 0) & (remap[np.maximum(h, 0)] < 0)
+        lost = remap_node_hosts(model, nodes, remap)
+        # (the grout force went with the deleted block's applied force; the node carries none from now on)
+        nodes["hforce"][gone] = 0.0
+        nodes["hmoment"][gone] = 0.0
         segs = st[SEGMENTS]
         gone = np.flatnonzero(lost)
         segs["gf"][np.isin(segs["na"], gone), 0] = 0.0

@@ -105,6 +105,26 @@ def zone_hosted(model, host: np.ndarray, hz: np.ndarray) -> np.ndarray:
     return rows[(hz[rows] != 0) | (model.blocks["kind"][host[rows]] != 0)]
 
 
+def remap_node_hosts(model, nodes, remap: np.ndarray) -> np.ndarray:
+    """After blocks are deleted (old row -> new row, -1 gone): the structural ``nodes``' hosts renumbered,
+    the zone-hosted ones of surviving blocks found again (the zones' and gridpoints' rows moved), ``hz`` 0
+    where the host went or no element holds the node any more. Returns the mask of the nodes that lost
+    their host (the caller drops the forces they carried)."""
+    h = nodes["host"]
+    ok = h >= 0
+    h[ok] = remap[h[ok]]
+    lost = ok & (h < 0)
+    for i in zone_hosted(model, h, nodes["hz"]):
+        z = host_element(model, int(h[i]), nodes["hpos"][i], 1e-9)
+        if z is None:
+            h[i] = -1
+            lost[i] = True
+        else:
+            nodes["hz"][i], nodes["hzone"][i], nodes["hgp"][i], nodes["hw"][i] = z
+    nodes["hz"][lost] = 0
+    return lost
+
+
 def next_id(what: str, *ids: np.ndarray) -> int:
     """The id after the largest of ``ids`` (a cable's, beam's or liner's: 1 when there are none); a
     CommandError when that is past 64 bits (an `id 9223372036854775807` given before: the next one

@@ -46,7 +46,7 @@ from dec3d.errors import CommandError
 from dec3d.kernels.dkt import element_frame
 
 from .groups import group_field
-from .hosts import NHOST, host_element, next_id, widen, zone_hosted
+from .hosts import NHOST, host_element, next_id, remap_node_hosts, widen
 from .model import Model
 from .store import Field, Store
 
@@ -225,18 +225,7 @@ def remap_liner_hosts(model: Model, remap: np.ndarray) -> int:
     if LNODES not in model.stores or not model.stores[LNODES].n:
         return 0
     nodes = liner_stores(model)[0]
-    h = nodes["host"]
-    ok = h >= 0
-    h[ok] = remap[h[ok]]
-    lost = ok & (h < 0)
-    for i in zone_hosted(model, h, nodes["hz"]):
-        z = host_element(model, int(h[i]), nodes["hpos"][i], 1e-9)
-        if z is None:
-            h[i] = -1
-            lost[i] = True
-        else:
-            nodes["hz"][i], nodes["hzone"][i], nodes["hgp"][i], nodes["hw"][i] = z
-    nodes["hz"][lost] = 0
+    lost = remap_node_hosts(model, nodes, remap)
     for k in ("fs", "hforce", "hmoment"):
         nodes[k][lost] = 0.0
     nodes["fn"][lost] = 0.0
